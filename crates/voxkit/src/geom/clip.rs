@@ -1,0 +1,74 @@
+//! Sutherland–Hodgman clipping of a convex polygon against an axis-aligned box.
+//!
+//! This work is based on: I. Sutherland, G. Hodgman, "Reentrant polygon
+//! clipping", CACM 1974.
+//!
+//! Used only for triangles that reach beyond the fixed-point lattice range
+//! ([`crate::geom::fixed::DIRECT_LIMIT_VOXELS`]): such a triangle is clipped,
+//! in f64 grid units, to the grid enlarged by one voxel on every side, then
+//! fan-triangulated and snapped. Voxels of the grid lie at least one voxel
+//! away from the clipping planes, so clipping never changes which of them the
+//! triangle meets (up to the lattice snapping every triangle undergoes).
+
+use glam::DVec3;
+
+/// Clips the convex polygon `poly` to the box `[lo, hi]` (closed).
+/// Returns the clipped polygon; fewer than 3 vertices means nothing is left.
+pub fn clip_polygon_to_box(poly: &[DVec3], lo: DVec3, hi: DVec3) -> Vec<DVec3> {
+    let mut cur: Vec<DVec3> = poly.to_vec();
+    for axis in 0..3 {
+        for (bound, keep_below) in [(lo[axis], false), (hi[axis], true)] {
+            if cur.is_empty() {
+                return cur;
+            }
+            // Signed distance, non-negative on the kept side.
+            let dist = |p: DVec3| if keep_below { bound - p[axis] } else { p[axis] - bound };
+            let mut next = Vec::with_capacity(cur.len() + 2);
+            for idx in 0..cur.len() {
+                let a = cur[idx];
+                let b = cur[(idx + 1) % cur.len()];
+                let (da, db) = (dist(a), dist(b));
+                if da >= 0.0 {
+                    next.push(a);
+                }
+                if (da >= 0.0) != (db >= 0.0) {
+                    let t = da / (da - db);
+                    let mut p = a + (b - a) * t;
+                    p[axis] = bound; // exact on the plane
+                    next.push(p);
+                }
+            }
+            cur = next;
+        }
+    }
+    cur
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triangle_inside_is_unchanged() {
+        let t = [DVec3::new(1.0, 1.0, 1.0), DVec3::new(2.0, 1.0, 1.0), DVec3::new(1.0, 2.0, 1.0)];
+        let c = clip_polygon_to_box(&t, DVec3::ZERO, DVec3::splat(4.0));
+        assert_eq!(c, t.to_vec());
+    }
+
+    #[test]
+    fn huge_triangle_is_cut_to_the_box() {
+        let t = [DVec3::new(-1e9, -1e9, 0.5), DVec3::new(1e9, -1e9, 0.5), DVec3::new(0.0, 1e9, 0.5)];
+        let c = clip_polygon_to_box(&t, DVec3::ZERO, DVec3::splat(4.0));
+        assert!(c.len() >= 3);
+        for p in &c {
+            assert!(p.x >= 0.0 && p.x <= 4.0 && p.y >= 0.0 && p.y <= 4.0);
+            assert_eq!(p.z, 0.5);
+        }
+    }
+
+    #[test]
+    fn triangle_outside_vanishes() {
+        let t = [DVec3::new(10.0, 10.0, 10.0), DVec3::new(11.0, 10.0, 10.0), DVec3::new(10.0, 11.0, 10.0)];
+        assert!(clip_polygon_to_box(&t, DVec3::ZERO, DVec3::splat(4.0)).len() < 3);
+    }
+}

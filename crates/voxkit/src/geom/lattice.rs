@@ -1,0 +1,218 @@
+//! Triangles on the fixed-point lattice, and turning a mesh into them.
+//!
+//! [`prepare`] is shared by every voxelization path, so all of them see the
+//! same snapped triangles and skip the same degenerate ones.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::clip::clip_polygon_to_box;
+use super::fixed::{snap, voxel_span, DIRECT_LIMIT_VOXELS, MAX_ABS, ONE};
+use crate::grid::spec::GridSpec;
+use crate::mesh::MeshRef;
+
+/// A triangle with vertices on the lattice (grid units × 4096).
+///
+/// # Guarantees
+/// Built by [`prepare`]: every coordinate is within `±MAX_ABS` and the
+/// triangle has non-zero area.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LatticeTriangle {
+    /// The three vertices, in the mesh's winding order.
+    pub v: [[i64; 3]; 3],
+}
+
+impl LatticeTriangle {
+    /// Edge `i` runs from vertex `i` to vertex `i+1 (mod 3)`.
+    #[inline]
+    pub fn edge(&self, i: usize) -> [i64; 3] {
+        let a = self.v[i];
+        let b = self.v[(i + 1) % 3];
+        [b[0] - a[0], b[1] - a[1], b[2] - a[2]]
+    }
+
+    /// The (unnormalised) normal `e0 × e1`; exact, fits in `i64` under the lattice bound.
+    #[inline]
+    pub fn normal(&self) -> [i64; 3] {
+        cross(self.edge(0), self.edge(1))
+    }
+
+    /// Zero area: the three vertices are collinear (or coincide).
+    pub fn is_degenerate(&self) -> bool {
+        self.normal() == [0, 0, 0]
+    }
+
+    /// Per-axis `(min, max)` lattice coordinates.
+    #[inline]
+    pub fn bounds(&self) -> ([i64; 3], [i64; 3]) {
+        let mut lo = self.v[0];
+        let mut hi = self.v[0];
+        for p in &self.v[1..] {
+            for a in 0..3 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// The inclusive range of voxel indices per axis whose closed boxes meet
+    /// the triangle's bounding box, clamped to `dims`; `None` if empty.
+    #[inline]
+    pub fn voxel_bounds(&self, dims: [u32; 3]) -> Option<([i64; 3], [i64; 3])> {
+        let (lo, hi) = self.bounds();
+        let mut a = [0i64; 3];
+        let mut b = [0i64; 3];
+        for ax in 0..3 {
+            let (s, e) = voxel_span(lo[ax], hi[ax]);
+            a[ax] = s.max(0);
+            b[ax] = e.min(dims[ax] as i64 - 1);
+            if a[ax] > b[ax] {
+                return None;
+            }
+        }
+        Some((a, b))
+    }
+}
+
+/// Exact cross product of two lattice vectors (inputs below 2^31 in magnitude).
+#[inline]
+pub fn cross(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// What [`prepare`] did with the input triangles.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PrepareStats {
+    /// Triangles in the input.
+    pub input: u64,
+    /// Skipped: an index past the end of the positions.
+    pub invalid_index: u64,
+    /// Skipped: a NaN or infinite coordinate.
+    pub non_finite: u64,
+    /// Skipped: zero area after snapping (the documented tie rule: a
+    /// degenerate triangle draws nothing).
+    pub degenerate: u64,
+    /// Not voxelized because they lie entirely outside the grid.
+    pub outside: u64,
+    /// Reached beyond the lattice range and were clipped before snapping.
+    pub clipped: u64,
+    /// Lattice triangles produced (clipping may produce several per input).
+    pub output: u64,
+}
+
+impl PrepareStats {
+    fn merge(mut self, o: PrepareStats) -> PrepareStats {
+        self.input += o.input;
+        self.invalid_index += o.invalid_index;
+        self.non_finite += o.non_finite;
+        self.degenerate += o.degenerate;
+        self.outside += o.outside;
+        self.clipped += o.clipped;
+        self.output += o.output;
+        self
+    }
+}
+
+/// Snaps every triangle of `mesh` to the lattice of `grid`, skipping (and
+/// counting) invalid, non-finite, degenerate and fully outside triangles.
+/// The output order follows the input order, whatever the thread count.
+pub fn prepare(mesh: MeshRef<'_>, grid: &GridSpec) -> (Vec<LatticeTriangle>, PrepareStats) {
+    const CHUNK: usize = 4096;
+    let parts: Vec<(Vec<LatticeTriangle>, PrepareStats)> = mesh
+        .triangles
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut out = Vec::with_capacity(chunk.len());
+            let mut st = PrepareStats::default();
+            for tri in chunk {
+                prepare_one(mesh.positions, tri, grid, &mut out, &mut st);
+            }
+            (out, st)
+        })
+        .collect();
+    let mut stats = PrepareStats::default();
+    let mut tris = Vec::with_capacity(parts.iter().map(|p| p.0.len()).sum());
+    for (t, s) in parts {
+        tris.extend(t);
+        stats = stats.merge(s);
+    }
+    (tris, stats)
+}
+
+fn prepare_one(
+    positions: &[DVec3],
+    tri: &[u32; 3],
+    grid: &GridSpec,
+    out: &mut Vec<LatticeTriangle>,
+    st: &mut PrepareStats,
+) {
+    st.input += 1;
+    let mut g = [DVec3::ZERO; 3];
+    for (c, &idx) in tri.iter().enumerate() {
+        let Some(p) = positions.get(idx as usize) else {
+            st.invalid_index += 1;
+            return;
+        };
+        g[c] = grid.to_grid_units(*p);
+    }
+    if !g.iter().all(|p| p.is_finite()) {
+        st.non_finite += 1;
+        return;
+    }
+    let dims = DVec3::new(grid.dims()[0] as f64, grid.dims()[1] as f64, grid.dims()[2] as f64);
+    // Cull triangles far from the grid's closed box [0, dims]. The margin of
+    // one voxel keeps this f64 test conservative; the exact decision is made
+    // on the snapped triangle by `voxel_bounds`.
+    let lo = g[0].min(g[1]).min(g[2]);
+    let hi = g[0].max(g[1]).max(g[2]);
+    if hi.cmplt(DVec3::splat(-1.0)).any() || lo.cmpgt(dims + DVec3::ONE).any() {
+        st.outside += 1;
+        return;
+    }
+    let fits = g.iter().all(|p| p.abs().max_element() <= DIRECT_LIMIT_VOXELS);
+    let before = out.len();
+    if fits {
+        push_snapped(g[0], g[1], g[2], grid.dims(), out, st);
+    } else {
+        st.clipped += 1;
+        let poly = clip_polygon_to_box(&g, DVec3::splat(-1.0), dims + DVec3::ONE);
+        if poly.len() < 3 {
+            st.outside += 1;
+            return;
+        }
+        for w in 1..poly.len() - 1 {
+            push_snapped(poly[0], poly[w], poly[w + 1], grid.dims(), out, st);
+        }
+        // A clipped polygon whose fan is entirely degenerate counts once.
+        if out.len() == before {
+            return;
+        }
+    }
+    st.output += (out.len() - before) as u64;
+}
+
+fn push_snapped(
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+    dims: [u32; 3],
+    out: &mut Vec<LatticeTriangle>,
+    st: &mut PrepareStats,
+) {
+    let s = |p: DVec3| [snap(p.x), snap(p.y), snap(p.z)];
+    let t = LatticeTriangle { v: [s(a), s(b), s(c)] };
+    debug_assert!(t.v.iter().flatten().all(|c| c.abs() <= MAX_ABS));
+    if t.is_degenerate() {
+        st.degenerate += 1;
+        return;
+    }
+    if t.voxel_bounds(dims).is_none() {
+        st.outside += 1;
+        return;
+    }
+    out.push(t);
+}
+
+/// Lattice units per voxel, re-exported for kernels.
+pub const LATTICE_ONE: i64 = ONE;

@@ -1,0 +1,231 @@
+//! Dense voxel storage: one bit per voxel.
+
+use rayon::prelude::*;
+
+/// A dense grid of bits, one per voxel.
+///
+/// Layout: rows along `i` (x) packed into `u64` words, each row padded to
+/// whole words; rows ordered by `j`, then `k`. Word index of voxel
+/// `(i,j,k)` is `(k * ny + j) * words_per_row + i / 64`, bit `i % 64`.
+/// A z-slab `[k0, k1)` is therefore one contiguous run of words, which is
+/// what lets the parallel driver hand slabs to threads without atomics.
+///
+/// # Guarantees
+/// Padding bits past `nx` in each row are always zero, so equality of the
+/// word vectors is equality of the voxel sets.
+#[derive(Clone, PartialEq, Eq)]
+pub struct DenseBits {
+    dims: [u32; 3],
+    words_per_row: usize,
+    words: Vec<u64>,
+}
+
+impl std::fmt::Debug for DenseBits {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "DenseBits {{ dims: {:?}, set: {} }}", self.dims, self.count())
+    }
+}
+
+impl DenseBits {
+    /// An all-clear grid. Memory comes from the allocator zeroed, so pages
+    /// never written cost nothing on systems with lazy zero pages.
+    pub fn new(dims: [u32; 3]) -> DenseBits {
+        let words_per_row = (dims[0] as usize).div_ceil(64);
+        let n = words_per_row * dims[1] as usize * dims[2] as usize;
+        DenseBits { dims, words_per_row, words: vec![0u64; n] }
+    }
+
+    /// Voxels along x, y, z.
+    pub fn dims(&self) -> [u32; 3] {
+        self.dims
+    }
+
+    /// Words per `i` row.
+    pub fn words_per_row(&self) -> usize {
+        self.words_per_row
+    }
+
+    /// The raw words, in the layout described on the type.
+    pub fn words(&self) -> &[u64] {
+        &self.words
+    }
+
+    #[inline]
+    fn word_index(&self, i: u32, j: u32, k: u32) -> usize {
+        (k as usize * self.dims[1] as usize + j as usize) * self.words_per_row + (i as usize >> 6)
+    }
+
+    /// Whether voxel `(i,j,k)` is set. Panics if out of range.
+    #[inline]
+    pub fn get(&self, i: u32, j: u32, k: u32) -> bool {
+        assert!(i < self.dims[0] && j < self.dims[1] && k < self.dims[2], "voxel out of range");
+        (self.words[self.word_index(i, j, k)] >> (i & 63)) & 1 == 1
+    }
+
+    /// Sets voxel `(i,j,k)`. Panics if out of range.
+    #[inline]
+    pub fn set(&mut self, i: u32, j: u32, k: u32) {
+        assert!(i < self.dims[0] && j < self.dims[1] && k < self.dims[2], "voxel out of range");
+        let w = self.word_index(i, j, k);
+        self.words[w] |= 1u64 << (i & 63);
+    }
+
+    /// Number of set voxels.
+    pub fn count(&self) -> u64 {
+        self.words.par_chunks(1 << 16).map(|c| c.iter().map(|w| w.count_ones() as u64).sum::<u64>()).sum()
+    }
+
+    /// Calls `f(i, j, k)` for every set voxel, in order of `k`, then `j`, then `i`.
+    pub fn for_each_set(&self, mut f: impl FnMut(u32, u32, u32)) {
+        let wpr = self.words_per_row;
+        if wpr == 0 {
+            return;
+        }
+        for (row, chunk) in self.words.chunks_exact(wpr).enumerate() {
+            let j = (row % self.dims[1] as usize) as u32;
+            let k = (row / self.dims[1] as usize) as u32;
+            for (wi, &w) in chunk.iter().enumerate() {
+                let mut w = w;
+                while w != 0 {
+                    let b = w.trailing_zeros();
+                    f((wi as u32) * 64 + b, j, k);
+                    w &= w - 1;
+                }
+            }
+        }
+    }
+
+    /// The first voxel (in `k`, `j`, `i` order) where `self` and `other`
+    /// differ, or `None` if equal. Panics if dims differ.
+    pub fn first_difference(&self, other: &DenseBits) -> Option<[u32; 3]> {
+        assert_eq!(self.dims, other.dims, "grids of different dims");
+        let wpr = self.words_per_row;
+        let idx = self.words.iter().zip(&other.words).position(|(a, b)| a != b)?;
+        let diff = self.words[idx] ^ other.words[idx];
+        let row = idx / wpr;
+        let i = (idx % wpr) as u32 * 64 + diff.trailing_zeros();
+        Some([i, (row % self.dims[1] as usize) as u32, (row / self.dims[1] as usize) as u32])
+    }
+
+    /// Splits the grid into z-slabs of `slab_height` layers (the last may be
+    /// thinner), each a mutable view over its own words.
+    pub fn slabs_mut(&mut self, slab_height: u32) -> Vec<SlabMut<'_>> {
+        let slab_height = slab_height.max(1);
+        let layer = self.words_per_row * self.dims[1] as usize;
+        let (ny, wpr, nz) = (self.dims[1], self.words_per_row, self.dims[2]);
+        if layer == 0 {
+            return Vec::new();
+        }
+        self.words
+            .chunks_mut(layer * slab_height as usize)
+            .enumerate()
+            .map(|(n, words)| {
+                let k0 = n as u32 * slab_height;
+                SlabMut { k0, k1: (k0 + slab_height).min(nz), ny, words_per_row: wpr, words }
+            })
+            .collect()
+    }
+
+    /// Fills `out` with the bits of the `count` planes `i0 .. i0+count` as
+    /// bytes (0 or 1). Plane `p` occupies `out[p*ny*nz .. (p+1)*ny*nz]`,
+    /// laid out `[j][k]` (k fastest) when `k_fastest`, else `[k][j]`.
+    /// Cost is proportional to the number of words read plus voxels set.
+    pub fn fill_i_planes(&self, i0: u32, count: u32, k_fastest: bool, out: &mut [u8]) {
+        let (ny, nz) = (self.dims[1] as usize, self.dims[2] as usize);
+        let plane = ny * nz;
+        assert!(i0 + count <= self.dims[0] && out.len() >= plane * count as usize);
+        out[..plane * count as usize].fill(0);
+        let (w0, w1) = (i0 as usize / 64, (i0 + count - 1) as usize / 64);
+        for k in 0..nz {
+            for j in 0..ny {
+                let base = (k * ny + j) * self.words_per_row;
+                for wi in w0..=w1 {
+                    let mut w = self.words[base + wi];
+                    while w != 0 {
+                        let b = w.trailing_zeros() as usize;
+                        w &= w - 1;
+                        let i = wi * 64 + b;
+                        if i < i0 as usize || i >= (i0 + count) as usize {
+                            continue;
+                        }
+                        let pos = if k_fastest { j * nz + k } else { k * ny + j };
+                        out[(i - i0 as usize) * plane + pos] = 1;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A mutable view of the z-layers `[k0, k1)` of a [`DenseBits`].
+pub struct SlabMut<'a> {
+    /// First layer in the slab.
+    pub k0: u32,
+    /// One past the last layer.
+    pub k1: u32,
+    ny: u32,
+    words_per_row: usize,
+    words: &'a mut [u64],
+}
+
+impl SlabMut<'_> {
+    /// Sets voxel `(i, j, k)`; `k` must lie in `[k0, k1)`, `i`, `j` in range.
+    #[inline]
+    pub fn set(&mut self, i: u32, j: u32, k: u32) {
+        debug_assert!(k >= self.k0 && k < self.k1 && j < self.ny);
+        let idx = ((k - self.k0) as usize * self.ny as usize + j as usize) * self.words_per_row + (i as usize >> 6);
+        self.words[idx] |= 1u64 << (i & 63);
+    }
+
+    /// Set voxels in this slab.
+    pub fn count(&self) -> u64 {
+        self.words.iter().map(|w| w.count_ones() as u64).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn set_get_count_and_iterate() {
+        let mut g = DenseBits::new([70, 3, 2]);
+        g.set(0, 0, 0);
+        g.set(69, 2, 1);
+        g.set(64, 1, 1);
+        assert!(g.get(69, 2, 1) && g.get(0, 0, 0) && !g.get(1, 0, 0));
+        assert_eq!(g.count(), 3);
+        let mut v = Vec::new();
+        g.for_each_set(|i, j, k| v.push([i, j, k]));
+        assert_eq!(v, vec![[0, 0, 0], [64, 1, 1], [69, 2, 1]]);
+    }
+
+    #[test]
+    fn slabs_write_where_set_would() {
+        let mut a = DenseBits::new([5, 4, 7]);
+        let mut b = a.clone();
+        for s in a.slabs_mut(3).iter_mut() {
+            for k in s.k0..s.k1 {
+                s.set(k % 5, 3, k);
+            }
+        }
+        for k in 0..7 {
+            b.set(k % 5, 3, k);
+        }
+        assert_eq!(a, b);
+        b.set(0, 0, 6);
+        assert_eq!(a.first_difference(&b), Some([0, 0, 6]));
+    }
+
+    #[test]
+    fn planes_in_both_orders() {
+        let mut g = DenseBits::new([3, 2, 4]);
+        g.set(1, 1, 3);
+        let mut out = vec![9u8; 2 * 2 * 4];
+        g.fill_i_planes(1, 2, true, &mut out);
+        assert_eq!(out.iter().filter(|&&b| b == 1).count(), 1);
+        assert_eq!(out[4 + 3], 1);
+        g.fill_i_planes(1, 2, false, &mut out);
+        assert_eq!(out[3 * 2 + 1], 1);
+    }
+}

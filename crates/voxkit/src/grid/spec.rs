@@ -1,0 +1,193 @@
+//! The grid specification: origin, voxel size and dims.
+
+use glam::DVec3;
+
+use crate::geom::aabb::Aabb;
+
+/// Largest number of voxels along one axis. Keeps every lattice coordinate
+/// of a clipped triangle inside the fixed-point range (see [`crate::geom::fixed`]).
+pub const MAX_DIM: u32 = 65_536;
+
+/// Why a grid could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GridError {
+    /// Voxel size zero, negative, NaN or infinite.
+    #[error("voxel size must be a positive finite number, got {0}")]
+    BadVoxelSize(f64),
+    /// Origin has a NaN or infinite coordinate.
+    #[error("grid origin must be finite, got {0:?}")]
+    BadOrigin([f64; 3]),
+    /// A dimension is zero or above [`MAX_DIM`].
+    #[error("grid dims must each be between 1 and {MAX_DIM}, got {0:?}")]
+    BadDims([u64; 3]),
+    /// Resolution zero or above [`MAX_DIM`].
+    #[error("resolution must be between 1 and {MAX_DIM}, got {0}")]
+    BadResolution(u64),
+    /// The bounding box to fit is empty or not finite.
+    #[error("cannot fit a grid to an empty or non-finite bounding box")]
+    EmptyBounds,
+    /// The bounding box has zero extent on every axis (a single point).
+    #[error("cannot fit a grid to a mesh of zero extent (all vertices coincide)")]
+    ZeroExtent,
+}
+
+/// Where the voxels are.
+///
+/// Voxel `(i, j, k)` is the **closed** box
+/// `[origin + (i,j,k)·s, origin + (i+1,j+1,k+1)·s]` with `s = voxel_size`,
+/// for `0 <= i < dims[0]` and so on. Neighbouring voxels share their faces.
+///
+/// # Guarantees
+/// Built only through [`GridSpec::new`], [`GridSpec::from_resolution`] or
+/// [`GridSpec::from_voxel_size`]: origin finite, `voxel_size > 0` finite,
+/// `1 <= dims[a] <= MAX_DIM`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridSpec {
+    origin: DVec3,
+    voxel_size: f64,
+    dims: [u32; 3],
+}
+
+impl GridSpec {
+    /// An explicit grid.
+    pub fn new(origin: DVec3, voxel_size: f64, dims: [u64; 3]) -> Result<GridSpec, GridError> {
+        if !(voxel_size.is_finite() && voxel_size > 0.0) {
+            return Err(GridError::BadVoxelSize(voxel_size));
+        }
+        if !origin.is_finite() {
+            return Err(GridError::BadOrigin(origin.to_array()));
+        }
+        if dims.iter().any(|&d| d == 0 || d > MAX_DIM as u64) {
+            return Err(GridError::BadDims(dims));
+        }
+        Ok(GridSpec { origin, voxel_size, dims: dims.map(|d| d as u32) })
+    }
+
+    /// Fits a grid to `bounds` so its longest side spans `n` voxels:
+    /// `s = longest / n`, `origin = bounds.min`, and on each axis
+    /// `dims = max(1, ceil(extent / s))` clamped to `n` (so floating-point
+    /// rounding never adds a voxel).
+    pub fn from_resolution(bounds: &Aabb, n: u64) -> Result<GridSpec, GridError> {
+        if n == 0 || n > MAX_DIM as u64 {
+            return Err(GridError::BadResolution(n));
+        }
+        let ext = checked_extent(bounds)?;
+        let longest = ext.max_element();
+        if longest <= 0.0 {
+            return Err(GridError::ZeroExtent);
+        }
+        let s = longest / n as f64;
+        let dims = ext.to_array().map(|e| ((e / s).ceil() as u64).clamp(1, n));
+        GridSpec::new(bounds.min, s, dims)
+    }
+
+    /// Fits a grid of voxel size `s` to `bounds`: `origin = bounds.min`,
+    /// `dims = max(1, ceil(extent / s))` on each axis.
+    pub fn from_voxel_size(bounds: &Aabb, s: f64) -> Result<GridSpec, GridError> {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(GridError::BadVoxelSize(s));
+        }
+        let ext = checked_extent(bounds)?;
+        let dims = ext.to_array().map(|e| {
+            let d = (e / s).ceil();
+            if d >= (MAX_DIM as f64) * 2.0 {
+                u64::MAX
+            } else {
+                (d as u64).max(1)
+            }
+        });
+        GridSpec::new(bounds.min, s, dims)
+    }
+
+    /// World position of the grid's minimum corner.
+    pub fn origin(&self) -> DVec3 {
+        self.origin
+    }
+
+    /// Edge length of a voxel.
+    pub fn voxel_size(&self) -> f64 {
+        self.voxel_size
+    }
+
+    /// Voxels along x, y, z.
+    pub fn dims(&self) -> [u32; 3] {
+        self.dims
+    }
+
+    /// Total number of voxels.
+    pub fn voxel_count(&self) -> u64 {
+        self.dims.iter().map(|&d| d as u64).product()
+    }
+
+    /// Bytes a [`crate::DenseBits`] of this grid occupies.
+    pub fn dense_bytes(&self) -> u64 {
+        let words_per_row = (self.dims[0] as u64).div_ceil(64);
+        words_per_row * self.dims[1] as u64 * self.dims[2] as u64 * 8
+    }
+
+    /// `(p - origin) / voxel_size`: position in voxel units.
+    #[inline]
+    pub fn to_grid_units(&self, p: DVec3) -> DVec3 {
+        (p - self.origin) / self.voxel_size
+    }
+
+    /// World position of voxel `(i,j,k)`'s minimum corner.
+    pub fn voxel_min(&self, ijk: [u32; 3]) -> DVec3 {
+        self.origin + DVec3::new(ijk[0] as f64, ijk[1] as f64, ijk[2] as f64) * self.voxel_size
+    }
+
+    /// World position of voxel `(i,j,k)`'s centre.
+    pub fn voxel_center(&self, ijk: [u32; 3]) -> DVec3 {
+        self.voxel_min(ijk) + DVec3::splat(0.5 * self.voxel_size)
+    }
+}
+
+fn checked_extent(bounds: &Aabb) -> Result<DVec3, GridError> {
+    if bounds.is_empty() || !bounds.min.is_finite() || !bounds.max.is_finite() {
+        return Err(GridError::EmptyBounds);
+    }
+    Ok(bounds.extent())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bbox(min: [f64; 3], max: [f64; 3]) -> Aabb {
+        Aabb { min: DVec3::from(min), max: DVec3::from(max) }
+    }
+
+    #[test]
+    fn resolution_fits_longest_side() {
+        let g = GridSpec::from_resolution(&bbox([0.0; 3], [2.0, 1.0, 0.5]), 8).unwrap();
+        assert_eq!(g.dims(), [8, 4, 2]);
+        assert_eq!(g.voxel_size(), 0.25);
+    }
+
+    #[test]
+    fn resolution_never_adds_a_voxel() {
+        // 0.1*3 / (0.3/3) may round above 3 in f64; the clamp keeps n.
+        let g = GridSpec::from_resolution(&bbox([0.0; 3], [0.3, 0.3, 0.1]), 3).unwrap();
+        assert_eq!(g.dims()[0], 3);
+        assert_eq!(g.dims()[1], 3);
+    }
+
+    #[test]
+    fn flat_axis_gets_one_voxel() {
+        let g = GridSpec::from_resolution(&bbox([0.0; 3], [1.0, 1.0, 0.0]), 10).unwrap();
+        assert_eq!(g.dims(), [10, 10, 1]);
+    }
+
+    #[test]
+    fn bad_inputs_are_errors() {
+        let b = bbox([0.0; 3], [1.0; 3]);
+        assert!(GridSpec::from_resolution(&b, 0).is_err());
+        assert!(GridSpec::from_resolution(&b, 1 << 20).is_err());
+        assert!(GridSpec::from_voxel_size(&b, 0.0).is_err());
+        assert!(GridSpec::from_voxel_size(&b, f64::NAN).is_err());
+        assert!(GridSpec::from_voxel_size(&b, 1e-12).is_err());
+        assert!(GridSpec::from_resolution(&bbox([1.0; 3], [1.0; 3]), 4).is_err());
+        assert!(GridSpec::new(DVec3::ZERO, 1.0, [0, 1, 1]).is_err());
+        assert!(GridSpec::new(DVec3::NAN, 1.0, [1, 1, 1]).is_err());
+    }
+}

@@ -1,0 +1,29 @@
+//! # voxkit core
+//!
+//! Turns triangle meshes into voxel grids with an exactly stated guarantee.
+//! This crate does no I/O: it knows nothing of files, clocks, environment or
+//! logging. Readers and writers live in `voxkit-io`, the command line in
+//! `voxkit-cli`.
+//!
+//! Entry points:
+//! - [`GridSpec`] — origin, voxel size and dims; voxel `(i,j,k)` is the
+//!   *closed* box `[origin + (i,j,k)·s, origin + (i+1,j+1,k+1)·s]`.
+//! - [`MeshRef`] — a borrowed view of positions and triangles.
+//! - [`voxelize::cover`] — conservative surface voxelization (fast path) and
+//!   [`voxelize::cover::reference::cover`] (brute force, the definition).
+//! - [`DenseBits`] — the result, one bit per voxel.
+//!
+//! # Guarantees
+//! Every predicate is evaluated in exact integer arithmetic on vertices
+//! snapped to the lattice described in [`geom::fixed`], so every path
+//! (reference, fast, any thread count) returns bit-identical grids.
+
+pub mod geom;
+pub mod grid;
+pub mod mesh;
+pub mod voxelize;
+
+pub use geom::aabb::Aabb;
+pub use grid::dense::DenseBits;
+pub use grid::spec::{GridError, GridSpec};
+pub use mesh::{Mesh, MeshRef};

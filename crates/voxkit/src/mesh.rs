@@ -1,0 +1,73 @@
+//! Triangle meshes: an owned [`Mesh`] and a borrowed [`MeshRef`].
+
+use glam::DVec3;
+
+use crate::geom::aabb::Aabb;
+
+/// An indexed triangle mesh.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions (world space).
+    pub positions: Vec<DVec3>,
+    /// Triangles as indices into `positions`, in winding order.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    /// A borrowed view.
+    pub fn as_ref(&self) -> MeshRef<'_> {
+        MeshRef { positions: &self.positions, triangles: &self.triangles }
+    }
+
+    /// Applies `f` to every position (for rotations and transforms in tests and readers).
+    pub fn transform(&mut self, f: impl Fn(DVec3) -> DVec3) {
+        for p in &mut self.positions {
+            *p = f(*p);
+        }
+    }
+}
+
+/// A borrowed view of an indexed triangle mesh.
+///
+/// Invalid indices and non-finite coordinates are allowed here; the
+/// voxelizers skip such triangles and count them in their report.
+#[derive(Clone, Copy, Debug)]
+pub struct MeshRef<'a> {
+    /// Vertex positions.
+    pub positions: &'a [DVec3],
+    /// Triangles as indices into `positions`.
+    pub triangles: &'a [[u32; 3]],
+}
+
+impl MeshRef<'_> {
+    /// Bounding box of the vertices used by triangles (finite ones only).
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for t in self.triangles {
+            for &i in t {
+                if let Some(p) = self.positions.get(i as usize) {
+                    if p.is_finite() {
+                        b.grow(*p);
+                    }
+                }
+            }
+        }
+        b
+    }
+
+    /// Triangles with two equal indices or zero area (exactly, in f64).
+    pub fn degenerate_count(&self) -> usize {
+        self.triangles
+            .iter()
+            .filter(|t| {
+                if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                    return true;
+                }
+                match (self.positions.get(t[0] as usize), self.positions.get(t[1] as usize), self.positions.get(t[2] as usize)) {
+                    (Some(a), Some(b), Some(c)) => (*b - *a).cross(*c - *a) == DVec3::ZERO,
+                    _ => false,
+                }
+            })
+            .count()
+    }
+}
