@@ -1,1 +1,171 @@
+//! # voxkit-io
+//!
+//! Readers for triangle meshes (OBJ, STL, PLY, glTF/GLB) and writers and
+//! readers for voxel grids (NumPy `.npy`, binvox, MagicaVoxel `.vox`, text).
+//! One file per format. Every failure is an [`IoError`] naming the file and
+//! the problem; no reader panics on malformed input (the third-party
+//! parsers are additionally fenced with `catch_unwind`).
+//!
+//! **Architecture Invariant:** outputs are written to a temporary file in the
+//! destination directory and renamed into place, so a failure never leaves a
+//! half-written file ([`atomic::write_atomically`]).
 
+pub mod atomic;
+pub mod binvox;
+pub mod error;
+pub mod gltf;
+pub mod mesh_report;
+pub mod npy;
+pub mod obj;
+pub mod ply;
+pub mod stl;
+pub mod text;
+pub mod vox;
+
+use std::path::Path;
+
+pub use error::{ErrorKind, IoError};
+pub use mesh_report::{LoadedMesh, MeshReport};
+use voxkit::{DenseBits, GridSpec};
+
+/// Mesh file formats voxkit reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront OBJ (+ MTL).
+    Obj,
+    /// STL, ASCII or binary.
+    Stl,
+    /// PLY, ASCII or binary.
+    Ply,
+    /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`).
+    Gltf,
+}
+
+impl MeshFormat {
+    /// The format for a file extension (case-insensitive), if known.
+    pub fn from_extension(ext: &str) -> Option<MeshFormat> {
+        match ext.to_ascii_lowercase().as_str() {
+            "obj" => Some(MeshFormat::Obj),
+            "stl" => Some(MeshFormat::Stl),
+            "ply" => Some(MeshFormat::Ply),
+            "gltf" | "glb" => Some(MeshFormat::Gltf),
+            _ => None,
+        }
+    }
+}
+
+/// Reads a mesh file, choosing the format from its extension.
+pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    let format = MeshFormat::from_extension(ext).ok_or_else(|| {
+        IoError::new(path, ErrorKind::UnknownFormat { ext: ext.to_string(), expected: "obj, stl, ply, gltf, glb" })
+    })?;
+    let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    read_mesh_bytes(&bytes, format, Some(base)).map_err(|kind| IoError::new(path, kind))
+}
+
+/// Parses a mesh from memory. `base_dir` resolves relative references
+/// (OBJ material libraries, glTF external buffers); `None` disables them.
+pub fn read_mesh_bytes(bytes: &[u8], format: MeshFormat, base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKind> {
+    fence(|| match format {
+        MeshFormat::Obj => obj::read(bytes, base_dir),
+        MeshFormat::Stl => stl::read(bytes),
+        MeshFormat::Ply => ply::read(bytes),
+        MeshFormat::Gltf => gltf::read(bytes, base_dir),
+    })
+}
+
+/// Runs a third-party parser so that a panic inside it becomes an error
+/// instead of aborting the program.
+fn fence<T>(f: impl FnOnce() -> Result<T, ErrorKind>) -> Result<T, ErrorKind> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+        Ok(r) => r,
+        Err(p) => {
+            let msg = p
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| p.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown cause".into());
+            Err(ErrorKind::Malformed { format: "input", detail: format!("parser failed: {msg}") })
+        }
+    }
+}
+
+/// Voxel file formats voxkit writes and reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VoxelFormat {
+    /// NumPy `.npy`, dtype uint8, shape (nx, ny, nz).
+    Npy,
+    /// NumPy `.npy`, dtype bool, shape (nx, ny, nz).
+    NpyBool,
+    /// binvox (cube of side max(dims), run-length encoded).
+    Binvox,
+    /// MagicaVoxel `.vox`, split into models of at most 256³.
+    Vox,
+    /// Plain text: one `i j k` line per set voxel.
+    Text,
+}
+
+impl VoxelFormat {
+    /// Names accepted by `--format`.
+    pub const NAMES: &'static str = "npy, npy-bool, binvox, vox, txt";
+
+    /// The format for a `--format` name or a file extension.
+    pub fn from_name(name: &str) -> Option<VoxelFormat> {
+        match name.to_ascii_lowercase().as_str() {
+            "npy" => Some(VoxelFormat::Npy),
+            "npy-bool" | "npy_bool" => Some(VoxelFormat::NpyBool),
+            "binvox" => Some(VoxelFormat::Binvox),
+            "vox" => Some(VoxelFormat::Vox),
+            "txt" | "text" | "xyz" => Some(VoxelFormat::Text),
+            _ => None,
+        }
+    }
+
+    /// The format for a path's extension.
+    pub fn from_path(path: &Path) -> Option<VoxelFormat> {
+        VoxelFormat::from_name(path.extension()?.to_str()?)
+    }
+}
+
+/// Writes `bits` on `grid` to `path` atomically (temporary file + rename).
+pub fn write_voxels(path: &Path, format: VoxelFormat, bits: &DenseBits, grid: &GridSpec) -> Result<(), IoError> {
+    atomic::write_atomically(path, |w| match format {
+        VoxelFormat::Npy => npy::write(w, bits, npy::Dtype::U8),
+        VoxelFormat::NpyBool => npy::write(w, bits, npy::Dtype::Bool),
+        VoxelFormat::Binvox => binvox::write(w, bits, grid),
+        VoxelFormat::Vox => vox::write(w, bits),
+        VoxelFormat::Text => text::write(w, bits, grid),
+    })
+}
+
+/// A voxel grid read back from a file, with the grid placement when the
+/// format stores it.
+#[derive(Clone, Debug)]
+pub struct LoadedVoxels {
+    /// The voxels.
+    pub bits: DenseBits,
+    /// Origin and voxel size, when the format carries them (binvox, text).
+    pub placement: Option<(glam::DVec3, f64)>,
+}
+
+/// Reads any voxel file voxkit writes, choosing the format from the extension.
+pub fn read_voxels(path: &Path) -> Result<LoadedVoxels, IoError> {
+    let format = VoxelFormat::from_path(path).ok_or_else(|| {
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_string();
+        IoError::new(path, ErrorKind::UnknownFormat { ext, expected: VoxelFormat::NAMES })
+    })?;
+    let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+    read_voxels_bytes(&bytes, format).map_err(|k| IoError::new(path, k))
+}
+
+/// Parses a voxel file from memory.
+pub fn read_voxels_bytes(bytes: &[u8], format: VoxelFormat) -> Result<LoadedVoxels, ErrorKind> {
+    fence(|| match format {
+        VoxelFormat::Npy | VoxelFormat::NpyBool => npy::read(bytes),
+        VoxelFormat::Binvox => binvox::read(bytes),
+        VoxelFormat::Vox => vox::read(bytes),
+        VoxelFormat::Text => text::read(bytes),
+    })
+}

@@ -1,0 +1,65 @@
+//! A loaded mesh with its report and warnings, and the validation every
+//! reader ends with.
+
+use glam::DVec3;
+use voxkit::{Aabb, Mesh};
+
+use crate::error::ErrorKind;
+
+/// Facts about a loaded mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeshReport {
+    /// Vertices.
+    pub vertices: usize,
+    /// Triangles (after fan triangulation of polygons).
+    pub triangles: usize,
+    /// Triangles with repeated indices or zero area; voxelizers skip them.
+    pub degenerate: usize,
+    /// Bounding box of the vertices used by triangles.
+    pub bounds: Aabb,
+}
+
+/// A mesh as read from a file.
+#[derive(Clone, Debug)]
+pub struct LoadedMesh {
+    /// The geometry.
+    pub mesh: Mesh,
+    /// Counts and bounds.
+    pub report: MeshReport,
+    /// Non-fatal problems (for example a missing material library).
+    pub warnings: Vec<String>,
+}
+
+/// Validates and packages reader output: every coordinate finite, every
+/// index in range, at least one triangle.
+pub(crate) fn finish(positions: Vec<DVec3>, triangles: Vec<[i64; 3]>, warnings: Vec<String>) -> Result<LoadedMesh, ErrorKind> {
+    for (index, p) in positions.iter().enumerate() {
+        if let Some(&value) = p.to_array().iter().find(|c| !c.is_finite()) {
+            return Err(ErrorKind::NonFinite { index, value });
+        }
+    }
+    let count = positions.len();
+    let mut tris = Vec::with_capacity(triangles.len());
+    for (face, t) in triangles.iter().enumerate() {
+        for &index in t {
+            if index < 0 || index as usize >= count {
+                return Err(ErrorKind::IndexOutOfRange { face, index, count });
+            }
+        }
+        tris.push(t.map(|i| i as u32));
+    }
+    if tris.is_empty() {
+        return Err(ErrorKind::Empty);
+    }
+    let mesh = Mesh { positions, triangles: tris };
+    let r = mesh.as_ref();
+    let report = MeshReport { vertices: count, triangles: mesh.triangles.len(), degenerate: r.degenerate_count(), bounds: r.bounds() };
+    Ok(LoadedMesh { mesh, report, warnings })
+}
+
+/// Fan-triangulates a polygon given by vertex indices: (0,1,2), (0,2,3), …
+pub(crate) fn fan(poly: &[i64], out: &mut Vec<[i64; 3]>) {
+    for w in 1..poly.len().saturating_sub(1) {
+        out.push([poly[0], poly[w], poly[w + 1]]);
+    }
+}

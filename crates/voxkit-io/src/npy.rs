@@ -1,0 +1,100 @@
+//! NumPy `.npy` (format version 1.0), written by hand.
+//!
+//! Shape `(nx, ny, nz)`, C order, element `[i, j, k]` = voxel `(i, j, k)`,
+//! dtype `uint8` (`|u1`, 0 or 1) or `bool` (`|b1`). Written directly rather
+//! than through `npyz`: its per-element writer is far slower for the 10⁹
+//! elements of a 1024³ grid, and the header is a dozen lines. Tests read
+//! the files back with NumPy itself.
+
+use std::io::Write;
+
+use voxkit::DenseBits;
+
+use crate::error::ErrorKind;
+use crate::LoadedVoxels;
+
+/// Element type of the array.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dtype {
+    /// `uint8`, values 0 and 1.
+    U8,
+    /// `bool`.
+    Bool,
+}
+
+/// Writes `bits` as an `.npy` array of shape `(nx, ny, nz)`.
+pub fn write(w: &mut dyn Write, bits: &DenseBits, dtype: Dtype) -> std::io::Result<()> {
+    let [nx, ny, nz] = bits.dims();
+    let descr = match dtype {
+        Dtype::U8 => "|u1",
+        Dtype::Bool => "|b1",
+    };
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': ({nx}, {ny}, {nz}), }}");
+    let total = 10 + header.len() + 1;
+    header.push_str(&" ".repeat(total.div_ceil(64) * 64 - total));
+    header.push('\n');
+    w.write_all(b"\x93NUMPY\x01\x00")?;
+    w.write_all(&(header.len() as u16).to_le_bytes())?;
+    w.write_all(header.as_bytes())?;
+    let plane = ny as usize * nz as usize;
+    let block = ((32usize << 20) / plane.max(1)).clamp(1, 64) as u32;
+    let mut buf = vec![0u8; plane * block as usize];
+    let mut i0 = 0;
+    while i0 < nx {
+        let count = block.min(nx - i0);
+        bits.fill_i_planes(i0, count, true, &mut buf);
+        w.write_all(&buf[..plane * count as usize])?;
+        i0 += count;
+    }
+    Ok(())
+}
+
+/// Reads a 3-D `.npy` array of dtype uint8/int8/bool in C order; nonzero = set.
+pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
+    let bad = |d: &str| ErrorKind::malformed("npy", d);
+    if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
+        return Err(bad("missing \\x93NUMPY magic"));
+    }
+    let (hlen, hstart) = match bytes[6] {
+        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10),
+        2 | 3 if bytes.len() >= 12 => (u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize, 12),
+        v => return Err(bad(&format!("unsupported format version {v}"))),
+    };
+    let header = bytes.get(hstart..hstart + hlen).ok_or_else(|| bad("truncated header"))?;
+    let header = std::str::from_utf8(header).map_err(|_| bad("header is not text"))?;
+    let field = |key: &str| -> Option<&str> {
+        let at = header.find(&format!("'{key}'"))? + key.len() + 2;
+        let rest = header[at..].trim_start().strip_prefix(':')?.trim_start();
+        Some(rest)
+    };
+    let descr = field("descr").and_then(|r| r.strip_prefix('\'')).and_then(|r| r.split('\'').next()).ok_or_else(|| bad("no descr"))?;
+    if !matches!(descr, "|u1" | "|b1" | "|i1" | "<u1" | "<i1") {
+        return Err(ErrorKind::Unsupported(format!("npy dtype {descr} (expected uint8 or bool)")));
+    }
+    if field("fortran_order").is_some_and(|r| r.starts_with("True")) {
+        return Err(ErrorKind::Unsupported("Fortran-ordered npy arrays".into()));
+    }
+    let shape = field("shape").and_then(|r| r.strip_prefix('(')).and_then(|r| r.split(')').next()).ok_or_else(|| bad("no shape"))?;
+    let dims: Vec<u64> = shape.split(',').map(str::trim).filter(|s| !s.is_empty()).map(|s| s.parse::<u64>()).collect::<Result<_, _>>().map_err(|_| bad("shape is not a tuple of integers"))?;
+    let [nx, ny, nz] = dims[..] else {
+        return Err(ErrorKind::Unsupported(format!("npy array of {} dimensions (expected 3)", dims.len())));
+    };
+    if [nx, ny, nz].iter().any(|&d| d == 0 || d > voxkit::grid::spec::MAX_DIM as u64) {
+        return Err(bad(&format!("shape ({nx}, {ny}, {nz}) out of range")));
+    }
+    let data = &bytes[hstart + hlen..];
+    let n = (nx * ny * nz) as usize;
+    if data.len() < n {
+        return Err(bad(&format!("data holds {} bytes, shape needs {n} (truncated?)", data.len())));
+    }
+    let mut bits = DenseBits::new([nx as u32, ny as u32, nz as u32]);
+    for (idx, &b) in data[..n].iter().enumerate() {
+        if b != 0 {
+            let k = idx % nz as usize;
+            let j = (idx / nz as usize) % ny as usize;
+            let i = idx / (nz as usize * ny as usize);
+            bits.set(i as u32, j as u32, k as u32);
+        }
+    }
+    Ok(LoadedVoxels { bits, placement: None })
+}

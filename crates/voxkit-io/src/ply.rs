@@ -1,0 +1,70 @@
+//! PLY, ASCII and binary (both endiannesses), through the `ply-rs-bw` crate.
+//!
+//! Reads element `vertex` (properties `x`, `y`, `z`, any numeric type) and
+//! element `face` (list property `vertex_indices` or `vertex_index`);
+//! polygons are fan-triangulated.
+
+use std::io::Cursor;
+
+use glam::DVec3;
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{DefaultElement, Property};
+
+use crate::error::ErrorKind;
+use crate::mesh_report::{fan, finish, LoadedMesh};
+
+fn scalar(p: &Property) -> Option<f64> {
+    Some(match *p {
+        Property::Char(v) => v as f64,
+        Property::UChar(v) => v as f64,
+        Property::Short(v) => v as f64,
+        Property::UShort(v) => v as f64,
+        Property::Int(v) => v as f64,
+        Property::UInt(v) => v as f64,
+        Property::Float(v) => v as f64,
+        Property::Double(v) => v,
+        _ => return None,
+    })
+}
+
+fn list(p: &Property) -> Option<Vec<i64>> {
+    Some(match p {
+        Property::ListChar(v) => v.iter().map(|&x| x as i64).collect(),
+        Property::ListUChar(v) => v.iter().map(|&x| x as i64).collect(),
+        Property::ListShort(v) => v.iter().map(|&x| x as i64).collect(),
+        Property::ListUShort(v) => v.iter().map(|&x| x as i64).collect(),
+        Property::ListInt(v) => v.iter().map(|&x| x as i64).collect(),
+        Property::ListUInt(v) => v.iter().map(|&x| x as i64).collect(),
+        _ => return None,
+    })
+}
+
+/// Parses PLY bytes.
+pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
+    let parser = Parser::<DefaultElement>::new();
+    let ply = parser.read_ply(&mut Cursor::new(bytes)).map_err(|e| ErrorKind::malformed("PLY", e))?;
+    let verts = ply.payload.get("vertex").ok_or_else(|| ErrorKind::malformed("PLY", "no 'vertex' element"))?;
+    let mut positions = Vec::with_capacity(verts.len());
+    for (n, v) in verts.iter().enumerate() {
+        let mut c = [0.0; 3];
+        for (a, name) in ["x", "y", "z"].iter().enumerate() {
+            c[a] = v
+                .get(*name)
+                .and_then(scalar)
+                .ok_or_else(|| ErrorKind::malformed("PLY", format!("vertex {n} has no numeric '{name}' property")))?;
+        }
+        positions.push(DVec3::from(c));
+    }
+    let mut triangles = Vec::new();
+    if let Some(faces) = ply.payload.get("face") {
+        for (n, f) in faces.iter().enumerate() {
+            let idx = f
+                .get("vertex_indices")
+                .or_else(|| f.get("vertex_index"))
+                .and_then(list)
+                .ok_or_else(|| ErrorKind::malformed("PLY", format!("face {n} has no 'vertex_indices' list")))?;
+            fan(&idx, &mut triangles);
+        }
+    }
+    finish(positions, triangles, Vec::new())
+}
