@@ -38,14 +38,13 @@ use crate::mesh::MeshRef;
 /// Conservative surface voxelization, fast path (parallel over z-slabs).
 pub fn cover(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (DenseBits, Report) {
     let (tris, prepare_stats) = prepare(mesh, grid);
-    let bits = cover_lattice(&tris, grid.dims(), opts);
-    let voxels = bits.count();
+    let (bits, voxels) = run_slabs(&CoverKernel, &tris, grid.dims(), opts);
     (bits, Report { prepare: prepare_stats, voxels })
 }
 
 /// The fast path on already prepared triangles.
 pub fn cover_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> DenseBits {
-    run_slabs(&CoverKernel, tris, dims, opts)
+    run_slabs(&CoverKernel, tris, dims, opts).0
 }
 
 /// A 2D edge function `f(p, q) = a·p + b·q + c` over voxel indices; the
@@ -55,13 +54,6 @@ struct Edge2 {
     a: i64,
     b: i64,
     c: i64,
-}
-
-impl Edge2 {
-    #[inline(always)]
-    fn eval(&self, p: i64, q: i64) -> i64 {
-        self.a * p + self.b * q + self.c
-    }
 }
 
 /// Schwarz–Seidel edge functions of the triangle projected onto the plane of
@@ -83,27 +75,64 @@ fn edges_2d(tri: &LatticeTriangle, p: usize, q: usize, sigma: i64) -> [Edge2; 3]
     })
 }
 
+/// Integer types the plane test runs in: `i64` for triangles small enough
+/// that every plane value fits (the common case), `i128` otherwise.
+trait PlaneInt: Copy + PartialOrd + std::ops::Add<Output = Self> + std::ops::Mul<Output = Self> + std::ops::Neg<Output = Self> {
+    const ZERO: Self;
+    fn from_i64(x: i64) -> Self;
+    fn to_f64(self) -> f64;
+}
+
+impl PlaneInt for i64 {
+    const ZERO: Self = 0;
+    #[inline(always)]
+    fn from_i64(x: i64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+}
+
+impl PlaneInt for i128 {
+    const ZERO: Self = 0;
+    #[inline(always)]
+    fn from_i64(x: i64) -> Self {
+        x as i128
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+}
+
+/// Largest `extent + 2 voxels` (lattice units) for which the plane test is
+/// exact in `i64`: plane values are bounded by `24·B³ < 2^62` when `B <= 2^19`.
+const I64_PLANE_LIMIT: i64 = 1 << 19;
+
 /// Per-triangle setup of the fast test, in axes permuted so that `w` is the
 /// dominant axis of the normal and `(u, v, w)` is a cyclic (right-handed)
-/// permutation of `(x, y, z)`.
+/// permutation of `(x, y, z)`. Plane values are relative to the voxel
+/// `origin` (the low corner of the box being traversed), which keeps them
+/// small enough for `i64` on all but huge triangles.
 #[derive(Clone, Copy, Debug)]
-struct Setup {
-    u: usize,
-    v: usize,
+struct Setup<T> {
     w: usize,
     uv: [Edge2; 3],
     vw: [Edge2; 3],
     wu: [Edge2; 3],
+    origin: [i64; 3],
     /// Normal, oriented so `n[w] > 0`, scaled to voxel-index units (`× ONE`).
-    n: [i128; 3],
+    n: [T; 3],
     /// Plane value offsets at the voxel's min- and max-side critical corners.
-    d_min: i128,
-    d_max: i128,
+    d_min: T,
+    d_max: T,
     inv_nw: f64,
 }
 
-impl Setup {
-    fn new(tri: &LatticeTriangle) -> Setup {
+impl<T: PlaneInt> Setup<T> {
+    fn new(tri: &LatticeTriangle, origin: [i64; 3]) -> Setup<T> {
         let n = tri.normal();
         let w = (0..3).fold(0, |best, a| if n[a].abs() > n[best].abs() { a } else { best });
         let (u, v) = ((w + 1) % 3, (w + 2) % 3);
@@ -112,81 +141,233 @@ impl Setup {
         let vw = edges_2d(tri, v, w, sign(n[u]));
         let wu = edges_2d(tri, w, u, sign(n[v]));
         let flip = if n[w] < 0 { -1 } else { 1 };
-        let no: [i128; 3] = std::array::from_fn(|a| (n[a] * flip) as i128);
-        let v0: [i128; 3] = tri.v[0].map(|c| c as i128);
+        let no: [T; 3] = std::array::from_fn(|a| T::from_i64(n[a] * flip));
+        let one = T::from_i64(ONE);
+        let v0: [T; 3] = std::array::from_fn(|a| T::from_i64(tri.v[0][a] - origin[a] * ONE));
         let nv0 = no[0] * v0[0] + no[1] * v0[1] + no[2] * v0[2];
-        let one = ONE as i128;
-        let d_min = no.iter().map(|&c| (c * one).min(0)).sum::<i128>() - nv0;
-        let d_max = no.iter().map(|&c| (c * one).max(0)).sum::<i128>() - nv0;
+        let (mut d_min, mut d_max) = (-nv0, -nv0);
+        for c in no {
+            let t = c * one;
+            if t < T::ZERO {
+                d_min = d_min + t;
+            } else {
+                d_max = d_max + t;
+            }
+        }
         let n_idx = no.map(|c| c * one);
-        Setup { u, v, w, uv, vw, wu, n: n_idx, d_min, d_max, inv_nw: 1.0 / n_idx[w] as f64 }
+        Setup { w, uv, vw, wu, origin, n: n_idx, d_min, d_max, inv_nw: 1.0 / n_idx[w].to_f64() }
     }
-}
-
-#[inline]
-fn floor_div(a: i64, b: i64) -> i64 {
-    a.div_euclid(b)
-}
-
-#[inline]
-fn ceil_div(a: i64, b: i64) -> i64 {
-    -((-a).div_euclid(b))
 }
 
 struct CoverKernel;
 
 impl Kernel for CoverKernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut SlabMut<'_>) {
-        let s = Setup::new(tri);
-        let (u, v, w) = (s.u, s.v, s.w);
-        let (lo_w, hi_w) = (lo[w], hi[w]);
-        'rows: for iv in lo[v]..=hi[v] {
-            // Exact span of iu where all three dominant-plane edge tests pass.
-            let (mut a0, mut a1) = (lo[u], hi[u]);
-            for e in &s.uv {
-                let r = e.b * iv + e.c;
-                if e.a > 0 {
-                    a0 = a0.max(ceil_div(-r, e.a));
-                } else if e.a < 0 {
-                    a1 = a1.min(floor_div(r, -e.a));
-                } else if r < 0 {
-                    continue 'rows;
+        let (blo, bhi) = tri.bounds();
+        let extent = (0..3).map(|a| bhi[a] - blo[a]).max().unwrap_or(0);
+        if extent + 2 * ONE <= I64_PLANE_LIMIT {
+            dispatch::<i64>(tri, &Setup::new(tri, lo), lo, hi, slab);
+        } else {
+            dispatch::<i128>(tri, &Setup::new(tri, lo), lo, hi, slab);
+        }
+    }
+}
+
+/// Exact incremental bound of a linear constraint `a·x + b·y + c >= 0` on
+/// integer `x`, stepped along `y` (Bresenham-style: one division at the
+/// start, then an addition and a comparison per step).
+#[derive(Clone, Copy, Debug)]
+enum Walker {
+    /// `a > 0`: `x >= lo`; `lo = ceil(-(b·y + c) / a)`, `r = a·lo + b·y + c ∈ [0, a)`.
+    Lower { lo: i64, r: i64, q: i64, m: i64, d: i64 },
+    /// `a < 0`: `x <= hi`; `hi = floor((b·y + c) / -a)`, `r = (b·y + c) - (-a)·hi ∈ [0, -a)`.
+    Upper { hi: i64, r: i64, q: i64, m: i64, d: i64 },
+    /// `a == 0`: all `x` or none, as `n = b·y + c` is `>= 0` or not.
+    Const { n: i64, b: i64 },
+}
+
+impl Walker {
+    #[inline(always)]
+    fn new(a: i64, b: i64, c: i64, y0: i64) -> Walker {
+        let n = b * y0 + c;
+        if a > 0 {
+            let lo = -n.div_euclid(a);
+            Walker::Lower { lo, r: a * lo + n, q: (-b).div_euclid(a), m: (-b).rem_euclid(a), d: a }
+        } else if a < 0 {
+            let d = -a;
+            Walker::Upper { hi: n.div_euclid(d), r: n.rem_euclid(d), q: b.div_euclid(d), m: b.rem_euclid(d), d }
+        } else {
+            Walker::Const { n, b }
+        }
+    }
+
+    /// Moves to `y + 1`.
+    #[inline(always)]
+    fn step(&mut self) {
+        match self {
+            Walker::Lower { lo, r, q, m, d } => {
+                *lo += *q;
+                *r -= *m;
+                if *r < 0 {
+                    *lo += 1;
+                    *r += *d;
                 }
             }
-            for iu in a0..=a1 {
-                let base = s.n[u] * iu as i128 + s.n[v] * iv as i128;
-                let nw = s.n[w];
-                // Plane test: g_min(t) <= 0 <= g_max(t), both increasing in t.
-                let g_max = |t: i64| base + nw * t as i128 + s.d_max;
-                let g_min = |t: i64| base + nw * t as i128 + s.d_min;
-                let clamp = |x: f64| x.clamp((lo_w - 1) as f64, (hi_w + 1) as f64) as i64;
-                let mut t0 = clamp((-(base + s.d_max) as f64 * s.inv_nw).ceil());
-                while t0 > lo_w && g_max(t0 - 1) >= 0 {
-                    t0 -= 1;
+            Walker::Upper { hi, r, q, m, d } => {
+                *hi += *q;
+                *r += *m;
+                if *r >= *d {
+                    *hi += 1;
+                    *r -= *d;
                 }
-                while t0 <= hi_w && g_max(t0) < 0 {
-                    t0 += 1;
-                }
-                let mut t1 = clamp((-(base + s.d_min) as f64 * s.inv_nw).floor());
-                while t1 < hi_w && g_min(t1 + 1) <= 0 {
-                    t1 += 1;
-                }
-                while t1 >= lo_w && g_min(t1) > 0 {
-                    t1 -= 1;
-                }
-                for t in t0.max(lo_w)..=t1.min(hi_w) {
-                    let pass = s.vw.iter().all(|e| e.eval(iv, t) >= 0) && s.wu.iter().all(|e| e.eval(t, iu) >= 0);
-                    if pass {
-                        let mut idx = [0i64; 3];
-                        idx[u] = iu;
-                        idx[v] = iv;
-                        idx[w] = t;
-                        slab.set(idx[0] as u32, idx[1] as u32, idx[2] as u32);
-                    }
+            }
+            Walker::Const { n, b } => *n += *b,
+        }
+    }
+
+    /// Intersects `[lo, hi]` with the allowed range at the current `y`.
+    #[inline(always)]
+    fn clip(&self, lo: &mut i64, hi: &mut i64) {
+        match *self {
+            Walker::Lower { lo: l, .. } => *lo = (*lo).max(l),
+            Walker::Upper { hi: h, .. } => *hi = (*hi).min(h),
+            Walker::Const { n, .. } => {
+                if n < 0 {
+                    *lo = 1;
+                    *hi = 0;
                 }
             }
         }
     }
+}
+
+/// Clips `[lo, hi]` by three walkers.
+#[inline(always)]
+fn clip3(w: &[Walker; 3], mut lo: i64, mut hi: i64) -> (i64, i64) {
+    for x in w {
+        x.clip(&mut lo, &mut hi);
+    }
+    (lo, hi)
+}
+
+/// Selects the traversal compiled for the triangle's dominant axis, so the
+/// mapping from `(u, v, w)` back to `(i, j, k)` is static.
+#[inline(always)]
+fn dispatch<T: PlaneInt>(tri: &LatticeTriangle, s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut SlabMut<'_>) {
+    match s.w {
+        0 => traverse::<T, 0>(tri, s, lo, hi, slab),
+        1 => traverse::<T, 1>(tri, s, lo, hi, slab),
+        _ => traverse::<T, 2>(tri, s, lo, hi, slab),
+    }
+}
+
+/// Walks the rows of the dominant-axis projection. In each row:
+/// - the exact span of columns whose square meets the projected triangle,
+///   and the *interior* span whose square lies entirely inside it;
+/// - the exact range of `t` allowed by the `(v, w)` edge tests;
+/// - along the row, incrementally (additions only), the exact range of `t`
+///   where the plane crosses the voxel, which moves by at most one per
+///   column since `|n_u| <= n_w`.
+///
+/// In interior columns the plane test alone decides (a plane point inside
+/// the voxel projects inside the triangle, so it is a triangle point); in
+/// boundary columns the `(w, u)` edge tests run per voxel.
+#[inline(always)]
+fn traverse<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut SlabMut<'_>) {
+    let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
+    let o = s.origin;
+    let nw = s.n[w];
+    let nu = s.n[u];
+    // The triangle's own (unclamped) voxel span along w bounds the estimates.
+    let (tlo, thi) = tri.bounds();
+    let (span_lo, span_hi) = crate::geom::fixed::voxel_span(tlo[w], thi[w]);
+    let est = |x: f64| x.clamp((span_lo - 1) as f64, (span_hi + 1) as f64) as i64;
+    let y0 = lo[v];
+    // Columns whose square meets the projected triangle; columns whose
+    // square lies inside it (edge value at the far corner >= 0); and the t
+    // range allowed by the (v, w) edge tests — each walked row by row.
+    let mut outer: [Walker; 3] = std::array::from_fn(|i| Walker::new(s.uv[i].a, s.uv[i].b, s.uv[i].c, y0));
+    let mut inner: [Walker; 3] = std::array::from_fn(|i| {
+        let e = s.uv[i];
+        Walker::new(e.a, e.b, e.c - e.a.abs() - e.b.abs(), y0)
+    });
+    let mut tband: [Walker; 3] = std::array::from_fn(|i| Walker::new(s.vw[i].b, s.vw[i].a, s.vw[i].c, y0));
+    let (lo_w, hi_w) = (lo[w], hi[w]);
+    for iv in lo[v]..=hi[v] {
+        if iv > y0 {
+            for x in outer.iter_mut().chain(inner.iter_mut()).chain(tband.iter_mut()) {
+                x.step();
+            }
+        }
+        let (a0, a1) = clip3(&outer, lo[u], hi[u]);
+        if a0 > a1 {
+            continue;
+        }
+        let (c0, c1) = clip3(&tband, lo_w, hi_w);
+        if c0 > c1 {
+            continue;
+        }
+        let (i0, i1) = clip3(&inner, a0, a1);
+        // Plane range at the first column: t0 = min t with g_max(t) >= 0,
+        // t1 = max t with g_min(t) <= 0; g0 = g_max(t0), g1 = g_min(t1).
+        let base = s.n[v] * T::from_i64(iv - o[v]) + nu * T::from_i64(a0 - o[u]);
+        let mut t0 = est(-(base + s.d_max).to_f64() * s.inv_nw + o[w] as f64);
+        let mut t1 = est(-(base + s.d_min).to_f64() * s.inv_nw + o[w] as f64);
+        let mut g0 = base + nw * T::from_i64(t0 - o[w]) + s.d_max;
+        let mut g1 = base + nw * T::from_i64(t1 - o[w]) + s.d_min;
+        let mut iu = a0;
+        loop {
+            while g0 + (-nw) >= T::ZERO {
+                t0 -= 1;
+                g0 = g0 + (-nw);
+            }
+            while g0 < T::ZERO {
+                t0 += 1;
+                g0 = g0 + nw;
+            }
+            while g1 + nw <= T::ZERO {
+                t1 += 1;
+                g1 = g1 + nw;
+            }
+            while g1 > T::ZERO {
+                t1 -= 1;
+                g1 = g1 + (-nw);
+            }
+            let (ta, tb) = (t0.max(c0), t1.min(c1));
+            let mut t = ta;
+            if iu >= i0 && iu <= i1 {
+                while t <= tb {
+                    set::<W>(slab, iu, iv, t);
+                    t += 1;
+                }
+            } else {
+                let r: [i64; 3] = std::array::from_fn(|i| s.wu[i].b * iu + s.wu[i].c);
+                while t <= tb {
+                    if s.wu[0].a * t + r[0] >= 0 && s.wu[1].a * t + r[1] >= 0 && s.wu[2].a * t + r[2] >= 0 {
+                        set::<W>(slab, iu, iv, t);
+                    }
+                    t += 1;
+                }
+            }
+            if iu == a1 {
+                break;
+            }
+            iu += 1;
+            g0 = g0 + nu;
+            g1 = g1 + nu;
+        }
+    }
+}
+
+/// Sets voxel `(u, v, w)`; `(u, v, w)` is a cyclic shift of `(x, y, z)` by `W`.
+#[inline(always)]
+fn set<const W: usize>(slab: &mut SlabMut<'_>, iu: i64, iv: i64, t: i64) {
+    let (i, j, k) = match W {
+        0 => (t, iu, iv),
+        1 => (iv, t, iu),
+        _ => (iu, iv, t),
+    };
+    slab.set(i as u32, j as u32, k as u32);
 }
 
 /// The slow, obviously correct definition of `cover`.

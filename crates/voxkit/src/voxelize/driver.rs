@@ -20,7 +20,9 @@ pub trait Kernel: Sync {
 }
 
 /// Runs `kernel` over `tris` on a grid of `dims`, in parallel over z-slabs.
-pub fn run_slabs<K: Kernel>(kernel: &K, tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> DenseBits {
+/// Returns the grid and the number of voxels set (counted by each slab's
+/// task while its words are still in cache).
+pub fn run_slabs<K: Kernel>(kernel: &K, tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> (DenseBits, u64) {
     let mut grid = DenseBits::new(dims);
     let nz = dims[2];
     let height = if opts.slab_height > 0 {
@@ -43,7 +45,7 @@ pub fn run_slabs<K: Kernel>(kernel: &K, tris: &[LatticeTriangle], dims: [u32; 3]
         p.set_total(nslabs as u64);
     }
     let mut slabs = grid.slabs_mut(height);
-    slabs.par_iter_mut().zip(bins.par_iter()).for_each(|(slab, bin)| {
+    let count = slabs.par_iter_mut().zip(bins.par_iter()).map(|(slab, bin)| {
         for &idx in bin {
             let Some((mut lo, mut hi)) = bounds[idx as usize] else { continue };
             lo[2] = lo[2].max(slab.k0 as i64);
@@ -55,7 +57,8 @@ pub fn run_slabs<K: Kernel>(kernel: &K, tris: &[LatticeTriangle], dims: [u32; 3]
         if let Some(p) = opts.progress {
             p.advance(1);
         }
-    });
+        slab.count()
+    }).sum();
     drop(slabs);
-    grid
+    (grid, count)
 }

@@ -1,0 +1,141 @@
+//! Raw command-line arguments (stage one of two: see `plan.rs`).
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+/// voxkit: voxelize triangle meshes with guaranteed topology.
+#[derive(Parser, Debug)]
+#[command(name = "voxkit", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Voxelize a mesh into a voxel file (.npy, .binvox, .vox, .txt).
+    Voxelize(VoxelizeArgs),
+    /// Print a report of a mesh file: vertices, triangles, degenerate triangles, bounds.
+    Info(InfoArgs),
+    /// Benchmark voxelization (medians over repeats) on a mesh at several resolutions.
+    Bench(BenchArgs),
+}
+
+/// Voxelization modes. Only `cover` is implemented so far; the others are
+/// accepted by the parser and rejected with an error that says so.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Mode {
+    /// Conservative surface: every voxel whose closed box meets a triangle.
+    Cover,
+    /// Laine's minimal 26-separating surface (space-diagonal target).
+    Sep26,
+    /// Laine's thin 6-separating surface (3D crosshair target).
+    Sep6,
+    /// Schwarz–Seidel 6-separating surface.
+    Ss6,
+    /// Solid: voxels whose centre is inside.
+    Solid,
+    /// 6-connected polyline voxelization.
+    Line6,
+    /// 26-connected polyline voxelization.
+    Line26,
+    /// Projected optimal scanline, as published.
+    Pos,
+}
+
+/// Voxelization methods.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Method {
+    /// The fastest correct method for the mode.
+    Auto,
+    /// The slow brute-force reference implementation of the mode.
+    Reference,
+    /// The triangle/box fast path (Schwarz & Seidel 2010), parallel.
+    Fast,
+    /// Projected optimal scanline fast path.
+    Scanline,
+    /// GPU (wgpu).
+    Gpu,
+    /// Solid by ray parity.
+    Parity,
+    /// Solid by generalized winding number.
+    Winding,
+}
+
+/// How the grid is chosen.
+#[derive(Args, Debug, Clone, Default)]
+pub struct GridArgs {
+    /// Fit the grid so the longest side of the mesh's bounding box spans N voxels (default 128).
+    #[arg(long, value_name = "N")]
+    pub resolution: Option<u64>,
+    /// Voxel edge length; alone, fits the grid to the mesh's bounding box.
+    #[arg(long, value_name = "S")]
+    pub voxel_size: Option<f64>,
+    /// Explicit grid origin (with --voxel-size and --dims).
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', num_args = 3, allow_negative_numbers = true)]
+    pub origin: Option<Vec<f64>>,
+    /// Explicit grid dims (with --origin and --voxel-size).
+    #[arg(long, value_name = "NX,NY,NZ", value_delimiter = ',', num_args = 3)]
+    pub dims: Option<Vec<u64>>,
+}
+
+#[derive(Args, Debug)]
+pub struct VoxelizeArgs {
+    /// Input mesh (.obj, .stl, .ply, .gltf, .glb).
+    pub mesh: PathBuf,
+    /// Output voxel file; the format comes from the extension unless --format is given.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Voxelization mode.
+    #[arg(long, value_enum, default_value = "cover")]
+    pub mode: Mode,
+    /// Method.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub method: Method,
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// Output format: npy, npy-bool, binvox, vox, txt (default: from the extension).
+    #[arg(long, value_name = "FORMAT")]
+    pub format: Option<String>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress bar and no summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// Input mesh.
+    pub mesh: PathBuf,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Mesh to voxelize.
+    #[arg(long, default_value = "../shared/meshes/stanford-bunny.obj")]
+    pub mesh: PathBuf,
+    /// Resolutions (longest side in voxels).
+    #[arg(long, value_delimiter = ',', default_value = "128,256,512,1024")]
+    pub resolutions: Vec<u64>,
+    /// Thread counts to measure.
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    pub threads: Vec<usize>,
+    /// Repeats per measurement (the median is reported).
+    #[arg(long, default_value_t = 9)]
+    pub repeats: usize,
+    /// Resolution at which the reference path is timed as the baseline.
+    #[arg(long, default_value_t = 128)]
+    pub reference_resolution: u64,
+    /// Print JSON lines instead of a Markdown table.
+    #[arg(long)]
+    pub json: bool,
+}

@@ -1,0 +1,127 @@
+//! `voxkit voxelize MESH -o OUT`.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use serde_json::json;
+use voxkit::voxelize::{cover, Options};
+use voxkit_io::VoxelFormat;
+
+use crate::args::VoxelizeArgs;
+use crate::plan::{self, GridRequest};
+use crate::progress::Bar;
+
+pub fn run(a: &VoxelizeArgs) -> Result<()> {
+    let t_total = Instant::now();
+    // Validate everything that does not need the mesh first.
+    let request = GridRequest::from_args(&a.grid)?;
+    let method = plan::resolve_method(a.mode, a.method)?;
+    let format = match &a.format {
+        Some(f) => VoxelFormat::from_name(f).with_context(|| format!("unknown --format {f:?} (expected one of: {})", VoxelFormat::NAMES))?,
+        None => VoxelFormat::from_path(&a.output).with_context(|| {
+            format!("{}: cannot tell the output format from the extension (use one of: {}, or --format)", a.output.display(), VoxelFormat::NAMES)
+        })?,
+    };
+    check_output_dir(&a.output)?;
+    let pool = crate::thread_pool(a.threads)?;
+    let threads = pool.current_num_threads();
+
+    let bar = Bar::new(a.quiet || a.json);
+    bar.phase("loading mesh");
+    let t_load = Instant::now();
+    let loaded = voxkit_io::read_mesh(&a.mesh)?;
+    let load_s = t_load.elapsed().as_secs_f64();
+    for w in &loaded.warnings {
+        eprintln!("voxkit: warning: {}: {w}", a.mesh.display());
+    }
+    let grid = request.fit(&loaded.report.bounds)?;
+    plan::check_memory(&grid)?;
+
+    let t_vox = Instant::now();
+    let (bits, report) = pool.install(|| match method {
+        "reference" => cover::reference::cover(loaded.mesh.as_ref(), &grid),
+        _ => cover::cover(loaded.mesh.as_ref(), &grid, &Options { progress: Some(&bar), ..Options::default() }),
+    });
+    let voxelize_s = t_vox.elapsed().as_secs_f64();
+
+    bar.phase("writing");
+    let t_write = Instant::now();
+    voxkit_io::write_voxels(&a.output, format, &bits, &grid)?;
+    let write_s = t_write.elapsed().as_secs_f64();
+    bar.finish();
+    let total_s = t_total.elapsed().as_secs_f64();
+
+    let p = report.prepare;
+    if p.non_finite + p.invalid_index > 0 {
+        eprintln!("voxkit: warning: skipped {} triangles with invalid vertices", p.non_finite + p.invalid_index);
+    }
+    let o = grid.origin();
+    let dims = grid.dims();
+    if a.json {
+        let v = json!({
+            "mode": plan::mode_name(a.mode),
+            "method": method,
+            "origin": [o.x, o.y, o.z],
+            "voxel_size": grid.voxel_size(),
+            "dims": dims,
+            "voxels": report.voxels,
+            "voxelize_s": voxelize_s,
+            "load_s": load_s,
+            "write_s": write_s,
+            "total_s": total_s,
+            "threads": threads,
+            "input": a.mesh.display().to_string(),
+            "output": a.output.display().to_string(),
+            "format": format!("{format:?}").to_lowercase(),
+            "mesh": {
+                "vertices": loaded.report.vertices,
+                "triangles": loaded.report.triangles,
+                "degenerate": loaded.report.degenerate,
+            },
+            "triangles": {
+                "input": p.input,
+                "voxelized": p.output,
+                "skipped_degenerate": p.degenerate,
+                "skipped_non_finite": p.non_finite,
+                "skipped_invalid_index": p.invalid_index,
+                "outside_grid": p.outside,
+                "clipped": p.clipped,
+            },
+            "warnings": loaded.warnings,
+        });
+        crate::print_stdout(&v.to_string())?;
+    } else if !a.quiet {
+        crate::print_stdout(&format!(
+            "{}: {} voxels set on grid {}x{}x{} (origin {}, {}, {}; voxel size {}) by {} in {:.1} ms; total {:.2} s -> {}",
+            plan::mode_name(a.mode),
+            report.voxels,
+            dims[0],
+            dims[1],
+            dims[2],
+            o.x,
+            o.y,
+            o.z,
+            grid.voxel_size(),
+            method,
+            voxelize_s * 1e3,
+            total_s,
+            a.output.display()
+        ))?;
+    }
+    Ok(())
+}
+
+fn check_output_dir(out: &Path) -> Result<()> {
+    let dir = match out.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        bail!("{}: cannot write: directory {} does not exist", out.display(), dir.display());
+    }
+    if out.is_dir() {
+        bail!("{}: cannot write: it is a directory", out.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,132 @@
+//! Stage two of argument handling: raw arguments → a validated plan.
+
+use anyhow::{bail, Context, Result};
+use glam::DVec3;
+use voxkit::{Aabb, GridSpec};
+
+use crate::args::{GridArgs, Method, Mode};
+
+/// The grid request, validated but not yet fitted to a mesh.
+#[derive(Clone, Debug)]
+pub enum GridRequest {
+    /// Longest side spans N voxels.
+    Resolution(u64),
+    /// Fit to the bounding box with this voxel size.
+    VoxelSize(f64),
+    /// Fully explicit.
+    Explicit { origin: DVec3, voxel_size: f64, dims: [u64; 3] },
+}
+
+impl GridRequest {
+    /// Checks that the grid options form one of the three documented ways.
+    pub fn from_args(g: &GridArgs) -> Result<GridRequest> {
+        if g.origin.is_some() || g.dims.is_some() {
+            let (Some(o), Some(s), Some(d)) = (&g.origin, g.voxel_size, &g.dims) else {
+                bail!("an explicit grid needs all of --origin X,Y,Z --voxel-size S --dims NX,NY,NZ");
+            };
+            if g.resolution.is_some() {
+                bail!("--resolution cannot be combined with an explicit grid (--origin/--dims)");
+            }
+            return Ok(GridRequest::Explicit { origin: DVec3::new(o[0], o[1], o[2]), voxel_size: s, dims: [d[0], d[1], d[2]] });
+        }
+        match (g.resolution, g.voxel_size) {
+            (Some(_), Some(_)) => bail!("give either --resolution or --voxel-size, not both"),
+            (Some(n), None) => Ok(GridRequest::Resolution(n)),
+            (None, Some(s)) => Ok(GridRequest::VoxelSize(s)),
+            (None, None) => Ok(GridRequest::Resolution(128)),
+        }
+    }
+
+    /// The grid for a mesh with these bounds.
+    pub fn fit(&self, bounds: &Aabb) -> Result<GridSpec> {
+        let g = match *self {
+            GridRequest::Resolution(n) => GridSpec::from_resolution(bounds, n),
+            GridRequest::VoxelSize(s) => GridSpec::from_voxel_size(bounds, s),
+            GridRequest::Explicit { origin, voxel_size, dims } => GridSpec::new(origin, voxel_size, dims),
+        };
+        g.context("invalid grid")
+    }
+}
+
+/// The method that will run for `mode`, or an error saying why none can.
+pub fn resolve_method(mode: Mode, method: Method) -> Result<&'static str> {
+    if mode != Mode::Cover {
+        bail!(
+            "mode '{}' is not implemented yet in this build (only 'cover' is); see the project's issues for sep26/sep6/ss6, lines, solid and pos",
+            mode_name(mode)
+        );
+    }
+    match method {
+        Method::Auto | Method::Fast => Ok("fast"),
+        Method::Reference => Ok("reference"),
+        Method::Scanline => bail!("--method scanline is not implemented yet in this build; use auto, fast or reference"),
+        Method::Gpu => bail!("--method gpu is not implemented yet in this build (no GPU backend); use auto, fast or reference"),
+        Method::Parity | Method::Winding => bail!("--method {} applies only to --mode solid", method_name(method)),
+    }
+}
+
+pub fn mode_name(m: Mode) -> &'static str {
+    match m {
+        Mode::Cover => "cover",
+        Mode::Sep26 => "sep26",
+        Mode::Sep6 => "sep6",
+        Mode::Ss6 => "ss6",
+        Mode::Solid => "solid",
+        Mode::Line6 => "line6",
+        Mode::Line26 => "line26",
+        Mode::Pos => "pos",
+    }
+}
+
+fn method_name(m: Method) -> &'static str {
+    match m {
+        Method::Auto => "auto",
+        Method::Reference => "reference",
+        Method::Fast => "fast",
+        Method::Scanline => "scanline",
+        Method::Gpu => "gpu",
+        Method::Parity => "parity",
+        Method::Winding => "winding",
+    }
+}
+
+/// Memory available to this process, from `/proc/meminfo` (None if unknown).
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Human-readable byte count.
+pub fn bytes(n: u64) -> String {
+    const U: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = n as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u < U.len() - 1 {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{n} B")
+    } else {
+        format!("{v:.1} {}", U[u])
+    }
+}
+
+/// Fails if a dense grid of `grid` would not fit in available memory.
+pub fn check_memory(grid: &GridSpec) -> Result<()> {
+    let need = grid.dense_bytes();
+    if let Some(avail) = available_memory() {
+        // Leave headroom for the mesh, the writer's buffers and the system.
+        if need > avail / 10 * 9 {
+            let [x, y, z] = grid.dims();
+            bail!(
+                "grid {x}x{y}x{z} needs {} of dense storage (1 bit per voxel) but only {} of memory is available; lower the resolution",
+                bytes(need),
+                bytes(avail)
+            );
+        }
+    }
+    Ok(())
+}
