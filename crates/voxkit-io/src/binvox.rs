@@ -46,6 +46,18 @@ impl Rle<'_> {
         Ok(())
     }
 
+    /// Pushes a slice of 0/1 bytes run by run.
+    fn push_slice(&mut self, s: &[u8]) -> std::io::Result<()> {
+        let mut i = 0;
+        while i < s.len() {
+            let v = s[i];
+            let n = s[i..].iter().position(|&x| x != v).unwrap_or(s.len() - i);
+            self.push(v, n as u32)?;
+            i += n;
+        }
+        Ok(())
+    }
+
     fn flush_run(&mut self) -> std::io::Result<()> {
         if self.run > 0 {
             self.buf.push(self.value);
@@ -71,25 +83,25 @@ pub fn write(w: &mut dyn Write, bits: &DenseBits, grid: &GridSpec) -> std::io::R
     writeln!(w, "scale {}", grid.voxel_size() * d as f64)?;
     writeln!(w, "data")?;
     let (nyu, nzu) = (ny as usize, nz as usize);
-    let mut plane = vec![0u8; nyu * nzu];
+    let plane = nyu * nzu;
+    let block = crate::npy::plane_block(plane);
+    let mut planes = vec![0u8; plane * block as usize];
     let mut rle = Rle { w, value: 0, run: 0, buf: Vec::with_capacity(1 << 16) };
-    for i in 0..d {
-        if i >= nx {
-            rle.push(0, d * d)?;
-            continue;
-        }
-        bits.fill_i_planes(i, 1, false, &mut plane);
-        for k in 0..d {
-            if k >= nz {
-                rle.push(0, d)?;
-                continue;
+    let mut i0 = 0;
+    while i0 < nx {
+        let count = block.min(nx - i0);
+        bits.fill_i_planes(i0, count, false, &mut planes);
+        for p in 0..count as usize {
+            let pl = &planes[p * plane..(p + 1) * plane];
+            for k in 0..nzu {
+                rle.push_slice(&pl[k * nyu..(k + 1) * nyu])?;
+                rle.push(0, d - ny)?;
             }
-            for &b in &plane[k as usize * nyu..(k as usize + 1) * nyu] {
-                rle.push(b, 1)?;
-            }
-            rle.push(0, d - ny)?;
+            rle.push(0, (d - nz) * d)?;
         }
+        i0 += count;
     }
+    rle.push(0, (d - nx) * d * d)?;
     rle.flush_run()?;
     let Rle { w, buf, .. } = rle;
     w.write_all(&buf)

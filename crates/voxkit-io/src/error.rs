@@ -71,7 +71,10 @@ pub enum ErrorKind {
 }
 
 impl ErrorKind {
+    /// A malformed-file error; multi-line messages from parsers are folded
+    /// onto one line.
     pub(crate) fn malformed(format: &'static str, detail: impl std::fmt::Display) -> ErrorKind {
-        ErrorKind::Malformed { format, detail: detail.to_string() }
+        let detail = detail.to_string().split('\n').map(str::trim).filter(|l| !l.is_empty()).collect::<Vec<_>>().join("; ");
+        ErrorKind::Malformed { format, detail }
     }
 }

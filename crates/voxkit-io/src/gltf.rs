@@ -66,6 +66,14 @@ impl Builder {
                 self.warnings.push(format!("mesh {}: skipped a {mode:?} primitive (not triangles)", mesh.index()));
                 continue;
             }
+            let mi = mesh.index();
+            let pos_acc = prim.get(&gltf::Semantic::Positions);
+            if let Some(a) = &pos_acc {
+                check_accessor(a, buffers, mi)?;
+            }
+            if let Some(a) = prim.indices() {
+                check_accessor(&a, buffers, mi)?;
+            }
             let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
             let Some(pos) = reader.read_positions() else {
                 self.warnings.push(format!("mesh {}: primitive without POSITION skipped", mesh.index()));
@@ -99,4 +107,30 @@ impl Builder {
         }
         Ok(())
     }
+}
+
+/// Checks that an accessor's elements lie inside its buffer view and the
+/// view inside its buffer, so reading can neither fail silently nor panic.
+fn check_accessor(a: &gltf::Accessor<'_>, buffers: &[gltf::buffer::Data], mesh: usize) -> Result<(), ErrorKind> {
+    let bad = |d: String| ErrorKind::malformed("glTF", format!("mesh {mesh}, accessor {}: {d}", a.index()));
+    let Some(view) = a.view() else {
+        if a.sparse().is_some() {
+            return Err(ErrorKind::Unsupported(format!("sparse accessor {} without a buffer view", a.index())));
+        }
+        return Err(bad("no buffer view".into()));
+    };
+    let buf_len = buffers.get(view.buffer().index()).map(|d| d.0.len()).ok_or_else(|| bad("buffer not loaded".into()))?;
+    let view_end = view.offset().checked_add(view.length()).ok_or_else(|| bad("view overflows".into()))?;
+    if view_end > buf_len {
+        return Err(bad(format!("buffer view {} ends at byte {view_end}, past the buffer's {buf_len} bytes", view.index())));
+    }
+    if a.count() > 0 {
+        let elem = a.size();
+        let stride = view.stride().unwrap_or(elem);
+        let need = (a.count() as u64 - 1) * stride as u64 + elem as u64 + a.offset() as u64;
+        if need > view.length() as u64 {
+            return Err(bad(format!("{} elements need {need} bytes but buffer view {} has {}", a.count(), view.index(), view.length())));
+        }
+    }
+    Ok(())
 }

@@ -68,7 +68,13 @@ pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
 /// Parses a mesh from memory. `base_dir` resolves relative references
 /// (OBJ material libraries, glTF external buffers); `None` disables them.
 pub fn read_mesh_bytes(bytes: &[u8], format: MeshFormat, base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKind> {
-    fence(|| match format {
+    let name = match format {
+        MeshFormat::Obj => "OBJ",
+        MeshFormat::Stl => "STL",
+        MeshFormat::Ply => "PLY",
+        MeshFormat::Gltf => "glTF",
+    };
+    fence(name, || match format {
         MeshFormat::Obj => obj::read(bytes, base_dir),
         MeshFormat::Stl => stl::read(bytes),
         MeshFormat::Ply => ply::read(bytes),
@@ -76,10 +82,24 @@ pub fn read_mesh_bytes(bytes: &[u8], format: MeshFormat, base_dir: Option<&Path>
     })
 }
 
-/// Runs a third-party parser so that a panic inside it becomes an error
+thread_local! {
+    static FENCED: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
+}
+
+/// True while this thread runs a third-party parser inside [`fence`]: a
+/// panic hook can stay silent, since the panic becomes an ordinary error.
+pub fn panic_is_fenced() -> bool {
+    FENCED.with(|f| f.get() > 0)
+}
+
+/// Runs a third-party parser so that a panic inside it (a bug in that
+/// crate, triggered by malformed input) becomes an error naming the format
 /// instead of aborting the program.
-fn fence<T>(f: impl FnOnce() -> Result<T, ErrorKind>) -> Result<T, ErrorKind> {
-    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+fn fence<T>(format: &'static str, f: impl FnOnce() -> Result<T, ErrorKind>) -> Result<T, ErrorKind> {
+    FENCED.with(|c| c.set(c.get() + 1));
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+    FENCED.with(|c| c.set(c.get() - 1));
+    match r {
         Ok(r) => r,
         Err(p) => {
             let msg = p
@@ -87,7 +107,7 @@ fn fence<T>(f: impl FnOnce() -> Result<T, ErrorKind>) -> Result<T, ErrorKind> {
                 .map(|s| s.to_string())
                 .or_else(|| p.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "unknown cause".into());
-            Err(ErrorKind::Malformed { format: "input", detail: format!("parser failed: {msg}") })
+            Err(ErrorKind::malformed(format, format!("the parser crashed on it ({msg})")))
         }
     }
 }
@@ -162,7 +182,7 @@ pub fn read_voxels(path: &Path) -> Result<LoadedVoxels, IoError> {
 
 /// Parses a voxel file from memory.
 pub fn read_voxels_bytes(bytes: &[u8], format: VoxelFormat) -> Result<LoadedVoxels, ErrorKind> {
-    fence(|| match format {
+    fence("voxel", || match format {
         VoxelFormat::Npy | VoxelFormat::NpyBool => npy::read(bytes),
         VoxelFormat::Binvox => binvox::read(bytes),
         VoxelFormat::Vox => vox::read(bytes),

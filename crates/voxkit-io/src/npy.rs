@@ -37,7 +37,7 @@ pub fn write(w: &mut dyn Write, bits: &DenseBits, dtype: Dtype) -> std::io::Resu
     w.write_all(&(header.len() as u16).to_le_bytes())?;
     w.write_all(header.as_bytes())?;
     let plane = ny as usize * nz as usize;
-    let block = ((32usize << 20) / plane.max(1)).clamp(1, 64) as u32;
+    let block = plane_block(plane);
     let mut buf = vec![0u8; plane * block as usize];
     let mut i0 = 0;
     while i0 < nx {
@@ -47,6 +47,16 @@ pub fn write(w: &mut dyn Write, bits: &DenseBits, dtype: Dtype) -> std::io::Resu
         i0 += count;
     }
     Ok(())
+}
+
+/// How many `i`-planes of `plane` bytes to extract at once: a power of two
+/// up to 64 (so blocks never straddle a storage word) using at most 64 MiB.
+pub(crate) fn plane_block(plane: usize) -> u32 {
+    let mut b = 64u32;
+    while b > 1 && plane * b as usize > 64 << 20 {
+        b /= 2;
+    }
+    b
 }
 
 /// Reads a 3-D `.npy` array of dtype uint8/int8/bool in C order; nonzero = set.

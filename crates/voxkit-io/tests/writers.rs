@@ -1,0 +1,122 @@
+//! Every voxel format round-trips through its reader; `.vox` grids over 256
+//! are split into models that reassemble into the same grid.
+
+use std::path::PathBuf;
+
+use glam::DVec3;
+use voxkit::{DenseBits, GridSpec};
+use voxkit_io::{read_voxels, write_voxels, VoxelFormat};
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("voxkit-io-writers-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn pattern(dims: [u32; 3]) -> DenseBits {
+    let mut b = DenseBits::new(dims);
+    let mut x: u64 = 12345;
+    for _ in 0..2000 {
+        x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        let (i, j, k) = ((x >> 11) as u32 % dims[0], (x >> 27) as u32 % dims[1], (x >> 43) as u32 % dims[2]);
+        b.set(i, j, k);
+    }
+    b.set(dims[0] - 1, dims[1] - 1, dims[2] - 1);
+    b.set(0, 0, 0);
+    b
+}
+
+#[test]
+fn npy_and_text_round_trip_exactly() {
+    let dims = [13, 70, 5];
+    let bits = pattern(dims);
+    let grid = GridSpec::new(DVec3::new(-1.0, 2.0, 0.5), 0.25, [13, 70, 5]).unwrap();
+    for (name, f) in [("a.npy", VoxelFormat::Npy), ("b.npy", VoxelFormat::NpyBool), ("c.txt", VoxelFormat::Text)] {
+        let p = tmp(name);
+        write_voxels(&p, f, &bits, &grid).unwrap();
+        let back = read_voxels(&p).unwrap();
+        assert_eq!(back.bits, bits, "{name}");
+    }
+    let bytes = std::fs::read(tmp("a.npy")).unwrap();
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    assert_eq!((10 + header_len) % 64, 0);
+    assert_eq!(bytes.len(), 10 + header_len + 13 * 70 * 5);
+    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+    assert!(header.contains("'shape': (13, 70, 5)") && header.contains("'descr': '|u1'"), "{header}");
+    // Element [i, j, k] is at (i*ny + j)*nz + k.
+    assert_eq!(bytes[10 + header_len + (12 * 70 + 69) * 5 + 4], 1);
+}
+
+#[test]
+fn binvox_is_a_padded_cube_that_round_trips() {
+    let bits = pattern([9, 4, 6]);
+    let grid = GridSpec::new(DVec3::new(1.0, 2.0, 3.0), 0.5, [9, 4, 6]).unwrap();
+    let p = tmp("a.binvox");
+    write_voxels(&p, VoxelFormat::Binvox, &bits, &grid).unwrap();
+    let text = std::fs::read(&p).unwrap();
+    assert!(text.starts_with(b"#binvox 1\ndim 9 9 9\ntranslate 1 2 3\nscale 4.5\ndata\n"));
+    let back = read_voxels(&p).unwrap();
+    assert_eq!(back.bits.dims(), [9, 9, 9]);
+    assert_eq!(back.placement, Some((DVec3::new(1.0, 2.0, 3.0), 0.5)));
+    let mut a = Vec::new();
+    bits.for_each_set(|i, j, k| a.push([i, j, k]));
+    let mut b = Vec::new();
+    back.bits.for_each_set(|i, j, k| b.push([i, j, k]));
+    assert_eq!(a, b);
+}
+
+#[test]
+fn vox_splits_large_grids_into_models_that_reassemble() {
+    let dims = [300, 20, 513];
+    let bits = pattern(dims);
+    let grid = GridSpec::new(DVec3::ZERO, 1.0, [300, 20, 513]).unwrap();
+    let p = tmp("big.vox");
+    write_voxels(&p, VoxelFormat::Vox, &bits, &grid).unwrap();
+    let data = dot_vox_models(&p);
+    assert!(data.0 >= 4, "expected several models, got {}", data.0);
+    assert!(data.1.iter().all(|s| s.iter().all(|&d| d <= 256)));
+    let back = read_voxels(&p).unwrap();
+    assert_eq!(back.bits, bits);
+}
+
+fn dot_vox_models(p: &std::path::Path) -> (usize, Vec<[u32; 3]>) {
+    // Read through the format crate directly, not our reader.
+    let bytes = std::fs::read(p).unwrap();
+    let sizes = parse_sizes(&bytes);
+    (sizes.len(), sizes)
+}
+
+/// Minimal independent scan of the RIFF-like chunks for SIZE chunks.
+fn parse_sizes(b: &[u8]) -> Vec<[u32; 3]> {
+    assert_eq!(&b[..4], b"VOX ");
+    let u = |o: usize| u32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]);
+    let mut out = Vec::new();
+    let mut o = 8 + 12; // header, MAIN chunk header
+    while o + 12 <= b.len() {
+        let id = &b[o..o + 4];
+        let (content, children) = (u(o + 4) as usize, u(o + 8) as usize);
+        if id == b"SIZE" {
+            out.push([u(o + 12), u(o + 16), u(o + 20)]);
+        }
+        o += 12 + content + children;
+    }
+    out
+}
+
+#[test]
+fn failed_write_leaves_no_file() {
+    let bits = pattern([4, 4, 4]);
+    let grid = GridSpec::new(DVec3::ZERO, 1.0, [4, 4, 4]).unwrap();
+    let p = std::path::Path::new("/nonexistent-dir/out.npy");
+    let e = write_voxels(p, VoxelFormat::Npy, &bits, &grid).unwrap_err();
+    assert!(e.to_string().starts_with("/nonexistent-dir/out.npy: cannot write"), "{e}");
+    // Writing over an existing file replaces it whole.
+    let dir = std::env::temp_dir().join(format!("voxkit-io-replace-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let q = dir.join("replace.txt");
+    std::fs::write(&q, "old").unwrap();
+    write_voxels(&q, VoxelFormat::Text, &bits, &grid).unwrap();
+    assert!(std::fs::read_to_string(&q).unwrap().starts_with("# voxkit voxels"));
+    let leftovers: Vec<_> = std::fs::read_dir(q.parent().unwrap()).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains("voxkit-tmp")).collect();
+    assert!(leftovers.is_empty());
+}
