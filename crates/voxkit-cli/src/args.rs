@@ -73,10 +73,10 @@ pub struct GridArgs {
     #[arg(long, value_name = "S")]
     pub voxel_size: Option<f64>,
     /// Explicit grid origin (with --voxel-size and --dims).
-    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', num_args = 3, allow_negative_numbers = true)]
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', allow_hyphen_values = true)]
     pub origin: Option<Vec<f64>>,
     /// Explicit grid dims (with --origin and --voxel-size).
-    #[arg(long, value_name = "NX,NY,NZ", value_delimiter = ',', num_args = 3)]
+    #[arg(long, value_name = "NX,NY,NZ", value_delimiter = ',')]
     pub dims: Option<Vec<u64>>,
 }
 

@@ -14,6 +14,13 @@ use clap::Parser;
 use args::{Cli, Command};
 
 fn main() -> ExitCode {
+    // Panics inside third-party parsers are turned into errors by voxkit-io;
+    // keep them silent. Any other panic is a bug: say so in one line.
+    std::panic::set_hook(Box::new(|info| {
+        if !voxkit_io::panic_is_fenced() {
+            eprintln!("voxkit: internal error (please report): {info}");
+        }
+    }));
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Voxelize(a) => commands::voxelize::run(a),

@@ -24,6 +24,9 @@ impl GridRequest {
             let (Some(o), Some(s), Some(d)) = (&g.origin, g.voxel_size, &g.dims) else {
                 bail!("an explicit grid needs all of --origin X,Y,Z --voxel-size S --dims NX,NY,NZ");
             };
+            if o.len() != 3 || d.len() != 3 {
+                bail!("--origin and --dims take three comma-separated values (X,Y,Z and NX,NY,NZ)");
+            }
             if g.resolution.is_some() {
                 bail!("--resolution cannot be combined with an explicit grid (--origin/--dims)");
             }

@@ -1,0 +1,128 @@
+//! The `voxkit` binary end to end: outputs, JSON summaries, the explicit
+//! grid form, and one-line errors with a non-zero exit for bad input.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn voxkit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_voxkit")).args(args).output().expect("run voxkit")
+}
+
+fn tmp(name: &str) -> String {
+    let d = std::env::temp_dir().join(format!("voxkit-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name).to_string_lossy().into_owned()
+}
+
+fn shared(name: &str) -> String {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes").join(name);
+    assert!(p.exists(), "missing {}", p.display());
+    p.to_string_lossy().into_owned()
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    assert!(out.status.success(), "failed: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
+}
+
+/// Runs a failing command and returns its single stderr line.
+fn error_line(args: &[&str]) -> String {
+    let out = voxkit(args);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    let lines: Vec<&str> = err.lines().filter(|l| !l.starts_with("voxkit: warning")).collect();
+    assert_eq!(lines.len(), 1, "{args:?}: expected one error line, got {err:?}");
+    assert!(lines[0].starts_with("voxkit: error: "), "{err}");
+    lines[0].to_string()
+}
+
+#[test]
+fn bunny_at_256_fast_equals_reference_and_json_has_the_fields() {
+    let bunny = shared("stanford-bunny.obj");
+    let (a, b) = (tmp("fast.npy"), tmp("ref.npy"));
+    let fast = json(&voxkit(&["voxelize", &bunny, "-o", &a, "--mode", "cover", "--resolution", "256", "--json"]));
+    let reference = json(&voxkit(&["voxelize", &bunny, "-o", &b, "--resolution", "256", "--method", "reference", "--json"]));
+    for key in ["mode", "method", "origin", "voxel_size", "dims", "voxels", "voxelize_s", "total_s"] {
+        assert!(fast.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(fast["mode"], "cover");
+    assert_eq!(fast["method"], "fast");
+    assert_eq!(reference["method"], "reference");
+    assert_eq!(fast["dims"], serde_json::json!([256, 254, 199]));
+    assert_eq!(fast["voxels"], reference["voxels"]);
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+}
+
+#[test]
+fn explicit_grid_matches_the_fitted_grid() {
+    let cow = shared("cow.obj");
+    let fitted = json(&voxkit(&["voxelize", &cow, "-o", &tmp("fit.txt"), "--resolution", "64", "--json"]));
+    let o: Vec<String> = fitted["origin"].as_array().unwrap().iter().map(|v| v.to_string()).collect();
+    let d: Vec<String> = fitted["dims"].as_array().unwrap().iter().map(|v| v.to_string()).collect();
+    let s = fitted["voxel_size"].to_string();
+    let explicit = json(&voxkit(&["voxelize", &cow, "-o", &tmp("exp.txt"), "--origin", &o.join(","), "--voxel-size", &s, "--dims", &d.join(","), "--json"]));
+    assert_eq!(explicit["voxels"], fitted["voxels"]);
+    let a = std::fs::read_to_string(tmp("fit.txt")).unwrap();
+    let b = std::fs::read_to_string(tmp("exp.txt")).unwrap();
+    assert_eq!(a, b);
+}
+
+#[test]
+fn voxel_size_fits_the_bounding_box() {
+    let out = json(&voxkit(&["voxelize", &shared("cow.obj"), "-o", &tmp("vs.binvox"), "--voxel-size", "0.05", "--json", "--threads", "1"]));
+    assert_eq!(out["voxel_size"], 0.05);
+    assert_eq!(out["threads"], 1);
+}
+
+#[test]
+fn every_output_format_is_written() {
+    let cow = shared("cow.obj");
+    for name in ["o.npy", "o.binvox", "o.vox", "o.txt"] {
+        let p = tmp(name);
+        json(&voxkit(&["voxelize", &cow, "-o", &p, "--resolution", "32", "--json"]));
+        assert!(std::fs::metadata(&p).unwrap().len() > 0);
+    }
+    json(&voxkit(&["voxelize", &cow, "-o", &tmp("b.bin"), "--format", "npy-bool", "--resolution", "16", "--json"]));
+}
+
+#[test]
+fn info_reports_the_mesh() {
+    let v = json(&voxkit(&["info", &shared("suzanne.obj"), "--json"]));
+    assert_eq!(v["vertices"], 507);
+    assert!(v["triangles"].as_u64().unwrap() > 500);
+}
+
+#[test]
+fn bad_input_gives_one_line_errors() {
+    let out = tmp("x.npy");
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (vec!["voxelize".into(), "/no/such/mesh.obj".into(), "-o".into(), out.clone()], "/no/such/mesh.obj: cannot read"),
+        (vec!["voxelize".into(), "mesh.dxf".into(), "-o".into(), out.clone()], "unknown file extension"),
+        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), tmp("x.unknown")], "cannot tell the output format"),
+        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), "/no/such/dir/x.npy".into()], "does not exist"),
+        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--resolution".into(), "0".into()], "resolution must be"),
+        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--voxel-size".into(), "1e-9".into()], "grid dims"),
+        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--resolution".into(), "60000".into()], "needs"),
+        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--mode".into(), "sep6".into()], "not implemented"),
+        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--method".into(), "gpu".into()], "not implemented"),
+        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--origin".into(), "0,0,0".into()], "explicit grid needs"),
+        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--origin".into(), "0,0".into(), "--voxel-size".into(), "1".into(), "--dims".into(), "2,2,2".into()], "three comma-separated"),
+        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--threads".into(), "0".into()], "--threads"),
+    ];
+    for (args, expect) in cases {
+        let a: Vec<&str> = args.iter().map(String::as_str).collect();
+        let line = error_line(&a);
+        assert!(line.contains(expect), "{a:?}: {line}");
+    }
+    assert!(!std::path::Path::new(&out).exists(), "a failed run left an output");
+}
+
+#[test]
+fn malformed_meshes_name_the_file() {
+    let corpus = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../voxkit-io/tests/corpus/malformed");
+    for name in ["nan_vertex.obj", "truncated_binary.stl", "index_out_of_range.ply", "bad_accessor_index.gltf", "no_faces.obj"] {
+        let p = corpus.join(name).to_string_lossy().into_owned();
+        let line = error_line(&["voxelize", &p, "-o", &tmp("m.npy")]);
+        assert!(line.contains(name), "{line}");
+    }
+}
