@@ -60,7 +60,19 @@ fn explicit_grid_matches_the_fitted_grid() {
     let o: Vec<String> = fitted["origin"].as_array().unwrap().iter().map(|v| v.to_string()).collect();
     let d: Vec<String> = fitted["dims"].as_array().unwrap().iter().map(|v| v.to_string()).collect();
     let s = fitted["voxel_size"].to_string();
-    let explicit = json(&voxkit(&["voxelize", &cow, "-o", &tmp("exp.txt"), "--origin", &o.join(","), "--voxel-size", &s, "--dims", &d.join(","), "--json"]));
+    let explicit = json(&voxkit(&[
+        "voxelize",
+        &cow,
+        "-o",
+        &tmp("exp.txt"),
+        "--origin",
+        &o.join(","),
+        "--voxel-size",
+        &s,
+        "--dims",
+        &d.join(","),
+        "--json",
+    ]));
     assert_eq!(explicit["voxels"], fitted["voxels"]);
     let a = std::fs::read_to_string(tmp("fit.txt")).unwrap();
     let b = std::fs::read_to_string(tmp("exp.txt")).unwrap();
@@ -106,7 +118,21 @@ fn bad_input_gives_one_line_errors() {
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--mode".into(), "sep6".into()], "not implemented"),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--method".into(), "gpu".into()], "not implemented"),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--origin".into(), "0,0,0".into()], "explicit grid needs"),
-        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--origin".into(), "0,0".into(), "--voxel-size".into(), "1".into(), "--dims".into(), "2,2,2".into()], "three comma-separated"),
+        (
+            vec![
+                "voxelize".into(),
+                shared("cow.obj"),
+                "-o".into(),
+                out.clone(),
+                "--origin".into(),
+                "0,0".into(),
+                "--voxel-size".into(),
+                "1".into(),
+                "--dims".into(),
+                "2,2,2".into(),
+            ],
+            "three comma-separated",
+        ),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--threads".into(), "0".into()], "--threads"),
     ];
     for (args, expect) in cases {

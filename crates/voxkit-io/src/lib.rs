@@ -57,9 +57,8 @@ impl MeshFormat {
 /// Reads a mesh file, choosing the format from its extension.
 pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    let format = MeshFormat::from_extension(ext).ok_or_else(|| {
-        IoError::new(path, ErrorKind::UnknownFormat { ext: ext.to_string(), expected: "obj, stl, ply, gltf, glb" })
-    })?;
+    let format = MeshFormat::from_extension(ext)
+        .ok_or_else(|| IoError::new(path, ErrorKind::UnknownFormat { ext: ext.to_string(), expected: "obj, stl, ply, gltf, glb" }))?;
     let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
     let base = path.parent().unwrap_or(Path::new("."));
     read_mesh_bytes(&bytes, format, Some(base)).map_err(|kind| IoError::new(path, kind))

@@ -85,7 +85,13 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         return Err(ErrorKind::Unsupported("Fortran-ordered npy arrays".into()));
     }
     let shape = field("shape").and_then(|r| r.strip_prefix('(')).and_then(|r| r.split(')').next()).ok_or_else(|| bad("no shape"))?;
-    let dims: Vec<u64> = shape.split(',').map(str::trim).filter(|s| !s.is_empty()).map(|s| s.parse::<u64>()).collect::<Result<_, _>>().map_err(|_| bad("shape is not a tuple of integers"))?;
+    let dims: Vec<u64> = shape
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse::<u64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad("shape is not a tuple of integers"))?;
     let [nx, ny, nz] = dims[..] else {
         return Err(ErrorKind::Unsupported(format!("npy array of {} dimensions (expected 3)", dims.len())));
     };

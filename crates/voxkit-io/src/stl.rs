@@ -13,7 +13,8 @@ use crate::mesh_report::{finish, LoadedMesh};
 /// Parses STL bytes (ASCII or binary).
 pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
     let head = &bytes[..bytes.len().min(4096)];
-    let looks_ascii = bytes.trim_ascii_start().starts_with(b"solid") && (head.windows(5).any(|w| w == b"facet") || head.windows(8).any(|w| w == b"endsolid"));
+    let looks_ascii = bytes.trim_ascii_start().starts_with(b"solid")
+        && (head.windows(5).any(|w| w == b"facet") || head.windows(8).any(|w| w == b"endsolid"));
     if !looks_ascii {
         if bytes.len() < 84 {
             return Err(ErrorKind::malformed("STL", format!("binary file of {} bytes is shorter than its 84-byte header", bytes.len())));

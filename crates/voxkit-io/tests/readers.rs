@@ -84,7 +84,9 @@ fn stl_ascii_and_binary_agree() {
 
 #[test]
 fn ply_ascii_and_binary_with_polygons() {
-    let header = |fmt: &str| format!("ply\nformat {fmt} 1.0\ncomment test\nelement vertex 4\nproperty float x\nproperty float y\nproperty double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n");
+    let header = |fmt: &str| {
+        format!("ply\nformat {fmt} 1.0\ncomment test\nelement vertex 4\nproperty float x\nproperty float y\nproperty double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n")
+    };
     let pts = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.5]];
     let mut ascii = header("ascii");
     for p in pts {

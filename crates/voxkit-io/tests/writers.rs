@@ -117,6 +117,10 @@ fn failed_write_leaves_no_file() {
     std::fs::write(&q, "old").unwrap();
     write_voxels(&q, VoxelFormat::Text, &bits, &grid).unwrap();
     assert!(std::fs::read_to_string(&q).unwrap().starts_with("# voxkit voxels"));
-    let leftovers: Vec<_> = std::fs::read_dir(q.parent().unwrap()).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().contains("voxkit-tmp")).collect();
+    let leftovers: Vec<_> = std::fs::read_dir(q.parent().unwrap())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains("voxkit-tmp"))
+        .collect();
     assert!(leftovers.is_empty());
 }

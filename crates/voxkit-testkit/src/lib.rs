@@ -47,7 +47,12 @@ pub fn shared_mesh(name: &str) -> Mesh {
 /// A uniformly random rotation.
 pub fn random_rotation(rng: &mut impl Rng) -> DMat3 {
     loop {
-        let q = DQuat::from_xyzw(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+        let q = DQuat::from_xyzw(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
         let len = q.length();
         if len > 0.1 && len <= 1.0 {
             return DMat3::from_quat(q / len);
@@ -71,7 +76,11 @@ pub fn rotated(mesh: &Mesh, rot: DMat3) -> Mesh {
 
 /// An axis-aligned box `[lo, hi]` as 12 outward-facing triangles.
 pub fn box_mesh(lo: DVec3, hi: DVec3) -> Mesh {
-    let positions: Vec<DVec3> = (0..8).map(|i| DVec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z })).collect();
+    let positions: Vec<DVec3> = (0..8)
+        .map(|i| {
+            DVec3::new(if i & 1 == 0 { lo.x } else { hi.x }, if i & 2 == 0 { lo.y } else { hi.y }, if i & 4 == 0 { lo.z } else { hi.z })
+        })
+        .collect();
     let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     let mut triangles = Vec::new();
     for q in quads {
@@ -134,7 +143,10 @@ pub fn agree(mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits, String> {
 
 /// A mesh of independent triangles given by their vertices.
 pub fn soup(tris: &[[DVec3; 3]]) -> Mesh {
-    Mesh { positions: tris.iter().flatten().copied().collect(), triangles: (0..tris.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect() }
+    Mesh {
+        positions: tris.iter().flatten().copied().collect(),
+        triangles: (0..tris.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
+    }
 }
 
 /// Proptest strategies aimed at the edge cases of voxelization: vertices on

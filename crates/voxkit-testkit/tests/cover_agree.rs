@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use voxkit::GridSpec;
-use voxkit_testkit::{agree, box_mesh, random_rotation, rotated, rng, shared_mesh, soup, sphere, SHARED_MESHES};
+use voxkit_testkit::{agree, box_mesh, random_rotation, rng, rotated, shared_mesh, soup, sphere, SHARED_MESHES};
 
 #[test]
 fn every_shared_mesh_at_two_resolutions() {

@@ -50,7 +50,8 @@ fn triangle_in_a_grid_plane_sets_both_layers() {
 
 #[test]
 fn degenerate_triangles_draw_nothing_and_are_counted() {
-    let m = soup(&[[DVec3::ONE, DVec3::new(2.0, 2.0, 2.0), DVec3::new(3.0, 3.0, 3.0)], [DVec3::ONE, DVec3::ONE, DVec3::new(1.0, 2.0, 1.0)]]);
+    let m =
+        soup(&[[DVec3::ONE, DVec3::new(2.0, 2.0, 2.0), DVec3::new(3.0, 3.0, 3.0)], [DVec3::ONE, DVec3::ONE, DVec3::new(1.0, 2.0, 1.0)]]);
     let (b, rep) = cover::cover(m.as_ref(), &unit_grid(4), &Options::default());
     assert_eq!(b.count(), 0);
     assert_eq!(rep.prepare.degenerate, 2);

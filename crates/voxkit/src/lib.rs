@@ -18,6 +18,8 @@
 //! snapped to the lattice described in [`geom::fixed`], so every path
 //! (reference, fast, any thread count) returns bit-identical grids.
 
+pub use glam;
+
 pub mod geom;
 pub mod grid;
 pub mod mesh;

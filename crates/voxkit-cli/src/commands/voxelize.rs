@@ -18,9 +18,15 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let request = GridRequest::from_args(&a.grid)?;
     let method = plan::resolve_method(a.mode, a.method)?;
     let format = match &a.format {
-        Some(f) => VoxelFormat::from_name(f).with_context(|| format!("unknown --format {f:?} (expected one of: {})", VoxelFormat::NAMES))?,
+        Some(f) => {
+            VoxelFormat::from_name(f).with_context(|| format!("unknown --format {f:?} (expected one of: {})", VoxelFormat::NAMES))?
+        }
         None => VoxelFormat::from_path(&a.output).with_context(|| {
-            format!("{}: cannot tell the output format from the extension (use one of: {}, or --format)", a.output.display(), VoxelFormat::NAMES)
+            format!(
+                "{}: cannot tell the output format from the extension (use one of: {}, or --format)",
+                a.output.display(),
+                VoxelFormat::NAMES
+            )
         })?,
     };
     check_output_dir(&a.output)?;

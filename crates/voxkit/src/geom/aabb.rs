@@ -17,10 +17,7 @@ pub struct Aabb {
 
 impl Aabb {
     /// The empty box: contains nothing, and grows to the first point added.
-    pub const EMPTY: Aabb = Aabb {
-        min: DVec3::splat(f64::INFINITY),
-        max: DVec3::splat(f64::NEG_INFINITY),
-    };
+    pub const EMPTY: Aabb = Aabb { min: DVec3::splat(f64::INFINITY), max: DVec3::splat(f64::NEG_INFINITY) };
 
     /// The smallest box holding every point (ignores non-finite points).
     pub fn from_points<'a>(points: impl IntoIterator<Item = &'a DVec3>) -> Aabb {

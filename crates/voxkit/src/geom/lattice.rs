@@ -140,13 +140,7 @@ pub fn prepare(mesh: MeshRef<'_>, grid: &GridSpec) -> (Vec<LatticeTriangle>, Pre
     (tris, stats)
 }
 
-fn prepare_one(
-    positions: &[DVec3],
-    tri: &[u32; 3],
-    grid: &GridSpec,
-    out: &mut Vec<LatticeTriangle>,
-    st: &mut PrepareStats,
-) {
+fn prepare_one(positions: &[DVec3], tri: &[u32; 3], grid: &GridSpec, out: &mut Vec<LatticeTriangle>, st: &mut PrepareStats) {
     st.input += 1;
     let mut g = [DVec3::ZERO; 3];
     for (c, &idx) in tri.iter().enumerate() {
@@ -192,14 +186,7 @@ fn prepare_one(
     st.output += (out.len() - before) as u64;
 }
 
-fn push_snapped(
-    a: DVec3,
-    b: DVec3,
-    c: DVec3,
-    dims: [u32; 3],
-    out: &mut Vec<LatticeTriangle>,
-    st: &mut PrepareStats,
-) {
+fn push_snapped(a: DVec3, b: DVec3, c: DVec3, dims: [u32; 3], out: &mut Vec<LatticeTriangle>, st: &mut PrepareStats) {
     let s = |p: DVec3| [snap(p.x), snap(p.y), snap(p.z)];
     let t = LatticeTriangle { v: [s(a), s(b), s(c)] };
     debug_assert!(t.v.iter().flatten().all(|c| c.abs() <= MAX_ABS));

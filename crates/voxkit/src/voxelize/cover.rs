@@ -410,9 +410,7 @@ pub mod reference {
         let corner: [i128; 3] = ijk.map(|c| c as i128 * one);
         let v: [[i128; 3]; 3] = t.v.map(|p| p.map(|c| c as i128));
         let e: [[i128; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|a| v[(i + 1) % 3][a] - v[i][a]));
-        let cross = |a: [i128; 3], b: [i128; 3]| {
-            [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-        };
+        let cross = |a: [i128; 3], b: [i128; 3]| [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
         let unit = |a: usize| std::array::from_fn::<i128, 3, _>(|c| (c == a) as i128);
         let mut axes: Vec<[i128; 3]> = Vec::with_capacity(13);
         for a in 0..3 {
@@ -457,7 +455,9 @@ mod tests {
     #[test]
     fn vertex_on_a_corner_touches_all_eight() {
         // A tiny triangle whose vertex sits on the corner (2,2,2).
-        let t = LatticeTriangle { v: [[2 * ONE, 2 * ONE, 2 * ONE], [2 * ONE - 5, 2 * ONE - 1, 2 * ONE - 3], [2 * ONE - 1, 2 * ONE - 7, 2 * ONE - 2]] };
+        let t = LatticeTriangle {
+            v: [[2 * ONE, 2 * ONE, 2 * ONE], [2 * ONE - 5, 2 * ONE - 1, 2 * ONE - 3], [2 * ONE - 1, 2 * ONE - 7, 2 * ONE - 2]],
+        };
         let (f, s) = both(t, [4, 4, 4]);
         assert_eq!(f, s);
         for (i, j, k) in [(1, 1, 1), (2, 2, 2), (1, 2, 1), (2, 1, 2)] {

@@ -45,20 +45,24 @@ pub fn run_slabs<K: Kernel>(kernel: &K, tris: &[LatticeTriangle], dims: [u32; 3]
         p.set_total(nslabs as u64);
     }
     let mut slabs = grid.slabs_mut(height);
-    let count = slabs.par_iter_mut().zip(bins.par_iter()).map(|(slab, bin)| {
-        for &idx in bin {
-            let Some((mut lo, mut hi)) = bounds[idx as usize] else { continue };
-            lo[2] = lo[2].max(slab.k0 as i64);
-            hi[2] = hi[2].min(slab.k1 as i64 - 1);
-            if lo[2] <= hi[2] {
-                kernel.run(&tris[idx as usize], lo, hi, slab);
+    let count = slabs
+        .par_iter_mut()
+        .zip(bins.par_iter())
+        .map(|(slab, bin)| {
+            for &idx in bin {
+                let Some((mut lo, mut hi)) = bounds[idx as usize] else { continue };
+                lo[2] = lo[2].max(slab.k0 as i64);
+                hi[2] = hi[2].min(slab.k1 as i64 - 1);
+                if lo[2] <= hi[2] {
+                    kernel.run(&tris[idx as usize], lo, hi, slab);
+                }
             }
-        }
-        if let Some(p) = opts.progress {
-            p.advance(1);
-        }
-        slab.count()
-    }).sum();
+            if let Some(p) = opts.progress {
+                p.advance(1);
+            }
+            slab.count()
+        })
+        .sum();
     drop(slabs);
     (grid, count)
 }
