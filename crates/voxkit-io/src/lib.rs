@@ -85,7 +85,7 @@ thread_local! {
     static FENCED: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
 }
 
-/// True while this thread runs a third-party parser inside [`fence`]: a
+/// True while this thread runs a third-party parser inside the panic fence: a
 /// panic hook can stay silent, since the panic becomes an ordinary error.
 pub fn panic_is_fenced() -> bool {
     FENCED.with(|f| f.get() > 0)

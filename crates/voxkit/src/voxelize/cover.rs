@@ -191,11 +191,15 @@ impl Walker {
     fn new(a: i64, b: i64, c: i64, y0: i64) -> Walker {
         let n = b * y0 + c;
         if a > 0 {
-            let lo = -n.div_euclid(a);
-            Walker::Lower { lo, r: a * lo + n, q: (-b).div_euclid(a), m: (-b).rem_euclid(a), d: a }
+            let (q0, r0) = div_floor(n, a);
+            let (lo, r) = (-q0, r0);
+            let (q, m) = div_floor(-b, a);
+            Walker::Lower { lo, r, q, m, d: a }
         } else if a < 0 {
             let d = -a;
-            Walker::Upper { hi: n.div_euclid(d), r: n.rem_euclid(d), q: b.div_euclid(d), m: b.rem_euclid(d), d }
+            let (hi, r) = div_floor(n, d);
+            let (q, m) = div_floor(b, d);
+            Walker::Upper { hi, r, q, m, d }
         } else {
             Walker::Const { n, b }
         }
@@ -239,6 +243,25 @@ impl Walker {
             }
         }
     }
+}
+
+/// `(floor(n / d), n mod d)` for `d > 0`, without a hardware division: an
+/// f64 estimate corrected exactly. The callers' operands satisfy
+/// `|n| < 2^62` and `d >= 4096`, so the estimate is off by at most one.
+#[inline(always)]
+fn div_floor(n: i64, d: i64) -> (i64, i64) {
+    debug_assert!(d > 0);
+    let mut q = (n as f64 / d as f64) as i64;
+    let mut r = n - q * d;
+    while r < 0 {
+        q -= 1;
+        r += d;
+    }
+    while r >= d {
+        q += 1;
+        r -= d;
+    }
+    (q, r)
 }
 
 /// Clips `[lo, hi]` by three walkers.
