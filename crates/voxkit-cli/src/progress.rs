@@ -17,6 +17,8 @@ impl Bar {
 
     /// Shows a spinner with a message (for phases of unknown length).
     pub fn phase(&self, msg: &'static str) {
+        self.0.set_length(0);
+        self.0.set_position(0);
         self.0.set_style(ProgressStyle::with_template("{spinner} {msg} {elapsed}").unwrap_or_else(|_| ProgressStyle::default_spinner()));
         self.0.set_message(msg);
         self.0.enable_steady_tick(std::time::Duration::from_millis(120));

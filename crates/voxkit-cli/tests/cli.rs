@@ -113,7 +113,10 @@ fn bad_input_gives_one_line_errors() {
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), tmp("x.unknown")], "cannot tell the output format"),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), "/no/such/dir/x.npy".into()], "does not exist"),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--resolution".into(), "0".into()], "resolution must be"),
-        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--voxel-size".into(), "1e-9".into()], "grid dims"),
+        (
+            vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--voxel-size".into(), "1e-9".into()],
+            "at most 65536 per axis",
+        ),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--resolution".into(), "60000".into()], "needs"),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--mode".into(), "sep6".into()], "not implemented"),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--method".into(), "gpu".into()], "not implemented"),

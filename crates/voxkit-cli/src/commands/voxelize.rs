@@ -44,6 +44,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let grid = request.fit(&loaded.report.bounds)?;
     plan::check_memory(&grid)?;
 
+    bar.phase(if method == "reference" { "voxelizing (reference, serial)" } else { "voxelizing" });
     let t_vox = Instant::now();
     let (bits, report) = pool.install(|| match method {
         "reference" => cover::reference::cover(loaded.mesh.as_ref(), &grid),

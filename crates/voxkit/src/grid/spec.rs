@@ -20,6 +20,14 @@ pub enum GridError {
     /// A dimension is zero or above [`MAX_DIM`].
     #[error("grid dims must each be between 1 and {MAX_DIM}, got {0:?}")]
     BadDims([u64; 3]),
+    /// A voxel size so small that some axis would need more than [`MAX_DIM`] voxels.
+    #[error("voxel size {voxel_size:e} would need {:.3e} x {:.3e} x {:.3e} voxels; at most {MAX_DIM} per axis", needed[0], needed[1], needed[2])]
+    VoxelSizeTooSmall {
+        /// The voxel size asked for.
+        voxel_size: f64,
+        /// Voxels each axis would need.
+        needed: [f64; 3],
+    },
     /// Resolution zero or above [`MAX_DIM`].
     #[error("resolution must be between 1 and {MAX_DIM}, got {0}")]
     BadResolution(u64),
@@ -88,14 +96,11 @@ impl GridSpec {
             return Err(GridError::BadVoxelSize(s));
         }
         let ext = checked_extent(bounds)?;
-        let dims = ext.to_array().map(|e| {
-            let d = (e / s).ceil();
-            if d >= (MAX_DIM as f64) * 2.0 {
-                u64::MAX
-            } else {
-                (d as u64).max(1)
-            }
-        });
+        let needed = ext.to_array().map(|e| (e / s).ceil());
+        if needed.iter().any(|&d| d > MAX_DIM as f64) {
+            return Err(GridError::VoxelSizeTooSmall { voxel_size: s, needed });
+        }
+        let dims = needed.map(|d| (d as u64).max(1));
         GridSpec::new(bounds.min, s, dims)
     }
 
