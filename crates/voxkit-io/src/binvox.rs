@@ -20,7 +20,7 @@
 use std::io::Write;
 
 use glam::DVec3;
-use voxkit::{DenseBits, GridSpec};
+use voxkit::{DenseBits, GridSpec, VoxelSource};
 
 use crate::error::ErrorKind;
 use crate::LoadedVoxels;
@@ -73,7 +73,7 @@ impl Rle<'_> {
 }
 
 /// Writes `bits` on `grid` as binvox.
-pub fn write(w: &mut dyn Write, bits: &DenseBits, grid: &GridSpec) -> std::io::Result<()> {
+pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
     let [nx, ny, nz] = bits.dims();
     let d = nx.max(ny).max(nz);
     let o = grid.origin();

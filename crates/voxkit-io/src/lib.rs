@@ -26,7 +26,7 @@ use std::path::Path;
 
 pub use error::{ErrorKind, IoError};
 pub use mesh_report::{LoadedMesh, MeshReport};
-use voxkit::{DenseBits, GridSpec};
+use voxkit::{DenseBits, GridSpec, VoxelSource};
 
 /// Mesh file formats voxkit reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -149,7 +149,7 @@ impl VoxelFormat {
 }
 
 /// Writes `bits` on `grid` to `path` atomically (temporary file + rename).
-pub fn write_voxels(path: &Path, format: VoxelFormat, bits: &DenseBits, grid: &GridSpec) -> Result<(), IoError> {
+pub fn write_voxels(path: &Path, format: VoxelFormat, bits: &dyn VoxelSource, grid: &GridSpec) -> Result<(), IoError> {
     atomic::write_atomically(path, |w| match format {
         VoxelFormat::Npy => npy::write(w, bits, npy::Dtype::U8),
         VoxelFormat::NpyBool => npy::write(w, bits, npy::Dtype::Bool),

@@ -8,7 +8,7 @@
 
 use std::io::Write;
 
-use voxkit::DenseBits;
+use voxkit::{DenseBits, VoxelSource};
 
 use crate::error::ErrorKind;
 use crate::LoadedVoxels;
@@ -23,7 +23,7 @@ pub enum Dtype {
 }
 
 /// Writes `bits` as an `.npy` array of shape `(nx, ny, nz)`.
-pub fn write(w: &mut dyn Write, bits: &DenseBits, dtype: Dtype) -> std::io::Result<()> {
+pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, dtype: Dtype) -> std::io::Result<()> {
     let [nx, ny, nz] = bits.dims();
     let descr = match dtype {
         Dtype::U8 => "|u1",

@@ -10,18 +10,18 @@
 use std::io::Write;
 
 use glam::DVec3;
-use voxkit::{DenseBits, GridSpec};
+use voxkit::{DenseBits, GridSpec, VoxelSource};
 
 use crate::error::ErrorKind;
 use crate::LoadedVoxels;
 
 /// Writes the header and one line per set voxel.
-pub fn write(w: &mut dyn Write, bits: &DenseBits, grid: &GridSpec) -> std::io::Result<()> {
+pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
     let [nx, ny, nz] = bits.dims();
     let o = grid.origin();
     writeln!(w, "# voxkit voxels dims {nx} {ny} {nz} origin {} {} {} voxel_size {}", o.x, o.y, o.z, grid.voxel_size())?;
     let mut result = Ok(());
-    bits.for_each_set(|i, j, k| {
+    bits.for_each_set(&mut |i, j, k| {
         if result.is_ok() {
             result = writeln!(w, "{i} {j} {k}");
         }

@@ -13,7 +13,7 @@ use std::collections::BTreeMap;
 use std::io::Write;
 
 use dot_vox::{Color, Dict, DotVoxData, Frame, Layer, Model, SceneNode, ShapeModel, Size, Voxel};
-use voxkit::DenseBits;
+use voxkit::{DenseBits, VoxelSource};
 
 use crate::error::ErrorKind;
 use crate::LoadedVoxels;
@@ -21,10 +21,10 @@ use crate::LoadedVoxels;
 const BLOCK: u32 = 256;
 
 /// Writes `bits` as a `.vox` file.
-pub fn write(w: &mut dyn Write, bits: &DenseBits) -> std::io::Result<()> {
+pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource) -> std::io::Result<()> {
     let dims = bits.dims();
     let mut blocks: BTreeMap<[u32; 3], Vec<Voxel>> = BTreeMap::new();
-    bits.for_each_set(|i, j, k| {
+    bits.for_each_set(&mut |i, j, k| {
         blocks.entry([i / BLOCK, j / BLOCK, k / BLOCK]).or_default().push(Voxel {
             x: (i % BLOCK) as u8,
             y: (j % BLOCK) as u8,

@@ -124,3 +124,20 @@ fn failed_write_leaves_no_file() {
         .collect();
     assert!(leftovers.is_empty());
 }
+
+#[test]
+fn brick_and_dense_storage_write_identical_files() {
+    let dims = [37, 20, 300];
+    let dense = pattern(dims);
+    let mut bricks = voxkit::BrickBits::new(dims);
+    dense.for_each_set(|i, j, k| bricks.set(i, j, k));
+    let grid = GridSpec::new(DVec3::new(0.5, -1.0, 2.0), 0.1, [37, 20, 300]).unwrap();
+    for (name, f) in
+        [("n.npy", VoxelFormat::Npy), ("n.binvox", VoxelFormat::Binvox), ("n.vox", VoxelFormat::Vox), ("n.txt", VoxelFormat::Text)]
+    {
+        let (a, b) = (tmp(&format!("dense-{name}")), tmp(&format!("bricks-{name}")));
+        write_voxels(&a, f, &dense, &grid).unwrap();
+        write_voxels(&b, f, &bricks, &grid).unwrap();
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{name}");
+    }
+}

@@ -126,6 +126,10 @@ pub fn agree(mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits, String> {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
         for slab_height in [0, 1, 7] {
             let (fast, frep) = pool.install(|| cover::cover(mesh.as_ref(), grid, &Options { slab_height, ..Options::default() }));
+            if fast.count() != frep.voxels {
+                return Err(format!("fast report says {} voxels, grid has {}", frep.voxels, fast.count()));
+            }
+            let fast = fast.to_dense();
             if let Some(v) = reference.first_difference(&fast) {
                 return Err(format!(
                     "fast (threads {threads}, slab height {slab_height}) differs from reference at voxel {v:?}: reference {}, fast {}",

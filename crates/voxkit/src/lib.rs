@@ -11,7 +11,8 @@
 //! - [`MeshRef`] — a borrowed view of positions and triangles.
 //! - [`voxelize::cover`] — conservative surface voxelization (fast path) and
 //!   [`voxelize::cover::reference::cover`] (brute force, the definition).
-//! - [`DenseBits`] — the result, one bit per voxel.
+//! - [`BrickBits`] (sparse, the fast paths' result) and [`DenseBits`]
+//!   (one bit per voxel, the references' result), both [`VoxelSource`]s.
 //!
 //! # Guarantees
 //! Every predicate is evaluated in exact integer arithmetic on vertices
@@ -26,6 +27,8 @@ pub mod mesh;
 pub mod voxelize;
 
 pub use geom::aabb::Aabb;
+pub use grid::bricks::BrickBits;
 pub use grid::dense::DenseBits;
 pub use grid::spec::{GridError, GridSpec};
+pub use grid::VoxelSource;
 pub use mesh::{Mesh, MeshRef};

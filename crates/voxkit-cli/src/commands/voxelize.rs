@@ -6,6 +6,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use serde_json::json;
 use voxkit::voxelize::{cover, Options};
+use voxkit::VoxelSource;
 use voxkit_io::VoxelFormat;
 
 use crate::args::VoxelizeArgs;
@@ -46,15 +47,21 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
 
     bar.phase(if method == "reference" { "voxelizing (reference, serial)" } else { "voxelizing" });
     let t_vox = Instant::now();
-    let (bits, report) = pool.install(|| match method {
-        "reference" => cover::reference::cover(loaded.mesh.as_ref(), &grid),
-        _ => cover::cover(loaded.mesh.as_ref(), &grid, &Options { progress: Some(&bar), ..Options::default() }),
+    let (bits, report): (Box<dyn VoxelSource + Send>, _) = pool.install(|| match method {
+        "reference" => {
+            let (b, r) = cover::reference::cover(loaded.mesh.as_ref(), &grid);
+            (Box::new(b) as Box<dyn VoxelSource + Send>, r)
+        }
+        _ => {
+            let (b, r) = cover::cover(loaded.mesh.as_ref(), &grid, &Options { progress: Some(&bar), ..Options::default() });
+            (Box::new(b) as Box<dyn VoxelSource + Send>, r)
+        }
     });
     let voxelize_s = t_vox.elapsed().as_secs_f64();
 
     bar.phase("writing");
     let t_write = Instant::now();
-    voxkit_io::write_voxels(&a.output, format, &bits, &grid)?;
+    voxkit_io::write_voxels(&a.output, format, bits.as_ref(), &grid)?;
     let write_s = t_write.elapsed().as_secs_f64();
     bar.finish();
     let total_s = t_total.elapsed().as_secs_f64();

@@ -107,23 +107,13 @@ impl DenseBits {
         Some([i, (row % self.dims[1] as usize) as u32, (row / self.dims[1] as usize) as u32])
     }
 
-    /// Splits the grid into z-slabs of `slab_height` layers (the last may be
-    /// thinner), each a mutable view over its own words.
-    pub fn slabs_mut(&mut self, slab_height: u32) -> Vec<SlabMut<'_>> {
-        let slab_height = slab_height.max(1);
-        let layer = self.words_per_row * self.dims[1] as usize;
-        let (ny, wpr, nz) = (self.dims[1], self.words_per_row, self.dims[2]);
-        if layer == 0 {
-            return Vec::new();
-        }
-        self.words
-            .chunks_mut(layer * slab_height as usize)
-            .enumerate()
-            .map(|(n, words)| {
-                let k0 = n as u32 * slab_height;
-                SlabMut { k0, k1: (k0 + slab_height).min(nz), ny, words_per_row: wpr, words }
-            })
-            .collect()
+    /// ORs the 8 bits of `byte` into voxels `(i0 .. i0+8, j, k)`; `i0` is a
+    /// multiple of 8 and bits past `nx` must be zero.
+    #[inline]
+    pub fn or_byte(&mut self, i0: u32, j: u32, k: u32, byte: u8) {
+        debug_assert!(i0 % 8 == 0 && j < self.dims[1] && k < self.dims[2]);
+        let w = self.word_index(i0, j, k);
+        self.words[w] |= (byte as u64) << (i0 & 63);
     }
 
     /// Fills `out` with the bits of the `count` planes `i0 .. i0+count` as
@@ -157,31 +147,21 @@ impl DenseBits {
     }
 }
 
-/// A mutable view of the z-layers `[k0, k1)` of a [`DenseBits`].
-pub struct SlabMut<'a> {
-    /// First layer in the slab.
-    pub k0: u32,
-    /// One past the last layer.
-    pub k1: u32,
-    ny: u32,
-    words_per_row: usize,
-    words: &'a mut [u64],
-}
-
-impl SlabMut<'_> {
-    /// Sets voxel `(i, j, k)`; `k` must lie in `[k0, k1)`, `i`, `j` in range.
-    #[inline]
-    pub fn set(&mut self, i: u32, j: u32, k: u32) {
-        debug_assert!(k >= self.k0 && k < self.k1 && j < self.ny);
-        let idx = ((k - self.k0) as usize * self.ny as usize + j as usize) * self.words_per_row + (i as usize >> 6);
-        self.words[idx] |= 1u64 << (i & 63);
+impl super::VoxelSource for DenseBits {
+    fn dims(&self) -> [u32; 3] {
+        self.dims
     }
 
-    /// Set voxels in this slab.
-    pub fn count(&self) -> u64 {
-        // Most words of a surface voxelization are zero; skipping them
-        // avoids a software popcount on targets without POPCNT.
-        self.words.iter().filter(|&&w| w != 0).map(|w| w.count_ones() as u64).sum()
+    fn count(&self) -> u64 {
+        DenseBits::count(self)
+    }
+
+    fn for_each_set(&self, f: &mut dyn FnMut(u32, u32, u32)) {
+        DenseBits::for_each_set(self, f)
+    }
+
+    fn fill_i_planes(&self, i0: u32, count: u32, k_fastest: bool, out: &mut [u8]) {
+        DenseBits::fill_i_planes(self, i0, count, k_fastest, out)
     }
 }
 
@@ -203,20 +183,12 @@ mod tests {
     }
 
     #[test]
-    fn slabs_write_where_set_would() {
-        let mut a = DenseBits::new([5, 4, 7]);
+    fn first_difference_names_the_voxel() {
+        let a = DenseBits::new([5, 4, 7]);
         let mut b = a.clone();
-        for s in a.slabs_mut(3).iter_mut() {
-            for k in s.k0..s.k1 {
-                s.set(k % 5, 3, k);
-            }
-        }
-        for k in 0..7 {
-            b.set(k % 5, 3, k);
-        }
-        assert_eq!(a, b);
-        b.set(0, 0, 6);
-        assert_eq!(a.first_difference(&b), Some([0, 0, 6]));
+        b.set(3, 2, 6);
+        assert_eq!(a.first_difference(&b), Some([3, 2, 6]));
+        assert_eq!(a.first_difference(&a), None);
     }
 
     #[test]

@@ -1,4 +1,20 @@
 //! Grids: the specification (where voxels are) and storage (which are set).
 
+pub mod bricks;
 pub mod dense;
 pub mod spec;
+
+/// Read access shared by the storages ([`dense::DenseBits`],
+/// [`bricks::BrickBits`]), so writers and checks take either.
+pub trait VoxelSource: Sync {
+    /// Voxels along x, y, z.
+    fn dims(&self) -> [u32; 3];
+    /// Number of set voxels.
+    fn count(&self) -> u64;
+    /// Calls `f(i, j, k)` for every set voxel, in order of `k`, then `j`, then `i`.
+    fn for_each_set(&self, f: &mut dyn FnMut(u32, u32, u32));
+    /// Fills `out` with the `count` planes `i0 .. i0+count` as bytes (0 or 1);
+    /// plane `p` occupies `out[p*ny*nz .. (p+1)*ny*nz]`, laid out `[j][k]`
+    /// (k fastest) when `k_fastest`, else `[k][j]`.
+    fn fill_i_planes(&self, i0: u32, count: u32, k_fastest: bool, out: &mut [u8]);
+}

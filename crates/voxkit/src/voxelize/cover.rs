@@ -31,19 +31,21 @@ use super::driver::{run_slabs, Kernel};
 use super::{Options, Report};
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::{prepare, LatticeTriangle};
-use crate::grid::dense::{DenseBits, SlabMut};
+use crate::grid::bricks::{BrickBits, BrickSlab};
+use crate::grid::dense::DenseBits;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
 
-/// Conservative surface voxelization, fast path (parallel over z-slabs).
-pub fn cover(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (DenseBits, Report) {
+/// Conservative surface voxelization, fast path (parallel over z-slabs),
+/// into sparse brick storage (`.to_dense()` for a dense grid).
+pub fn cover(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBits, Report) {
     let (tris, prepare_stats) = prepare(mesh, grid);
     let (bits, voxels) = run_slabs(&CoverKernel, &tris, grid.dims(), opts);
     (bits, Report { prepare: prepare_stats, voxels })
 }
 
 /// The fast path on already prepared triangles.
-pub fn cover_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> DenseBits {
+pub fn cover_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> BrickBits {
     run_slabs(&CoverKernel, tris, dims, opts).0
 }
 
@@ -162,7 +164,7 @@ impl<T: PlaneInt> Setup<T> {
 struct CoverKernel;
 
 impl Kernel for CoverKernel {
-    fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut SlabMut<'_>) {
+    fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
         let (blo, bhi) = tri.bounds();
         let extent = (0..3).map(|a| bhi[a] - blo[a]).max().unwrap_or(0);
         if extent + 2 * ONE <= I64_PLANE_LIMIT {
@@ -276,7 +278,7 @@ fn clip3(w: &[Walker; 3], mut lo: i64, mut hi: i64) -> (i64, i64) {
 /// Selects the traversal compiled for the triangle's dominant axis, so the
 /// mapping from `(u, v, w)` back to `(i, j, k)` is static.
 #[inline(always)]
-fn dispatch<T: PlaneInt>(tri: &LatticeTriangle, s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut SlabMut<'_>) {
+fn dispatch<T: PlaneInt>(tri: &LatticeTriangle, s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     match s.w {
         0 => traverse::<T, 0>(tri, s, lo, hi, slab),
         1 => traverse::<T, 1>(tri, s, lo, hi, slab),
@@ -296,7 +298,7 @@ fn dispatch<T: PlaneInt>(tri: &LatticeTriangle, s: &Setup<T>, lo: [i64; 3], hi: 
 /// the voxel projects inside the triangle, so it is a triangle point); in
 /// boundary columns the `(w, u)` edge tests run per voxel.
 #[inline(always)]
-fn traverse<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut SlabMut<'_>) {
+fn traverse<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
     let o = s.origin;
     let nw = s.n[w];
@@ -384,7 +386,7 @@ fn traverse<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, s: &Setup<T>, lo
 
 /// Sets voxel `(u, v, w)`; `(u, v, w)` is a cyclic shift of `(x, y, z)` by `W`.
 #[inline(always)]
-fn set<const W: usize>(slab: &mut SlabMut<'_>, iu: i64, iv: i64, t: i64) {
+fn set<const W: usize>(slab: &mut BrickSlab<'_>, iu: i64, iv: i64, t: i64) {
     let (i, j, k) = match W {
         0 => (t, iu, iv),
         1 => (iv, t, iu),
@@ -470,7 +472,7 @@ mod tests {
     }
 
     fn both(t: LatticeTriangle, dims: [u32; 3]) -> (DenseBits, DenseBits) {
-        let fast = cover_lattice(&[t], dims, &Options::default());
+        let fast = cover_lattice(&[t], dims, &Options::default()).to_dense();
         let slow = reference::cover_lattice(&[t], dims);
         (fast, slow)
     }

@@ -3,33 +3,35 @@
 //!
 //! Parallelism is a driver, not a second algorithm: a [`Kernel`] is a pure
 //! function of one triangle and the voxel box it may touch. Each slab owns
-//! its words of the [`DenseBits`] exclusively, and kernels only OR bits in,
-//! so the result is bit-identical for any thread count and slab height.
+//! its brick-index entries of the [`BrickBits`] exclusively and allocates
+//! bricks from its own pool; kernels only OR bits in. Pools are merged in
+//! slab order, so the result is bit-identical for any thread count and slab
+//! height.
 
 use rayon::prelude::*;
 
 use super::Options;
 use crate::geom::lattice::LatticeTriangle;
-use crate::grid::dense::{DenseBits, SlabMut};
+use crate::grid::bricks::{BrickBits, BrickSlab, BRICK};
 
 /// A per-triangle voxelization kernel.
 pub trait Kernel: Sync {
     /// Sets, in `slab`, the voxels of `tri` whose indices lie in the inclusive
     /// box `[lo, hi]` (already clamped to the grid and to the slab's layers).
-    fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut SlabMut<'_>);
+    fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>);
 }
 
-/// Runs `kernel` over `tris` on a grid of `dims`, in parallel over z-slabs.
-/// Returns the grid and the number of voxels set (counted by each slab's
-/// task while its words are still in cache).
-pub fn run_slabs<K: Kernel>(kernel: &K, tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> (DenseBits, u64) {
-    let mut grid = DenseBits::new(dims);
+/// Runs `kernel` over `tris` on a grid of `dims`, in parallel over z-slabs
+/// (whole brick layers). Returns the grid and the number of voxels set
+/// (counted by each slab's task while its bricks are still in cache).
+pub fn run_slabs<K: Kernel>(kernel: &K, tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> (BrickBits, u64) {
+    let mut grid = BrickBits::new(dims);
     let nz = dims[2];
     let height = if opts.slab_height > 0 {
-        opts.slab_height
+        opts.slab_height.div_ceil(BRICK) * BRICK
     } else {
         let threads = rayon::current_num_threads() as u32;
-        (nz / (16 * threads)).clamp(4, 64)
+        ((nz / (16 * threads)).clamp(BRICK, 64) / BRICK) * BRICK
     };
     let nslabs = nz.div_ceil(height) as usize;
     let bounds: Vec<Option<([i64; 3], [i64; 3])>> = tris.par_iter().map(|t| t.voxel_bounds(dims)).collect();
@@ -44,25 +46,27 @@ pub fn run_slabs<K: Kernel>(kernel: &K, tris: &[LatticeTriangle], dims: [u32; 3]
     if let Some(p) = opts.progress {
         p.set_total(nslabs as u64);
     }
-    let mut slabs = grid.slabs_mut(height);
-    let count = slabs
-        .par_iter_mut()
+    let slabs = grid.slabs_mut(height / BRICK);
+    let done: Vec<((usize, Vec<crate::grid::bricks::Brick>), u64)> = slabs
+        .into_par_iter()
         .zip(bins.par_iter())
-        .map(|(slab, bin)| {
+        .map(|(mut slab, bin)| {
             for &idx in bin {
                 let Some((mut lo, mut hi)) = bounds[idx as usize] else { continue };
                 lo[2] = lo[2].max(slab.k0 as i64);
                 hi[2] = hi[2].min(slab.k1 as i64 - 1);
                 if lo[2] <= hi[2] {
-                    kernel.run(&tris[idx as usize], lo, hi, slab);
+                    kernel.run(&tris[idx as usize], lo, hi, &mut slab);
                 }
             }
             if let Some(p) = opts.progress {
                 p.advance(1);
             }
-            slab.count()
+            let n = slab.count();
+            (slab.into_pool(), n)
         })
-        .sum();
-    drop(slabs);
+        .collect();
+    let count = done.iter().map(|d| d.1).sum();
+    grid.merge_slabs(done.into_iter().map(|d| d.0).collect());
     (grid, count)
 }
