@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use glam::{DMat3, DQuat, DVec3};
 use rand::{Rng, SeedableRng};
-use voxkit::voxelize::{cover, Options};
+use voxkit::voxelize::{cover, Options, Traversal};
 use voxkit::{DenseBits, GridSpec, Mesh};
 
 /// Every mesh in `shared/meshes`.
@@ -115,7 +115,7 @@ pub fn sphere(center: DVec3, radius: f64, n: u32) -> Mesh {
 }
 
 /// Runs every `cover` path — the reference, and the fast path on 1, 2 and 8
-/// threads with several slab heights — and returns the common result, or a
+/// threads with several slab heights and every traversal — and returns the common result, or a
 /// message naming the first configuration and voxel that differ.
 pub fn agree(mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits, String> {
     let (reference, rep) = cover::reference::cover(mesh.as_ref(), grid);
@@ -124,15 +124,18 @@ pub fn agree(mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits, String> {
     }
     for threads in [1, 2, 8] {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
-        for slab_height in [0, 1, 7] {
-            let (fast, frep) = pool.install(|| cover::cover(mesh.as_ref(), grid, &Options { slab_height, ..Options::default() }));
+        for (slab_height, traversal) in
+            [(0, Traversal::Auto), (1, Traversal::WalkRows), (7, Traversal::ScanBoxes), (0, Traversal::WalkRows)]
+        {
+            let (fast, frep) =
+                pool.install(|| cover::cover(mesh.as_ref(), grid, &Options { slab_height, traversal, ..Options::default() }));
             if fast.count() != frep.voxels {
                 return Err(format!("fast report says {} voxels, grid has {}", frep.voxels, fast.count()));
             }
             let fast = fast.to_dense();
             if let Some(v) = reference.first_difference(&fast) {
                 return Err(format!(
-                    "fast (threads {threads}, slab height {slab_height}) differs from reference at voxel {v:?}: reference {}, fast {}",
+                    "fast (threads {threads}, slab height {slab_height}, {traversal:?}) differs from reference at voxel {v:?}: reference {}, fast {}",
                     reference.get(v[0], v[1], v[2]),
                     fast.get(v[0], v[1], v[2])
                 ));

@@ -132,7 +132,7 @@ impl BrickBits {
             .map(|(n, index)| {
                 let bk0 = n as u32 * h;
                 let k0 = bk0 * BRICK;
-                SlabView { k0, k1: ((bk0 + h) * BRICK).min(nz), bk0, bx, by, index, pool: Vec::new() }
+                SlabView { k0, k1: ((bk0 + h) * BRICK).min(nz), bk0, bx, by, index, pool: Vec::new(), last: (usize::MAX, 0) }
             })
             .collect()
     }
@@ -254,6 +254,8 @@ pub struct SlabView<'a> {
     by: u32,
     index: &'a mut [u32],
     pool: Vec<Brick>,
+    /// The brick-index entry and pool slot of the last voxel set.
+    last: (usize, usize),
 }
 
 /// The slab type handed to kernels.
@@ -265,13 +267,19 @@ impl SlabView<'_> {
     pub fn set(&mut self, i: u32, j: u32, k: u32) {
         debug_assert!(k >= self.k0 && k < self.k1);
         let b = (((k >> SHIFT) - self.bk0) as usize * self.by as usize + (j >> SHIFT) as usize) * self.bx as usize + (i >> SHIFT) as usize;
-        let mut id = self.index[b];
-        if id == 0 {
-            self.pool.push([0; 8]);
-            id = self.pool.len() as u32;
-            self.index[b] = id;
-        }
-        self.pool[id as usize - 1][(k & 7) as usize] |= 1u64 << (((j & 7) << 3) | (i & 7));
+        let slot = if self.last.0 == b {
+            self.last.1
+        } else {
+            let mut id = self.index[b];
+            if id == 0 {
+                self.pool.push([0; 8]);
+                id = self.pool.len() as u32;
+                self.index[b] = id;
+            }
+            self.last = (b, id as usize - 1);
+            id as usize - 1
+        };
+        self.pool[slot][(k & 7) as usize] |= 1u64 << (((j & 7) << 3) | (i & 7));
     }
 
     /// Set voxels in this slab.

@@ -28,7 +28,7 @@
 //! thirteen axes for every voxel of each triangle's bounding box.
 
 use super::driver::{run_slabs, Kernel};
-use super::{Options, Report};
+use super::{Options, Report, Traversal};
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::{prepare, LatticeTriangle};
 use crate::grid::bricks::{BrickBits, BrickSlab};
@@ -40,13 +40,13 @@ use crate::mesh::MeshRef;
 /// into sparse brick storage (`.to_dense()` for a dense grid).
 pub fn cover(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBits, Report) {
     let (tris, prepare_stats) = prepare(mesh, grid);
-    let (bits, voxels) = run_slabs(&CoverKernel, &tris, grid.dims(), opts);
+    let (bits, voxels) = run_slabs(&CoverKernel { traversal: opts.traversal }, &tris, grid.dims(), opts);
     (bits, Report { prepare: prepare_stats, voxels })
 }
 
 /// The fast path on already prepared triangles.
 pub fn cover_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> BrickBits {
-    run_slabs(&CoverKernel, tris, dims, opts).0
+    run_slabs(&CoverKernel { traversal: opts.traversal }, tris, dims, opts).0
 }
 
 /// A 2D edge function `f(p, q) = a·p + b·q + c` over voxel indices; the
@@ -161,14 +161,31 @@ impl<T: PlaneInt> Setup<T> {
     }
 }
 
-struct CoverKernel;
+struct CoverKernel {
+    traversal: Traversal,
+}
 
 impl Kernel for CoverKernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
         let (blo, bhi) = tri.bounds();
         let extent = (0..3).map(|a| bhi[a] - blo[a]).max().unwrap_or(0);
         if extent + 2 * ONE <= I64_PLANE_LIMIT {
-            dispatch::<i64>(tri, &Setup::new(tri, lo), lo, hi, slab);
+            let s = Setup::<i64>::new(tri, lo);
+            let volume: i64 = (0..3).map(|a| hi[a] - lo[a] + 1).product();
+            let scan = match self.traversal {
+                Traversal::Auto => volume <= SMALL_BOX,
+                Traversal::ScanBoxes => true,
+                Traversal::WalkRows => false,
+            };
+            if scan {
+                match s.w {
+                    0 => scan_box::<0>(tri, &s, lo, hi, slab),
+                    1 => scan_box::<1>(tri, &s, lo, hi, slab),
+                    _ => scan_box::<2>(tri, &s, lo, hi, slab),
+                }
+            } else {
+                dispatch::<i64>(tri, &s, lo, hi, slab);
+            }
         } else {
             dispatch::<i128>(tri, &Setup::new(tri, lo), lo, hi, slab);
         }
@@ -273,6 +290,81 @@ fn clip3(w: &[Walker; 3], mut lo: i64, mut hi: i64) -> (i64, i64) {
         x.clip(&mut lo, &mut hi);
     }
     (lo, hi)
+}
+
+/// Voxel boxes up to this many voxels are scanned directly ([`scan_box`]);
+/// larger ones use the row walkers of [`traverse`], whose setup pays off
+/// only when rows are long.
+const SMALL_BOX: i64 = 1024;
+
+/// Scans every column of the box in the dominant projection, with the
+/// dominant-plane edge functions kept as running sums (additions only, no
+/// per-row setup), and tracks along each row the exact range of `t` where
+/// the plane crosses the voxel (it moves by at most one per column since
+/// `|n_u| <= n_w`). Only the voxels in that range get the remaining six
+/// edge tests. Same predicates as [`traverse`], so the same voxels.
+#[inline(always)]
+fn scan_box<const W: usize>(tri: &LatticeTriangle, s: &Setup<i64>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+    let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
+    let o = s.origin;
+    let (nu, nv, nw) = (s.n[u], s.n[v], s.n[w]);
+    let (uv, vw, wu) = (s.uv, s.vw, s.wu);
+    let (tlo, thi) = tri.bounds();
+    let (span_lo, span_hi) = crate::geom::fixed::voxel_span(tlo[w], thi[w]);
+    let est = |x: f64| x.clamp((span_lo - 1) as f64, (span_hi + 1) as f64) as i64;
+    for iv in lo[v]..=hi[v] {
+        let mut fuv: [i64; 3] = std::array::from_fn(|i| uv[i].a * lo[u] + uv[i].b * iv + uv[i].c);
+        let rvw: [i64; 3] = std::array::from_fn(|i| vw[i].a * iv + vw[i].c);
+        // t0 = min t with g_max(t) >= 0, t1 = max t with g_min(t) <= 0.
+        let base = nv * (iv - o[v]) + nu * (lo[u] - o[u]);
+        let mut t0 = est(-(base + s.d_max) as f64 * s.inv_nw + o[w] as f64);
+        let mut t1 = est(-(base + s.d_min) as f64 * s.inv_nw + o[w] as f64);
+        let mut g0 = base + nw * (t0 - o[w]) + s.d_max;
+        let mut g1 = base + nw * (t1 - o[w]) + s.d_min;
+        let mut iu = lo[u];
+        loop {
+            while g0 - nw >= 0 {
+                t0 -= 1;
+                g0 -= nw;
+            }
+            while g0 < 0 {
+                t0 += 1;
+                g0 += nw;
+            }
+            while g1 + nw <= 0 {
+                t1 += 1;
+                g1 += nw;
+            }
+            while g1 > 0 {
+                t1 -= 1;
+                g1 -= nw;
+            }
+            // `x | y | z` is negative iff one of them is: one branch per test group.
+            if (fuv[0] | fuv[1] | fuv[2]) >= 0 {
+                let (ta, tb) = (t0.max(lo[w]), t1.min(hi[w]));
+                let mut t = ta;
+                while t <= tb {
+                    let f = (vw[0].b * t + rvw[0]) | (vw[1].b * t + rvw[1]) | (vw[2].b * t + rvw[2]);
+                    let g = (wu[0].a * t + wu[0].b * iu + wu[0].c)
+                        | (wu[1].a * t + wu[1].b * iu + wu[1].c)
+                        | (wu[2].a * t + wu[2].b * iu + wu[2].c);
+                    if (f | g) >= 0 {
+                        set::<W>(slab, iu, iv, t);
+                    }
+                    t += 1;
+                }
+            }
+            if iu == hi[u] {
+                break;
+            }
+            iu += 1;
+            g0 += nu;
+            g1 += nu;
+            for i in 0..3 {
+                fuv[i] += uv[i].a;
+            }
+        }
+    }
 }
 
 /// Selects the traversal compiled for the triangle's dominant axis, so the

@@ -19,6 +19,21 @@ pub trait Progress: Sync {
     fn advance(&self, n: u64);
 }
 
+/// How the fast `cover` path walks a triangle's voxels. Every choice gives
+/// the same voxels; the choice exists so tests can pin each traversal and
+/// benchmarks can compare them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Traversal {
+    /// Scan the box of small triangles, walk rows of large ones (default).
+    #[default]
+    Auto,
+    /// Scan every triangle's box column by column (triangles whose plane
+    /// values need `i128` still walk rows).
+    ScanBoxes,
+    /// Walk rows with exact incremental edge bounds for every triangle.
+    WalkRows,
+}
+
 /// Options shared by the voxelizers. `Options::default()` is the default
 /// for every field.
 #[derive(Clone, Copy, Default)]
@@ -28,6 +43,9 @@ pub struct Options<'a> {
     /// Layers per z-slab in the parallel driver; `0` (default) picks one
     /// from the grid and the thread count. The result does not depend on it.
     pub slab_height: u32,
+    /// Traversal of the fast `cover` path. Default: [`Traversal::Auto`].
+    /// The result does not depend on it.
+    pub traversal: Traversal,
 }
 
 /// What a voxelization did.
