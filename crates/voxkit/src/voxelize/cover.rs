@@ -18,11 +18,12 @@
 //! reference decide every touch the same way. Zero-area triangles (after
 //! snapping) are skipped and counted.
 //!
-//! **Cost.** Per triangle: constant setup, then one exact span computation
-//! per row of the dominant-axis projection, O(1) `i128` work per column and
-//! six `i64` edge tests per candidate voxel. Candidates are the voxels of
-//! the projection's columns that the triangle's plane passes through, so
-//! the work is proportional to the output, not to the bounding box.
+//! **Cost.** Per triangle: constant setup; then, for each column of the
+//! dominant-axis projection, a few additions to track the plane's range
+//! exactly; and per candidate voxel (those the plane crosses) at most six
+//! integer edge tests. Small triangles scan their box's columns; large ones
+//! walk rows with exact incremental edge bounds, so their work is
+//! proportional to their area, not to their bounding box.
 //!
 //! **Reference:** [`reference::cover`], the separating axis test on all
 //! thirteen axes for every voxel of each triangle's bounding box.
