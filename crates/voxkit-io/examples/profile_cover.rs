@@ -1,12 +1,12 @@
-//! Times the phases of `cover` separately (prepare, allocation + count,
-//! kernel) on one mesh: `cargo run --release -p voxkit-io --example
+//! Times the phases of `cover` separately (prepare, kernel) and reports the
+//! sparse storage used, on one mesh: `cargo run --release -p voxkit-io --example
 //! profile_cover -- MESH RESOLUTION THREADS`.
 
 use std::time::Instant;
 
 use voxkit::geom::lattice::prepare;
 use voxkit::voxelize::{cover, Options};
-use voxkit::{DenseBits, GridSpec};
+use voxkit::GridSpec;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -26,10 +26,15 @@ fn main() {
         let reps: usize = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(11);
         let time = |f: &mut dyn FnMut()| median((0..reps).map(|_| { let t = Instant::now(); f(); t.elapsed().as_secs_f64() * 1e3 }).collect());
         let prep = time(&mut || { std::hint::black_box(prepare(mesh, &grid)); });
-        let alloc = time(&mut || { let b = DenseBits::new(grid.dims()); std::hint::black_box(b.count()); });
         let (tris, _) = prepare(mesh, &grid);
         let kernel = time(&mut || { std::hint::black_box(cover::cover_lattice(&tris, grid.dims(), &Options::default())); });
+        let bits = cover::cover_lattice(&tris, grid.dims(), &Options::default());
         let full = time(&mut || { std::hint::black_box(cover::cover(mesh, &grid, &Options::default())); });
-        println!("threads {threads} res {res}: prepare {prep:.2} ms, alloc+count(untouched) {alloc:.2} ms, kernel+alloc {kernel:.2} ms, full {full:.2} ms");
+        println!(
+            "threads {threads} res {res}: prepare {prep:.2} ms, kernel {kernel:.2} ms, full {full:.2} ms; {} voxels in {} bricks ({:.1} MB)",
+            bits.count(),
+            bits.brick_count(),
+            bits.memory_bytes() as f64 / 1e6
+        );
     });
 }

@@ -7,7 +7,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::clip::clip_polygon_to_box;
-use super::fixed::{snap, voxel_span, DIRECT_LIMIT_VOXELS, MAX_ABS, ONE};
+use super::fixed::{snap, voxel_span, DIRECT_LIMIT_VOXELS, MAX_ABS};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
 
@@ -200,6 +200,3 @@ fn push_snapped(a: DVec3, b: DVec3, c: DVec3, dims: [u32; 3], out: &mut Vec<Latt
     }
     out.push(t);
 }
-
-/// Lattice units per voxel, re-exported for kernels.
-pub const LATTICE_ONE: i64 = ONE;
