@@ -313,9 +313,12 @@ fn scan_box<const W: usize>(tri: &LatticeTriangle, s: &Setup<i64>, lo: [i64; 3],
     let (tlo, thi) = tri.bounds();
     let (span_lo, span_hi) = crate::geom::fixed::voxel_span(tlo[w], thi[w]);
     let est = |x: f64| x.clamp((span_lo - 1) as f64, (span_hi + 1) as f64) as i64;
+    // wu edge functions at (t = 0, iu = lo_u); each column adds `b`.
+    let wu_row0: [i64; 3] = std::array::from_fn(|i| wu[i].b * lo[u] + wu[i].c);
     for iv in lo[v]..=hi[v] {
         let mut fuv: [i64; 3] = std::array::from_fn(|i| uv[i].a * lo[u] + uv[i].b * iv + uv[i].c);
         let rvw: [i64; 3] = std::array::from_fn(|i| vw[i].a * iv + vw[i].c);
+        let mut rwu = wu_row0;
         // t0 = min t with g_max(t) >= 0, t1 = max t with g_min(t) <= 0.
         let base = nv * (iv - o[v]) + nu * (lo[u] - o[u]);
         let mut t0 = est(-(base + s.d_max) as f64 * s.inv_nw + o[w] as f64);
@@ -343,16 +346,24 @@ fn scan_box<const W: usize>(tri: &LatticeTriangle, s: &Setup<i64>, lo: [i64; 3],
             // `x | y | z` is negative iff one of them is: one branch per test group.
             if (fuv[0] | fuv[1] | fuv[2]) >= 0 {
                 let (ta, tb) = (t0.max(lo[w]), t1.min(hi[w]));
-                let mut t = ta;
-                while t <= tb {
-                    let f = (vw[0].b * t + rvw[0]) | (vw[1].b * t + rvw[1]) | (vw[2].b * t + rvw[2]);
-                    let g = (wu[0].a * t + wu[0].b * iu + wu[0].c)
-                        | (wu[1].a * t + wu[1].b * iu + wu[1].c)
-                        | (wu[2].a * t + wu[2].b * iu + wu[2].c);
-                    if (f | g) >= 0 {
-                        set::<W>(slab, iu, iv, t);
+                if ta <= tb {
+                    // The six remaining edge functions at t = ta, then stepped along t.
+                    let mut f: [i64; 3] = std::array::from_fn(|i| vw[i].b * ta + rvw[i]);
+                    let mut g: [i64; 3] = std::array::from_fn(|i| wu[i].a * ta + rwu[i]);
+                    let mut t = ta;
+                    loop {
+                        if (f[0] | f[1] | f[2] | g[0] | g[1] | g[2]) >= 0 {
+                            set::<W>(slab, iu, iv, t);
+                        }
+                        if t == tb {
+                            break;
+                        }
+                        t += 1;
+                        for i in 0..3 {
+                            f[i] += vw[i].b;
+                            g[i] += wu[i].a;
+                        }
                     }
-                    t += 1;
                 }
             }
             if iu == hi[u] {
@@ -363,6 +374,7 @@ fn scan_box<const W: usize>(tri: &LatticeTriangle, s: &Setup<i64>, lo: [i64; 3],
             g1 += nu;
             for i in 0..3 {
                 fuv[i] += uv[i].a;
+                rwu[i] += wu[i].b;
             }
         }
     }
