@@ -95,6 +95,21 @@ proptest! {
     }
 
     #[test]
+    fn fast_equals_reference_on_huge_triangles_crossing_the_grid(
+        tris in prop::collection::vec(prop::array::uniform3((-600.0f64..600.0, -600.0f64..600.0, -4.0f64..16.0)), 1..3),
+        center in (0.0f64..12.0, 0.0f64..12.0, 0.0f64..12.0),
+    ) {
+        // Triangles hundreds of voxels wide (the i128 plane path) that cut
+        // through a 12³ grid: clipping and wide arithmetic at once.
+        let c = DVec3::new(center.0, center.1, center.2);
+        let tris: Vec<[DVec3; 3]> = tris.iter().map(|t| t.map(|(x, y, z)| c + DVec3::new(x, y, z - 6.0))).collect();
+        let m = soup(&tris);
+        if let Err(e) = agree(&m, &unit_grid(12)) {
+            prop_assert!(false, "{e}\ntriangles: {tris:?}");
+        }
+    }
+
+    #[test]
     fn translating_by_whole_voxels_shifts_the_result(tris in prop::collection::vec(triangle(), 1..3), t in (0i32..3, 0i32..3, 0i32..3)) {
         let m = soup(&tris);
         let shift = DVec3::new(t.0 as f64, t.1 as f64, t.2 as f64);
