@@ -91,7 +91,7 @@ impl BrickBits {
 
     /// Number of set voxels.
     pub fn count(&self) -> u64 {
-        self.bricks.par_iter().map(|b| b.iter().filter(|&&w| w != 0).map(|w| w.count_ones() as u64).sum::<u64>()).sum()
+        self.bricks.par_chunks(1 << 13).map(|c| super::count_bits(c.iter().flatten())).sum()
     }
 
     /// The same voxels in dense storage.
@@ -284,7 +284,7 @@ impl SlabView<'_> {
 
     /// Set voxels in this slab.
     pub fn count(&self) -> u64 {
-        self.pool.iter().flatten().filter(|&&w| w != 0).map(|w| w.count_ones() as u64).sum()
+        super::count_bits(self.pool.iter().flatten())
     }
 
     /// Index entries this slab owns and its pool, for [`BrickBits::merge_slabs`].

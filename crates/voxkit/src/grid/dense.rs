@@ -72,7 +72,7 @@ impl DenseBits {
 
     /// Number of set voxels.
     pub fn count(&self) -> u64 {
-        self.words.par_chunks(1 << 16).map(|c| c.iter().filter(|&&w| w != 0).map(|w| w.count_ones() as u64).sum::<u64>()).sum()
+        self.words.par_chunks(1 << 16).map(super::count_bits).sum()
     }
 
     /// Calls `f(i, j, k)` for every set voxel, in order of `k`, then `j`, then `i`.

@@ -4,6 +4,12 @@ pub mod bricks;
 pub mod dense;
 pub mod spec;
 
+/// Set bits in `words`. Most words of a surface voxelization are zero;
+/// skipping them avoids a software popcount on targets without POPCNT.
+pub(crate) fn count_bits<'a>(words: impl IntoIterator<Item = &'a u64>) -> u64 {
+    words.into_iter().filter(|&&w| w != 0).map(|w| w.count_ones() as u64).sum()
+}
+
 /// Read access shared by the storages ([`dense::DenseBits`],
 /// [`bricks::BrickBits`]), so writers and checks take either.
 pub trait VoxelSource: Sync {

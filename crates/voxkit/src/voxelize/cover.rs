@@ -80,7 +80,14 @@ fn edges_2d(tri: &LatticeTriangle, p: usize, q: usize, sigma: i64) -> [Edge2; 3]
 
 /// Integer types the plane test runs in: `i64` for triangles small enough
 /// that every plane value fits (the common case), `i128` otherwise.
-trait PlaneInt: Copy + PartialOrd + std::ops::Add<Output = Self> + std::ops::Mul<Output = Self> + std::ops::Neg<Output = Self> {
+trait PlaneInt:
+    Copy
+    + PartialOrd
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Neg<Output = Self>
+{
     const ZERO: Self;
     fn from_i64(x: i64) -> Self;
     fn to_f64(self) -> f64;
@@ -132,6 +139,8 @@ struct Setup<T> {
     d_min: T,
     d_max: T,
     inv_nw: f64,
+    /// The triangle's own (unclamped) voxel span along `w`; bounds estimates.
+    span_w: (i64, i64),
 }
 
 impl<T: PlaneInt> Setup<T> {
@@ -158,7 +167,9 @@ impl<T: PlaneInt> Setup<T> {
             }
         }
         let n_idx = no.map(|c| c * one);
-        Setup { w, uv, vw, wu, origin, n: n_idx, d_min, d_max, inv_nw: 1.0 / n_idx[w].to_f64() }
+        let (tlo, thi) = tri.bounds();
+        let span_w = crate::geom::fixed::voxel_span(tlo[w], thi[w]);
+        Setup { w, uv, vw, wu, origin, n: n_idx, d_min, d_max, inv_nw: 1.0 / n_idx[w].to_f64(), span_w }
     }
 }
 
@@ -180,15 +191,15 @@ impl Kernel for CoverKernel {
             };
             if scan {
                 match s.w {
-                    0 => scan_box::<0>(tri, &s, lo, hi, slab),
-                    1 => scan_box::<1>(tri, &s, lo, hi, slab),
-                    _ => scan_box::<2>(tri, &s, lo, hi, slab),
+                    0 => scan_box::<0>(&s, lo, hi, slab),
+                    1 => scan_box::<1>(&s, lo, hi, slab),
+                    _ => scan_box::<2>(&s, lo, hi, slab),
                 }
             } else {
-                dispatch::<i64>(tri, &s, lo, hi, slab);
+                dispatch::<i64>(&s, lo, hi, slab);
             }
         } else {
-            dispatch::<i128>(tri, &Setup::new(tri, lo), lo, hi, slab);
+            dispatch::<i128>(&Setup::new(tri, lo), lo, hi, slab);
         }
     }
 }
@@ -293,6 +304,66 @@ fn clip3(w: &[Walker; 3], mut lo: i64, mut hi: i64) -> (i64, i64) {
     (lo, hi)
 }
 
+/// The exact range `t0 ..= t1` of voxels along `w` whose box the triangle's
+/// plane crosses, in column `(iu, iv)`, tracked along a row: `t0` is the
+/// least `t` with `g_max(t) >= 0`, `t1` the greatest with `g_min(t) <= 0`,
+/// and `g0 = g_max(t0)`, `g1 = g_min(t1)`. Moving one column changes both
+/// by `n_u`, and the range by at most one since `|n_u| <= n_w`, so the
+/// correction loops run a step or two: additions and comparisons only.
+struct PlaneRange<T> {
+    t0: i64,
+    t1: i64,
+    g0: T,
+    g1: T,
+}
+
+impl<T: PlaneInt> PlaneRange<T> {
+    /// The range at column `(iu, iv)`: an f64 estimate (clamped to the
+    /// triangle's span) made exact by the correction loops.
+    #[inline(always)]
+    fn at<const W: usize>(s: &Setup<T>, iu: i64, iv: i64) -> PlaneRange<T> {
+        let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
+        let o = s.origin;
+        let est = |x: f64| x.clamp((s.span_w.0 - 1) as f64, (s.span_w.1 + 1) as f64) as i64;
+        let base = s.n[v] * T::from_i64(iv - o[v]) + s.n[u] * T::from_i64(iu - o[u]);
+        let t0 = est(-(base + s.d_max).to_f64() * s.inv_nw + o[w] as f64);
+        let t1 = est(-(base + s.d_min).to_f64() * s.inv_nw + o[w] as f64);
+        let g0 = base + s.n[w] * T::from_i64(t0 - o[w]) + s.d_max;
+        let g1 = base + s.n[w] * T::from_i64(t1 - o[w]) + s.d_min;
+        let mut r = PlaneRange { t0, t1, g0, g1 };
+        r.correct(s.n[w]);
+        r
+    }
+
+    /// Moves to the next column along `u`.
+    #[inline(always)]
+    fn next_column(&mut self, nu: T, nw: T) {
+        self.g0 = self.g0 + nu;
+        self.g1 = self.g1 + nu;
+        self.correct(nw);
+    }
+
+    #[inline(always)]
+    fn correct(&mut self, nw: T) {
+        while self.g0 - nw >= T::ZERO {
+            self.t0 -= 1;
+            self.g0 = self.g0 - nw;
+        }
+        while self.g0 < T::ZERO {
+            self.t0 += 1;
+            self.g0 = self.g0 + nw;
+        }
+        while self.g1 + nw <= T::ZERO {
+            self.t1 += 1;
+            self.g1 = self.g1 + nw;
+        }
+        while self.g1 > T::ZERO {
+            self.t1 -= 1;
+            self.g1 = self.g1 - nw;
+        }
+    }
+}
+
 /// Voxel boxes up to this many voxels are scanned directly ([`scan_box`]);
 /// larger ones use the row walkers of [`traverse`], whose setup pays off
 /// only when rows are long.
@@ -305,47 +376,22 @@ const SMALL_BOX: i64 = 1024;
 /// `|n_u| <= n_w`). Only the voxels in that range get the remaining six
 /// edge tests. Same predicates as [`traverse`], so the same voxels.
 #[inline(always)]
-fn scan_box<const W: usize>(tri: &LatticeTriangle, s: &Setup<i64>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+fn scan_box<const W: usize>(s: &Setup<i64>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
-    let o = s.origin;
-    let (nu, nv, nw) = (s.n[u], s.n[v], s.n[w]);
+    let (nu, nw) = (s.n[u], s.n[w]);
     let (uv, vw, wu) = (s.uv, s.vw, s.wu);
-    let (tlo, thi) = tri.bounds();
-    let (span_lo, span_hi) = crate::geom::fixed::voxel_span(tlo[w], thi[w]);
-    let est = |x: f64| x.clamp((span_lo - 1) as f64, (span_hi + 1) as f64) as i64;
     // wu edge functions at (t = 0, iu = lo_u); each column adds `b`.
     let wu_row0: [i64; 3] = std::array::from_fn(|i| wu[i].b * lo[u] + wu[i].c);
     for iv in lo[v]..=hi[v] {
         let mut fuv: [i64; 3] = std::array::from_fn(|i| uv[i].a * lo[u] + uv[i].b * iv + uv[i].c);
         let rvw: [i64; 3] = std::array::from_fn(|i| vw[i].a * iv + vw[i].c);
         let mut rwu = wu_row0;
-        // t0 = min t with g_max(t) >= 0, t1 = max t with g_min(t) <= 0.
-        let base = nv * (iv - o[v]) + nu * (lo[u] - o[u]);
-        let mut t0 = est(-(base + s.d_max) as f64 * s.inv_nw + o[w] as f64);
-        let mut t1 = est(-(base + s.d_min) as f64 * s.inv_nw + o[w] as f64);
-        let mut g0 = base + nw * (t0 - o[w]) + s.d_max;
-        let mut g1 = base + nw * (t1 - o[w]) + s.d_min;
+        let mut plane = PlaneRange::at::<W>(s, lo[u], iv);
         let mut iu = lo[u];
         loop {
-            while g0 - nw >= 0 {
-                t0 -= 1;
-                g0 -= nw;
-            }
-            while g0 < 0 {
-                t0 += 1;
-                g0 += nw;
-            }
-            while g1 + nw <= 0 {
-                t1 += 1;
-                g1 += nw;
-            }
-            while g1 > 0 {
-                t1 -= 1;
-                g1 -= nw;
-            }
             // `x | y | z` is negative iff one of them is: one branch per test group.
             if (fuv[0] | fuv[1] | fuv[2]) >= 0 {
-                let (ta, tb) = (t0.max(lo[w]), t1.min(hi[w]));
+                let (ta, tb) = (plane.t0.max(lo[w]), plane.t1.min(hi[w]));
                 if ta <= tb {
                     // The six remaining edge functions at t = ta, then stepped along t.
                     let mut f: [i64; 3] = std::array::from_fn(|i| vw[i].b * ta + rvw[i]);
@@ -370,8 +416,7 @@ fn scan_box<const W: usize>(tri: &LatticeTriangle, s: &Setup<i64>, lo: [i64; 3],
                 break;
             }
             iu += 1;
-            g0 += nu;
-            g1 += nu;
+            plane.next_column(nu, nw);
             for i in 0..3 {
                 fuv[i] += uv[i].a;
                 rwu[i] += wu[i].b;
@@ -383,11 +428,11 @@ fn scan_box<const W: usize>(tri: &LatticeTriangle, s: &Setup<i64>, lo: [i64; 3],
 /// Selects the traversal compiled for the triangle's dominant axis, so the
 /// mapping from `(u, v, w)` back to `(i, j, k)` is static.
 #[inline(always)]
-fn dispatch<T: PlaneInt>(tri: &LatticeTriangle, s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+fn dispatch<T: PlaneInt>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     match s.w {
-        0 => traverse::<T, 0>(tri, s, lo, hi, slab),
-        1 => traverse::<T, 1>(tri, s, lo, hi, slab),
-        _ => traverse::<T, 2>(tri, s, lo, hi, slab),
+        0 => traverse::<T, 0>(s, lo, hi, slab),
+        1 => traverse::<T, 1>(s, lo, hi, slab),
+        _ => traverse::<T, 2>(s, lo, hi, slab),
     }
 }
 
@@ -403,15 +448,9 @@ fn dispatch<T: PlaneInt>(tri: &LatticeTriangle, s: &Setup<T>, lo: [i64; 3], hi: 
 /// the voxel projects inside the triangle, so it is a triangle point); in
 /// boundary columns the `(w, u)` edge tests run per voxel.
 #[inline(always)]
-fn traverse<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+fn traverse<T: PlaneInt, const W: usize>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
-    let o = s.origin;
-    let nw = s.n[w];
-    let nu = s.n[u];
-    // The triangle's own (unclamped) voxel span along w bounds the estimates.
-    let (tlo, thi) = tri.bounds();
-    let (span_lo, span_hi) = crate::geom::fixed::voxel_span(tlo[w], thi[w]);
-    let est = |x: f64| x.clamp((span_lo - 1) as f64, (span_hi + 1) as f64) as i64;
+    let (nu, nw) = (s.n[u], s.n[w]);
     let y0 = lo[v];
     // Columns whose square meets the projected triangle; columns whose
     // square lies inside it (edge value at the far corner >= 0); and the t
@@ -438,32 +477,10 @@ fn traverse<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, s: &Setup<T>, lo
             continue;
         }
         let (i0, i1) = clip3(&inner, a0, a1);
-        // Plane range at the first column: t0 = min t with g_max(t) >= 0,
-        // t1 = max t with g_min(t) <= 0; g0 = g_max(t0), g1 = g_min(t1).
-        let base = s.n[v] * T::from_i64(iv - o[v]) + nu * T::from_i64(a0 - o[u]);
-        let mut t0 = est(-(base + s.d_max).to_f64() * s.inv_nw + o[w] as f64);
-        let mut t1 = est(-(base + s.d_min).to_f64() * s.inv_nw + o[w] as f64);
-        let mut g0 = base + nw * T::from_i64(t0 - o[w]) + s.d_max;
-        let mut g1 = base + nw * T::from_i64(t1 - o[w]) + s.d_min;
+        let mut plane = PlaneRange::at::<W>(s, a0, iv);
         let mut iu = a0;
         loop {
-            while g0 + (-nw) >= T::ZERO {
-                t0 -= 1;
-                g0 = g0 + (-nw);
-            }
-            while g0 < T::ZERO {
-                t0 += 1;
-                g0 = g0 + nw;
-            }
-            while g1 + nw <= T::ZERO {
-                t1 += 1;
-                g1 = g1 + nw;
-            }
-            while g1 > T::ZERO {
-                t1 -= 1;
-                g1 = g1 + (-nw);
-            }
-            let (ta, tb) = (t0.max(c0), t1.min(c1));
+            let (ta, tb) = (plane.t0.max(c0), plane.t1.min(c1));
             let mut t = ta;
             if iu >= i0 && iu <= i1 {
                 while t <= tb {
@@ -483,8 +500,7 @@ fn traverse<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, s: &Setup<T>, lo
                 break;
             }
             iu += 1;
-            g0 = g0 + nu;
-            g1 = g1 + nu;
+            plane.next_column(nu, nw);
         }
     }
 }
