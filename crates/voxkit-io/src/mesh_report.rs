@@ -51,7 +51,7 @@ pub(crate) fn finish(positions: Vec<DVec3>, triangles: Vec<[i64; 3]>, warnings: 
     if tris.is_empty() {
         return Err(ErrorKind::Empty);
     }
-    let mesh = Mesh { positions, triangles: tris };
+    let mesh = Mesh { positions, triangles: tris, segments: Vec::new() };
     let r = mesh.as_ref();
     let report = MeshReport { vertices: count, triangles: mesh.triangles.len(), degenerate: r.degenerate_count(), bounds: r.bounds() };
     Ok(LoadedMesh { mesh, report, warnings })

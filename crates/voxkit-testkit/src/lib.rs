@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use glam::{DMat3, DQuat, DVec3};
 use rand::{Rng, SeedableRng};
-use voxkit::voxelize::{cover, Options, Traversal};
+use voxkit::voxelize::{self, Mode, Options, Traversal};
 use voxkit::{DenseBits, GridSpec, Mesh};
 
 /// Every mesh in `shared/meshes`.
@@ -87,7 +87,7 @@ pub fn box_mesh(lo: DVec3, hi: DVec3) -> Mesh {
         triangles.push([q[0], q[1], q[2]]);
         triangles.push([q[0], q[2], q[3]]);
     }
-    Mesh { positions, triangles }
+    Mesh { positions, triangles, segments: Vec::new() }
 }
 
 /// A UV sphere of `n` rings (closed, about `2n²` triangles).
@@ -111,14 +111,21 @@ pub fn sphere(center: DVec3, radius: f64, n: u32) -> Mesh {
             triangles.push([ring(r, s), ring(r + 1, s + 1), ring(r, s + 1)]);
         }
     }
-    Mesh { positions, triangles }
+    Mesh { positions, triangles, segments: Vec::new() }
 }
 
 /// Runs every `cover` path — the reference, and the fast path on 1, 2 and 8
 /// threads with several slab heights and every traversal — and returns the common result, or a
 /// message naming the first configuration and voxel that differ.
 pub fn agree(mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits, String> {
-    let (reference, rep) = cover::reference::cover(mesh.as_ref(), grid);
+    agree_mode(Mode::Cover, mesh, grid)
+}
+
+/// [`agree`] for any surface or line mode: the mode's reference against its
+/// fast path on 1, 2 and 8 threads, several slab heights and every
+/// traversal; names the first differing voxel. Returns the reference grid.
+pub fn agree_mode(mode: Mode, mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits, String> {
+    let (reference, rep) = voxelize::reference(mode, mesh.as_ref(), grid);
     if reference.count() != rep.voxels {
         return Err(format!("reference report says {} voxels, grid has {}", rep.voxels, reference.count()));
     }
@@ -128,14 +135,15 @@ pub fn agree(mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits, String> {
             [(0, Traversal::Auto), (1, Traversal::WalkRows), (7, Traversal::ScanBoxes), (0, Traversal::WalkRows)]
         {
             let (fast, frep) =
-                pool.install(|| cover::cover(mesh.as_ref(), grid, &Options { slab_height, traversal, ..Options::default() }));
+                pool.install(|| voxelize::fast(mode, mesh.as_ref(), grid, &Options { slab_height, traversal, ..Options::default() }));
             if fast.count() != frep.voxels {
                 return Err(format!("fast report says {} voxels, grid has {}", frep.voxels, fast.count()));
             }
             let fast = fast.to_dense();
             if let Some(v) = reference.first_difference(&fast) {
                 return Err(format!(
-                    "fast (threads {threads}, slab height {slab_height}, {traversal:?}) differs from reference at voxel {v:?}: reference {}, fast {}",
+                    "{} fast (threads {threads}, slab height {slab_height}, {traversal:?}) differs from reference at voxel {v:?}: reference {}, fast {}",
+                    mode.name(),
                     reference.get(v[0], v[1], v[2]),
                     fast.get(v[0], v[1], v[2])
                 ));
@@ -153,6 +161,7 @@ pub fn soup(tris: &[[DVec3; 3]]) -> Mesh {
     Mesh {
         positions: tris.iter().flatten().copied().collect(),
         triangles: (0..tris.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect(),
+        segments: Vec::new(),
     }
 }
 

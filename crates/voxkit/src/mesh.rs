@@ -11,12 +11,14 @@ pub struct Mesh {
     pub positions: Vec<DVec3>,
     /// Triangles as indices into `positions`, in winding order.
     pub triangles: Vec<[u32; 3]>,
+    /// Line segments (polyline input, OBJ `l` records) as indices into `positions`.
+    pub segments: Vec<[u32; 2]>,
 }
 
 impl Mesh {
     /// A borrowed view.
     pub fn as_ref(&self) -> MeshRef<'_> {
-        MeshRef { positions: &self.positions, triangles: &self.triangles }
+        MeshRef { positions: &self.positions, triangles: &self.triangles, segments: &self.segments }
     }
 
     /// Applies `f` to every position (for rotations and transforms in tests and readers).
@@ -37,14 +39,16 @@ pub struct MeshRef<'a> {
     pub positions: &'a [DVec3],
     /// Triangles as indices into `positions`.
     pub triangles: &'a [[u32; 3]],
+    /// Line segments as indices into `positions`.
+    pub segments: &'a [[u32; 2]],
 }
 
 impl MeshRef<'_> {
-    /// Bounding box of the vertices used by triangles (finite ones only).
+    /// Bounding box of the vertices used by triangles and segments (finite ones only).
     pub fn bounds(&self) -> Aabb {
         let mut b = Aabb::EMPTY;
-        for t in self.triangles {
-            for &i in t {
+        for &i in self.triangles.iter().flatten().chain(self.segments.iter().flatten()) {
+            {
                 if let Some(p) = self.positions.get(i as usize) {
                     if p.is_finite() {
                         b.grow(*p);

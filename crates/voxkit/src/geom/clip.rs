@@ -44,6 +44,31 @@ pub fn clip_polygon_to_box(poly: &[DVec3], lo: DVec3, hi: DVec3) -> Vec<DVec3> {
     cur
 }
 
+/// Clips the segment `[a, b]` to the closed box `[lo, hi]` (Liang–Barsky);
+/// `None` if nothing is left.
+pub fn clip_segment_to_box(a: DVec3, b: DVec3, lo: DVec3, hi: DVec3) -> Option<(DVec3, DVec3)> {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    let d = b - a;
+    for axis in 0..3 {
+        for (p, q) in [(-d[axis], a[axis] - lo[axis]), (d[axis], hi[axis] - a[axis])] {
+            if p == 0.0 {
+                if q < 0.0 {
+                    return None;
+                }
+            } else {
+                let r = q / p;
+                if p < 0.0 {
+                    t0 = t0.max(r);
+                } else {
+                    t1 = t1.min(r);
+                }
+            }
+        }
+    }
+    // Clamping puts the end points exactly on the planes they were cut at.
+    (t0 <= t1).then(|| ((a + d * t0).clamp(lo, hi), (a + d * t1).clamp(lo, hi)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -64,6 +89,13 @@ mod tests {
             assert!(p.x >= 0.0 && p.x <= 4.0 && p.y >= 0.0 && p.y <= 4.0);
             assert_eq!(p.z, 0.5);
         }
+    }
+
+    #[test]
+    fn segment_is_cut_to_the_box() {
+        let (a, b) = clip_segment_to_box(DVec3::new(-1e9, 1.0, 1.0), DVec3::new(1e9, 1.0, 1.0), DVec3::ZERO, DVec3::splat(4.0)).unwrap();
+        assert_eq!((a.x, b.x), (0.0, 4.0));
+        assert!(clip_segment_to_box(DVec3::new(-1e9, 9.0, 1.0), DVec3::new(1e9, 9.0, 1.0), DVec3::ZERO, DVec3::splat(4.0)).is_none());
     }
 
     #[test]

@@ -41,6 +41,54 @@ pub fn voxel_span(lo: i64, hi: i64) -> (i64, i64) {
     ((lo - 1).div_euclid(ONE), hi.div_euclid(ONE))
 }
 
+/// Integer types the exact predicates run in: `i64` for triangles small enough
+/// that every plane value fits (the common case), `i128` otherwise.
+pub(crate) trait PlaneInt:
+    Copy
+    + PartialOrd
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Neg<Output = Self>
+{
+    const ZERO: Self;
+    fn from_i64(x: i64) -> Self;
+    fn to_f64(self) -> f64;
+    fn to_i128(self) -> i128;
+}
+
+impl PlaneInt for i64 {
+    const ZERO: Self = 0;
+    #[inline(always)]
+    fn from_i64(x: i64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    #[inline(always)]
+    fn to_i128(self) -> i128 {
+        self as i128
+    }
+}
+
+impl PlaneInt for i128 {
+    const ZERO: Self = 0;
+    #[inline(always)]
+    fn from_i64(x: i64) -> Self {
+        x as i128
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    #[inline(always)]
+    fn to_i128(self) -> i128 {
+        self
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,7 +6,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::clip::clip_polygon_to_box;
+use super::clip::{clip_polygon_to_box, clip_segment_to_box};
 use super::fixed::{snap, voxel_span, DIRECT_LIMIT_VOXELS, MAX_ABS};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
@@ -60,19 +60,46 @@ impl LatticeTriangle {
     /// the triangle's bounding box, clamped to `dims`; `None` if empty.
     #[inline]
     pub fn voxel_bounds(&self, dims: [u32; 3]) -> Option<([i64; 3], [i64; 3])> {
-        let (lo, hi) = self.bounds();
-        let mut a = [0i64; 3];
-        let mut b = [0i64; 3];
-        for ax in 0..3 {
-            let (s, e) = voxel_span(lo[ax], hi[ax]);
-            a[ax] = s.max(0);
-            b[ax] = e.min(dims[ax] as i64 - 1);
-            if a[ax] > b[ax] {
-                return None;
-            }
-        }
-        Some((a, b))
+        bounds_to_voxels(self.bounds(), dims)
     }
+}
+
+/// A segment of polyline input with end points on the lattice.
+///
+/// # Guarantees
+/// Built by [`prepare_segments`]: coordinates within `±MAX_ABS`, non-zero length.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LatticeSegment {
+    /// The two end points.
+    pub v: [[i64; 3]; 2],
+}
+
+impl LatticeSegment {
+    /// Per-axis `(min, max)` lattice coordinates.
+    #[inline]
+    pub fn bounds(&self) -> ([i64; 3], [i64; 3]) {
+        let (a, b) = (self.v[0], self.v[1]);
+        (std::array::from_fn(|i| a[i].min(b[i])), std::array::from_fn(|i| a[i].max(b[i])))
+    }
+
+    /// Like [`LatticeTriangle::voxel_bounds`].
+    pub fn voxel_bounds(&self, dims: [u32; 3]) -> Option<([i64; 3], [i64; 3])> {
+        bounds_to_voxels(self.bounds(), dims)
+    }
+}
+
+fn bounds_to_voxels((lo, hi): ([i64; 3], [i64; 3]), dims: [u32; 3]) -> Option<([i64; 3], [i64; 3])> {
+    let mut a = [0i64; 3];
+    let mut b = [0i64; 3];
+    for ax in 0..3 {
+        let (s, e) = voxel_span(lo[ax], hi[ax]);
+        a[ax] = s.max(0);
+        b[ax] = e.min(dims[ax] as i64 - 1);
+        if a[ax] > b[ax] {
+            return None;
+        }
+    }
+    Some((a, b))
 }
 
 /// Exact cross product of two lattice vectors (inputs below 2^31 in magnitude).
@@ -102,7 +129,8 @@ pub struct PrepareStats {
 }
 
 impl PrepareStats {
-    fn merge(mut self, o: PrepareStats) -> PrepareStats {
+    /// Sums two reports.
+    pub fn merge(mut self, o: PrepareStats) -> PrepareStats {
         self.input += o.input;
         self.invalid_index += o.invalid_index;
         self.non_finite += o.non_finite;
@@ -199,4 +227,47 @@ fn push_snapped(a: DVec3, b: DVec3, c: DVec3, dims: [u32; 3], out: &mut Vec<Latt
         return;
     }
     out.push(t);
+}
+
+/// Snaps every segment of `mesh` to the lattice of `grid`, like [`prepare`]
+/// does for triangles (zero-length segments count as degenerate).
+pub fn prepare_segments(mesh: MeshRef<'_>, grid: &GridSpec) -> (Vec<LatticeSegment>, PrepareStats) {
+    let mut st = PrepareStats::default();
+    let mut out = Vec::with_capacity(mesh.segments.len());
+    let dims = DVec3::new(grid.dims()[0] as f64, grid.dims()[1] as f64, grid.dims()[2] as f64);
+    for seg in mesh.segments {
+        st.input += 1;
+        let (Some(a), Some(b)) = (mesh.positions.get(seg[0] as usize), mesh.positions.get(seg[1] as usize)) else {
+            st.invalid_index += 1;
+            continue;
+        };
+        let (mut a, mut b) = (grid.to_grid_units(*a), grid.to_grid_units(*b));
+        if !(a.is_finite() && b.is_finite()) {
+            st.non_finite += 1;
+            continue;
+        }
+        if a.max(b).cmplt(DVec3::splat(-1.0)).any() || a.min(b).cmpgt(dims + DVec3::ONE).any() {
+            st.outside += 1;
+            continue;
+        }
+        if a.abs().max_element() > DIRECT_LIMIT_VOXELS || b.abs().max_element() > DIRECT_LIMIT_VOXELS {
+            st.clipped += 1;
+            let Some((p, q)) = clip_segment_to_box(a, b, DVec3::splat(-1.0), dims + DVec3::ONE) else {
+                st.outside += 1;
+                continue;
+            };
+            (a, b) = (p, q);
+        }
+        let s = |p: DVec3| [snap(p.x), snap(p.y), snap(p.z)];
+        let l = LatticeSegment { v: [s(a), s(b)] };
+        if l.v[0] == l.v[1] {
+            st.degenerate += 1;
+        } else if l.voxel_bounds(grid.dims()).is_none() {
+            st.outside += 1;
+        } else {
+            out.push(l);
+            st.output += 1;
+        }
+    }
+    (out, st)
 }

@@ -5,3 +5,4 @@ pub mod aabb;
 pub mod clip;
 pub mod fixed;
 pub mod lattice;
+pub mod perturb;

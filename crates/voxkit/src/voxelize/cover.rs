@@ -28,9 +28,9 @@
 //! **Reference:** [`reference::cover`], the separating axis test on all
 //! thirteen axes for every voxel of each triangle's bounding box.
 
-use super::driver::{run_slabs, Kernel};
+use super::driver::{run_slabs, Kernel, Sink};
 use super::{Options, Report, Traversal};
-use crate::geom::fixed::ONE;
+use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{prepare, LatticeTriangle};
 use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::dense::DenseBits;
@@ -76,45 +76,6 @@ fn edges_2d(tri: &LatticeTriangle, p: usize, q: usize, sigma: i64) -> [Edge2; 3]
         let c = -(a * v[p] + b * v[q]) + (a * ONE).max(0) + (b * ONE).max(0);
         Edge2 { a: a * ONE, b: b * ONE, c }
     })
-}
-
-/// Integer types the plane test runs in: `i64` for triangles small enough
-/// that every plane value fits (the common case), `i128` otherwise.
-trait PlaneInt:
-    Copy
-    + PartialOrd
-    + std::ops::Add<Output = Self>
-    + std::ops::Sub<Output = Self>
-    + std::ops::Mul<Output = Self>
-    + std::ops::Neg<Output = Self>
-{
-    const ZERO: Self;
-    fn from_i64(x: i64) -> Self;
-    fn to_f64(self) -> f64;
-}
-
-impl PlaneInt for i64 {
-    const ZERO: Self = 0;
-    #[inline(always)]
-    fn from_i64(x: i64) -> Self {
-        x
-    }
-    #[inline(always)]
-    fn to_f64(self) -> f64 {
-        self as f64
-    }
-}
-
-impl PlaneInt for i128 {
-    const ZERO: Self = 0;
-    #[inline(always)]
-    fn from_i64(x: i64) -> Self {
-        x as i128
-    }
-    #[inline(always)]
-    fn to_f64(self) -> f64 {
-        self as f64
-    }
 }
 
 /// Largest `extent + 2 voxels` (lattice units) for which the plane test is
@@ -177,30 +138,38 @@ struct CoverKernel {
     traversal: Traversal,
 }
 
-impl Kernel for CoverKernel {
+impl Kernel<LatticeTriangle> for CoverKernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
-        let (blo, bhi) = tri.bounds();
-        let extent = (0..3).map(|a| bhi[a] - blo[a]).max().unwrap_or(0);
-        if extent + 2 * ONE <= I64_PLANE_LIMIT {
-            let s = Setup::<i64>::new(tri, lo);
-            let volume: i64 = (0..3).map(|a| hi[a] - lo[a] + 1).product();
-            let scan = match self.traversal {
-                Traversal::Auto => volume <= SMALL_BOX,
-                Traversal::ScanBoxes => true,
-                Traversal::WalkRows => false,
-            };
-            if scan {
-                match s.w {
-                    0 => scan_box::<0>(&s, lo, hi, slab),
-                    1 => scan_box::<1>(&s, lo, hi, slab),
-                    _ => scan_box::<2>(&s, lo, hi, slab),
-                }
-            } else {
-                dispatch::<i64>(&s, lo, hi, slab);
+        cover_triangle(tri, lo, hi, self.traversal, slab);
+    }
+}
+
+/// Emits into `out` exactly the voxels of the inclusive index box `[lo, hi]`
+/// whose closed box meets `tri` (each at most once). Every mode whose
+/// target lies inside the voxel is a subset of this, so their fast paths
+/// use it to enumerate candidates.
+pub(crate) fn cover_triangle<O: Sink>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], traversal: Traversal, out: &mut O) {
+    let (blo, bhi) = tri.bounds();
+    let extent = (0..3).map(|a| bhi[a] - blo[a]).max().unwrap_or(0);
+    if extent + 2 * ONE <= I64_PLANE_LIMIT {
+        let s = Setup::<i64>::new(tri, lo);
+        let volume: i64 = (0..3).map(|a| hi[a] - lo[a] + 1).product();
+        let scan = match traversal {
+            Traversal::Auto => volume <= SMALL_BOX,
+            Traversal::ScanBoxes => true,
+            Traversal::WalkRows => false,
+        };
+        if scan {
+            match s.w {
+                0 => scan_box::<O, 0>(&s, lo, hi, out),
+                1 => scan_box::<O, 1>(&s, lo, hi, out),
+                _ => scan_box::<O, 2>(&s, lo, hi, out),
             }
         } else {
-            dispatch::<i128>(&Setup::new(tri, lo), lo, hi, slab);
+            dispatch::<i64, O>(&s, lo, hi, out);
         }
+    } else {
+        dispatch::<i128, O>(&Setup::new(tri, lo), lo, hi, out);
     }
 }
 
@@ -376,7 +345,7 @@ const SMALL_BOX: i64 = 1024;
 /// `|n_u| <= n_w`). Only the voxels in that range get the remaining six
 /// edge tests. Same predicates as [`traverse`], so the same voxels.
 #[inline(always)]
-fn scan_box<const W: usize>(s: &Setup<i64>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+fn scan_box<O: Sink, const W: usize>(s: &Setup<i64>, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
     let (nu, nw) = (s.n[u], s.n[w]);
     let (uv, vw, wu) = (s.uv, s.vw, s.wu);
@@ -399,7 +368,7 @@ fn scan_box<const W: usize>(s: &Setup<i64>, lo: [i64; 3], hi: [i64; 3], slab: &m
                     let mut t = ta;
                     loop {
                         if (f[0] | f[1] | f[2] | g[0] | g[1] | g[2]) >= 0 {
-                            set::<W>(slab, iu, iv, t);
+                            set::<O, W>(out, iu, iv, t);
                         }
                         if t == tb {
                             break;
@@ -428,11 +397,11 @@ fn scan_box<const W: usize>(s: &Setup<i64>, lo: [i64; 3], hi: [i64; 3], slab: &m
 /// Selects the traversal compiled for the triangle's dominant axis, so the
 /// mapping from `(u, v, w)` back to `(i, j, k)` is static.
 #[inline(always)]
-fn dispatch<T: PlaneInt>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+fn dispatch<T: PlaneInt, O: Sink>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     match s.w {
-        0 => traverse::<T, 0>(s, lo, hi, slab),
-        1 => traverse::<T, 1>(s, lo, hi, slab),
-        _ => traverse::<T, 2>(s, lo, hi, slab),
+        0 => traverse::<T, O, 0>(s, lo, hi, out),
+        1 => traverse::<T, O, 1>(s, lo, hi, out),
+        _ => traverse::<T, O, 2>(s, lo, hi, out),
     }
 }
 
@@ -448,7 +417,7 @@ fn dispatch<T: PlaneInt>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut Br
 /// the voxel projects inside the triangle, so it is a triangle point); in
 /// boundary columns the `(w, u)` edge tests run per voxel.
 #[inline(always)]
-fn traverse<T: PlaneInt, const W: usize>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+fn traverse<T: PlaneInt, O: Sink, const W: usize>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
     let (nu, nw) = (s.n[u], s.n[w]);
     let y0 = lo[v];
@@ -484,14 +453,14 @@ fn traverse<T: PlaneInt, const W: usize>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3
             let mut t = ta;
             if iu >= i0 && iu <= i1 {
                 while t <= tb {
-                    set::<W>(slab, iu, iv, t);
+                    set::<O, W>(out, iu, iv, t);
                     t += 1;
                 }
             } else {
                 let r: [i64; 3] = std::array::from_fn(|i| s.wu[i].b * iu + s.wu[i].c);
                 while t <= tb {
                     if s.wu[0].a * t + r[0] >= 0 && s.wu[1].a * t + r[1] >= 0 && s.wu[2].a * t + r[2] >= 0 {
-                        set::<W>(slab, iu, iv, t);
+                        set::<O, W>(out, iu, iv, t);
                     }
                     t += 1;
                 }
@@ -507,13 +476,13 @@ fn traverse<T: PlaneInt, const W: usize>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3
 
 /// Sets voxel `(u, v, w)`; `(u, v, w)` is a cyclic shift of `(x, y, z)` by `W`.
 #[inline(always)]
-fn set<const W: usize>(slab: &mut BrickSlab<'_>, iu: i64, iv: i64, t: i64) {
+fn set<O: Sink, const W: usize>(out: &mut O, iu: i64, iv: i64, t: i64) {
     let (i, j, k) = match W {
         0 => (t, iu, iv),
         1 => (iv, t, iu),
         _ => (iu, iv, t),
     };
-    slab.set(i as u32, j as u32, k as u32);
+    out.set(i as u32, j as u32, k as u32);
 }
 
 /// The slow, obviously correct definition of `cover`.
@@ -531,20 +500,7 @@ pub mod reference {
 
     /// The reference on already prepared triangles.
     pub fn cover_lattice(tris: &[LatticeTriangle], dims: [u32; 3]) -> DenseBits {
-        let mut bits = DenseBits::new(dims);
-        for t in tris {
-            let Some((lo, hi)) = t.voxel_bounds(dims) else { continue };
-            for k in lo[2]..=hi[2] {
-                for j in lo[1]..=hi[1] {
-                    for i in lo[0]..=hi[0] {
-                        if triangle_box_overlap(t, [i, j, k]) {
-                            bits.set(i as u32, j as u32, k as u32);
-                        }
-                    }
-                }
-            }
-        }
-        bits
+        super::super::brute_force(tris, dims, triangle_box_overlap)
     }
 
     /// Exact separating axis test: does the closed triangle meet the closed

@@ -14,17 +14,62 @@ use super::Options;
 use crate::geom::lattice::LatticeTriangle;
 use crate::grid::bricks::{BrickBits, BrickSlab, BRICK};
 
-/// A per-triangle voxelization kernel.
-pub trait Kernel: Sync {
-    /// Sets, in `slab`, the voxels of `tri` whose indices lie in the inclusive
+/// An input primitive on the lattice: it knows which voxels it may touch.
+pub trait Primitive: Sync {
+    /// The inclusive voxel index box whose closed voxels meet the
+    /// primitive's bounding box, clamped to `dims`; `None` if empty.
+    fn voxel_bounds(&self, dims: [u32; 3]) -> Option<([i64; 3], [i64; 3])>;
+}
+
+impl Primitive for LatticeTriangle {
+    #[inline]
+    fn voxel_bounds(&self, dims: [u32; 3]) -> Option<([i64; 3], [i64; 3])> {
+        LatticeTriangle::voxel_bounds(self, dims)
+    }
+}
+
+/// A per-primitive voxelization kernel.
+pub trait Kernel<P>: Sync {
+    /// Sets, in `slab`, the voxels of `prim` whose indices lie in the inclusive
     /// box `[lo, hi]` (already clamped to the grid and to the slab's layers).
-    fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>);
+    fn run(&self, prim: &P, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>);
+}
+
+/// Where a traversal emits voxels: a slab, or a filter in front of one.
+pub trait Sink {
+    /// Emits voxel `(i, j, k)` (inside the grid).
+    fn set(&mut self, i: u32, j: u32, k: u32);
+}
+
+impl Sink for BrickSlab<'_> {
+    #[inline(always)]
+    fn set(&mut self, i: u32, j: u32, k: u32) {
+        BrickSlab::set(self, i, j, k);
+    }
+}
+
+/// Passes on to `slab` only the voxels `keep` accepts: a mode whose voxels
+/// are a subset of `cover` runs the `cover` traversal through one of these.
+pub struct Filter<'s, 'b, F> {
+    /// Destination.
+    pub slab: &'s mut BrickSlab<'b>,
+    /// The mode's exact per-voxel predicate.
+    pub keep: F,
+}
+
+impl<F: FnMut([i64; 3]) -> bool> Sink for Filter<'_, '_, F> {
+    #[inline(always)]
+    fn set(&mut self, i: u32, j: u32, k: u32) {
+        if (self.keep)([i as i64, j as i64, k as i64]) {
+            self.slab.set(i, j, k);
+        }
+    }
 }
 
 /// Runs `kernel` over `tris` on a grid of `dims`, in parallel over z-slabs
 /// (whole brick layers). Returns the grid and the number of voxels set
 /// (counted by each slab's task while its bricks are still in cache).
-pub fn run_slabs<K: Kernel>(kernel: &K, tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> (BrickBits, u64) {
+pub fn run_slabs<P: Primitive, K: Kernel<P>>(kernel: &K, tris: &[P], dims: [u32; 3], opts: &Options<'_>) -> (BrickBits, u64) {
     let mut grid = BrickBits::new(dims);
     let nz = dims[2];
     let height = if opts.slab_height > 0 {

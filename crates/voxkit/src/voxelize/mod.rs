@@ -4,11 +4,115 @@
 //! | mode | file | guarantee |
 //! |---|---|---|
 //! | `cover` | [`cover`] | exactly the voxels whose closed box meets a triangle (26-separating for closed surfaces) |
+//! | `sep26` | [`sep26`] | a triangle meets a space diagonal (26-separating, ⊆ `cover`) |
+//! | `sep6` | [`sep6`] | a triangle meets the 3D crosshair (6-separating, thin) |
+//! | `ss6` | [`ss6`] | Schwarz–Seidel plane + diamond tests (6-separating, ⊇ `sep6`) |
+//! | `line26`, `line6` | [`line`] | an element meets the bisecting squares / the surface (26- / 6-connected) |
+//!
+//! [`Mode`] with [`fast`] and [`reference`] dispatches over all of them.
 
 pub mod cover;
 pub mod driver;
+pub mod line;
+pub mod sep26;
+pub mod sep6;
+pub mod ss6;
+pub mod targets;
 
-use crate::geom::lattice::PrepareStats;
+use crate::geom::lattice::{prepare, LatticeTriangle, PrepareStats};
+use crate::grid::dense::DenseBits;
+use crate::grid::spec::GridSpec;
+use crate::mesh::MeshRef;
+
+/// The shared shape of the references: for every voxel of every
+/// primitive's bounding box, evaluate the mode's definition. Serial, dense,
+/// obviously correct.
+pub(crate) fn brute_force<P: driver::Primitive>(prims: &[P], dims: [u32; 3], hit: impl Fn(&P, [i64; 3]) -> bool) -> DenseBits {
+    let mut bits = DenseBits::new(dims);
+    for t in prims {
+        let Some((lo, hi)) = t.voxel_bounds(dims) else { continue };
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                for i in lo[0]..=hi[0] {
+                    if hit(t, [i, j, k]) {
+                        bits.set(i as u32, j as u32, k as u32);
+                    }
+                }
+            }
+        }
+    }
+    bits
+}
+
+/// [`brute_force`] on a mesh's snapped triangles.
+pub(crate) fn brute_force_triangles(
+    mesh: MeshRef<'_>,
+    grid: &GridSpec,
+    hit: impl Fn(&LatticeTriangle, [i64; 3]) -> bool,
+) -> (DenseBits, Report) {
+    let (tris, prepare_stats) = prepare(mesh, grid);
+    let bits = brute_force(&tris, grid.dims(), hit);
+    let voxels = bits.count();
+    (bits, Report { prepare: prepare_stats, voxels })
+}
+
+/// A surface or 1D voxelization mode (the solid modes live elsewhere).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Mode {
+    /// Conservative cover.
+    Cover,
+    /// Laine's 26-separating (space diagonals).
+    Sep26,
+    /// Laine's thin 6-separating (3D crosshair).
+    Sep6,
+    /// Schwarz–Seidel 6-separating.
+    Ss6,
+    /// 26-connected 1D (bisecting squares).
+    Line26,
+    /// 6-connected 1D (voxel surface).
+    Line6,
+}
+
+impl Mode {
+    /// Every mode, in documentation order.
+    pub const ALL: [Mode; 6] = [Mode::Cover, Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Line26, Mode::Line6];
+
+    /// The CLI name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Cover => "cover",
+            Mode::Sep26 => "sep26",
+            Mode::Sep6 => "sep6",
+            Mode::Ss6 => "ss6",
+            Mode::Line26 => "line26",
+            Mode::Line6 => "line6",
+        }
+    }
+}
+
+/// The mode's fast path (parallel, sparse bricks).
+pub fn fast(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (crate::grid::bricks::BrickBits, Report) {
+    match mode {
+        Mode::Cover => cover::cover(mesh, grid, opts),
+        Mode::Sep26 => sep26::sep26(mesh, grid, opts),
+        Mode::Sep6 => sep6::sep6(mesh, grid, opts),
+        Mode::Ss6 => ss6::ss6(mesh, grid, opts),
+        Mode::Line26 => line::line(mesh, grid, line::LineTarget::Squares26, opts),
+        Mode::Line6 => line::line(mesh, grid, line::LineTarget::Surface6, opts),
+    }
+}
+
+/// The mode's brute-force reference (serial, dense).
+pub fn reference(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec) -> (DenseBits, Report) {
+    match mode {
+        Mode::Cover => cover::reference::cover(mesh, grid),
+        Mode::Sep26 => sep26::reference::sep26(mesh, grid),
+        Mode::Sep6 => sep6::reference::sep6(mesh, grid),
+        Mode::Ss6 => ss6::reference::ss6(mesh, grid),
+        Mode::Line26 => line::reference::line(mesh, grid, line::LineTarget::Squares26),
+        Mode::Line6 => line::reference::line(mesh, grid, line::LineTarget::Surface6),
+    }
+}
 
 /// Receives progress of long voxelizations. Implemented by the CLI's
 /// progress bar; core never prints.

@@ -1,0 +1,80 @@
+//! Every topological mode's fast path equals its reference voxel for voxel
+//! on real meshes, rotated meshes, clipped grids, huge triangles and lattice
+//! edge cases (vertices on corners, faces on grid planes).
+
+use glam::DVec3;
+use voxkit::voxelize::Mode;
+use voxkit::GridSpec;
+use voxkit_testkit::{agree_mode, box_mesh, random_rotation, rng, rotated, shared_mesh, soup, SHARED_MESHES};
+
+const SURFACE: [Mode; 3] = [Mode::Sep26, Mode::Sep6, Mode::Ss6];
+
+#[test]
+fn every_shared_mesh_every_surface_mode() {
+    let mut r = rng(0x70b0);
+    for name in SHARED_MESHES {
+        let mesh = shared_mesh(name);
+        let rot = rotated(&mesh, random_rotation(&mut r));
+        for (m, res) in [(&mesh, 41), (&rot, 33)] {
+            let grid = GridSpec::from_resolution(&m.as_ref().bounds(), res).unwrap();
+            for mode in SURFACE {
+                let bits = agree_mode(mode, m, &grid).unwrap_or_else(|e| panic!("{name} at {res}: {e}"));
+                assert!(bits.count() > 0, "{name} {mode:?}: empty");
+            }
+        }
+    }
+}
+
+#[test]
+fn grid_aligned_boxes_hit_every_tie() {
+    // Faces on grid planes, on voxel-centre planes and half-way between;
+    // vertices on corners and face centres.
+    for (lo, hi) in [
+        (DVec3::new(1.0, 1.0, 1.0), DVec3::new(5.0, 4.0, 3.0)),
+        (DVec3::new(1.5, 1.5, 1.5), DVec3::new(4.5, 3.5, 5.5)),
+        (DVec3::new(1.25, 0.5, 2.0), DVec3::new(4.75, 3.0, 2.5)),
+    ] {
+        let m = box_mesh(lo, hi);
+        let grid = GridSpec::new(DVec3::ZERO, 1.0, [7, 6, 7]).unwrap();
+        for mode in SURFACE.into_iter().chain([Mode::Line26, Mode::Line6]) {
+            agree_mode(mode, &m, &grid).unwrap_or_else(|e| panic!("{lo} {hi}: {e}"));
+        }
+        let rot = rotated(&m, random_rotation(&mut rng(lo.x.to_bits())));
+        let grid = GridSpec::from_resolution(&rot.as_ref().bounds(), 9).unwrap();
+        for mode in SURFACE {
+            agree_mode(mode, &rot, &grid).unwrap();
+        }
+    }
+}
+
+#[test]
+fn huge_triangles_take_the_wide_arithmetic_path() {
+    // Faces of a box 90 voxels wide exceed the i64 bound of the target tests.
+    let m = box_mesh(DVec3::new(0.3, 0.2, 0.1), DVec3::new(90.3, 70.7, 80.9));
+    let rot = rotated(&m, random_rotation(&mut rng(11)));
+    let grid = GridSpec::from_resolution(&rot.as_ref().bounds(), 96).unwrap();
+    for mode in SURFACE {
+        agree_mode(mode, &rot, &grid).unwrap();
+    }
+}
+
+#[test]
+fn explicit_grid_clipping_the_mesh() {
+    let mesh = shared_mesh("cow.obj");
+    let b = mesh.as_ref().bounds();
+    let e = b.extent();
+    let grid = GridSpec::new(b.min + e * 0.3, e.max_element() / 40.0, [16, 13, 19]).unwrap();
+    for mode in SURFACE {
+        assert!(agree_mode(mode, &mesh, &grid).unwrap().count() > 0);
+    }
+}
+
+#[test]
+fn thin_tubes_as_triangles_in_line_modes() {
+    // A long sliver triangle: effective dimension 1.
+    let m = soup(&[[DVec3::new(0.3, 0.4, 0.2), DVec3::new(9.1, 6.3, 7.7), DVec3::new(9.1, 6.35, 7.72)]]);
+    let grid = GridSpec::new(DVec3::ZERO, 1.0, [10, 8, 9]).unwrap();
+    for mode in [Mode::Line26, Mode::Line6] {
+        assert!(agree_mode(mode, &m, &grid).unwrap().count() >= 9);
+    }
+}

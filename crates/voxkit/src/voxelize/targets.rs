@@ -1,0 +1,277 @@
+//! Intersection targets (Laine 2013) and the exact tests against them.
+//!
+//! This work is based on: S. Laine, "A Topological Approach to
+//! Voxelization", Computer Graphics Forum 32(4), 2013. A voxel is set iff
+//! the input meets the voxel's *target*; the target's shape, not the
+//! primitive, decides the topology of the result:
+//!
+//! | target | voxel `(i,j,k)`, corner `c = (i,j,k)·s`, centre `m = c + s/2` | used by |
+//! |---|---|---|
+//! | space diagonals | the four segments joining opposite corners | `sep26` (26-separating) |
+//! | 3D crosshair | the three axis-parallel segments through `m` from face centre to face centre | `sep6` (6-separating, thin) |
+//! | bisecting squares | the three axis-aligned squares through `m` spanning the voxel | `line26` (26-connected) |
+//! | voxel surface | the six closed faces | `line6` (6-connected) |
+//!
+//! Every target lies in the closed voxel, so each mode is a subset of
+//! `cover`, and fast paths may enumerate `cover`'s voxels as candidates.
+//! Ties follow [`crate::geom::perturb`]: targets are displaced by
+//! `δ = −(ε, ε², ε³)`.
+//!
+//! The `*_hit` functions here are the definitions, in `i128` via the generic
+//! orientation predicate; `TriSetup` is the same test specialised for one
+//! triangle and a fixed segment direction, for the fast paths.
+
+use crate::geom::fixed::{PlaneInt, ONE};
+use crate::geom::lattice::{LatticeSegment, LatticeTriangle};
+use crate::geom::perturb::{bias, segment_meets_square, segment_meets_triangle, triangle_meets_square, P3};
+
+const H: i64 = ONE / 2;
+
+fn corner(ijk: [i64; 3]) -> P3 {
+    ijk.map(|c| c * ONE)
+}
+
+fn add(a: P3, b: P3) -> P3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// Start offsets (from the voxel's low corner) and directions of the four
+/// space diagonals.
+pub const DIAGONALS: [(P3, P3); 4] =
+    [([0, 0, 0], [ONE, ONE, ONE]), ([ONE, 0, 0], [-ONE, ONE, ONE]), ([0, ONE, 0], [ONE, -ONE, ONE]), ([0, 0, ONE], [ONE, ONE, -ONE])];
+
+/// Start offsets and directions of the three crosshair segments (along x, y, z).
+pub const CROSSHAIR: [(P3, P3); 3] = [([0, H, H], [ONE, 0, 0]), ([H, 0, H], [0, ONE, 0]), ([H, H, 0], [0, 0, ONE])];
+
+/// The four space diagonals of voxel `ijk`.
+pub fn diagonals(ijk: [i64; 3]) -> [[P3; 2]; 4] {
+    DIAGONALS.map(|(o, d)| {
+        let p = add(corner(ijk), o);
+        [p, add(p, d)]
+    })
+}
+
+/// The three crosshair segments of voxel `ijk`.
+pub fn crosshair(ijk: [i64; 3]) -> [[P3; 2]; 3] {
+    CROSSHAIR.map(|(o, d)| {
+        let p = add(corner(ijk), o);
+        [p, add(p, d)]
+    })
+}
+
+/// The square perpendicular to `axis` at offset `at` (lattice units from
+/// the voxel's low corner), spanning the voxel, corners in order.
+fn square(ijk: [i64; 3], axis: usize, at: i64) -> [P3; 4] {
+    let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+    let c = corner(ijk);
+    let pt = |du: i64, dv: i64| {
+        let mut p = c;
+        p[axis] += at;
+        p[u] += du;
+        p[v] += dv;
+        p
+    };
+    [pt(0, 0), pt(ONE, 0), pt(ONE, ONE), pt(0, ONE)]
+}
+
+/// The three axis-aligned squares bisecting voxel `ijk`.
+pub fn bisecting_squares(ijk: [i64; 3]) -> [[P3; 4]; 3] {
+    std::array::from_fn(|a| square(ijk, a, H))
+}
+
+/// The six faces of voxel `ijk`.
+pub fn faces(ijk: [i64; 3]) -> [[P3; 4]; 6] {
+    std::array::from_fn(|f| square(ijk, f / 2, (f % 2) as i64 * ONE))
+}
+
+/// `sep26` definition: the triangle meets one of the voxel's space diagonals.
+pub fn sep26_hit(t: &LatticeTriangle, ijk: [i64; 3]) -> bool {
+    diagonals(ijk).iter().any(|s| segment_meets_triangle(*s, t.v, true))
+}
+
+/// `sep6` definition: the triangle meets one of the voxel's crosshair segments.
+pub fn sep6_hit(t: &LatticeTriangle, ijk: [i64; 3]) -> bool {
+    crosshair(ijk).iter().any(|s| segment_meets_triangle(*s, t.v, true))
+}
+
+/// An input element of the line modes: a segment, or a triangle (whose
+/// effective dimension may be 1, e.g. a thin tube).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Element {
+    /// A polyline segment.
+    Segment(LatticeSegment),
+    /// A triangle.
+    Triangle(LatticeTriangle),
+}
+
+impl Element {
+    fn meets_square(&self, q: [P3; 4]) -> bool {
+        match self {
+            Element::Segment(s) => segment_meets_square(s.v, q),
+            Element::Triangle(t) => triangle_meets_square(t.v, q),
+        }
+    }
+}
+
+/// `line26` definition: the element meets one of the three bisecting squares.
+pub fn line26_hit(e: &Element, ijk: [i64; 3]) -> bool {
+    bisecting_squares(ijk).iter().any(|q| e.meets_square(*q))
+}
+
+/// `line6` definition: the element meets the voxel's surface.
+pub fn line6_hit(e: &Element, ijk: [i64; 3]) -> bool {
+    faces(ijk).iter().any(|q| e.meets_square(*q))
+}
+
+/// Largest `extent + 2 voxels` for which `TriSetup` is exact in `i64`:
+/// relative coordinates stay below `2^19`, normals below `2^37`, plane and
+/// orientation values below `2^58`.
+pub(crate) const I64_TARGET_LIMIT: i64 = 1 << 18;
+
+/// One triangle, set up for exact tests against displaced target segments
+/// of fixed directions. Coordinates are relative to the triangle's first
+/// vertex, in `T` (`i64` for small triangles, `i128` otherwise).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TriSetup<T> {
+    /// The first vertex (absolute lattice coordinates).
+    pub a: P3,
+    /// The vertices relative to `a`.
+    pub rel: [[T; 3]; 3],
+    /// The normal `e0 × e1`.
+    pub n: [T; 3],
+    /// Plane bias: a displaced point `p` is on the positive side iff `n·(p−a) >= bn`.
+    pub bn: T,
+}
+
+/// Per-direction data of [`TriSetup::segment_hits`]: the direction and the
+/// tie bias of each edge's orientation test.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct DirSetup<T> {
+    d: [T; 3],
+    /// Tie bias of each edge's orientation test.
+    pub be: [T; 3],
+}
+
+#[inline(always)]
+fn dot<T: PlaneInt>(a: [T; 3], b: [T; 3]) -> T {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+fn crs<T: PlaneInt>(a: [T; 3], b: [T; 3]) -> [T; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+#[inline(always)]
+fn sub<T: PlaneInt>(a: [T; 3], b: [T; 3]) -> [T; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+impl<T: PlaneInt> TriSetup<T> {
+    /// Setup for `t`.
+    pub fn new(t: &LatticeTriangle) -> TriSetup<T> {
+        let a = t.v[0];
+        let n = t.normal();
+        TriSetup { a, rel: t.v.map(|p| std::array::from_fn(|c| T::from_i64(p[c] - a[c]))), n: n.map(T::from_i64), bn: T::from_i64(bias(n)) }
+    }
+
+    /// Setup for target segments of direction `d` (lattice units).
+    pub fn dir(&self, t: &LatticeTriangle, d: P3) -> DirSetup<T> {
+        // orient(p+δ, q+δ, A, B) = O − δ·(e × d): its tie is decided by −(e × d).
+        let be = std::array::from_fn(|i| {
+            let m = crate::geom::lattice::cross(t.edge(i), d);
+            T::from_i64(bias([-m[0], -m[1], -m[2]]))
+        });
+        DirSetup { d: d.map(T::from_i64), be }
+    }
+
+    /// A lattice point relative to `a`.
+    #[inline(always)]
+    pub fn local(&self, p: P3) -> [T; 3] {
+        std::array::from_fn(|c| T::from_i64(p[c] - self.a[c]))
+    }
+
+    /// Is the displaced point `p` (relative to `a`) on the positive side of the plane?
+    #[inline(always)]
+    pub fn above(&self, p: [T; 3]) -> bool {
+        dot(self.n, p) >= self.bn
+    }
+
+    /// Does the displaced target segment from `p` (relative to `a`) to
+    /// `p + d` meet the triangle? Same decision as
+    /// [`segment_meets_triangle`] with the segment as target.
+    #[inline(always)]
+    pub fn segment_hits(&self, ds: &DirSetup<T>, p: [T; 3]) -> bool {
+        let q = [p[0] + ds.d[0], p[1] + ds.d[1], p[2] + ds.d[2]];
+        if self.above(p) == self.above(q) {
+            return false;
+        }
+        let o = |i: usize| dot(ds.d, crs(sub(self.rel[i], p), sub(self.rel[(i + 1) % 3], p))) >= ds.be[i];
+        let o0 = o(0);
+        o0 == o(1) && o0 == o(2)
+    }
+
+    /// The three edge orientation values of the target line through `p`
+    /// (relative to `a`) with direction `ds`. The displaced line meets the
+    /// triangle iff the three `values[i] >= ds.be[i]` agree.
+    #[inline(always)]
+    pub fn line_values(&self, ds: &DirSetup<T>, p: [T; 3]) -> [T; 3] {
+        std::array::from_fn(|i| dot(ds.d, crs(sub(self.rel[i], p), sub(self.rel[(i + 1) % 3], p))))
+    }
+}
+
+/// Is a triangle with these lattice bounds small enough for `i64` setups?
+pub(crate) fn fits_i64(t: &LatticeTriangle) -> bool {
+    let (lo, hi) = t.bounds();
+    (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0) + 2 * ONE <= I64_TARGET_LIMIT
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lt(v: [[i64; 3]; 3]) -> LatticeTriangle {
+        LatticeTriangle { v }
+    }
+
+    #[test]
+    fn fast_segment_test_matches_the_definition() {
+        // Triangles through corners, along faces, on centre planes: the
+        // degenerate touches the perturbation must decide.
+        let tris = [
+            lt([[0, 0, 0], [2 * ONE, 0, 0], [0, 2 * ONE, 0]]),
+            lt([[0, 0, H], [2 * ONE, 0, H], [0, 2 * ONE, H]]),
+            lt([[0, 0, 0], [ONE, ONE, ONE], [2 * ONE, 0, ONE]]),
+            lt([[H, -ONE, -ONE], [H, 3 * ONE, -ONE], [H, -ONE, 3 * ONE]]),
+            lt([[0, 0, 0], [ONE, 0, ONE], [0, ONE, ONE]]),
+            lt([[ONE, 0, 0], [0, ONE, 0], [0, 0, ONE]]),
+        ];
+        for t in &tris {
+            let s64 = TriSetup::<i64>::new(t);
+            let s128 = TriSetup::<i128>::new(t);
+            for (o, d) in DIAGONALS.iter().chain(CROSSHAIR.iter()) {
+                let (d64, d128) = (s64.dir(t, *d), s128.dir(t, *d));
+                for k in -1..3 {
+                    for j in -1..3 {
+                        for i in -1..3 {
+                            let p = add(corner([i, j, k]), *o);
+                            let want = segment_meets_triangle([p, add(p, *d)], t.v, true);
+                            assert_eq!(s64.segment_hits(&d64, s64.local(p)), want, "{t:?} {p:?} {d:?}");
+                            assert_eq!(s128.segment_hits(&d128, s128.local(p)), want);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn triangle_on_a_grid_plane_sets_one_layer_of_sep6() {
+        // z = 0 is a layer boundary. Displaced by −ε³, the z-segment of
+        // layer 0 spans (−ε³, 1 − ε³) and crosses the triangle; layer −1
+        // lies below.
+        let t = lt([[0, 0, 0], [4 * ONE, 0, 0], [0, 4 * ONE, 0]]);
+        let hit = |k| sep6_hit(&t, [0, 0, k]);
+        assert!(hit(0) && !hit(-1));
+    }
+}
