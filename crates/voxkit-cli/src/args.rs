@@ -126,6 +126,9 @@ pub struct BenchArgs {
     /// Resolutions (longest side in voxels).
     #[arg(long, value_delimiter = ',', default_value = "128,256,512,1024")]
     pub resolutions: Vec<u64>,
+    /// Modes to measure (surface and line modes).
+    #[arg(long, value_delimiter = ',', default_value = "cover")]
+    pub modes: Vec<Mode>,
     /// Thread counts to measure.
     #[arg(long, value_delimiter = ',', default_value = "1,2")]
     pub threads: Vec<usize>,

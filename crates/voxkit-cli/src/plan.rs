@@ -51,21 +51,28 @@ impl GridRequest {
     }
 }
 
-/// The method that will run for `mode`, or an error saying why none can.
-pub fn resolve_method(mode: Mode, method: Method) -> Result<&'static str> {
-    if mode != Mode::Cover {
-        bail!(
-            "mode '{}' is not implemented yet in this build (only 'cover' is); see the project's issues for sep26/sep6/ss6, lines, solid and pos",
-            mode_name(mode)
-        );
-    }
-    match method {
-        Method::Auto | Method::Fast => Ok("fast"),
-        Method::Reference => Ok("reference"),
+/// The core mode and the method that will run, or an error saying why none can.
+pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::Mode, &'static str)> {
+    use voxkit::voxelize::Mode as Core;
+    let core = match mode {
+        Mode::Cover => Core::Cover,
+        Mode::Sep26 => Core::Sep26,
+        Mode::Sep6 => Core::Sep6,
+        Mode::Ss6 => Core::Ss6,
+        Mode::Line26 => Core::Line26,
+        Mode::Line6 => Core::Line6,
+        Mode::Solid | Mode::Pos => {
+            bail!("mode '{}' is not implemented yet in this build; available: cover, sep26, sep6, ss6, line26, line6", mode_name(mode))
+        }
+    };
+    let m = match method {
+        Method::Auto | Method::Fast => "fast",
+        Method::Reference => "reference",
         Method::Scanline => bail!("--method scanline is not implemented yet in this build; use auto, fast or reference"),
         Method::Gpu => bail!("--method gpu is not implemented yet in this build (no GPU backend); use auto, fast or reference"),
         Method::Parity | Method::Winding => bail!("--method {} applies only to --mode solid", method_name(method)),
-    }
+    };
+    Ok((core, m))
 }
 
 pub fn mode_name(m: Mode) -> &'static str {

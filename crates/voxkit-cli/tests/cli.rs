@@ -118,7 +118,7 @@ fn bad_input_gives_one_line_errors() {
             "at most 65536 per axis",
         ),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--resolution".into(), "60000".into()], "needs"),
-        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--mode".into(), "sep6".into()], "not implemented"),
+        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--mode".into(), "pos".into()], "not implemented"),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--method".into(), "gpu".into()], "not implemented"),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--origin".into(), "0,0,0".into()], "explicit grid needs"),
         (

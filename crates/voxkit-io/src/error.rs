@@ -62,8 +62,18 @@ pub enum ErrorKind {
         /// Number of vertices.
         count: usize,
     },
-    /// The file holds no triangles.
-    #[error("contains no triangles")]
+    /// A segment refers to a vertex that does not exist.
+    #[error("segment {line} refers to vertex {index}, but there are only {count} vertices")]
+    SegmentIndexOutOfRange {
+        /// Segment index (0-based, after splitting polylines).
+        line: usize,
+        /// The index found.
+        index: i64,
+        /// Number of vertices.
+        count: usize,
+    },
+    /// The file holds no triangles (and no line segments).
+    #[error("contains no triangles or line segments")]
     Empty,
     /// The data is valid but uses something voxkit does not support.
     #[error("unsupported: {0}")]

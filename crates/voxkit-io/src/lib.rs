@@ -18,6 +18,7 @@ pub mod mesh_report;
 pub mod npy;
 pub mod obj;
 pub mod ply;
+pub mod polyline;
 pub mod stl;
 pub mod text;
 pub mod vox;
@@ -39,6 +40,8 @@ pub enum MeshFormat {
     Ply,
     /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`).
     Gltf,
+    /// Plain text polylines (`.lines`).
+    Polyline,
 }
 
 impl MeshFormat {
@@ -49,6 +52,7 @@ impl MeshFormat {
             "stl" => Some(MeshFormat::Stl),
             "ply" => Some(MeshFormat::Ply),
             "gltf" | "glb" => Some(MeshFormat::Gltf),
+            "lines" => Some(MeshFormat::Polyline),
             _ => None,
         }
     }
@@ -57,8 +61,9 @@ impl MeshFormat {
 /// Reads a mesh file, choosing the format from its extension.
 pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    let format = MeshFormat::from_extension(ext)
-        .ok_or_else(|| IoError::new(path, ErrorKind::UnknownFormat { ext: ext.to_string(), expected: "obj, stl, ply, gltf, glb" }))?;
+    let format = MeshFormat::from_extension(ext).ok_or_else(|| {
+        IoError::new(path, ErrorKind::UnknownFormat { ext: ext.to_string(), expected: "obj, stl, ply, gltf, glb, lines" })
+    })?;
     let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
     let base = path.parent().unwrap_or(Path::new("."));
     read_mesh_bytes(&bytes, format, Some(base)).map_err(|kind| IoError::new(path, kind))
@@ -72,12 +77,14 @@ pub fn read_mesh_bytes(bytes: &[u8], format: MeshFormat, base_dir: Option<&Path>
         MeshFormat::Stl => "STL",
         MeshFormat::Ply => "PLY",
         MeshFormat::Gltf => "glTF",
+        MeshFormat::Polyline => "polyline",
     };
     fence(name, || match format {
         MeshFormat::Obj => obj::read(bytes, base_dir),
         MeshFormat::Stl => stl::read(bytes),
         MeshFormat::Ply => ply::read(bytes),
         MeshFormat::Gltf => gltf::read(bytes, base_dir),
+        MeshFormat::Polyline => polyline::read(bytes),
     })
 }
 

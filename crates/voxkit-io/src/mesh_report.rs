@@ -15,7 +15,9 @@ pub struct MeshReport {
     pub triangles: usize,
     /// Triangles with repeated indices or zero area; voxelizers skip them.
     pub degenerate: usize,
-    /// Bounding box of the vertices used by triangles.
+    /// Line segments (polyline input).
+    pub segments: usize,
+    /// Bounding box of the vertices used by triangles and segments.
     pub bounds: Aabb,
 }
 
@@ -33,6 +35,17 @@ pub struct LoadedMesh {
 /// Validates and packages reader output: every coordinate finite, every
 /// index in range, at least one triangle.
 pub(crate) fn finish(positions: Vec<DVec3>, triangles: Vec<[i64; 3]>, warnings: Vec<String>) -> Result<LoadedMesh, ErrorKind> {
+    finish_with_segments(positions, triangles, Vec::new(), warnings)
+}
+
+/// [`finish`] for input that may carry line segments: at least one
+/// triangle or segment.
+pub(crate) fn finish_with_segments(
+    positions: Vec<DVec3>,
+    triangles: Vec<[i64; 3]>,
+    segments: Vec<[i64; 2]>,
+    warnings: Vec<String>,
+) -> Result<LoadedMesh, ErrorKind> {
     for (index, p) in positions.iter().enumerate() {
         if let Some(&value) = p.to_array().iter().find(|c| !c.is_finite()) {
             return Err(ErrorKind::NonFinite { index, value });
@@ -48,12 +61,27 @@ pub(crate) fn finish(positions: Vec<DVec3>, triangles: Vec<[i64; 3]>, warnings: 
         }
         tris.push(t.map(|i| i as u32));
     }
-    if tris.is_empty() {
+    let mut segs = Vec::with_capacity(segments.len());
+    for (line, s) in segments.iter().enumerate() {
+        for &index in s {
+            if index < 0 || index as usize >= count {
+                return Err(ErrorKind::SegmentIndexOutOfRange { line, index, count });
+            }
+        }
+        segs.push(s.map(|i| i as u32));
+    }
+    if tris.is_empty() && segs.is_empty() {
         return Err(ErrorKind::Empty);
     }
-    let mesh = Mesh { positions, triangles: tris, segments: Vec::new() };
+    let mesh = Mesh { positions, triangles: tris, segments: segs };
     let r = mesh.as_ref();
-    let report = MeshReport { vertices: count, triangles: mesh.triangles.len(), degenerate: r.degenerate_count(), bounds: r.bounds() };
+    let report = MeshReport {
+        vertices: count,
+        triangles: mesh.triangles.len(),
+        degenerate: r.degenerate_count(),
+        segments: mesh.segments.len(),
+        bounds: r.bounds(),
+    };
     Ok(LoadedMesh { mesh, report, warnings })
 }
 

@@ -3,6 +3,11 @@
 //! Polygons with more than three vertices are fan-triangulated; negative
 //! (relative) indices are resolved by tobj. A missing or broken material
 //! library is a warning, not an error: geometry does not need it.
+//!
+//! Polylines (`l v1 v2 … vn`) become `n − 1` segments. tobj reads an `l`
+//! record with three vertices as a triangle, so `l` records are read here
+//! (vertex indices only; `v/vt` forms accepted, negative indices relative
+//! to the vertices read so far) and blanked out before tobj sees the file.
 
 use std::io::{BufReader, Cursor};
 use std::path::Path;
@@ -11,10 +16,12 @@ use std::sync::Mutex;
 use glam::DVec3;
 
 use crate::error::ErrorKind;
-use crate::mesh_report::{fan, finish, LoadedMesh};
+use crate::mesh_report::{fan, finish_with_segments, LoadedMesh};
 
 /// Parses OBJ bytes; `base_dir` is where `mtllib` files are looked up.
 pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKind> {
+    let (blanked, line_positions, line_segments) = split_polylines(bytes)?;
+    let bytes: &[u8] = blanked.as_deref().unwrap_or(bytes);
     let warnings = Mutex::new(Vec::<String>::new());
     let opts = tobj::LoadOptions { triangulate: false, single_index: false, ignore_points: true, ignore_lines: true };
     let mut reader = BufReader::new(Cursor::new(bytes));
@@ -64,5 +71,59 @@ pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKi
             }
         }
     }
-    finish(positions, triangles, warnings)
+    let base = positions.len() as i64;
+    positions.extend(line_positions);
+    let segments = line_segments.into_iter().map(|[a, b]| [base + a, base + b]).collect();
+    finish_with_segments(positions, triangles, segments, warnings)
+}
+
+/// Reads the `v` and `l` records. Returns the bytes with `l` records
+/// blanked (None if there are none), the vertex positions, and the segments
+/// as 0-based indices into them.
+#[allow(clippy::type_complexity)]
+fn split_polylines(bytes: &[u8]) -> Result<(Option<Vec<u8>>, Vec<DVec3>, Vec<[i64; 2]>), ErrorKind> {
+    let is_l = |line: &[u8]| line.first() == Some(&b'l') && line.get(1).is_some_and(|c| c.is_ascii_whitespace());
+    if !bytes.split(|&b| b == b'\n').any(|l| is_l(l.trim_ascii_start())) {
+        return Ok((None, Vec::new(), Vec::new()));
+    }
+    let mut out = bytes.to_vec();
+    let mut positions = Vec::new();
+    let mut segments = Vec::new();
+    let mut at = 0usize;
+    for (number, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+        let start = at;
+        at += raw.len() + 1;
+        let line = raw.trim_ascii_start();
+        let text = String::from_utf8_lossy(line);
+        let mut words = text.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let c: Vec<f64> = words.take(3).map_while(|w| w.parse().ok()).collect();
+                // Malformed vertices are tobj's to report; keep numbering aligned.
+                positions.push(if c.len() == 3 { DVec3::new(c[0], c[1], c[2]) } else { DVec3::NAN });
+            }
+            Some("l") => {
+                let mut poly = Vec::new();
+                for w in words {
+                    let first = w.split('/').next().unwrap_or("");
+                    let i: i64 = first
+                        .parse()
+                        .map_err(|_| ErrorKind::malformed("OBJ", format!("line {}: bad vertex index {w:?} in 'l'", number + 1)))?;
+                    let resolved = match i {
+                        0 => return Err(ErrorKind::malformed("OBJ", format!("line {}: vertex index 0 in 'l'", number + 1))),
+                        i if i > 0 => i - 1,
+                        i => positions.len() as i64 + i,
+                    };
+                    poly.push(resolved);
+                }
+                if poly.len() < 2 {
+                    return Err(ErrorKind::malformed("OBJ", format!("line {}: 'l' needs at least two vertices", number + 1)));
+                }
+                segments.extend(poly.windows(2).map(|w| [w[0], w[1]]));
+                out[start..start + raw.len()].iter_mut().for_each(|b| *b = b' ');
+            }
+            _ => {}
+        }
+    }
+    Ok((Some(out), positions, segments))
 }

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use serde_json::json;
-use voxkit::voxelize::{cover, Options};
+use voxkit::voxelize::{self, Options};
 use voxkit::VoxelSource;
 use voxkit_io::VoxelFormat;
 
@@ -17,7 +17,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let t_total = Instant::now();
     // Validate everything that does not need the mesh first.
     let request = GridRequest::from_args(&a.grid)?;
-    let method = plan::resolve_method(a.mode, a.method)?;
+    let (mode, method) = plan::resolve_method(a.mode, a.method)?;
     let format = match &a.format {
         Some(f) => {
             VoxelFormat::from_name(f).with_context(|| format!("unknown --format {f:?} (expected one of: {})", VoxelFormat::NAMES))?
@@ -42,6 +42,18 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     for w in &loaded.warnings {
         eprintln!("voxkit: warning: {}: {w}", a.mesh.display());
     }
+    let is_line = matches!(mode, voxelize::Mode::Line26 | voxelize::Mode::Line6);
+    if !is_line && loaded.report.triangles == 0 {
+        bail!("{}: has only line segments; surface modes need triangles (use --mode line26 or line6)", a.mesh.display());
+    }
+    if !is_line && loaded.report.segments > 0 {
+        eprintln!(
+            "voxkit: warning: {}: {} line segments ignored by surface mode {} (line26 and line6 voxelize them)",
+            a.mesh.display(),
+            loaded.report.segments,
+            mode.name()
+        );
+    }
     let grid = request.fit(&loaded.report.bounds)?;
     plan::check_memory(&grid)?;
 
@@ -49,11 +61,11 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let t_vox = Instant::now();
     let (bits, report): (Box<dyn VoxelSource + Send>, _) = pool.install(|| match method {
         "reference" => {
-            let (b, r) = cover::reference::cover(loaded.mesh.as_ref(), &grid);
+            let (b, r) = voxelize::reference(mode, loaded.mesh.as_ref(), &grid);
             (Box::new(b) as Box<dyn VoxelSource + Send>, r)
         }
         _ => {
-            let (b, r) = cover::cover(loaded.mesh.as_ref(), &grid, &Options { progress: Some(&bar), ..Options::default() });
+            let (b, r) = voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &Options { progress: Some(&bar), ..Options::default() });
             (Box::new(b) as Box<dyn VoxelSource + Send>, r)
         }
     });
@@ -68,7 +80,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
 
     let p = report.prepare;
     if p.non_finite + p.invalid_index > 0 {
-        eprintln!("voxkit: warning: skipped {} triangles with invalid vertices", p.non_finite + p.invalid_index);
+        eprintln!("voxkit: warning: skipped {} primitives with invalid vertices", p.non_finite + p.invalid_index);
     }
     let o = grid.origin();
     let dims = grid.dims();
@@ -92,6 +104,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
                 "vertices": loaded.report.vertices,
                 "triangles": loaded.report.triangles,
                 "degenerate": loaded.report.degenerate,
+                "segments": loaded.report.segments,
             },
             "triangles": {
                 "input": p.input,

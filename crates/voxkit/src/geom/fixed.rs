@@ -55,6 +55,8 @@ pub(crate) trait PlaneInt:
     fn from_i64(x: i64) -> Self;
     fn to_f64(self) -> f64;
     fn to_i128(self) -> i128;
+    /// Floor division (`d != 0`).
+    fn div_floor(self, d: Self) -> Self;
 }
 
 impl PlaneInt for i64 {
@@ -71,6 +73,10 @@ impl PlaneInt for i64 {
     fn to_i128(self) -> i128 {
         self as i128
     }
+    #[inline(always)]
+    fn div_floor(self, d: Self) -> Self {
+        self.div_euclid(d) - if d < 0 && self.rem_euclid(d) != 0 { 1 } else { 0 }
+    }
 }
 
 impl PlaneInt for i128 {
@@ -86,6 +92,10 @@ impl PlaneInt for i128 {
     #[inline(always)]
     fn to_i128(self) -> i128 {
         self
+    }
+    #[inline(always)]
+    fn div_floor(self, d: Self) -> Self {
+        self.div_euclid(d) - if d < 0 && self.rem_euclid(d) != 0 { 1 } else { 0 }
     }
 }
 

@@ -20,7 +20,7 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_slabs, Filter, Kernel};
-use super::targets::{fits_i64, TriSetup, DIAGONALS};
+use super::targets::{dominant_axes, fits_i64, PixelTest, TriSetup, DIAGONALS};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{prepare, LatticeTriangle};
@@ -51,10 +51,43 @@ impl Kernel<LatticeTriangle> for Sep26Kernel {
 
 fn filtered<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], traversal: Traversal, slab: &mut BrickSlab<'_>) {
     let s = TriSetup::<T>::new(tri);
-    let dirs = DIAGONALS.map(|(o, d)| (o.map(T::from_i64), s.dir(tri, d)));
+    let dirs = DIAGONALS.map(|(o, d)| {
+        let o = o.map(T::from_i64);
+        (o, s.plane(o), s.dir(tri, d))
+    });
+    // Plane values of the voxel's corners span [vc + lo, vc + hi].
+    let (mut vlo, mut vhi) = (T::ZERO, T::ZERO);
+    for c in s.n {
+        let x = c * T::from_i64(ONE);
+        if x < T::ZERO {
+            vlo = vlo + x;
+        } else {
+            vhi = vhi + x;
+        }
+    }
+    let (u, v, w) = dominant_axes(tri);
+    let pix = PixelTest::new(&s, tri, (u, v, w));
+    // cover emits a column's voxels together: decide once per column
+    // whether its pixel lies strictly inside the projected triangle.
+    let mut column = (i64::MIN, i64::MIN, false);
     let keep = |ijk: [i64; 3]| {
         let c = s.local(ijk.map(|x| x * ONE));
-        dirs.iter().any(|(o, ds)| s.segment_hits(ds, [c[0] + o[0], c[1] + o[1], c[2] + o[2]]))
+        let vc = s.plane(c);
+        if (ijk[u], ijk[v]) != (column.0, column.1) {
+            let mut pc = c;
+            pc[u] = pc[u] + T::from_i64(ONE / 2);
+            pc[v] = pc[v] + T::from_i64(ONE / 2);
+            column = (ijk[u], ijk[v], pix.strictly_inside(&s.line_values(&pix.dw, pc)));
+        }
+        if column.2 {
+            // Every point of the voxel's plane section projects strictly
+            // inside the triangle, so a diagonal is hit iff the (displaced)
+            // corners are not all on one side: for an affine plane value,
+            // opposite corners average to the centre's value, so corners
+            // on both sides put some opposite pair on both sides.
+            return vc + vlo < s.bn && vc + vhi >= s.bn;
+        }
+        dirs.iter().any(|(o, vo, ds)| s.segment_hits_with(ds, [c[0] + o[0], c[1] + o[1], c[2] + o[2]], vc + *vo))
     };
     cover_triangle(tri, lo, hi, traversal, &mut Filter { slab, keep });
 }

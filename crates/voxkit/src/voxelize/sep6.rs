@@ -27,7 +27,7 @@
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
 use super::driver::{run_slabs, Kernel};
-use super::targets::{fits_i64, TriSetup};
+use super::targets::{dominant_axes, fits_i64, PixelTest, TriSetup};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{prepare, LatticeTriangle};
@@ -62,81 +62,82 @@ fn unit(a: usize) -> [i64; 3] {
     d
 }
 
-fn div_floor(n: i128, d: i128) -> i128 {
-    let q = n / d;
-    if (n % d != 0) && ((n < 0) != (d < 0)) {
-        q - 1
-    } else {
-        q
-    }
-}
-
 /// Laine's single-projection algorithm for one triangle, restricted to the
 /// voxel box `[lo, hi]`.
 fn project<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     let s = TriSetup::<T>::new(tri);
     let n = tri.normal();
-    let w = (0..3).fold(0, |best, a| if n[a].abs() > n[best].abs() { a } else { best });
-    let (u, v) = ((w + 1) % 3, (w + 2) % 3);
-    let (dw, du, dv) = (s.dir(tri, unit(w)), s.dir(tri, unit(u)), s.dir(tri, unit(v)));
-    // Inside the projection the w-line's edge values are positive iff n_w > 0.
-    let sgn = if n[w] > 0 { T::from_i64(1) } else { T::from_i64(-1) };
-    // How much an edge value can grow from the pixel centre to its square.
-    let reach: [T; 3] = std::array::from_fn(|i| {
-        let e = tri.edge(i);
-        T::from_i64(H * ONE * (e[u].abs() + e[v].abs()))
-    });
-    let (nu, nv, nw) = (n[u] as i128, n[v] as i128, n[w] as i128);
+    let (u, v, w) = dominant_axes(tri);
+    let pix = PixelTest::new(&s, tri, (u, v, w));
+    let dw = &pix.dw;
+    let (du, dv) = (s.dir(tri, unit(u)), s.dir(tri, unit(v)));
+    let (nu, nv, nw) = (T::from_i64(n[u]), T::from_i64(n[v]), T::from_i64(n[w]));
+    let (one, h) = (T::from_i64(ONE), T::from_i64(H));
+    let inv_nw = 1.0 / n[w] as f64;
     let emit = |slab: &mut BrickSlab<'_>, iu: i64, iv: i64, t: i64| {
         let mut ijk = [0i64; 3];
         (ijk[u], ijk[v], ijk[w]) = (iu, iv, t);
         slab.set(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
     };
+    // Edge values of the w-line are affine in the pixel centre: step them
+    // along u by `step`.
+    let mut c0 = s.a;
+    (c0[u], c0[v]) = (lo[u] * ONE + H, lo[v] * ONE + H);
+    let mut c1 = c0;
+    c1[u] += ONE;
+    let (o0, o1) = (s.line_values(dw, s.local(c0)), s.line_values(dw, s.local(c1)));
+    let step: [T; 3] = std::array::from_fn(|i| o1[i] - o0[i]);
     for iv in lo[v]..=hi[v] {
+        let mut c = s.a;
+        (c[u], c[v]) = (lo[u] * ONE + H, iv * ONE + H);
+        let mut pc = s.local(c);
+        let mut o = s.line_values(dw, pc);
         for iu in lo[u]..=hi[u] {
-            // The pixel centre, at the depth of the triangle's first vertex.
-            let mut c = s.a;
-            (c[u], c[v]) = (iu * ONE + H, iv * ONE + H);
-            let pc = s.local(c);
-            let o = s.line_values(&dw, pc);
+            if iu > lo[u] {
+                pc[u] = pc[u] + one;
+                for i in 0..3 {
+                    o[i] = o[i] + step[i];
+                }
+            }
             let inside = [0, 1, 2].map(|i| o[i] >= dw.be[i]);
+            // Plane value along the column: V(W) = v0 + n_w·(W − a_w).
+            let v0 = nu * pc[u] + nv * pc[v];
             if inside[0] == inside[1] && inside[1] == inside[2] {
-                // Plane value along the column: V(W) = v0 + n_w·(W − a_w),
-                // positive side iff V >= bn. The hit voxel's segment
-                // [t·ONE, (t+1)·ONE] straddles the switch.
-                let v0 = nu * pc[u].to_i128() + nv * pc[v].to_i128();
-                let bn = s.bn.to_i128();
-                let aw = s.a[w] as i128;
-                let t = if nw > 0 {
-                    // above iff W >= a_w + ceil((bn − v0) / n_w)
-                    let w_star = aw - div_floor(v0 - bn, nw);
-                    div_floor(w_star - 1, ONE as i128)
+                // The hit voxel's w-segment [t·ONE, (t+1)·ONE] straddles the
+                // switch to the plane's positive side (V >= bn).
+                let t = if nw > T::ZERO {
+                    // positive iff W >= a_w + ceil((bn − v0) / n_w)
+                    let w_star = T::from_i64(s.a[w]) - (v0 - s.bn).div_floor(nw);
+                    (w_star - T::from_i64(1)).div_floor(one)
                 } else {
-                    // above iff W <= a_w + floor((v0 − bn) / −n_w)
-                    let w_star = aw + div_floor(v0 - bn, -nw);
-                    div_floor(w_star, ONE as i128)
+                    // positive iff W <= a_w + floor((v0 − bn) / −n_w)
+                    let w_star = T::from_i64(s.a[w]) + (v0 - s.bn).div_floor(-nw);
+                    w_star.div_floor(one)
                 };
-                if t >= lo[w] as i128 && t <= hi[w] as i128 {
-                    emit(slab, iu, iv, t as i64);
+                if t >= T::from_i64(lo[w]) && t <= T::from_i64(hi[w]) {
+                    emit(slab, iu, iv, t.to_i128() as i64);
                 }
                 continue;
             }
             // Centre outside: skip pixels whose square misses the projection.
-            if (0..3).any(|i| sgn * o[i] + reach[i] < T::ZERO) {
+            if pix.misses(&o) {
                 continue;
             }
-            // The plane's depth at the centre; over the pixel it moves by at
-            // most one voxel (|n_u|, |n_v| <= |n_w|). The margin keeps the
-            // f64 estimate a superset; the tests below are exact.
-            let depth = s.a[w] as f64 - (nu as f64 * pc[u].to_f64() + nv as f64 * pc[v].to_f64()) / nw as f64;
-            let t0 = (((depth - (ONE + H) as f64) / ONE as f64).floor() as i64 - 1).max(lo[w]);
-            let t1 = (((depth + (ONE - H) as f64) / ONE as f64).ceil() as i64 + 1).min(hi[w]);
+            // The plane's depth at the centre. Along a perpendicular
+            // crosshair segment (half a voxel each way) it moves by at most
+            // half a voxel (|n_u|, |n_v| <= |n_w|), so only segments at
+            // depth t·ONE + H within H of it can be hit; one lattice unit of
+            // margin covers the f64 rounding. The tests below are exact.
+            let depth = s.a[w] as f64 - v0.to_f64() * inv_nw;
+            let t0 = (((depth - (ONE + 1) as f64) / ONE as f64).floor() as i64).max(lo[w]);
+            let t1 = (((depth + 1.0) / ONE as f64).floor() as i64).min(hi[w]);
             for t in t0..=t1 {
-                let mut pu = [0i64; 3];
-                (pu[u], pu[v], pu[w]) = (iu * ONE, iv * ONE + H, t * ONE + H);
-                let mut pv = [0i64; 3];
-                (pv[u], pv[v], pv[w]) = (iu * ONE + H, iv * ONE, t * ONE + H);
-                if s.segment_hits(&du, s.local(pu)) || s.segment_hits(&dv, s.local(pv)) {
+                let tw = T::from_i64(t * ONE + H - s.a[w]);
+                let mut pu = pc;
+                (pu[u], pu[w]) = (pc[u] - h, tw);
+                let mut pv = pc;
+                (pv[v], pv[w]) = (pc[v] - h, tw);
+                if s.segment_hits(&du, pu) || s.segment_hits(&dv, pv) {
                     emit(slab, iu, iv, t);
                 }
             }

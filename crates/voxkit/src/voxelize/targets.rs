@@ -124,8 +124,8 @@ pub fn line6_hit(e: &Element, ijk: [i64; 3]) -> bool {
 }
 
 /// Largest `extent + 2 voxels` for which `TriSetup` is exact in `i64`:
-/// relative coordinates stay below `2^19`, normals below `2^37`, plane and
-/// orientation values below `2^58`.
+/// relative coordinates stay below `2^19`; normals, `A × B` and `e × d`
+/// below `2^38`; plane and orientation values below `2^58`.
 pub(crate) const I64_TARGET_LIMIT: i64 = 1 << 18;
 
 /// One triangle, set up for exact tests against displaced target segments
@@ -147,7 +147,12 @@ pub(crate) struct TriSetup<T> {
 /// tie bias of each edge's orientation test.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct DirSetup<T> {
-    d: [T; 3],
+    /// `n·d`: the plane value's change from a segment's start to its end.
+    nd: T,
+    /// Edge orientation `O_e(p) = c_e − p·m_e` with `m_e = e × d` and
+    /// `c_e = d·(A × B)` (`A`, `B` the edge's end points relative to `a`).
+    m: [[T; 3]; 3],
+    c: [T; 3],
     /// Tie bias of each edge's orientation test.
     pub be: [T; 3],
 }
@@ -160,11 +165,6 @@ fn dot<T: PlaneInt>(a: [T; 3], b: [T; 3]) -> T {
 #[inline(always)]
 fn crs<T: PlaneInt>(a: [T; 3], b: [T; 3]) -> [T; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-#[inline(always)]
-fn sub<T: PlaneInt>(a: [T; 3], b: [T; 3]) -> [T; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 impl<T: PlaneInt> TriSetup<T> {
@@ -182,7 +182,10 @@ impl<T: PlaneInt> TriSetup<T> {
             let m = crate::geom::lattice::cross(t.edge(i), d);
             T::from_i64(bias([-m[0], -m[1], -m[2]]))
         });
-        DirSetup { d: d.map(T::from_i64), be }
+        let dt = d.map(T::from_i64);
+        let m = std::array::from_fn(|i| crate::geom::lattice::cross(t.edge(i), d).map(T::from_i64));
+        let c = std::array::from_fn(|i| dot(dt, crs(self.rel[i], self.rel[(i + 1) % 3])));
+        DirSetup { nd: dot(self.n, dt), m, c, be }
     }
 
     /// A lattice point relative to `a`.
@@ -191,10 +194,11 @@ impl<T: PlaneInt> TriSetup<T> {
         std::array::from_fn(|c| T::from_i64(p[c] - self.a[c]))
     }
 
-    /// Is the displaced point `p` (relative to `a`) on the positive side of the plane?
+    /// The plane value `n·p` of a point `p` relative to `a` (its displaced
+    /// copy is on the positive side iff the value is `>= bn`).
     #[inline(always)]
-    pub fn above(&self, p: [T; 3]) -> bool {
-        dot(self.n, p) >= self.bn
+    pub fn plane(&self, p: [T; 3]) -> T {
+        dot(self.n, p)
     }
 
     /// Does the displaced target segment from `p` (relative to `a`) to
@@ -202,11 +206,16 @@ impl<T: PlaneInt> TriSetup<T> {
     /// [`segment_meets_triangle`] with the segment as target.
     #[inline(always)]
     pub fn segment_hits(&self, ds: &DirSetup<T>, p: [T; 3]) -> bool {
-        let q = [p[0] + ds.d[0], p[1] + ds.d[1], p[2] + ds.d[2]];
-        if self.above(p) == self.above(q) {
+        self.segment_hits_with(ds, p, self.plane(p))
+    }
+
+    /// [`Self::segment_hits`] given the start's plane value `vp = plane(p)`.
+    #[inline(always)]
+    pub fn segment_hits_with(&self, ds: &DirSetup<T>, p: [T; 3], vp: T) -> bool {
+        if (vp >= self.bn) == (vp + ds.nd >= self.bn) {
             return false;
         }
-        let o = |i: usize| dot(ds.d, crs(sub(self.rel[i], p), sub(self.rel[(i + 1) % 3], p))) >= ds.be[i];
+        let o = |i: usize| ds.c[i] - dot(p, ds.m[i]) >= ds.be[i];
         let o0 = o(0);
         o0 == o(1) && o0 == o(2)
     }
@@ -216,7 +225,55 @@ impl<T: PlaneInt> TriSetup<T> {
     /// triangle iff the three `values[i] >= ds.be[i]` agree.
     #[inline(always)]
     pub fn line_values(&self, ds: &DirSetup<T>, p: [T; 3]) -> [T; 3] {
-        std::array::from_fn(|i| dot(ds.d, crs(sub(self.rel[i], p), sub(self.rel[(i + 1) % 3], p))))
+        std::array::from_fn(|i| ds.c[i] - dot(p, ds.m[i]))
+    }
+}
+
+/// The dominant axis `w` of the triangle's normal (the first of equal
+/// largest components) and the projection axes `(u, v)` after it.
+pub(crate) fn dominant_axes(t: &LatticeTriangle) -> (usize, usize, usize) {
+    let n = t.normal();
+    let w = (0..3).fold(0, |best, a| if n[a].abs() > n[best].abs() { a } else { best });
+    ((w + 1) % 3, (w + 2) % 3, w)
+}
+
+/// The pixel test of the `w` projection: the `w`-line edge values at a
+/// pixel centre, multiplied by `sign`, are all `> 0` at every point of
+/// the pixel iff each exceeds its `reach` (how much an edge value changes
+/// from the centre to the square's corners).
+pub(crate) struct PixelTest<T> {
+    /// Direction setup of the `w` lines.
+    pub dw: DirSetup<T>,
+    /// `+1` if `n_w > 0`, else `−1`: inside the projection the signed values are positive.
+    pub sign: T,
+    /// Per edge: the largest change of its value over half a pixel each way.
+    pub reach: [T; 3],
+}
+
+impl<T: PlaneInt> PixelTest<T> {
+    /// Setup for `t` projected along `w` (with `(u, v, w)` from [`dominant_axes`]).
+    pub fn new(s: &TriSetup<T>, t: &LatticeTriangle, (u, v, w): (usize, usize, usize)) -> PixelTest<T> {
+        let mut d = [0; 3];
+        d[w] = ONE;
+        let sign = if t.normal()[w] > 0 { T::from_i64(1) } else { T::from_i64(-1) };
+        let reach = std::array::from_fn(|i| {
+            let e = t.edge(i);
+            T::from_i64(H * ONE * (e[u].abs() + e[v].abs()))
+        });
+        PixelTest { dw: s.dir(t, d), sign, reach }
+    }
+
+    /// Does the closed pixel square around centre `pc` (relative, any `w`)
+    /// miss the projected triangle?
+    #[inline(always)]
+    pub fn misses(&self, o: &[T; 3]) -> bool {
+        (0..3).any(|i| self.sign * o[i] + self.reach[i] < T::ZERO)
+    }
+
+    /// Does the closed pixel square lie strictly inside the projected triangle?
+    #[inline(always)]
+    pub fn strictly_inside(&self, o: &[T; 3]) -> bool {
+        (0..3).all(|i| self.sign * o[i] - self.reach[i] > T::ZERO)
     }
 }
 
