@@ -20,10 +20,13 @@ pub enum Command {
     Info(InfoArgs),
     /// Benchmark voxelization (medians over repeats) on a mesh at several resolutions.
     Bench(BenchArgs),
+    /// Certify a voxel file's topology: components, and with the source mesh
+    /// separation (with a witness), thinness and tunnels.
+    Check(CheckArgs),
 }
 
-/// Voxelization modes. Only `cover` is implemented so far; the others are
-/// accepted by the parser and rejected with an error that says so.
+/// Voxelization modes. `solid` and `pos` are accepted by the parser and
+/// rejected with an error saying they are not implemented yet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Mode {
     /// Conservative surface: every voxel whose closed box meets a triangle.
@@ -107,6 +110,26 @@ pub struct VoxelizeArgs {
     /// No progress bar and no summary line.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct CheckArgs {
+    /// Voxel file written by voxkit (.npy, .binvox, .vox, .txt).
+    pub voxels: PathBuf,
+    /// The source mesh (a closed surface for the separation checks).
+    #[arg(long)]
+    pub mesh: Option<PathBuf>,
+    /// The grid the voxels were made on, when the file does not carry it
+    /// (npy, vox); without these the grid is inferred as the mesh's fitted
+    /// grid at resolution = the largest dimension.
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Args, Debug)]

@@ -26,6 +26,7 @@ fn main() -> ExitCode {
         Command::Voxelize(a) => commands::voxelize::run(a),
         Command::Info(a) => commands::info::run(a),
         Command::Bench(a) => commands::bench::run(a),
+        Command::Check(a) => commands::check::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -24,6 +24,7 @@ pub use glam;
 pub mod geom;
 pub mod grid;
 pub mod mesh;
+pub mod topology;
 pub mod voxelize;
 
 pub use geom::aabb::Aabb;

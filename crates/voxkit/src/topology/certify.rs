@@ -1,0 +1,304 @@
+//! Certifying a voxel set's topology: components, separation, thinness and
+//! tunnels (what `voxkit check` reports).
+//!
+//! Definitions (Laine 2013 §2; Cohen-Or & Kaufman 1995):
+//! - A set `V` is *N-separating* for a closed surface iff no N-connected
+//!   path of voxels outside `V` joins a voxel whose centre is inside to one
+//!   whose centre is outside. Any such path has a step between two
+//!   N-adjacent unset voxels of different class, so `V` is N-separating iff
+//!   no such pair exists; the first pair found is the witness. Paths stay in
+//!   the grid.
+//! - *Thin removable*: set voxels whose removal alone keeps the set
+//!   6-separating — those whose unset 6-neighbours all share their class.
+//! - A *6-tunnel* (26-tunnel) is a segment joining the centres of two
+//!   6-adjacent (26-adjacent) unset voxels that meets the surface; a set is
+//!   tunnel-free iff there is none. This needs no closed surface.
+//! - *Thick voxels*: set voxels with a set neighbour along each of the three
+//!   axes (zero for a voxelization that is one voxel thin along some axis
+//!   everywhere).
+//!
+//! Inside/outside comes from [`super::inside`]; all tests are exact.
+
+use rayon::prelude::*;
+
+use super::inside::{snap_all, ClassifyError, Parity};
+use super::runs::{components, Connectivity, Runs};
+use crate::geom::fixed::ONE;
+use crate::geom::lattice::LatticeTriangle;
+use crate::grid::dense::DenseBits;
+use crate::grid::spec::GridSpec;
+use crate::mesh::MeshRef;
+use crate::voxelize::targets::{fits_i64, TriSetup};
+
+/// Everything `voxkit check` reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckReport {
+    /// Set voxels.
+    pub voxels: u64,
+    /// 6-connected components of the set voxels.
+    pub components_6: usize,
+    /// 26-connected components of the set voxels.
+    pub components_26: usize,
+    /// Set voxels with set neighbours along all three axes.
+    pub thick_voxels: u64,
+    /// What needs the source mesh.
+    pub mesh: Option<MeshFacts>,
+}
+
+/// The checks against the source surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshFacts {
+    /// Edges (keyed by snapped end points) used by an odd number of triangles.
+    pub boundary_edges: usize,
+    /// Segments between centres of 6-adjacent unset voxels that meet the surface.
+    pub tunnels_6: u64,
+    /// Segments between centres of 26-adjacent unset voxels that meet the surface.
+    pub tunnels_26: u64,
+    /// Separation, only for a closed surface (`boundary_edges == 0`).
+    pub separation: Option<Separation>,
+}
+
+/// Separation facts for a closed surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Separation {
+    /// Voxels (set or not) whose centre is inside.
+    pub inside_voxels: u64,
+    /// `None` if 6-separating, else an inside and an outside voxel, both
+    /// unset and 6-adjacent.
+    pub witness_6: Option<[[u32; 3]; 2]>,
+    /// The same for 26-adjacency.
+    pub witness_26: Option<[[u32; 3]; 2]>,
+    /// Set voxels removable one at a time keeping 6-separation.
+    pub thin_removable: u64,
+}
+
+/// Checks `bits`; with `mesh` (on `grid`), also separation and tunnels.
+pub fn certify(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec)>) -> Result<CheckReport, ClassifyError> {
+    let set_runs = Runs::of(bits, true);
+    let (_, components_6) = components(&set_runs, Connectivity::Six);
+    let (_, components_26) = components(&set_runs, Connectivity::TwentySix);
+    let mut report = CheckReport { voxels: bits.count(), components_6, components_26, thick_voxels: thick_voxels(bits), mesh: None };
+    if let Some((mesh, grid)) = mesh {
+        let snapped = snap_all(mesh, grid)?;
+        let tris: Vec<LatticeTriangle> = snapped.triangles.iter().filter(|t| !t.is_degenerate()).copied().collect();
+        let separation = (snapped.boundary_edges == 0).then(|| {
+            let parity = Parity::classify(&tris, bits.dims());
+            Separation {
+                inside_voxels: inside_count(&parity, bits.dims()),
+                witness_6: witness(bits, &parity, Connectivity::Six),
+                witness_26: witness(bits, &parity, Connectivity::TwentySix),
+                thin_removable: thin_removable(bits, &parity),
+            }
+        });
+        report.mesh = Some(MeshFacts {
+            boundary_edges: snapped.boundary_edges,
+            tunnels_6: tunnels(bits, &tris, Connectivity::Six),
+            tunnels_26: tunnels(bits, &tris, Connectivity::TwentySix),
+            separation,
+        });
+    }
+    Ok(report)
+}
+
+/// Neighbour offsets `(di, dj, dk)`, each unordered pair once.
+fn forward_offsets(conn: Connectivity) -> Vec<[i64; 3]> {
+    let mut out = Vec::new();
+    for dk in -1..=1i64 {
+        for dj in -1..=1i64 {
+            for di in -1..=1i64 {
+                let n = di.abs() + dj.abs() + dk.abs();
+                let forward = (dk, dj, di) > (0, 0, 0);
+                if forward && (conn == Connectivity::TwentySix || n == 1) {
+                    out.push([di, dj, dk]);
+                }
+            }
+        }
+    }
+    out
+}
+
+fn inside_count(p: &Parity, dims: [u32; 3]) -> u64 {
+    (0..dims[2])
+        .into_par_iter()
+        .map(|k| {
+            (0..dims[1])
+                .map(|j| {
+                    let t = p.row(j, k);
+                    let mut n = 0u64;
+                    for c in t.chunks(2) {
+                        n += (*c.get(1).unwrap_or(&dims[0]) - c[0]) as u64;
+                    }
+                    n
+                })
+                .sum::<u64>()
+        })
+        .sum()
+}
+
+/// The first (in `k`, `j`, `i` order) pair of adjacent unset voxels of
+/// different class, as `[inside, outside]`.
+fn witness(bits: &DenseBits, p: &Parity, conn: Connectivity) -> Option<[[u32; 3]; 2]> {
+    let [nx, ny, nz] = bits.dims();
+    let offsets = forward_offsets(conn);
+    (0..nz).into_par_iter().find_map_first(|k| {
+        for j in 0..ny {
+            for d in &offsets {
+                let (jj, kk) = (j as i64 + d[1], k as i64 + d[2]);
+                if jj < 0 || jj >= ny as i64 || kk >= nz as i64 {
+                    continue;
+                }
+                let (jj, kk) = (jj as u32, kk as u32);
+                // The class differs only on intervals bounded by toggles of
+                // either row (the second shifted by −di).
+                let (tr, tq) = (p.row(j, k), p.row(jj, kk));
+                let mut cuts: Vec<i64> = tr.iter().map(|&t| t as i64).chain(tq.iter().map(|&t| t as i64 - d[0])).collect();
+                cuts.push(0);
+                cuts.push(nx as i64);
+                cuts.sort_unstable();
+                cuts.dedup();
+                for w in cuts.windows(2) {
+                    let (a, b) = (w[0].max(0).max(-d[0]), w[1].min(nx as i64).min(nx as i64 - d[0]));
+                    if a >= b {
+                        continue;
+                    }
+                    let (ir, iq) = (a as u32, (a + d[0]) as u32);
+                    let (cr, cq) = (p.inside(ir, j, k), p.inside(iq, jj, kk));
+                    if cr == cq {
+                        continue;
+                    }
+                    for i in a..b {
+                        let (ir, iq) = (i as u32, (i + d[0]) as u32);
+                        if !bits.get(ir, j, k) && !bits.get(iq, jj, kk) {
+                            let (u, v) = ([ir, j, k], [iq, jj, kk]);
+                            return Some(if cr { [u, v] } else { [v, u] });
+                        }
+                    }
+                }
+            }
+        }
+        None
+    })
+}
+
+/// Calls `f(i)` for every set voxel of row `(j, k)`.
+#[inline]
+fn for_each_set_in_row(bits: &DenseBits, j: u32, k: u32, mut f: impl FnMut(u32)) {
+    let wpr = bits.words_per_row();
+    let row = (k as usize * bits.dims()[1] as usize + j as usize) * wpr;
+    for (wi, &w) in bits.words()[row..row + wpr].iter().enumerate() {
+        let mut w = w;
+        while w != 0 {
+            let b = w.trailing_zeros();
+            f(wi as u32 * 64 + b);
+            w &= w - 1;
+        }
+    }
+}
+
+/// Sums `f` over every set voxel, in parallel over `k`.
+fn sum_over_set(bits: &DenseBits, f: impl Fn(u32, u32, u32) -> bool + Sync) -> u64 {
+    let [_, ny, nz] = bits.dims();
+    (0..nz)
+        .into_par_iter()
+        .map(|k| {
+            let mut n = 0u64;
+            for j in 0..ny {
+                for_each_set_in_row(bits, j, k, |i| n += f(i, j, k) as u64);
+            }
+            n
+        })
+        .sum()
+}
+
+fn thin_removable(bits: &DenseBits, p: &Parity) -> u64 {
+    let [nx, ny, nz] = bits.dims();
+    let six: Vec<[i64; 3]> = forward_offsets(Connectivity::Six).iter().flat_map(|d| [*d, d.map(|x| -x)]).collect();
+    sum_over_set(bits, |i, j, k| {
+        let c = p.inside(i, j, k);
+        six.iter().all(|d| {
+            let q = [i as i64 + d[0], j as i64 + d[1], k as i64 + d[2]];
+            if q.iter().zip([nx, ny, nz]).any(|(&x, n)| x < 0 || x >= n as i64) {
+                return true;
+            }
+            let q = q.map(|x| x as u32);
+            bits.get(q[0], q[1], q[2]) || p.inside(q[0], q[1], q[2]) == c
+        })
+    })
+}
+
+fn thick_voxels(bits: &DenseBits) -> u64 {
+    let [nx, ny, nz] = bits.dims();
+    let get = |i: i64, j: i64, k: i64| {
+        i >= 0 && j >= 0 && k >= 0 && i < nx as i64 && j < ny as i64 && k < nz as i64 && bits.get(i as u32, j as u32, k as u32)
+    };
+    sum_over_set(bits, |i, j, k| {
+        let (i, j, k) = (i as i64, j as i64, k as i64);
+        (get(i - 1, j, k) || get(i + 1, j, k)) && (get(i, j - 1, k) || get(i, j + 1, k)) && (get(i, j, k - 1) || get(i, j, k + 1))
+    })
+}
+
+/// Distinct segments between centres of adjacent unset voxels that meet a
+/// triangle (the segments displaced like every target).
+fn tunnels(bits: &DenseBits, tris: &[LatticeTriangle], conn: Connectivity) -> u64 {
+    let dims = bits.dims();
+    let offsets = forward_offsets(conn);
+    let mut found: Vec<(u64, u8)> = tris
+        .par_chunks(256)
+        .flat_map_iter(|chunk| {
+            let mut out = Vec::new();
+            for t in chunk {
+                if fits_i64(t) {
+                    tunnels_of::<i64>(bits, t, &offsets, dims, &mut out);
+                } else {
+                    tunnels_of::<i128>(bits, t, &offsets, dims, &mut out);
+                }
+            }
+            out
+        })
+        .collect();
+    found.par_sort_unstable();
+    found.dedup();
+    found.len() as u64
+}
+
+fn tunnels_of<T: crate::geom::fixed::PlaneInt>(
+    bits: &DenseBits,
+    t: &LatticeTriangle,
+    offsets: &[[i64; 3]],
+    dims: [u32; 3],
+    out: &mut Vec<(u64, u8)>,
+) {
+    let (lo, hi) = t.bounds();
+    let s = TriSetup::<T>::new(t);
+    let h = ONE / 2;
+    for (di, d) in offsets.iter().enumerate() {
+        // Voxels v whose segment [centre(v), centre(v) + d] has a bounding
+        // box meeting the triangle's.
+        let mut r = [(0i64, 0i64); 3];
+        for a in 0..3 {
+            let (smin, smax) = (d[a].min(0) * ONE, d[a].max(0) * ONE);
+            // centre = v·ONE + h; need centre + smin <= hi and centre + smax >= lo.
+            let first = (lo[a] - smax - h + ONE - 1).div_euclid(ONE).max(0).max(-d[a]);
+            let last = (hi[a] - smin - h).div_euclid(ONE).min(dims[a] as i64 - 1).min(dims[a] as i64 - 1 - d[a]);
+            r[a] = (first, last);
+        }
+        if (0..3).any(|a| r[a].0 > r[a].1) {
+            continue;
+        }
+        let ds = s.dir(t, d.map(|x| x * ONE));
+        for k in r[2].0..=r[2].1 {
+            for j in r[1].0..=r[1].1 {
+                for i in r[0].0..=r[0].1 {
+                    let (q0, q1, q2) = ((i + d[0]) as u32, (j + d[1]) as u32, (k + d[2]) as u32);
+                    if bits.get(i as u32, j as u32, k as u32) || bits.get(q0, q1, q2) {
+                        continue;
+                    }
+                    if s.segment_hits(&ds, s.local([i * ONE + h, j * ONE + h, k * ONE + h])) {
+                        let idx = (k as u64 * dims[1] as u64 + j as u64) * dims[0] as u64 + i as u64;
+                        out.push((idx, di as u8));
+                    }
+                }
+            }
+        }
+    }
+}

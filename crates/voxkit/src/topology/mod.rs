@@ -1,0 +1,8 @@
+//! Topology of voxel sets: connected components, exact inside/outside
+//! classification, and the certificate `voxkit check` prints.
+
+pub mod certify;
+pub mod inside;
+pub mod runs;
+
+pub use certify::{certify, CheckReport, MeshFacts, Separation};
