@@ -155,3 +155,59 @@ fn malformed_meshes_name_the_file() {
         assert!(line.contains(name), "{line}");
     }
 }
+
+#[test]
+fn every_topological_mode_is_certified_by_check() {
+    let cow = shared("cow.obj");
+    for (mode, sep26) in [("cover", true), ("sep26", true), ("sep6", false), ("ss6", false)] {
+        let out = tmp(&format!("{mode}.npy"));
+        let v = json(&voxkit(&["voxelize", &cow, "-o", &out, "--mode", mode, "--resolution", "48", "--json"]));
+        assert_eq!(v["mode"], mode);
+        let c = json(&voxkit(&["check", &out, "--mesh", &cow, "--json"]));
+        for key in ["voxels", "components_6", "components_26", "separating_6", "separating_26", "thin_removable"] {
+            assert!(c.get(key).is_some(), "missing {key}");
+        }
+        assert_eq!(c["voxels"], v["voxels"]);
+        assert_eq!(c["closed"], true);
+        assert_eq!(c["separating_6"], true, "{mode}");
+        assert_eq!(c["separating_26"], sep26, "{mode}");
+        assert_eq!(c["grid"]["source"], "inferred");
+        // The explicit grid form gives the same certificate.
+        let g = &v["origin"];
+        let o = format!("{},{},{}", g[0], g[1], g[2]);
+        let d = format!("{},{},{}", v["dims"][0], v["dims"][1], v["dims"][2]);
+        let s = v["voxel_size"].to_string();
+        let e = json(&voxkit(&["check", &out, "--mesh", &cow, "--origin", &o, "--voxel-size", &s, "--dims", &d, "--json"]));
+        assert_eq!(e["separating_26"], c["separating_26"]);
+    }
+    // Without the mesh: components only, separation unknown.
+    let c = json(&voxkit(&["check", &tmp("sep6.npy"), "--json"]));
+    assert_eq!(c["separating_6"], serde_json::Value::Null);
+    assert_eq!(c["thin_removable"], serde_json::Value::Null);
+    // An open mesh: tunnels, no separation.
+    let bunny = shared("stanford-bunny.obj");
+    let out = tmp("bunny6.binvox");
+    json(&voxkit(&["voxelize", &bunny, "-o", &out, "--mode", "sep6", "--resolution", "40", "--json"]));
+    let c = json(&voxkit(&["check", &out, "--mesh", &bunny, "--json"]));
+    assert_eq!(c["closed"], false);
+    assert_eq!(c["separating_6"], serde_json::Value::Null);
+    assert_eq!(c["tunnel_free_6"], true);
+}
+
+#[test]
+fn polylines_voxelize_connected() {
+    let lines = tmp("p.lines");
+    // Two polylines, the second starting where the first ends.
+    std::fs::write(&lines, "0 0 0 10 3 7 2 9 9\n2,9,9, 10,0,0, 0,10,10\n").unwrap();
+    for (mode, key) in [("line26", "components_26"), ("line6", "components_6")] {
+        let out = tmp(&format!("{mode}.txt"));
+        let v = json(&voxkit(&["voxelize", &lines, "-o", &out, "--mode", mode, "--resolution", "32", "--json"]));
+        assert!(v["voxels"].as_u64().unwrap() > 32);
+        let c = json(&voxkit(&["check", &out, "--json"]));
+        assert_eq!(c[key], 1, "{mode}");
+    }
+    let e = error_line(&["voxelize", &lines, "-o", &tmp("x.npy"), "--mode", "sep6"]);
+    assert!(e.contains("only line segments"), "{e}");
+    let e = error_line(&["check", &tmp("sep6.npy"), "--mesh", &shared("cow.obj"), "--resolution", "20"]);
+    assert!(e.contains("pass the grid options"), "{e}");
+}

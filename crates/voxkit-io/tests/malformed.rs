@@ -48,7 +48,7 @@ fn random_bytes_never_panic_any_reader() {
                     x as u8
                 })
                 .collect();
-            for f in [MeshFormat::Obj, MeshFormat::Stl, MeshFormat::Ply, MeshFormat::Gltf] {
+            for f in [MeshFormat::Obj, MeshFormat::Stl, MeshFormat::Ply, MeshFormat::Gltf, MeshFormat::Polyline] {
                 if let Err(e) = read_mesh_bytes(&bytes, f, None) {
                     let _ = e;
                 }
