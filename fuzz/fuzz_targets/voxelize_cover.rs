@@ -1,19 +1,29 @@
-//! Fuzzes `cover`: triangles from raw bytes on a small grid; the fast path
-//! must equal the reference.
+//! Fuzzes every surface and line mode: triangles (and the same points as
+//! segments) from raw bytes on a small grid; each fast path must equal its
+//! reference.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use voxkit::glam::DVec3;
-use voxkit::voxelize::{cover, Options};
+use voxkit::voxelize::{self, Mode, Options};
 use voxkit::{GridSpec, Mesh};
 
 fuzz_target!(|data: &[u8]| {
     let coords: Vec<f64> = data.chunks_exact(2).map(|c| i16::from_le_bytes([c[0], c[1]]) as f64 / 2048.0).collect();
     let positions: Vec<DVec3> = coords.chunks_exact(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect();
-    let triangles = (0..positions.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
-    let mesh = Mesh { positions, triangles, segments: Vec::new() };
+    let n = positions.len() as u32;
+    let triangles: Vec<[u32; 3]> = (0..n / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+    let segments: Vec<[u32; 2]> = (1..n).map(|i| [i - 1, i]).collect();
     let Ok(grid) = GridSpec::new(DVec3::splat(-4.0), 0.75, [11, 11, 11]) else { return };
-    let (fast, _) = cover::cover(mesh.as_ref(), &grid, &Options::default());
-    let (slow, _) = cover::reference::cover(mesh.as_ref(), &grid);
-    assert_eq!(fast.to_dense().first_difference(&slow), None);
+    for mode in Mode::ALL {
+        let is_line = matches!(mode, Mode::Line26 | Mode::Line6);
+        let mesh = Mesh {
+            positions: positions.clone(),
+            triangles: if is_line { Vec::new() } else { triangles.clone() },
+            segments: if is_line { segments.clone() } else { Vec::new() },
+        };
+        let (fast, _) = voxelize::fast(mode, mesh.as_ref(), &grid, &Options::default());
+        let (slow, _) = voxelize::reference(mode, mesh.as_ref(), &grid);
+        assert_eq!(fast.to_dense().first_difference(&slow), None, "{mode:?}");
+    }
 });

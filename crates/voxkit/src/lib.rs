@@ -8,9 +8,13 @@
 //! Entry points:
 //! - [`GridSpec`] — origin, voxel size and dims; voxel `(i,j,k)` is the
 //!   *closed* box `[origin + (i,j,k)·s, origin + (i+1,j+1,k+1)·s]`.
-//! - [`MeshRef`] — a borrowed view of positions and triangles.
-//! - [`voxelize::cover`] — conservative surface voxelization (fast path) and
-//!   [`voxelize::cover::reference::cover`] (brute force, the definition).
+//! - [`MeshRef`] — a borrowed view of positions, triangles and segments.
+//! - [`voxelize::fast`] and [`voxelize::reference`] — every surface and line
+//!   mode ([`voxelize::Mode`]): `cover`, Laine's `sep26` and `sep6`,
+//!   Schwarz–Seidel `ss6`, `line26`, `line6`; one file per mode, each with
+//!   its brute-force reference (the definition).
+//! - [`topology::certify()`] — components, separation (with a witness),
+//!   thinness and tunnels of a voxel set.
 //! - [`BrickBits`] (sparse, the fast paths' result) and [`DenseBits`]
 //!   (one bit per voxel, the references' result), both [`VoxelSource`]s.
 //!

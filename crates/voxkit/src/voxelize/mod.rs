@@ -7,9 +7,9 @@
 //! | `sep26` | [`sep26`] | a triangle meets a space diagonal (26-separating, ⊆ `cover`) |
 //! | `sep6` | [`sep6`] | a triangle meets the 3D crosshair (6-separating, thin) |
 //! | `ss6` | [`ss6`] | Schwarz–Seidel plane + diamond tests (6-separating, ⊇ `sep6`) |
-//! | `line26`, `line6` | [`line`] | an element meets the bisecting squares / the surface (26- / 6-connected) |
+//! | `line26`, `line6` | [`line`](mod@line) | an element meets the bisecting squares / the surface (26- / 6-connected) |
 //!
-//! [`Mode`] with [`fast`] and [`reference`] dispatches over all of them.
+//! [`Mode`] with [`fast()`] and [`reference()`] dispatches over all of them.
 
 pub mod cover;
 pub mod driver;
