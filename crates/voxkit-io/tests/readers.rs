@@ -189,10 +189,7 @@ fn glb_with_binary_chunk() {
 fn obj_polylines_become_segments_next_to_faces() {
     // A triangle, a 3-point polyline (tobj alone would read it as a
     // triangle) with a relative index and a v/vt form, and a 2-point line.
-    let p = write(
-        "lines.obj",
-        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 2 2 2\nl 1 4 -3/1\nvt 0 0\nl 2 3\n",
-    );
+    let p = write("lines.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 2 2 2\nl 1 4 -3/1\nvt 0 0\nl 2 3\n");
     let m = voxkit_io::read_mesh(&p).unwrap();
     assert_eq!((m.report.triangles, m.report.segments), (1, 3));
     let seg = |s: [u32; 2]| [m.mesh.positions[s[0] as usize], m.mesh.positions[s[1] as usize]];

@@ -37,6 +37,11 @@ fn surface_guarantees(name: &str, mesh: &Mesh, grid: &GridSpec) {
         if *mode == Mode::Sep6 {
             assert_eq!(f.tunnels_6, 0, "{name}: sep6 has 6-tunnels");
         }
+        if *mode != Mode::Sep26 {
+            // sep6 ⊆ ss6 ⊆ cover, and sep6 sets every column's crossing voxel.
+            assert_eq!(f.columns.empty, 0, "{name} {mode:?}: holes in columns");
+            assert!(f.columns.samples > 0);
+        }
     }
     assert!(is_subset(&bits[1].1, &bits[0].1), "{name}: sep26 not within cover");
     assert!(is_subset(&bits[2].1, &bits[3].1), "{name}: sep6 not within ss6");

@@ -71,6 +71,10 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         "tunnels_26": facts.map(|f| f.tunnels_26),
         "tunnel_free_6": facts.map(|f| f.tunnels_6 == 0),
         "tunnel_free_26": facts.map(|f| f.tunnels_26 == 0),
+        "columns": facts.map(|f| {
+            let c = f.columns;
+            json!({"samples": c.samples, "empty": c.empty, "one": c.one, "two": c.two, "three_or_more": c.more, "max": c.max})
+        }),
         "grid": mesh.as_ref().map(|(_, g, source)| {
             let o = g.origin();
             json!({"origin": [o.x, o.y, o.z], "voxel_size": g.voxel_size(), "dims": g.dims(), "source": source})
@@ -116,6 +120,11 @@ fn text(v: &Value, a: &CheckArgs) -> String {
         } else {
             s += &format!("\n  not closed ({} boundary edges): separation needs a closed surface", v["boundary_edges"]);
         }
+        let c = &v["columns"];
+        s += &format!(
+            "\n  runs along each triangle's dominant axis at its columns: {} x1, {} x2, {} x3+ (max {}), {} holes",
+            c["one"], c["two"], c["three_or_more"], c["max"], c["empty"]
+        );
         s += &format!(
             "\n  6-tunnel-free: {} ({} tunnels)\n  26-tunnel-free: {} ({} tunnels)",
             yes_no(&v["tunnel_free_6"]),

@@ -16,6 +16,11 @@
 //! - *Thick voxels*: set voxels with a set neighbour along each of the three
 //!   axes (zero for a voxelization that is one voxel thin along some axis
 //!   everywhere).
+//! - *Columns along the dominant axis* (with the mesh): for every triangle
+//!   and every pixel of its dominant-axis projection whose centre it
+//!   covers, the run of set voxels along that axis through the voxel where
+//!   the surface crosses the column (0 if that voxel is unset). Laine's
+//!   thinness is "every run is 1".
 //!
 //! Inside/outside comes from [`super::inside`]; all tests are exact.
 
@@ -54,8 +59,40 @@ pub struct MeshFacts {
     pub tunnels_6: u64,
     /// Segments between centres of 26-adjacent unset voxels that meet the surface.
     pub tunnels_26: u64,
+    /// Runs along each triangle's dominant axis where it crosses a column.
+    pub columns: ColumnStats,
     /// Separation, only for a closed surface (`boundary_edges == 0`).
     pub separation: Option<Separation>,
+}
+
+/// Histogram of the runs of set voxels along each triangle's dominant axis,
+/// sampled at the columns whose centre the triangle covers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ColumnStats {
+    /// Columns sampled (a column covered by two triangles counts twice).
+    pub samples: u64,
+    /// The crossing voxel is unset: a hole.
+    pub empty: u64,
+    /// Runs of exactly one voxel (thin).
+    pub one: u64,
+    /// Runs of two voxels.
+    pub two: u64,
+    /// Runs of three or more.
+    pub more: u64,
+    /// The longest run.
+    pub max: u64,
+}
+
+impl ColumnStats {
+    fn add(mut self, o: ColumnStats) -> ColumnStats {
+        self.samples += o.samples;
+        self.empty += o.empty;
+        self.one += o.one;
+        self.two += o.two;
+        self.more += o.more;
+        self.max = self.max.max(o.max);
+        self
+    }
 }
 
 /// Separation facts for a closed surface.
@@ -94,6 +131,7 @@ pub fn certify(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec)>) -> Resu
             boundary_edges: snapped.boundary_edges,
             tunnels_6: tunnels(bits, &tris, Connectivity::Six),
             tunnels_26: tunnels(bits, &tris, Connectivity::TwentySix),
+            columns: columns(bits, &tris),
             separation,
         });
     }
@@ -235,6 +273,76 @@ fn thick_voxels(bits: &DenseBits) -> u64 {
         let (i, j, k) = (i as i64, j as i64, k as i64);
         (get(i - 1, j, k) || get(i + 1, j, k)) && (get(i, j - 1, k) || get(i, j + 1, k)) && (get(i, j, k - 1) || get(i, j, k + 1))
     })
+}
+
+fn columns(bits: &DenseBits, tris: &[LatticeTriangle]) -> ColumnStats {
+    tris.par_chunks(256)
+        .map(|chunk| {
+            let mut st = ColumnStats::default();
+            for t in chunk {
+                if fits_i64(t) {
+                    columns_of::<i64>(bits, t, &mut st);
+                } else {
+                    columns_of::<i128>(bits, t, &mut st);
+                }
+            }
+            st
+        })
+        .reduce(ColumnStats::default, ColumnStats::add)
+}
+
+fn columns_of<T: crate::geom::fixed::PlaneInt>(bits: &DenseBits, t: &LatticeTriangle, st: &mut ColumnStats) {
+    let dims = bits.dims();
+    let Some((lo, hi)) = t.voxel_bounds(dims) else { return };
+    let (u, v, w) = crate::voxelize::targets::dominant_axes(t);
+    let s = TriSetup::<T>::new(t);
+    let mut d = [0i64; 3];
+    d[w] = ONE;
+    let dw = s.dir(t, d);
+    let n = t.normal();
+    let h = ONE / 2;
+    let at = |ijk: [i64; 3]| bits.get(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
+    for iv in lo[v]..=hi[v] {
+        for iu in lo[u]..=hi[u] {
+            let mut c = s.a;
+            (c[u], c[v]) = (iu * ONE + h, iv * ONE + h);
+            let pc = s.local(c);
+            let o = s.line_values(&dw, pc);
+            let inside = [0, 1, 2].map(|i| o[i] >= dw.be[i]);
+            if !(inside[0] == inside[1] && inside[1] == inside[2]) {
+                continue;
+            }
+            let v0 = T::from_i64(n[u]) * pc[u] + T::from_i64(n[v]) * pc[v];
+            let tw = s.column_voxel(w, T::from_i64(n[w]), v0).to_i128();
+            if tw < 0 || tw >= dims[w] as i128 {
+                continue;
+            }
+            let mut ijk = [0i64; 3];
+            (ijk[u], ijk[v], ijk[w]) = (iu, iv, tw as i64);
+            st.samples += 1;
+            if !at(ijk) {
+                st.empty += 1;
+                continue;
+            }
+            let mut run = 1u64;
+            for step in [-1i64, 1] {
+                let mut q = ijk;
+                loop {
+                    q[w] += step;
+                    if q[w] < 0 || q[w] >= dims[w] as i64 || !at(q) {
+                        break;
+                    }
+                    run += 1;
+                }
+            }
+            match run {
+                1 => st.one += 1,
+                2 => st.two += 1,
+                _ => st.more += 1,
+            }
+            st.max = st.max.max(run);
+        }
+    }
 }
 
 /// Distinct segments between centres of adjacent unset voxels that meet a

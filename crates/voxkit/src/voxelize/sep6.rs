@@ -103,17 +103,7 @@ fn project<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab:
             // Plane value along the column: V(W) = v0 + n_w·(W − a_w).
             let v0 = nu * pc[u] + nv * pc[v];
             if inside[0] == inside[1] && inside[1] == inside[2] {
-                // The hit voxel's w-segment [t·ONE, (t+1)·ONE] straddles the
-                // switch to the plane's positive side (V >= bn).
-                let t = if nw > T::ZERO {
-                    // positive iff W >= a_w + ceil((bn − v0) / n_w)
-                    let w_star = T::from_i64(s.a[w]) - (v0 - s.bn).div_floor(nw);
-                    (w_star - T::from_i64(1)).div_floor(one)
-                } else {
-                    // positive iff W <= a_w + floor((v0 − bn) / −n_w)
-                    let w_star = T::from_i64(s.a[w]) + (v0 - s.bn).div_floor(-nw);
-                    w_star.div_floor(one)
-                };
+                let t = s.column_voxel(w, nw, v0);
                 if t >= T::from_i64(lo[w]) && t <= T::from_i64(hi[w]) {
                     emit(slab, iu, iv, t.to_i128() as i64);
                 }

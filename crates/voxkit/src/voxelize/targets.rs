@@ -220,6 +220,24 @@ impl<T: PlaneInt> TriSetup<T> {
         o0 == o(1) && o0 == o(2)
     }
 
+    /// For a `w`-line that meets the triangle, with plane value
+    /// `v0 = n_u·p_u + n_v·p_v` (relative to `a`) along it: the voxel index
+    /// `t` whose displaced `w` crosshair segment `[t·ONE, (t+1)·ONE]`
+    /// straddles the plane — the one voxel of the column `sep6` sets.
+    #[inline(always)]
+    pub fn column_voxel(&self, w: usize, nw: T, v0: T) -> T {
+        let one = T::from_i64(ONE);
+        if nw > T::ZERO {
+            // positive iff W >= a_w + ceil((bn − v0) / n_w)
+            let w_star = T::from_i64(self.a[w]) - (v0 - self.bn).div_floor(nw);
+            (w_star - T::from_i64(1)).div_floor(one)
+        } else {
+            // positive iff W <= a_w + floor((v0 − bn) / −n_w)
+            let w_star = T::from_i64(self.a[w]) + (v0 - self.bn).div_floor(-nw);
+            w_star.div_floor(one)
+        }
+    }
+
     /// The three edge orientation values of the target line through `p`
     /// (relative to `a`) with direction `ds`. The displaced line meets the
     /// triangle iff the three `values[i] >= ds.be[i]` agree.
