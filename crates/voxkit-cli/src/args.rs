@@ -81,6 +81,9 @@ pub struct GridArgs {
     /// Explicit grid dims (with --origin and --voxel-size).
     #[arg(long, value_name = "NX,NY,NZ", value_delimiter = ',')]
     pub dims: Option<Vec<u64>>,
+    /// Empty voxels added on every side of a fitted grid (default 0).
+    #[arg(long, value_name = "P")]
+    pub pad: Option<u32>,
 }
 
 #[derive(Args, Debug)]

@@ -8,7 +8,14 @@ use crate::args::{GridArgs, Method, Mode};
 
 /// The grid request, validated but not yet fitted to a mesh.
 #[derive(Clone, Debug)]
-pub enum GridRequest {
+pub struct GridRequest {
+    kind: GridKind,
+    /// Voxels of margin on every side of a fitted grid.
+    pad: u32,
+}
+
+#[derive(Clone, Debug)]
+enum GridKind {
     /// Longest side spans N voxels.
     Resolution(u64),
     /// Fit to the bounding box with this voxel size.
@@ -20,6 +27,27 @@ pub enum GridRequest {
 impl GridRequest {
     /// Checks that the grid options form one of the three documented ways.
     pub fn from_args(g: &GridArgs) -> Result<GridRequest> {
+        let kind = GridKind::from_args(g)?;
+        let pad = g.pad.unwrap_or(0);
+        if pad > 0 && matches!(kind, GridKind::Explicit { .. }) {
+            bail!("--pad applies to fitted grids (--resolution or --voxel-size), not to an explicit --origin/--dims grid");
+        }
+        Ok(GridRequest { kind, pad })
+    }
+
+    /// The grid for a mesh with these bounds.
+    pub fn fit(&self, bounds: &Aabb) -> Result<GridSpec> {
+        let g = self.kind.fit(bounds)?;
+        if self.pad == 0 {
+            return Ok(g);
+        }
+        let (p, s) = (self.pad as f64, g.voxel_size());
+        GridSpec::new(g.origin() - DVec3::splat(p * s), s, g.dims().map(|d| d as u64 + 2 * self.pad as u64)).context("invalid grid")
+    }
+}
+
+impl GridKind {
+    fn from_args(g: &GridArgs) -> Result<GridKind> {
         if g.origin.is_some() || g.dims.is_some() {
             let (Some(o), Some(s), Some(d)) = (&g.origin, g.voxel_size, &g.dims) else {
                 bail!("an explicit grid needs all of --origin X,Y,Z --voxel-size S --dims NX,NY,NZ");
@@ -30,22 +58,21 @@ impl GridRequest {
             if g.resolution.is_some() {
                 bail!("--resolution cannot be combined with an explicit grid (--origin/--dims)");
             }
-            return Ok(GridRequest::Explicit { origin: DVec3::new(o[0], o[1], o[2]), voxel_size: s, dims: [d[0], d[1], d[2]] });
+            return Ok(GridKind::Explicit { origin: DVec3::new(o[0], o[1], o[2]), voxel_size: s, dims: [d[0], d[1], d[2]] });
         }
         match (g.resolution, g.voxel_size) {
             (Some(_), Some(_)) => bail!("give either --resolution or --voxel-size, not both"),
-            (Some(n), None) => Ok(GridRequest::Resolution(n)),
-            (None, Some(s)) => Ok(GridRequest::VoxelSize(s)),
-            (None, None) => Ok(GridRequest::Resolution(128)),
+            (Some(n), None) => Ok(GridKind::Resolution(n)),
+            (None, Some(s)) => Ok(GridKind::VoxelSize(s)),
+            (None, None) => Ok(GridKind::Resolution(128)),
         }
     }
 
-    /// The grid for a mesh with these bounds.
-    pub fn fit(&self, bounds: &Aabb) -> Result<GridSpec> {
+    fn fit(&self, bounds: &Aabb) -> Result<GridSpec> {
         let g = match *self {
-            GridRequest::Resolution(n) => GridSpec::from_resolution(bounds, n),
-            GridRequest::VoxelSize(s) => GridSpec::from_voxel_size(bounds, s),
-            GridRequest::Explicit { origin, voxel_size, dims } => GridSpec::new(origin, voxel_size, dims),
+            GridKind::Resolution(n) => GridSpec::from_resolution(bounds, n),
+            GridKind::VoxelSize(s) => GridSpec::from_voxel_size(bounds, s),
+            GridKind::Explicit { origin, voxel_size, dims } => GridSpec::new(origin, voxel_size, dims),
         };
         g.context("invalid grid")
     }

@@ -211,3 +211,34 @@ fn polylines_voxelize_connected() {
     let e = error_line(&["check", &tmp("sep6.npy"), "--mesh", &shared("cow.obj"), "--resolution", "20"]);
     assert!(e.contains("pass the grid options"), "{e}");
 }
+
+#[test]
+fn pad_keeps_faces_on_the_high_side_of_a_fitted_grid() {
+    // A cube: on a fitted grid its high faces lie exactly in the grid's
+    // high planes, where the tie rule gives them to the voxels beyond.
+    let cube = tmp("cube.obj");
+    let mut obj = String::new();
+    for c in 0..8 {
+        obj += &format!("v {} {} {}\n", c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    }
+    for q in [[1, 3, 4, 2], [5, 6, 8, 7], [1, 2, 6, 5], [3, 7, 8, 4], [1, 5, 7, 3], [2, 4, 8, 6]] {
+        obj += &format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+    }
+    std::fs::write(&cube, obj).unwrap();
+    let (a, b) = (tmp("cube0.npy"), tmp("cube1.npy"));
+    let plain = json(&voxkit(&["voxelize", &cube, "-o", &a, "--mode", "sep6", "--resolution", "8", "--json"]));
+    let padded = json(&voxkit(&["voxelize", &cube, "-o", &b, "--mode", "sep6", "--resolution", "8", "--pad", "1", "--json"]));
+    assert_eq!(padded["dims"], serde_json::json!([10, 10, 10]));
+    // The cube spans grid planes 1..9. Displaced by −δ, crosshairs give the
+    // low faces to the first layer inside (the union of three 8×8 faces:
+    // 8³ − 7³ voxels) and the high faces to the first layer outside (three
+    // disjoint 8×8 faces).
+    assert_eq!(padded["voxels"], 8 * 8 * 8 - 7 * 7 * 7 + 3 * 64);
+    // Unpadded, the high faces' voxels lie beyond the grid.
+    assert_eq!(plain["voxels"], 8 * 8 * 8 - 7 * 7 * 7);
+    let c = json(&voxkit(&["check", &b, "--mesh", &cube, "--resolution", "8", "--pad", "1", "--json"]));
+    assert_eq!(c["separating_6"], true);
+    assert_eq!(c["inside_voxels"], 8 * 8 * 8);
+    let e = error_line(&["voxelize", &cube, "-o", &a, "--origin", "0,0,0", "--voxel-size", "1", "--dims", "2,2,2", "--pad", "1"]);
+    assert!(e.contains("--pad applies to fitted grids"), "{e}");
+}

@@ -15,7 +15,8 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     let pool = crate::thread_pool(a.threads)?;
     let loaded = voxkit_io::read_voxels(&a.voxels)?;
     let dims = loaded.bits.dims();
-    let grid_given = a.grid.resolution.is_some() || a.grid.voxel_size.is_some() || a.grid.origin.is_some() || a.grid.dims.is_some();
+    let g = &a.grid;
+    let grid_given = g.resolution.is_some() || g.voxel_size.is_some() || g.origin.is_some() || g.dims.is_some() || g.pad.is_some();
     let mesh = match &a.mesh {
         Some(path) => {
             let m = voxkit_io::read_mesh(path)?;
