@@ -182,6 +182,11 @@ pub fn read_voxels(path: &Path) -> Result<LoadedVoxels, IoError> {
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_string();
         IoError::new(path, ErrorKind::UnknownFormat { ext, expected: VoxelFormat::NAMES })
     })?;
+    if matches!(format, VoxelFormat::Npy | VoxelFormat::NpyBool) {
+        let file = std::fs::File::open(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+        let mut r = std::io::BufReader::new(file);
+        return npy::read_stream(&mut r).map_err(|k| IoError::new(path, k));
+    }
     let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
     read_voxels_bytes(&bytes, format).map_err(|k| IoError::new(path, k))
 }

@@ -61,6 +61,69 @@ pub(crate) fn plane_block(plane: usize) -> u32 {
 
 /// Reads a 3-D `.npy` array of dtype uint8/int8/bool in C order; nonzero = set.
 pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
+    let (dims, data_at) = parse_header(bytes)?;
+    let data = &bytes[data_at..];
+    let n = (dims[0] * dims[1] * dims[2]) as usize;
+    if data.len() < n {
+        return Err(truncated(data.len(), n));
+    }
+    let mut bits = DenseBits::new(dims.map(|d| d as u32));
+    fill(&mut bits, &data[..n], 0);
+    Ok(LoadedVoxels { bits, placement: None })
+}
+
+/// [`read`] from a stream, a few megabytes at a time: a 1024³ grid is a
+/// gigabyte of bytes that need not all be in memory at once.
+pub fn read_stream(r: &mut impl std::io::Read) -> Result<LoadedVoxels, ErrorKind> {
+    let io = |e: std::io::Error| {
+        if e.kind() == std::io::ErrorKind::UnexpectedEof {
+            ErrorKind::malformed("npy", "truncated header")
+        } else {
+            ErrorKind::Read(e)
+        }
+    };
+    let mut head = vec![0u8; 12];
+    r.read_exact(&mut head[..10]).map_err(io)?;
+    let hlen = match head[6] {
+        1 => u16::from_le_bytes([head[8], head[9]]) as usize,
+        2 | 3 => {
+            r.read_exact(&mut head[10..12]).map_err(io)?;
+            u32::from_le_bytes([head[8], head[9], head[10], head[11]]) as usize
+        }
+        _ => 0,
+    };
+    if head[6] == 1 {
+        head.truncate(10);
+    }
+    if hlen > 1 << 20 {
+        return Err(ErrorKind::malformed("npy", format!("header of {hlen} bytes")));
+    }
+    let start = head.len();
+    head.resize(start + hlen, 0);
+    r.read_exact(&mut head[start..]).map_err(io)?;
+    let (dims, _) = parse_header(&head)?;
+    let n = (dims[0] * dims[1] * dims[2]) as usize;
+    let mut bits = DenseBits::new(dims.map(|d| d as u32));
+    let mut buf = vec![0u8; 1 << 22];
+    let mut at = 0usize;
+    while at < n {
+        let want = buf.len().min(n - at);
+        let got = r.read(&mut buf[..want]).map_err(ErrorKind::Read)?;
+        if got == 0 {
+            return Err(truncated(at, n));
+        }
+        fill(&mut bits, &buf[..got], at);
+        at += got;
+    }
+    Ok(LoadedVoxels { bits, placement: None })
+}
+
+fn truncated(have: usize, need: usize) -> ErrorKind {
+    ErrorKind::malformed("npy", format!("data holds {have} bytes, shape needs {need} (truncated?)"))
+}
+
+/// Validates the header; returns the shape and where the data starts.
+fn parse_header(bytes: &[u8]) -> Result<([u64; 3], usize), ErrorKind> {
     let bad = |d: &str| ErrorKind::malformed("npy", d);
     if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
         return Err(bad("missing \\x93NUMPY magic"));
@@ -98,19 +161,24 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if [nx, ny, nz].iter().any(|&d| d == 0 || d > voxkit::grid::spec::MAX_DIM as u64) {
         return Err(bad(&format!("shape ({nx}, {ny}, {nz}) out of range")));
     }
-    let data = &bytes[hstart + hlen..];
-    let n = (nx * ny * nz) as usize;
-    if data.len() < n {
-        return Err(bad(&format!("data holds {} bytes, shape needs {n} (truncated?)", data.len())));
-    }
-    let mut bits = DenseBits::new([nx as u32, ny as u32, nz as u32]);
-    for (idx, &b) in data[..n].iter().enumerate() {
-        if b != 0 {
-            let k = idx % nz as usize;
-            let j = (idx / nz as usize) % ny as usize;
-            let i = idx / (nz as usize * ny as usize);
-            bits.set(i as u32, j as u32, k as u32);
+    Ok(([nx, ny, nz], hstart + hlen))
+}
+
+/// Sets the voxels of the nonzero bytes of `data`, whose first byte is
+/// element `start` of the C-ordered array.
+fn fill(bits: &mut DenseBits, data: &[u8], start: usize) {
+    let [_, ny, nz] = bits.dims().map(|d| d as usize);
+    // Surfaces are sparse: skip zero bytes eight at a time.
+    for (c, chunk) in data.chunks(8).enumerate() {
+        if chunk.len() == 8 && u64::from_ne_bytes(chunk.try_into().unwrap_or([0; 8])) == 0 {
+            continue;
+        }
+        for (o, &b) in chunk.iter().enumerate() {
+            if b != 0 {
+                let idx = start + c * 8 + o;
+                let (k, j, i) = (idx % nz, (idx / nz) % ny, idx / (nz * ny));
+                bits.set(i as u32, j as u32, k as u32);
+            }
         }
     }
-    Ok(LoadedVoxels { bits, placement: None })
 }

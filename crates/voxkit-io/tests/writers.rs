@@ -141,3 +141,16 @@ fn brick_and_dense_storage_write_identical_files() {
         assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{name}");
     }
 }
+
+#[test]
+fn truncated_npy_files_are_rejected_when_streamed() {
+    let grid = GridSpec::new(glam::DVec3::ZERO, 1.0, [40, 30, 20]).unwrap();
+    let p = tmp("trunc.npy");
+    write_voxels(&p, VoxelFormat::Npy, &pattern([40, 30, 20]), &grid).unwrap();
+    let bytes = std::fs::read(&p).unwrap();
+    for cut in [5, 60, bytes.len() - 1] {
+        std::fs::write(&p, &bytes[..cut]).unwrap();
+        let e = read_voxels(&p).unwrap_err().to_string();
+        assert!(e.contains("trunc.npy") && (e.contains("truncated") || e.contains("magic")), "{cut}: {e}");
+    }
+}
