@@ -60,7 +60,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         "components_6": report.components_6,
         "components_26": report.components_26,
         "thick_voxels": report.thick_voxels,
-        "closed": facts.map(|f| f.boundary_edges == 0),
+        "closed": facts.map(|f| f.closed),
         "boundary_edges": facts.map(|f| f.boundary_edges),
         "separating_6": sep.map(|s| s.witness_6.is_none()),
         "separating_26": sep.map(|s| s.witness_26.is_none()),
@@ -119,7 +119,10 @@ fn text(v: &Value, a: &CheckArgs) -> String {
                 }
             }
         } else {
-            s += &format!("\n  not closed ({} boundary edges): separation needs a closed surface", v["boundary_edges"]);
+            s += &format!(
+                "\n  not a closed surface ({} boundary edges, or no triangles): separation needs one",
+                v["boundary_edges"]
+            );
         }
         let c = &v["columns"];
         s += &format!(

@@ -55,13 +55,15 @@ pub struct CheckReport {
 pub struct MeshFacts {
     /// Edges (keyed by snapped end points) used by an odd number of triangles.
     pub boundary_edges: usize,
+    /// The mesh has triangles and no boundary edges.
+    pub closed: bool,
     /// Segments between centres of 6-adjacent unset voxels that meet the surface.
     pub tunnels_6: u64,
     /// Segments between centres of 26-adjacent unset voxels that meet the surface.
     pub tunnels_26: u64,
     /// Runs along each triangle's dominant axis where it crosses a column.
     pub columns: ColumnStats,
-    /// Separation, only for a closed surface (`boundary_edges == 0`).
+    /// Separation, only for a closed surface.
     pub separation: Option<Separation>,
 }
 
@@ -118,7 +120,8 @@ pub fn certify(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec)>) -> Resu
     if let Some((mesh, grid)) = mesh {
         let snapped = snap_all(mesh, grid)?;
         let tris: Vec<LatticeTriangle> = snapped.triangles.iter().filter(|t| !t.is_degenerate()).copied().collect();
-        let separation = (snapped.boundary_edges == 0).then(|| {
+        let closed = snapped.boundary_edges == 0 && !tris.is_empty();
+        let separation = closed.then(|| {
             let parity = Parity::classify(&tris, bits.dims());
             Separation {
                 inside_voxels: inside_count(&parity, bits.dims()),
@@ -129,6 +132,7 @@ pub fn certify(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec)>) -> Resu
         });
         report.mesh = Some(MeshFacts {
             boundary_edges: snapped.boundary_edges,
+            closed,
             tunnels_6: tunnels(bits, &tris, Connectivity::Six),
             tunnels_26: tunnels(bits, &tris, Connectivity::TwentySix),
             columns: columns(bits, &tris),
