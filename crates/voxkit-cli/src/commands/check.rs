@@ -119,10 +119,7 @@ fn text(v: &Value, a: &CheckArgs) -> String {
                 }
             }
         } else {
-            s += &format!(
-                "\n  not a closed surface ({} boundary edges, or no triangles): separation needs one",
-                v["boundary_edges"]
-            );
+            s += &format!("\n  not a closed surface ({} boundary edges, or no triangles): separation needs one", v["boundary_edges"]);
         }
         let c = &v["columns"];
         s += &format!(

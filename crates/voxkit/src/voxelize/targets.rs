@@ -155,6 +155,9 @@ pub(crate) struct DirSetup<T> {
     c: [T; 3],
     /// Tie bias of each edge's orientation test.
     pub be: [T; 3],
+    /// `n·d > 0`: the orientation tests of a segment crossing the
+    /// triangle's interior are all positive (else all negative).
+    pos: bool,
 }
 
 #[inline(always)]
@@ -185,13 +188,27 @@ impl<T: PlaneInt> TriSetup<T> {
         let dt = d.map(T::from_i64);
         let m = std::array::from_fn(|i| crate::geom::lattice::cross(t.edge(i), d).map(T::from_i64));
         let c = std::array::from_fn(|i| dot(dt, crs(self.rel[i], self.rel[(i + 1) % 3])));
-        DirSetup { nd: dot(self.n, dt), m, c, be }
+        let nd = dot(self.n, dt);
+        DirSetup { nd, m, c, be, pos: nd > T::ZERO }
     }
 
     /// A lattice point relative to `a`.
     #[inline(always)]
     pub fn local(&self, p: P3) -> [T; 3] {
         std::array::from_fn(|c| T::from_i64(p[c] - self.a[c]))
+    }
+
+    /// [`Self::segment_hits_with`], skipping the edges flagged `safe`: those
+    /// the caller knows the crossing point lies strictly inside of (for
+    /// a crossing segment, a point outside the triangle is outside at least
+    /// one edge, so testing the other edges against the expected sign
+    /// decides).
+    #[inline(always)]
+    pub fn segment_hits_unsafe_edges(&self, ds: &DirSetup<T>, p: [T; 3], vp: T, safe: [bool; 3]) -> bool {
+        if (vp >= self.bn) == (vp + ds.nd >= self.bn) {
+            return false;
+        }
+        (0..3).all(|i| safe[i] || (ds.c[i] - dot(p, ds.m[i]) >= ds.be[i]) == ds.pos)
     }
 
     /// The plane value `n·p` of a point `p` relative to `a` (its displaced
@@ -288,10 +305,10 @@ impl<T: PlaneInt> PixelTest<T> {
         (0..3).any(|i| self.sign * o[i] + self.reach[i] < T::ZERO)
     }
 
-    /// Does the closed pixel square lie strictly inside the projected triangle?
+    /// Per edge: does the closed pixel square lie strictly on the inner side?
     #[inline(always)]
-    pub fn strictly_inside(&self, o: &[T; 3]) -> bool {
-        (0..3).all(|i| self.sign * o[i] - self.reach[i] > T::ZERO)
+    pub fn strictly_inside_edges(&self, o: &[T; 3]) -> [bool; 3] {
+        std::array::from_fn(|i| self.sign * o[i] - self.reach[i] > T::ZERO)
     }
 }
 
