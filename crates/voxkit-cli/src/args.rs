@@ -39,12 +39,22 @@ pub enum Mode {
     Ss6,
     /// Solid: voxels whose centre is inside.
     Solid,
+    /// Solid united with a surface mode (--surface), so thin parts never vanish.
+    #[value(name = "solid+surface")]
+    SolidSurface,
     /// 6-connected polyline voxelization.
     Line6,
     /// 26-connected polyline voxelization.
     Line26,
     /// Projected optimal scanline, as published.
     Pos,
+}
+
+/// Solid filling strategies other than the inside test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Fill {
+    /// Everything not reachable from the grid boundary through unset voxels of a surface shell.
+    Flood,
 }
 
 /// Voxelization methods.
@@ -99,6 +109,18 @@ pub struct VoxelizeArgs {
     /// Method.
     #[arg(long, value_enum, default_value = "auto")]
     pub method: Method,
+    /// Solid modes: the surface mode of `solid+surface` and of the
+    /// `--fill flood` shell (default cover).
+    #[arg(long, value_enum, value_name = "MODE")]
+    pub surface: Option<Mode>,
+    /// Solid modes: `flood` fills everything a surface shell encloses
+    /// (everything not reachable from the grid boundary through unset voxels).
+    #[arg(long, value_enum)]
+    pub fill: Option<Fill>,
+    /// Solid modes: keep only the voxels touching the outside through a face
+    /// (6) or also an edge or corner (26).
+    #[arg(long, value_name = "6|26", value_parser = clap::builder::PossibleValuesParser::new(["6", "26"]))]
+    pub hollow: Option<String>,
     #[command(flatten)]
     pub grid: GridArgs,
     /// Output format: npy, npy-bool, binvox, vox, txt (default: from the extension).

@@ -88,9 +88,10 @@ pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::M
         Mode::Ss6 => Core::Ss6,
         Mode::Line26 => Core::Line26,
         Mode::Line6 => Core::Line6,
-        Mode::Solid | Mode::Pos => {
-            bail!("mode '{}' is not implemented yet in this build; available: cover, sep26, sep6, ss6, line26, line6", mode_name(mode))
-        }
+        Mode::Solid | Mode::SolidSurface => bail!("mode '{}' is a solid mode, planned by solid_plan", mode_name(mode)),
+        Mode::Pos => bail!(
+            "mode 'pos' is not implemented yet in this build; available: cover, sep26, sep6, ss6, line26, line6, solid, solid+surface"
+        ),
     };
     let m = match method {
         Method::Auto | Method::Fast => "fast",
@@ -102,6 +103,65 @@ pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::M
     Ok((core, m))
 }
 
+/// How a solid is made.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SolidMethod {
+    /// Parity if the mesh is closed and consistently oriented, else winding.
+    Auto,
+    /// Ray parity.
+    Parity,
+    /// Winding number.
+    Winding,
+    /// Brute-force exact winding number.
+    Reference,
+    /// Flood fill against a surface shell.
+    Flood,
+}
+
+/// A validated solid job.
+#[derive(Clone, Copy, Debug)]
+pub struct SolidPlan {
+    /// How the inside is decided.
+    pub method: SolidMethod,
+    /// The surface united with the solid (`solid+surface`), or the shell of a flood fill.
+    pub surface: Option<voxkit::voxelize::Mode>,
+    /// Keep only the skin, 6- or 26-connected to the outside.
+    pub hollow: Option<voxkit::topology::runs::Connectivity>,
+}
+
+/// Validates the solid options: `None` for a surface or line mode (where
+/// they are refused if given).
+pub fn solid_plan(a: &crate::args::VoxelizeArgs) -> Result<Option<SolidPlan>> {
+    use voxkit::topology::runs::Connectivity;
+    let solid = matches!(a.mode, Mode::Solid | Mode::SolidSurface);
+    if !solid {
+        if a.fill.is_some() || a.hollow.is_some() || a.surface.is_some() {
+            bail!("--fill, --hollow and --surface apply to --mode solid and solid+surface");
+        }
+        return Ok(None);
+    }
+    let surface_mode = match a.surface.unwrap_or(Mode::Cover) {
+        m @ (Mode::Cover | Mode::Sep26 | Mode::Sep6 | Mode::Ss6) => resolve_method(m, Method::Auto)?.0,
+        m => bail!("--surface takes cover, sep26, sep6 or ss6, not {}", mode_name(m)),
+    };
+    let method = match (a.fill, a.method) {
+        (Some(crate::args::Fill::Flood), Method::Auto) => SolidMethod::Flood,
+        (Some(_), m) => bail!("--fill flood replaces the inside test; it cannot be combined with --method {}", method_name(m)),
+        (None, Method::Auto) => SolidMethod::Auto,
+        (None, Method::Parity) => SolidMethod::Parity,
+        (None, Method::Winding) => SolidMethod::Winding,
+        (None, Method::Reference) => SolidMethod::Reference,
+        (None, m) => bail!("--method {} does not apply to solid modes (use auto, parity, winding or reference)", method_name(m)),
+    };
+    let surface = (a.mode == Mode::SolidSurface || method == SolidMethod::Flood).then_some(surface_mode);
+    let hollow = match a.hollow.as_deref() {
+        None => None,
+        Some("6") => Some(Connectivity::Six),
+        Some(_) => Some(Connectivity::TwentySix),
+    };
+    Ok(Some(SolidPlan { method, surface, hollow }))
+}
+
 pub fn mode_name(m: Mode) -> &'static str {
     match m {
         Mode::Cover => "cover",
@@ -109,6 +169,7 @@ pub fn mode_name(m: Mode) -> &'static str {
         Mode::Sep6 => "sep6",
         Mode::Ss6 => "ss6",
         Mode::Solid => "solid",
+        Mode::SolidSurface => "solid+surface",
         Mode::Line6 => "line6",
         Mode::Line26 => "line26",
         Mode::Pos => "pos",

@@ -242,3 +242,38 @@ fn pad_keeps_faces_on_the_high_side_of_a_fitted_grid() {
     let e = error_line(&["voxelize", &cube, "-o", &a, "--origin", "0,0,0", "--voxel-size", "1", "--dims", "2,2,2", "--pad", "1"]);
     assert!(e.contains("--pad applies to fitted grids"), "{e}");
 }
+
+#[test]
+fn solid_modes_say_what_they_did() {
+    let cube = tmp("solid_cube.obj");
+    let mut obj = String::new();
+    for c in 0..8 {
+        obj += &format!("v {} {} {}\n", c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    }
+    for q in [[1, 3, 4, 2], [5, 6, 8, 7], [1, 2, 6, 5], [3, 7, 8, 4], [1, 5, 7, 3], [2, 4, 8, 6]] {
+        obj += &format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+    }
+    std::fs::write(&cube, obj).unwrap();
+    let out = tmp("solid.npy");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["voxelize", &cube, "-o", &out, "--resolution", "8", "--json"];
+        args.extend_from_slice(extra);
+        json(&voxkit(&args))
+    };
+    let s = run(&["--mode", "solid"]);
+    assert_eq!((s["voxels"].as_u64(), s["method"].as_str()), (Some(512), Some("parity")));
+    assert_eq!(s["solid"]["closed"], true);
+    assert_eq!(run(&["--mode", "solid", "--method", "winding"])["voxels"], 512);
+    assert_eq!(run(&["--mode", "solid", "--method", "reference"])["voxels"], 512);
+    assert_eq!(run(&["--mode", "solid", "--hollow", "6"])["voxels"], 512 - 216);
+    assert_eq!(run(&["--mode", "solid", "--fill", "flood", "--pad", "1"])["method"], "flood");
+    assert!(run(&["--mode", "solid+surface", "--pad", "1"])["voxels"].as_u64().unwrap() > 512);
+    // An open mesh: auto needs the generalized winding number, and says so.
+    let bunny = shared("stanford-bunny.obj");
+    let e = error_line(&["voxelize", &bunny, "-o", &out, "--mode", "solid", "--resolution", "32"]);
+    assert!(e.contains("not implemented yet") && e.contains("boundary edges"), "{e}");
+    let p = json(&voxkit(&["voxelize", &bunny, "-o", &out, "--mode", "solid", "--method", "parity", "--resolution", "32", "--json"]));
+    assert_eq!(p["solid"]["closed"], false);
+    let e = error_line(&["voxelize", &cube, "-o", &out, "--mode", "sep6", "--hollow", "6"]);
+    assert!(e.contains("apply to --mode solid"), "{e}");
+}

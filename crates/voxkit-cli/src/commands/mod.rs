@@ -3,4 +3,5 @@
 pub mod bench;
 pub mod check;
 pub mod info;
+pub mod solid;
 pub mod voxelize;

@@ -17,7 +17,11 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let t_total = Instant::now();
     // Validate everything that does not need the mesh first.
     let request = GridRequest::from_args(&a.grid)?;
-    let (mode, method) = plan::resolve_method(a.mode, a.method)?;
+    let solid_plan = plan::solid_plan(a)?;
+    let (mode, method) = match solid_plan {
+        Some(_) => (voxelize::Mode::Cover, "solid"),
+        None => plan::resolve_method(a.mode, a.method)?,
+    };
     let format = match &a.format {
         Some(f) => {
             VoxelFormat::from_name(f).with_context(|| format!("unknown --format {f:?} (expected one of: {})", VoxelFormat::NAMES))?
@@ -42,7 +46,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     for w in &loaded.warnings {
         eprintln!("voxkit: warning: {}: {w}", a.mesh.display());
     }
-    let is_line = matches!(mode, voxelize::Mode::Line26 | voxelize::Mode::Line6);
+    let is_line = solid_plan.is_none() && matches!(mode, voxelize::Mode::Line26 | voxelize::Mode::Line6);
     if !is_line && loaded.report.triangles == 0 {
         bail!("{}: has only line segments; surface modes need triangles (use --mode line26 or line6)", a.mesh.display());
     }
@@ -51,7 +55,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
             "voxkit: warning: {}: {} line segments ignored by surface mode {} (line26 and line6 voxelize them)",
             a.mesh.display(),
             loaded.report.segments,
-            mode.name()
+            plan::mode_name(a.mode)
         );
     }
     let grid = request.fit(&loaded.report.bounds)?;
@@ -59,16 +63,33 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
 
     bar.phase(if method == "reference" { "voxelizing (reference, serial)" } else { "voxelizing" });
     let t_vox = Instant::now();
-    let (bits, report): (Box<dyn VoxelSource + Send>, _) = pool.install(|| match method {
-        "reference" => {
-            let (b, r) = voxelize::reference(mode, loaded.mesh.as_ref(), &grid);
-            (Box::new(b) as Box<dyn VoxelSource + Send>, r)
+    let mut method = method;
+    let mut solid_facts = serde_json::Value::Null;
+    let (bits, report): (Box<dyn VoxelSource + Send>, _) = if let Some(sp) = &solid_plan {
+        let name = a.mesh.display().to_string();
+        let out = pool.install(|| {
+            crate::commands::solid::run(sp, loaded.mesh.as_ref(), &name, &grid, &Options { progress: Some(&bar), ..Options::default() })
+        })?;
+        for w in &out.warnings {
+            eprintln!("voxkit: warning: {w}");
         }
-        _ => {
-            let (b, r) = voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &Options { progress: Some(&bar), ..Options::default() });
-            (Box::new(b) as Box<dyn VoxelSource + Send>, r)
-        }
-    });
+        method = out.method;
+        solid_facts = out.facts;
+        let voxels = out.bits.count();
+        let report = voxelize::Report { voxels, prepare: voxkit::geom::lattice::PrepareStats::default() };
+        (Box::new(out.bits) as Box<dyn VoxelSource + Send>, report)
+    } else {
+        pool.install(|| match method {
+            "reference" => {
+                let (b, r) = voxelize::reference(mode, loaded.mesh.as_ref(), &grid);
+                (Box::new(b) as Box<dyn VoxelSource + Send>, r)
+            }
+            _ => {
+                let (b, r) = voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &Options { progress: Some(&bar), ..Options::default() });
+                (Box::new(b) as Box<dyn VoxelSource + Send>, r)
+            }
+        })
+    };
     let voxelize_s = t_vox.elapsed().as_secs_f64();
 
     bar.phase("writing");
@@ -106,7 +127,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
                 "degenerate": loaded.report.degenerate,
                 "segments": loaded.report.segments,
             },
-            "triangles": {
+            "triangles": if solid_plan.is_some() { serde_json::Value::Null } else { json!({
                 "input": p.input,
                 "voxelized": p.output,
                 "skipped_degenerate": p.degenerate,
@@ -114,11 +135,17 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
                 "skipped_invalid_index": p.invalid_index,
                 "outside_grid": p.outside,
                 "clipped": p.clipped,
-            },
+            })},
             "warnings": loaded.warnings,
+            "solid": solid_facts,
         });
         crate::print_stdout(&v.to_string())?;
     } else if !a.quiet {
+        let method = match solid_facts.get("closed").and_then(|c| c.as_bool()) {
+            Some(true) => format!("{method} (mesh closed)"),
+            Some(false) => format!("{method} (mesh not closed)"),
+            None => method.to_string(),
+        };
         crate::print_stdout(&format!(
             "{}: {} voxels set on grid {}x{}x{} (origin {}, {}, {}; voxel size {}) by {} in {:.1} ms; total {:.2} s -> {}",
             plan::mode_name(a.mode),

@@ -70,6 +70,34 @@ impl DenseBits {
         self.words[w] |= 1u64 << (i & 63);
     }
 
+    /// The rows (`j`, then `k`; `words_per_row` words each), mutable.
+    pub fn rows_mut(&mut self) -> std::slice::ChunksExactMut<'_, u64> {
+        let wpr = self.words_per_row.max(1);
+        self.words.chunks_exact_mut(wpr)
+    }
+
+    /// [`Self::rows_mut`] as a rayon parallel iterator (row order is the index).
+    pub fn par_rows_mut(&mut self) -> rayon::slice::ChunksExactMut<'_, u64> {
+        let wpr = self.words_per_row.max(1);
+        self.words.par_chunks_exact_mut(wpr)
+    }
+
+    /// Sets voxels `i0 ..= i1` of one row (as returned by [`Self::rows_mut`]).
+    pub fn fill_row(row: &mut [u64], i0: u32, i1: u32) {
+        let (w0, w1) = ((i0 / 64) as usize, (i1 / 64) as usize);
+        let lo_mask = u64::MAX << (i0 % 64);
+        let hi_mask = u64::MAX >> (63 - i1 % 64);
+        if w0 == w1 {
+            row[w0] |= lo_mask & hi_mask;
+            return;
+        }
+        row[w0] |= lo_mask;
+        for w in &mut row[w0 + 1..w1] {
+            *w = u64::MAX;
+        }
+        row[w1] |= hi_mask;
+    }
+
     /// Number of set voxels.
     pub fn count(&self) -> u64 {
         self.words.par_chunks(1 << 16).map(super::count_bits).sum()

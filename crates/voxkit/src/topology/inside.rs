@@ -20,7 +20,7 @@
 use rayon::prelude::*;
 
 use super::super::voxelize::targets::TriSetup;
-use crate::geom::fixed::{snap, DIRECT_LIMIT_VOXELS, ONE};
+use crate::geom::fixed::{snap, PlaneInt, DIRECT_LIMIT_VOXELS, ONE};
 use crate::geom::lattice::LatticeTriangle;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
@@ -35,6 +35,9 @@ pub struct Snapped {
     pub triangles: Vec<LatticeTriangle>,
     /// Edges (by snapped end points) used by an odd number of triangles.
     pub boundary_edges: usize,
+    /// Edges not used equally often in both directions (0 for a closed,
+    /// consistently oriented surface).
+    pub unbalanced_edges: usize,
 }
 
 /// Why a mesh cannot be classified.
@@ -67,24 +70,28 @@ pub fn snap_all(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<Snapped, ClassifyE
             triangles.push(LatticeTriangle { v });
         }
     }
-    let mut edges: Vec<([i64; 3], [i64; 3])> = triangles
+    // Undirected key, and +1 / −1 for the direction of use.
+    let mut edges: Vec<([i64; 3], [i64; 3], i8)> = triangles
         .iter()
         .flat_map(|t| (0..3).map(move |i| (t.v[i], t.v[(i + 1) % 3])))
         .filter(|(a, b)| a != b)
-        .map(|(a, b)| if a < b { (a, b) } else { (b, a) })
+        .map(|(a, b)| if a < b { (a, b, 1) } else { (b, a, -1) })
         .collect();
     edges.par_sort_unstable();
-    let mut boundary_edges = 0;
+    let (mut boundary_edges, mut unbalanced_edges) = (0, 0);
     let mut i = 0;
     while i < edges.len() {
         let mut j = i;
-        while j < edges.len() && edges[j] == edges[i] {
+        let mut balance = 0i64;
+        while j < edges.len() && (edges[j].0, edges[j].1) == (edges[i].0, edges[i].1) {
+            balance += edges[j].2 as i64;
             j += 1;
         }
         boundary_edges += (j - i) % 2;
+        unbalanced_edges += (balance != 0) as usize;
         i = j;
     }
-    Ok(Snapped { triangles, boundary_edges })
+    Ok(Snapped { triangles, boundary_edges, unbalanced_edges })
 }
 
 /// Per row `(j, k)` of a grid, the sorted voxel indices `i` at which the
@@ -101,17 +108,7 @@ impl Parity {
     /// Classifies every voxel centre of `grid` against `tris`.
     pub fn classify(tris: &[LatticeTriangle], dims: [u32; 3]) -> Parity {
         let [nx, ny, nz] = dims;
-        let mut hits: Vec<(u32, u32)> = tris
-            .par_chunks(1024)
-            .flat_map_iter(|chunk| {
-                let mut out = Vec::new();
-                for t in chunk {
-                    crossings(t, dims, &mut out);
-                }
-                out
-            })
-            .collect();
-        hits.par_sort_unstable();
+        let hits: Vec<(u32, u32)> = row_crossings(tris, dims).into_iter().map(|(r, i, _)| (r, i)).collect();
         // Toggles at the same voxel cancel in pairs.
         let rows = ny as usize * nz as usize;
         let mut row_start = Vec::with_capacity(rows + 1);
@@ -146,10 +143,30 @@ impl Parity {
     }
 }
 
-/// Appends `(row, i0)` for every row whose centre line crosses `t`, where
-/// `i0` is the first voxel whose displaced centre lies beyond the crossing
-/// (clamped to `[0, nx]`; voxels `>= i0` see one more crossing).
-fn crossings(t: &LatticeTriangle, dims: [u32; 3], out: &mut Vec<(u32, u32)>) {
+/// Every crossing of the rows' centre lines with the triangles, as
+/// `(row, i0, sign)` sorted by row and `i0`: voxels `i >= i0` of the row
+/// have this crossing on their `−x` ray, and `sign` is its contribution to
+/// the winding number (`+1` where the ray leaves through an outward face,
+/// i.e. `−sign(n_x)`).
+pub fn row_crossings(tris: &[LatticeTriangle], dims: [u32; 3]) -> Vec<(u32, u32, i8)> {
+    let mut hits: Vec<(u32, u32, i8)> = tris
+        .par_chunks(1024)
+        .flat_map_iter(|chunk| {
+            let mut out = Vec::new();
+            for t in chunk {
+                crossings(t, dims, &mut out);
+            }
+            out
+        })
+        .collect();
+    hits.par_sort_unstable();
+    hits
+}
+
+/// Appends `(row, i0, sign)` for every row whose centre line crosses `t`,
+/// where `i0` is the first voxel whose displaced centre lies beyond the
+/// crossing (clamped to `[0, nx]`; voxels `>= i0` see one more crossing).
+fn crossings(t: &LatticeTriangle, dims: [u32; 3], out: &mut Vec<(u32, u32, i8)>) {
     let n = t.normal();
     if n[0] == 0 {
         // Parallel to the rays: a displaced ray misses it.
@@ -163,13 +180,28 @@ fn crossings(t: &LatticeTriangle, dims: [u32; 3], out: &mut Vec<(u32, u32)>) {
         let last = ((hi[a] - H + 1).div_euclid(ONE)).min(dims[a] as i64 - 1);
         first..=last
     };
-    let s = TriSetup::<i128>::new(t);
+    if crate::voxelize::targets::fits_i64(t) {
+        crossings_in::<i64>(t, n, dims, rows(1), rows(2), out);
+    } else {
+        crossings_in::<i128>(t, n, dims, rows(1), rows(2), out);
+    }
+}
+
+fn crossings_in<T: PlaneInt>(
+    t: &LatticeTriangle,
+    n: [i64; 3],
+    dims: [u32; 3],
+    rows_j: std::ops::RangeInclusive<i64>,
+    rows_k: std::ops::RangeInclusive<i64>,
+    out: &mut Vec<(u32, u32, i8)>,
+) {
+    let s = TriSetup::<T>::new(t);
     let dx = s.dir(t, [ONE, 0, 0]);
     let nx = n[0] as i128;
-    let bn = s.bn;
-    for k in rows(2) {
-        for j in rows(1) {
-            let p = s.local([0, j * ONE + H, k * ONE + H]);
+    let bn = s.bn.to_i128();
+    for k in rows_k {
+        for j in rows_j.clone() {
+            let p = s.local([s.a[0], j * ONE + H, k * ONE + H]);
             let o = s.line_values(&dx, p);
             let inside = [0, 1, 2].map(|e| o[e] >= dx.be[e]);
             if !(inside[0] == inside[1] && inside[1] == inside[2]) {
@@ -178,12 +210,12 @@ fn crossings(t: &LatticeTriangle, dims: [u32; 3], out: &mut Vec<(u32, u32)>) {
             // Plane value along the row: V(X) = v0 + n_x·(X − a_x); the
             // displaced point at X is beyond the crossing iff
             // (V >= bn) == (n_x > 0).
-            let v0 = n[1] as i128 * p[1] + n[2] as i128 * p[2];
+            let v0 = n[1] as i128 * p[1].to_i128() + n[2] as i128 * p[2].to_i128();
             let ax = s.a[0] as i128;
             let x_star = if nx > 0 { ax - (v0 - bn).div_euclid(nx) } else { ax + (v0 - bn).div_euclid(-nx) + 1 };
             // First i with i·ONE + H >= x_star.
             let i0 = (x_star - H as i128 + ONE as i128 - 1).div_euclid(ONE as i128).clamp(0, dims[0] as i128);
-            out.push(((k as u64 * dims[1] as u64 + j as u64) as u32, i0 as u32));
+            out.push(((k as u64 * dims[1] as u64 + j as u64) as u32, i0 as u32, if nx > 0 { -1 } else { 1 }));
         }
     }
 }

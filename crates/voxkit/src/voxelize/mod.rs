@@ -8,14 +8,17 @@
 //! | `sep6` | [`sep6`] | a triangle meets the 3D crosshair (6-separating, thin) |
 //! | `ss6` | [`ss6`] | Schwarz–Seidel plane + diamond tests (6-separating, ⊇ `sep6`) |
 //! | `line26`, `line6` | [`line`](mod@line) | an element meets the bisecting squares / the surface (26- / 6-connected) |
+//! | `solid` | [`solid`] | the voxel's centre is inside (winding number); ray parity for watertight meshes |
 //!
 //! [`Mode`] with [`fast()`] and [`reference()`] dispatches over all of them.
 
 pub mod cover;
 pub mod driver;
+pub mod fill;
 pub mod line;
 pub mod sep26;
 pub mod sep6;
+pub mod solid;
 pub mod ss6;
 pub mod targets;
 

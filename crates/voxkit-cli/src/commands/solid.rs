@@ -1,0 +1,87 @@
+//! The solid modes of `voxkit voxelize`: choosing the method, running it,
+//! and the `solid+surface`, `--fill flood` and `--hollow` variants.
+
+use anyhow::{bail, Result};
+use serde_json::{json, Value};
+use voxkit::grid::dense::DenseBits;
+use voxkit::voxelize::{self, fill, solid, Options};
+use voxkit::{GridSpec, MeshRef};
+
+use crate::plan::{SolidMethod, SolidPlan};
+
+/// A solid and what was done to get it.
+pub struct Outcome {
+    pub bits: DenseBits,
+    /// The method that ran.
+    pub method: &'static str,
+    /// Facts for the summary and JSON.
+    pub facts: Value,
+    pub warnings: Vec<String>,
+}
+
+pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opts: &Options<'_>) -> Result<Outcome> {
+    let mut warnings = Vec::new();
+    let (mut bits, method, mut facts) = if plan.method == SolidMethod::Flood {
+        let surface = plan.surface.unwrap_or(voxelize::Mode::Cover);
+        let shell = voxelize::fast(surface, mesh, grid, opts).0.to_dense();
+        let (bits, rep) = fill::flood_fill(&shell);
+        if rep.enclosed == 0 {
+            warnings.push(format!(
+                "the {} shell encloses no voxel: it leaks through a hole wider than the shell, or the mesh is too thin for this grid",
+                surface.name()
+            ));
+        }
+        (bits, "flood", json!({"shell": surface.name(), "shell_voxels": rep.shell, "enclosed_voxels": rep.enclosed}))
+    } else {
+        let inspect = solid::inspect(mesh, grid)?;
+        let watertight = inspect.watertight();
+        let open = || {
+            format!(
+                "{name}: not closed and consistently oriented ({} boundary edges, {} inconsistently oriented edges)",
+                inspect.boundary_edges, inspect.unbalanced_edges
+            )
+        };
+        let needs_gwn = || {
+            format!(
+                "{}: the generalized winding number such meshes need is not implemented yet; --method parity runs ray parity anyway (rows through holes may streak), --fill flood fills what a surface shell encloses",
+                open()
+            )
+        };
+        let (bits, rep, method) = match plan.method {
+            SolidMethod::Auto | SolidMethod::Parity if watertight || plan.method == SolidMethod::Parity => {
+                if !watertight {
+                    warnings.push(format!("{}: ray parity may streak through holes", open()));
+                }
+                let (b, r) = solid::parity(mesh, grid)?;
+                (b, r, "parity")
+            }
+            SolidMethod::Winding if watertight => {
+                let (b, r) = solid::winding_closed(mesh, grid)?;
+                (b, r, "winding")
+            }
+            SolidMethod::Reference if watertight => {
+                let (b, r) = solid::reference::solid(mesh, grid)?;
+                (b, r, "reference")
+            }
+            _ => bail!("{}", needs_gwn()),
+        };
+        let facts = json!({
+            "closed": rep.boundary_edges == 0,
+            "consistently_oriented": rep.unbalanced_edges == 0,
+            "boundary_edges": rep.boundary_edges,
+            "inconsistent_edges": rep.unbalanced_edges,
+        });
+        (bits, method, facts)
+    };
+    if plan.surface.is_some() && plan.method != SolidMethod::Flood {
+        let surface = plan.surface.unwrap_or(voxelize::Mode::Cover);
+        let (shell, _) = voxelize::fast(surface, mesh, grid, opts);
+        voxkit::VoxelSource::for_each_set(&shell, &mut |i, j, k| bits.set(i, j, k));
+        facts["surface"] = json!(surface.name());
+    }
+    if let Some(conn) = plan.hollow {
+        bits = fill::hollow(&bits, conn);
+        facts["hollow"] = json!(if conn == voxkit::topology::runs::Connectivity::Six { 6 } else { 26 });
+    }
+    Ok(Outcome { bits, method, facts, warnings })
+}
