@@ -5,8 +5,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use serde_json::json;
-use voxkit::voxelize::{self, Options};
-use voxkit::GridSpec;
+use voxkit::voxelize::{self, solid, Options};
+use voxkit::{GridSpec, MeshRef};
 
 use crate::args::BenchArgs;
 
@@ -33,6 +33,54 @@ fn time<T>(repeats: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     (median(times), last.expect("at least one repeat"))
 }
 
+/// What a benchmark row runs: a surface/line mode, or the solid by parity.
+enum Engine {
+    Surface(voxelize::Mode),
+    SolidParity,
+}
+
+impl Engine {
+    fn new(m: crate::args::Mode) -> Result<Engine> {
+        Ok(match m {
+            crate::args::Mode::Solid => Engine::SolidParity,
+            m => Engine::Surface(crate::plan::resolve_method(m, crate::args::Method::Auto)?.0),
+        })
+    }
+
+    fn is_solid(&self) -> bool {
+        matches!(self, Engine::SolidParity)
+    }
+
+    fn name(&self) -> &'static str {
+        match self {
+            Engine::Surface(m) => m.name(),
+            Engine::SolidParity => "solid",
+        }
+    }
+
+    fn fast_name(&self) -> &'static str {
+        if self.is_solid() {
+            "parity"
+        } else {
+            "fast"
+        }
+    }
+
+    fn reference(&self, mesh: MeshRef<'_>, grid: &GridSpec) -> Result<u64> {
+        Ok(match self {
+            Engine::Surface(m) => voxelize::reference(*m, mesh, grid).1.voxels,
+            Engine::SolidParity => solid::reference::solid(mesh, grid)?.1.voxels,
+        })
+    }
+
+    fn fast(&self, mesh: MeshRef<'_>, grid: &GridSpec) -> Result<u64> {
+        Ok(match self {
+            Engine::Surface(m) => voxelize::fast(*m, mesh, grid, &Options::default()).1.voxels,
+            Engine::SolidParity => solid::parity(mesh, grid)?.1.voxels,
+        })
+    }
+}
+
 struct Row {
     mode: &'static str,
     method: &'static str,
@@ -52,18 +100,21 @@ pub fn run(a: &BenchArgs) -> Result<()> {
 
     let mut ref_s = std::collections::HashMap::new();
     for &cli_mode in &a.modes {
-        let (mode, _) = crate::plan::resolve_method(cli_mode, crate::args::Method::Auto)?;
-        // Baseline: the reference path (serial by construction).
-        let grid = GridSpec::from_resolution(&bounds, a.reference_resolution).context("invalid grid")?;
-        let (s, (_, rep)) = time(a.repeats.clamp(1, 3), || voxelize::reference(mode, mesh, &grid));
-        ref_s.insert(mode.name(), s);
+        let engine = Engine::new(cli_mode)?;
+        // Baseline: the reference path (serial by construction). The solid
+        // reference tests every triangle for every voxel: capped at 32.
+        let ref_res = if engine.is_solid() { a.reference_resolution.min(32) } else { a.reference_resolution };
+        let grid = GridSpec::from_resolution(&bounds, ref_res).context("invalid grid")?;
+        let (s, voxels) = time(a.repeats.clamp(1, 3), || engine.reference(mesh, &grid));
+        let voxels = voxels?;
+        ref_s.insert(engine.name(), (ref_res, s));
         rows.push(Row {
-            mode: mode.name(),
+            mode: engine.name(),
             method: "reference",
             threads: 1,
-            resolution: a.reference_resolution,
+            resolution: ref_res,
             dims: grid.dims(),
-            voxels: rep.voxels,
+            voxels,
             voxelize_s: s,
             with_loading_s: None,
         });
@@ -73,22 +124,23 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             for &res in &a.resolutions {
                 let grid = GridSpec::from_resolution(&bounds, res).context("invalid grid")?;
                 crate::plan::check_memory(&grid)?;
-                let (vox_s, (_, rep)) = pool.install(|| time(a.repeats, || voxelize::fast(mode, mesh, &grid, &Options::default())));
+                let (vox_s, voxels) = pool.install(|| time(a.repeats, || engine.fast(mesh, &grid)));
+                let voxels = voxels?;
                 let (load_s, r) = pool.install(|| {
                     time(a.repeats.min(5), || -> Result<u64> {
                         let l = voxkit_io::read_mesh(&a.mesh)?;
                         let g = GridSpec::from_resolution(&l.report.bounds, res)?;
-                        Ok(voxelize::fast(mode, l.mesh.as_ref(), &g, &Options::default()).1.voxels)
+                        engine.fast(l.mesh.as_ref(), &g)
                     })
                 });
                 r?;
                 rows.push(Row {
-                    mode: mode.name(),
-                    method: "fast",
+                    mode: engine.name(),
+                    method: engine.fast_name(),
                     threads,
                     resolution: res,
                     dims: grid.dims(),
-                    voxels: rep.voxels,
+                    voxels,
                     voxelize_s: vox_s,
                     with_loading_s: Some(load_s),
                 });
@@ -116,7 +168,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     for r in &rows {
         let d = r.dims;
         let load = r.with_loading_s.map(|s| format!("{:.1}", s * 1e3)).unwrap_or_else(|| "-".into());
-        let speed = if r.resolution == a.reference_resolution { format!("{:.1}x", ref_s[r.mode] / r.voxelize_s) } else { "-".into() };
+        let (rr, rs) = ref_s[r.mode];
+        let speed = if r.resolution == rr { format!("{:.1}x", rs / r.voxelize_s) } else { "-".into() };
         out += &format!(
             "| {} | {} | {} | {} | {}x{}x{} | {} | {:.2} | {} | {} |\n",
             r.mode,

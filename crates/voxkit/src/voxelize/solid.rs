@@ -12,20 +12,25 @@
 //! centres takes exactly one of the two boundary layers on each axis.
 //!
 //! **Methods.**
-//! - [`parity`]: every triangle adds, to each grid row whose centre line it
+//! - [`parity()`]: every triangle adds, to each grid row whose centre line it
 //!   crosses, a crossing at an exact position (integer predicates, the
 //!   displacement decides rows through edges and vertices, so no streaks);
 //!   a voxel is inside iff an odd number of crossings lie on its `−x` ray.
 //!   For a closed surface that is consistently oriented and does not
 //!   intersect itself, `w ∈ {0, 1}` (or `{0, −1}`) and parity equals the
 //!   definition. Triangle-parallel with rayon, then one sorted pass per row.
-//! - [`reference`]: the definition by brute force for closed meshes — for
+//! - [`reference`](mod@reference): the definition by brute force for closed meshes — for
 //!   every voxel centre and every triangle, does the displaced `−x` ray
 //!   cross it (the generic exact segment predicate), summing `±1` by the
 //!   triangle's orientation: the exact integer winding number.
 //!
+//! - [`winding_closed`]: the same crossings, signed and summed: the exact
+//!   winding number of a watertight mesh, which also fills regions wrapped
+//!   twice (self-intersections, same-orientation nested shells).
+//!
 //! The generalized winding number for open meshes (Jacobson et al. 2013,
-//! Barill et al. 2018) is not built yet: callers get an error saying so.
+//! Barill et al. 2018) is not built yet: the CLI refuses such meshes with
+//! an error saying so (and offers `parity` or a flood fill).
 
 use rayon::prelude::*;
 
