@@ -268,10 +268,11 @@ fn solid_modes_say_what_they_did() {
     assert_eq!(run(&["--mode", "solid", "--hollow", "6"])["voxels"], 512 - 216);
     assert_eq!(run(&["--mode", "solid", "--fill", "flood", "--pad", "1"])["method"], "flood");
     assert!(run(&["--mode", "solid+surface", "--pad", "1"])["voxels"].as_u64().unwrap() > 512);
-    // An open mesh: auto needs the generalized winding number, and says so.
+    // An open mesh: auto takes the generalized winding number, and says so.
     let bunny = shared("stanford-bunny.obj");
-    let e = error_line(&["voxelize", &bunny, "-o", &out, "--mode", "solid", "--resolution", "32"]);
-    assert!(e.contains("not implemented yet") && e.contains("boundary edges"), "{e}");
+    let w = json(&voxkit(&["voxelize", &bunny, "-o", &out, "--mode", "solid", "--resolution", "32", "--json"]));
+    assert_eq!((w["method"].as_str(), w["solid"]["closed"].as_bool()), (Some("winding"), Some(false)));
+    assert!(w["solid"]["generalized_winding"]["boundary_cycles"].as_u64().unwrap() > 0);
     let p = json(&voxkit(&["voxelize", &bunny, "-o", &out, "--mode", "solid", "--method", "parity", "--resolution", "32", "--json"]));
     assert_eq!(p["solid"]["closed"], false);
     let e = error_line(&["voxelize", &cube, "-o", &out, "--mode", "sep6", "--hollow", "6"]);

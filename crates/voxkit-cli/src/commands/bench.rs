@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use serde_json::json;
-use voxkit::voxelize::{self, solid, Options};
+use voxkit::voxelize::{self, solid, winding, Options};
 use voxkit::{GridSpec, MeshRef};
 
 use crate::args::BenchArgs;
@@ -37,32 +37,41 @@ fn time<T>(repeats: usize, mut f: impl FnMut() -> T) -> (f64, T) {
 enum Engine {
     Surface(voxelize::Mode),
     SolidParity,
+    SolidWinding,
 }
 
 impl Engine {
-    fn new(m: crate::args::Mode) -> Result<Engine> {
+    /// `solid` measures both parity and the generalized winding number.
+    fn new(m: crate::args::Mode) -> Result<Vec<Engine>> {
         Ok(match m {
-            crate::args::Mode::Solid => Engine::SolidParity,
-            m => Engine::Surface(crate::plan::resolve_method(m, crate::args::Method::Auto)?.0),
+            crate::args::Mode::Solid => vec![Engine::SolidParity, Engine::SolidWinding],
+            m => vec![Engine::Surface(crate::plan::resolve_method(m, crate::args::Method::Auto)?.0)],
         })
     }
 
-    fn is_solid(&self) -> bool {
-        matches!(self, Engine::SolidParity)
+    /// Largest resolution the reference runs at (the solid references test
+    /// every triangle for every voxel).
+    fn reference_cap(&self) -> u64 {
+        match self {
+            Engine::Surface(_) => u64::MAX,
+            Engine::SolidParity => 32,
+            Engine::SolidWinding => 12,
+        }
     }
 
     fn name(&self) -> &'static str {
         match self {
             Engine::Surface(m) => m.name(),
-            Engine::SolidParity => "solid",
+            Engine::SolidParity => "solid (parity)",
+            Engine::SolidWinding => "solid (winding)",
         }
     }
 
     fn fast_name(&self) -> &'static str {
-        if self.is_solid() {
-            "parity"
-        } else {
-            "fast"
+        match self {
+            Engine::Surface(_) => "fast",
+            Engine::SolidParity => "parity",
+            Engine::SolidWinding => "winding",
         }
     }
 
@@ -70,6 +79,7 @@ impl Engine {
         Ok(match self {
             Engine::Surface(m) => voxelize::reference(*m, mesh, grid).1.voxels,
             Engine::SolidParity => solid::reference::solid(mesh, grid)?.1.voxels,
+            Engine::SolidWinding => winding::reference::winding(mesh, grid)?.count(),
         })
     }
 
@@ -77,6 +87,7 @@ impl Engine {
         Ok(match self {
             Engine::Surface(m) => voxelize::fast(*m, mesh, grid, &Options::default()).1.voxels,
             Engine::SolidParity => solid::parity(mesh, grid)?.1.voxels,
+            Engine::SolidWinding => winding::winding(mesh, grid)?.1.solid.voxels,
         })
     }
 }
@@ -99,11 +110,11 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let mut rows = Vec::new();
 
     let mut ref_s = std::collections::HashMap::new();
-    for &cli_mode in &a.modes {
-        let engine = Engine::new(cli_mode)?;
-        // Baseline: the reference path (serial by construction). The solid
-        // reference tests every triangle for every voxel: capped at 32.
-        let ref_res = if engine.is_solid() { a.reference_resolution.min(32) } else { a.reference_resolution };
+    let engines: Vec<Engine> = a.modes.iter().map(|&m| Engine::new(m)).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect();
+    for engine in &engines {
+        // Baseline: the reference path (serial by construction), capped for
+        // the solids.
+        let ref_res = a.reference_resolution.min(engine.reference_cap());
         let grid = GridSpec::from_resolution(&bounds, ref_res).context("invalid grid")?;
         let (s, voxels) = time(a.repeats.clamp(1, 3), || engine.reference(mesh, &grid));
         let voxels = voxels?;

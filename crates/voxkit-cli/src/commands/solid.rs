@@ -1,10 +1,10 @@
 //! The solid modes of `voxkit voxelize`: choosing the method, running it,
 //! and the `solid+surface`, `--fill flood` and `--hollow` variants.
 
-use anyhow::{bail, Result};
+use anyhow::Result;
 use serde_json::{json, Value};
 use voxkit::grid::dense::DenseBits;
-use voxkit::voxelize::{self, fill, solid, Options};
+use voxkit::voxelize::{self, fill, solid, winding, Options};
 use voxkit::{GridSpec, MeshRef};
 
 use crate::plan::{SolidMethod, SolidPlan};
@@ -41,17 +41,16 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
                 inspect.boundary_edges, inspect.unbalanced_edges
             )
         };
-        let needs_gwn = || {
-            format!(
-                "{}: the generalized winding number such meshes need is not implemented yet; --method parity runs ray parity anyway (rows through holes may streak), --fill flood fills what a surface shell encloses",
-                open()
-            )
-        };
+        let mut gwn = None;
         let (bits, rep, method) = match plan.method {
-            SolidMethod::Auto | SolidMethod::Parity if watertight || plan.method == SolidMethod::Parity => {
+            SolidMethod::Parity => {
                 if !watertight {
                     warnings.push(format!("{}: ray parity may streak through holes", open()));
                 }
+                let (b, r) = solid::parity(mesh, grid)?;
+                (b, r, "parity")
+            }
+            SolidMethod::Auto if watertight => {
                 let (b, r) = solid::parity(mesh, grid)?;
                 (b, r, "parity")
             }
@@ -59,13 +58,25 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
                 let (b, r) = solid::winding_closed(mesh, grid)?;
                 (b, r, "winding")
             }
+            SolidMethod::Auto | SolidMethod::Winding => {
+                let (b, r) = winding::winding(mesh, grid)?;
+                gwn = Some(json!({"boundary_cycles": r.cycles, "cap_triangles": r.cap_triangles, "evaluated_voxels": r.evaluated}));
+                (b, r.solid, "winding")
+            }
             SolidMethod::Reference if watertight => {
                 let (b, r) = solid::reference::solid(mesh, grid)?;
                 (b, r, "reference")
             }
-            _ => bail!("{}", needs_gwn()),
+            SolidMethod::Reference => {
+                let b = winding::reference::winding(mesh, grid)?;
+                let mut r = inspect;
+                r.voxels = b.count();
+                (b, r, "reference")
+            }
+            SolidMethod::Flood => unreachable!("handled above"),
         };
         let facts = json!({
+            "generalized_winding": gwn,
             "closed": rep.boundary_edges == 0,
             "consistently_oriented": rep.unbalanced_edges == 0,
             "boundary_edges": rep.boundary_edges,

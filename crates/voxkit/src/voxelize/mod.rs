@@ -21,6 +21,7 @@ pub mod sep6;
 pub mod solid;
 pub mod ss6;
 pub mod targets;
+pub mod winding;
 
 use crate::geom::lattice::{prepare, LatticeTriangle, PrepareStats};
 use crate::grid::dense::DenseBits;

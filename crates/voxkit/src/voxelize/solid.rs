@@ -28,9 +28,8 @@
 //!   winding number of a watertight mesh, which also fills regions wrapped
 //!   twice (self-intersections, same-orientation nested shells).
 //!
-//! The generalized winding number for open meshes (Jacobson et al. 2013,
-//! Barill et al. 2018) is not built yet: the CLI refuses such meshes with
-//! an error saying so (and offers `parity` or a flood fill).
+//! Open or inconsistently oriented meshes need the generalized winding
+//! number: [`super::winding`].
 
 use rayon::prelude::*;
 
