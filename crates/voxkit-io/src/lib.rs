@@ -184,8 +184,9 @@ pub fn read_voxels(path: &Path) -> Result<LoadedVoxels, IoError> {
     })?;
     if matches!(format, VoxelFormat::Npy | VoxelFormat::NpyBool) {
         let file = std::fs::File::open(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+        let total = file.metadata().map_err(|e| IoError::new(path, ErrorKind::Read(e)))?.len();
         let mut r = std::io::BufReader::new(file);
-        return npy::read_stream(&mut r).map_err(|k| IoError::new(path, k));
+        return npy::read_stream(&mut r, total).map_err(|k| IoError::new(path, k));
     }
     let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
     read_voxels_bytes(&bytes, format).map_err(|k| IoError::new(path, k))

@@ -72,9 +72,11 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     Ok(LoadedVoxels { bits, placement: None })
 }
 
-/// [`read`] from a stream, a few megabytes at a time: a 1024³ grid is a
-/// gigabyte of bytes that need not all be in memory at once.
-pub fn read_stream(r: &mut impl std::io::Read) -> Result<LoadedVoxels, ErrorKind> {
+/// [`read`] from a stream of `total` bytes, a few megabytes at a time: a
+/// 1024³ grid is a gigabyte of bytes that need not all be in memory at
+/// once. A header promising more data than `total` is rejected before
+/// anything is allocated.
+pub fn read_stream(r: &mut impl std::io::Read, total: u64) -> Result<LoadedVoxels, ErrorKind> {
     let io = |e: std::io::Error| {
         if e.kind() == std::io::ErrorKind::UnexpectedEof {
             ErrorKind::malformed("npy", "truncated header")
@@ -103,6 +105,10 @@ pub fn read_stream(r: &mut impl std::io::Read) -> Result<LoadedVoxels, ErrorKind
     r.read_exact(&mut head[start..]).map_err(io)?;
     let (dims, _) = parse_header(&head)?;
     let n = (dims[0] * dims[1] * dims[2]) as usize;
+    let have = total.saturating_sub(head.len() as u64);
+    if have < n as u64 {
+        return Err(truncated(have as usize, n));
+    }
     let mut bits = DenseBits::new(dims.map(|d| d as u32));
     let mut buf = vec![0u8; 1 << 22];
     let mut at = 0usize;

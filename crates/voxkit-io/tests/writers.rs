@@ -154,3 +154,21 @@ fn truncated_npy_files_are_rejected_when_streamed() {
         assert!(e.contains("trunc.npy") && (e.contains("truncated") || e.contains("magic")), "{cut}: {e}");
     }
 }
+
+#[test]
+fn an_npy_header_promising_a_huge_grid_is_rejected_before_allocating() {
+    let p = tmp("huge.npy");
+    let mut h = b"\x93NUMPY\x01\x00".to_vec();
+    let dict = "{'descr': '|u1', 'fortran_order': False, 'shape': (65536, 65536, 65536), }";
+    let mut header = dict.to_string();
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    h.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    h.extend_from_slice(header.as_bytes());
+    h.extend_from_slice(&[1, 0, 1]);
+    std::fs::write(&p, h).unwrap();
+    let e = read_voxels(&p).unwrap_err().to_string();
+    assert!(e.contains("huge.npy") && e.contains("truncated"), "{e}");
+}
