@@ -33,7 +33,10 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         }
         (bits, "flood", json!({"shell": surface.name(), "shell_voxels": rep.shell, "enclosed_voxels": rep.enclosed}))
     } else {
-        let inspect = solid::inspect(mesh, grid)?;
+        // Snapped once: the closedness test and whichever method runs share it.
+        let snapped = voxkit::topology::inside::snap_all(mesh, grid)?;
+        let inspect = solid::inspect(&snapped);
+        let dims = grid.dims();
         let watertight = inspect.watertight();
         let open = || {
             format!(
@@ -47,19 +50,19 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
                 if !watertight {
                     warnings.push(format!("{}: ray parity may streak through holes", open()));
                 }
-                let (b, r) = solid::parity(mesh, grid)?;
+                let (b, r) = solid::parity_snapped(&snapped, dims);
                 (b, r, "parity")
             }
             SolidMethod::Auto if watertight => {
-                let (b, r) = solid::parity(mesh, grid)?;
+                let (b, r) = solid::parity_snapped(&snapped, dims);
                 (b, r, "parity")
             }
             SolidMethod::Winding if watertight => {
-                let (b, r) = solid::winding_closed(mesh, grid)?;
+                let (b, r) = solid::winding_closed_snapped(&snapped, dims);
                 (b, r, "winding")
             }
             SolidMethod::Auto | SolidMethod::Winding => {
-                let (b, r) = winding::winding(mesh, grid)?;
+                let (b, r) = winding::winding_snapped(&snapped, dims);
                 gwn = Some(json!({"boundary_cycles": r.cycles, "cap_triangles": r.cap_triangles, "evaluated_voxels": r.evaluated}));
                 (b, r.solid, "winding")
             }

@@ -119,7 +119,7 @@ pub fn certify(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec)>) -> Resu
     let mut report = CheckReport { voxels: bits.count(), components_6, components_26, thick_voxels: thick_voxels(bits), mesh: None };
     if let Some((mesh, grid)) = mesh {
         let snapped = snap_all(mesh, grid)?;
-        let tris: Vec<LatticeTriangle> = snapped.triangles.iter().filter(|t| !t.is_degenerate()).copied().collect();
+        let tris = snapped.crossing_triangles();
         let closed = snapped.boundary_edges == 0 && !tris.is_empty();
         let separation = closed.then(|| {
             let parity = Parity::classify(&tris, bits.dims());

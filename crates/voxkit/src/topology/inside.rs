@@ -40,6 +40,27 @@ pub struct Snapped {
     pub unbalanced_edges: usize,
 }
 
+impl Snapped {
+    /// The triangles that can cross a ray: all but the zero-area ones.
+    pub fn crossing_triangles(&self) -> Vec<LatticeTriangle> {
+        self.triangles.iter().filter(|t| !t.is_degenerate()).copied().collect()
+    }
+}
+
+/// Offsets of each row's entries in a list sorted by row: entries of row
+/// `r` are `[starts[r], starts[r + 1])`. `row_of` yields each entry's row,
+/// in order.
+pub fn row_starts(rows: usize, row_of: impl Iterator<Item = usize>) -> Vec<usize> {
+    let mut start = vec![0usize; rows + 1];
+    for r in row_of {
+        start[r + 1] += 1;
+    }
+    for r in 0..rows {
+        start[r + 1] += start[r];
+    }
+    start
+}
+
 /// Why a mesh cannot be classified.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum ClassifyError {

@@ -34,11 +34,10 @@
 use rayon::prelude::*;
 
 use crate::geom::fixed::ONE;
-use crate::geom::lattice::LatticeTriangle;
 use crate::grid::dense::DenseBits;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
-use crate::topology::inside::{row_crossings, snap_all, ClassifyError, Snapped};
+use crate::topology::inside::{row_crossings, row_starts, snap_all, ClassifyError, Snapped};
 
 /// What a solid voxelization saw and did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -60,7 +59,9 @@ impl SolidReport {
     }
 }
 
-fn report(s: &Snapped) -> SolidReport {
+/// What the solid methods report about a snapped mesh before voxelizing
+/// (`voxels` is 0): whether it is watertight.
+pub fn inspect(s: &Snapped) -> SolidReport {
     SolidReport {
         triangles: s.triangles.len() as u64,
         boundary_edges: s.boundary_edges as u64,
@@ -69,15 +70,15 @@ fn report(s: &Snapped) -> SolidReport {
     }
 }
 
-/// Snaps the mesh and reports whether it is watertight, without voxelizing.
-pub fn inspect(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<SolidReport, ClassifyError> {
-    Ok(report(&snap_all(mesh, grid)?))
-}
-
 /// Solid by ray parity (exact; right for closed, consistently oriented,
 /// non-self-intersecting meshes). Dense output, parallel over rows.
 pub fn parity(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, SolidReport), ClassifyError> {
-    fill(mesh, grid, Rule::Parity)
+    Ok(parity_snapped(&snap_all(mesh, grid)?, grid.dims()))
+}
+
+/// [`parity`] on an already snapped mesh (see [`snap_all`]).
+pub fn parity_snapped(snapped: &Snapped, dims: [u32; 3]) -> (DenseBits, SolidReport) {
+    fill(snapped, dims, Rule::Parity)
 }
 
 /// Solid by the exact winding number of a closed mesh: the signed crossings
@@ -87,7 +88,12 @@ pub fn parity(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, SolidRep
 /// parity leaves holes. For meshes with boundary edges the sum depends on
 /// the ray and callers must not use it (see [`SolidReport::watertight`]).
 pub fn winding_closed(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, SolidReport), ClassifyError> {
-    fill(mesh, grid, Rule::Winding)
+    Ok(winding_closed_snapped(&snap_all(mesh, grid)?, grid.dims()))
+}
+
+/// [`winding_closed`] on an already snapped mesh.
+pub fn winding_closed_snapped(snapped: &Snapped, dims: [u32; 3]) -> (DenseBits, SolidReport) {
+    fill(snapped, dims, Rule::Winding)
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -100,22 +106,12 @@ enum Rule {
 
 /// Shared row filler: per row, walks the crossings in order and fills the
 /// spans where `rule` says inside.
-fn fill(mesh: MeshRef<'_>, grid: &GridSpec, rule: Rule) -> Result<(DenseBits, SolidReport), ClassifyError> {
-    let snapped = snap_all(mesh, grid)?;
-    let tris: Vec<LatticeTriangle> = snapped.triangles.iter().filter(|t| !t.is_degenerate()).copied().collect();
-    let dims = grid.dims();
-    let hits = row_crossings(&tris, dims);
+fn fill(snapped: &Snapped, dims: [u32; 3], rule: Rule) -> (DenseBits, SolidReport) {
+    let hits = row_crossings(&snapped.crossing_triangles(), dims);
     let mut bits = DenseBits::new(dims);
     let nx = dims[0];
     // Row r's crossings are hits[start[r] .. start[r + 1]].
-    let rows = dims[1] as usize * dims[2] as usize;
-    let mut start = vec![0usize; rows + 1];
-    for h in &hits {
-        start[h.0 as usize + 1] += 1;
-    }
-    for r in 0..rows {
-        start[r + 1] += start[r];
-    }
+    let start = row_starts(dims[1] as usize * dims[2] as usize, hits.iter().map(|h| h.0 as usize));
     bits.par_rows_mut().enumerate().for_each(|(r, row)| {
         let row_hits = &hits[start[r]..start[r + 1]];
         // State before the first voxel, then the changes voxel by voxel.
@@ -153,9 +149,9 @@ fn fill(mesh: MeshRef<'_>, grid: &GridSpec, rule: Rule) -> Result<(DenseBits, So
             DenseBits::fill_row(row, from, nx - 1);
         }
     });
-    let mut rep = report(&snapped);
+    let mut rep = inspect(snapped);
     rep.voxels = bits.count();
-    Ok((bits, rep))
+    (bits, rep)
 }
 
 /// The slow, obviously correct definition for closed meshes.
@@ -168,7 +164,7 @@ pub mod reference {
     /// triangle. Serial; small grids only.
     pub fn solid(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, SolidReport), ClassifyError> {
         let snapped = snap_all(mesh, grid)?;
-        let tris: Vec<&LatticeTriangle> = snapped.triangles.iter().filter(|t| !t.is_degenerate()).collect();
+        let tris = snapped.crossing_triangles();
         let dims = grid.dims();
         let min_x = tris.iter().flat_map(|t| t.v.iter().map(|p| p[0])).min().unwrap_or(0).min(0);
         let bounds: Vec<([i64; 3], [i64; 3])> = tris.iter().map(|t| t.bounds()).collect();
@@ -196,7 +192,7 @@ pub mod reference {
                 }
             }
         }
-        let mut rep = report(&snapped);
+        let mut rep = inspect(&snapped);
         rep.voxels = bits.count();
         Ok((bits, rep))
     }

@@ -43,7 +43,7 @@ use crate::geom::perturb::{orient, P3};
 use crate::grid::dense::DenseBits;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
-use crate::topology::inside::{row_crossings, snap_all, ClassifyError};
+use crate::topology::inside::{row_crossings, row_starts, snap_all, ClassifyError, Snapped};
 
 /// What the winding-number solid did beyond [`SolidReport`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -380,23 +380,20 @@ fn split(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut Vec<S
 
 /// Solid by the generalized winding number (see the module documentation).
 pub fn winding(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, WindingReport), ClassifyError> {
-    let snapped = snap_all(mesh, grid)?;
+    Ok(winding_snapped(&snap_all(mesh, grid)?, grid.dims()))
+}
+
+/// [`winding`] on an already snapped mesh.
+pub fn winding_snapped(snapped: &Snapped, dims: [u32; 3]) -> (DenseBits, WindingReport) {
     let cycles = boundary_cycles(&snapped.triangles);
     let caps = caps(&cycles);
-    let mut closed: Vec<LatticeTriangle> = snapped.triangles.iter().filter(|t| !t.is_degenerate()).copied().collect();
+    let mut closed = snapped.crossing_triangles();
     for c in &caps {
         closed.extend(c.tris.iter().map(|&v| LatticeTriangle { v }).filter(|t| !t.is_degenerate()));
     }
-    let dims = grid.dims();
     let hits = row_crossings(&closed, dims);
     let rows = dims[1] as usize * dims[2] as usize;
-    let mut start = vec![0usize; rows + 1];
-    for h in &hits {
-        start[h.0 as usize + 1] += 1;
-    }
-    for r in 0..rows {
-        start[r + 1] += start[r];
-    }
+    let start = row_starts(rows, hits.iter().map(|h| h.0 as usize));
     // Voxels whose decision needs w_cap: octree refinement from 8³ blocks.
     // A block is settled (inside iff J ≠ 0) when |w_cap| stays below 1/2
     // over it, by each cap's sphere bound or by w_cap at its centre plus a
@@ -417,13 +414,7 @@ pub fn winding(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, Winding
             .collect()
     };
     needed.par_sort_unstable_by_key(|s| (s.row, s.i0));
-    let mut nstart = vec![0usize; rows + 1];
-    for n in &needed {
-        nstart[n.row as usize + 1] += 1;
-    }
-    for r in 0..rows {
-        nstart[r + 1] += nstart[r];
-    }
+    let nstart = row_starts(rows, needed.iter().map(|n| n.row as usize));
     let mut bits = DenseBits::new(dims);
     let nx = dims[0];
     bits.par_rows_mut().enumerate().for_each(|(r, row)| {
@@ -462,14 +453,10 @@ pub fn winding(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, Winding
     });
     let evaluated = needed.iter().filter(|s| matches!(s.rule, Rule::Exact(_))).count() as u64;
 
-    let solid = SolidReport {
-        triangles: snapped.triangles.len() as u64,
-        boundary_edges: snapped.boundary_edges as u64,
-        unbalanced_edges: snapped.unbalanced_edges as u64,
-        voxels: bits.count(),
-    };
+    let mut solid = super::solid::inspect(snapped);
+    solid.voxels = bits.count();
     let cap_triangles = caps.iter().map(|c| c.tris.len() as u64).sum();
-    Ok((bits, WindingReport { solid, cycles: cycles.len() as u64, cap_triangles, evaluated }))
+    (bits, WindingReport { solid, cycles: cycles.len() as u64, cap_triangles, evaluated })
 }
 
 /// The slow, obviously correct definition.
@@ -479,7 +466,7 @@ pub mod reference {
     /// `w` at every voxel centre by the direct sum over all triangles.
     /// Serial; small grids only.
     pub fn winding_numbers(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<Vec<f64>, ClassifyError> {
-        let snapped = snap_all(mesh, grid)?;
+        let tris = snap_all(mesh, grid)?.crossing_triangles();
         let dims = grid.dims();
         let h = ONE / 2;
         let mut out = Vec::with_capacity(dims.iter().map(|&d| d as usize).product());
@@ -487,7 +474,7 @@ pub mod reference {
             for j in 0..dims[1] as i64 {
                 for i in 0..dims[0] as i64 {
                     let q = [i * ONE + h, j * ONE + h, k * ONE + h];
-                    out.push(snapped.triangles.iter().filter(|t| !t.is_degenerate()).map(|t| winding_of(&t.v, q)).sum());
+                    out.push(tris.iter().map(|t| winding_of(&t.v, q)).sum());
                 }
             }
         }
