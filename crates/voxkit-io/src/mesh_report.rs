@@ -52,24 +52,8 @@ pub(crate) fn finish_with_segments(
         }
     }
     let count = positions.len();
-    let mut tris = Vec::with_capacity(triangles.len());
-    for (face, t) in triangles.iter().enumerate() {
-        for &index in t {
-            if index < 0 || index as usize >= count {
-                return Err(ErrorKind::IndexOutOfRange { face, index, count });
-            }
-        }
-        tris.push(t.map(|i| i as u32));
-    }
-    let mut segs = Vec::with_capacity(segments.len());
-    for (line, s) in segments.iter().enumerate() {
-        for &index in s {
-            if index < 0 || index as usize >= count {
-                return Err(ErrorKind::SegmentIndexOutOfRange { line, index, count });
-            }
-        }
-        segs.push(s.map(|i| i as u32));
-    }
+    let tris = checked_indices(&triangles, count, |face, index| ErrorKind::IndexOutOfRange { face, index, count })?;
+    let segs = checked_indices(&segments, count, |line, index| ErrorKind::SegmentIndexOutOfRange { line, index, count })?;
     if tris.is_empty() && segs.is_empty() {
         return Err(ErrorKind::Empty);
     }
@@ -83,6 +67,23 @@ pub(crate) fn finish_with_segments(
         bounds: r.bounds(),
     };
     Ok(LoadedMesh { mesh, report, warnings })
+}
+
+/// Converts index tuples to `u32`, or the error `bad(element, index)` for
+/// the first index outside `0..count`.
+fn checked_indices<const N: usize>(
+    items: &[[i64; N]],
+    count: usize,
+    bad: impl Fn(usize, i64) -> ErrorKind,
+) -> Result<Vec<[u32; N]>, ErrorKind> {
+    items
+        .iter()
+        .enumerate()
+        .map(|(e, t)| match t.iter().find(|&&i| i < 0 || i as usize >= count) {
+            Some(&index) => Err(bad(e, index)),
+            None => Ok(t.map(|i| i as u32)),
+        })
+        .collect()
 }
 
 /// Fan-triangulates a polygon given by vertex indices: (0,1,2), (0,2,3), …

@@ -98,6 +98,14 @@ impl DenseBits {
         row[w1] |= hi_mask;
     }
 
+    /// Is `(i, j, k)` inside the grid and set? Signed coordinates, so
+    /// neighbour lookups need no bounds checks of their own.
+    #[inline]
+    pub fn get_signed(&self, i: i64, j: i64, k: i64) -> bool {
+        let [nx, ny, nz] = self.dims.map(|d| d as i64);
+        (0..nx).contains(&i) && (0..ny).contains(&j) && (0..nz).contains(&k) && self.get(i as u32, j as u32, k as u32)
+    }
+
     /// Number of set voxels.
     pub fn count(&self) -> u64 {
         self.words.par_chunks(1 << 16).map(super::count_bits).sum()

@@ -269,10 +269,7 @@ fn thin_removable(bits: &DenseBits, p: &Parity) -> u64 {
 }
 
 fn thick_voxels(bits: &DenseBits) -> u64 {
-    let [nx, ny, nz] = bits.dims();
-    let get = |i: i64, j: i64, k: i64| {
-        i >= 0 && j >= 0 && k >= 0 && i < nx as i64 && j < ny as i64 && k < nz as i64 && bits.get(i as u32, j as u32, k as u32)
-    };
+    let get = |i, j, k| bits.get_signed(i, j, k);
     sum_over_set(bits, |i, j, k| {
         let (i, j, k) = (i as i64, j as i64, k as i64);
         (get(i - 1, j, k) || get(i + 1, j, k)) && (get(i, j - 1, k) || get(i, j + 1, k)) && (get(i, j, k - 1) || get(i, j, k + 1))

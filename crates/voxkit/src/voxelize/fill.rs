@@ -65,10 +65,8 @@ pub fn flood_fill(shell: &DenseBits) -> (DenseBits, FloodReport) {
 /// The voxels of `solid` with a neighbour (6- or 26-connected) outside it
 /// or outside the grid.
 pub fn hollow(solid: &DenseBits, conn: Connectivity) -> DenseBits {
-    let [nx, ny, nz] = solid.dims();
-    let get = |i: i64, j: i64, k: i64| {
-        i >= 0 && j >= 0 && k >= 0 && i < nx as i64 && j < ny as i64 && k < nz as i64 && solid.get(i as u32, j as u32, k as u32)
-    };
+    let ny = solid.dims()[1];
+    let get = |i, j, k| solid.get_signed(i, j, k);
     let mut out = DenseBits::new(solid.dims());
     let wpr = solid.words_per_row();
     out.par_rows_mut().enumerate().for_each(|(r, row)| {
