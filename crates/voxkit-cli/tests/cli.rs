@@ -25,6 +25,20 @@ fn json(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
 }
 
+/// Writes the unit cube as an OBJ of six outward quads; returns its path.
+fn unit_cube_obj(name: &str) -> String {
+    let path = tmp(name);
+    let mut obj = String::new();
+    for c in 0..8 {
+        obj += &format!("v {} {} {}\n", c & 1, (c >> 1) & 1, (c >> 2) & 1);
+    }
+    for q in [[1, 3, 4, 2], [5, 6, 8, 7], [1, 2, 6, 5], [3, 7, 8, 4], [1, 5, 7, 3], [2, 4, 8, 6]] {
+        obj += &format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+    }
+    std::fs::write(&path, obj).unwrap();
+    path
+}
+
 /// Runs a failing command and returns its single stderr line.
 fn error_line(args: &[&str]) -> String {
     let out = voxkit(args);
@@ -216,15 +230,7 @@ fn polylines_voxelize_connected() {
 fn pad_keeps_faces_on_the_high_side_of_a_fitted_grid() {
     // A cube: on a fitted grid its high faces lie exactly in the grid's
     // high planes, where the tie rule gives them to the voxels beyond.
-    let cube = tmp("cube.obj");
-    let mut obj = String::new();
-    for c in 0..8 {
-        obj += &format!("v {} {} {}\n", c & 1, (c >> 1) & 1, (c >> 2) & 1);
-    }
-    for q in [[1, 3, 4, 2], [5, 6, 8, 7], [1, 2, 6, 5], [3, 7, 8, 4], [1, 5, 7, 3], [2, 4, 8, 6]] {
-        obj += &format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]);
-    }
-    std::fs::write(&cube, obj).unwrap();
+    let cube = unit_cube_obj("cube.obj");
     let (a, b) = (tmp("cube0.npy"), tmp("cube1.npy"));
     let plain = json(&voxkit(&["voxelize", &cube, "-o", &a, "--mode", "sep6", "--resolution", "8", "--json"]));
     let padded = json(&voxkit(&["voxelize", &cube, "-o", &b, "--mode", "sep6", "--resolution", "8", "--pad", "1", "--json"]));
@@ -245,15 +251,7 @@ fn pad_keeps_faces_on_the_high_side_of_a_fitted_grid() {
 
 #[test]
 fn solid_modes_say_what_they_did() {
-    let cube = tmp("solid_cube.obj");
-    let mut obj = String::new();
-    for c in 0..8 {
-        obj += &format!("v {} {} {}\n", c & 1, (c >> 1) & 1, (c >> 2) & 1);
-    }
-    for q in [[1, 3, 4, 2], [5, 6, 8, 7], [1, 2, 6, 5], [3, 7, 8, 4], [1, 5, 7, 3], [2, 4, 8, 6]] {
-        obj += &format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]);
-    }
-    std::fs::write(&cube, obj).unwrap();
+    let cube = unit_cube_obj("solid_cube.obj");
     let out = tmp("solid.npy");
     let run = |extra: &[&str]| {
         let mut args = vec!["voxelize", &cube, "-o", &out, "--resolution", "8", "--json"];

@@ -156,6 +156,28 @@ pub fn agree_mode(mode: Mode, mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits,
     Ok(reference)
 }
 
+/// Metamorphic check: voxelizing `mesh` moved by whole voxels `shift` on a
+/// grid grown by `margin` voxels per side gives the unmoved result shifted.
+/// `voxelize` is the method under test.
+pub fn assert_whole_voxel_shift(
+    mesh: &Mesh,
+    grid: &GridSpec,
+    shift: [i32; 3],
+    margin: u32,
+    voxelize: impl Fn(&Mesh, &GridSpec) -> DenseBits,
+) {
+    let s = grid.voxel_size();
+    let big = GridSpec::new(grid.origin() - DVec3::splat(margin as f64 * s), s, grid.dims().map(|d| (d + 2 * margin) as u64)).unwrap();
+    let a = voxelize(mesh, &big);
+    let mut moved = mesh.clone();
+    moved.transform(|p| p + DVec3::new(shift[0] as f64, shift[1] as f64, shift[2] as f64) * s);
+    let b = voxelize(&moved, &big);
+    assert!(a.count() > 0);
+    assert_eq!(a.count(), b.count());
+    let at = |c: u32, d: i32| (c as i64 + d as i64) as u32;
+    a.for_each_set(|i, j, k| assert!(b.get(at(i, shift[0]), at(j, shift[1]), at(k, shift[2])), "{i} {j} {k}"));
+}
+
 /// A mesh of independent triangles given by their vertices.
 pub fn soup(tris: &[[DVec3; 3]]) -> Mesh {
     Mesh {

@@ -6,7 +6,7 @@
 use glam::DVec3;
 use voxkit::voxelize::solid;
 use voxkit::{DenseBits, GridSpec, Mesh};
-use voxkit_testkit::{box_mesh, random_rotation, rng, rotated, shared_mesh, sphere};
+use voxkit_testkit::{assert_whole_voxel_shift, box_mesh, random_rotation, rng, rotated, shared_mesh, sphere};
 
 /// The exact winding number (signed crossings) equals the brute-force
 /// reference; parity equals it too unless `overlaps` (a surface that wraps
@@ -94,15 +94,7 @@ fn flipping_orientation_changes_nothing_and_translation_shifts() {
     let (b, _) = solid::parity(flipped.as_ref(), &grid).unwrap();
     assert_eq!(a.first_difference(&b), None);
     // Shift the mesh by whole voxels (3, −2, 1) inside a larger grid.
-    let s = grid.voxel_size();
-    let big = GridSpec::new(grid.origin() - DVec3::splat(4.0 * s), s, grid.dims().map(|d| d as u64 + 8)).unwrap();
-    let (c, _) = solid::parity(m.as_ref(), &big).unwrap();
-    let mut moved = m.clone();
-    moved.transform(|p| p + DVec3::new(3.0, -2.0, 1.0) * s);
-    let (d, _) = solid::parity(moved.as_ref(), &big).unwrap();
-    assert!(c.count() > 0);
-    assert_eq!(c.count(), d.count());
-    c.for_each_set(|i, j, k| assert!(d.get(i + 3, j - 2, k + 1), "{i} {j} {k}"));
+    assert_whole_voxel_shift(&m, &grid, [3, -2, 1], 4, |m, g| solid::parity(m.as_ref(), g).unwrap().0);
 }
 
 #[test]

@@ -6,7 +6,7 @@
 use glam::DVec3;
 use voxkit::voxelize::{solid, winding};
 use voxkit::{GridSpec, Mesh};
-use voxkit_testkit::{box_mesh, random_rotation, rng, rotated, shared_mesh, sphere};
+use voxkit_testkit::{assert_whole_voxel_shift, box_mesh, random_rotation, rng, rotated, shared_mesh, sphere};
 
 /// Fast vs reference: every disagreement must be at an ambiguous voxel.
 fn agree(name: &str, m: &Mesh, grid: &GridSpec) -> u64 {
@@ -119,15 +119,7 @@ fn swapping_axes_transposes_the_solid_of_open_meshes() {
 fn translating_an_open_mesh_by_whole_voxels_shifts_the_solid() {
     let m = shared_mesh("teapot.obj");
     let grid = GridSpec::from_resolution(&m.as_ref().bounds(), 30).unwrap();
-    let s = grid.voxel_size();
-    let big = GridSpec::new(grid.origin() - DVec3::splat(3.0 * s), s, grid.dims().map(|d| d as u64 + 6)).unwrap();
-    let (a, _) = winding::winding(m.as_ref(), &big).unwrap();
-    let mut moved = m.clone();
-    moved.transform(|p| p + DVec3::new(2.0, -1.0, 3.0) * s);
-    let (b, _) = winding::winding(moved.as_ref(), &big).unwrap();
-    assert!(a.count() > 0);
-    assert_eq!(a.count(), b.count());
-    a.for_each_set(|i, j, k| assert!(b.get(i + 2, j - 1, k + 3), "{i} {j} {k}"));
+    assert_whole_voxel_shift(&m, &grid, [2, -1, 3], 3, |m, g| winding::winding(m.as_ref(), g).unwrap().0);
 }
 
 /// A torus (genus 1): every method agrees with the exact reference.
