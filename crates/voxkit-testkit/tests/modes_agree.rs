@@ -78,3 +78,32 @@ fn thin_tubes_as_triangles_in_line_modes() {
         assert!(agree_mode(mode, &m, &grid).unwrap().count() >= 9);
     }
 }
+
+mod polylines {
+    use super::*;
+    use proptest::prelude::*;
+    use voxkit::Mesh;
+    use voxkit_testkit::strategies::point;
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+        /// `line6`'s exact integer walk and `line26`'s filtered walk against
+        /// the definitions, on polylines whose points sit on voxel corners,
+        /// edges, faces and a few ulps off them.
+        #[test]
+        fn random_polylines_in_line_modes(pts in prop::collection::vec(point(), 2..6)) {
+            let mesh = Mesh {
+                positions: pts.clone(),
+                triangles: Vec::new(),
+                segments: (0..pts.len() as u32 - 1).map(|i| [i, i + 1]).collect(),
+            };
+            let grid = GridSpec::new(DVec3::ZERO, 1.0, [8, 8, 8]).unwrap();
+            for mode in [Mode::Line6, Mode::Line26] {
+                if let Err(e) = agree_mode(mode, &mesh, &grid) {
+                    prop_assert!(false, "{e}\npoints: {pts:?}");
+                }
+            }
+        }
+    }
+}

@@ -19,9 +19,11 @@
 //! Both are subsets of `cover`. Zero-length segments and zero-area
 //! triangles are skipped like everywhere else.
 //!
-//! **Fast path.** Parallel over z-slabs. Segments: walk the segment's
-//! layers along its dominant axis; in each layer only the voxels within a
-//! one-voxel margin of the segment's span are tested, exactly. Triangles:
+//! **Fast path.** Parallel over z-slabs. `line6` segments: the exact integer
+//! line walk ([`super::ilv::lattice_path`]), no per-voxel test. `line26`
+//! segments: walk the segment's layers along its dominant axis; in each
+//! layer only the voxels within a one-voxel margin of the segment's span
+//! are tested, exactly. Triangles:
 //! `cover`'s traversal enumerates candidates, each tested exactly.
 //!
 //! **Reference:** [`reference::line`], the definition for every voxel of
@@ -29,6 +31,7 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_slabs, Filter, Kernel, Primitive};
+use super::ilv::{lattice_path, voxel_of};
 use super::targets::{line26_hit, line6_hit, Element};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::ONE;
@@ -89,9 +92,27 @@ impl Kernel<Element> for LineKernel {
         let keep = |ijk: [i64; 3]| self.target.hit(e, ijk);
         match e {
             Element::Triangle(t) => cover_triangle(t, lo, hi, self.traversal, &mut Filter { slab, keep }),
-            Element::Segment(s) => walk_segment(s, lo, hi, &mut Filter { slab, keep }),
+            Element::Segment(s) => match self.target {
+                LineTarget::Surface6 => surface6_segment(s, lo, hi, slab),
+                LineTarget::Squares26 => walk_segment(s, lo, hi, &mut Filter { slab, keep }),
+            },
         }
     }
+}
+
+/// `line6` for one segment, exactly: the voxels it passes through (the
+/// integer line walk of [`super::ilv::lattice_path`]), or none when it stays
+/// inside one voxel; those in `[lo, hi]` are set.
+fn surface6_segment(s: &LatticeSegment, lo: [i64; 3], hi: [i64; 3], out: &mut impl super::driver::Sink) {
+    let (a, b) = (s.v[0], s.v[1]);
+    if voxel_of(a) == voxel_of(b) {
+        return;
+    }
+    lattice_path(a, b, |p| {
+        if (0..3).all(|x| lo[x] <= p[x] && p[x] <= hi[x]) {
+            out.set(p[0] as u32, p[1] as u32, p[2] as u32);
+        }
+    });
 }
 
 /// Emits a superset of the voxels of `[lo, hi]` whose closed box meets the

@@ -15,6 +15,7 @@
 pub mod cover;
 pub mod driver;
 pub mod fill;
+pub mod ilv;
 pub mod line;
 pub mod sep26;
 pub mod sep6;
