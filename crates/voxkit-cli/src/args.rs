@@ -186,6 +186,10 @@ pub struct BenchArgs {
     /// Resolution at which the reference path is timed as the baseline.
     #[arg(long, default_value_t = 128)]
     pub reference_resolution: u64,
+    /// Split every triangle into four this many times before measuring
+    /// (e.g. 2 turns the 69k-triangle bunny into 1.1M triangles).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=5))]
+    pub subdivide: u32,
     /// Print JSON lines instead of a Markdown table.
     #[arg(long)]
     pub json: bool,

@@ -78,29 +78,72 @@ impl GridKind {
     }
 }
 
-/// The core mode and the method that will run, or an error saying why none can.
-pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::Mode, &'static str)> {
+/// The core surface/line mode of a CLI mode (solid modes are planned by
+/// [`solid_plan`]).
+pub fn core_mode(mode: Mode) -> Result<voxkit::voxelize::Mode> {
     use voxkit::voxelize::Mode as Core;
-    let core = match mode {
+    Ok(match mode {
         Mode::Cover => Core::Cover,
         Mode::Sep26 => Core::Sep26,
         Mode::Sep6 => Core::Sep6,
         Mode::Ss6 => Core::Ss6,
         Mode::Line26 => Core::Line26,
         Mode::Line6 => Core::Line6,
+        Mode::Pos => Core::Pos,
         Mode::Solid | Mode::SolidSurface => bail!("mode '{}' is a solid mode, planned by solid_plan", mode_name(mode)),
-        Mode::Pos => bail!(
-            "mode 'pos' is not implemented yet in this build; available: cover, sep26, sep6, ss6, line26, line6, solid, solid+surface"
-        ),
-    };
+    })
+}
+
+/// The surface/line paths `--method` can name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SurfaceMethod {
+    /// Brute force from the definition.
+    Reference,
+    /// The triangle-box path (parallel, sparse).
+    Fast,
+    /// The exact scanline path (cover, sep26, sep6).
+    Scanline,
+}
+
+impl SurfaceMethod {
+    /// The name printed in summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            SurfaceMethod::Reference => "reference",
+            SurfaceMethod::Fast => "fast",
+            SurfaceMethod::Scanline => "scanline",
+        }
+    }
+}
+
+/// The core mode and the path that will run, or an error saying why none can.
+/// `auto` takes the scanline path where it exists and measured faster
+/// (`cover`, and `sep26`, on meshes whose triangles are small in voxels;
+/// see [`auto_method`]), the fast path otherwise.
+pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::Mode, SurfaceMethod)> {
+    let core = core_mode(mode)?;
     let m = match method {
-        Method::Auto | Method::Fast => "fast",
-        Method::Reference => "reference",
-        Method::Scanline => bail!("--method scanline is not implemented yet in this build; use auto, fast or reference"),
+        Method::Auto | Method::Fast => SurfaceMethod::Fast,
+        Method::Reference => SurfaceMethod::Reference,
+        Method::Scanline if voxkit::voxelize::scanline::supports(core) => SurfaceMethod::Scanline,
+        Method::Scanline => {
+            bail!("--method scanline exists for cover, sep26 and sep6, not {}; use auto, fast or reference", mode_name(mode))
+        }
         Method::Gpu => bail!("--method gpu is not implemented yet in this build (no GPU backend); use auto, fast or reference"),
         Method::Parity | Method::Winding => bail!("--method {} applies only to --mode solid", method_name(method)),
     };
     Ok((core, m))
+}
+
+/// What `--method auto` runs for a surface mode on this mesh and grid: the
+/// scanline path for `cover` when the mesh's triangles are small in voxels
+/// (where its batched column loop applies and was measured faster, see
+/// BENCHMARKS.md), the fast path otherwise.
+pub fn auto_method(mode: voxkit::voxelize::Mode, mesh: voxkit::MeshRef<'_>, grid: &GridSpec) -> SurfaceMethod {
+    if !voxkit::voxelize::scanline::prefers(mode, mesh, grid) {
+        return SurfaceMethod::Fast;
+    }
+    SurfaceMethod::Scanline
 }
 
 /// How a solid is made.
@@ -141,7 +184,7 @@ pub fn solid_plan(a: &crate::args::VoxelizeArgs) -> Result<Option<SolidPlan>> {
         return Ok(None);
     }
     let surface_mode = match a.surface.unwrap_or(Mode::Cover) {
-        m @ (Mode::Cover | Mode::Sep26 | Mode::Sep6 | Mode::Ss6) => resolve_method(m, Method::Auto)?.0,
+        m @ (Mode::Cover | Mode::Sep26 | Mode::Sep6 | Mode::Ss6) => core_mode(m)?,
         m => bail!("--surface takes cover, sep26, sep6 or ss6, not {}", mode_name(m)),
     };
     let method = match (a.fill, a.method) {

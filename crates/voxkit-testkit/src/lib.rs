@@ -123,7 +123,8 @@ pub fn agree(mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits, String> {
 
 /// [`agree`] for any surface or line mode: the mode's reference against its
 /// fast path on 1, 2 and 8 threads, several slab heights and every
-/// traversal; names the first differing voxel. Returns the reference grid.
+/// traversal, and against its scanline path where it has one; names the
+/// first differing voxel. Returns the reference grid.
 pub fn agree_mode(mode: Mode, mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits, String> {
     let (reference, rep) = voxelize::reference(mode, mesh.as_ref(), grid);
     if reference.count() != rep.voxels {
@@ -150,6 +151,22 @@ pub fn agree_mode(mode: Mode, mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits,
             }
             if frep.voxels != rep.voxels || frep.prepare != rep.prepare {
                 return Err(format!("fast report {frep:?} differs from reference report {rep:?}"));
+            }
+        }
+        for slab_height in [0, 1, 7] {
+            let opts = Options { slab_height, ..Options::default() };
+            let Some((scan, srep)) = pool.install(|| voxelize::scanline::scanline(mode, mesh.as_ref(), grid, &opts)) else { break };
+            let scan = scan.to_dense();
+            if let Some(v) = reference.first_difference(&scan) {
+                return Err(format!(
+                    "{} scanline (threads {threads}, slab height {slab_height}) differs from reference at voxel {v:?}: reference {}, scanline {}",
+                    mode.name(),
+                    reference.get(v[0], v[1], v[2]),
+                    scan.get(v[0], v[1], v[2])
+                ));
+            }
+            if srep.voxels != rep.voxels || srep.prepare != rep.prepare {
+                return Err(format!("scanline report {srep:?} differs from reference report {rep:?}"));
             }
         }
     }

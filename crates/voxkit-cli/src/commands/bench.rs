@@ -33,27 +33,43 @@ fn time<T>(repeats: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     (median(times), last.expect("at least one repeat"))
 }
 
-/// What a benchmark row runs: a surface/line mode, or the solid by parity.
+/// What a benchmark row runs: a surface/line mode by its triangle-box fast
+/// path or its scanline path, or the solid by parity or winding.
 enum Engine {
     Surface(voxelize::Mode),
+    Scanline(voxelize::Mode),
     SolidParity,
     SolidWinding,
 }
 
 impl Engine {
-    /// `solid` measures both parity and the generalized winding number.
+    /// `solid` measures both parity and the generalized winding number;
+    /// modes with a scanline path measure it beside the fast path.
     fn new(m: crate::args::Mode) -> Result<Vec<Engine>> {
         Ok(match m {
             crate::args::Mode::Solid => vec![Engine::SolidParity, Engine::SolidWinding],
-            m => vec![Engine::Surface(crate::plan::resolve_method(m, crate::args::Method::Auto)?.0)],
+            m => {
+                let core = crate::plan::core_mode(m)?;
+                let mut v = vec![Engine::Surface(core)];
+                if voxelize::scanline::supports(core) {
+                    v.push(Engine::Scanline(core));
+                }
+                v
+            }
         })
+    }
+
+    /// Whether this engine's reference row is the one just before it (the
+    /// scanline path shares its mode's baseline).
+    fn shares_reference(&self) -> bool {
+        matches!(self, Engine::Scanline(_))
     }
 
     /// Largest resolution the reference runs at (the solid references test
     /// every triangle for every voxel).
     fn reference_cap(&self) -> u64 {
         match self {
-            Engine::Surface(_) => u64::MAX,
+            Engine::Surface(_) | Engine::Scanline(_) => u64::MAX,
             Engine::SolidParity => 32,
             Engine::SolidWinding => 12,
         }
@@ -61,7 +77,7 @@ impl Engine {
 
     fn name(&self) -> &'static str {
         match self {
-            Engine::Surface(m) => m.name(),
+            Engine::Surface(m) | Engine::Scanline(m) => m.name(),
             Engine::SolidParity => "solid (parity)",
             Engine::SolidWinding => "solid (winding)",
         }
@@ -70,6 +86,7 @@ impl Engine {
     fn fast_name(&self) -> &'static str {
         match self {
             Engine::Surface(_) => "fast",
+            Engine::Scanline(_) => "scanline",
             Engine::SolidParity => "parity",
             Engine::SolidWinding => "winding",
         }
@@ -77,7 +94,7 @@ impl Engine {
 
     fn reference(&self, mesh: MeshRef<'_>, grid: &GridSpec) -> Result<u64> {
         Ok(match self {
-            Engine::Surface(m) => voxelize::reference(*m, mesh, grid).1.voxels,
+            Engine::Surface(m) | Engine::Scanline(m) => voxelize::reference(*m, mesh, grid).1.voxels,
             Engine::SolidParity => solid::reference::solid(mesh, grid)?.1.voxels,
             Engine::SolidWinding => winding::reference::winding(mesh, grid)?.count(),
         })
@@ -86,6 +103,9 @@ impl Engine {
     fn fast(&self, mesh: MeshRef<'_>, grid: &GridSpec) -> Result<u64> {
         Ok(match self {
             Engine::Surface(m) => voxelize::fast(*m, mesh, grid, &Options::default()).1.voxels,
+            Engine::Scanline(m) => {
+                voxelize::scanline::scanline(*m, mesh, grid, &Options::default()).context("mode has no scanline path")?.1.voxels
+            }
             Engine::SolidParity => solid::parity(mesh, grid)?.1.voxels,
             Engine::SolidWinding => winding::winding(mesh, grid)?.1.solid.voxels,
         })
@@ -105,7 +125,11 @@ struct Row {
 
 pub fn run(a: &BenchArgs) -> Result<()> {
     let loaded = voxkit_io::read_mesh(&a.mesh)?;
-    let mesh = loaded.mesh.as_ref();
+    let mut owned = loaded.mesh.clone();
+    for _ in 0..a.subdivide {
+        owned = subdivide(&owned);
+    }
+    let mesh = owned.as_ref();
     let bounds = loaded.report.bounds;
     let mut rows = Vec::new();
 
@@ -114,21 +138,23 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     for engine in &engines {
         // Baseline: the reference path (serial by construction), capped for
         // the solids.
-        let ref_res = a.reference_resolution.min(engine.reference_cap());
-        let grid = GridSpec::from_resolution(&bounds, ref_res).context("invalid grid")?;
-        let (s, voxels) = time(a.repeats.clamp(1, 3), || engine.reference(mesh, &grid));
-        let voxels = voxels?;
-        ref_s.insert(engine.name(), (ref_res, s));
-        rows.push(Row {
-            mode: engine.name(),
-            method: "reference",
-            threads: 1,
-            resolution: ref_res,
-            dims: grid.dims(),
-            voxels,
-            voxelize_s: s,
-            with_loading_s: None,
-        });
+        if !engine.shares_reference() {
+            let ref_res = a.reference_resolution.min(engine.reference_cap());
+            let grid = GridSpec::from_resolution(&bounds, ref_res).context("invalid grid")?;
+            let (s, voxels) = time(a.repeats.clamp(1, 3), || engine.reference(mesh, &grid));
+            let voxels = voxels?;
+            ref_s.insert(engine.name(), (ref_res, s));
+            rows.push(Row {
+                mode: engine.name(),
+                method: "reference",
+                threads: 1,
+                resolution: ref_res,
+                dims: grid.dims(),
+                voxels,
+                voxelize_s: s,
+                with_loading_s: None,
+            });
+        }
 
         for &threads in &a.threads {
             let pool = crate::thread_pool(Some(threads))?;
@@ -137,14 +163,21 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                 crate::plan::check_memory(&grid)?;
                 let (vox_s, voxels) = pool.install(|| time(a.repeats, || engine.fast(mesh, &grid)));
                 let voxels = voxels?;
-                let (load_s, r) = pool.install(|| {
-                    time(a.repeats.min(5), || -> Result<u64> {
-                        let l = voxkit_io::read_mesh(&a.mesh)?;
-                        let g = GridSpec::from_resolution(&l.report.bounds, res)?;
-                        engine.fast(l.mesh.as_ref(), &g)
-                    })
-                });
-                r?;
+                // With loading: only for the file as it is (a subdivided
+                // mesh is built in memory).
+                let load_s = if a.subdivide == 0 {
+                    let (load_s, r) = pool.install(|| {
+                        time(a.repeats.min(5), || -> Result<u64> {
+                            let l = voxkit_io::read_mesh(&a.mesh)?;
+                            let g = GridSpec::from_resolution(&l.report.bounds, res)?;
+                            engine.fast(l.mesh.as_ref(), &g)
+                        })
+                    });
+                    r?;
+                    Some(load_s)
+                } else {
+                    None
+                };
                 rows.push(Row {
                     mode: engine.name(),
                     method: engine.fast_name(),
@@ -153,7 +186,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
                     dims: grid.dims(),
                     voxels,
                     voxelize_s: vox_s,
-                    with_loading_s: Some(load_s),
+                    with_loading_s: load_s,
                 });
             }
         }
@@ -168,21 +201,28 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         return Ok(());
     }
     let mut out = format!(
-        "mesh: {} ({} triangles); median of {} repeats ({} with loading); {} hardware threads\n\n",
+        "mesh: {}{} ({} triangles); median of {} repeats ({} with loading); {} hardware threads\n\n",
         a.mesh.display(),
-        loaded.report.triangles,
+        if a.subdivide > 0 { format!(" subdivided {} times", a.subdivide) } else { String::new() },
+        mesh.triangles.len(),
         a.repeats,
         a.repeats.min(5),
         std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
     );
-    out += "| mode | method | threads | resolution | grid | voxels | voxelize (ms) | with loading (ms) | vs reference |\n|---|---|---|---|---|---|---|---|---|\n";
+    out += "| mode | method | threads | resolution | grid | voxels | voxelize (ms) | with loading (ms) | vs reference | vs fast |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for r in &rows {
+        let vs_fast = rows
+            .iter()
+            .find(|f| f.method == "fast" && f.mode == r.mode && f.threads == r.threads && f.resolution == r.resolution)
+            .filter(|_| r.method == "scanline")
+            .map(|f| format!("{:.2}x", f.voxelize_s / r.voxelize_s))
+            .unwrap_or_else(|| "-".into());
         let d = r.dims;
         let load = r.with_loading_s.map(|s| format!("{:.1}", s * 1e3)).unwrap_or_else(|| "-".into());
         let (rr, rs) = ref_s[r.mode];
         let speed = if r.resolution == rr { format!("{:.1}x", rs / r.voxelize_s) } else { "-".into() };
         out += &format!(
-            "| {} | {} | {} | {} | {}x{}x{} | {} | {:.2} | {} | {} |\n",
+            "| {} | {} | {} | {} | {}x{}x{} | {} | {:.2} | {} | {} | {} |\n",
             r.mode,
             r.method,
             r.threads,
@@ -193,8 +233,24 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             r.voxels,
             r.voxelize_s * 1e3,
             load,
-            speed
+            speed,
+            vs_fast
         );
     }
     crate::print_stdout(out.trim_end())
+}
+
+/// Splits every triangle into four at its edge midpoints (positions are
+/// duplicated per triangle; the voxelizers do not need shared vertices).
+fn subdivide(m: &voxkit::Mesh) -> voxkit::Mesh {
+    let mut positions = Vec::with_capacity(m.triangles.len() * 6);
+    let mut triangles = Vec::with_capacity(m.triangles.len() * 4);
+    for t in &m.triangles {
+        let [a, b, c] = t.map(|i| m.positions[i as usize]);
+        let base = positions.len() as u32;
+        positions.extend([a, b, c, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5]);
+        let [a, b, c, ab, bc, ca] = [0, 1, 2, 3, 4, 5].map(|i| base + i);
+        triangles.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+    }
+    voxkit::Mesh { positions, triangles, segments: m.segments.clone() }
 }

@@ -18,8 +18,8 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     // Validate everything that does not need the mesh first.
     let request = GridRequest::from_args(&a.grid)?;
     let solid_plan = plan::solid_plan(a)?;
-    let (mode, method) = match solid_plan {
-        Some(_) => (voxelize::Mode::Cover, "solid"),
+    let (mode, surface_method) = match solid_plan {
+        Some(_) => (voxelize::Mode::Cover, plan::SurfaceMethod::Fast),
         None => plan::resolve_method(a.mode, a.method)?,
     };
     let format = match &a.format {
@@ -60,6 +60,12 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     }
     let grid = request.fit(&loaded.report.bounds)?;
     plan::check_memory(&grid)?;
+    let surface_method = if a.method == crate::args::Method::Auto {
+        plan::auto_method(mode, loaded.mesh.as_ref(), &grid)
+    } else {
+        surface_method
+    };
+    let method = if solid_plan.is_some() { "solid" } else { surface_method.name() };
 
     bar.phase(if method == "reference" { "voxelizing (reference, serial)" } else { "voxelizing" });
     let t_vox = Instant::now();
@@ -79,13 +85,19 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
         let report = voxelize::Report { voxels, prepare: voxkit::geom::lattice::PrepareStats::default() };
         (Box::new(out.bits) as Box<dyn VoxelSource + Send>, report)
     } else {
-        pool.install(|| match method {
-            "reference" => {
+        let opts = Options { progress: Some(&bar), ..Options::default() };
+        pool.install(|| match surface_method {
+            plan::SurfaceMethod::Reference => {
                 let (b, r) = voxelize::reference(mode, loaded.mesh.as_ref(), &grid);
                 (Box::new(b) as Box<dyn VoxelSource + Send>, r)
             }
-            _ => {
-                let (b, r) = voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &Options { progress: Some(&bar), ..Options::default() });
+            plan::SurfaceMethod::Scanline => {
+                let (b, r) = voxelize::scanline::scanline(mode, loaded.mesh.as_ref(), &grid, &opts)
+                    .expect("resolve_method allows scanline only for modes that have it");
+                (Box::new(b) as Box<dyn VoxelSource + Send>, r)
+            }
+            plan::SurfaceMethod::Fast => {
+                let (b, r) = voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &opts);
                 (Box::new(b) as Box<dyn VoxelSource + Send>, r)
             }
         })

@@ -267,19 +267,57 @@ impl SlabView<'_> {
     pub fn set(&mut self, i: u32, j: u32, k: u32) {
         debug_assert!(k >= self.k0 && k < self.k1);
         let b = (((k >> SHIFT) - self.bk0) as usize * self.by as usize + (j >> SHIFT) as usize) * self.bx as usize + (i >> SHIFT) as usize;
-        let slot = if self.last.0 == b {
-            self.last.1
-        } else {
-            let mut id = self.index[b];
-            if id == 0 {
-                self.pool.push([0; 8]);
-                id = self.pool.len() as u32;
-                self.index[b] = id;
-            }
-            self.last = (b, id as usize - 1);
-            id as usize - 1
-        };
+        let slot = self.slot(b);
         self.pool[slot][(k & 7) as usize] |= 1u64 << (((j & 7) << 3) | (i & 7));
+    }
+
+    /// Sets the `len` voxels from `(i, j, k)` along `axis` (0, 1 or 2), all
+    /// inside the slab and the grid: one brick lookup and one `OR` per
+    /// brick the run touches (per brick word along z).
+    #[inline(always)]
+    pub fn set_run(&mut self, axis: usize, i: u32, j: u32, k: u32, len: u32) {
+        let mut p = [i, j, k];
+        let end = p[axis] + len;
+        while p[axis] < end {
+            let at = p[axis] & 7;
+            let n = (8 - at).min(end - p[axis]);
+            let b = (((p[2] >> SHIFT) - self.bk0) as usize * self.by as usize + (p[1] >> SHIFT) as usize) * self.bx as usize
+                + (p[0] >> SHIFT) as usize;
+            let slot = self.slot(b);
+            let ones = (1u64 << n) - 1;
+            let brick = &mut self.pool[slot];
+            match axis {
+                0 => brick[(p[2] & 7) as usize] |= ones << (((p[1] & 7) << 3) | at),
+                1 => {
+                    // One bit per byte: bytes at..at+n of the word, column x & 7.
+                    let bytes = 0x0101_0101_0101_0101u64 >> ((8 - n) << 3);
+                    brick[(p[2] & 7) as usize] |= (bytes << (at << 3)) << (p[0] & 7);
+                }
+                _ => {
+                    let bit = 1u64 << (((p[1] & 7) << 3) | (p[0] & 7));
+                    for z in at..at + n {
+                        brick[z as usize] |= bit;
+                    }
+                }
+            }
+            p[axis] += n;
+        }
+    }
+
+    /// The pool slot of brick-index entry `b`, allocating it if needed.
+    #[inline(always)]
+    fn slot(&mut self, b: usize) -> usize {
+        if self.last.0 == b {
+            return self.last.1;
+        }
+        let mut id = self.index[b];
+        if id == 0 {
+            self.pool.push([0; 8]);
+            id = self.pool.len() as u32;
+            self.index[b] = id;
+        }
+        self.last = (b, id as usize - 1);
+        id as usize - 1
     }
 
     /// Set voxels in this slab.
@@ -297,6 +335,39 @@ impl SlabView<'_> {
 mod tests {
     use super::*;
     use crate::grid::VoxelSource;
+
+    #[test]
+    fn runs_set_the_same_bits_as_single_voxels() {
+        let dims = [21, 19, 23];
+        for axis in 0..3 {
+            for start in [0u32, 3, 7, 8, 13] {
+                for len in [1u32, 2, 5, 8, 9, 17] {
+                    if start + len > dims[axis] {
+                        continue;
+                    }
+                    let mut p = [3u32, 6, 2];
+                    p[axis] = start;
+                    let (mut a, mut b) = (BrickBits::new(dims), BrickBits::new(dims));
+                    // One slab holds the whole grid (8 brick layers > 23 voxels).
+                    let mut slabs = a.slabs_mut(8);
+                    assert_eq!(slabs.len(), 1);
+                    slabs[0].set_run(axis, p[0], p[1], p[2], len);
+                    let pools = slabs.into_iter().map(|s| s.into_pool()).collect();
+                    a.merge_slabs(pools);
+                    let mut q = p;
+                    for _ in 0..len {
+                        b.set(q[0], q[1], q[2]);
+                        q[axis] += 1;
+                    }
+                    let mut got = Vec::new();
+                    a.for_each_set(|i, j, k| got.push([i, j, k]));
+                    let mut want = Vec::new();
+                    b.for_each_set(|i, j, k| want.push([i, j, k]));
+                    assert_eq!(got, want, "axis {axis} start {start} len {len}");
+                }
+            }
+        }
+    }
 
     fn random_pair(dims: [u32; 3], n: usize, seed: u64) -> (BrickBits, DenseBits) {
         let mut b = BrickBits::new(dims);

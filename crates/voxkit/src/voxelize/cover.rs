@@ -53,10 +53,10 @@ pub fn cover_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_
 /// A 2D edge function `f(p, q) = a·p + b·q + c` over voxel indices; the
 /// projected voxel square is not outside the edge iff `f >= 0`.
 #[derive(Clone, Copy, Debug)]
-struct Edge2 {
-    a: i64,
-    b: i64,
-    c: i64,
+pub(crate) struct Edge2 {
+    pub a: i64,
+    pub b: i64,
+    pub c: i64,
 }
 
 /// Schwarz–Seidel edge functions of the triangle projected onto the plane of
@@ -67,7 +67,7 @@ struct Edge2 {
 /// The critical-corner offset `max(0, a)·1 + max(0, b)·1` makes
 /// `f(corner) >= 0` equivalent to "some point of the unit square is on the
 /// inner side of the edge" — the separating axis test on that edge normal.
-fn edges_2d(tri: &LatticeTriangle, p: usize, q: usize, sigma: i64) -> [Edge2; 3] {
+pub(crate) fn edges_2d(tri: &LatticeTriangle, p: usize, q: usize, sigma: i64) -> [Edge2; 3] {
     std::array::from_fn(|i| {
         let e = tri.edge(i);
         let v = tri.v[i];
@@ -476,7 +476,7 @@ fn traverse<T: PlaneInt, O: Sink, const W: usize>(s: &Setup<T>, lo: [i64; 3], hi
 
 /// Sets voxel `(u, v, w)`; `(u, v, w)` is a cyclic shift of `(x, y, z)` by `W`.
 #[inline(always)]
-fn set<O: Sink, const W: usize>(out: &mut O, iu: i64, iv: i64, t: i64) {
+pub(crate) fn set<O: Sink, const W: usize>(out: &mut O, iu: i64, iv: i64, t: i64) {
     let (i, j, k) = match W {
         0 => (t, iu, iv),
         1 => (iv, t, iu),

@@ -39,12 +39,27 @@ pub trait Kernel<P>: Sync {
 pub trait Sink {
     /// Emits voxel `(i, j, k)` (inside the grid).
     fn set(&mut self, i: u32, j: u32, k: u32);
+
+    /// Emits the `len` voxels from `p` along `axis` (all inside the grid).
+    #[inline(always)]
+    fn set_run(&mut self, axis: usize, p: [u32; 3], len: u32) {
+        let mut q = p;
+        for _ in 0..len {
+            self.set(q[0], q[1], q[2]);
+            q[axis] += 1;
+        }
+    }
 }
 
 impl Sink for BrickSlab<'_> {
     #[inline(always)]
     fn set(&mut self, i: u32, j: u32, k: u32) {
         BrickSlab::set(self, i, j, k);
+    }
+
+    #[inline(always)]
+    fn set_run(&mut self, axis: usize, p: [u32; 3], len: u32) {
+        BrickSlab::set_run(self, axis, p[0], p[1], p[2], len);
     }
 }
 

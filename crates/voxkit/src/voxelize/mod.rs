@@ -8,6 +8,7 @@
 //! | `sep6` | [`sep6`] | a triangle meets the 3D crosshair (6-separating, thin) |
 //! | `ss6` | [`ss6`] | Schwarz–Seidel plane + diamond tests (6-separating, ⊇ `sep6`) |
 //! | `line26`, `line6` | [`line`](mod@line) | an element meets the bisecting squares / the surface (26- / 6-connected) |
+//! | `pos` | [`pos`](mod@pos) | none: the published projected-optimal-scanline algorithm, kept to measure its gaps |
 //! | `solid` | [`solid`] | the voxel's centre is inside (winding number); ray parity for watertight meshes |
 //!
 //! [`Mode`] with [`fast()`] and [`reference()`] dispatches over all of them.
@@ -17,6 +18,8 @@ pub mod driver;
 pub mod fill;
 pub mod ilv;
 pub mod line;
+pub mod pos;
+pub mod scanline;
 pub mod sep26;
 pub mod sep6;
 pub mod solid;
@@ -76,11 +79,13 @@ pub enum Mode {
     Line26,
     /// 6-connected 1D (voxel surface).
     Line6,
+    /// The published projected optimal scanline algorithm (no guarantee).
+    Pos,
 }
 
 impl Mode {
     /// Every mode, in documentation order.
-    pub const ALL: [Mode; 6] = [Mode::Cover, Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Line26, Mode::Line6];
+    pub const ALL: [Mode; 7] = [Mode::Cover, Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Line26, Mode::Line6, Mode::Pos];
 
     /// The CLI name.
     pub fn name(self) -> &'static str {
@@ -91,6 +96,7 @@ impl Mode {
             Mode::Ss6 => "ss6",
             Mode::Line26 => "line26",
             Mode::Line6 => "line6",
+            Mode::Pos => "pos",
         }
     }
 }
@@ -104,6 +110,7 @@ pub fn fast(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) 
         Mode::Ss6 => ss6::ss6(mesh, grid, opts),
         Mode::Line26 => line::line(mesh, grid, line::LineTarget::Squares26, opts),
         Mode::Line6 => line::line(mesh, grid, line::LineTarget::Surface6, opts),
+        Mode::Pos => pos::pos(mesh, grid, opts),
     }
 }
 
@@ -116,6 +123,7 @@ pub fn reference(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec) -> (DenseBits, 
         Mode::Ss6 => ss6::reference::ss6(mesh, grid),
         Mode::Line26 => line::reference::line(mesh, grid, line::LineTarget::Squares26),
         Mode::Line6 => line::reference::line(mesh, grid, line::LineTarget::Surface6),
+        Mode::Pos => pos::reference::pos(mesh, grid),
     }
 }
 
