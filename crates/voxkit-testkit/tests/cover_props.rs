@@ -155,3 +155,48 @@ proptest! {
         prop_assert_eq!(a.to_dense(), b);
     }
 }
+
+/// A large triangle across a 48³ grid: general, or nearly parallel to a
+/// grid plane (the scanline path then emits whole runs along its rows).
+fn large_triangle() -> impl Strategy<Value = [DVec3; 3]> {
+    let p = || (-4.0f64..52.0, -4.0f64..52.0, -4.0f64..52.0).prop_map(|(x, y, z)| DVec3::new(x, y, z));
+    prop_oneof![
+        (p(), p(), p()).prop_map(|(a, b, c)| [a, b, c]),
+        (p(), p(), p(), 0usize..3, -0.3f64..0.3, -0.3f64..0.3).prop_map(|(mut a, mut b, mut c, axis, s, t)| {
+            // w = base + s·(first other coordinate) + t·(second): shallow along w.
+            let (o1, o2) = ((axis + 1) % 3, (axis + 2) % 3);
+            let base = a[axis];
+            for q in [&mut a, &mut b, &mut c] {
+                q[axis] = base + s * q[o1] + t * q[o2];
+            }
+            [a, b, c]
+        }),
+        (p(), p(), 0usize..3, (0i32..48)).prop_map(|(a, b, axis, k)| {
+            // Exactly in a grid plane.
+            let (mut a, mut b) = (a, b);
+            a[axis] = k as f64;
+            b[axis] = k as f64;
+            let mut c = (a + b) * 0.5;
+            c[(axis + 1) % 3] += 17.0;
+            [a, b, c]
+        }),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// Large triangles take the scanline path's row walk with runs (along
+    /// the row for shallow planes, along w otherwise); every mode with a
+    /// scanline path must still equal its definition.
+    #[test]
+    fn large_triangles_in_every_scanline_mode(tris in prop::collection::vec(large_triangle(), 1..3)) {
+        let m = soup(&tris);
+        let grid = GridSpec::new(DVec3::ZERO, 1.0, [48, 48, 48]).unwrap();
+        for mode in [voxkit::voxelize::Mode::Cover, voxkit::voxelize::Mode::Sep26, voxkit::voxelize::Mode::Sep6] {
+            if let Err(e) = voxkit_testkit::agree_mode(mode, &m, &grid) {
+                prop_assert!(false, "{e}\ntriangles: {tris:?}");
+            }
+        }
+    }
+}

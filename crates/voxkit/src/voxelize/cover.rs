@@ -166,10 +166,25 @@ pub(crate) fn cover_triangle<O: Sink>(tri: &LatticeTriangle, lo: [i64; 3], hi: [
                 _ => scan_box::<O, 2>(&s, lo, hi, out),
             }
         } else {
-            dispatch::<i64, O>(&s, lo, hi, out);
+            dispatch::<i64, O, false>(&s, lo, hi, out);
         }
     } else {
-        dispatch::<i128, O>(&Setup::new(tri, lo), lo, hi, out);
+        dispatch::<i128, O, false>(&Setup::new(tri, lo), lo, hi, out);
+    }
+}
+
+/// The row walk of [`cover_triangle`] with run emission: in each row, the
+/// columns inside the projected triangle are emitted as runs — along the
+/// row (one run per layer `t`, solved exactly from the plane inequalities)
+/// when the plane is shallow along the row, else one run along `w` per
+/// column. The scanline path uses it for large triangles.
+pub(crate) fn cover_triangle_runs<O: Sink>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
+    let (blo, bhi) = tri.bounds();
+    let extent = (0..3).map(|a| bhi[a] - blo[a]).max().unwrap_or(0);
+    if extent + 2 * ONE <= I64_PLANE_LIMIT {
+        dispatch::<i64, O, true>(&Setup::new(tri, lo), lo, hi, out);
+    } else {
+        dispatch::<i128, O, true>(&Setup::new(tri, lo), lo, hi, out);
     }
 }
 
@@ -249,7 +264,7 @@ impl Walker {
 /// f64 estimate corrected exactly. The callers' operands satisfy
 /// `|n| < 2^62` and `d >= 4096`, so the estimate is off by at most one.
 #[inline(always)]
-fn div_floor(n: i64, d: i64) -> (i64, i64) {
+pub(crate) fn div_floor(n: i64, d: i64) -> (i64, i64) {
     debug_assert!(d > 0);
     let mut q = (n as f64 / d as f64) as i64;
     let mut r = n - q * d;
@@ -397,11 +412,11 @@ fn scan_box<O: Sink, const W: usize>(s: &Setup<i64>, lo: [i64; 3], hi: [i64; 3],
 /// Selects the traversal compiled for the triangle's dominant axis, so the
 /// mapping from `(u, v, w)` back to `(i, j, k)` is static.
 #[inline(always)]
-fn dispatch<T: PlaneInt, O: Sink>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
+fn dispatch<T: PlaneInt, O: Sink, const RUNS: bool>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     match s.w {
-        0 => traverse::<T, O, 0>(s, lo, hi, out),
-        1 => traverse::<T, O, 1>(s, lo, hi, out),
-        _ => traverse::<T, O, 2>(s, lo, hi, out),
+        0 => traverse::<T, O, 0, RUNS>(s, lo, hi, out),
+        1 => traverse::<T, O, 1, RUNS>(s, lo, hi, out),
+        _ => traverse::<T, O, 2, RUNS>(s, lo, hi, out),
     }
 }
 
@@ -417,7 +432,7 @@ fn dispatch<T: PlaneInt, O: Sink>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], out:
 /// the voxel projects inside the triangle, so it is a triangle point); in
 /// boundary columns the `(w, u)` edge tests run per voxel.
 #[inline(always)]
-fn traverse<T: PlaneInt, O: Sink, const W: usize>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
+fn traverse<T: PlaneInt, O: Sink, const W: usize, const RUNS: bool>(s: &Setup<T>, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
     let (nu, nw) = (s.n[u], s.n[w]);
     let y0 = lo[v];
@@ -449,6 +464,15 @@ fn traverse<T: PlaneInt, O: Sink, const W: usize>(s: &Setup<T>, lo: [i64; 3], hi
         let mut plane = PlaneRange::at::<W>(s, a0, iv);
         let mut iu = a0;
         loop {
+            if RUNS && iu == i0 && i0 <= i1 {
+                interior_runs::<T, O, W>(s, iv, (i0, i1), (c0, c1), &plane, out);
+                if i1 == a1 {
+                    break;
+                }
+                iu = i1 + 1;
+                plane = PlaneRange::at::<W>(s, iu, iv);
+                continue;
+            }
             let (ta, tb) = (plane.t0.max(c0), plane.t1.min(c1));
             let mut t = ta;
             if iu >= i0 && iu <= i1 {
@@ -472,6 +496,86 @@ fn traverse<T: PlaneInt, O: Sink, const W: usize>(s: &Setup<T>, lo: [i64; 3], hi
             plane.next_column(nu, nw);
         }
     }
+}
+
+/// Emits the interior columns `i0 ..= i1` of row `iv` (their squares lie
+/// inside the projected triangle, so the plane test alone decides), clipped
+/// to `c0 ..= c1` along `w`; `first` is the plane range at column `i0`.
+///
+/// If the plane's range over the block spans few layers compared with the
+/// block's width, each layer `t` is one run along `u`: the columns where
+/// `g_max(u, t) >= 0` and `g_min(u, t) <= 0`, two linear inequalities in `u`
+/// solved exactly. Otherwise each column is one run along `w`.
+#[inline(always)]
+fn interior_runs<T: PlaneInt, O: Sink, const W: usize>(
+    s: &Setup<T>,
+    iv: i64,
+    (i0, i1): (i64, i64),
+    (c0, c1): (i64, i64),
+    first: &PlaneRange<T>,
+    out: &mut O,
+) {
+    let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
+    let width = i1 - i0 + 1;
+    let last = PlaneRange::at::<W>(s, i1, iv);
+    let (tmin, tmax) = (first.t0.min(last.t0).max(c0), first.t1.max(last.t1).min(c1));
+    if tmin > tmax {
+        return;
+    }
+    let run_at = |out: &mut O, axis: usize, iu: i64, t: i64, len: i64| {
+        let mut p = [0u32; 3];
+        (p[u], p[v], p[w]) = (iu as u32, iv as u32, t as u32);
+        out.set_run(axis, p, len as u32);
+    };
+    if 3 * (tmax - tmin + 1) > width {
+        let mut plane = PlaneRange { t0: first.t0, t1: first.t1, g0: first.g0, g1: first.g1 };
+        for iu in i0..=i1 {
+            let (ta, tb) = (plane.t0.max(c0), plane.t1.min(c1));
+            if ta <= tb {
+                run_at(out, W, iu, ta, tb - ta + 1);
+            }
+            if iu < i1 {
+                plane.next_column(s.n[u], s.n[w]);
+            }
+        }
+        return;
+    }
+    // Plane values relative to the setup's origin: base = n_v·(iv − o_v) − n_u·o_u,
+    // g(u, t) = base + n_u·u + n_w·(t − o_w) + d.
+    let o = s.origin;
+    let base = s.n[v] * T::from_i64(iv - o[v]) - s.n[u] * T::from_i64(o[u]);
+    let nu = s.n[u];
+    for t in tmin..=tmax {
+        let k = base + s.n[w] * T::from_i64(t - o[w]);
+        // n_u·u >= -(k + d_max)  and  n_u·u <= -(k + d_min).
+        let (lo_rhs, hi_rhs) = (-(k + s.d_max), -(k + s.d_min));
+        let (mut ua, mut ub) = (i0, i1);
+        if nu > T::ZERO {
+            ua = ua.max(ceil_div(lo_rhs, nu));
+            ub = ub.min(floor_div(hi_rhs, nu));
+        } else if nu < T::ZERO {
+            ua = ua.max(ceil_div(-hi_rhs, -nu));
+            ub = ub.min(floor_div(-lo_rhs, -nu));
+        } else if lo_rhs > T::ZERO || hi_rhs < T::ZERO {
+            continue;
+        }
+        if ua <= ub {
+            run_at(out, u, ua, t, ub - ua + 1);
+        }
+    }
+}
+
+/// `floor(n / d)` for `d > 0`, as an index.
+#[inline(always)]
+fn floor_div<T: PlaneInt>(n: T, d: T) -> i64 {
+    let q = n.div_floor(d).to_i128();
+    q.clamp(i64::MIN as i128 / 2, i64::MAX as i128 / 2) as i64
+}
+
+/// `ceil(n / d)` for `d > 0`, as an index.
+#[inline(always)]
+fn ceil_div<T: PlaneInt>(n: T, d: T) -> i64 {
+    -floor_div(-n, d)
 }
 
 /// Sets voxel `(u, v, w)`; `(u, v, w)` is a cyclic shift of `(x, y, z)` by `W`.

@@ -39,10 +39,10 @@
 //! thread count. **Reference:** the modes' brute-force references; the
 //! tests compare voxel for voxel.
 
-use super::cover::{cover_triangle, edges_2d, set};
+use super::cover::{cover_triangle_runs, div_floor, edges_2d, set};
 use super::driver::{run_slabs, Filter, Kernel, Sink};
 use super::targets::{fits_i64, DirSetup, TriSetup, CROSSHAIR, DIAGONALS};
-use super::{Mode, Options, Report, Traversal};
+use super::{Mode, Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{prepare, LatticeTriangle};
 use crate::geom::perturb::P3;
@@ -76,7 +76,7 @@ pub fn prefers(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec) -> bool {
         return false;
     }
     let step = mesh.triangles.len().div_ceil(4096);
-    let limit = (F64_EXTENT_LIMIT / ONE) as f64 * grid.voxel_size();
+    let limit = (SMALL_EXTENT / ONE) as f64 * grid.voxel_size();
     let (mut small, mut seen) = (0usize, 0usize);
     for t in mesh.triangles.iter().step_by(step) {
         let Some(p) = t.iter().map(|&i| mesh.positions.get(i as usize).copied()).collect::<Option<Vec<_>>>() else { continue };
@@ -123,20 +123,18 @@ fn targets<T: PlaneInt, const N: usize>(tri: &LatticeTriangle, lo: [i64; 3], hi:
     scan_triangle(tri, lo, hi, &mut Filter { slab, keep });
 }
 
-/// Triangles up to this extent (lattice units) take the `f64` batch path;
-/// see the module doc for the bound.
-const F64_EXTENT_LIMIT: i64 = 14 * ONE;
-
-/// Columns per batch of the vectorised loop.
-const BATCH: usize = 8;
+/// Triangles up to this extent (lattice units) scan their box's columns
+/// ([`scan_rows`]); the plane values' division by the reciprocal is exact
+/// below it (numerators under `2^52`).
+const SMALL_EXTENT: i64 = 14 * ONE;
 
 /// Emits exactly the voxels of `[lo, hi]` whose closed box meets `tri`.
 pub(crate) fn scan_triangle<O: Sink>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     let (blo, bhi) = tri.bounds();
     let extent = (0..3).map(|a| bhi[a] - blo[a]).max().unwrap_or(0);
-    if extent > F64_EXTENT_LIMIT {
+    if extent > SMALL_EXTENT {
         // The scalar twin: exact incremental bounds along each row.
-        cover_triangle(tri, lo, hi, Traversal::WalkRows, out);
+        cover_triangle_runs(tri, lo, hi, out);
         return;
     }
     let n = tri.normal();
@@ -148,126 +146,8 @@ pub(crate) fn scan_triangle<O: Sink>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i
     }
 }
 
-/// `floor(x)` for `|x| < 2^51` in plain additions and a comparison (so it
-/// vectorises without SSE4.1's `roundpd`): adding and removing `1.5·2^52`
-/// rounds to the nearest integer.
-#[inline(always)]
-fn floor_small(x: f64) -> f64 {
-    const MAGIC: f64 = 6_755_399_441_055_744.0; // 1.5 · 2^52
-    let r = (x + MAGIC) - MAGIC;
-    if r > x {
-        r - 1.0
-    } else {
-        r
-    }
-}
-
-/// `floor(num / d)` for integers `|num| < 2^52`, `0 < d < 2^52`, quotient
-/// well below `2^40`: the estimate `num · (1/d)` is off by at most one, and
-/// the exact remainder `num − q·d` (all integers below `2^53`) corrects it.
-#[inline(always)]
-fn div_floor(num: f64, d: f64, inv: f64) -> f64 {
-    let q = floor_small(num * inv);
-    let r = num - q * d;
-    let q = if r < 0.0 { q - 1.0 } else { q };
-    if r >= d {
-        q + 1.0
-    } else {
-        q
-    }
-}
-
-/// One bound `floor((α + β·u) / d)` on `w` per column `u`.
-#[derive(Clone, Copy, Debug, Default)]
-struct Bound {
-    alpha: f64,
-    beta: f64,
-    d: f64,
-    inv: f64,
-    /// `-inf` unless this is a lower bound (`w >= -floor(..)`).
-    lower_off: f64,
-    /// `+inf` unless this is an upper bound (`w <= floor(..)`).
-    upper_off: f64,
-}
-
-impl Bound {
-    #[inline(always)]
-    fn new(alpha: i64, beta: i64, d: i64, lower: bool) -> Bound {
-        let (d, inf) = (d as f64, f64::INFINITY);
-        Bound {
-            alpha: alpha as f64,
-            beta: beta as f64,
-            d,
-            inv: 1.0 / d,
-            lower_off: if lower { 0.0 } else { -inf },
-            upper_off: if lower { inf } else { 0.0 },
-        }
-    }
-
-    /// No constraint.
-    fn none() -> Bound {
-        Bound { alpha: 0.0, beta: 0.0, d: 1.0, inv: 1.0, lower_off: f64::NEG_INFINITY, upper_off: f64::INFINITY }
-    }
-}
-
-impl Bound {
-    /// The constraint `a·y + (β·x + α) >= 0` on an integer `y`, for each
-    /// `x`: a lower bound on `y` if `a > 0`, an upper one if `a < 0`; `None`
-    /// if `a = 0` (then it constrains `x` alone, see [`x_range`]).
-    #[inline(always)]
-    fn solving(a: i64, beta: i64, alpha: i64) -> Option<Bound> {
-        match a.signum() {
-            // y >= ceil(-(β·x + α) / a) = -floor((β·x + α) / a)
-            1 => Some(Bound::new(alpha, beta, a, true)),
-            // y <= floor((β·x + α) / -a)
-            -1 => Some(Bound::new(alpha, beta, -a, false)),
-            _ => None,
-        }
-    }
-
-    /// Intersects `[l, h]` with this bound at `x`.
-    #[inline(always)]
-    fn clip(&self, x: f64, l: f64, h: f64) -> (f64, f64) {
-        let q = div_floor(self.alpha + self.beta * x, self.d, self.inv);
-        let (lq, hq) = (-q + self.lower_off, q + self.upper_off);
-        (if lq > l { lq } else { l }, if hq < h { hq } else { h })
-    }
-}
-
-/// The integers `x` in `[lo, hi]` with `β·x + α >= 0`.
-fn x_range(beta: i64, alpha: i64, lo: i64, hi: i64) -> (i64, i64) {
-    match beta.signum() {
-        1 => (lo.max(-alpha.div_euclid(beta)), hi),
-        -1 => (lo, hi.min(alpha.div_euclid(-beta))),
-        _ if alpha >= 0 => (lo, hi),
-        _ => (1, 0),
-    }
-}
-
-/// Three linear constraints `a·y + b·x + c >= 0` solved for `y` per `x`,
-/// and the range of `x` left by those with `a = 0`.
-#[inline(always)]
-fn solve3(edges: [(i64, i64, i64); 3], x_lo: i64, x_hi: i64) -> ([Bound; 3], (i64, i64)) {
-    let mut xr = (x_lo, x_hi);
-    let mut bounds = [Bound::none(); 3];
-    for (b, &(a, beta, alpha)) in bounds.iter_mut().zip(&edges) {
-        match Bound::solving(a, beta, alpha) {
-            Some(s) => *b = s,
-            None => xr = x_range(beta, alpha, xr.0, xr.1),
-        }
-    }
-    (bounds, xr)
-}
-
-/// `(floor(n / d), n − d·floor(n / d))` for `d > 0`.
-#[inline(always)]
-fn div_rem(n: i64, d: i64) -> (i64, i64) {
-    let q = div_floor(n as f64, d as f64, 1.0 / d as f64) as i64;
-    (q, n - q * d)
-}
-
-/// The batch path; see the module doc. Coordinates are relative to `lo`,
-/// so every value stays small.
+/// The small-triangle path; see the module doc. Coordinates are relative
+/// to `lo`, so every value stays small.
 #[inline(always)]
 fn scan_rows<O: Sink, const W: usize>(tri: &LatticeTriangle, n: [i64; 3], lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
@@ -275,127 +155,64 @@ fn scan_rows<O: Sink, const W: usize>(tri: &LatticeTriangle, n: [i64; 3], lo: [i
     let size: [i64; 3] = std::array::from_fn(|a| hi[a] - lo[a]);
     let sign = |x: i64| if x >= 0 { 1 } else { -1 };
     // Edge functions `a·p + b·q + c >= 0` over voxel indices of the
-    // projections (u, v), (v, w), (w, u).
+    // projections (u, v), (v, w), (w, u), at each square's best corner. A
+    // (u, v) square lies inside the projected triangle iff every edge is
+    // non-negative at its worst corner too: `f >= |a| + |b|`.
     let uv = edges_2d(&rel, u, v, sign(n[w]));
     let vw = edges_2d(&rel, v, w, sign(n[u]));
     let wu = edges_2d(&rel, w, u, sign(n[v]));
+    let inside: [i64; 3] = uv.map(|e| e.a.abs() + e.b.abs());
 
-    // Per row, from the (u, v) edges: the columns whose square meets the
-    // projected triangle, and those whose square lies inside it (edge value
-    // at the square's worst corner >= 0); from the (v, w) edges: the row's
-    // w range. Constraints that do not involve the solved variable narrow
-    // the range of rows instead (for the interior span: of rows that have one).
-    let (outer_b, (v0, v1)) = solve3(uv.map(|e| (e.a, e.b, e.c)), 0, size[v]);
-    let (inner_b, (vi0, vi1)) = solve3(uv.map(|e| (e.a, e.b, e.c - e.a.abs() - e.b.abs())), 0, size[v]);
-    let (vw_b, (v0, v1)) = solve3(vw.map(|e| (e.b, e.a, e.c)), v0, v1);
-    // (w, u) edges with no w term constrain the columns.
-    let (mut u0, mut u1) = (0, size[u]);
-    for e in wu.iter().filter(|e| e.a == 0) {
-        (u0, u1) = x_range(e.b, e.c, u0, u1);
-    }
-    if v0 > v1 || u0 > u1 {
-        return;
-    }
-
-    // Plane, oriented so n_w > 0, in voxel-index units (× ONE). Per column:
-    // w >= -floor((nu·u + nv·v + d_max) / nw) and
-    // w <= floor(-(nu·u + nv·v + d_min) / nw); α gets `nv·v` per row.
+    // Plane, oriented so n_w > 0, in voxel-index units (× ONE): the voxel
+    // at t is crossed iff t >= -floor((nu·u + nv·v + d_max) / nw) and
+    // t <= floor(-(nu·u + nv·v + d_min) / nw).
     let flip = sign(n[w]);
     let no = n.map(|c| c * flip);
     let nv0 = no[0] * rel.v[0][0] + no[1] * rel.v[0][1] + no[2] * rel.v[0][2];
     let (d_min, d_max) = no.iter().fold((-nv0, -nv0), |(a, b), &c| if c < 0 { (a + c * ONE, b) } else { (a, b + c * ONE) });
     let (nu, nv, nw) = (no[u] * ONE, no[v] * ONE, no[w] * ONE);
-    let (p_lo, p_hi) = (d_max, -d_min);
 
-    let (u0f, u1f, wmax) = (u0 as f64, u1 as f64, size[w] as f64);
-    let mut iv0 = v0;
-    while iv0 <= v1 {
-        // Eight rows at a time: column spans, interior spans and w ranges.
-        let x0 = iv0 as f64;
-        let (ra0, ra1) = ranges8(&outer_b, x0, u0f, u1f);
-        let (ri0, ri1) = ranges8(&inner_b, x0, u0f, u1f);
-        let (rc0, rc1) = ranges8(&vw_b, x0, 0.0, wmax);
-        for r in 0..BATCH.min((v1 - iv0 + 1) as usize) {
-            let (a0, a1, c0, c1) = (ra0[r], ra1[r], rc0[r], rc1[r]);
-            if a0 > a1 || c0 > c1 {
-                continue;
-            }
-            let iv = iv0 + r as i64;
-            let (a0, a1) = (a0 as i64, a1 as i64);
-            let (i0, i1) = if (vi0..=vi1).contains(&iv) { (ri0[r] as i64, ri1[r] as i64) } else { (1, 0) };
-            // Plane range at column a0 exactly, then stepped along the row:
-            // F = floor(num / nw), R = num − F·nw ∈ [0, nw); each column
-            // adds nu to num, and |nu| <= nw moves F by at most one.
-            let (mut f0, mut r0) = div_rem(p_lo + nv * iv + nu * a0, nw);
-            let (mut f1, mut r1) = div_rem(p_hi - nv * iv - nu * a0, nw);
-            let (c0, c1) = (c0 as i64, c1 as i64);
-            for iu in a0..=a1 {
-                let (t0, t1) = ((-f0).max(c0), f1.min(c1));
-                if i0 <= iu && iu <= i1 {
-                    // Inside the projection: the plane test decides; the
-                    // whole range is one run along w.
-                    if t0 <= t1 {
+    for iv in 0..=size[v] {
+        // The scanline: running (u, v) edge values, and the plane range
+        // as F = floor(num / nw), R = num − F·nw ∈ [0, nw); each column adds
+        // nu to num, and |nu| <= nw moves F by at most one.
+        let mut f: [i64; 3] = std::array::from_fn(|i| uv[i].b * iv + uv[i].c);
+        let (mut f0, mut r0) = div_floor(d_max + nv * iv, nw);
+        let (mut f1, mut r1) = div_floor(-d_min - nv * iv, nw);
+        let rvw: [i64; 3] = std::array::from_fn(|i| vw[i].a * iv + vw[i].c);
+        for iu in 0..=size[u] {
+            if (f[0] | f[1] | f[2]) >= 0 {
+                let (t0, t1) = ((-f0).max(0), f1.min(size[w]));
+                if t0 <= t1 {
+                    if f[0] >= inside[0] && f[1] >= inside[1] && f[2] >= inside[2] {
+                        // Inside the projection the plane test decides: a plane
+                        // point in the voxel projects into the triangle. One run.
                         let mut p = [0u32; 3];
                         (p[u], p[v], p[w]) = ((iu + lo[u]) as u32, (iv + lo[v]) as u32, (t0 + lo[w]) as u32);
                         out.set_run(W, p, (t1 - t0 + 1) as u32);
-                    }
-                } else {
-                    // On its boundary: the (w, u) edge tests per voxel.
-                    let r: [i64; 3] = std::array::from_fn(|i| wu[i].b * iu + wu[i].c);
-                    for t in t0..=t1 {
-                        if wu[0].a * t + r[0] >= 0 && wu[1].a * t + r[1] >= 0 && wu[2].a * t + r[2] >= 0 {
-                            set::<O, W>(out, iu + lo[u], iv + lo[v], t + lo[w]);
+                    } else {
+                        // On its boundary: the (v, w) and (w, u) edge tests per voxel.
+                        let rwu: [i64; 3] = std::array::from_fn(|i| wu[i].b * iu + wu[i].c);
+                        for t in t0..=t1 {
+                            let ok = (0..3).all(|i| vw[i].b * t + rvw[i] >= 0 && wu[i].a * t + rwu[i] >= 0);
+                            if ok {
+                                set::<O, W>(out, iu + lo[u], iv + lo[v], t + lo[w]);
+                            }
                         }
                     }
                 }
-                r0 += nu;
-                let s0 = (r0 >= nw) as i64 - (r0 < 0) as i64;
-                f0 += s0;
-                r0 -= s0 * nw;
-                r1 -= nu;
-                let s1 = (r1 >= nw) as i64 - (r1 < 0) as i64;
-                f1 += s1;
-                r1 -= s1 * nw;
             }
-        }
-        iv0 += BATCH as i64;
-    }
-}
-
-/// The vectorised inner loop: for the eight positions `x0, x0 + 1, …`, the
-/// range `[l, h] ∩ [lo, hi]` allowed by `bounds`. Bounds are the outer
-/// loop and positions the inner one, so each bound's fields are broadcast
-/// and the eight lanes run as straight-line packed `f64` code.
-#[inline(always)]
-fn ranges8(bounds: &[Bound], x0: f64, lo: f64, hi: f64) -> ([f64; BATCH], [f64; BATCH]) {
-    let xs: [f64; BATCH] = std::array::from_fn(|k| x0 + k as f64);
-    let (mut l, mut h) = ([lo; BATCH], [hi; BATCH]);
-    for b in bounds {
-        for k in 0..BATCH {
-            (l[k], h[k]) = b.clip(xs[k], l[k], h[k]);
-        }
-    }
-    (l, h)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn floor_division_is_exact_near_integers() {
-        for d in [1i64, 3, 4096, 4097, 1 << 30, (1 << 40) + 7] {
-            for num in [-(1i64 << 51) + 1, -d - 1, -d, -d + 1, -1, 0, 1, d - 1, d, d + 1, (1 << 51) - 1] {
-                let q = div_floor(num as f64, d as f64, 1.0 / d as f64);
-                assert_eq!(q as i64, num.div_euclid(d), "{num} / {d}");
+            for i in 0..3 {
+                f[i] += uv[i].a;
             }
-        }
-    }
-
-    #[test]
-    fn floor_small_matches_floor() {
-        for x in [-2.5, -2.0, -1.5, -0.5, -0.0, 0.0, 0.5, 1.0, 1.5, 2.5, 1e12 + 0.5, -1e12 - 0.5] {
-            assert_eq!(floor_small(x), x.floor(), "{x}");
+            r0 += nu;
+            let s0 = (r0 >= nw) as i64 - (r0 < 0) as i64;
+            f0 += s0;
+            r0 -= s0 * nw;
+            r1 -= nu;
+            let s1 = (r1 >= nw) as i64 - (r1 < 0) as i64;
+            f1 += s1;
+            r1 -= s1 * nw;
         }
     }
 }
