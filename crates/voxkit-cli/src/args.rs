@@ -23,10 +23,13 @@ pub enum Command {
     /// Certify a voxel file's topology: components, and with the source mesh
     /// separation (with a witness), thinness and tunnels.
     Check(CheckArgs),
+    /// Compare a mode's voxels with reference modes on meshes: voxels
+    /// missing and extra, and whether `check` certifies 6-separation (the
+    /// gap table of the published `pos` algorithm).
+    Gaps(GapsArgs),
 }
 
-/// Voxelization modes. `solid` and `pos` are accepted by the parser and
-/// rejected with an error saying they are not implemented yet.
+/// Voxelization modes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Mode {
     /// Conservative surface: every voxel whose closed box meets a triangle.
@@ -190,6 +193,25 @@ pub struct BenchArgs {
     /// (e.g. 2 turns the 69k-triangle bunny into 1.1M triangles).
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=5))]
     pub subdivide: u32,
+    /// Print JSON lines instead of a Markdown table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct GapsArgs {
+    /// Meshes to compare on.
+    #[arg(required = true)]
+    pub meshes: Vec<PathBuf>,
+    /// The mode under test.
+    #[arg(long, default_value = "pos")]
+    pub mode: Mode,
+    /// Modes it is compared against (voxels they set that it lacks).
+    #[arg(long, value_delimiter = ',', default_value = "sep6,cover")]
+    pub against: Vec<Mode>,
+    /// Resolutions (longest side in voxels).
+    #[arg(long, value_delimiter = ',', default_value = "128,256,512,1024")]
+    pub resolutions: Vec<u64>,
     /// Print JSON lines instead of a Markdown table.
     #[arg(long)]
     pub json: bool,

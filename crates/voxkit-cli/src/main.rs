@@ -27,6 +27,7 @@ fn main() -> ExitCode {
         Command::Info(a) => commands::info::run(a),
         Command::Bench(a) => commands::bench::run(a),
         Command::Check(a) => commands::check::run(a),
+        Command::Gaps(a) => commands::gaps::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -117,9 +117,8 @@ impl SurfaceMethod {
 }
 
 /// The core mode and the path that will run, or an error saying why none can.
-/// `auto` takes the scanline path where it exists and measured faster
-/// (`cover`, and `sep26`, on meshes whose triangles are small in voxels;
-/// see [`auto_method`]), the fast path otherwise.
+/// `auto` resolves to the fast path here; once the mesh and grid are known,
+/// [`auto_method`] may pick the scanline path instead.
 pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::Mode, SurfaceMethod)> {
     let core = core_mode(mode)?;
     let m = match method {
@@ -136,9 +135,9 @@ pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::M
 }
 
 /// What `--method auto` runs for a surface mode on this mesh and grid: the
-/// scanline path for `cover` when the mesh's triangles are small in voxels
-/// (where its batched column loop applies and was measured faster, see
-/// BENCHMARKS.md), the fast path otherwise.
+/// scanline path where it measured faster ([`voxkit::voxelize::scanline::prefers`]:
+/// `cover` and `sep26` on meshes whose triangles span a few voxels or
+/// more), the fast path otherwise.
 pub fn auto_method(mode: voxkit::voxelize::Mode, mesh: voxkit::MeshRef<'_>, grid: &GridSpec) -> SurfaceMethod {
     if !voxkit::voxelize::scanline::prefers(mode, mesh, grid) {
         return SurfaceMethod::Fast;

@@ -132,7 +132,10 @@ fn bad_input_gives_one_line_errors() {
             "at most 65536 per axis",
         ),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--resolution".into(), "60000".into()], "needs"),
-        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--mode".into(), "pos".into()], "not implemented"),
+        (
+            vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--mode".into(), "ss6".into(), "--method".into(), "scanline".into()],
+            "exists for cover, sep26 and sep6",
+        ),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--method".into(), "gpu".into()], "not implemented"),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--origin".into(), "0,0,0".into()], "explicit grid needs"),
         (
@@ -275,4 +278,41 @@ fn solid_modes_say_what_they_did() {
     assert_eq!(p["solid"]["closed"], false);
     let e = error_line(&["voxelize", &cube, "-o", &out, "--mode", "sep6", "--hollow", "6"]);
     assert!(e.contains("apply to --mode solid"), "{e}");
+}
+
+#[test]
+fn scanline_method_writes_the_same_file_as_fast_and_auto_says_which_ran() {
+    let mesh = shared("stanford-bunny.obj");
+    for mode in ["cover", "sep26", "sep6"] {
+        let (a, b) = (tmp(&format!("scan-{mode}.binvox")), tmp(&format!("fast-{mode}.binvox")));
+        let s = json(&voxkit(&["voxelize", &mesh, "-o", &a, "--mode", mode, "--resolution", "96", "--method", "scanline", "--json"]));
+        let f = json(&voxkit(&["voxelize", &mesh, "-o", &b, "--mode", mode, "--resolution", "96", "--method", "fast", "--json"]));
+        assert_eq!(s["method"], "scanline");
+        assert_eq!(f["method"], "fast");
+        assert_eq!(s["voxels"], f["voxels"]);
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{mode}: files differ");
+    }
+    // auto: the scanline path for cover once triangles span a few voxels, never for sep6.
+    let out = tmp("auto.binvox");
+    let big = json(&voxkit(&["voxelize", &mesh, "-o", &out, "--mode", "cover", "--resolution", "1024", "--json"]));
+    assert_eq!(big["method"], "scanline");
+    let small = json(&voxkit(&["voxelize", &mesh, "-o", &out, "--mode", "cover", "--resolution", "64", "--json"]));
+    assert_eq!(small["method"], "fast");
+    let sep6 = json(&voxkit(&["voxelize", &mesh, "-o", &out, "--mode", "sep6", "--resolution", "1024", "--json"]));
+    assert_eq!(sep6["method"], "fast");
+}
+
+#[test]
+fn pos_runs_and_gaps_reports_what_it_misses() {
+    let out = tmp("pos.binvox");
+    let p = json(&voxkit(&["voxelize", &shared("cow.obj"), "-o", &out, "--mode", "pos", "--resolution", "64", "--json"]));
+    assert_eq!(p["mode"], "pos");
+    assert!(p["voxels"].as_u64().unwrap() > 0);
+    let g = voxkit(&["gaps", &shared("cow.obj"), "--resolutions", "64", "--json"]);
+    assert!(g.status.success(), "{}", String::from_utf8_lossy(&g.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&g.stdout).unwrap();
+    assert_eq!(v["voxels"], p["voxels"]);
+    assert_eq!(v["closed"], true);
+    assert!(v["missing"]["cover"].as_u64().unwrap() > 0, "{v}");
+    assert!(v["separating_6"].is_boolean());
 }

@@ -2,6 +2,7 @@
 
 pub mod bench;
 pub mod check;
+pub mod gaps;
 pub mod info;
 pub mod solid;
 pub mod voxelize;

@@ -568,8 +568,13 @@ fn interior_runs<T: PlaneInt, O: Sink, const W: usize>(
 /// `floor(n / d)` for `d > 0`, as an index.
 #[inline(always)]
 fn floor_div<T: PlaneInt>(n: T, d: T) -> i64 {
-    let q = n.div_floor(d).to_i128();
-    q.clamp(i64::MIN as i128 / 2, i64::MAX as i128 / 2) as i64
+    let (n, d) = (n.to_i128(), d.to_i128());
+    const FAST: i128 = 1 << 62;
+    if n.abs() < FAST && d < FAST && d >= ONE as i128 {
+        // No hardware division: the f64 estimate corrected exactly.
+        return div_floor(n as i64, d as i64).0;
+    }
+    n.div_euclid(d).clamp(i64::MIN as i128 / 2, i64::MAX as i128 / 2) as i64
 }
 
 /// `ceil(n / d)` for `d > 0`, as an index.

@@ -67,31 +67,39 @@ pub fn scanline(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'
 }
 
 /// Whether the scanline path is expected to beat the triangle-box fast path
-/// for `mode` on this mesh and grid (what `--method auto` asks): for modes
-/// where it measured faster, when nearly all triangles are small enough
-/// in voxels for the batched column loop (a deterministic sample of up to
-/// 4096 triangles is looked at).
+/// for `mode` on this mesh and grid (what `--method auto` asks). Measured
+/// (BENCHMARKS.md): for `cover` and `sep26` it is as fast on triangles of a
+/// voxel or two and pulls ahead as triangles grow (runs replace per-voxel
+/// work), up to several times on large faces; for `sep6` Laine's
+/// single-projection fast path stays ahead. So: `cover` and `sep26` when
+/// the median triangle (over a deterministic sample of up to 4096) spans
+/// at least [`PREFER_EXTENT_VOXELS`] voxels.
 pub fn prefers(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec) -> bool {
-    if !PREFERRED.contains(&mode) || mesh.triangles.is_empty() {
+    if !matches!(mode, Mode::Cover | Mode::Sep26) || mesh.triangles.is_empty() {
         return false;
     }
     let step = mesh.triangles.len().div_ceil(4096);
-    let limit = (SMALL_EXTENT / ONE) as f64 * grid.voxel_size();
-    let (mut small, mut seen) = (0usize, 0usize);
-    for t in mesh.triangles.iter().step_by(step) {
-        let Some(p) = t.iter().map(|&i| mesh.positions.get(i as usize).copied()).collect::<Option<Vec<_>>>() else { continue };
-        let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
-        seen += 1;
-        if (hi - lo).max_element() <= limit {
-            small += 1;
-        }
+    let mut extents: Vec<f64> = mesh
+        .triangles
+        .iter()
+        .step_by(step)
+        .filter_map(|t| {
+            let p: Option<Vec<_>> = t.iter().map(|&i| mesh.positions.get(i as usize).copied()).collect();
+            let p = p?;
+            let e = (p[0].max(p[1]).max(p[2]) - p[0].min(p[1]).min(p[2])).max_element() / grid.voxel_size();
+            e.is_finite().then_some(e)
+        })
+        .collect();
+    if extents.is_empty() {
+        return false;
     }
-    seen > 0 && small * 10 >= seen * 9
+    let mid = extents.len() / 2;
+    let (_, median, _) = extents.select_nth_unstable_by(mid, f64::total_cmp);
+    *median >= PREFER_EXTENT_VOXELS
 }
 
-/// Modes whose scanline path measured faster than the fast path on meshes
-/// of small triangles (BENCHMARKS.md).
-const PREFERRED: [Mode; 1] = [Mode::Cover];
+/// Median triangle extent (voxels) from which `auto` takes the scanline path.
+pub const PREFER_EXTENT_VOXELS: f64 = 4.0;
 
 struct ScanKernel {
     mode: Mode,
@@ -123,17 +131,21 @@ fn targets<T: PlaneInt, const N: usize>(tri: &LatticeTriangle, lo: [i64; 3], hi:
     scan_triangle(tri, lo, hi, &mut Filter { slab, keep });
 }
 
-/// Triangles up to this extent (lattice units) scan their box's columns
-/// ([`scan_rows`]); the plane values' division by the reciprocal is exact
-/// below it (numerators under `2^52`).
-const SMALL_EXTENT: i64 = 14 * ONE;
+/// Triangles whose voxel box has at most this many voxels scan the box's
+/// rows ([`scan_rows`]); larger ones walk exact row spans.
+const SMALL_BOX: i64 = 8192;
+
+/// ... and whose extent (lattice units) keeps every value of [`scan_rows`]
+/// in `i64` (plane values below `2^61`).
+const SMALL_EXTENT: i64 = (1 << 19) - 2 * ONE;
 
 /// Emits exactly the voxels of `[lo, hi]` whose closed box meets `tri`.
 pub(crate) fn scan_triangle<O: Sink>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     let (blo, bhi) = tri.bounds();
     let extent = (0..3).map(|a| bhi[a] - blo[a]).max().unwrap_or(0);
-    if extent > SMALL_EXTENT {
-        // The scalar twin: exact incremental bounds along each row.
+    let volume: i64 = (0..3).map(|a| hi[a] - lo[a] + 1).product();
+    if volume > SMALL_BOX || extent > SMALL_EXTENT {
+        // Large: exact row spans walked incrementally, runs emitted.
         cover_triangle_runs(tri, lo, hi, out);
         return;
     }
