@@ -522,17 +522,12 @@ fn interior_runs<T: PlaneInt, O: Sink, const W: usize>(
     if tmin > tmax {
         return;
     }
-    let run_at = |out: &mut O, axis: usize, iu: i64, t: i64, len: i64| {
-        let mut p = [0u32; 3];
-        (p[u], p[v], p[w]) = (iu as u32, iv as u32, t as u32);
-        out.set_run(axis, p, len as u32);
-    };
     if 3 * (tmax - tmin + 1) > width {
         let mut plane = PlaneRange { t0: first.t0, t1: first.t1, g0: first.g0, g1: first.g1 };
         for iu in i0..=i1 {
             let (ta, tb) = (plane.t0.max(c0), plane.t1.min(c1));
             if ta <= tb {
-                run_at(out, W, iu, ta, tb - ta + 1);
+                run::<O, W>(out, W, iu, iv, ta, tb - ta + 1);
             }
             if iu < i1 {
                 plane.next_column(s.n[u], s.n[w]);
@@ -560,9 +555,18 @@ fn interior_runs<T: PlaneInt, O: Sink, const W: usize>(
             continue;
         }
         if ua <= ub {
-            run_at(out, u, ua, t, ub - ua + 1);
+            run::<O, W>(out, u, ua, iv, t, ub - ua + 1);
         }
     }
+}
+
+/// Emits `len` voxels from `(u, v, w)` along `axis`; `(u, v, w)` is a cyclic
+/// shift of `(x, y, z)` by `W`.
+#[inline(always)]
+fn run<O: Sink, const W: usize>(out: &mut O, axis: usize, iu: i64, iv: i64, t: i64, len: i64) {
+    let mut p = [0u32; 3];
+    (p[(W + 1) % 3], p[(W + 2) % 3], p[W]) = (iu as u32, iv as u32, t as u32);
+    out.set_run(axis, p, len as u32);
 }
 
 /// `floor(n / d)` for `d > 0`, as an index.

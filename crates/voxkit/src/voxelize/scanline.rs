@@ -184,19 +184,45 @@ fn scan_rows<O: Sink, const W: usize>(tri: &LatticeTriangle, n: [i64; 3], lo: [i
     let (d_min, d_max) = no.iter().fold((-nv0, -nv0), |(a, b), &c| if c < 0 { (a + c * ONE, b) } else { (a, b + c * ONE) });
     let (nu, nv, nw) = (no[u] * ONE, no[v] * ONE, no[w] * ONE);
 
+    // (u, v) edge values as exact f64 integers (below 2^46 here) for the
+    // vectorised classification of columns.
+    let ea: [f64; 3] = uv.map(|e| e.a as f64);
+    let inside_f: [f64; 3] = inside.map(|x| x as f64);
     for iv in 0..=size[v] {
-        // The scanline: running (u, v) edge values, and the plane range
-        // as F = floor(num / nw), R = num − F·nw ∈ [0, nw); each column adds
-        // nu to num, and |nu| <= nw moves F by at most one.
-        let mut f: [i64; 3] = std::array::from_fn(|i| uv[i].b * iv + uv[i].c);
-        let (mut f0, mut r0) = div_floor(d_max + nv * iv, nw);
-        let (mut f1, mut r1) = div_floor(-d_min - nv * iv, nw);
+        // The scanline: 16 columns at a time are classified (outside, on the
+        // boundary, inside) by the vectorised loop of `classify`; the
+        // columns that meet the projection are one contiguous run.
+        let e0: [f64; 3] = std::array::from_fn(|i| (uv[i].b * iv + uv[i].c) as f64);
         let rvw: [i64; 3] = std::array::from_fn(|i| vw[i].a * iv + vw[i].c);
-        for iu in 0..=size[u] {
-            if (f[0] | f[1] | f[2]) >= 0 {
+        // Plane range as F = floor(num / nw), R = num − F·nw ∈ [0, nw), set
+        // at the run's first column; each column adds nu to num, and
+        // |nu| <= nw moves F by at most one.
+        let (mut f0, mut r0, mut f1, mut r1) = (0, 0, 0, 0);
+        let mut started = false;
+        let mut x0 = 0;
+        while x0 <= size[u] {
+            let n = (size[u] - x0 + 1).min(LANES as i64) as u32;
+            let keep = if n == 32 { u32::MAX } else { (1u32 << n) - 1 };
+            let (outer, inner) = classify(&e0, &ea, &inside_f, x0 as f64);
+            let outer = outer & keep;
+            if outer == 0 {
+                if started {
+                    break;
+                }
+                x0 += LANES as i64;
+                continue;
+            }
+            let first = x0 + outer.trailing_zeros() as i64;
+            let last = x0 + (31 - outer.leading_zeros()) as i64;
+            if !started {
+                started = true;
+                (f0, r0) = div_floor(d_max + nv * iv + nu * first, nw);
+                (f1, r1) = div_floor(-d_min - nv * iv - nu * first, nw);
+            }
+            for iu in first..=last {
                 let (t0, t1) = ((-f0).max(0), f1.min(size[w]));
                 if t0 <= t1 {
-                    if f[0] >= inside[0] && f[1] >= inside[1] && f[2] >= inside[2] {
+                    if (inner >> (iu - x0)) & 1 == 1 {
                         // Inside the projection the plane test decides: a plane
                         // point in the voxel projects into the triangle. One run.
                         let mut p = [0u32; 3];
@@ -213,18 +239,50 @@ fn scan_rows<O: Sink, const W: usize>(tri: &LatticeTriangle, n: [i64; 3], lo: [i
                         }
                     }
                 }
+                r0 += nu;
+                let s0 = (r0 >= nw) as i64 - (r0 < 0) as i64;
+                f0 += s0;
+                r0 -= s0 * nw;
+                r1 -= nu;
+                let s1 = (r1 >= nw) as i64 - (r1 < 0) as i64;
+                f1 += s1;
+                r1 -= s1 * nw;
             }
-            for i in 0..3 {
-                f[i] += uv[i].a;
+            if last < x0 + n as i64 - 1 {
+                break;
             }
-            r0 += nu;
-            let s0 = (r0 >= nw) as i64 - (r0 < 0) as i64;
-            f0 += s0;
-            r0 -= s0 * nw;
-            r1 -= nu;
-            let s1 = (r1 >= nw) as i64 - (r1 < 0) as i64;
-            f1 += s1;
-            r1 -= s1 * nw;
+            x0 += LANES as i64;
         }
     }
+}
+
+/// Columns classified per call of [`classify`].
+const LANES: usize = 16;
+
+/// The vectorised inner loop: for the columns `x0 .. x0 + 16` of a row, with
+/// the (u, v) edge values `e0[i] + a[i]·x` (exact integers in `f64`), bit
+/// `k` of the first mask says column `x0 + k` meets the projected triangle
+/// (every edge `>= 0` at the square's best corner), of the second that its
+/// square lies inside it (every edge `>= inside[i]`, the worst corner).
+/// Straight-line code over a fixed 16 lanes: packed compares and minima,
+/// then a bit gather.
+#[inline(always)]
+fn classify(e0: &[f64; 3], a: &[f64; 3], inside: &[f64; 3], x0: f64) -> (u32, u32) {
+    let mut best = [0f64; LANES];
+    let mut worst = [0f64; LANES];
+    for k in 0..LANES {
+        let x = x0 + k as f64;
+        let (g0, g1, g2) = (e0[0] + a[0] * x, e0[1] + a[1] * x, e0[2] + a[2] * x);
+        let m = if g0 < g1 { g0 } else { g1 };
+        best[k] = if m < g2 { m } else { g2 };
+        let (h0, h1, h2) = (g0 - inside[0], g1 - inside[1], g2 - inside[2]);
+        let m = if h0 < h1 { h0 } else { h1 };
+        worst[k] = if m < h2 { m } else { h2 };
+    }
+    let (mut outer, mut inner) = (0u32, 0u32);
+    for k in 0..LANES {
+        outer |= ((best[k] >= 0.0) as u32) << k;
+        inner |= ((worst[k] >= 0.0) as u32) << k;
+    }
+    (outer, inner)
 }
