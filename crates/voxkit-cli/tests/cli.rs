@@ -133,7 +133,16 @@ fn bad_input_gives_one_line_errors() {
         ),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--resolution".into(), "60000".into()], "needs"),
         (
-            vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--mode".into(), "ss6".into(), "--method".into(), "scanline".into()],
+            vec![
+                "voxelize".into(),
+                shared("cow.obj"),
+                "-o".into(),
+                out.clone(),
+                "--mode".into(),
+                "ss6".into(),
+                "--method".into(),
+                "scanline".into(),
+            ],
             "exists for cover, sep26 and sep6",
         ),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--method".into(), "gpu".into()], "not implemented"),

@@ -60,11 +60,8 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     }
     let grid = request.fit(&loaded.report.bounds)?;
     plan::check_memory(&grid)?;
-    let surface_method = if a.method == crate::args::Method::Auto {
-        plan::auto_method(mode, loaded.mesh.as_ref(), &grid)
-    } else {
-        surface_method
-    };
+    let surface_method =
+        if a.method == crate::args::Method::Auto { plan::auto_method(mode, loaded.mesh.as_ref(), &grid) } else { surface_method };
     let method = if solid_plan.is_some() { "solid" } else { surface_method.name() };
 
     bar.phase(if method == "reference" { "voxelizing (reference, serial)" } else { "voxelizing" });

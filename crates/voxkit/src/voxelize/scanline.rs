@@ -19,21 +19,29 @@
 //!
 //! **How.** With `w` the dominant axis of the normal and `(u, v, w)` a
 //! cyclic permutation of `(x, y, z)`, each scanline is a row `v` of the
-//! projection. Every test of the overlap theorem is linear in the voxel
-//! index, so per row:
-//! - the three `(u, v)` edge tests give the row's exact column span;
-//! - the three `(v, w)` edge tests give one `w` range for the whole row;
-//! - per column, the plane test and the three `(w, u)` edge tests give
-//!   lower or upper bounds `floor((α + β·u) / d)` on `w`.
+//! projection along `w`. Every test of the overlap theorem is linear in the
+//! voxel index, and along a row:
+//! - the three `(u, v)` edge tests classify each column as outside the
+//!   projected triangle, on its boundary (the square straddles an edge) or
+//!   inside it (the edge value at the square's worst corner is `>= 0`).
+//!   `classify` does this for 16 columns at once in straight-line `f64`
+//!   code (exact: the values are integers below `2^46`) that compiles to
+//!   packed SIMD compares and minima; by convexity the columns that meet
+//!   the projection are one contiguous run.
+//! - the plane test gives each column its range of `w`: a floor division at
+//!   the run's first column, then an exact remainder step per column
+//!   (`|n_u| <= n_w`, so the range moves by at most one).
+//! - inside columns need nothing else (a plane point in the voxel projects
+//!   into the triangle, so it is a triangle point): the range is emitted as
+//!   one run of bits. Boundary columns test their few voxels against the
+//!   `(v, w)` and `(w, u)` edges.
 //!
-//! The column loop evaluates those five bounds for a batch of columns in
-//! straight-line `f64` code (exact: every value is an integer below `2^52`
-//! for triangles up to 14 voxels across; floor division is an estimate by
-//! the reciprocal corrected with the exact remainder), which the compiler
-//! turns into packed SIMD; then each column's range `[w0, w1]` is emitted
-//! whole. No voxel is tested individually. Larger triangles take the scalar
-//! twin: the same bounds walked incrementally in exact integers along each
-//! row (`cover`'s row walker), which costs per row, not per column.
+//! Triangles with a voxel box over `SMALL_BOX` (8192) voxels walk exact row spans
+//! instead (`cover`'s row walker with incremental bounds, so the cost is
+//! per row and per run, not per bounding-box column) and emit inside
+//! columns as runs along the row, one per layer `t`, when the plane is
+//! shallow along the row: the columns of layer `t` solve two linear
+//! inequalities exactly.
 //!
 //! Parallel over z-slabs with the shared driver: deterministic for any
 //! thread count. **Reference:** the modes' brute-force references; the
