@@ -1,6 +1,6 @@
 //! Fuzzes every surface and line mode: triangles (and the same points as
-//! segments) from raw bytes on a small grid; each fast path must equal its
-//! reference.
+//! segments) from raw bytes on a small grid; each fast path, and each
+//! scanline path, must equal its reference.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -25,5 +25,8 @@ fuzz_target!(|data: &[u8]| {
         let (fast, _) = voxelize::fast(mode, mesh.as_ref(), &grid, &Options::default());
         let (slow, _) = voxelize::reference(mode, mesh.as_ref(), &grid);
         assert_eq!(fast.to_dense().first_difference(&slow), None, "{mode:?}");
+        if let Some((scan, _)) = voxelize::scanline::scanline(mode, mesh.as_ref(), &grid, &Options::default()) {
+            assert_eq!(scan.to_dense().first_difference(&slow), None, "{mode:?} scanline");
+        }
     }
 });
