@@ -20,6 +20,23 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
+/// Runs `f` on each of `items` once per round, `repeats` rounds, so that drifts in the
+/// machine's speed hit every one alike; returns each one's median seconds
+/// and last result.
+fn time_alternating<E, T>(repeats: usize, items: &[E], f: impl Fn(&E) -> T) -> Vec<(f64, T)> {
+    let mut times = vec![Vec::with_capacity(repeats); items.len()];
+    let mut last: Vec<Option<T>> = items.iter().map(|_| None).collect();
+    for _ in 0..repeats.max(1) {
+        for (i, item) in items.iter().enumerate() {
+            let t = Instant::now();
+            let r = f(item);
+            times[i].push(t.elapsed().as_secs_f64());
+            last[i] = Some(r);
+        }
+    }
+    times.into_iter().zip(last).map(|(t, r)| (median(t), r.expect("at least one round"))).collect()
+}
+
 /// Runs `f` `repeats` times; returns the median seconds and the last result.
 fn time<T>(repeats: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     let mut times = Vec::with_capacity(repeats);
@@ -43,26 +60,22 @@ enum Engine {
 }
 
 impl Engine {
-    /// `solid` measures both parity and the generalized winding number;
-    /// modes with a scanline path measure it beside the fast path.
-    fn new(m: crate::args::Mode) -> Result<Vec<Engine>> {
+    /// Groups of engines, each timed against one reference: `solid`
+    /// measures parity and the generalized winding number (two groups);
+    /// modes with a scanline path measure it beside the fast path, in one
+    /// group whose engines are timed in alternation.
+    fn new(m: crate::args::Mode) -> Result<Vec<Vec<Engine>>> {
         Ok(match m {
-            crate::args::Mode::Solid => vec![Engine::SolidParity, Engine::SolidWinding],
+            crate::args::Mode::Solid => vec![vec![Engine::SolidParity], vec![Engine::SolidWinding]],
             m => {
                 let core = crate::plan::core_mode(m)?;
                 let mut v = vec![Engine::Surface(core)];
                 if voxelize::scanline::supports(core) {
                     v.push(Engine::Scanline(core));
                 }
-                v
+                vec![v]
             }
         })
-    }
-
-    /// Whether this engine's reference row is the one just before it (the
-    /// scanline path shares its mode's baseline).
-    fn shares_reference(&self) -> bool {
-        matches!(self, Engine::Scanline(_))
     }
 
     /// Largest resolution the reference runs at (the solid references test
@@ -134,60 +147,61 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let mut rows = Vec::new();
 
     let mut ref_s = std::collections::HashMap::new();
-    let engines: Vec<Engine> = a.modes.iter().map(|&m| Engine::new(m)).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect();
-    for engine in &engines {
+    let groups: Vec<Vec<Engine>> = a.modes.iter().map(|&m| Engine::new(m)).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect();
+    for group in &groups {
         // Baseline: the reference path (serial by construction), capped for
         // the solids.
-        if !engine.shares_reference() {
-            let ref_res = a.reference_resolution.min(engine.reference_cap());
-            let grid = GridSpec::from_resolution(&bounds, ref_res).context("invalid grid")?;
-            let (s, voxels) = time(a.repeats.clamp(1, 3), || engine.reference(mesh, &grid));
-            let voxels = voxels?;
-            ref_s.insert(engine.name(), (ref_res, s));
-            rows.push(Row {
-                mode: engine.name(),
-                method: "reference",
-                threads: 1,
-                resolution: ref_res,
-                dims: grid.dims(),
-                voxels,
-                voxelize_s: s,
-                with_loading_s: None,
-            });
-        }
+        let first = &group[0];
+        let ref_res = a.reference_resolution.min(first.reference_cap());
+        let grid = GridSpec::from_resolution(&bounds, ref_res).context("invalid grid")?;
+        let (s, voxels) = time(a.repeats.clamp(1, 3), || first.reference(mesh, &grid));
+        let voxels = voxels?;
+        ref_s.insert(first.name(), (ref_res, s));
+        rows.push(Row {
+            mode: first.name(),
+            method: "reference",
+            threads: 1,
+            resolution: ref_res,
+            dims: grid.dims(),
+            voxels,
+            voxelize_s: s,
+            with_loading_s: None,
+        });
 
         for &threads in &a.threads {
             let pool = crate::thread_pool(Some(threads))?;
             for &res in &a.resolutions {
                 let grid = GridSpec::from_resolution(&bounds, res).context("invalid grid")?;
                 crate::plan::check_memory(&grid)?;
-                let (vox_s, voxels) = pool.install(|| time(a.repeats, || engine.fast(mesh, &grid)));
-                let voxels = voxels?;
-                // With loading: only for the file as it is (a subdivided
-                // mesh is built in memory).
-                let load_s = if a.subdivide == 0 {
-                    let (load_s, r) = pool.install(|| {
-                        time(a.repeats.min(5), || -> Result<u64> {
-                            let l = voxkit_io::read_mesh(&a.mesh)?;
-                            let g = GridSpec::from_resolution(&l.report.bounds, res)?;
-                            engine.fast(l.mesh.as_ref(), &g)
-                        })
+                let timed = pool.install(|| time_alternating(a.repeats, group, |e| e.fast(mesh, &grid)));
+                for (engine, (vox_s, voxels)) in group.iter().zip(timed) {
+                    let voxels = voxels?;
+                    // With loading: only for the file as it is (a subdivided
+                    // mesh is built in memory).
+                    let load_s = if a.subdivide == 0 {
+                        let (load_s, r) = pool.install(|| {
+                            time(a.repeats.min(5), || -> Result<u64> {
+                                let l = voxkit_io::read_mesh(&a.mesh)?;
+                                let g = GridSpec::from_resolution(&l.report.bounds, res)?;
+                                engine.fast(l.mesh.as_ref(), &g)
+                            })
+                        });
+                        r?;
+                        Some(load_s)
+                    } else {
+                        None
+                    };
+                    rows.push(Row {
+                        mode: engine.name(),
+                        method: engine.fast_name(),
+                        threads,
+                        resolution: res,
+                        dims: grid.dims(),
+                        voxels,
+                        voxelize_s: vox_s,
+                        with_loading_s: load_s,
                     });
-                    r?;
-                    Some(load_s)
-                } else {
-                    None
-                };
-                rows.push(Row {
-                    mode: engine.name(),
-                    method: engine.fast_name(),
-                    threads,
-                    resolution: res,
-                    dims: grid.dims(),
-                    voxels,
-                    voxelize_s: vox_s,
-                    with_loading_s: load_s,
-                });
+                }
             }
         }
     }
