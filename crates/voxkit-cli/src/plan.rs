@@ -137,7 +137,7 @@ pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::M
 /// What `--method auto` runs for a surface mode on this mesh and grid: the
 /// scanline path where it measured faster ([`voxkit::voxelize::scanline::prefers`]:
 /// `cover` and `sep26` on meshes whose triangles span a few voxels or
-/// more), the fast path otherwise.
+/// more, `sep6` on meshes of very large faces), the fast path otherwise.
 pub fn auto_method(mode: voxkit::voxelize::Mode, mesh: voxkit::MeshRef<'_>, grid: &GridSpec) -> SurfaceMethod {
     if !voxkit::voxelize::scanline::prefers(mode, mesh, grid) {
         return SurfaceMethod::Fast;

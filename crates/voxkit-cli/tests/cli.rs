@@ -301,7 +301,7 @@ fn scanline_method_writes_the_same_file_as_fast_and_auto_says_which_ran() {
         assert_eq!(s["voxels"], f["voxels"]);
         assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{mode}: files differ");
     }
-    // auto: the scanline path for cover once triangles span a few voxels, never for sep6.
+    // auto: the scanline path for cover once triangles span a few voxels, for sep6 only on huge faces.
     let out = tmp("auto.binvox");
     let big = json(&voxkit(&["voxelize", &mesh, "-o", &out, "--mode", "cover", "--resolution", "1024", "--json"]));
     assert_eq!(big["method"], "scanline");
@@ -309,6 +309,11 @@ fn scanline_method_writes_the_same_file_as_fast_and_auto_says_which_ran() {
     assert_eq!(small["method"], "fast");
     let sep6 = json(&voxkit(&["voxelize", &mesh, "-o", &out, "--mode", "sep6", "--resolution", "1024", "--json"]));
     assert_eq!(sep6["method"], "fast");
+    // A 12-triangle box: huge faces, the scanline path for sep6 too.
+    let boxr = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/meshes/box-rotated.obj");
+    let boxr = boxr.to_string_lossy();
+    let b = json(&voxkit(&["voxelize", &boxr, "-o", &out, "--mode", "sep6", "--resolution", "256", "--json"]));
+    assert_eq!(b["method"], "scanline");
 }
 
 #[test]

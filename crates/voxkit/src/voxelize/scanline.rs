@@ -75,15 +75,22 @@ pub fn scanline(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'
 }
 
 /// Whether the scanline path is expected to beat the triangle-box fast path
-/// for `mode` on this mesh and grid (what `--method auto` asks). Measured
-/// (BENCHMARKS.md): for `cover` and `sep26` it is as fast on triangles of a
-/// voxel or two and pulls ahead as triangles grow (runs replace per-voxel
-/// work), up to several times on large faces; for `sep6` Laine's
-/// single-projection fast path stays ahead. So: `cover` and `sep26` when
-/// the median triangle (over a deterministic sample of up to 4096) spans
-/// at least [`PREFER_EXTENT_VOXELS`] voxels.
+/// for `mode` on this mesh and grid (what `--method auto` asks), from the
+/// measurements in BENCHMARKS.md: on triangles of a voxel or two it is
+/// slower (per-row setup with little to amortise it); from a few voxels on
+/// `cover` and `sep26` are as fast or faster, and on large faces several
+/// times faster (runs replace per-voxel work); `sep6`'s single-projection
+/// fast path stays ahead until faces are very large. So: the median
+/// triangle extent (over a deterministic sample of up to 4096 triangles)
+/// must reach [`PREFER_EXTENT_VOXELS`] for `cover` and `sep26`, and
+/// [`PREFER_EXTENT_VOXELS_SEP6`] for `sep6`.
 pub fn prefers(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec) -> bool {
-    if !matches!(mode, Mode::Cover | Mode::Sep26) || mesh.triangles.is_empty() {
+    let threshold = match mode {
+        Mode::Cover | Mode::Sep26 => PREFER_EXTENT_VOXELS,
+        Mode::Sep6 => PREFER_EXTENT_VOXELS_SEP6,
+        _ => return false,
+    };
+    if mesh.triangles.is_empty() {
         return false;
     }
     let step = mesh.triangles.len().div_ceil(4096);
@@ -103,11 +110,15 @@ pub fn prefers(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec) -> bool {
     }
     let mid = extents.len() / 2;
     let (_, median, _) = extents.select_nth_unstable_by(mid, f64::total_cmp);
-    *median >= PREFER_EXTENT_VOXELS
+    *median >= threshold
 }
 
-/// Median triangle extent (voxels) from which `auto` takes the scanline path.
+/// Median triangle extent (voxels) from which `auto` takes the scanline
+/// path for `cover` and `sep26`.
 pub const PREFER_EXTENT_VOXELS: f64 = 4.0;
+
+/// The same for `sep6`.
+pub const PREFER_EXTENT_VOXELS_SEP6: f64 = 64.0;
 
 struct ScanKernel {
     mode: Mode,
