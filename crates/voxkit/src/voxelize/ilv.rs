@@ -24,13 +24,18 @@
 //!   passes through under the project's tie rule ([`crate::geom::perturb`]:
 //!   the segment moved by `+(ε, ε², ε³)`), in order. `line6` uses it: a
 //!   segment meets a voxel's surface iff it passes through the voxel and
-//!   does not stay inside a single voxel.
+//!   does not stay inside a single voxel. [`segment_voxels`] is the same
+//!   walk for a world-space segment on a grid: the line-voxelization API.
 //!
 //! **Reference:** the tests compare [`lattice_path`] with `line6`'s
 //! brute-force definition and [`voxel_line`] with a floating-point DDA on
 //! random lines.
 
-use crate::geom::fixed::ONE;
+use glam::DVec3;
+
+use crate::geom::clip::clip_segment_to_box;
+use crate::geom::fixed::{snap, DIRECT_LIMIT_VOXELS, ONE};
+use crate::grid::spec::GridSpec;
 
 /// The published ILV walk (`MARKLINEILV`) between voxel indices `p0` and
 /// `p1`, calling `mark` on every voxel of the path, `p0` first and `p1`
@@ -49,14 +54,17 @@ use crate::geom::fixed::ONE;
 pub fn voxel_line(p0: [i64; 3], p1: [i64; 3], mut mark: impl FnMut([i64; 3])) {
     let d: [i64; 3] = std::array::from_fn(|a| p1[a] - p0[a]);
     let step: [i64; 3] = d.map(i64::signum);
+    // Deviation: products over the non-zero deltas only (see above).
     let m = products(d.map(|x| x as i128));
     // Next crossing parameter of each axis, times 2·Π|Δ|: the first face is
     // half a voxel away (M), each further one a whole voxel (2M).
     let mut next: [i128; 3] = m;
     let mut left: [i64; 3] = d.map(i64::abs);
     let mut p = p0;
+    // Deviation: the start voxel is marked too.
     mark(p);
     while left != [0, 0, 0] {
+        // Deviation: only axes with steps left; ties to the lowest axis.
         let mut a = 3;
         for x in 0..3 {
             if left[x] > 0 && (a == 3 || next[x] < next[a]) {
@@ -112,6 +120,43 @@ pub fn lattice_path(a: [i64; 3], b: [i64; 3], mut mark: impl FnMut([i64; 3])) {
     }
 }
 
+/// The voxels of `grid` that the world-space segment `a → b` passes
+/// through, in order from `a`'s end, under the tie rule: the line
+/// voxelization entry point for callers, the same voxels `line6` sets for
+/// the segment. It is snapped like every input (and clipped only where it
+/// reaches too far to snap), and voxels outside the grid are left out, so
+/// the result is one 6-connected run. A segment within one voxel gives that
+/// voxel (`line6` gives none); a non-finite end point or a segment missing
+/// the grid gives none.
+pub fn segment_voxels(grid: &GridSpec, a: DVec3, b: DVec3) -> Vec<[u32; 3]> {
+    let (a, b) = (grid.to_grid_units(a), grid.to_grid_units(b));
+    if !(a.is_finite() && b.is_finite()) {
+        return Vec::new();
+    }
+    let d = grid.dims();
+    let hi = DVec3::new(d[0] as f64, d[1] as f64, d[2] as f64) + DVec3::ONE;
+    if a.max(b).cmplt(DVec3::splat(-1.0)).any() || a.min(b).cmpgt(hi).any() {
+        return Vec::new();
+    }
+    // Like every input: clipped only where too far out to snap directly.
+    let (p, q) = if a.abs().max_element() > DIRECT_LIMIT_VOXELS || b.abs().max_element() > DIRECT_LIMIT_VOXELS {
+        match clip_segment_to_box(a, b, DVec3::splat(-1.0), hi) {
+            Some(pq) => pq,
+            None => return Vec::new(),
+        }
+    } else {
+        (a, b)
+    };
+    let s = |p: DVec3| [snap(p.x), snap(p.y), snap(p.z)];
+    let mut out = Vec::new();
+    lattice_path(s(p), s(q), |v| {
+        if (0..3).all(|x| v[x] >= 0 && v[x] < d[x] as i64) {
+            out.push(v.map(|c| c as u32));
+        }
+    });
+    out
+}
+
 /// `M[a] = Π |Δ_b|` over the other axes with non-zero delta (`1` when there
 /// is none): a crossing `t` along axis `a` is `dist / |Δ_a|`, which times
 /// `Π |Δ|` is `dist · M[a]`, an integer.
@@ -149,6 +194,38 @@ mod tests {
     fn diagonal_ties_go_to_the_lowest_axis() {
         assert_eq!(collect_voxel_line([0, 0, 0], [1, 1, 0]), vec![[0, 0, 0], [1, 0, 0], [1, 1, 0]]);
         assert_eq!(collect_voxel_line([0, 0, 0], [1, 1, 1]), vec![[0, 0, 0], [1, 0, 0], [1, 1, 0], [1, 1, 1]]);
+    }
+
+    #[test]
+    fn world_segments_walk_the_voxels_line6_sets() {
+        let grid = GridSpec::new(DVec3::new(-1.0, 0.5, 2.0), 0.5, [9, 7, 8]).unwrap();
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut r = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x % 10_000) as f64 / 10_000.0
+        };
+        for _ in 0..300 {
+            let mut p = || DVec3::new(-1.5 + 5.5 * r(), 0.0 + 4.5 * r(), 1.5 + 5.0 * r());
+            let (a, b) = (p(), p());
+            let path = segment_voxels(&grid, a, b);
+            let mesh = crate::mesh::Mesh { positions: vec![a, b], triangles: vec![], segments: vec![[0, 1]] };
+            let (bits, _) = crate::voxelize::line::reference::line(mesh.as_ref(), &grid, crate::voxelize::line::LineTarget::Surface6);
+            let mut want = Vec::new();
+            bits.for_each_set(|i, j, k| want.push([i, j, k]));
+            let mut got = path.clone();
+            got.sort();
+            want.sort();
+            if got.len() == 1 && want.is_empty() {
+                continue; // inside one voxel: line6 sets nothing, the path is that voxel
+            }
+            assert_eq!(got, want, "{a} -> {b}");
+            let steps_ok = path.windows(2).all(|w| (0..3).map(|x| (w[1][x] as i64 - w[0][x] as i64).abs()).sum::<i64>() == 1);
+            assert!(steps_ok, "not 6-connected: {path:?}");
+        }
+        assert!(segment_voxels(&grid, DVec3::splat(f64::NAN), DVec3::ONE).is_empty());
+        assert!(segment_voxels(&grid, DVec3::splat(100.0), DVec3::splat(101.0)).is_empty());
     }
 
     proptest! {

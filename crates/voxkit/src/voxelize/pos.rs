@@ -71,16 +71,16 @@ fn pos_triangle(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], out: &mut imp
             out.set(p[0] as u32, p[1] as u32, p[2] as u32);
         }
     };
-    // Deviation 1: the voxel containing each snapped vertex.
+    // Deviation: (1) the voxel containing each snapped vertex.
     let v = tri.v.map(voxel_of);
-    // Deviation 2: the axis of largest spread.
+    // Deviation: (2) the axis of largest spread.
     let spread = |a: usize| v.iter().map(|p| p[a]).max().unwrap_or(0) - v.iter().map(|p| p[a]).min().unwrap_or(0);
     let axis = (0..3).fold(0, |best, a| if spread(a) > spread(best) { a } else { best });
     let mut order = [0usize, 1, 2];
     order.sort_by_key(|&i| v[i][axis]);
     let [p0, p1, p2] = order.map(|i| v[i]);
 
-    // Edges. Deviation 4: Q1 is the chain P0→P1→P2, P1 once.
+    // Edges. Deviation: (4) Q1 is the chain P0→P1→P2, P1 once.
     let mut q1 = Vec::new();
     voxel_line(p0, p1, |p| q1.push(p));
     voxel_line(p1, p2, |p| {
@@ -100,10 +100,10 @@ fn pos_triangle(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], out: &mut imp
     for layer in p0[axis]..=p2[axis] {
         let run = |q: &[[i64; 3]], from: usize| q[from..].iter().take_while(|p| p[axis] == layer).count();
         let (n1, n2) = (run(&q1, a), run(&q2, b));
-        // Deviation 6: the slice is the voxel layer; scanlines stay in it.
+        // Deviation: (6) the slice is the voxel layer; scanlines stay in it.
         if lo[axis] <= layer && layer <= hi[axis] && n1 > 0 && n2 > 0 {
             for t in 0..n1.max(n2) {
-                // Deviation 5: an exhausted sub-sequence repeats its last voxel.
+                // Deviation: (5) an exhausted sub-sequence repeats its last voxel.
                 let start = q1[a + t.min(n1 - 1)];
                 let stop = q2[b + t.min(n2 - 1)];
                 let misses = (0..3).any(|x| start[x].max(stop[x]) < lo[x] || start[x].min(stop[x]) > hi[x]);
