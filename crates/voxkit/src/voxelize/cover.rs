@@ -535,16 +535,17 @@ fn interior_runs<T: PlaneInt, O: Sink, const W: usize>(
         }
         return;
     }
-    // Plane values relative to the setup's origin: base = n_v·(iv − o_v) − n_u·o_u,
-    // g(u, t) = base + n_u·u + n_w·(t − o_w) + d.
+    // Plane values relative to the setup's origin `o` (as in `PlaneRange`,
+    // so they stay in `T`): with u' = u − o_u,
+    // g(u', t) = n_u·u' + n_v·(iv − o_v) + n_w·(t − o_w) + d.
     let o = s.origin;
-    let base = s.n[v] * T::from_i64(iv - o[v]) - s.n[u] * T::from_i64(o[u]);
+    let base = s.n[v] * T::from_i64(iv - o[v]);
     let nu = s.n[u];
     for t in tmin..=tmax {
         let k = base + s.n[w] * T::from_i64(t - o[w]);
-        // n_u·u >= -(k + d_max)  and  n_u·u <= -(k + d_min).
+        // n_u·u' >= -(k + d_max)  and  n_u·u' <= -(k + d_min).
         let (lo_rhs, hi_rhs) = (-(k + s.d_max), -(k + s.d_min));
-        let (mut ua, mut ub) = (i0, i1);
+        let (mut ua, mut ub) = (i0 - o[u], i1 - o[u]);
         if nu > T::ZERO {
             ua = ua.max(ceil_div(lo_rhs, nu));
             ub = ub.min(floor_div(hi_rhs, nu));
@@ -554,6 +555,7 @@ fn interior_runs<T: PlaneInt, O: Sink, const W: usize>(
         } else if lo_rhs > T::ZERO || hi_rhs < T::ZERO {
             continue;
         }
+        let (ua, ub) = (ua + o[u], ub + o[u]);
         if ua <= ub {
             run::<O, W>(out, u, ua, iv, t, ub - ua + 1);
         }
@@ -688,5 +690,51 @@ mod tests {
         assert_eq!(f, s);
         assert!(f.get(0, 0, 1) && f.get(0, 0, 2));
         assert!(!f.get(0, 0, 0) && !f.get(0, 0, 3));
+    }
+
+    /// Collects emitted voxels (runs expanded), for calling a traversal
+    /// directly on boxes no grid has to hold.
+    #[derive(Default)]
+    struct Collect(Vec<[i64; 3]>);
+
+    impl Sink for Collect {
+        fn set(&mut self, i: u32, j: u32, k: u32) {
+            self.0.push([i as i64, j as i64, k as i64]);
+        }
+    }
+
+    #[test]
+    fn row_runs_far_from_the_origin_stay_exact() {
+        // Large shallow triangles (row runs along u) near voxel 60 000 on
+        // each axis: the plane values must stay relative to the box, or
+        // n_u·u overflows i64.
+        let far = 60_000i64;
+        for axis in 0..3 {
+            for slope in [0i64, 1, 3] {
+                let (u, v, w) = ((axis + 1) % 3, (axis + 2) % 3, axis);
+                let mut pts = [[0i64; 3]; 3];
+                for (p, (a, b)) in pts.iter_mut().zip([(0i64, 0i64), (120, 15), (8, 117)]) {
+                    p[u] = (far + a) * ONE + 1234;
+                    p[v] = (far + b) * ONE + 77;
+                    p[w] = (far + 40) * ONE + slope * a * ONE / 10 + 555;
+                }
+                let t = LatticeTriangle { v: pts };
+                let (blo, bhi) = t.bounds();
+                let lo: [i64; 3] = std::array::from_fn(|a| crate::geom::fixed::voxel_span(blo[a], bhi[a]).0);
+                let hi: [i64; 3] = std::array::from_fn(|a| crate::geom::fixed::voxel_span(blo[a], bhi[a]).1);
+                let mut got = Collect::default();
+                cover_triangle_runs(&t, lo, hi, &mut got);
+                let mut want = Collect::default();
+                cover_triangle(&t, lo, hi, Traversal::WalkRows, &mut want);
+                got.0.sort();
+                want.0.sort();
+                assert_eq!(got.0.len(), want.0.len(), "axis {axis} slope {slope}");
+                assert!(got.0 == want.0, "axis {axis} slope {slope}");
+                // Spot-check the definition on a sample of the box.
+                for (n, ijk) in got.0.iter().enumerate().step_by(97) {
+                    assert!(reference::triangle_box_overlap(&t, *ijk), "{n}: {ijk:?}");
+                }
+            }
+        }
     }
 }
