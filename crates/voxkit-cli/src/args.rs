@@ -27,6 +27,8 @@ pub enum Command {
     /// missing and extra, and whether `check` certifies 6-separation (the
     /// gap table of the published `pos` algorithm).
     Gaps(GapsArgs),
+    /// Render a voxel file or a mesh to a PNG picture (CPU ray casting).
+    Render(RenderArgs),
 }
 
 /// Voxelization modes.
@@ -129,6 +131,11 @@ pub struct VoxelizeArgs {
     /// Output format: npy, npy-bool, binvox, vox, txt (default: from the extension).
     #[arg(long, value_name = "FORMAT")]
     pub format: Option<String>,
+    /// Also render the result to this PNG (see `voxkit render` for --view, --size, --up).
+    #[arg(long, value_name = "PNG")]
+    pub preview: Option<PathBuf>,
+    #[command(flatten)]
+    pub picture: PictureArgs,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
@@ -138,6 +145,42 @@ pub struct VoxelizeArgs {
     /// No progress bar and no summary line.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+/// How a picture is taken.
+#[derive(Args, Debug, Clone)]
+pub struct PictureArgs {
+    /// Camera: iso, x, y, z (from that axis's positive side), or AZIMUTH,ELEVATION in degrees.
+    #[arg(long, default_value = "iso", value_name = "VIEW")]
+    pub view: String,
+    /// Picture size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768", value_name = "WxH")]
+    pub size: String,
+    /// The world axis drawn pointing up: x, y or z (OBJ and glTF models are usually y-up).
+    #[arg(long, default_value = "y", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
+    pub up: String,
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// A voxel file (.npy, .binvox, .vox, .txt) or a mesh (voxelized first, with --mode and the grid options).
+    pub input: PathBuf,
+    /// Output picture (.png).
+    #[arg(short, long, value_name = "PNG")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub picture: PictureArgs,
+    /// For a mesh: the surface mode to voxelize with.
+    #[arg(long, value_enum, default_value = "cover")]
+    pub mode: Mode,
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Args, Debug)]

@@ -18,6 +18,7 @@ pub mod mesh_report;
 pub mod npy;
 pub mod obj;
 pub mod ply;
+pub mod png;
 pub mod polyline;
 pub mod stl;
 pub mod text;
@@ -27,6 +28,7 @@ use std::path::Path;
 
 pub use error::{ErrorKind, IoError};
 pub use mesh_report::{LoadedMesh, MeshReport};
+pub use png::write_png;
 use voxkit::{DenseBits, GridSpec, VoxelSource};
 
 /// Mesh file formats voxkit reads.

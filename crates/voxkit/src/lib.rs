@@ -28,6 +28,7 @@ pub use glam;
 pub mod geom;
 pub mod grid;
 pub mod mesh;
+pub mod render;
 pub mod topology;
 pub mod voxelize;
 

@@ -4,5 +4,6 @@ pub mod bench;
 pub mod check;
 pub mod gaps;
 pub mod info;
+pub mod render;
 pub mod solid;
 pub mod voxelize;

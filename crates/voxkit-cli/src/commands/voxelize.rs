@@ -35,6 +35,13 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
         })?,
     };
     check_output_dir(&a.output)?;
+    let preview = match &a.preview {
+        Some(p) => {
+            crate::commands::render::check_png_path(p)?;
+            Some((p, crate::commands::render::options(&a.picture)?))
+        }
+        None => None,
+    };
     let pool = crate::thread_pool(a.threads)?;
     let threads = pool.current_num_threads();
 
@@ -105,6 +112,10 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let t_write = Instant::now();
     voxkit_io::write_voxels(&a.output, format, bits.as_ref(), &grid)?;
     let write_s = t_write.elapsed().as_secs_f64();
+    if let Some((path, o)) = &preview {
+        bar.phase("rendering the preview");
+        pool.install(|| crate::commands::render::picture(bits.as_ref(), path, o))?;
+    }
     bar.finish();
     let total_s = t_total.elapsed().as_secs_f64();
 
@@ -125,6 +136,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
             "voxelize_s": voxelize_s,
             "load_s": load_s,
             "write_s": write_s,
+            "preview": a.preview,
             "total_s": total_s,
             "threads": threads,
             "input": a.mesh.display().to_string(),
@@ -175,7 +187,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     Ok(())
 }
 
-fn check_output_dir(out: &Path) -> Result<()> {
+pub(crate) fn check_output_dir(out: &Path) -> Result<()> {
     let dir = match out.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),

@@ -89,6 +89,28 @@ impl BrickBits {
         self.bricks[id][(k & 7) as usize] |= 1u64 << (((j & 7) << 3) | (i & 7));
     }
 
+    /// Bricks along x, y, z.
+    pub fn brick_dims(&self) -> [u32; 3] {
+        self.bdims
+    }
+
+    /// Brick `(bi, bj, bk)` (word `z & 7`, bit `(y & 7) * 8 + (x & 7)`), or
+    /// `None` where no voxel of it is set.
+    #[inline]
+    pub fn brick(&self, bi: u32, bj: u32, bk: u32) -> Option<&Brick> {
+        match self.index[((bk * self.bdims[1] + bj) * self.bdims[0] + bi) as usize] {
+            0 => None,
+            id => Some(&self.bricks[id as usize - 1]),
+        }
+    }
+
+    /// The same voxels as any voxel source, in bricks.
+    pub fn from_source(src: &dyn VoxelSource) -> BrickBits {
+        let mut b = BrickBits::new(src.dims());
+        src.for_each_set(&mut |i, j, k| b.set(i, j, k));
+        b
+    }
+
     /// Number of set voxels.
     pub fn count(&self) -> u64 {
         self.bricks.par_chunks(1 << 13).map(|c| super::count_bits(c.iter().flatten())).sum()

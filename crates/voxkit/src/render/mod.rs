@@ -1,0 +1,3 @@
+//! Pictures of results: [`raycast`], a headless CPU renderer of voxel grids.
+
+pub mod raycast;

@@ -1,0 +1,377 @@
+//! Pictures of voxel grids without a GPU: orthographic ray casting through
+//! the bricks and then the voxels with a two-level 3D DDA, Blinn–Phong
+//! shading with one key light and an ambient term, and gamma.
+//!
+//! This work is based on: J. Amanatides, A. Woo, "A Fast Voxel Traversal
+//! Algorithm for Ray Tracing", Eurographics 1987 (the DDA: per axis the ray
+//! parameter of the next cell boundary, step along the smallest), and J. F.
+//! Blinn, "Models of Light Reflection for Computer Synthesized Pictures",
+//! SIGGRAPH 1977 (the half-vector specular term).
+//!
+//! **Guarantee.** Each pixel shows the first set voxel its ray enters (the
+//! voxel, not an approximation: the DDA visits every cell the ray passes
+//! through, in order), shaded by the face it enters through. Empty 8×8×8
+//! bricks are crossed in one step. The result depends only on the voxels,
+//! the options and the image size, not on the thread count.
+//!
+//! **Reference:** [`reference::first_hit`], the entry parameter of every set
+//! voxel's box by the slab test, minimum taken; the tests compare it with
+//! [`first_hit`] on random grids and rays.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::grid::bricks::{BrickBits, BRICK};
+
+/// Where the camera looks from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum View {
+    /// Azimuth 45°, elevation 35.26°: the three visible faces of a cube equally lit.
+    Iso,
+    /// From the positive side of axis 0, 1 or 2, looking back along it.
+    Axis(usize),
+    /// Azimuth and elevation in degrees, around the up axis (azimuth 0 looks
+    /// from the "front" axis, the one after `up`; 90 from the one after that).
+    Angles(f64, f64),
+}
+
+/// What to draw.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderOptions {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Camera direction.
+    pub view: View,
+    /// The world axis drawn pointing up (0, 1 or 2).
+    pub up: usize,
+    /// Linear RGB of the voxels.
+    pub colour: [f64; 3],
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions { width: 1024, height: 768, view: View::Iso, up: 1, colour: [0.62, 0.55, 0.46] }
+    }
+}
+
+/// An 8-bit sRGB image, rows top to bottom.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width · height · 3` bytes.
+    pub rgb: Vec<u8>,
+    /// Pixels that show a voxel.
+    pub covered: u64,
+}
+
+/// The first set voxel along a ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter where the ray enters the voxel.
+    pub t: f64,
+    /// The voxel.
+    pub voxel: [u32; 3],
+    /// The axis of the face it enters through.
+    pub axis: usize,
+}
+
+/// The camera: orthographic, framing the grid's bounding sphere.
+struct Camera {
+    forward: DVec3,
+    right: DVec3,
+    up: DVec3,
+    centre: DVec3,
+    radius: f64,
+    scale: f64,
+}
+
+fn unit(a: usize) -> DVec3 {
+    let mut v = DVec3::ZERO;
+    v[a] = 1.0;
+    v
+}
+
+impl Camera {
+    fn new(dims: [u32; 3], o: &RenderOptions) -> Camera {
+        let up_axis = o.up.min(2);
+        let (front, side) = (unit((up_axis + 1) % 3), unit((up_axis + 2) % 3));
+        let world_up = unit(up_axis);
+        let towards_camera = match o.view {
+            View::Axis(a) => unit(a.min(2)),
+            View::Iso => angles(front, side, world_up, 45.0, 35.264_389_682_754_654),
+            View::Angles(az, el) => angles(front, side, world_up, az, el),
+        };
+        let forward = -towards_camera.normalize();
+        // Image "up": the world up projected onto the image plane, or the
+        // front axis when looking straight along the up axis.
+        let reference_up = if forward.dot(world_up).abs() > 0.999 { front } else { world_up };
+        let right = forward.cross(reference_up).normalize();
+        let up = right.cross(forward).normalize();
+        let size = DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64);
+        let radius = 0.5 * size.length().max(1.0);
+        let scale = 2.0 * radius * 1.02 / o.width.min(o.height).max(1) as f64;
+        Camera { forward, right, up, centre: size * 0.5, radius, scale }
+    }
+
+    /// The ray through the centre of pixel `(x, y)` (row 0 at the top).
+    fn ray(&self, x: u32, y: u32, w: u32, h: u32) -> (DVec3, DVec3) {
+        let sx = (x as f64 + 0.5 - w as f64 * 0.5) * self.scale;
+        let sy = (h as f64 * 0.5 - y as f64 - 0.5) * self.scale;
+        let origin = self.centre + self.right * sx + self.up * sy - self.forward * (self.radius + 1.0);
+        (origin, self.forward)
+    }
+}
+
+fn angles(front: DVec3, side: DVec3, up: DVec3, az: f64, el: f64) -> DVec3 {
+    let (az, el) = (az.to_radians(), el.to_radians());
+    (front * az.cos() + side * az.sin()) * el.cos() + up * el.sin()
+}
+
+/// Renders `bits` (rows of pixels in parallel).
+pub fn render(bits: &BrickBits, o: &RenderOptions) -> Image {
+    let (w, h) = (o.width.max(1), o.height.max(1));
+    let cam = Camera::new(bits.dims(), o);
+    // Key light from the upper left, in front of the surface; view vector
+    // towards the camera.
+    let light = (-cam.forward * 0.55 + cam.up * 0.65 - cam.right * 0.5).normalize();
+    let view = -cam.forward;
+    let half = (light + view).normalize();
+    let background = [0.86, 0.87, 0.89];
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
+    let covered: u64 = rgb
+        .par_chunks_mut(w as usize * 3)
+        .enumerate()
+        .map(|(y, row)| {
+            let mut n = 0;
+            for x in 0..w {
+                let (origin, dir) = cam.ray(x, y as u32, w, h);
+                let lin = match first_hit(bits, origin, dir) {
+                    Some(hit) => {
+                        n += 1;
+                        // The face entered through faces against the ray.
+                        let mut normal = unit(hit.axis);
+                        if dir[hit.axis] > 0.0 {
+                            normal = -normal;
+                        }
+                        let diffuse = normal.dot(light).max(0.0);
+                        let specular = normal.dot(half).max(0.0).powi(32) * 0.25;
+                        o.colour.map(|c| c * (0.22 + 0.78 * diffuse) + specular)
+                    }
+                    None => background,
+                };
+                for (c, v) in row[x as usize * 3..x as usize * 3 + 3].iter_mut().zip(lin) {
+                    *c = (v.clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0).round() as u8;
+                }
+            }
+            n
+        })
+        .sum();
+    Image { width: w, height: h, rgb, covered }
+}
+
+/// The ray `origin + t·dir` clipped to the grid box: `(t_in, t_out, axis of
+/// the entry face)`, or `None` if it misses.
+fn clip_to_box(dims: [u32; 3], origin: DVec3, dir: DVec3) -> Option<(f64, f64, usize)> {
+    let (mut t0, mut t1, mut axis) = (0.0f64, f64::INFINITY, 0);
+    for a in 0..3 {
+        let hi = dims[a] as f64;
+        if dir[a] == 0.0 {
+            if origin[a] < 0.0 || origin[a] > hi {
+                return None;
+            }
+            continue;
+        }
+        let (mut a0, mut a1) = ((0.0 - origin[a]) / dir[a], (hi - origin[a]) / dir[a]);
+        if a0 > a1 {
+            std::mem::swap(&mut a0, &mut a1);
+        }
+        if a0 > t0 {
+            t0 = a0;
+            axis = a;
+        }
+        t1 = t1.min(a1);
+    }
+    (t0 <= t1).then_some((t0, t1, axis))
+}
+
+/// One level of the DDA: visits, in order, the cells of size `size` that the
+/// ray crosses between `t_in` and `t_out`, within the inclusive cell range
+/// `[lo, hi]`, with the parameter where it enters each and the axis of the
+/// face it enters through. Stops at the first `Some` of `visit`.
+fn walk<T>(
+    origin: DVec3,
+    dir: DVec3,
+    (t_in, t_out, entry_axis): (f64, f64, usize),
+    size: f64,
+    (lo, hi): ([i64; 3], [i64; 3]),
+    mut visit: impl FnMut([i64; 3], (f64, f64, usize)) -> Option<T>,
+) -> Option<T> {
+    let p = origin + dir * t_in;
+    let mut cell = [0i64; 3];
+    let mut next = [f64::INFINITY; 3];
+    let mut delta = [f64::INFINITY; 3];
+    let mut step = [0i64; 3];
+    for a in 0..3 {
+        cell[a] = ((p[a] / size).floor() as i64).clamp(lo[a], hi[a]);
+        if dir[a] > 0.0 {
+            step[a] = 1;
+            next[a] = ((cell[a] + 1) as f64 * size - origin[a]) / dir[a];
+            delta[a] = size / dir[a];
+        } else if dir[a] < 0.0 {
+            step[a] = -1;
+            next[a] = (cell[a] as f64 * size - origin[a]) / dir[a];
+            delta[a] = -size / dir[a];
+        }
+    }
+    let (mut t, mut axis) = (t_in, entry_axis);
+    loop {
+        let a = if next[0] <= next[1] && next[0] <= next[2] {
+            0
+        } else if next[1] <= next[2] {
+            1
+        } else {
+            2
+        };
+        let leave = next[a].min(t_out);
+        if let Some(r) = visit(cell, (t, leave, axis)) {
+            return Some(r);
+        }
+        if next[a] >= t_out {
+            return None;
+        }
+        cell[a] += step[a];
+        if cell[a] < lo[a] || cell[a] > hi[a] {
+            return None;
+        }
+        t = next[a];
+        axis = a;
+        next[a] += delta[a];
+    }
+}
+
+/// The first set voxel along `origin + t·dir` (`t >= 0`), in voxel units
+/// (voxel `(i, j, k)` is the box `[i, i+1] × [j, j+1] × [k, k+1]`).
+pub fn first_hit(bits: &BrickBits, origin: DVec3, dir: DVec3) -> Option<Hit> {
+    let dims = bits.dims();
+    let span = clip_to_box(dims, origin, dir)?;
+    let b = BRICK as i64;
+    let bd = bits.brick_dims().map(|c| c as i64 - 1);
+    let vd = dims.map(|c| c as i64 - 1);
+    walk(origin, dir, span, BRICK as f64, ([0; 3], bd), |bc, (t0, t1, axis)| {
+        let brick = bits.brick(bc[0] as u32, bc[1] as u32, bc[2] as u32)?;
+        let lo = bc.map(|c| c * b);
+        let hi: [i64; 3] = std::array::from_fn(|a| (lo[a] + b - 1).min(vd[a]));
+        walk(origin, dir, (t0, t1, axis), 1.0, (lo, hi), |v, (t, _, axis)| {
+            let (x, y, z) = (v[0] as u32 & 7, v[1] as u32 & 7, v[2] as u32 & 7);
+            ((brick[z as usize] >> (y * 8 + x)) & 1 == 1).then_some(Hit { t, voxel: v.map(|c| c as u32), axis })
+        })
+    })
+}
+
+/// The slow, obviously correct first hit.
+pub mod reference {
+    use super::*;
+
+    /// The set voxel whose box the ray enters first (ties: the first in
+    /// `k`, `j`, `i` order), by the slab test against every set voxel.
+    pub fn first_hit(bits: &BrickBits, origin: DVec3, dir: DVec3) -> Option<([u32; 3], f64)> {
+        let mut best: Option<([u32; 3], f64)> = None;
+        bits.for_each_set(|i, j, k| {
+            let lo = DVec3::new(i as f64, j as f64, k as f64);
+            let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+            for a in 0..3 {
+                if dir[a] == 0.0 {
+                    if origin[a] < lo[a] || origin[a] > lo[a] + 1.0 {
+                        return;
+                    }
+                    continue;
+                }
+                let (p, q) = ((lo[a] - origin[a]) / dir[a], (lo[a] + 1.0 - origin[a]) / dir[a]);
+                t0 = t0.max(p.min(q));
+                t1 = t1.min(p.max(q));
+            }
+            if t0 <= t1 && best.is_none_or(|(_, bt)| t0 < bt) {
+                best = Some(([i, j, k], t0));
+            }
+        });
+        best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(dims: [u32; 3], voxels: &[[u32; 3]]) -> BrickBits {
+        let mut b = BrickBits::new(dims);
+        for v in voxels {
+            b.set(v[0], v[1], v[2]);
+        }
+        b
+    }
+
+    #[test]
+    fn dda_finds_the_same_first_voxel_as_the_slab_test() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut r = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for round in 0..60 {
+            let dims = [5 + (r() % 20) as u32, 5 + (r() % 20) as u32, 5 + (r() % 20) as u32];
+            let n = 1 + r() % 40;
+            let voxels: Vec<[u32; 3]> = (0..n).map(|_| std::array::from_fn(|a| (r() % dims[a] as u64) as u32)).collect();
+            let bits = grid(dims, &voxels);
+            for _ in 0..200 {
+                let f = |r: &mut dyn FnMut() -> u64| (r() % 20_000) as f64 / 1000.0 - 10.0;
+                let origin = DVec3::new(f(&mut r) * 3.0, f(&mut r) * 3.0, f(&mut r) * 3.0);
+                let target = DVec3::new(f(&mut r).abs() * 2.0, f(&mut r).abs() * 2.0, f(&mut r).abs() * 2.0);
+                let dir = (target - origin).normalize();
+                let fast = first_hit(&bits, origin, dir);
+                let slow = reference::first_hit(&bits, origin, dir);
+                match (fast, slow) {
+                    (None, None) => {}
+                    (Some(h), Some((v, t))) => {
+                        // Rays through a shared edge or corner may report a
+                        // different voxel at the same parameter.
+                        assert!((h.t - t).abs() < 1e-9, "round {round}: t {} vs {t} ({:?} vs {v:?})", h.t, h.voxel);
+                    }
+                    (a, b) => panic!("round {round}: {a:?} vs {b:?} ({origin} {dir})"),
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn one_voxel_in_the_middle_of_the_picture() {
+        let bits = grid([3, 3, 3], &[[1, 1, 1]]);
+        for view in [View::Iso, View::Axis(0), View::Axis(1), View::Axis(2), View::Angles(200.0, -30.0)] {
+            let img = render(&bits, &RenderOptions { width: 64, height: 48, view, ..RenderOptions::default() });
+            assert_eq!(img.rgb.len(), 64 * 48 * 3);
+            let px = |x: usize, y: usize| &img.rgb[(y * 64 + x) * 3..(y * 64 + x) * 3 + 3];
+            assert_ne!(px(32, 24), px(0, 0), "{view:?}: centre shows the voxel");
+            assert_eq!(px(0, 0), px(63, 47), "{view:?}: corners show the background");
+            assert!(img.covered > 0 && img.covered < 64 * 48 / 4, "{view:?}: {}", img.covered);
+        }
+    }
+
+    #[test]
+    fn lit_faces_differ_and_the_picture_is_deterministic() {
+        let bits = grid([4, 4, 4], &[[1, 1, 1], [2, 1, 1], [1, 2, 1], [1, 1, 2]]);
+        let o = RenderOptions { width: 80, height: 60, ..RenderOptions::default() };
+        let a = render(&bits, &o);
+        let b = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(|| render(&bits, &o));
+        assert_eq!(a, b);
+        let mut shades: Vec<&[u8]> = a.rgb.chunks(3).collect();
+        shades.sort();
+        shades.dedup();
+        assert!(shades.len() >= 4, "background and three face shades: {}", shades.len());
+    }
+}
