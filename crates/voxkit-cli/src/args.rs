@@ -29,6 +29,8 @@ pub enum Command {
     Gaps(GapsArgs),
     /// Render a voxel file or a mesh to a PNG picture (CPU ray casting).
     Render(RenderArgs),
+    /// Convert a voxel file to another voxel format.
+    Convert(ConvertArgs),
 }
 
 /// Voxelization modes.
@@ -256,6 +258,26 @@ pub struct GapsArgs {
     #[arg(long, value_delimiter = ',', default_value = "128,256,512,1024")]
     pub resolutions: Vec<u64>,
     /// Print JSON lines instead of a Markdown table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct ConvertArgs {
+    /// Voxel file written by voxkit (.npy, .binvox, .vox, .txt).
+    pub input: PathBuf,
+    /// Output voxel file; the format comes from the extension unless --format is given.
+    pub output: PathBuf,
+    /// Output format: npy, npy-bool, binvox, vox, txt (default: from the extension).
+    #[arg(long, value_name = "FORMAT")]
+    pub format: Option<String>,
+    /// Grid origin X,Y,Z for formats that record it (binvox, txt), when the input does not carry it (default 0,0,0).
+    #[arg(long, value_delimiter = ',', value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub origin: Option<Vec<f64>>,
+    /// Voxel size for formats that record it, when the input does not carry it (default 1).
+    #[arg(long, value_name = "S")]
+    pub voxel_size: Option<f64>,
+    /// Print one JSON object on stdout instead of the summary line.
     #[arg(long)]
     pub json: bool,
 }

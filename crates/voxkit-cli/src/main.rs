@@ -29,6 +29,7 @@ fn main() -> ExitCode {
         Command::Check(a) => commands::check::run(a),
         Command::Gaps(a) => commands::gaps::run(a),
         Command::Render(a) => commands::render::run(a),
+        Command::Convert(a) => commands::convert::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -374,3 +374,29 @@ fn render_draws_voxel_files_and_meshes_and_voxelize_previews() {
         assert!(line.contains(expect), "{args:?}: {line}");
     }
 }
+
+#[test]
+fn convert_round_trips_every_voxel_format() {
+    let npy = tmp("c.npy");
+    json(&voxkit(&["voxelize", &shared("cow.obj"), "-o", &npy, "--resolution", "40", "--json"]));
+    let want = std::fs::read(&npy).unwrap();
+    // npy -> every format -> npy gives the same bytes back (binvox pads to a
+    // cube, so it goes last with explicit dims checked separately).
+    for ext in ["txt", "vox", "npy"] {
+        let mid = tmp(&format!("c-mid.{ext}"));
+        let back = tmp(&format!("c-back-{ext}.npy"));
+        let a = json(&voxkit(&["convert", &npy, &mid, "--json"]));
+        let b = json(&voxkit(&["convert", &mid, &back, "--json"]));
+        assert_eq!(a["voxels"], b["voxels"], "{ext}");
+        assert_eq!(std::fs::read(&back).unwrap(), want, "{ext}: npy -> {ext} -> npy changed the voxels");
+    }
+    let bv = tmp("c.binvox");
+    let c = json(&voxkit(&["convert", &npy, &bv, "--origin", "1,-2,3", "--voxel-size", "0.5", "--json"]));
+    assert_eq!(c["grid_from"], "options");
+    let back = json(&voxkit(&["convert", &bv, &tmp("c-bv.txt"), "--json"]));
+    assert_eq!(back["grid_from"], "input");
+    assert_eq!(back["origin"], serde_json::json!([1.0, -2.0, 3.0]));
+    assert_eq!(back["voxels"], c["voxels"]);
+    let line = error_line(&["convert", &npy, &tmp("c.unknown")]);
+    assert!(line.contains("cannot tell the output format"), "{line}");
+}

@@ -151,6 +151,17 @@ impl VoxelFormat {
         }
     }
 
+    /// The `--format` name of this format.
+    pub fn name(self) -> &'static str {
+        match self {
+            VoxelFormat::Npy => "npy",
+            VoxelFormat::NpyBool => "npy-bool",
+            VoxelFormat::Binvox => "binvox",
+            VoxelFormat::Vox => "vox",
+            VoxelFormat::Text => "txt",
+        }
+    }
+
     /// The format for a path's extension.
     pub fn from_path(path: &Path) -> Option<VoxelFormat> {
         VoxelFormat::from_name(path.extension()?.to_str()?)

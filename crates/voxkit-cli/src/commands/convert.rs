@@ -1,0 +1,56 @@
+//! `voxkit convert IN OUT`: a voxel file in another voxel format.
+
+use anyhow::{bail, Context, Result};
+use serde_json::json;
+use voxkit::glam::DVec3;
+use voxkit::GridSpec;
+use voxkit_io::VoxelFormat;
+
+use crate::args::ConvertArgs;
+
+pub fn run(a: &ConvertArgs) -> Result<()> {
+    let format = match &a.format {
+        Some(f) => {
+            VoxelFormat::from_name(f).with_context(|| format!("unknown --format {f:?} (expected one of: {})", VoxelFormat::NAMES))?
+        }
+        None => VoxelFormat::from_path(&a.output).with_context(|| {
+            format!(
+                "{}: cannot tell the output format from the extension (use one of: {}, or --format)",
+                a.output.display(),
+                VoxelFormat::NAMES
+            )
+        })?,
+    };
+    crate::commands::voxelize::check_output_dir(&a.output)?;
+    let loaded = voxkit_io::read_voxels(&a.input)?;
+    let dims = loaded.bits.dims();
+    // The grid: what the input records, else the options, else unit voxels at the origin.
+    let (origin, size, source) = match (loaded.placement, &a.origin, a.voxel_size) {
+        (Some((o, s)), None, None) => (o, s, "input"),
+        (placement, o, s) => {
+            let origin = match o {
+                Some(v) if v.len() == 3 => DVec3::new(v[0], v[1], v[2]),
+                Some(_) => bail!("--origin takes three comma-separated values X,Y,Z"),
+                None => placement.map(|p| p.0).unwrap_or(DVec3::ZERO),
+            };
+            let size = s.or(placement.map(|p| p.1)).unwrap_or(1.0);
+            (origin, size, "options")
+        }
+    };
+    let grid = GridSpec::new(origin, size, dims.map(u64::from)).context("invalid grid")?;
+    voxkit_io::write_voxels(&a.output, format, &loaded.bits, &grid)?;
+    let voxels = loaded.bits.count();
+    if a.json {
+        let o = grid.origin();
+        let v = json!({"input": a.input, "output": a.output, "format": format.name(), "dims": dims, "voxels": voxels,
+            "origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size(), "grid_from": source});
+        return crate::print_stdout(&v.to_string());
+    }
+    crate::print_stdout(&format!(
+        "convert: {voxels} voxels on a {}x{}x{} grid (placement from the {source}) -> {}",
+        dims[0],
+        dims[1],
+        dims[2],
+        a.output.display()
+    ))
+}
