@@ -29,7 +29,7 @@ pub enum Command {
     Gaps(GapsArgs),
     /// Render a voxel file or a mesh to a PNG picture (CPU ray casting).
     Render(RenderArgs),
-    /// Convert a voxel file to another voxel format.
+    /// Convert a voxel file to another voxel format, or to a mesh of the voxels (.obj, greedy quads).
     Convert(ConvertArgs),
 }
 
@@ -266,9 +266,9 @@ pub struct GapsArgs {
 pub struct ConvertArgs {
     /// Voxel file written by voxkit (.npy, .binvox, .vox, .txt).
     pub input: PathBuf,
-    /// Output voxel file; the format comes from the extension unless --format is given.
+    /// Output voxel file, or `.obj` for a mesh of the voxels; the format comes from the extension unless --format is given.
     pub output: PathBuf,
-    /// Output format: npy, npy-bool, binvox, vox, txt (default: from the extension).
+    /// Output format: npy, npy-bool, binvox, vox, txt, or obj (default: from the extension).
     #[arg(long, value_name = "FORMAT")]
     pub format: Option<String>,
     /// Grid origin X,Y,Z for formats that record it (binvox, txt), when the input does not carry it (default 0,0,0).

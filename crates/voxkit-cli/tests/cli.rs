@@ -400,3 +400,37 @@ fn convert_round_trips_every_voxel_format() {
     let line = error_line(&["convert", &npy, &tmp("c.unknown")]);
     assert!(line.contains("cannot tell the output format"), "{line}");
 }
+
+#[test]
+fn convert_to_obj_gives_a_mesh_that_voxelizes_back_to_the_same_voxels() {
+    let npy = tmp("m.npy");
+    let s = json(&voxkit(&["voxelize", &shared("cow.obj"), "-o", &npy, "--mode", "solid", "--resolution", "24", "--json"]));
+    let (o, size, d) = (&s["origin"], s["voxel_size"].as_f64().unwrap(), &s["dims"]);
+    let origin = format!("{},{},{}", o[0], o[1], o[2]);
+    let dims = format!("{},{},{}", d[0], d[1], d[2]);
+    let obj = tmp("m.obj");
+    let size_s = size.to_string();
+    let c = json(&voxkit(&["convert", &npy, &obj, "--origin", &origin, "--voxel-size", &size_s, "--json"]));
+    assert!(c["quads"].as_u64().unwrap() > 6);
+    let back = tmp("m-back.npy");
+    let args = [
+        "voxelize",
+        &obj,
+        "-o",
+        &back,
+        "--mode",
+        "solid",
+        "--method",
+        "parity",
+        "--origin",
+        &origin,
+        "--voxel-size",
+        &size_s,
+        "--dims",
+        &dims,
+        "--json",
+    ];
+    let b = json(&voxkit(&args));
+    assert_eq!(b["voxels"], s["voxels"]);
+    assert_eq!(std::fs::read(&back).unwrap(), std::fs::read(&npy).unwrap(), "the mesh of the voxels does not bound the same voxels");
+}

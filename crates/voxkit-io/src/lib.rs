@@ -23,6 +23,7 @@ pub mod polyline;
 pub mod stl;
 pub mod text;
 pub mod vox;
+pub mod voxel_mesh;
 
 use std::path::Path;
 

@@ -1,0 +1,3 @@
+//! Meshes of voxel results: [`greedy`] quads of the boundary faces.
+
+pub mod greedy;
