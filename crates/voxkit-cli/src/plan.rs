@@ -230,6 +230,21 @@ fn method_name(m: Method) -> &'static str {
     }
 }
 
+/// The voxel format of an output: `--format` if given, else the extension.
+pub fn output_format(format: Option<&str>, output: &std::path::Path) -> Result<voxkit_io::VoxelFormat> {
+    use voxkit_io::VoxelFormat;
+    match format {
+        Some(f) => VoxelFormat::from_name(f).with_context(|| format!("unknown --format {f:?} (expected one of: {})", VoxelFormat::NAMES)),
+        None => VoxelFormat::from_path(output).with_context(|| {
+            format!(
+                "{}: cannot tell the output format from the extension (use one of: {}, or --format)",
+                output.display(),
+                VoxelFormat::NAMES
+            )
+        }),
+    }
+}
+
 /// Memory available to this process, from `/proc/meminfo` (None if unknown).
 pub fn available_memory() -> Option<u64> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;

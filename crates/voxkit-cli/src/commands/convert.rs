@@ -4,9 +4,9 @@ use anyhow::{bail, Context, Result};
 use serde_json::json;
 use voxkit::glam::DVec3;
 use voxkit::GridSpec;
-use voxkit_io::VoxelFormat;
 
 use crate::args::ConvertArgs;
+use crate::plan;
 
 pub fn run(a: &ConvertArgs) -> Result<()> {
     let to_mesh = a.format.as_deref() == Some("obj")
@@ -14,18 +14,7 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
     if to_mesh {
         return mesh_of_voxels(a);
     }
-    let format = match &a.format {
-        Some(f) => {
-            VoxelFormat::from_name(f).with_context(|| format!("unknown --format {f:?} (expected one of: {})", VoxelFormat::NAMES))?
-        }
-        None => VoxelFormat::from_path(&a.output).with_context(|| {
-            format!(
-                "{}: cannot tell the output format from the extension (use one of: {}, or --format)",
-                a.output.display(),
-                VoxelFormat::NAMES
-            )
-        })?,
-    };
+    let format = plan::output_format(a.format.as_deref(), &a.output)?;
     crate::commands::voxelize::check_output_dir(&a.output)?;
     let loaded = voxkit_io::read_voxels(&a.input)?;
     let dims = loaded.bits.dims();

@@ -3,11 +3,10 @@
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use serde_json::json;
 use voxkit::voxelize::{self, Options};
 use voxkit::VoxelSource;
-use voxkit_io::VoxelFormat;
 
 use crate::args::VoxelizeArgs;
 use crate::plan::{self, GridRequest};
@@ -22,18 +21,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
         Some(_) => (voxelize::Mode::Cover, plan::SurfaceMethod::Fast),
         None => plan::resolve_method(a.mode, a.method)?,
     };
-    let format = match &a.format {
-        Some(f) => {
-            VoxelFormat::from_name(f).with_context(|| format!("unknown --format {f:?} (expected one of: {})", VoxelFormat::NAMES))?
-        }
-        None => VoxelFormat::from_path(&a.output).with_context(|| {
-            format!(
-                "{}: cannot tell the output format from the extension (use one of: {}, or --format)",
-                a.output.display(),
-                VoxelFormat::NAMES
-            )
-        })?,
-    };
+    let format = plan::output_format(a.format.as_deref(), &a.output)?;
     check_output_dir(&a.output)?;
     let preview = match &a.preview {
         Some(p) => {
