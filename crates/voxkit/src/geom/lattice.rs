@@ -229,37 +229,65 @@ fn push_snapped(a: DVec3, b: DVec3, c: DVec3, dims: [u32; 3], out: &mut Vec<Latt
     out.push(t);
 }
 
+/// A world-space segment on the lattice of a grid, or why it is not.
+pub(crate) enum SnappedSegment {
+    /// A coordinate is NaN or infinite.
+    NonFinite,
+    /// It misses the grid grown by one voxel (`clipped`: found by clipping).
+    Outside { clipped: bool },
+    /// The snapped end points (possibly equal); `clipped` if it reached too
+    /// far to snap directly and was clipped to the grown grid first.
+    Ok { v: [[i64; 3]; 2], clipped: bool },
+}
+
+/// Snaps the segment `a → b` (world space) to `grid`'s lattice, clipping it
+/// to the grid grown by one voxel only where it reaches too far to snap.
+pub(crate) fn snap_segment(grid: &GridSpec, a: DVec3, b: DVec3) -> SnappedSegment {
+    let dims = DVec3::new(grid.dims()[0] as f64, grid.dims()[1] as f64, grid.dims()[2] as f64);
+    let (mut a, mut b) = (grid.to_grid_units(a), grid.to_grid_units(b));
+    if !(a.is_finite() && b.is_finite()) {
+        return SnappedSegment::NonFinite;
+    }
+    if a.max(b).cmplt(DVec3::splat(-1.0)).any() || a.min(b).cmpgt(dims + DVec3::ONE).any() {
+        return SnappedSegment::Outside { clipped: false };
+    }
+    let clipped = a.abs().max_element() > DIRECT_LIMIT_VOXELS || b.abs().max_element() > DIRECT_LIMIT_VOXELS;
+    if clipped {
+        let Some((p, q)) = clip_segment_to_box(a, b, DVec3::splat(-1.0), dims + DVec3::ONE) else {
+            return SnappedSegment::Outside { clipped: true };
+        };
+        (a, b) = (p, q);
+    }
+    let s = |p: DVec3| [snap(p.x), snap(p.y), snap(p.z)];
+    SnappedSegment::Ok { v: [s(a), s(b)], clipped }
+}
+
 /// Snaps every segment of `mesh` to the lattice of `grid`, like [`prepare`]
 /// does for triangles (zero-length segments count as degenerate).
 pub fn prepare_segments(mesh: MeshRef<'_>, grid: &GridSpec) -> (Vec<LatticeSegment>, PrepareStats) {
     let mut st = PrepareStats::default();
     let mut out = Vec::with_capacity(mesh.segments.len());
-    let dims = DVec3::new(grid.dims()[0] as f64, grid.dims()[1] as f64, grid.dims()[2] as f64);
     for seg in mesh.segments {
         st.input += 1;
         let (Some(a), Some(b)) = (mesh.positions.get(seg[0] as usize), mesh.positions.get(seg[1] as usize)) else {
             st.invalid_index += 1;
             continue;
         };
-        let (mut a, mut b) = (grid.to_grid_units(*a), grid.to_grid_units(*b));
-        if !(a.is_finite() && b.is_finite()) {
-            st.non_finite += 1;
-            continue;
-        }
-        if a.max(b).cmplt(DVec3::splat(-1.0)).any() || a.min(b).cmpgt(dims + DVec3::ONE).any() {
-            st.outside += 1;
-            continue;
-        }
-        if a.abs().max_element() > DIRECT_LIMIT_VOXELS || b.abs().max_element() > DIRECT_LIMIT_VOXELS {
-            st.clipped += 1;
-            let Some((p, q)) = clip_segment_to_box(a, b, DVec3::splat(-1.0), dims + DVec3::ONE) else {
+        let l = match snap_segment(grid, *a, *b) {
+            SnappedSegment::NonFinite => {
+                st.non_finite += 1;
+                continue;
+            }
+            SnappedSegment::Outside { clipped } => {
+                st.clipped += clipped as u64;
                 st.outside += 1;
                 continue;
-            };
-            (a, b) = (p, q);
-        }
-        let s = |p: DVec3| [snap(p.x), snap(p.y), snap(p.z)];
-        let l = LatticeSegment { v: [s(a), s(b)] };
+            }
+            SnappedSegment::Ok { v, clipped } => {
+                st.clipped += clipped as u64;
+                LatticeSegment { v }
+            }
+        };
         if l.v[0] == l.v[1] {
             st.degenerate += 1;
         } else if l.voxel_bounds(grid.dims()).is_none() {

@@ -33,8 +33,8 @@
 
 use glam::DVec3;
 
-use crate::geom::clip::clip_segment_to_box;
-use crate::geom::fixed::{snap, DIRECT_LIMIT_VOXELS, ONE};
+use crate::geom::fixed::ONE;
+use crate::geom::lattice::{snap_segment, SnappedSegment};
 use crate::grid::spec::GridSpec;
 
 /// The published ILV walk (`MARKLINEILV`) between voxel indices `p0` and
@@ -129,27 +129,10 @@ pub fn lattice_path(a: [i64; 3], b: [i64; 3], mut mark: impl FnMut([i64; 3])) {
 /// voxel (`line6` gives none); a non-finite end point or a segment missing
 /// the grid gives none.
 pub fn segment_voxels(grid: &GridSpec, a: DVec3, b: DVec3) -> Vec<[u32; 3]> {
-    let (a, b) = (grid.to_grid_units(a), grid.to_grid_units(b));
-    if !(a.is_finite() && b.is_finite()) {
-        return Vec::new();
-    }
+    let SnappedSegment::Ok { v: [p, q], .. } = snap_segment(grid, a, b) else { return Vec::new() };
     let d = grid.dims();
-    let hi = DVec3::new(d[0] as f64, d[1] as f64, d[2] as f64) + DVec3::ONE;
-    if a.max(b).cmplt(DVec3::splat(-1.0)).any() || a.min(b).cmpgt(hi).any() {
-        return Vec::new();
-    }
-    // Like every input: clipped only where too far out to snap directly.
-    let (p, q) = if a.abs().max_element() > DIRECT_LIMIT_VOXELS || b.abs().max_element() > DIRECT_LIMIT_VOXELS {
-        match clip_segment_to_box(a, b, DVec3::splat(-1.0), hi) {
-            Some(pq) => pq,
-            None => return Vec::new(),
-        }
-    } else {
-        (a, b)
-    };
-    let s = |p: DVec3| [snap(p.x), snap(p.y), snap(p.z)];
     let mut out = Vec::new();
-    lattice_path(s(p), s(q), |v| {
+    lattice_path(p, q, |v| {
         if (0..3).all(|x| v[x] >= 0 && v[x] < d[x] as i64) {
             out.push(v.map(|c| c as u32));
         }
