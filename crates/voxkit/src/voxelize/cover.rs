@@ -294,6 +294,7 @@ fn clip3(w: &[Walker; 3], mut lo: i64, mut hi: i64) -> (i64, i64) {
 /// and `g0 = g_max(t0)`, `g1 = g_min(t1)`. Moving one column changes both
 /// by `n_u`, and the range by at most one since `|n_u| <= n_w`, so the
 /// correction loops run a step or two: additions and comparisons only.
+#[derive(Clone, Copy)]
 struct PlaneRange<T> {
     t0: i64,
     t1: i64,
@@ -523,7 +524,7 @@ fn interior_runs<T: PlaneInt, O: Sink, const W: usize>(
         return;
     }
     if 3 * (tmax - tmin + 1) > width {
-        let mut plane = PlaneRange { t0: first.t0, t1: first.t1, g0: first.g0, g1: first.g1 };
+        let mut plane = *first;
         for iu in i0..=i1 {
             let (ta, tb) = (plane.t0.max(c0), plane.t1.min(c1));
             if ta <= tb {
@@ -565,7 +566,7 @@ fn interior_runs<T: PlaneInt, O: Sink, const W: usize>(
 /// Emits `len` voxels from `(u, v, w)` along `axis`; `(u, v, w)` is a cyclic
 /// shift of `(x, y, z)` by `W`.
 #[inline(always)]
-fn run<O: Sink, const W: usize>(out: &mut O, axis: usize, iu: i64, iv: i64, t: i64, len: i64) {
+pub(crate) fn run<O: Sink, const W: usize>(out: &mut O, axis: usize, iu: i64, iv: i64, t: i64, len: i64) {
     let mut p = [0u32; 3];
     (p[(W + 1) % 3], p[(W + 2) % 3], p[W]) = (iu as u32, iv as u32, t as u32);
     out.set_run(axis, p, len as u32);

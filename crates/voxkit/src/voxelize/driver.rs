@@ -63,6 +63,13 @@ impl Sink for BrickSlab<'_> {
     }
 }
 
+impl Sink for crate::grid::dense::DenseBits {
+    #[inline(always)]
+    fn set(&mut self, i: u32, j: u32, k: u32) {
+        crate::grid::dense::DenseBits::set(self, i, j, k);
+    }
+}
+
 /// Passes on to `slab` only the voxels `keep` accepts: a mode whose voxels
 /// are a subset of `cover` runs the `cover` traversal through one of these.
 pub struct Filter<'s, 'b, F> {

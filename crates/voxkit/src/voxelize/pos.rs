@@ -122,14 +122,6 @@ pub mod reference {
     use super::*;
     use crate::grid::dense::DenseBits;
 
-    struct Dense<'a>(&'a mut DenseBits);
-
-    impl Sink for Dense<'_> {
-        fn set(&mut self, i: u32, j: u32, k: u32) {
-            self.0.set(i, j, k);
-        }
-    }
-
     /// `pos` one triangle at a time over the whole grid.
     pub fn pos(mesh: MeshRef<'_>, grid: &GridSpec) -> (DenseBits, Report) {
         let (tris, prepare_stats) = prepare(mesh, grid);
@@ -137,7 +129,7 @@ pub mod reference {
         let mut bits = DenseBits::new(dims);
         let hi = dims.map(|d| d as i64 - 1);
         for t in &tris {
-            pos_triangle(t, [0; 3], hi, &mut Dense(&mut bits));
+            pos_triangle(t, [0; 3], hi, &mut bits);
         }
         let voxels = bits.count();
         (bits, Report { prepare: prepare_stats, voxels })

@@ -47,7 +47,7 @@
 //! thread count. **Reference:** the modes' brute-force references; the
 //! tests compare voxel for voxel.
 
-use super::cover::{cover_triangle_runs, div_floor, edges_2d, set};
+use super::cover::{cover_triangle_runs, div_floor, edges_2d, run, set};
 use super::driver::{run_slabs, Filter, Kernel, Sink};
 use super::targets::{fits_i64, DirSetup, TriSetup, CROSSHAIR, DIAGONALS};
 use super::{Mode, Options, Report};
@@ -221,9 +221,8 @@ fn scan_rows<O: Sink, const W: usize>(tri: &LatticeTriangle, n: [i64; 3], lo: [i
         let mut x0 = 0;
         while x0 <= size[u] {
             let n = (size[u] - x0 + 1).min(LANES as i64) as u32;
-            let keep = if n == 32 { u32::MAX } else { (1u32 << n) - 1 };
             let (outer, inner) = classify(&e0, &ea, &inside_f, x0 as f64);
-            let outer = outer & keep;
+            let outer = outer & ((1u32 << n) - 1);
             if outer == 0 {
                 if started {
                     break;
@@ -244,9 +243,7 @@ fn scan_rows<O: Sink, const W: usize>(tri: &LatticeTriangle, n: [i64; 3], lo: [i
                     if (inner >> (iu - x0)) & 1 == 1 {
                         // Inside the projection the plane test decides: a plane
                         // point in the voxel projects into the triangle. One run.
-                        let mut p = [0u32; 3];
-                        (p[u], p[v], p[w]) = ((iu + lo[u]) as u32, (iv + lo[v]) as u32, (t0 + lo[w]) as u32);
-                        out.set_run(W, p, (t1 - t0 + 1) as u32);
+                        run::<O, W>(out, W, iu + lo[u], iv + lo[v], t0 + lo[w], t1 - t0 + 1);
                     } else {
                         // On its boundary: the (v, w) and (w, u) edge tests per voxel.
                         let rwu: [i64; 3] = std::array::from_fn(|i| wu[i].b * iu + wu[i].c);
@@ -258,14 +255,8 @@ fn scan_rows<O: Sink, const W: usize>(tri: &LatticeTriangle, n: [i64; 3], lo: [i
                         }
                     }
                 }
-                r0 += nu;
-                let s0 = (r0 >= nw) as i64 - (r0 < 0) as i64;
-                f0 += s0;
-                r0 -= s0 * nw;
-                r1 -= nu;
-                let s1 = (r1 >= nw) as i64 - (r1 < 0) as i64;
-                f1 += s1;
-                r1 -= s1 * nw;
+                step_floor(&mut f0, &mut r0, nu, nw);
+                step_floor(&mut f1, &mut r1, -nu, nw);
             }
             if last < x0 + n as i64 - 1 {
                 break;
@@ -273,6 +264,17 @@ fn scan_rows<O: Sink, const W: usize>(tri: &LatticeTriangle, n: [i64; 3], lo: [i
             x0 += LANES as i64;
         }
     }
+}
+
+/// Adds `delta` (`|delta| <= d`) to the numerator of `f = floor(num / d)`
+/// with remainder `r = num − f·d ∈ [0, d)`, keeping both exact without a
+/// division or a branch.
+#[inline(always)]
+fn step_floor(f: &mut i64, r: &mut i64, delta: i64, d: i64) {
+    *r += delta;
+    let s = (*r >= d) as i64 - (*r < 0) as i64;
+    *f += s;
+    *r -= s * d;
 }
 
 /// Columns classified per call of [`classify`].
