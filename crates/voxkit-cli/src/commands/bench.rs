@@ -23,7 +23,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// Runs `f` on each of `items` once per round, `repeats` rounds, so that drifts in the
 /// machine's speed hit every one alike; returns each one's median seconds
 /// and last result.
-fn time_alternating<E, T>(repeats: usize, items: &[E], f: impl Fn(&E) -> T) -> Vec<(f64, T)> {
+fn time_alternating<E, T>(repeats: usize, items: &[E], mut f: impl FnMut(&E) -> T) -> Vec<(f64, T)> {
     let mut times = vec![Vec::with_capacity(repeats); items.len()];
     let mut last: Vec<Option<T>> = items.iter().map(|_| None).collect();
     for _ in 0..repeats.max(1) {
@@ -39,15 +39,7 @@ fn time_alternating<E, T>(repeats: usize, items: &[E], f: impl Fn(&E) -> T) -> V
 
 /// Runs `f` `repeats` times; returns the median seconds and the last result.
 fn time<T>(repeats: usize, mut f: impl FnMut() -> T) -> (f64, T) {
-    let mut times = Vec::with_capacity(repeats);
-    let mut last = None;
-    for _ in 0..repeats.max(1) {
-        let t = Instant::now();
-        let r = f();
-        times.push(t.elapsed().as_secs_f64());
-        last = Some(r);
-    }
-    (median(times), last.expect("at least one repeat"))
+    time_alternating(repeats, &[()], |_| f()).pop().expect("one item")
 }
 
 /// What a benchmark row runs: a surface/line mode by its triangle-box fast
