@@ -130,14 +130,16 @@ pub struct VoxelizeArgs {
     pub hollow: Option<String>,
     #[command(flatten)]
     pub grid: GridArgs,
-    /// Output format: npy, npy-bool, binvox, vox, txt (default: from the extension).
+    /// Output format: npy, npy-bool, binvox, vox, txt, schem, vti, ply, or obj / glb for a mesh of the voxels (default: from the extension).
     #[arg(long, value_name = "FORMAT")]
     pub format: Option<String>,
-    /// Also render the result to this PNG (see `voxkit render` for --view, --size, --up).
+    /// Also render the result to this PNG (see `voxkit render` for --view, --size, --up, --outline).
     #[arg(long, value_name = "PNG")]
     pub preview: Option<PathBuf>,
     #[command(flatten)]
     pub picture: PictureArgs,
+    #[command(flatten)]
+    pub export: ExportArgs,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
@@ -147,6 +149,33 @@ pub struct VoxelizeArgs {
     /// No progress bar and no summary line.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+/// Colour and attribute options of the writers.
+#[derive(Args, Debug, Clone, Default)]
+pub struct ExportArgs {
+    /// How the colours of the surface inside a voxel combine: `dominant` (the colour covering the most area; never a new colour) or `blend` (area-weighted mean in linear light).
+    #[arg(long, value_enum, default_value = "dominant", value_name = "RULE")]
+    pub colour_rule: ColourRule,
+    /// .vti: also store each voxel's average surface normal.
+    #[arg(long)]
+    pub normals: bool,
+    /// .vox: dither colours onto the 255-colour palette (error diffusion; off by default).
+    #[arg(long)]
+    pub dither: bool,
+    /// .schem: a colour -> block table, `namespace:block R G B` per line (default: the built-in table).
+    #[arg(long, value_name = "FILE")]
+    pub block_palette: Option<PathBuf>,
+}
+
+/// `--colour-rule`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum ColourRule {
+    /// The colour covering the most area.
+    #[default]
+    Dominant,
+    /// The area-weighted mean, in linear light.
+    Blend,
 }
 
 /// How a picture is taken.
@@ -161,6 +190,9 @@ pub struct PictureArgs {
     /// The world axis drawn pointing up: x, y or z (OBJ and glTF models are usually y-up).
     #[arg(long, default_value = "y", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
     pub up: String,
+    /// Draw the outline of the source mesh's silhouette over the voxels (mesh inputs and --preview).
+    #[arg(long)]
+    pub outline: bool,
 }
 
 #[derive(Args, Debug)]
@@ -177,6 +209,9 @@ pub struct RenderArgs {
     pub mode: Mode,
     #[command(flatten)]
     pub grid: GridArgs,
+    /// For a mesh: how surface colours combine in a voxel (dominant or blend).
+    #[arg(long, value_enum, default_value = "dominant", value_name = "RULE")]
+    pub colour_rule: ColourRule,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
@@ -264,13 +299,15 @@ pub struct GapsArgs {
 
 #[derive(Args, Debug)]
 pub struct ConvertArgs {
-    /// Voxel file written by voxkit (.npy, .binvox, .vox, .txt).
+    /// Voxel file written by voxkit (.npy, .binvox, .vox, .txt, .schem, .vti, .ply).
     pub input: PathBuf,
-    /// Output voxel file, or `.obj` for a mesh of the voxels; the format comes from the extension unless --format is given.
+    /// Output voxel file, or `.obj` / `.glb` for a mesh of the voxels; the format comes from the extension unless --format is given.
     pub output: PathBuf,
-    /// Output format: npy, npy-bool, binvox, vox, txt, or obj (default: from the extension).
+    /// Output format: npy, npy-bool, binvox, vox, txt, schem, vti, ply, obj or glb (default: from the extension).
     #[arg(long, value_name = "FORMAT")]
     pub format: Option<String>,
+    #[command(flatten)]
+    pub export: ExportArgs,
     /// Grid origin X,Y,Z for formats that record it (binvox, txt), when the input does not carry it (default 0,0,0).
     #[arg(long, value_delimiter = ',', value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub origin: Option<Vec<f64>>,

@@ -231,17 +231,59 @@ fn method_name(m: Method) -> &'static str {
 }
 
 /// The voxel format of an output: `--format` if given, else the extension.
-pub fn output_format(format: Option<&str>, output: &std::path::Path) -> Result<voxkit_io::VoxelFormat> {
+pub fn output_format(format: Option<&str>, output: &std::path::Path) -> Result<Output> {
     use voxkit_io::VoxelFormat;
+    let parse = |name: &str| match name.to_ascii_lowercase().as_str() {
+        "obj" => Some(Output::Mesh(MeshKind::Obj)),
+        "glb" => Some(Output::Mesh(MeshKind::Glb)),
+        n => VoxelFormat::from_name(n).map(Output::Voxels),
+    };
     match format {
-        Some(f) => VoxelFormat::from_name(f).with_context(|| format!("unknown --format {f:?} (expected one of: {})", VoxelFormat::NAMES)),
-        None => VoxelFormat::from_path(output).with_context(|| {
+        Some(f) => parse(f).with_context(|| format!("unknown --format {f:?} (expected one of: {}, obj, glb)", VoxelFormat::NAMES)),
+        None => output.extension().and_then(|e| e.to_str()).and_then(parse).with_context(|| {
             format!(
-                "{}: cannot tell the output format from the extension (use one of: {}, or --format)",
+                "{}: cannot tell the output format from the extension (use one of: {}, obj, glb, or --format)",
                 output.display(),
                 VoxelFormat::NAMES
             )
         }),
+    }
+}
+
+/// What an output file holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// A voxel format.
+    Voxels(voxkit_io::VoxelFormat),
+    /// A mesh of the voxels (greedy quads).
+    Mesh(MeshKind),
+}
+
+/// Mesh formats for the voxels' boundary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshKind {
+    /// Wavefront OBJ (+ MTL with colours).
+    Obj,
+    /// Binary glTF.
+    Glb,
+}
+
+impl Output {
+    /// The `--format` name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Output::Voxels(f) => f.name(),
+            Output::Mesh(MeshKind::Obj) => "obj",
+            Output::Mesh(MeshKind::Glb) => "glb",
+        }
+    }
+
+    /// True when the output stores colours.
+    pub fn has_colour(self) -> bool {
+        match self {
+            Output::Voxels(f) => f.has_colour(),
+            Output::Mesh(_) => true,
+        }
     }
 }
 

@@ -170,5 +170,5 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if idx != total {
         return Err(bad(format!("data covers {idx} of {total} voxels (truncated?)")));
     }
-    Ok(LoadedVoxels { bits, placement: Some((translate, scale / d as f64)) })
+    Ok(LoadedVoxels { bits, placement: Some((translate, scale / d as f64)), attributes: None })
 }

@@ -9,7 +9,11 @@
 use std::path::Path;
 
 use glam::{DMat4, DVec3, Mat4};
+use gltf::image::Format;
 use gltf::mesh::Mode;
+use gltf::texture::WrappingMode;
+use voxkit::attributes::colour::from_linear;
+use voxkit::attributes::{Appearance, Material, Texture, Wrap};
 
 use crate::error::ErrorKind;
 use crate::mesh_report::{finish, LoadedMesh};
@@ -19,6 +23,7 @@ pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKi
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(bytes).map_err(|e| ErrorKind::malformed("glTF", e))?;
     let buffers = gltf::import_buffers(&document, base_dir, blob).map_err(|e| ErrorKind::malformed("glTF", format!("buffer: {e}")))?;
     let mut out = Builder::default();
+    out.materials(&document, &buffers, base_dir);
     let scene = document.default_scene().or_else(|| document.scenes().next());
     match scene {
         Some(scene) => {
@@ -33,7 +38,19 @@ pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKi
             }
         }
     }
-    finish(out.positions, out.triangles, out.warnings)
+    let mut app = out.app;
+    // Only glTF's default material: the file has no colour of its own.
+    if app.materials.len() == 1 {
+        app.triangle_material.clear();
+        app.triangle_uv.clear();
+        app.materials.clear();
+    }
+    if app.vertex_colour.iter().all(|&c| c == [255; 3]) {
+        app.vertex_colour.clear();
+    }
+    let mut loaded = finish(out.positions, out.triangles, out.warnings)?;
+    loaded.appearance = app;
+    Ok(loaded)
 }
 
 #[derive(Default)]
@@ -41,9 +58,70 @@ struct Builder {
     positions: Vec<DVec3>,
     triangles: Vec<[i64; 3]>,
     warnings: Vec<String>,
+    app: Appearance,
+    /// Per glTF material: its texture coordinate set.
+    tex_coord: Vec<u32>,
 }
 
 impl Builder {
+    /// Every material of the document, plus glTF's default material (white, last).
+    fn materials(&mut self, document: &gltf::Document, buffers: &[gltf::buffer::Data], base_dir: Option<&Path>) {
+        let mut decoded: Vec<Option<Option<u32>>> = vec![None; document.textures().len()];
+        for m in document.materials() {
+            let pbr = m.pbr_metallic_roughness();
+            let f = pbr.base_color_factor();
+            let mut texture = None;
+            let mut set = 0;
+            if let Some(info) = pbr.base_color_texture() {
+                set = info.tex_coord();
+                let t = info.texture();
+                texture = *decoded[t.index()].get_or_insert_with(|| match self.texture(&t, buffers, base_dir) {
+                    Ok(tex) => {
+                        self.app.textures.push(tex);
+                        Some(self.app.textures.len() as u32 - 1)
+                    }
+                    Err(e) => {
+                        self.warnings.push(format!("texture {}: {e}; the base colour factor is used instead", t.index()));
+                        None
+                    }
+                });
+            }
+            let name = format!("material {}", m.index().unwrap_or(0));
+            self.app.materials.push(Material { name, factor: [f[0], f[1], f[2]], texture });
+            self.tex_coord.push(set);
+        }
+        self.app.materials.push(Material { name: "default".into(), factor: [1.0; 3], texture: None });
+        self.tex_coord.push(0);
+    }
+
+    fn texture(&self, t: &gltf::Texture<'_>, buffers: &[gltf::buffer::Data], base_dir: Option<&Path>) -> Result<Texture, String> {
+        let wrap = |m: WrappingMode| match m {
+            WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+            WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+            WrappingMode::Repeat => Wrap::Repeat,
+        };
+        let sampler = t.sampler();
+        let wrap = [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())];
+        let data = gltf::image::Data::from_source(t.source().source(), base_dir, buffers).map_err(|e| format!("image could not be loaded ({e})"))?;
+        let n = data.width as usize * data.height as usize;
+        let (step, pick): (usize, fn(&[u8]) -> [u8; 4]) = match data.format {
+            Format::R8 => (1, |p| [p[0], p[0], p[0], 255]),
+            Format::R8G8 => (2, |p| [p[0], p[0], p[0], p[1]]),
+            Format::R8G8B8 => (3, |p| [p[0], p[1], p[2], 255]),
+            Format::R8G8B8A8 => (4, |p| [p[0], p[1], p[2], p[3]]),
+            Format::R16 => (2, |p| [p[1], p[1], p[1], 255]),
+            Format::R16G16 => (4, |p| [p[1], p[1], p[1], p[3]]),
+            Format::R16G16B16 => (6, |p| [p[1], p[3], p[5], 255]),
+            Format::R16G16B16A16 => (8, |p| [p[1], p[3], p[5], p[7]]),
+            f => return Err(format!("{f:?} images are not supported")),
+        };
+        if n == 0 || data.pixels.len() < n * step {
+            return Err(format!("image is {}x{} but has {} bytes", data.width, data.height, data.pixels.len()));
+        }
+        let rgba = data.pixels.chunks_exact(step).take(n).flat_map(pick).collect();
+        Ok(Texture { name: format!("texture {}", t.index()), width: data.width, height: data.height, rgba, wrap })
+    }
+
     fn node(&mut self, node: &gltf::Node<'_>, parent: DMat4, buffers: &[gltf::buffer::Data], depth: usize) -> Result<(), ErrorKind> {
         if depth > 256 {
             return Err(ErrorKind::malformed("glTF", "node hierarchy deeper than 256 (cycle?)"));
@@ -82,6 +160,26 @@ impl Builder {
             let base = self.positions.len() as i64;
             self.positions.extend(pos.map(|p| world.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))));
             let n = self.positions.len() as i64 - base;
+            let material = prim.material().index().unwrap_or(self.app.materials.len() - 1);
+            let set = self.tex_coord.get(material).copied().unwrap_or(0);
+            let uvs: Vec<[f32; 2]> = match prim.get(&gltf::Semantic::TexCoords(set)) {
+                Some(a) => {
+                    check_accessor(&a, buffers, mi)?;
+                    reader.read_tex_coords(set).map(|t| t.into_f32().collect()).unwrap_or_default()
+                }
+                None => Vec::new(),
+            };
+            if let Some(a) = prim.get(&gltf::Semantic::Colors(0)) {
+                check_accessor(&a, buffers, mi)?;
+                if let Some(c) = reader.read_colors(0) {
+                    self.app.vertex_colour.resize(base as usize, [255; 3]);
+                    self.app.vertex_colour.extend(c.into_rgb_f32().map(|c| c.map(|x| from_linear(x as f64))));
+                }
+            }
+            if !self.app.vertex_colour.is_empty() {
+                self.app.vertex_colour.resize(self.positions.len(), [255; 3]);
+            }
+            let first_triangle = self.triangles.len();
             let idx: Vec<i64> = match reader.read_indices() {
                 Some(i) => i.into_u32().map(|i| i as i64 + base).collect(),
                 None => (base..base + n).collect(),
@@ -103,6 +201,11 @@ impl Builder {
                         self.triangles.push([idx[0], idx[w], idx[w + 1]]);
                     }
                 }
+            }
+            let uv_of = |v: i64| uvs.get((v - base) as usize).copied().unwrap_or([f32::NAN; 2]);
+            for t in &self.triangles[first_triangle..] {
+                self.app.triangle_material.push(material as u32);
+                self.app.triangle_uv.push(t.map(uv_of));
             }
         }
         Ok(())

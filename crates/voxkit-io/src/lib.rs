@@ -19,17 +19,22 @@ pub mod npy;
 pub mod obj;
 pub mod ply;
 pub mod png;
+pub mod points;
 pub mod polyline;
+pub mod schem;
 pub mod stl;
 pub mod text;
+pub mod texture;
 pub mod vox;
 pub mod voxel_mesh;
+pub mod vti;
 
 use std::path::Path;
 
 pub use error::{ErrorKind, IoError};
 pub use mesh_report::{LoadedMesh, MeshReport};
 pub use png::write_png;
+use voxkit::attributes::VoxelAttributes;
 use voxkit::{DenseBits, GridSpec, VoxelSource};
 
 /// Mesh file formats voxkit reads.
@@ -134,11 +139,17 @@ pub enum VoxelFormat {
     Vox,
     /// Plain text: one `i j k` line per set voxel.
     Text,
+    /// Minecraft Sponge schematic (version 2).
+    Schem,
+    /// VTK ImageData (XML, appended, zlib).
+    Vti,
+    /// PLY point cloud of voxel centres.
+    Ply,
 }
 
 impl VoxelFormat {
     /// Names accepted by `--format`.
-    pub const NAMES: &'static str = "npy, npy-bool, binvox, vox, txt";
+    pub const NAMES: &'static str = "npy, npy-bool, binvox, vox, txt, schem, vti, ply";
 
     /// The format for a `--format` name or a file extension.
     pub fn from_name(name: &str) -> Option<VoxelFormat> {
@@ -148,6 +159,9 @@ impl VoxelFormat {
             "binvox" => Some(VoxelFormat::Binvox),
             "vox" => Some(VoxelFormat::Vox),
             "txt" | "text" | "xyz" => Some(VoxelFormat::Text),
+            "schem" => Some(VoxelFormat::Schem),
+            "vti" => Some(VoxelFormat::Vti),
+            "ply" => Some(VoxelFormat::Ply),
             _ => None,
         }
     }
@@ -160,7 +174,15 @@ impl VoxelFormat {
             VoxelFormat::Binvox => "binvox",
             VoxelFormat::Vox => "vox",
             VoxelFormat::Text => "txt",
+            VoxelFormat::Schem => "schem",
+            VoxelFormat::Vti => "vti",
+            VoxelFormat::Ply => "ply",
         }
+    }
+
+    /// True when the format stores voxel colours.
+    pub fn has_colour(self) -> bool {
+        matches!(self, VoxelFormat::Vox | VoxelFormat::Schem | VoxelFormat::Vti | VoxelFormat::Ply)
     }
 
     /// The format for a path's extension.
@@ -171,12 +193,37 @@ impl VoxelFormat {
 
 /// Writes `bits` on `grid` to `path` atomically (temporary file + rename).
 pub fn write_voxels(path: &Path, format: VoxelFormat, bits: &dyn VoxelSource, grid: &GridSpec) -> Result<(), IoError> {
+    write_voxels_with(path, format, bits, grid, None, &WriteOptions::default())
+}
+
+/// Options of the coloured writers.
+#[derive(Clone, Debug, Default)]
+pub struct WriteOptions {
+    /// `.vox`: error-diffusion dithering onto the palette (off: nearest entry).
+    pub dither: bool,
+    /// `.schem`: the colour → block table (default: the built-in one).
+    pub blocks: Option<schem::BlockPalette>,
+}
+
+/// [`write_voxels`] with per-voxel attributes (colours for `.vox`,
+/// `.schem`, `.ply`; every array for `.vti`; ignored by the other formats).
+pub fn write_voxels_with(
+    path: &Path,
+    format: VoxelFormat,
+    bits: &dyn VoxelSource,
+    grid: &GridSpec,
+    attrs: Option<&VoxelAttributes>,
+    opts: &WriteOptions,
+) -> Result<(), IoError> {
     atomic::write_atomically(path, |w| match format {
         VoxelFormat::Npy => npy::write(w, bits, npy::Dtype::U8),
         VoxelFormat::NpyBool => npy::write(w, bits, npy::Dtype::Bool),
         VoxelFormat::Binvox => binvox::write(w, bits, grid),
-        VoxelFormat::Vox => vox::write(w, bits),
+        VoxelFormat::Vox => vox::write(w, bits, attrs, opts.dither),
         VoxelFormat::Text => text::write(w, bits, grid),
+        VoxelFormat::Schem => schem::write(w, bits, attrs, opts.blocks.as_ref().unwrap_or(&schem::BlockPalette::default())),
+        VoxelFormat::Vti => vti::write(w, bits, grid, attrs),
+        VoxelFormat::Ply => points::write(w, bits, grid, attrs),
     })
 }
 
@@ -186,8 +233,25 @@ pub fn write_voxels(path: &Path, format: VoxelFormat, bits: &dyn VoxelSource, gr
 pub struct LoadedVoxels {
     /// The voxels.
     pub bits: DenseBits,
-    /// Origin and voxel size, when the format carries them (binvox, text).
+    /// Origin and voxel size, when the format carries them (binvox, text, vti, ply).
     pub placement: Option<(glam::DVec3, f64)>,
+    /// Per-voxel attributes, when the format carries them (colours of
+    /// `.vox`, `.schem` and `.ply`; every array of `.vti`).
+    pub attributes: Option<VoxelAttributes>,
+}
+
+/// True when `path` names a voxel file (by extension; a `.ply` only when
+/// it is a voxkit point cloud — other PLY files are meshes).
+pub fn is_voxel_file(path: &Path) -> bool {
+    match VoxelFormat::from_path(path) {
+        Some(VoxelFormat::Ply) => {
+            let mut head = vec![0u8; 4096];
+            let n = std::fs::File::open(path).and_then(|mut f| std::io::Read::read(&mut f, &mut head)).unwrap_or(0);
+            points::is_voxel_cloud(&head[..n])
+        }
+        Some(_) => true,
+        None => false,
+    }
 }
 
 /// Reads any voxel file voxkit writes, choosing the format from the extension.
@@ -213,5 +277,8 @@ pub fn read_voxels_bytes(bytes: &[u8], format: VoxelFormat) -> Result<LoadedVoxe
         VoxelFormat::Binvox => binvox::read(bytes),
         VoxelFormat::Vox => vox::read(bytes),
         VoxelFormat::Text => text::read(bytes),
+        VoxelFormat::Schem => schem::read(bytes),
+        VoxelFormat::Vti => vti::read(bytes),
+        VoxelFormat::Ply => points::read(bytes),
     })
 }

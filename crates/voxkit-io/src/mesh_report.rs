@@ -2,6 +2,7 @@
 //! reader ends with.
 
 use glam::DVec3;
+use voxkit::attributes::Appearance;
 use voxkit::{Aabb, Mesh};
 
 use crate::error::ErrorKind;
@@ -30,6 +31,9 @@ pub struct LoadedMesh {
     pub report: MeshReport,
     /// Non-fatal problems (for example a missing material library).
     pub warnings: Vec<String>,
+    /// Materials, textures, UVs and vertex colours, aligned with the
+    /// triangles and vertices of `mesh` (empty lists where the file has none).
+    pub appearance: Appearance,
 }
 
 /// Validates and packages reader output: every coordinate finite, every
@@ -66,7 +70,7 @@ pub(crate) fn finish_with_segments(
         segments: mesh.segments.len(),
         bounds: r.bounds(),
     };
-    Ok(LoadedMesh { mesh, report, warnings })
+    Ok(LoadedMesh { mesh, report, warnings, appearance: Appearance::default() })
 }
 
 /// Converts index tuples to `u32`, or the error `bad(element, index)` for

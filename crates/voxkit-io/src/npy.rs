@@ -69,7 +69,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     }
     let mut bits = DenseBits::new(dims.map(|d| d as u32));
     fill(&mut bits, &data[..n], 0);
-    Ok(LoadedVoxels { bits, placement: None })
+    Ok(LoadedVoxels { bits, placement: None, attributes: None })
 }
 
 /// [`read`] from a stream of `total` bytes, a few megabytes at a time: a
@@ -121,7 +121,7 @@ pub fn read_stream(r: &mut impl std::io::Read, total: u64) -> Result<LoadedVoxel
         fill(&mut bits, &buf[..got], at);
         at += got;
     }
-    Ok(LoadedVoxels { bits, placement: None })
+    Ok(LoadedVoxels { bits, placement: None, attributes: None })
 }
 
 fn truncated(have: usize, need: usize) -> ErrorKind {

@@ -16,7 +16,9 @@ use std::sync::Mutex;
 use glam::DVec3;
 
 use crate::error::ErrorKind;
-use crate::mesh_report::{fan, finish_with_segments, LoadedMesh};
+use voxkit::attributes::{Appearance, Material, NO_MATERIAL};
+
+use crate::mesh_report::{finish_with_segments, LoadedMesh};
 
 /// Parses OBJ bytes; `base_dir` is where `mtllib` files are looked up.
 pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKind> {
@@ -40,13 +42,17 @@ pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKi
     });
     let (models, materials) = loaded.map_err(|e| ErrorKind::malformed("OBJ", e))?;
     let mut warnings = warnings.into_inner().unwrap_or_default();
-    if let Err(e) = materials {
+    if let Err(e) = &materials {
         if warnings.is_empty() && !matches!(e, tobj::LoadError::GenericFailure) {
             warnings.push(format!("materials ignored: {e}"));
         }
     }
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
+    let mut app = Appearance::default();
+    let mut tri_material = Vec::new();
+    let mut tri_uv = Vec::new();
+    let mut vertex_colour = Vec::new();
     for m in &models {
         let mesh = &m.mesh;
         let base = positions.len() as i64;
@@ -54,27 +60,77 @@ pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKi
             return Err(ErrorKind::malformed("OBJ", "vertex position with fewer than 3 coordinates"));
         }
         positions.extend(mesh.positions.chunks_exact(3).map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)));
-        let idx: Vec<i64> = mesh.indices.iter().map(|&i| base + i as i64).collect();
-        if mesh.face_arities.is_empty() {
-            for t in idx.chunks_exact(3) {
-                triangles.push([t[0], t[1], t[2]]);
-            }
-        } else {
-            let mut at = 0usize;
-            for &n in &mesh.face_arities {
-                let n = n as usize;
-                let Some(poly) = idx.get(at..at + n) else {
-                    return Err(ErrorKind::malformed("OBJ", "face arity past the index list"));
-                };
-                fan(poly, &mut triangles);
-                at += n;
-            }
+        // `v x y z r g b`: tobj keeps colours per position (sRGB in [0, 1]).
+        if mesh.vertex_color.len() == mesh.positions.len() {
+            vertex_colour.resize(base as usize, [255u8; 3]);
+            vertex_colour.extend(mesh.vertex_color.chunks_exact(3).map(|c| [0, 1, 2].map(|a| (c[a].clamp(0.0, 1.0) * 255.0).round() as u8)));
         }
+        let material = m.mesh.material_id.map(|i| i as u32).unwrap_or(NO_MATERIAL);
+        let has_uv = mesh.texcoord_indices.len() == mesh.indices.len() && !mesh.texcoords.is_empty();
+        // OBJ puts v = 0 at the bottom of the image; voxkit's textures at the top.
+        let uv_of = |corner: usize| -> [f32; 2] {
+            if !has_uv {
+                return [f32::NAN; 2];
+            }
+            let t = mesh.texcoord_indices[corner] as usize;
+            match mesh.texcoords.get(2 * t..2 * t + 2) {
+                Some(c) => [c[0], 1.0 - c[1]],
+                None => [f32::NAN; 2],
+            }
+        };
+        let arities: Vec<usize> =
+            if mesh.face_arities.is_empty() { vec![3; mesh.indices.len() / 3] } else { mesh.face_arities.iter().map(|&n| n as usize).collect() };
+        let mut at = 0usize;
+        for n in arities {
+            if at + n > mesh.indices.len() {
+                return Err(ErrorKind::malformed("OBJ", "face arity past the index list"));
+            }
+            for w in 1..n.saturating_sub(1) {
+                let corners = [at, at + w, at + w + 1];
+                triangles.push(corners.map(|c| base + mesh.indices[c] as i64));
+                tri_material.push(material);
+                tri_uv.push(corners.map(uv_of));
+            }
+            at += n;
+        }
+    }
+    if let (Ok(mats), Some(dir)) = (&materials, base_dir) {
+        for (index, mat) in mats.iter().enumerate() {
+            let factor = mat.diffuse.unwrap_or([1.0; 3]);
+            let texture = mat.diffuse_texture.as_deref().filter(|t| !t.trim().is_empty()).and_then(|statement| {
+                let (path, wrap) = crate::texture::parse_map_statement(statement, dir);
+                match crate::texture::load(&path, wrap) {
+                    Ok(t) => {
+                        app.textures.push(t);
+                        Some(app.textures.len() as u32 - 1)
+                    }
+                    Err(e) => {
+                        warnings.push(format!("material {:?}: {e}; its Kd colour is used instead", mat.name));
+                        None
+                    }
+                }
+            });
+            let name = if mat.name.is_empty() { format!("material {index}") } else { mat.name.clone() };
+            app.materials.push(Material { name, factor, texture });
+        }
+    }
+    if !app.materials.is_empty() {
+        app.triangle_material = tri_material;
+        app.triangle_uv = tri_uv;
+    }
+    if !vertex_colour.is_empty() {
+        vertex_colour.resize(positions.len(), [255; 3]);
+        app.vertex_colour = vertex_colour;
     }
     let base = positions.len() as i64;
     positions.extend(line_positions);
+    if !app.vertex_colour.is_empty() {
+        app.vertex_colour.resize(positions.len(), [255; 3]);
+    }
     let segments = line_segments.into_iter().map(|[a, b]| [base + a, base + b]).collect();
-    finish_with_segments(positions, triangles, segments, warnings)
+    let mut loaded = finish_with_segments(positions, triangles, segments, warnings)?;
+    loaded.appearance = app;
+    Ok(loaded)
 }
 
 /// Reads the `v` and `l` records. Returns the bytes with `l` records

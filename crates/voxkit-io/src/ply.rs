@@ -45,7 +45,12 @@ pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
     let ply = parser.read_ply(&mut Cursor::new(bytes)).map_err(|e| ErrorKind::malformed("PLY", e))?;
     let verts = ply.payload.get("vertex").ok_or_else(|| ErrorKind::malformed("PLY", "no 'vertex' element"))?;
     let mut positions = Vec::with_capacity(verts.len());
+    let mut colours = Vec::new();
     for (n, v) in verts.iter().enumerate() {
+        if let Some(c) = vertex_colour(v) {
+            colours.resize(n, [255; 3]);
+            colours.push(c);
+        }
         let mut c = [0.0; 3];
         for (a, name) in ["x", "y", "z"].iter().enumerate() {
             c[a] = v
@@ -66,5 +71,22 @@ pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
             fan(&idx, &mut triangles);
         }
     }
-    finish(positions, triangles, Vec::new())
+    if !colours.is_empty() {
+        colours.resize(positions.len(), [255; 3]);
+    }
+    let mut loaded = finish(positions, triangles, Vec::new())?;
+    loaded.appearance.vertex_colour = colours;
+    Ok(loaded)
+}
+
+/// A vertex's `red green blue` (or `r g b`, or `diffuse_red` …): bytes, or
+/// floats in [0, 1]; sRGB.
+fn vertex_colour(v: &DefaultElement) -> Option<[u8; 3]> {
+    for names in [["red", "green", "blue"], ["r", "g", "b"], ["diffuse_red", "diffuse_green", "diffuse_blue"]] {
+        let (Some(r), Some(g), Some(b)) = (v.get(names[0]), v.get(names[1]), v.get(names[2])) else { continue };
+        let float = matches!(r, Property::Float(_) | Property::Double(_));
+        let c = [r, g, b].map(|p| scalar(p).unwrap_or(0.0));
+        return Some(c.map(|x| if float { (x.clamp(0.0, 1.0) * 255.0).round() as u8 } else { x.clamp(0.0, 255.0) as u8 }));
+    }
+    None
 }

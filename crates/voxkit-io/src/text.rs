@@ -83,5 +83,5 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         }
         bits.set(v[0], v[1], v[2]);
     }
-    Ok(LoadedVoxels { bits, placement })
+    Ok(LoadedVoxels { bits, placement, attributes: None })
 }

@@ -7,12 +7,19 @@
 //! `floor(size / 2)` (MagicaVoxel pivots models on their centre), so `_t` is
 //! set to `256·(bx,by,bz) + floor(size/2)` and the whole grid opens in
 //! MagicaVoxel in one piece. Axes map directly: voxkit `(i, j, k)` →
-//! MagicaVoxel `(x, y, z)`, z up. Every voxel uses palette entry 1.
+//! MagicaVoxel `(x, y, z)`, z up.
+//!
+//! Colours: with voxel colours, the palette is at most 255 colours of the
+//! voxels themselves ([`voxkit::attributes::quantize`]: exact when there
+//! are no more, else median cut + k-means in Oklab), each voxel taking its
+//! nearest entry (or, with dithering, error diffusion across neighbours).
+//! Without colours every voxel uses palette entry 1 (a light grey).
 
 use std::collections::BTreeMap;
 use std::io::Write;
 
 use dot_vox::{Color, Dict, DotVoxData, Frame, Layer, Model, SceneNode, ShapeModel, Size, Voxel};
+use voxkit::attributes::{quantize, VoxelAttributes};
 use voxkit::{DenseBits, VoxelSource};
 
 use crate::error::ErrorKind;
@@ -20,16 +27,31 @@ use crate::LoadedVoxels;
 
 const BLOCK: u32 = 256;
 
-/// Writes `bits` as a `.vox` file.
-pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource) -> std::io::Result<()> {
+/// Writes `bits` as a `.vox` file, coloured by `attrs` when it has colours.
+pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, attrs: Option<&VoxelAttributes>, dither: bool) -> std::io::Result<()> {
     let dims = bits.dims();
+    let coloured = attrs.and_then(|a| a.colour.as_ref().map(|c| (a, c)));
+    let (palette_rgb, index) = match coloured {
+        Some((a, colours)) => {
+            let p = quantize::palette(colours, 255);
+            let idx = if dither { quantize::dither(a, colours, &p) } else { quantize::map_to_palette(colours, &p) };
+            (p, Some((a, idx)))
+        }
+        None => (vec![[200, 205, 215]], None),
+    };
+    let palette_index = |i: u32, j: u32, k: u32| -> u8 {
+        match &index {
+            Some((a, idx)) => a.slot(i, j, k).map(|s| idx[s]).unwrap_or(0),
+            None => 0,
+        }
+    };
     let mut blocks: BTreeMap<[u32; 3], Vec<Voxel>> = BTreeMap::new();
     bits.for_each_set(&mut |i, j, k| {
         blocks.entry([i / BLOCK, j / BLOCK, k / BLOCK]).or_default().push(Voxel {
             x: (i % BLOCK) as u8,
             y: (j % BLOCK) as u8,
             z: (k % BLOCK) as u8,
-            i: 0,
+            i: palette_index(i, j, k),
         });
     });
     if blocks.is_empty() {
@@ -57,7 +79,9 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource) -> std::io::Result<()> {
         *c = children;
     }
     let mut palette = vec![Color { r: 75, g: 75, b: 75, a: 255 }; 256];
-    palette[0] = Color { r: 200, g: 205, b: 215, a: 255 };
+    for (p, c) in palette.iter_mut().zip(&palette_rgb) {
+        *p = Color { r: c[0], g: c[1], b: c[2], a: 255 };
+    }
     let data = DotVoxData {
         version: 150,
         index_map: Vec::new(),
@@ -103,16 +127,22 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if dims.iter().any(|&d| d > voxkit::grid::spec::MAX_DIM as u64) {
         return Err(ErrorKind::malformed("vox", format!("scene spans {dims:?} voxels")));
     }
-    let mut bits = DenseBits::new(dims.map(|d| d as u32));
+    let dims = dims.map(|d| d as u32);
+    let mut bits = DenseBits::new(dims);
+    let mut coloured = Vec::new();
     for (model, min) in boxes {
         for v in &model.voxels {
             let p = [v.x as i64 + min[0] - lo[0], v.y as i64 + min[1] - lo[1], v.z as i64 + min[2] - lo[2]];
-            if (0..3).all(|a| p[a] >= 0 && (p[a] as u64) < dims[a]) {
-                bits.set(p[0] as u32, p[1] as u32, p[2] as u32);
+            if (0..3).all(|a| p[a] >= 0 && p[a] < dims[a] as i64) {
+                let p = p.map(|c| c as u32);
+                bits.set(p[0], p[1], p[2]);
+                let c = data.palette.get(v.i as usize).map(|c| [c.r, c.g, c.b]).unwrap_or([255; 3]);
+                coloured.push((p, c));
             }
         }
     }
-    Ok(LoadedVoxels { bits, placement: None })
+    let attributes = Some(VoxelAttributes::from_coloured(dims, coloured));
+    Ok(LoadedVoxels { bits, placement: None, attributes })
 }
 
 fn walk(data: &DotVoxData, node: u32, t: [i64; 3], depth: u32, out: &mut Vec<(u32, [i64; 3])>) -> Result<(), ErrorKind> {

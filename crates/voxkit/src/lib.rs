@@ -25,6 +25,7 @@
 
 pub use glam;
 
+pub mod attributes;
 pub mod export;
 pub mod geom;
 pub mod grid;

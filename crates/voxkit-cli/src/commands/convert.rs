@@ -9,49 +9,29 @@ use crate::args::ConvertArgs;
 use crate::plan;
 
 pub fn run(a: &ConvertArgs) -> Result<()> {
-    let to_mesh = a.format.as_deref() == Some("obj")
-        || (a.format.is_none() && a.output.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("obj")));
-    if to_mesh {
-        return mesh_of_voxels(a);
-    }
     let format = plan::output_format(a.format.as_deref(), &a.output)?;
     crate::commands::voxelize::check_output_dir(&a.output)?;
+    let write_opts = crate::commands::export::writer_options(&a.export)?;
     let loaded = voxkit_io::read_voxels(&a.input)?;
     let dims = loaded.bits.dims();
     let (grid, source) = placement(a, &loaded)?;
-    voxkit_io::write_voxels(&a.output, format, &loaded.bits, &grid)?;
+    let facts = crate::commands::export::write(&a.output, format, &loaded.bits, &grid, loaded.attributes.as_ref(), &write_opts)?;
     let voxels = loaded.bits.count();
     if a.json {
         let o = grid.origin();
         let v = json!({"input": a.input, "output": a.output, "format": format.name(), "dims": dims, "voxels": voxels,
-            "origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size(), "grid_from": source});
+            "origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size(), "grid_from": source, "export": facts});
         return crate::print_stdout(&v.to_string());
     }
+    let what = match (facts.get("quads"), facts.get("vertices")) {
+        (Some(q), Some(v)) => format!(" as {q} greedy quads, {v} vertices"),
+        _ => String::new(),
+    };
     crate::print_stdout(&format!(
-        "convert: {voxels} voxels on a {}x{}x{} grid (placement from the {source}) -> {}",
+        "convert: {voxels} voxels on a {}x{}x{} grid (placement from the {source}){what} -> {}",
         dims[0],
         dims[1],
         dims[2],
-        a.output.display()
-    ))
-}
-
-/// `convert VOXELS out.obj`: the greedy mesh of the voxels' boundary.
-fn mesh_of_voxels(a: &ConvertArgs) -> Result<()> {
-    crate::commands::voxelize::check_output_dir(&a.output)?;
-    let loaded = voxkit_io::read_voxels(&a.input)?;
-    let (grid, source) = placement(a, &loaded)?;
-    let quads = voxkit::export::greedy::greedy_quads(&loaded.bits);
-    let vertices = voxkit_io::voxel_mesh::write_quads_obj(&a.output, &quads, &grid)?;
-    if a.json {
-        let v = json!({"input": a.input, "output": a.output, "format": "obj", "voxels": loaded.bits.count(), "quads": quads.len(),
-            "vertices": vertices, "grid_from": source});
-        return crate::print_stdout(&v.to_string());
-    }
-    crate::print_stdout(&format!(
-        "convert: {} voxels -> {} greedy quads, {vertices} vertices -> {}",
-        loaded.bits.count(),
-        quads.len(),
         a.output.display()
     ))
 }

@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod check;
 pub mod convert;
+pub mod export;
 pub mod gaps;
 pub mod info;
 pub mod render;

@@ -6,10 +6,12 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use serde_json::json;
-use voxkit::render::raycast::{render, Image, RenderOptions, View};
+use voxkit::attributes::carry::{carry, CarryOptions};
+use voxkit::attributes::VoxelAttributes;
+use voxkit::glam::DVec3;
+use voxkit::render::raycast::{render_with, Image, RenderOptions, View};
 use voxkit::voxelize::{self, Options};
 use voxkit::{BrickBits, VoxelSource};
-use voxkit_io::VoxelFormat;
 
 use crate::args::{PictureArgs, RenderArgs};
 use crate::plan::{self, GridRequest};
@@ -47,10 +49,22 @@ pub fn options(p: &PictureArgs) -> Result<RenderOptions> {
     Ok(RenderOptions { width, height, view, up, ..RenderOptions::default() })
 }
 
-/// Renders `bits` and writes the PNG atomically.
-pub fn picture(bits: &dyn VoxelSource, path: &Path, o: &RenderOptions) -> Result<Image> {
+/// A mesh's triangles in grid units, for the silhouette outline.
+pub fn outline_triangles(mesh: voxkit::MeshRef<'_>, grid: &voxkit::GridSpec) -> Vec<[DVec3; 3]> {
+    mesh.triangles
+        .iter()
+        .filter_map(|t| {
+            let p = [0, 1, 2].map(|c| mesh.positions.get(t[c] as usize).map(|&p| grid.to_grid_units(p)));
+            Some([p[0]?, p[1]?, p[2]?])
+        })
+        .collect()
+}
+
+/// Renders `bits` (coloured by `colours` where present, with the outline of
+/// `outline`'s triangles) and writes the PNG atomically.
+pub fn picture(bits: &dyn VoxelSource, path: &Path, o: &RenderOptions, colours: Option<&VoxelAttributes>, outline: Option<&[[DVec3; 3]]>) -> Result<Image> {
     let bricks = BrickBits::from_source(bits);
-    let img = render(&bricks, o);
+    let img = render_with(&bricks, o, colours, outline);
     voxkit_io::write_png(path, img.width, img.height, &img.rgb)?;
     Ok(img)
 }
@@ -68,18 +82,30 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let o = options(&a.picture)?;
     check_png_path(&a.output)?;
     let pool = crate::thread_pool(a.threads)?;
-    let (bits, what): (Box<dyn VoxelSource + Send>, &str) = if VoxelFormat::from_path(&a.input).is_some() {
-        (Box::new(voxkit_io::read_voxels(&a.input)?.bits), "voxel file")
+    let (bits, what, colours, outline): (Box<dyn VoxelSource + Send>, &str, _, _) = if voxkit_io::is_voxel_file(&a.input) {
+        if a.picture.outline {
+            bail!("--outline draws the source mesh's silhouette; it needs a mesh input (or voxelize --preview)");
+        }
+        let loaded = voxkit_io::read_voxels(&a.input)?;
+        (Box::new(loaded.bits), "voxel file", loaded.attributes, None)
     } else {
         let (mode, _) = plan::resolve_method(a.mode, crate::args::Method::Fast)
             .context("render voxelizes meshes with a surface or line mode; voxelize solids to a file first")?;
         let loaded = voxkit_io::read_mesh(&a.input)?;
         let grid = GridRequest::from_args(&a.grid)?.fit(&loaded.report.bounds)?;
         plan::check_memory(&grid)?;
+        for w in &loaded.warnings {
+            eprintln!("voxkit: warning: {}: {w}", a.input.display());
+        }
         let (b, _) = pool.install(|| voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &Options::default()));
-        (Box::new(b), "mesh")
+        let colours = loaded.appearance.has_colour().then(|| {
+            let opts = CarryOptions { rule: crate::commands::export::colour_rule(a.colour_rule), normals: false };
+            pool.install(|| carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &b, &opts))
+        });
+        let outline = a.picture.outline.then(|| outline_triangles(loaded.mesh.as_ref(), &grid));
+        (Box::new(b), "mesh", colours, outline)
     };
-    let img = pool.install(|| picture(bits.as_ref(), &a.output, &o))?;
+    let img = pool.install(|| picture(bits.as_ref(), &a.output, &o, colours.as_ref(), outline.as_deref()))?;
     let total_s = t0.elapsed().as_secs_f64();
     if a.json {
         let v = json!({"input": a.input, "kind": what, "output": a.output, "width": img.width, "height": img.height,

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Result};
 use serde_json::json;
+use voxkit::attributes::carry::{carry, CarryOptions};
 use voxkit::voxelize::{self, Options};
 use voxkit::VoxelSource;
 
@@ -23,6 +24,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     };
     let format = plan::output_format(a.format.as_deref(), &a.output)?;
     check_output_dir(&a.output)?;
+    let write_opts = crate::commands::export::writer_options(&a.export)?;
     let preview = match &a.preview {
         Some(p) => {
             crate::commands::render::check_png_path(p)?;
@@ -96,13 +98,30 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     };
     let voxelize_s = t_vox.elapsed().as_secs_f64();
 
+    // Attributes: colours for the formats that store them (and the preview),
+    // every array (coverage, material, normal) for .vti.
+    let is_vti = format == plan::Output::Voxels(voxkit_io::VoxelFormat::Vti);
+    let app = &loaded.appearance;
+    let want_colour = app.has_colour() && (format.has_colour() || preview.is_some());
+    let t_attr = Instant::now();
+    let attrs = (!is_line && (want_colour || is_vti)).then(|| {
+        bar.phase("carrying colours into voxels");
+        let opts = CarryOptions { rule: crate::commands::export::colour_rule(a.export.colour_rule), normals: a.export.normals };
+        pool.install(|| carry(loaded.mesh.as_ref(), app, &grid, bits.as_ref(), &opts))
+    });
+    let attributes_s = t_attr.elapsed().as_secs_f64();
+    if format.has_colour() && !app.has_colour() && !a.quiet && !a.json {
+        eprintln!("voxkit: note: {} has no colours (materials, textures or vertex colours); voxels get one colour", a.mesh.display());
+    }
+
     bar.phase("writing");
     let t_write = Instant::now();
-    voxkit_io::write_voxels(&a.output, format, bits.as_ref(), &grid)?;
+    let export_facts = pool.install(|| crate::commands::export::write(&a.output, format, bits.as_ref(), &grid, attrs.as_ref(), &write_opts))?;
     let write_s = t_write.elapsed().as_secs_f64();
     if let Some((path, o)) = &preview {
         bar.phase("rendering the preview");
-        pool.install(|| crate::commands::render::picture(bits.as_ref(), path, o))?;
+        let outline = a.picture.outline.then(|| crate::commands::render::outline_triangles(loaded.mesh.as_ref(), &grid));
+        pool.install(|| crate::commands::render::picture(bits.as_ref(), path, o, attrs.as_ref(), outline.as_deref()))?;
     }
     bar.finish();
     let total_s = t_total.elapsed().as_secs_f64();
@@ -124,12 +143,21 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
             "voxelize_s": voxelize_s,
             "load_s": load_s,
             "write_s": write_s,
+            "attributes_s": attributes_s,
+            "attributes": attrs.as_ref().map(|t| json!({
+                "colour": t.colour.is_some(),
+                "colour_rule": format!("{:?}", a.export.colour_rule).to_lowercase(),
+                "material": t.material.is_some(),
+                "normal": t.normal.is_some(),
+                "coverage": t.coverage.is_some(),
+            })),
+            "export": export_facts,
             "preview": a.preview,
             "total_s": total_s,
             "threads": threads,
             "input": a.mesh.display().to_string(),
             "output": a.output.display().to_string(),
-            "format": format!("{format:?}").to_lowercase(),
+            "format": format.name(),
             "mesh": {
                 "vertices": loaded.report.vertices,
                 "triangles": loaded.report.triangles,

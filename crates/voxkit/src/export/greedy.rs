@@ -34,6 +34,10 @@ pub struct Quad {
     pub a: (u32, u32),
     /// The same along axis `(axis + 2) % 3`.
     pub b: (u32, u32),
+    /// The class of the voxels behind the quad (a palette index for
+    /// coloured meshes; 0 when uncoloured). Faces of different classes are
+    /// never merged.
+    pub class: u32,
 }
 
 impl Quad {
@@ -60,6 +64,13 @@ impl Quad {
 
 /// The boundary of the set voxels as greedy quads.
 pub fn greedy_quads(bits: &DenseBits) -> Vec<Quad> {
+    greedy_quads_by_class(bits, &|_, _, _| 0)
+}
+
+/// [`greedy_quads`] where a face takes the class `class(i, j, k)` of the
+/// set voxel behind it and only faces of one class merge (per-voxel
+/// colours survive meshing).
+pub fn greedy_quads_by_class(bits: &DenseBits, class: &(dyn Fn(u32, u32, u32) -> u32 + Sync)) -> Vec<Quad> {
     let [nx, ny, nz] = bits.dims();
     let mut quads = Vec::new();
     let wpr = bits.words_per_row();
@@ -71,8 +82,9 @@ pub fn greedy_quads(bits: &DenseBits) -> Vec<Quad> {
         nz,
         wpr,
         |r, s| &words[(s * ny as usize + r) * wpr..][..wpr],
-        |s, x, r, pos| {
-            quads.push(Quad { axis: 2, positive: pos, at: s, a: x, b: r });
+        &|s, x, r| class(x, r, s),
+        |s, x, r, pos, c| {
+            quads.push(Quad { axis: 2, positive: pos, at: s, a: x, b: r, class: c });
         },
     );
     // Faces across y: slices j, rows k, bits i.
@@ -82,8 +94,9 @@ pub fn greedy_quads(bits: &DenseBits) -> Vec<Quad> {
         ny,
         wpr,
         |r, s| &words[(r * ny as usize + s) * wpr..][..wpr],
-        |s, x, r, pos| {
-            quads.push(Quad { axis: 1, positive: pos, at: s, a: r, b: x });
+        &|s, x, r| class(x, s, r),
+        |s, x, r, pos, c| {
+            quads.push(Quad { axis: 1, positive: pos, at: s, a: r, b: x, class: c });
         },
     );
     // Faces across x: a copy with bits along j, rows k, slices i.
@@ -97,8 +110,9 @@ pub fn greedy_quads(bits: &DenseBits) -> Vec<Quad> {
         nx,
         twpr,
         |r, s| &tw[(s * nz as usize + r) * twpr..][..twpr],
-        |s, x, r, pos| {
-            quads.push(Quad { axis: 0, positive: pos, at: s, a: x, b: r });
+        &|s, x, r| class(s, x, r),
+        |s, x, r, pos, c| {
+            quads.push(Quad { axis: 0, positive: pos, at: s, a: x, b: r, class: c });
         },
     );
     quads
@@ -106,14 +120,16 @@ pub fn greedy_quads(bits: &DenseBits) -> Vec<Quad> {
 
 /// One axis: for every slice boundary `s` in `0 ..= n`, the masks of faces
 /// with the set voxel below (`+` normal) and above (`-` normal), then
-/// greedy rectangles `(s, bit range, row range, positive)`.
+/// greedy rectangles `(s, bit range, row range, positive, class)`, one
+/// class at a time (`class(slice, bit, row)` of the voxel behind a face).
 fn sweep<'a>(
     width: u32,
     height: u32,
     n: u32,
     wpr: usize,
     row: impl Fn(usize, usize) -> &'a [u64],
-    mut emit: impl FnMut(u32, (u32, u32), (u32, u32), bool),
+    class: &dyn Fn(u32, u32, u32) -> u32,
+    mut emit: impl FnMut(u32, (u32, u32), (u32, u32), bool, u32),
 ) {
     let h = height as usize;
     let mut plus = vec![0u64; h * wpr];
@@ -133,7 +149,21 @@ fn sweep<'a>(
             continue;
         }
         for (mask, pos) in [(&mut plus, true), (&mut minus, false)] {
-            greedy_2d(mask, width, h, wpr, |x, r| emit(s as u32, x, r, pos));
+            // The voxel behind a `+` face is in slice s − 1, behind a `−` face in slice s.
+            let vs = if pos { s as u32 - (s > 0) as u32 } else { s as u32 };
+            let classes = split_by_class(mask, wpr, |x, r| class(vs, x, r as u32));
+            match classes {
+                None => {
+                    let c = class_of_first(mask, wpr, &|x, r| class(vs, x, r));
+                    greedy_2d(mask, width, h, wpr, |x, r| emit(s as u32, x, r, pos, c));
+                }
+                Some(parts) => {
+                    for (c, mut m) in parts {
+                        greedy_2d(&mut m, width, h, wpr, |x, r| emit(s as u32, x, r, pos, c));
+                    }
+                    mask.iter_mut().for_each(|w| *w = 0);
+                }
+            }
         }
     }
 }
@@ -157,6 +187,51 @@ fn greedy_2d(mask: &mut [u64], width: u32, h: usize, wpr: usize, mut emit: impl 
 }
 
 /// The first set bit at or after `from`.
+/// `None` when every face of `mask` has the same class, else one mask per class (ascending).
+fn split_by_class(mask: &[u64], wpr: usize, class: impl Fn(u32, usize) -> u32) -> Option<Vec<(u32, Vec<u64>)>> {
+    let mut first = None;
+    let mut parts: Vec<(u32, Vec<u64>)> = Vec::new();
+    for (wi, &w) in mask.iter().enumerate() {
+        let mut bits = w;
+        while bits != 0 {
+            let b = bits.trailing_zeros();
+            bits &= bits - 1;
+            let (r, x) = (wi / wpr, (wi % wpr) as u32 * 64 + b);
+            let c = class(x, r);
+            let f = *first.get_or_insert(c);
+            if c == f && parts.is_empty() {
+                continue;
+            }
+            if parts.is_empty() {
+                // First differing face: bucket every face seen so far, then go on bucketing.
+                parts.push((f, mask.iter().map(|_| 0).collect()));
+                for (wj, &w2) in mask.iter().enumerate().take(wi + 1) {
+                    let keep = if wj == wi { w2 & ((1u64 << b) - 1) } else { w2 };
+                    parts[0].1[wj] = keep;
+                }
+            }
+            let at = match parts.iter().position(|p| p.0 == c) {
+                Some(at) => at,
+                None => {
+                    parts.push((c, vec![0; mask.len()]));
+                    parts.len() - 1
+                }
+            };
+            parts[at].1[wi] |= 1 << b;
+        }
+    }
+    if parts.is_empty() {
+        return None;
+    }
+    parts.sort_by_key(|p| p.0);
+    Some(parts)
+}
+
+/// The class of the first face of `mask` (0 if empty): when all faces share one.
+fn class_of_first(mask: &[u64], wpr: usize, class: &dyn Fn(u32, u32) -> u32) -> u32 {
+    mask.iter().position(|&w| w != 0).map(|wi| class((wi % wpr) as u32 * 64 + mask[wi].trailing_zeros(), (wi / wpr) as u32)).unwrap_or(0)
+}
+
 fn next_set(row: &[u64], from: u32) -> Option<u32> {
     let mut w = (from / 64) as usize;
     let mut word = row.get(w)? & (!0u64 << (from % 64));
@@ -244,6 +319,44 @@ mod tests {
             }
         }
         b
+    }
+
+    #[test]
+    fn classed_quads_cover_each_face_once_with_the_class_of_its_voxel() {
+        for (seed, dims) in [(3u64, [7u32, 5, 6]), (11, [70, 3, 4]), (5, [4, 66, 3])] {
+            let b = blob(dims, seed, 45);
+            let class = |i: u32, j: u32, k: u32| (i * 7 + j * 3 + k) % 3;
+            let quads = greedy_quads_by_class(&b, &class);
+            let mut seen = std::collections::HashSet::new();
+            for q in &quads {
+                let (d, ax, bx) = (q.axis, (q.axis + 1) % 3, (q.axis + 2) % 3);
+                for a in q.a.0..q.a.1 {
+                    for c in q.b.0..q.b.1 {
+                        let mut v = [0i64; 3];
+                        v[d] = q.at as i64 - q.positive as i64;
+                        v[ax] = a as i64;
+                        v[bx] = c as i64;
+                        let mut front = v;
+                        front[d] += if q.positive { 1 } else { -1 };
+                        assert!(b.get_signed(v[0], v[1], v[2]) && !b.get_signed(front[0], front[1], front[2]));
+                        assert_eq!(class(v[0] as u32, v[1] as u32, v[2] as u32), q.class, "{q:?}");
+                        assert!(seen.insert((v, q.axis, q.positive)), "face covered twice");
+                    }
+                }
+            }
+            let mut faces = 0;
+            b.for_each_set(|i, j, k| {
+                for d in 0..3 {
+                    for s in [-1i64, 1] {
+                        let mut n = [i as i64, j as i64, k as i64];
+                        n[d] += s;
+                        faces += !b.get_signed(n[0], n[1], n[2]) as usize;
+                    }
+                }
+            });
+            assert_eq!(seen.len(), faces);
+            assert!(quads.len() >= greedy_quads(&b).len());
+        }
     }
 
     #[test]

@@ -168,6 +168,13 @@ pub fn prepare(mesh: MeshRef<'_>, grid: &GridSpec) -> (Vec<LatticeTriangle>, Pre
     (tris, stats)
 }
 
+/// Snaps one triangle (`tri` indexes `positions`) to the lattice of `grid`
+/// exactly as [`prepare`] does, appending its lattice triangles (none if it
+/// is skipped, several if it was clipped) to `out`.
+pub fn prepare_triangle(positions: &[DVec3], tri: &[u32; 3], grid: &GridSpec, out: &mut Vec<LatticeTriangle>) {
+    prepare_one(positions, tri, grid, out, &mut PrepareStats::default());
+}
+
 fn prepare_one(positions: &[DVec3], tri: &[u32; 3], grid: &GridSpec, out: &mut Vec<LatticeTriangle>, st: &mut PrepareStats) {
     st.input += 1;
     let mut g = [DVec3::ZERO; 3];

@@ -8,6 +8,10 @@
 //! Blinn, "Models of Light Reflection for Computer Synthesized Pictures",
 //! SIGGRAPH 1977 (the half-vector specular term).
 //!
+//! Voxel colours, when given, replace the clay colour; a mesh's silhouette
+//! outline can be drawn over the picture (its triangles projected with the
+//! same camera and rasterized at pixel centres).
+//!
 //! **Guarantee.** Each pixel shows the first set voxel its ray enters (the
 //! voxel, not an approximation: the DDA visits every cell the ray passes
 //! through, in order), shaded by the face it enters through. Empty 8×8×8
@@ -21,6 +25,8 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::attributes::colour::to_linear;
+use crate::attributes::VoxelAttributes;
 use crate::grid::bricks::{BrickBits, BRICK};
 
 /// Where the camera looks from.
@@ -134,6 +140,73 @@ fn angles(front: DVec3, side: DVec3, up: DVec3, az: f64, el: f64) -> DVec3 {
 
 /// Renders `bits` (rows of pixels in parallel).
 pub fn render(bits: &BrickBits, o: &RenderOptions) -> Image {
+    render_with(bits, o, None, None)
+}
+
+/// [`render`] with voxel colours (`colours`, sRGB, where present) and the
+/// outline of a mesh's silhouette (`outline`: triangles in grid units,
+/// `grid.to_grid_units(p)`), drawn dark over the picture.
+pub fn render_with(bits: &BrickBits, o: &RenderOptions, colours: Option<&VoxelAttributes>, outline: Option<&[[DVec3; 3]]>) -> Image {
+    let colours = colours.filter(|c| c.colour.is_some());
+    let mut img = shade(bits, o, colours);
+    if let Some(tris) = outline {
+        let cam = Camera::new(bits.dims(), o);
+        let mask = silhouette(&cam, tris, img.width, img.height);
+        let (w, h) = (img.width as usize, img.height as usize);
+        let inside = |x: i64, y: i64| x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h && mask[y as usize * w + x as usize];
+        for y in 0..h as i64 {
+            for x in 0..w as i64 {
+                if !inside(x, y) {
+                    continue;
+                }
+                let edge = (-1..=1).any(|dy| (-1..=1).any(|dx| !inside(x + dx, y + dy)));
+                if edge {
+                    let at = (y as usize * w + x as usize) * 3;
+                    img.rgb[at..at + 3].copy_from_slice(&[24, 26, 34]);
+                }
+            }
+        }
+    }
+    img
+}
+
+/// Pixels whose centre lies inside (or on) a projected triangle.
+fn silhouette(cam: &Camera, tris: &[[DVec3; 3]], w: u32, h: u32) -> Vec<bool> {
+    let mut mask = vec![false; w as usize * h as usize];
+    let project = |p: DVec3| {
+        let d = p - cam.centre;
+        (d.dot(cam.right) / cam.scale + w as f64 * 0.5 - 0.5, h as f64 * 0.5 - 0.5 - d.dot(cam.up) / cam.scale)
+    };
+    for t in tris {
+        let q = t.map(project);
+        if q.iter().any(|p| !p.0.is_finite() || !p.1.is_finite()) {
+            continue;
+        }
+        let area = (q[1].0 - q[0].0) * (q[2].1 - q[0].1) - (q[1].1 - q[0].1) * (q[2].0 - q[0].0);
+        if area == 0.0 {
+            continue;
+        }
+        let x0 = q.iter().map(|p| p.0).fold(f64::INFINITY, f64::min).ceil().max(0.0) as i64;
+        let x1 = q.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max).floor().min(w as f64 - 1.0) as i64;
+        let y0 = q.iter().map(|p| p.1).fold(f64::INFINITY, f64::min).ceil().max(0.0) as i64;
+        let y1 = q.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max).floor().min(h as f64 - 1.0) as i64;
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let (px, py) = (x as f64, y as f64);
+                let inside = (0..3).all(|e| {
+                    let (a, b) = (q[e], q[(e + 1) % 3]);
+                    ((b.0 - a.0) * (py - a.1) - (b.1 - a.1) * (px - a.0)) * area.signum() >= 0.0
+                });
+                if inside {
+                    mask[y as usize * w as usize + x as usize] = true;
+                }
+            }
+        }
+    }
+    mask
+}
+
+fn shade(bits: &BrickBits, o: &RenderOptions, colours: Option<&VoxelAttributes>) -> Image {
     let (w, h) = (o.width.max(1), o.height.max(1));
     let cam = Camera::new(bits.dims(), o);
     // Key light from the upper left, in front of the surface; view vector
@@ -160,7 +233,11 @@ pub fn render(bits: &BrickBits, o: &RenderOptions) -> Image {
                         }
                         let diffuse = normal.dot(light).max(0.0);
                         let specular = normal.dot(half).max(0.0).powi(32) * 0.25;
-                        o.colour.map(|c| c * (0.22 + 0.78 * diffuse) + specular)
+                        let base = match colours.and_then(|c| c.colour_of(hit.voxel[0], hit.voxel[1], hit.voxel[2])) {
+                            Some(c) => c.map(to_linear),
+                            None => o.colour,
+                        };
+                        base.map(|c| c * (0.22 + 0.78 * diffuse) + specular)
                     }
                     None => background,
                 };

@@ -1,0 +1,454 @@
+//! Carrying colour, material, normal and coverage from triangles into voxels.
+//!
+//! For every triangle, the voxels it touches are enumerated exactly (the
+//! `cover` traversal on the snapped triangle, so every set voxel of every
+//! surface mode — all subsets of `cover` — is reached). Each voxel box then
+//! clips the triangle (Sutherland–Hodgman, f64, grid units) and the part
+//! inside is what the voxel gets:
+//! - **coverage**: the clipped polygon's area, in units of the voxel face;
+//! - **colour**: the clipped polygon is sampled on a regular barycentric
+//!   subdivision fine enough to visit every texel it covers (nearest-texel
+//!   lookups, up to 24² samples per fan triangle), each sample weighted by
+//!   its share of the area. [`ColourRule::Dominant`] keeps the colour with
+//!   the most area (ties: the smaller `0xRRGGBB`), so it only produces
+//!   colours of the source; [`ColourRule::Blend`] takes the area-weighted
+//!   mean in linear light;
+//! - **material**: the material with the most area (ties: the smaller id);
+//! - **normal**: the area-weighted mean of the triangles' unit normals.
+//!
+//! A voxel that a triangle only touches (zero area inside) uses that touch
+//! as a point sample, and only when no triangle has area inside it. Voxels
+//! no triangle touches (solid interiors, `pos`'s off-surface voxels) take the
+//! attributes of the nearest voxel that has them: a breadth-first search
+//! over 26-neighbours from all surface voxels at once, in key order, so ties
+//! resolve the same way on every run. Contributions are reduced in
+//! (voxel, triangle) order, so results do not depend on the thread count.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::colour::{from_linear, linear_to_rgb, pack, to_linear, unpack};
+use super::{Appearance, ColourRule, Texture, VoxelAttributes, NO_MATERIAL};
+use crate::geom::clip::clip_polygon_to_box;
+use crate::geom::lattice::prepare_triangle;
+use crate::voxelize::cover::cover_triangle;
+use crate::voxelize::driver::Sink;
+use crate::voxelize::Traversal;
+use crate::{GridSpec, MeshRef, VoxelSource};
+
+/// What to compute.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CarryOptions {
+    /// How colours inside a voxel combine.
+    pub rule: ColourRule,
+    /// Compute the average normal.
+    pub normals: bool,
+}
+
+/// The colour a voxel gets when the mesh has none of its own (the renderer's clay).
+pub const DEFAULT_COLOUR: [u8; 3] = [200, 200, 200];
+
+/// Most samples along a fan triangle's side.
+const MAX_SUBDIV: u32 = 24;
+
+struct Contribution {
+    slot: usize,
+    tri: u32,
+    area: f64,
+    /// Total weight of the colour samples (the area, or 1 for a touch).
+    w: f64,
+    /// Blend: weighted linear RGB.
+    lin: [f64; 3],
+    /// Dominant: area per `0xRRGGBB`.
+    hist: Vec<(u32, f64)>,
+}
+
+/// Attributes of the set voxels of `voxels` (on `grid`) from the triangles of `mesh`.
+/// Colour is present when `appearance` has colour, material ids when it has
+/// materials, normals when asked; coverage always.
+pub fn carry(mesh: MeshRef<'_>, appearance: &Appearance, grid: &GridSpec, voxels: &dyn VoxelSource, opts: &CarryOptions) -> VoxelAttributes {
+    let dims = grid.dims();
+    let mut keys = Vec::with_capacity(voxels.count() as usize);
+    voxels.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
+    let ctx = Ctx { mesh, app: appearance, grid, keys: &keys, rule: opts.rule, colour: appearance.has_colour() };
+    let mut contribs: Vec<Contribution> =
+        (0..mesh.triangles.len()).into_par_iter().with_min_len(64).flat_map_iter(|t| ctx.triangle(t)).collect();
+    contribs.par_sort_unstable_by_key(|c| (c.slot, c.tri));
+
+    let n = keys.len();
+    let materials = appearance.has_materials();
+    let mut has = vec![false; n];
+    let mut colour = vec![DEFAULT_COLOUR; if ctx.colour { n } else { 0 }];
+    let mut material = vec![NO_MATERIAL; if materials { n } else { 0 }];
+    let mut normal = vec![[0f32; 3]; if opts.normals { n } else { 0 }];
+    let mut coverage = vec![0f32; n];
+    let mut hist: Vec<(u32, f64)> = Vec::new();
+    let mut mats: Vec<(u32, f64)> = Vec::new();
+    for group in contribs.chunk_by(|a, b| a.slot == b.slot) {
+        let slot = group[0].slot;
+        has[slot] = true;
+        let any_area = group.iter().any(|c| c.area > 0.0);
+        let used = || group.iter().filter(move |c| !any_area || c.area > 0.0);
+        let weight = |c: &Contribution| if any_area { c.area } else { 1.0 };
+        coverage[slot] = group.iter().map(|c| c.area).sum::<f64>() as f32;
+        if ctx.colour {
+            colour[slot] = match opts.rule {
+                ColourRule::Blend => {
+                    let mut sum = [0.0; 3];
+                    let mut w = 0.0;
+                    for c in used() {
+                        (0..3).for_each(|a| sum[a] += c.lin[a]);
+                        w += c.w;
+                    }
+                    linear_to_rgb(sum.map(|s| if w > 0.0 { s / w } else { 0.0 }))
+                }
+                ColourRule::Dominant => {
+                    hist.clear();
+                    for c in used() {
+                        hist.extend(c.hist.iter().copied());
+                    }
+                    unpack(argmax(&mut hist).unwrap_or(pack(DEFAULT_COLOUR)))
+                }
+            };
+        }
+        if materials {
+            mats.clear();
+            mats.extend(used().map(|c| (ctx.app.triangle_material.get(c.tri as usize).copied().unwrap_or(NO_MATERIAL), weight(c))));
+            material[slot] = argmax(&mut mats).unwrap_or(NO_MATERIAL);
+        }
+        if opts.normals {
+            let mut s = DVec3::ZERO;
+            for c in used() {
+                s += ctx.unit_normal(c.tri as usize) * weight(c);
+            }
+            normal[slot] = s.normalize_or_zero().as_vec3().to_array();
+        }
+    }
+    let with_colour = ctx.colour;
+    drop(ctx);
+    fill_from_nearest(&keys, dims, &mut has, &mut colour, &mut material, &mut normal);
+    VoxelAttributes {
+        dims,
+        keys,
+        colour: with_colour.then_some(colour),
+        material: materials.then_some(material),
+        normal: opts.normals.then_some(normal),
+        coverage: Some(coverage),
+    }
+}
+
+/// The key with the largest summed weight (ties: the smallest key). Sorts `v`.
+fn argmax(v: &mut [(u32, f64)]) -> Option<u32> {
+    v.sort_unstable_by(|a, b| a.0.cmp(&b.0));
+    let mut best: Option<(u32, f64)> = None;
+    for run in v.chunk_by(|a, b| a.0 == b.0) {
+        let w: f64 = run.iter().map(|r| r.1).sum();
+        if best.is_none_or(|(_, bw)| w > bw) {
+            best = Some((run[0].0, w));
+        }
+    }
+    best.map(|b| b.0)
+}
+
+/// Breadth-first search from every voxel that has attributes, over
+/// 26-neighbours among the set voxels; each reached voxel copies its parent.
+fn fill_from_nearest(keys: &[u64], dims: [u32; 3], has: &mut [bool], colour: &mut [[u8; 3]], material: &mut [u32], normal: &mut [[f32; 3]]) {
+    if has.iter().all(|&h| h) || !has.iter().any(|&h| h) {
+        return;
+    }
+    let probe = VoxelAttributes { dims, ..VoxelAttributes::default() };
+    let mut queue: std::collections::VecDeque<usize> = (0..keys.len()).filter(|&s| has[s]).collect();
+    while let Some(s) = queue.pop_front() {
+        let v = probe.voxel(keys[s]).map(|c| c as i64);
+        for dz in -1..=1i64 {
+            for dy in -1..=1i64 {
+                for dx in -1..=1i64 {
+                    let q = [v[0] + dx, v[1] + dy, v[2] + dz];
+                    if (0..3).any(|a| q[a] < 0 || q[a] >= dims[a] as i64) {
+                        continue;
+                    }
+                    let key = VoxelAttributes::key(dims, q[0] as u32, q[1] as u32, q[2] as u32);
+                    let Ok(t) = keys.binary_search(&key) else { continue };
+                    if has[t] {
+                        continue;
+                    }
+                    has[t] = true;
+                    if !colour.is_empty() {
+                        colour[t] = colour[s];
+                    }
+                    if !material.is_empty() {
+                        material[t] = material[s];
+                    }
+                    if !normal.is_empty() {
+                        normal[t] = normal[s];
+                    }
+                    queue.push_back(t);
+                }
+            }
+        }
+    }
+}
+
+struct Ctx<'a> {
+    mesh: MeshRef<'a>,
+    app: &'a Appearance,
+    grid: &'a GridSpec,
+    keys: &'a [u64],
+    rule: ColourRule,
+    colour: bool,
+}
+
+struct Collect(Vec<[u32; 3]>);
+
+impl Sink for Collect {
+    fn set(&mut self, i: u32, j: u32, k: u32) {
+        self.0.push([i, j, k]);
+    }
+}
+
+impl Ctx<'_> {
+    fn corners(&self, t: usize) -> Option<[DVec3; 3]> {
+        let tri = self.mesh.triangles[t];
+        let mut p = [DVec3::ZERO; 3];
+        for c in 0..3 {
+            p[c] = self.grid.to_grid_units(*self.mesh.positions.get(tri[c] as usize)?);
+        }
+        p.iter().all(|q| q.is_finite()).then_some(p)
+    }
+
+    fn unit_normal(&self, t: usize) -> DVec3 {
+        self.corners(t).map(|p| (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero()).unwrap_or(DVec3::ZERO)
+    }
+
+    fn triangle(&self, t: usize) -> Vec<Contribution> {
+        let Some(p) = self.corners(t) else { return Vec::new() };
+        let dims = self.grid.dims();
+        let mut lattice = Vec::new();
+        prepare_triangle(self.mesh.positions, &self.mesh.triangles[t], self.grid, &mut lattice);
+        let mut voxels = Collect(Vec::new());
+        for lt in &lattice {
+            if let Some((lo, hi)) = lt.voxel_bounds(dims) {
+                cover_triangle(lt, lo, hi, Traversal::Auto, &mut voxels);
+            }
+        }
+        let mut voxels = voxels.0;
+        if lattice.len() > 1 {
+            voxels.sort_unstable();
+            voxels.dedup();
+        }
+        let shader = Shader::new(self, t, p);
+        let mut out = Vec::new();
+        for v in voxels {
+            let Ok(slot) = self.keys.binary_search(&VoxelAttributes::key(dims, v[0], v[1], v[2])) else { continue };
+            let lo = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+            let poly = clip_polygon_to_box(&p, lo, lo + DVec3::ONE);
+            let mut c = Contribution { slot, tri: t as u32, area: 0.0, w: 0.0, lin: [0.0; 3], hist: Vec::new() };
+            for w in 1..poly.len().saturating_sub(1) {
+                let (a, b, d) = (poly[0], poly[w], poly[w + 1]);
+                let area = 0.5 * (b - a).cross(d - a).length();
+                if area > 0.0 {
+                    c.area += area;
+                    if self.colour {
+                        shader.sample(a, b, d, area, &mut c);
+                    }
+                }
+            }
+            if c.area <= 0.0 && self.colour {
+                // A touch: one point sample where it touches (or, if the f64
+                // clip lost it, the voxel's nearest point of the triangle's plane).
+                let at = if poly.is_empty() { closest_point(&p, lo + DVec3::splat(0.5)) } else { centroid(&poly) };
+                shader.add(at, 1.0, &mut c);
+            }
+            out.push(c);
+        }
+        out
+    }
+}
+
+fn centroid(poly: &[DVec3]) -> DVec3 {
+    poly.iter().copied().sum::<DVec3>() / poly.len() as f64
+}
+
+/// The point of triangle `p` nearest to `q` (C. Ericson, *Real-Time
+/// Collision Detection*, 5.1.5), for touches the f64 clip misses.
+fn closest_point(p: &[DVec3; 3], q: DVec3) -> DVec3 {
+    let (a, b, c) = (p[0], p[1], p[2]);
+    let (ab, ac, ap) = (b - a, c - a, q - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = q - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = q - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = va + vb + vc;
+    if denom == 0.0 {
+        return a;
+    }
+    a + ab * (vb / denom) + ac * (vc / denom)
+}
+
+/// The colour of one triangle at a point: texture × factor × vertex colour.
+struct Shader<'a> {
+    rule: ColourRule,
+    p0: DVec3,
+    e1: DVec3,
+    e2: DVec3,
+    d: [f64; 4],
+    texture: Option<(&'a Texture, [[f64; 2]; 3])>,
+    factor: Option<[f64; 3]>,
+    vertex: Option<[[u8; 3]; 3]>,
+}
+
+impl<'a> Shader<'a> {
+    fn new(ctx: &Ctx<'a>, t: usize, p: [DVec3; 3]) -> Shader<'a> {
+        let app = ctx.app;
+        let material = app.triangle_material.get(t).and_then(|&m| app.materials.get(m as usize));
+        let uv = app.triangle_uv.get(t).map(|uv| uv.map(|c| [c[0] as f64, c[1] as f64]));
+        let texture = match (material.and_then(|m| m.texture).and_then(|i| app.textures.get(i as usize)), uv) {
+            (Some(tex), Some(uv)) if uv.iter().flatten().all(|c| c.is_finite()) && tex.width > 0 && tex.height > 0 => Some((tex, uv)),
+            _ => None,
+        };
+        let factor = material.map(|m| m.factor.map(|f| f as f64)).filter(|f| *f != [1.0; 3]);
+        let tri = ctx.mesh.triangles[t];
+        let vertex = if app.vertex_colour.is_empty() {
+            None
+        } else {
+            let get = |c: usize| app.vertex_colour.get(tri[c] as usize).copied().unwrap_or([255; 3]);
+            Some([get(0), get(1), get(2)])
+        };
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        Shader { rule: ctx.rule, p0: p[0], e1, e2, d: [d00, d01, d11, d00 * d11 - d01 * d01], texture, factor, vertex }
+    }
+
+    /// Barycentric coordinates of `q` (on the triangle's plane), clamped.
+    fn bary(&self, q: DVec3) -> [f64; 3] {
+        let [d00, d01, d11, den] = self.d;
+        if den <= 0.0 || !den.is_finite() {
+            return [1.0, 0.0, 0.0];
+        }
+        let v = q - self.p0;
+        let (d20, d21) = (v.dot(self.e1), v.dot(self.e2));
+        let b1 = ((d11 * d20 - d01 * d21) / den).clamp(0.0, 1.0);
+        let b2 = ((d00 * d21 - d01 * d20) / den).clamp(0.0, 1.0 - b1);
+        [1.0 - b1 - b2, b1, b2]
+    }
+
+    fn uv(uv: &[[f64; 2]; 3], b: [f64; 3]) -> [f64; 2] {
+        [0, 1].map(|a| b[0] * uv[0][a] + b[1] * uv[1][a] + b[2] * uv[2][a])
+    }
+
+    /// Samples the fan triangle `(a, b, c)` of area `area` on an `n × n`
+    /// barycentric subdivision (`n²` cells of equal area, one sample at each centroid).
+    fn sample(&self, a: DVec3, b: DVec3, c: DVec3, area: f64, out: &mut Contribution) {
+        let n = match &self.texture {
+            Some((tex, uv)) => {
+                let [ua, ub, uc] = [a, b, c].map(|q| Self::uv(uv, self.bary(q)));
+                let cross = (ub[0] - ua[0]) * (uc[1] - ua[1]) - (ub[1] - ua[1]) * (uc[0] - ua[0]);
+                let texels = 0.5 * cross.abs() * tex.width as f64 * tex.height as f64;
+                ((2.0 * texels).sqrt().ceil() as u32).clamp(1, MAX_SUBDIV)
+            }
+            None if self.vertex.is_some() => 4,
+            None => 1,
+        };
+        let w = area / (n * n) as f64;
+        let nf = n as f64;
+        let (e1, e2) = (b - a, c - a);
+        for i in 0..n {
+            for j in 0..n - i {
+                let (fi, fj) = (i as f64, j as f64);
+                self.add(a + e1 * ((fi + 1.0 / 3.0) / nf) + e2 * ((fj + 1.0 / 3.0) / nf), w, out);
+                if i + j + 1 < n {
+                    self.add(a + e1 * ((fi + 2.0 / 3.0) / nf) + e2 * ((fj + 2.0 / 3.0) / nf), w, out);
+                }
+            }
+        }
+    }
+
+    /// Adds one sample of weight `w` at `q`.
+    fn add(&self, q: DVec3, w: f64, out: &mut Contribution) {
+        let b = self.bary(q);
+        out.w += w;
+        match self.rule {
+            ColourRule::Dominant => {
+                let c = pack(self.dominant_colour(b));
+                match out.hist.iter_mut().find(|h| h.0 == c) {
+                    Some(h) => h.1 += w,
+                    None => out.hist.push((c, w)),
+                }
+            }
+            ColourRule::Blend => {
+                let l = self.linear_colour(b);
+                (0..3).for_each(|a| out.lin[a] += l[a] * w);
+            }
+        }
+    }
+
+    /// The exact source colour at `b`: the nearest texel, the nearest
+    /// vertex's colour; multiplied in linear light only when there is a
+    /// factor or both a texture and vertex colours.
+    fn dominant_colour(&self, b: [f64; 3]) -> [u8; 3] {
+        let texel = self.texture.map(|(tex, uv)| {
+            let [u, v] = Self::uv(&uv, b);
+            tex.texel(u, v)
+        });
+        let vertex = self.vertex.map(|vc| {
+            let nearest = if b[0] >= b[1] && b[0] >= b[2] {
+                0
+            } else if b[1] >= b[2] {
+                1
+            } else {
+                2
+            };
+            vc[nearest]
+        });
+        match (texel, vertex, self.factor) {
+            (Some(c), None, None) | (None, Some(c), None) => c,
+            (None, None, None) => [255; 3],
+            (t, v, f) => {
+                let mut l = [1.0; 3];
+                for c in [t, v].into_iter().flatten() {
+                    (0..3).for_each(|a| l[a] *= to_linear(c[a]));
+                }
+                if let Some(f) = f {
+                    (0..3).for_each(|a| l[a] *= f[a]);
+                }
+                l.map(from_linear)
+            }
+        }
+    }
+
+    /// The colour at `b` in linear light, vertex colours interpolated.
+    fn linear_colour(&self, b: [f64; 3]) -> [f64; 3] {
+        let mut l = self.factor.unwrap_or([1.0; 3]);
+        if let Some((tex, uv)) = self.texture {
+            let [u, v] = Self::uv(&uv, b);
+            let c = tex.texel(u, v);
+            (0..3).for_each(|a| l[a] *= to_linear(c[a]));
+        }
+        if let Some(vc) = self.vertex {
+            (0..3).for_each(|a| l[a] *= b[0] * to_linear(vc[0][a]) + b[1] * to_linear(vc[1][a]) + b[2] * to_linear(vc[2][a]));
+        }
+        l
+    }
+}
