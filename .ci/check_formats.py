@@ -2,7 +2,10 @@
 
 NumPy reads the .npy files; the `binvox` package from PyPI reads the
 .binvox file; both must hold exactly the voxels of voxkit's text list, with
-the grid placement reported by `--json`. Prints 'N passed, M failed'.
+the grid placement reported by `--json`. For the textured spot: VTK's own
+XML reader (`vtk` package) reads the .vti, `nbtlib` the .schem, `plyfile`
+the point cloud and `pygltflib` the .glb; each must agree with the .npy and
+with each other on voxels and colours. Prints 'N passed, M failed'.
 """
 import json
 import subprocess
@@ -68,6 +71,71 @@ with tempfile.TemporaryDirectory() as d:
         check(f"{mesh} binvox scale", abs(bv.scale - side * summary["voxel_size"]) < 1e-12, bv.scale)
         data = np.asarray(bv.data)
         check(f"{mesh} binvox voxels (binvox package, xyz order)", np.array_equal(data[:nx, :ny, :nz], a.astype(bool)) and int(data.sum()) == int(a.sum()))
+
+    # Coloured formats on the textured spot.
+    spot = MESHES / "spot-textured.obj"
+    summary = voxelize(spot, d / "s.npy", "--resolution", "64")
+    for ext in ["vti", "schem", "ply", "glb", "vox"]:
+        voxelize(spot, d / f"s.{ext}", "--resolution", "64")
+    occ = np.load(d / "s.npy").astype(bool)
+    nx, ny, nz = summary["dims"]
+
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+    r = vtk.vtkXMLImageDataReader()
+    r.SetFileName(str(d / "s.vti"))
+    r.Update()
+    img = r.GetOutput()
+    check("vti dims (points) via VTK", img.GetDimensions() == (nx + 1, ny + 1, nz + 1), img.GetDimensions())
+    check("vti origin and spacing via VTK", np.allclose(img.GetOrigin(), summary["origin"]) and np.allclose(img.GetSpacing(), [summary["voxel_size"]] * 3))
+    cells = img.GetCellData()
+    vocc = vtk_to_numpy(cells.GetArray("occupancy")).reshape(nz, ny, nx).transpose(2, 1, 0)
+    check("vti occupancy = npy", np.array_equal(vocc.astype(bool), occ))
+    vcol = vtk_to_numpy(cells.GetArray("colour")).reshape(nz, ny, nx, 3).transpose(2, 1, 0, 3)
+    cov = vtk_to_numpy(cells.GetArray("coverage")).reshape(nz, ny, nx).transpose(2, 1, 0)
+    check("vti coverage > 0 only on voxels", bool((cov[~occ] == 0).all()) and float(cov[occ].mean()) > 0.1)
+    mat = vtk_to_numpy(cells.GetArray("material")).reshape(nz, ny, nx).transpose(2, 1, 0)
+    check("vti material 0 on voxels, -1 elsewhere", bool((mat[occ] == 0).all()) and bool((mat[~occ] == -1).all()))
+
+    from plyfile import PlyData
+    ply = PlyData.read(str(d / "s.ply"))["vertex"]
+    o, s = np.array(summary["origin"]), summary["voxel_size"]
+    ijk = np.floor((np.stack([ply["x"], ply["y"], ply["z"]], 1) - o) / s).astype(int)
+    pocc = np.zeros_like(occ)
+    pocc[ijk[:, 0], ijk[:, 1], ijk[:, 2]] = True
+    check("ply point cloud voxels = npy (plyfile)", len(ijk) == occ.sum() and np.array_equal(pocc, occ))
+    pcol = np.stack([ply["red"], ply["green"], ply["blue"]], 1)
+    check("ply colours = vti colours", np.array_equal(pcol, vcol[ijk[:, 0], ijk[:, 1], ijk[:, 2]]))
+    check("spot has more than 4 distinct colours", len(np.unique(pcol, axis=0)) > 4)
+
+    import nbtlib
+    sch = nbtlib.load(str(d / "s.schem"))
+    root = sch["Schematic"] if "Schematic" in sch else sch
+    check("schem version 2 (nbtlib)", int(root["Version"]) == 2)
+    w, h, l = int(root["Width"]), int(root["Height"]), int(root["Length"])
+    check("schem size (x=i, y=k, z=j)", (w, h, l) == (nx, nz, ny), (w, h, l))
+    pal = {str(k): int(v) for k, v in root["Palette"].items()}
+    check("schem palette max", int(root["PaletteMax"]) == len(pal))
+    data = bytes(np.asarray(root["BlockData"], dtype=np.int8).astype(np.uint8))
+    ids, v, shift = [], 0, 0
+    for byte in data:
+        v |= (byte & 0x7F) << shift
+        shift += 7
+        if byte < 0x80:
+            ids.append(v)
+            v, shift = 0, 0
+    ids = np.array(ids).reshape(h, l, w)
+    air = pal["minecraft:air"]
+    blocks = (ids != air).transpose(2, 0, 1)  # [x][y][z] = [i][k][ny-1-j]
+    check("schem blocks = npy voxels", np.array_equal(blocks[:, :, ::-1].transpose(0, 2, 1), occ))
+
+    from pygltflib import GLTF2
+    g = GLTF2().load(str(d / "s.glb"))
+    prim = g.meshes[0].primitives[0]
+    check("glb has positions, normals and COLOR_0 (pygltflib)", prim.attributes.POSITION is not None and prim.attributes.NORMAL is not None and prim.attributes.COLOR_0 is not None)
+    acc = g.accessors[prim.attributes.POSITION]
+    hi = np.array(summary["origin"]) + np.array([nx, ny, nz]) * s
+    check("glb bounds inside the grid", np.all(np.array(acc.min) >= np.array(summary["origin"]) - 1e-5) and np.all(np.array(acc.max) <= hi + 1e-5))
 
 print(f"{passed} passed, {failed} failed")
 sys.exit(1 if failed else 0)

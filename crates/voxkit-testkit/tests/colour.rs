@@ -1,0 +1,268 @@
+//! Colours carried into voxels: against direct texture lookups (an
+//! independent OBJ + PNG reading of spot), the UV and wrap conventions on a
+//! hand-made quad, vertex colours under both rules, solid interiors, and
+//! independence from the thread count.
+
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use voxkit::attributes::carry::{carry, CarryOptions};
+use voxkit::attributes::{ColourRule, VoxelAttributes};
+use voxkit::voxelize::{self, Mode, Options};
+use voxkit::GridSpec;
+use voxkit_testkit::shared_meshes_dir;
+
+fn spot_path() -> PathBuf {
+    shared_meshes_dir().join("spot-textured.obj")
+}
+
+fn attrs_for(path: &Path, mode: Mode, res: u64, rule: ColourRule) -> (voxkit_io::LoadedMesh, GridSpec, VoxelAttributes) {
+    let loaded = voxkit_io::read_mesh(path).unwrap();
+    let grid = GridSpec::from_resolution(&loaded.report.bounds, res).unwrap();
+    let (bits, _) = voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &Options::default());
+    let a = carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &bits, &CarryOptions { rule, normals: true });
+    assert_eq!(a.keys.len() as u64, bits.count());
+    (loaded, grid, a)
+}
+
+fn texture_colours(path: &Path) -> HashSet<[u8; 3]> {
+    let img = image::open(path).unwrap().to_rgb8();
+    img.pixels().map(|p| p.0).collect()
+}
+
+#[test]
+fn dominant_only_produces_texture_colours_in_every_mode() {
+    let texels = texture_colours(&shared_meshes_dir().join("spot_texture.png"));
+    for mode in [Mode::Cover, Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Pos] {
+        let (_, _, a) = attrs_for(&spot_path(), mode, 80, ColourRule::Dominant);
+        let c = a.colour.as_ref().expect("spot has a texture");
+        let distinct: HashSet<_> = c.iter().collect();
+        assert!(distinct.len() > 20, "{mode:?}: only {} colours", distinct.len());
+        for col in c {
+            assert!(texels.contains(col), "{mode:?}: {col:?} is not a texture colour");
+        }
+        assert!(a.material.as_ref().unwrap().iter().all(|&m| m == 0));
+    }
+    // Blend makes colours between texels (area-weighted means).
+    let (_, _, b) = attrs_for(&spot_path(), Mode::Cover, 80, ColourRule::Blend);
+    let invented = b.colour.as_ref().unwrap().iter().filter(|c| !texels.contains(*c)).count();
+    assert!(invented > 0, "blend produced only texel colours");
+}
+
+/// An independent reading of spot: OBJ `v`/`vt`/`f v/vt` records and the PNG,
+/// v flipped by hand (row = (1 − v)·H).
+struct Spot {
+    tris: Vec<[DVec3; 3]>,
+    uvs: Vec<[[f64; 2]; 3]>,
+    img: image::RgbImage,
+}
+
+fn read_spot() -> Spot {
+    let text = std::fs::read_to_string(spot_path()).unwrap();
+    let (mut v, mut vt, mut tris, mut uvs) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for line in text.lines() {
+        let w: Vec<&str> = line.split_whitespace().collect();
+        match w.first() {
+            Some(&"v") => v.push(DVec3::new(w[1].parse().unwrap(), w[2].parse().unwrap(), w[3].parse().unwrap())),
+            Some(&"vt") => vt.push([w[1].parse::<f64>().unwrap(), w[2].parse::<f64>().unwrap()]),
+            Some(&"f") => {
+                let c: Vec<(usize, usize)> = w[1..]
+                    .iter()
+                    .map(|c| {
+                        let mut p = c.split('/');
+                        (p.next().unwrap().parse::<usize>().unwrap() - 1, p.next().unwrap().parse::<usize>().unwrap() - 1)
+                    })
+                    .collect();
+                for k in 1..c.len() - 1 {
+                    let t = [c[0], c[k], c[k + 1]];
+                    tris.push(t.map(|(p, _)| v[p]));
+                    uvs.push(t.map(|(_, u)| vt[u]));
+                }
+            }
+            _ => {}
+        }
+    }
+    Spot { tris, uvs, img: image::open(shared_meshes_dir().join("spot_texture.png")).unwrap().to_rgb8() }
+}
+
+/// Area per texel colour of the surface inside voxel box `[lo, hi]`, by
+/// dense stratified sampling of every triangle near it.
+fn direct_lookup(s: &Spot, lo: DVec3, hi: DVec3) -> Vec<([u8; 3], f64)> {
+    const N: usize = 120;
+    let mut area: HashMap<[u8; 3], f64> = HashMap::new();
+    let (w, h) = (s.img.width() as f64, s.img.height() as f64);
+    for (t, uv) in s.tris.iter().zip(&s.uvs) {
+        let tlo = t[0].min(t[1]).min(t[2]);
+        let thi = t[0].max(t[1]).max(t[2]);
+        if tlo.cmpgt(hi).any() || thi.cmplt(lo).any() {
+            continue;
+        }
+        let a = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+        let per = a / (N * N) as f64;
+        for i in 0..N {
+            for j in 0..N - i {
+                for (di, dj) in [(1.0 / 3.0, 1.0 / 3.0), (2.0 / 3.0, 2.0 / 3.0)] {
+                    if di > 0.5 && i + j + 1 >= N {
+                        continue;
+                    }
+                    let (b1, b2) = ((i as f64 + di) / N as f64, (j as f64 + dj) / N as f64);
+                    let p = t[0] + (t[1] - t[0]) * b1 + (t[2] - t[0]) * b2;
+                    if p.cmplt(lo).any() || p.cmpgt(hi).any() {
+                        continue;
+                    }
+                    let u = uv[0][0] + (uv[1][0] - uv[0][0]) * b1 + (uv[2][0] - uv[0][0]) * b2;
+                    let v = uv[0][1] + (uv[1][1] - uv[0][1]) * b1 + (uv[2][1] - uv[0][1]) * b2;
+                    let x = ((u.rem_euclid(1.0)) * w).floor().min(w - 1.0) as u32;
+                    let y = (((1.0 - v).rem_euclid(1.0)) * h).floor().min(h - 1.0) as u32;
+                    *area.entry(s.img.get_pixel(x, y).0).or_default() += per;
+                }
+            }
+        }
+    }
+    let mut v: Vec<_> = area.into_iter().collect();
+    v.sort_by(|a, b| b.1.total_cmp(&a.1));
+    v
+}
+
+#[test]
+fn spot_voxel_colours_match_direct_texture_lookups() {
+    let (_, grid, a) = attrs_for(&spot_path(), Mode::Cover, 48, ColourRule::Dominant);
+    let spot = read_spot();
+    let colours = a.colour.as_ref().unwrap();
+    let (mut checked, mut agree) = (0, 0);
+    for slot in (0..a.keys.len()).step_by(a.keys.len() / 150) {
+        let v = a.voxel(a.keys[slot]);
+        let lo = grid.voxel_min(v);
+        let hi = lo + DVec3::splat(grid.voxel_size());
+        let direct = direct_lookup(&spot, lo, hi);
+        let total: f64 = direct.iter().map(|d| d.1).sum();
+        if total <= 0.0 {
+            continue;
+        }
+        // Only voxels with a clear winner: sampling noise cannot flip them.
+        let second = direct.get(1).map(|d| d.1).unwrap_or(0.0);
+        if direct[0].1 < 0.5 * total || direct[0].1 - second < 0.25 * total {
+            continue;
+        }
+        checked += 1;
+        agree += (colours[slot] == direct[0].0) as usize;
+        assert_eq!(colours[slot], direct[0].0, "voxel {v:?}: voxkit {:?}, direct lookup {:?}", colours[slot], &direct[..direct.len().min(3)]);
+        let cov = a.coverage.as_ref().unwrap()[slot] as f64;
+        let want = total / (grid.voxel_size() * grid.voxel_size());
+        assert!((cov - want).abs() < 0.02 + 0.02 * want, "voxel {v:?}: coverage {cov} vs sampled {want}");
+    }
+    assert!(checked >= 40, "only {checked} voxels had a clear dominant colour");
+    assert_eq!(agree, checked);
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("voxkit-colour-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A 2×2 texture: top row red, green; bottom row blue, white.
+fn quad_scene(dir: &Path, u0: f64, map: &str) -> PathBuf {
+    let mut img = image::RgbImage::new(2, 2);
+    img.put_pixel(0, 0, image::Rgb([255, 0, 0]));
+    img.put_pixel(1, 0, image::Rgb([0, 255, 0]));
+    img.put_pixel(0, 1, image::Rgb([0, 0, 255]));
+    img.put_pixel(1, 1, image::Rgb([255, 255, 255]));
+    img.save(dir.join("t.png")).unwrap();
+    std::fs::write(dir.join("q.mtl"), format!("newmtl q\nKd 1 1 1\nmap_Kd {map}\n")).unwrap();
+    let obj = format!(
+        "mtllib q.mtl\nusemtl q\nv 0 0 0.25\nv 1 0 0.25\nv 1 1 0.25\nv 0 1 0.25\nvt {u0} 0\nvt {} 0\nvt {} 1\nvt {u0} 1\nf 1/1 2/2 3/3 4/4\n",
+        u0 + 1.0,
+        u0 + 1.0
+    );
+    let p = dir.join("q.obj");
+    std::fs::write(&p, obj).unwrap();
+    p
+}
+
+fn quad_colours(path: &Path) -> Vec<[u8; 3]> {
+    let loaded = voxkit_io::read_mesh(path).unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    let grid = GridSpec::new(DVec3::ZERO, 0.5, [2, 2, 1]).unwrap();
+    let (bits, _) = voxelize::fast(Mode::Cover, loaded.mesh.as_ref(), &grid, &Options::default());
+    let a = carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &bits, &CarryOptions::default());
+    [[0, 0], [1, 0], [0, 1], [1, 1]].iter().map(|&[i, j]| a.colour_of(i, j, 0).unwrap()).collect()
+}
+
+#[test]
+fn obj_uvs_are_flipped_and_wrapped() {
+    let d = temp_dir("quad");
+    // vt (0,0) is the bottom-left of the image in OBJ: voxel (0,0) is blue.
+    let want = vec![[0, 0, 255], [255, 255, 255], [255, 0, 0], [0, 255, 0]];
+    assert_eq!(quad_colours(&quad_scene(&d, 0.0, "t.png")), want);
+    // u in [1, 2] repeats to the same picture ...
+    assert_eq!(quad_colours(&quad_scene(&d, 1.0, "t.png")), want);
+    // ... and clamps to the right column with `-clamp on`.
+    let clamped = vec![[255, 255, 255], [255, 255, 255], [0, 255, 0], [0, 255, 0]];
+    assert_eq!(quad_colours(&quad_scene(&d, 1.0, "-clamp on t.png")), clamped);
+}
+
+#[test]
+fn a_missing_texture_warns_and_uses_the_material_colour() {
+    let d = temp_dir("missing");
+    std::fs::write(d.join("q.mtl"), "newmtl q\nKd 0.5 0.25 1\nmap_Kd nowhere.png\n").unwrap();
+    std::fs::write(d.join("q.obj"), "mtllib q.mtl\nusemtl q\nv 0 0 0.25\nv 1 0 0.25\nv 1 1 0.25\nvt 0 0\nvt 1 0\nvt 1 1\nf 1/1 2/2 3/3\n").unwrap();
+    let loaded = voxkit_io::read_mesh(&d.join("q.obj")).unwrap();
+    assert!(loaded.warnings.iter().any(|w| w.contains("nowhere.png") && w.contains("Kd")), "{:?}", loaded.warnings);
+    let grid = GridSpec::new(DVec3::ZERO, 0.5, [2, 2, 1]).unwrap();
+    let (bits, _) = voxelize::fast(Mode::Cover, loaded.mesh.as_ref(), &grid, &Options::default());
+    let a = carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &bits, &CarryOptions::default());
+    let want = [0.5f64, 0.25, 1.0].map(voxkit::attributes::colour::from_linear);
+    assert!(a.colour.unwrap().iter().all(|&c| c == want));
+}
+
+#[test]
+fn vertex_colours_dominant_picks_a_vertex_colour_blend_mixes() {
+    let d = temp_dir("ply");
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0.1 255 0 0\n4 0 0.1 0 255 0\n0 4 0.1 0 0 255\n3 0 1 2\n";
+    let p = d.join("t.ply");
+    std::fs::write(&p, ply).unwrap();
+    let loaded = voxkit_io::read_mesh(&p).unwrap();
+    assert_eq!(loaded.appearance.vertex_colour.len(), 3);
+    let grid = GridSpec::new(DVec3::ZERO, 0.5, [8, 8, 1]).unwrap();
+    let (bits, _) = voxelize::fast(Mode::Cover, loaded.mesh.as_ref(), &grid, &Options::default());
+    let dom = carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &bits, &CarryOptions { rule: ColourRule::Dominant, normals: false });
+    let corners: HashSet<[u8; 3]> = [[255, 0, 0], [0, 255, 0], [0, 0, 255]].into();
+    assert!(dom.colour.as_ref().unwrap().iter().all(|c| corners.contains(c)));
+    assert_eq!(dom.colour_of(0, 0, 0), Some([255, 0, 0]));
+    assert_eq!(dom.colour_of(7, 0, 0), Some([0, 255, 0]));
+    let blend = carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &bits, &CarryOptions { rule: ColourRule::Blend, normals: false });
+    let mid = blend.colour_of(3, 2, 0).unwrap();
+    assert!(mid.iter().all(|&c| c > 40), "a voxel inside the triangle mixes all three: {mid:?}");
+}
+
+#[test]
+fn solid_interiors_take_the_nearest_surface_colour() {
+    let loaded = voxkit_io::read_mesh(&spot_path()).unwrap();
+    let grid = GridSpec::from_resolution(&loaded.report.bounds, 40).unwrap();
+    let (solid, _) = voxkit::voxelize::solid::parity(loaded.mesh.as_ref(), &grid).unwrap();
+    let a = carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &solid, &CarryOptions::default());
+    let texels = texture_colours(&shared_meshes_dir().join("spot_texture.png"));
+    let c = a.colour.as_ref().unwrap();
+    assert_eq!(c.len() as u64, solid.count());
+    assert!(c.iter().all(|col| texels.contains(col)));
+    // Interior voxels (no surface inside) exist and are coloured from a neighbour.
+    let cov = a.coverage.as_ref().unwrap();
+    let interior = (0..c.len()).filter(|&s| cov[s] == 0.0).count();
+    assert!(interior > 100, "{interior}");
+}
+
+#[test]
+fn attributes_do_not_depend_on_the_thread_count() {
+    let loaded = voxkit_io::read_mesh(&spot_path()).unwrap();
+    let grid = GridSpec::from_resolution(&loaded.report.bounds, 64).unwrap();
+    let (bits, _) = voxelize::fast(Mode::Cover, loaded.mesh.as_ref(), &grid, &Options::default());
+    let run = |threads: usize, rule| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &bits, &CarryOptions { rule, normals: true }))
+    };
+    for rule in [ColourRule::Dominant, ColourRule::Blend] {
+        assert_eq!(run(1, rule), run(3, rule));
+    }
+}
