@@ -103,7 +103,7 @@ fn voxel_size_fits_the_bounding_box() {
 #[test]
 fn every_output_format_is_written() {
     let cow = shared("cow.obj");
-    for name in ["o.npy", "o.binvox", "o.vox", "o.txt"] {
+    for name in ["o.npy", "o.binvox", "o.vox", "o.txt", "o.schem", "o.vti", "o.ply", "o.glb", "o.obj"] {
         let p = tmp(name);
         json(&voxkit(&["voxelize", &cow, "-o", &p, "--resolution", "32", "--json"]));
         assert!(std::fs::metadata(&p).unwrap().len() > 0);
@@ -411,7 +411,7 @@ fn convert_to_obj_gives_a_mesh_that_voxelizes_back_to_the_same_voxels() {
     let obj = tmp("m.obj");
     let size_s = size.to_string();
     let c = json(&voxkit(&["convert", &npy, &obj, "--origin", &origin, "--voxel-size", &size_s, "--json"]));
-    assert!(c["quads"].as_u64().unwrap() > 6);
+    assert!(c["export"]["quads"].as_u64().unwrap() > 6);
     let back = tmp("m-back.npy");
     let args = [
         "voxelize",
@@ -433,4 +433,40 @@ fn convert_to_obj_gives_a_mesh_that_voxelizes_back_to_the_same_voxels() {
     let b = json(&voxkit(&args));
     assert_eq!(b["voxels"], s["voxels"]);
     assert_eq!(std::fs::read(&back).unwrap(), std::fs::read(&npy).unwrap(), "the mesh of the voxels does not bound the same voxels");
+}
+
+#[test]
+fn textured_spot_goes_to_every_coloured_format_and_back() {
+    let spot = shared("spot-textured.obj");
+    let vox = tmp("spot.vox");
+    let png = tmp("spot.png");
+    let s = json(&voxkit(&["voxelize", &spot, "-o", &vox, "--resolution", "48", "--preview", &png, "--outline", "--size", "160x120", "--json"]));
+    assert_eq!(s["attributes"]["colour"], true);
+    assert_eq!(s["attributes"]["colour_rule"], "dominant");
+    assert_eq!(png_size(&png), (160, 120));
+    for ext in ["schem", "vti", "ply", "glb", "obj", "npy"] {
+        let out = tmp(&format!("spot.{ext}"));
+        let c = json(&voxkit(&["convert", &vox, &out, "--json"]));
+        assert_eq!(c["voxels"], s["voxels"], "{ext}");
+        assert!(std::fs::metadata(&out).unwrap().len() > 100, "{ext}");
+    }
+    assert!(std::fs::metadata(tmp("spot.mtl")).is_ok(), "a coloured .obj comes with its .mtl");
+    // Every voxel file renders, with its colours.
+    for ext in ["vox", "schem", "vti", "ply"] {
+        let r = json(&voxkit(&["render", &tmp(&format!("spot.{ext}")), "-o", &tmp("r.png"), "--size", "64x48", "--json"]));
+        assert_eq!(r["voxels"], s["voxels"], "{ext}");
+    }
+    // The same voxels whatever the format: read back by check.
+    let c = json(&voxkit(&["check", &tmp("spot.vti"), "--json"]));
+    assert_eq!(c["voxels"], s["voxels"]);
+    // Blend and normals are accepted; a bad palette file is one line naming it.
+    let vti = tmp("spot-blend.vti");
+    let b = json(&voxkit(&["voxelize", &spot, "-o", &vti, "--resolution", "32", "--colour-rule", "blend", "--normals", "--json"]));
+    assert_eq!(b["attributes"]["normal"], true);
+    let pal = tmp("bad-palette.txt");
+    std::fs::write(&pal, "stone red\n").unwrap();
+    let line = error_line(&["voxelize", &spot, "-o", &tmp("x.schem"), "--block-palette", &pal]);
+    assert!(line.contains("bad-palette.txt") && line.contains("line 1"), "{line}");
+    let line = error_line(&["render", &vox, "-o", &tmp("x.png"), "--outline"]);
+    assert!(line.contains("--outline") && line.contains("mesh"), "{line}");
 }

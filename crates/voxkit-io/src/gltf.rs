@@ -102,9 +102,11 @@ impl Builder {
         };
         let sampler = t.sampler();
         let wrap = [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())];
-        let data = gltf::image::Data::from_source(t.source().source(), base_dir, buffers).map_err(|e| format!("image could not be loaded ({e})"))?;
+        let data = gltf::image::Data::from_source(t.source().source(), base_dir, buffers)
+            .map_err(|e| format!("image could not be loaded ({e})"))?;
         let n = data.width as usize * data.height as usize;
-        let (step, pick): (usize, fn(&[u8]) -> [u8; 4]) = match data.format {
+        type Pick = fn(&[u8]) -> [u8; 4];
+        let (step, pick): (usize, Pick) = match data.format {
             Format::R8 => (1, |p| [p[0], p[0], p[0], 255]),
             Format::R8G8 => (2, |p| [p[0], p[0], p[0], p[1]]),
             Format::R8G8B8 => (3, |p| [p[0], p[1], p[2], 255]),

@@ -63,7 +63,8 @@ pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKi
         // `v x y z r g b`: tobj keeps colours per position (sRGB in [0, 1]).
         if mesh.vertex_color.len() == mesh.positions.len() {
             vertex_colour.resize(base as usize, [255u8; 3]);
-            vertex_colour.extend(mesh.vertex_color.chunks_exact(3).map(|c| [0, 1, 2].map(|a| (c[a].clamp(0.0, 1.0) * 255.0).round() as u8)));
+            vertex_colour
+                .extend(mesh.vertex_color.chunks_exact(3).map(|c| [0, 1, 2].map(|a| (c[a].clamp(0.0, 1.0) * 255.0).round() as u8)));
         }
         let material = m.mesh.material_id.map(|i| i as u32).unwrap_or(NO_MATERIAL);
         let has_uv = mesh.texcoord_indices.len() == mesh.indices.len() && !mesh.texcoords.is_empty();
@@ -78,8 +79,11 @@ pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKi
                 None => [f32::NAN; 2],
             }
         };
-        let arities: Vec<usize> =
-            if mesh.face_arities.is_empty() { vec![3; mesh.indices.len() / 3] } else { mesh.face_arities.iter().map(|&n| n as usize).collect() };
+        let arities: Vec<usize> = if mesh.face_arities.is_empty() {
+            vec![3; mesh.indices.len() / 3]
+        } else {
+            mesh.face_arities.iter().map(|&n| n as usize).collect()
+        };
         let mut at = 0usize;
         for n in arities {
             if at + n > mesh.indices.len() {

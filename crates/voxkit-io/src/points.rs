@@ -68,10 +68,14 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     let bad = |m: String| ErrorKind::malformed("PLY point cloud", m);
     let end = bytes.windows(10).position(|w| w == b"end_header").ok_or_else(|| bad("no end_header".into()))?;
     let head = String::from_utf8_lossy(&bytes[..end]);
-    let line = head.lines().find(|l| l.starts_with(GRID_COMMENT)).ok_or_else(|| bad(format!("no '{GRID_COMMENT} …' line: not a voxkit voxel point cloud (meshes are read by voxelize)")))?;
+    let line = head
+        .lines()
+        .find(|l| l.starts_with(GRID_COMMENT))
+        .ok_or_else(|| bad(format!("no '{GRID_COMMENT} …' line: not a voxkit voxel point cloud (meshes are read by voxelize)")))?;
     let w: Vec<&str> = line.split_whitespace().collect();
     let num = |i: usize| w.get(i).and_then(|v| v.parse::<f64>().ok()).filter(|v| v.is_finite());
-    let (Some(ox), Some(oy), Some(oz), Some(s), Some(nx), Some(ny), Some(nz)) = (num(4), num(5), num(6), num(8), num(10), num(11), num(12)) else {
+    let (Some(ox), Some(oy), Some(oz), Some(s), Some(nx), Some(ny), Some(nz)) = (num(4), num(5), num(6), num(8), num(10), num(11), num(12))
+    else {
         return Err(bad(format!("unreadable grid line {line:?}")));
     };
     let grid = GridSpec::new(DVec3::new(ox, oy, oz), s, [nx as u64, ny as u64, nz as u64]).map_err(|e| bad(format!("grid: {e}")))?;

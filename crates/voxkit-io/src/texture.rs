@@ -16,9 +16,7 @@ pub fn load(path: &Path, wrap: [Wrap; 2]) -> Result<Texture, String> {
 
 /// Decodes image bytes; `name` is used in messages.
 pub fn decode(bytes: &[u8], name: &str, wrap: [Wrap; 2]) -> Result<Texture, String> {
-    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| format!("texture {name}: {e}"))?;
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(|e| format!("texture {name}: {e}"))?;
     let (w, h) = reader.into_dimensions().map_err(|e| format!("texture {name} could not be decoded ({e})"))?;
     if w == 0 || h == 0 || w as u64 * h as u64 > MAX_TEXELS {
         return Err(format!("texture {name} is {w}x{h} texels (at most {MAX_TEXELS} accepted)"));
@@ -50,7 +48,9 @@ pub fn parse_map_statement(statement: &str, base: &Path) -> (PathBuf, [Wrap; 2])
         }
         // Skip the option's arguments: numbers, on/off, or one word (-imfchan r, -type sphere).
         let mut taken = 0;
-        while at < words.len() - 1 && (words[at].parse::<f64>().is_ok() || matches!(words[at], "on" | "off") || (taken == 0 && !words[at].contains('.'))) {
+        while at < words.len() - 1
+            && (words[at].parse::<f64>().is_ok() || matches!(words[at], "on" | "off") || (taken == 0 && !words[at].contains('.')))
+        {
             at += 1;
             taken += 1;
         }

@@ -114,7 +114,13 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: 
             arrays.push(("colour", "UInt8", 3, 3, Some(Box::new(move |s| c[s].to_vec()))));
         }
         if let Some(m) = &a.material {
-            arrays.push(("material", "Int32", 1, 4, Some(Box::new(move |s| (if m[s] == NO_MATERIAL { -1 } else { m[s] as i32 }).to_le_bytes().to_vec()))));
+            arrays.push((
+                "material",
+                "Int32",
+                1,
+                4,
+                Some(Box::new(move |s| (if m[s] == NO_MATERIAL { -1 } else { m[s] as i32 }).to_le_bytes().to_vec())),
+            ));
         }
         if let Some(c) = &a.coverage {
             arrays.push(("coverage", "Float32", 1, 4, Some(Box::new(move |s| c[s].to_le_bytes().to_vec()))));
@@ -155,8 +161,13 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: 
     xml.push_str("<?xml version=\"1.0\"?>\n");
     xml.push_str("<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\">\n");
     let extent = format!("0 {} 0 {} 0 {}", dims[0], dims[1], dims[2]);
-    xml.push_str(&format!("  <ImageData WholeExtent=\"{extent}\" Origin=\"{:?} {:?} {:?}\" Spacing=\"{s:?} {s:?} {s:?}\">\n", o.x, o.y, o.z));
-    xml.push_str(&format!("    <Piece Extent=\"{extent}\">\n      <PointData>\n      </PointData>\n      <CellData Scalars=\"occupancy\">\n"));
+    xml.push_str(&format!(
+        "  <ImageData WholeExtent=\"{extent}\" Origin=\"{:?} {:?} {:?}\" Spacing=\"{s:?} {s:?} {s:?}\">\n",
+        o.x, o.y, o.z
+    ));
+    xml.push_str(&format!(
+        "    <Piece Extent=\"{extent}\">\n      <PointData>\n      </PointData>\n      <CellData Scalars=\"occupancy\">\n"
+    ));
     let mut offset = 0usize;
     for ((name, ty, comps, _, _), e) in arrays.iter().zip(&encoded) {
         xml.push_str(&format!(
@@ -184,7 +195,10 @@ fn attr<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
 /// `colour`, `material`, `coverage` and `normal` are read when present.
 pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     let bad = |m: String| ErrorKind::malformed("vti", m);
-    let marker = bytes.windows(13).position(|w| w == b"<AppendedData").ok_or_else(|| bad("no <AppendedData> section (only appended raw data is read)".into()))?;
+    let marker = bytes
+        .windows(13)
+        .position(|w| w == b"<AppendedData")
+        .ok_or_else(|| bad("no <AppendedData> section (only appended raw data is read)".into()))?;
     let head = std::str::from_utf8(&bytes[..marker]).map_err(|_| bad("the XML header is not UTF-8".into()))?;
     let start = marker + bytes[marker..].iter().position(|&b| b == b'_').ok_or_else(|| bad("appended data has no '_' mark".into()))? + 1;
     let data = &bytes[start..];
@@ -203,7 +217,8 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if !compressed && head.contains("compressor=") {
         return Err(ErrorKind::Unsupported("a .vti compressor other than zlib".into()));
     }
-    let image_tag = head.split("<ImageData").nth(1).and_then(|t| t.split('>').next()).ok_or_else(|| bad("no <ImageData> element".into()))?;
+    let image_tag =
+        head.split("<ImageData").nth(1).and_then(|t| t.split('>').next()).ok_or_else(|| bad("no <ImageData> element".into()))?;
     let nums = |name: &str, n: usize| -> Result<Vec<f64>, ErrorKind> {
         let v: Vec<f64> = attr(image_tag, name).unwrap_or("").split_whitespace().filter_map(|x| x.parse().ok()).collect();
         if v.len() == n {
@@ -229,7 +244,8 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         let name = attr(tag, "Name").unwrap_or("").to_string();
         let ty = attr(tag, "type").unwrap_or("").to_string();
         let comps: u64 = attr(tag, "NumberOfComponents").and_then(|c| c.parse().ok()).unwrap_or(1);
-        let offset: usize = attr(tag, "offset").and_then(|c| c.parse().ok()).ok_or_else(|| bad(format!("array {name:?} has no appended offset")))?;
+        let offset: usize =
+            attr(tag, "offset").and_then(|c| c.parse().ok()).ok_or_else(|| bad(format!("array {name:?} has no appended offset")))?;
         let width = match ty.as_str() {
             "UInt8" | "Int8" => 1,
             "Int32" | "UInt32" | "Float32" => 4,
@@ -237,7 +253,9 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
             t => return Err(ErrorKind::Unsupported(format!("{t} arrays in .vti"))),
         };
         let want = cells.checked_mul(comps * width).ok_or_else(|| bad("array size overflows".into()))?;
-        let raw = decode(data.get(offset..).ok_or_else(|| bad(format!("array {name:?} starts past the end")))?, want, compressed, u64_header).map_err(bad)?;
+        let raw =
+            decode(data.get(offset..).ok_or_else(|| bad(format!("array {name:?} starts past the end")))?, want, compressed, u64_header)
+                .map_err(bad)?;
         arrays.push((name, ty, comps as usize, raw));
     }
     let occ = arrays.iter().find(|a| a.0 == "occupancy").or(arrays.first()).ok_or_else(|| bad("no cell arrays".into()))?;
@@ -263,7 +281,12 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     let f32_at = |buf: &Vec<u8>, i: usize| f32::from_le_bytes([buf[4 * i], buf[4 * i + 1], buf[4 * i + 2], buf[4 * i + 3]]);
     if let Some(m) = at("material", "Int32", 1) {
         attrs.material = Some(
-            attrs.keys.iter().map(|&k| i32::from_le_bytes([0, 1, 2, 3].map(|b| m[4 * k as usize + b]))).map(|v| if v < 0 { NO_MATERIAL } else { v as u32 }).collect(),
+            attrs
+                .keys
+                .iter()
+                .map(|&k| i32::from_le_bytes([0, 1, 2, 3].map(|b| m[4 * k as usize + b])))
+                .map(|v| if v < 0 { NO_MATERIAL } else { v as u32 })
+                .collect(),
         );
     }
     if let Some(c) = at("coverage", "Float32", 1) {
@@ -282,7 +305,11 @@ fn decode(data: &[u8], want: u64, compressed: bool, u64_header: bool) -> Result<
     let hw = if u64_header { 8 } else { 4 };
     let word = |i: usize| -> Result<u64, String> {
         let b = data.get(i * hw..(i + 1) * hw).ok_or("the data ends inside an array header")?;
-        Ok(if u64_header { u64::from_le_bytes(b.try_into().map_err(|_| "header")?) } else { u32::from_le_bytes(b.try_into().map_err(|_| "header")?) as u64 })
+        Ok(if u64_header {
+            u64::from_le_bytes(b.try_into().map_err(|_| "header")?)
+        } else {
+            u32::from_le_bytes(b.try_into().map_err(|_| "header")?) as u64
+        })
     };
     if !compressed {
         let n = word(0)?;

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use glam::DVec3;
 use voxkit::attributes::{VoxelAttributes, NO_MATERIAL};
 use voxkit::export::greedy::greedy_quads_by_class;
-use voxkit::{DenseBits, GridSpec, VoxelSource};
+use voxkit::{DenseBits, GridSpec};
 use voxkit_io::{read_voxels, write_voxels_with, VoxelFormat, WriteOptions};
 
 fn tmp(name: &str) -> PathBuf {
@@ -122,7 +122,10 @@ fn schem_is_valid_nbt_and_round_trips_voxels() {
     let fastnbt::Value::Compound(root) = fastnbt::from_bytes::<fastnbt::Value>(&nbt).unwrap() else { panic!() };
     let Some(fastnbt::Value::Compound(palette)) = root.get("Palette") else { panic!("no palette") };
     let names: std::collections::BTreeSet<&str> = palette.keys().map(|s| s.as_str()).collect();
-    assert!(names.is_subset(&["minecraft:air", "minecraft:black_wool", "minecraft:white_wool", "minecraft:light_gray_concrete"].into()), "{names:?}");
+    assert!(
+        names.is_subset(&["minecraft:air", "minecraft:black_wool", "minecraft:white_wool", "minecraft:light_gray_concrete"].into()),
+        "{names:?}"
+    );
     std::fs::write(&pal, "minecraft:stone 1 2\n").unwrap();
     let e = voxkit_io::schem::BlockPalette::read(&pal).unwrap_err().to_string();
     assert!(e.contains("blocks.txt") && e.contains("line 1"), "{e}");
@@ -150,8 +153,12 @@ fn coloured_greedy_meshes_load_in_gltf_and_tobj() {
     let reader = prim.reader(|buf| buffers.get(buf.index()).map(|d| &d.0[..]));
     assert_eq!(reader.read_positions().unwrap().count(), nv);
     assert_eq!(reader.read_indices().unwrap().into_u32().count(), quads.len() * 6);
-    let colours: std::collections::HashSet<[u32; 3]> =
-        reader.read_colors(0).unwrap().into_rgb_f32().map(|c| c.map(|x| voxkit::attributes::colour::from_linear(x as f64) as u32)).collect();
+    let colours: std::collections::HashSet<[u32; 3]> = reader
+        .read_colors(0)
+        .unwrap()
+        .into_rgb_f32()
+        .map(|c| c.map(|x| voxkit::attributes::colour::from_linear(x as f64) as u32))
+        .collect();
     assert_eq!(colours.len(), palette.len());
     // The voxelized-back GLB (voxkit's own reader, which uses the gltf crate) is the voxels again.
     let loaded = voxkit_io::read_mesh(&glb).unwrap();

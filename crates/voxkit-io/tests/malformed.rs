@@ -53,7 +53,15 @@ fn random_bytes_never_panic_any_reader() {
                     let _ = e;
                 }
             }
-            for f in [VoxelFormat::Npy, VoxelFormat::Binvox, VoxelFormat::Vox, VoxelFormat::Text, VoxelFormat::Schem, VoxelFormat::Vti, VoxelFormat::Ply] {
+            for f in [
+                VoxelFormat::Npy,
+                VoxelFormat::Binvox,
+                VoxelFormat::Vox,
+                VoxelFormat::Text,
+                VoxelFormat::Schem,
+                VoxelFormat::Vti,
+                VoxelFormat::Ply,
+            ] {
                 let _ = read_voxels_bytes(&bytes, f);
             }
         }

@@ -147,7 +147,13 @@ fn spot_voxel_colours_match_direct_texture_lookups() {
         }
         checked += 1;
         agree += (colours[slot] == direct[0].0) as usize;
-        assert_eq!(colours[slot], direct[0].0, "voxel {v:?}: voxkit {:?}, direct lookup {:?}", colours[slot], &direct[..direct.len().min(3)]);
+        assert_eq!(
+            colours[slot],
+            direct[0].0,
+            "voxel {v:?}: voxkit {:?}, direct lookup {:?}",
+            colours[slot],
+            &direct[..direct.len().min(3)]
+        );
         let cov = a.coverage.as_ref().unwrap()[slot] as f64;
         let want = total / (grid.voxel_size() * grid.voxel_size());
         assert!((cov - want).abs() < 0.02 + 0.02 * want, "voxel {v:?}: coverage {cov} vs sampled {want}");
@@ -207,7 +213,8 @@ fn obj_uvs_are_flipped_and_wrapped() {
 fn a_missing_texture_warns_and_uses_the_material_colour() {
     let d = temp_dir("missing");
     std::fs::write(d.join("q.mtl"), "newmtl q\nKd 0.5 0.25 1\nmap_Kd nowhere.png\n").unwrap();
-    std::fs::write(d.join("q.obj"), "mtllib q.mtl\nusemtl q\nv 0 0 0.25\nv 1 0 0.25\nv 1 1 0.25\nvt 0 0\nvt 1 0\nvt 1 1\nf 1/1 2/2 3/3\n").unwrap();
+    std::fs::write(d.join("q.obj"), "mtllib q.mtl\nusemtl q\nv 0 0 0.25\nv 1 0 0.25\nv 1 1 0.25\nvt 0 0\nvt 1 0\nvt 1 1\nf 1/1 2/2 3/3\n")
+        .unwrap();
     let loaded = voxkit_io::read_mesh(&d.join("q.obj")).unwrap();
     assert!(loaded.warnings.iter().any(|w| w.contains("nowhere.png") && w.contains("Kd")), "{:?}", loaded.warnings);
     let grid = GridSpec::new(DVec3::ZERO, 0.5, [2, 2, 1]).unwrap();

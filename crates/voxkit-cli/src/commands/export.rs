@@ -29,7 +29,14 @@ pub fn writer_options(e: &ExportArgs) -> Result<WriteOptions> {
 }
 
 /// Writes `bits` (with `attrs`) to `out`; returns facts for `--json`.
-pub fn write(out: &Path, target: Output, bits: &dyn VoxelSource, grid: &GridSpec, attrs: Option<&VoxelAttributes>, opts: &WriteOptions) -> Result<Value> {
+pub fn write(
+    out: &Path,
+    target: Output,
+    bits: &dyn VoxelSource,
+    grid: &GridSpec,
+    attrs: Option<&VoxelAttributes>,
+    opts: &WriteOptions,
+) -> Result<Value> {
     match target {
         Output::Voxels(f) => {
             voxkit_io::write_voxels_with(out, f, bits, grid, attrs, opts)?;

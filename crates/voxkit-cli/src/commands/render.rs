@@ -62,7 +62,13 @@ pub fn outline_triangles(mesh: voxkit::MeshRef<'_>, grid: &voxkit::GridSpec) -> 
 
 /// Renders `bits` (coloured by `colours` where present, with the outline of
 /// `outline`'s triangles) and writes the PNG atomically.
-pub fn picture(bits: &dyn VoxelSource, path: &Path, o: &RenderOptions, colours: Option<&VoxelAttributes>, outline: Option<&[[DVec3; 3]]>) -> Result<Image> {
+pub fn picture(
+    bits: &dyn VoxelSource,
+    path: &Path,
+    o: &RenderOptions,
+    colours: Option<&VoxelAttributes>,
+    outline: Option<&[[DVec3; 3]]>,
+) -> Result<Image> {
     let bricks = BrickBits::from_source(bits);
     let img = render_with(&bricks, o, colours, outline);
     voxkit_io::write_png(path, img.width, img.height, &img.rgb)?;

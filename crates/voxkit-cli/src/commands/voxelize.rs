@@ -116,7 +116,8 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
 
     bar.phase("writing");
     let t_write = Instant::now();
-    let export_facts = pool.install(|| crate::commands::export::write(&a.output, format, bits.as_ref(), &grid, attrs.as_ref(), &write_opts))?;
+    let export_facts =
+        pool.install(|| crate::commands::export::write(&a.output, format, bits.as_ref(), &grid, attrs.as_ref(), &write_opts))?;
     let write_s = t_write.elapsed().as_secs_f64();
     if let Some((path, o)) = &preview {
         bar.phase("rendering the preview");

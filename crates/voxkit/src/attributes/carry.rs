@@ -66,7 +66,13 @@ struct Contribution {
 /// Attributes of the set voxels of `voxels` (on `grid`) from the triangles of `mesh`.
 /// Colour is present when `appearance` has colour, material ids when it has
 /// materials, normals when asked; coverage always.
-pub fn carry(mesh: MeshRef<'_>, appearance: &Appearance, grid: &GridSpec, voxels: &dyn VoxelSource, opts: &CarryOptions) -> VoxelAttributes {
+pub fn carry(
+    mesh: MeshRef<'_>,
+    appearance: &Appearance,
+    grid: &GridSpec,
+    voxels: &dyn VoxelSource,
+    opts: &CarryOptions,
+) -> VoxelAttributes {
     let dims = grid.dims();
     let mut keys = Vec::with_capacity(voxels.count() as usize);
     voxels.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
@@ -125,7 +131,6 @@ pub fn carry(mesh: MeshRef<'_>, appearance: &Appearance, grid: &GridSpec, voxels
         }
     }
     let with_colour = ctx.colour;
-    drop(ctx);
     fill_from_nearest(&keys, dims, &mut has, &mut colour, &mut material, &mut normal);
     VoxelAttributes {
         dims,
@@ -139,7 +144,7 @@ pub fn carry(mesh: MeshRef<'_>, appearance: &Appearance, grid: &GridSpec, voxels
 
 /// The key with the largest summed weight (ties: the smallest key). Sorts `v`.
 fn argmax(v: &mut [(u32, f64)]) -> Option<u32> {
-    v.sort_unstable_by(|a, b| a.0.cmp(&b.0));
+    v.sort_unstable_by_key(|a| a.0);
     let mut best: Option<(u32, f64)> = None;
     for run in v.chunk_by(|a, b| a.0 == b.0) {
         let w: f64 = run.iter().map(|r| r.1).sum();
@@ -152,7 +157,14 @@ fn argmax(v: &mut [(u32, f64)]) -> Option<u32> {
 
 /// Breadth-first search from every voxel that has attributes, over
 /// 26-neighbours among the set voxels; each reached voxel copies its parent.
-fn fill_from_nearest(keys: &[u64], dims: [u32; 3], has: &mut [bool], colour: &mut [[u8; 3]], material: &mut [u32], normal: &mut [[f32; 3]]) {
+fn fill_from_nearest(
+    keys: &[u64],
+    dims: [u32; 3],
+    has: &mut [bool],
+    colour: &mut [[u8; 3]],
+    material: &mut [u32],
+    normal: &mut [[f32; 3]],
+) {
     if has.iter().all(|&h| h) || !has.iter().any(|&h| h) {
         return;
     }
