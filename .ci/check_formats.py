@@ -137,5 +137,33 @@ with tempfile.TemporaryDirectory() as d:
     hi = np.array(summary["origin"]) + np.array([nx, ny, nz]) * s
     check("glb bounds inside the grid", np.all(np.array(acc.min) >= np.array(summary["origin"]) - 1e-5) and np.all(np.array(acc.max) <= hi + 1e-5))
 
+    # .vox, parsed here from the published format (MagicaVoxel-file-format-vox.txt
+    # and -extension.txt), independently of the dot_vox crate voxkit uses.
+    import struct
+    raw = (d / "s.vox").read_bytes()
+    check("vox magic and version 150", raw[:4] == b"VOX " and struct.unpack("<i", raw[4:8])[0] == 150)
+    chunks, at = [], 20  # skip the MAIN header (id, content size, children size)
+    while at < len(raw):
+        cid, n, m = raw[at:at + 4], *struct.unpack("<ii", raw[at + 4:at + 12])
+        chunks.append((cid, raw[at + 12:at + 12 + n]))
+        at += 12 + n + m
+    sizes = [struct.unpack("<iii", c) for i, c in chunks if i == b"SIZE"]
+    xyzis = [c for i, c in chunks if i == b"XYZI"]
+    rgba = [c for i, c in chunks if i == b"RGBA"]
+    check("vox has one SIZE per XYZI and a 256-entry RGBA", len(sizes) == len(xyzis) == 1 and len(rgba) == 1 and len(rgba[0]) == 1024)
+    check("vox model size = grid", sizes[0] == (nx, ny, nz), sizes[0])
+    check("vox has a scene graph (nTRN, nGRP, nSHP)", {i for i, _ in chunks} >= {b"nTRN", b"nGRP", b"nSHP"})
+    pal = np.frombuffer(rgba[0], dtype=np.uint8).reshape(256, 4)
+    n = struct.unpack("<i", xyzis[0][:4])[0]
+    vx = np.frombuffer(xyzis[0][4:4 + 4 * n], dtype=np.uint8).reshape(n, 4).astype(int)
+    check("vox colour indices in 1..255", bool((vx[:, 3] >= 1).all()))
+    vocc2 = np.zeros_like(occ)
+    vocc2[vx[:, 0], vx[:, 1], vx[:, 2]] = True
+    check("vox voxels = npy", n == occ.sum() and np.array_equal(vocc2, occ))
+    # RGBA entry k is colour index k + 1.
+    vox_rgb = pal[vx[:, 3] - 1, :3]
+    want_rgb = vcol[vx[:, 0], vx[:, 1], vx[:, 2]]
+    check("vox colours = vti colours (fewer than 256 colours: exact palette)", np.array_equal(vox_rgb, want_rgb))
+
 print(f"{passed} passed, {failed} failed")
 sys.exit(1 if failed else 0)

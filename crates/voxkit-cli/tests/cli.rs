@@ -440,7 +440,20 @@ fn textured_spot_goes_to_every_coloured_format_and_back() {
     let spot = shared("spot-textured.obj");
     let vox = tmp("spot.vox");
     let png = tmp("spot.png");
-    let s = json(&voxkit(&["voxelize", &spot, "-o", &vox, "--resolution", "48", "--preview", &png, "--outline", "--size", "160x120", "--json"]));
+    let s = json(&voxkit(&[
+        "voxelize",
+        &spot,
+        "-o",
+        &vox,
+        "--resolution",
+        "48",
+        "--preview",
+        &png,
+        "--outline",
+        "--size",
+        "160x120",
+        "--json",
+    ]));
     assert_eq!(s["attributes"]["colour"], true);
     assert_eq!(s["attributes"]["colour_rule"], "dominant");
     assert_eq!(png_size(&png), (160, 120));

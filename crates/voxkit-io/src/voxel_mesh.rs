@@ -139,6 +139,12 @@ pub fn write_quads_glb(path: &Path, quads: &[Quad], grid: &GridSpec, palette: Op
     }
     write_atomically(path, |w| {
         let total = 12 + 8 + text.len() + 8 + bin.len();
+        if total > u32::MAX as usize {
+            return Err(std::io::Error::other(format!(
+                "{} quads make a {total}-byte GLB; the format ends at 4 GiB (write .obj instead)",
+                quads.len()
+            )));
+        }
         w.write_all(b"glTF")?;
         w.write_all(&2u32.to_le_bytes())?;
         w.write_all(&(total as u32).to_le_bytes())?;

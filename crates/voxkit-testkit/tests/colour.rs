@@ -273,3 +273,48 @@ fn attributes_do_not_depend_on_the_thread_count() {
         assert_eq!(run(1, rule), run(3, rule));
     }
 }
+
+/// A glTF quad with an external buffer and the 2×2 texture of [`quad_scene`];
+/// glTF puts `v = 0` at the top of the image, so the UVs here are the OBJ
+/// scene's with `v` flipped, and the voxel colours must come out the same.
+fn gltf_quad(dir: &Path, u0: f32, wrap_s: u32, factor: [f32; 4]) -> PathBuf {
+    quad_scene(dir, 0.0, "t.png");
+    let pos: [[f32; 3]; 4] = [[0.0, 0.0, 0.25], [1.0, 0.0, 0.25], [1.0, 1.0, 0.25], [0.0, 1.0, 0.25]];
+    let uv: [[f32; 2]; 4] = [[u0, 1.0], [u0 + 1.0, 1.0], [u0 + 1.0, 0.0], [u0, 0.0]];
+    let idx: [u16; 6] = [0, 1, 2, 0, 2, 3];
+    let mut bin = Vec::new();
+    pos.iter().flatten().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
+    uv.iter().flatten().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
+    idx.iter().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
+    std::fs::write(dir.join("q.bin"), &bin).unwrap();
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"TEXCOORD_0":1}},"indices":2,"material":0}}]}}],
+        "materials":[{{"pbrMetallicRoughness":{{"baseColorFactor":{factor:?},"baseColorTexture":{{"index":0}}}}}}],
+        "textures":[{{"source":0,"sampler":0}}],"samplers":[{{"wrapS":{wrap_s},"wrapT":10497}}],
+        "images":[{{"uri":"t.png"}}],
+        "buffers":[{{"uri":"q.bin","byteLength":{}}}],
+        "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":32}},{{"buffer":0,"byteOffset":80,"byteLength":12}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0.25],"max":[1,1,0.25]}},
+          {{"bufferView":1,"componentType":5126,"count":4,"type":"VEC2"}},{{"bufferView":2,"componentType":5123,"count":6,"type":"SCALAR"}}]}}"#,
+        bin.len()
+    );
+    let p = dir.join("q.gltf");
+    std::fs::write(&p, json).unwrap();
+    p
+}
+
+#[test]
+fn gltf_uvs_are_not_flipped_and_samplers_wrap() {
+    let d = temp_dir("gltf");
+    let want = vec![[0, 0, 255], [255, 255, 255], [255, 0, 0], [0, 255, 0]];
+    assert_eq!(quad_colours(&gltf_quad(&d, 0.0, 10497, [1.0; 4])), want);
+    assert_eq!(quad_colours(&gltf_quad(&d, 1.0, 10497, [1.0; 4])), want, "REPEAT");
+    let clamped = vec![[255, 255, 255], [255, 255, 255], [0, 255, 0], [0, 255, 0]];
+    assert_eq!(quad_colours(&gltf_quad(&d, 1.0, 33071, [1.0; 4])), clamped, "CLAMP_TO_EDGE");
+    let mirrored = vec![[255, 255, 255], [0, 0, 255], [0, 255, 0], [255, 0, 0]];
+    assert_eq!(quad_colours(&gltf_quad(&d, 1.0, 33648, [1.0; 4])), mirrored, "MIRRORED_REPEAT");
+    // The base colour factor multiplies the texture (in linear light): red × (0, 1, 1) is black.
+    let tinted = quad_colours(&gltf_quad(&d, 0.0, 10497, [0.0, 1.0, 1.0, 1.0]));
+    assert_eq!(tinted, vec![[0, 0, 255], [0, 255, 255], [0, 0, 0], [0, 255, 0]]);
+}

@@ -9,6 +9,16 @@ pub fn run(a: &InfoArgs) -> Result<()> {
     let loaded = voxkit_io::read_mesh(&a.mesh)?;
     let r = &loaded.report;
     let (mn, mx) = (r.bounds.min, r.bounds.max);
+    let app = &loaded.appearance;
+    let with_uv = app.triangle_uv.iter().filter(|t| t.iter().flatten().all(|c| c.is_finite())).count();
+    let materials: Vec<serde_json::Value> = app
+        .materials
+        .iter()
+        .map(|m| {
+            let tex = m.texture.and_then(|t| app.textures.get(t as usize));
+            json!({"name": m.name, "factor": m.factor, "texture": tex.map(|t| json!({"name": t.name, "width": t.width, "height": t.height}))})
+        })
+        .collect();
     if a.json {
         let v = json!({
             "path": a.mesh.display().to_string(),
@@ -17,6 +27,12 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             "degenerate": r.degenerate,
             "bounds": { "min": [mn.x, mn.y, mn.z], "max": [mx.x, mx.y, mx.z] },
             "warnings": loaded.warnings,
+            "appearance": {
+                "materials": materials,
+                "textures": app.textures.len(),
+                "triangles_with_uv": with_uv,
+                "vertex_colours": !app.vertex_colour.is_empty(),
+            },
         });
         crate::print_stdout(&v.to_string())?;
     } else {
@@ -39,6 +55,13 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             e.x,
             e.y,
             e.z
+        ))?;
+        let colour = if app.has_colour() { "carried into voxels" } else { "none" };
+        crate::print_stdout(&format!(
+            "  colour:     {colour} ({} materials, {} textures, {with_uv} triangles with UVs, vertex colours: {})",
+            app.materials.len(),
+            app.textures.len(),
+            if app.vertex_colour.is_empty() { "no" } else { "yes" }
         ))?;
     }
     Ok(())
