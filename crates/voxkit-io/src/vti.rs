@@ -17,6 +17,7 @@ use std::io::{Read, Write};
 
 use flate2::write::ZlibEncoder;
 use glam::DVec3;
+use rayon::prelude::*;
 use voxkit::attributes::{VoxelAttributes, NO_MATERIAL};
 use voxkit::{DenseBits, GridSpec, VoxelSource};
 
@@ -32,11 +33,13 @@ struct Stream {
     filled: usize,
     buf: Vec<u8>,
     blocks: Vec<Vec<u8>>,
+    /// Compressed full blocks of one repeated byte (most blocks of a sparse grid).
+    uniform: std::collections::HashMap<u8, Vec<u8>>,
 }
 
 impl Stream {
     fn new(cells: u64, width: usize) -> Stream {
-        Stream { size: cells as usize * width, filled: 0, buf: Vec::with_capacity(BLOCK), blocks: Vec::new() }
+        Stream { size: cells as usize * width, filled: 0, buf: Vec::with_capacity(BLOCK), blocks: Vec::new(), uniform: Default::default() }
     }
 
     /// Appends `bytes`, compressing every full block.
@@ -53,32 +56,44 @@ impl Stream {
         Ok(())
     }
 
-    /// Appends `cells` copies of the empty-cell value `fill`.
+    /// Appends `cells` copies of the empty-cell value `fill` (one repeated
+    /// byte: 0, or 0xFF for material −1). Whole blocks of it reuse one
+    /// compressed block instead of being copied and compressed again.
     fn fill(&mut self, cells: usize, fill: &[u8]) -> std::io::Result<()> {
-        if fill.iter().all(|&b| b == 0) {
-            const Z: [u8; 4096] = [0; 4096];
-            let mut n = cells * fill.len();
-            while n > 0 {
-                let t = n.min(Z.len());
-                self.push(&Z[..t])?;
-                n -= t;
+        let b = fill[0];
+        debug_assert!(fill.iter().all(|&x| x == b));
+        let mut n = cells * fill.len();
+        while n > 0 {
+            if self.buf.is_empty() && n >= BLOCK {
+                let z = match self.uniform.get(&b) {
+                    Some(z) => z.clone(),
+                    None => {
+                        let z = compress(&vec![b; BLOCK])?;
+                        self.uniform.insert(b, z.clone());
+                        z
+                    }
+                };
+                self.blocks.push(z);
+                self.filled += BLOCK;
+                n -= BLOCK;
+                continue;
             }
-            return Ok(());
-        }
-        for _ in 0..cells {
-            self.push(fill)?;
+            let take = (BLOCK - self.buf.len()).min(n);
+            self.buf.resize(self.buf.len() + take, b);
+            self.filled += take;
+            n -= take;
+            if self.buf.len() == BLOCK {
+                self.flush()?;
+            }
         }
         Ok(())
     }
 
     fn flush(&mut self) -> std::io::Result<()> {
-        if self.buf.is_empty() {
-            return Ok(());
+        if !self.buf.is_empty() {
+            self.blocks.push(compress(&self.buf)?);
+            self.buf.clear();
         }
-        let mut z = ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
-        z.write_all(&self.buf)?;
-        self.blocks.push(z.finish()?);
-        self.buf.clear();
         Ok(())
     }
 
@@ -101,12 +116,18 @@ impl Stream {
     }
 }
 
+fn compress(bytes: &[u8]) -> std::io::Result<Vec<u8>> {
+    let mut z = ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
+    z.write_all(bytes)?;
+    z.finish()
+}
+
 /// Writes `bits` on `grid` as `.vti`, with the arrays `attrs` has.
 pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: Option<&VoxelAttributes>) -> std::io::Result<()> {
     let dims = bits.dims();
     let cells: u64 = dims.iter().map(|&d| d as u64).product();
     // (name, VTK type, components, bytes per cell, value of slot s; empty cells hold `fill`)
-    type Value<'a> = Box<dyn Fn(usize) -> Vec<u8> + 'a>;
+    type Value<'a> = Box<dyn Fn(usize) -> Vec<u8> + Sync + 'a>;
     let mut arrays: Vec<(&str, &str, usize, usize, Option<Value<'_>>)> = vec![("occupancy", "UInt8", 1, 1, None)];
     let fill_of = |name: &str, width: usize| if name == "material" { (-1i32).to_le_bytes().to_vec() } else { vec![0u8; width] };
     if let Some(a) = attrs {
@@ -129,32 +150,32 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: 
             arrays.push(("normal", "Float32", 3, 12, Some(Box::new(move |s| n[s].iter().flat_map(|v| v.to_le_bytes()).collect()))));
         }
     }
-    let mut encoded = Vec::new();
-    for (name, _, _, width, value) in &arrays {
+    // The set voxels' keys, ascending; `aligned` when they are the attributes' slots.
+    let mut keys = Vec::with_capacity(bits.count() as usize);
+    bits.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
+    let aligned = attrs.is_some_and(|a| a.keys == keys);
+    // One array per task: each is an independent block stream.
+    let encode = |(name, _, _, width, value): &(&str, &str, usize, usize, Option<Value<'_>>)| -> std::io::Result<Vec<u8>> {
         let fill = fill_of(name, *width);
         let mut st = Stream::new(cells, *width);
         let mut next: u64 = 0;
-        let mut result = Ok(());
-        bits.for_each_set(&mut |i, j, k| {
-            if result.is_err() {
-                return;
-            }
-            let key = VoxelAttributes::key(dims, i, j, k);
-            result = (|| {
-                st.fill((key - next) as usize, &fill)?;
-                match value {
-                    None => st.push(&[1]),
-                    Some(f) => match attrs.and_then(|a| a.slot(i, j, k)) {
-                        Some(s) => st.push(&f(s)),
-                        None => st.fill(1, &fill),
-                    },
+        for (at, &key) in keys.iter().enumerate() {
+            st.fill((key - next) as usize, &fill)?;
+            match value {
+                None => st.push(&[1])?,
+                Some(f) => {
+                    let slot = if aligned { Some(at) } else { attrs.and_then(|a| a.keys.binary_search(&key).ok()) };
+                    match slot {
+                        Some(s) => st.push(&f(s))?,
+                        None => st.fill(1, &fill)?,
+                    }
                 }
-            })();
+            }
             next = key + 1;
-        });
-        result?;
-        encoded.push(st.finish(&fill)?);
-    }
+        }
+        st.finish(&fill)
+    };
+    let encoded: Vec<Vec<u8>> = arrays.par_iter().map(encode).collect::<std::io::Result<_>>()?;
     let o = grid.origin();
     let s = grid.voxel_size();
     let mut xml = String::new();

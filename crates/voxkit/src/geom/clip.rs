@@ -15,33 +15,65 @@ use glam::DVec3;
 /// Clips the convex polygon `poly` to the box `[lo, hi]` (closed).
 /// Returns the clipped polygon; fewer than 3 vertices means nothing is left.
 pub fn clip_polygon_to_box(poly: &[DVec3], lo: DVec3, hi: DVec3) -> Vec<DVec3> {
+    if poly.len() > MAX_IN {
+        return clip_general(poly, lo, hi);
+    }
+    // Each plane adds at most one vertex: two fixed buffers, no allocation until the end.
+    let mut a = [DVec3::ZERO; MAX_IN + 6];
+    let mut b = [DVec3::ZERO; MAX_IN + 6];
+    a[..poly.len()].copy_from_slice(poly);
+    let mut n = poly.len();
+    for axis in 0..3 {
+        for (bound, keep_below) in [(lo[axis], false), (hi[axis], true)] {
+            if n == 0 {
+                return Vec::new();
+            }
+            n = clip_plane(&a[..n], axis, bound, keep_below, &mut b);
+            std::mem::swap(&mut a, &mut b);
+        }
+    }
+    a[..n].to_vec()
+}
+
+/// Largest input polygon clipped without allocating.
+const MAX_IN: usize = 8;
+
+fn clip_general(poly: &[DVec3], lo: DVec3, hi: DVec3) -> Vec<DVec3> {
     let mut cur: Vec<DVec3> = poly.to_vec();
     for axis in 0..3 {
         for (bound, keep_below) in [(lo[axis], false), (hi[axis], true)] {
-            if cur.is_empty() {
-                return cur;
-            }
-            // Signed distance, non-negative on the kept side.
-            let dist = |p: DVec3| if keep_below { bound - p[axis] } else { p[axis] - bound };
-            let mut next = Vec::with_capacity(cur.len() + 2);
-            for idx in 0..cur.len() {
-                let a = cur[idx];
-                let b = cur[(idx + 1) % cur.len()];
-                let (da, db) = (dist(a), dist(b));
-                if da >= 0.0 {
-                    next.push(a);
-                }
-                if (da >= 0.0) != (db >= 0.0) {
-                    let t = da / (da - db);
-                    let mut p = a + (b - a) * t;
-                    p[axis] = bound; // exact on the plane
-                    next.push(p);
-                }
-            }
+            let mut next = vec![DVec3::ZERO; cur.len() + 1];
+            let n = clip_plane(&cur, axis, bound, keep_below, &mut next);
+            next.truncate(n);
             cur = next;
         }
     }
     cur
+}
+
+/// One Sutherland–Hodgman pass: `cur` clipped to the half-space kept by
+/// the plane `p[axis] = bound` into `out` (room for `cur.len() + 1`); returns the count.
+fn clip_plane(cur: &[DVec3], axis: usize, bound: f64, keep_below: bool, out: &mut [DVec3]) -> usize {
+    // Signed distance, non-negative on the kept side.
+    let dist = |p: DVec3| if keep_below { bound - p[axis] } else { p[axis] - bound };
+    let mut n = 0;
+    for idx in 0..cur.len() {
+        let a = cur[idx];
+        let b = cur[(idx + 1) % cur.len()];
+        let (da, db) = (dist(a), dist(b));
+        if da >= 0.0 {
+            out[n] = a;
+            n += 1;
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            let t = da / (da - db);
+            let mut p = a + (b - a) * t;
+            p[axis] = bound; // exact on the plane
+            out[n] = p;
+            n += 1;
+        }
+    }
+    n
 }
 
 /// Clips the segment `[a, b]` to the closed box `[lo, hi]` (Liang–Barsky);
