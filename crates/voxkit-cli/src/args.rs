@@ -273,6 +273,11 @@ pub struct BenchArgs {
     /// (e.g. 2 turns the 69k-triangle bunny into 1.1M triangles).
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=5))]
     pub subdivide: u32,
+    /// Also time carrying colours into the `cover` voxels (dominant and
+    /// blend), a coloured 1024x768 picture and the .vox and .vti writers,
+    /// against voxelization as the baseline (the mesh must have colours).
+    #[arg(long)]
+    pub attributes: bool,
     /// Print JSON lines instead of a Markdown table.
     #[arg(long)]
     pub json: bool,

@@ -130,6 +130,9 @@ struct Row {
 
 pub fn run(a: &BenchArgs) -> Result<()> {
     let loaded = voxkit_io::read_mesh(&a.mesh)?;
+    if a.attributes {
+        return attributes(a, &loaded);
+    }
     let mut owned = loaded.mesh.clone();
     for _ in 0..a.subdivide {
         owned = subdivide(&owned);
@@ -242,6 +245,86 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             speed,
             vs_fast
         );
+    }
+    crate::print_stdout(out.trim_end())
+}
+
+/// `--attributes`: per thread count and resolution, the medians of
+/// voxelizing (`cover`, the baseline), carrying colours (dominant, blend),
+/// a coloured picture and two coloured writers, timed in alternation.
+fn attributes(a: &BenchArgs, loaded: &voxkit_io::LoadedMesh) -> Result<()> {
+    use voxkit::attributes::carry::{carry, CarryOptions};
+    use voxkit::attributes::ColourRule;
+    if !loaded.appearance.has_colour() {
+        anyhow::bail!("{}: --attributes needs a mesh with colours (materials, textures or vertex colours)", a.mesh.display());
+    }
+    if a.subdivide > 0 {
+        anyhow::bail!("--attributes times the mesh as it is; it cannot be combined with --subdivide");
+    }
+    let mesh = loaded.mesh.as_ref();
+    let dir = std::env::temp_dir().join(format!("voxkit-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    let mut out = format!(
+        "mesh: {} ({} triangles); cover by the fast path; median of {} repeats\n\n| threads | resolution | voxels | voxelize (ms) | carry dominant (ms) | carry blend (ms) | render 1024x768 (ms) | write .vox (ms) | write .vti (ms) | carry dominant vs voxelize |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        a.mesh.display(),
+        mesh.triangles.len(),
+        a.repeats
+    );
+    let mut json_rows = Vec::new();
+    for &threads in &a.threads {
+        let pool = crate::thread_pool(Some(threads))?;
+        for &res in &a.resolutions {
+            let grid = GridSpec::from_resolution(&loaded.report.bounds, res).context("invalid grid")?;
+            crate::plan::check_memory(&grid)?;
+            let (bits, _) = pool.install(|| voxelize::fast(voxelize::Mode::Cover, mesh, &grid, &Options::default()));
+            let attrs = pool.install(|| carry(mesh, &loaded.appearance, &grid, &bits, &CarryOptions::default()));
+            let render_opts = voxkit::render::raycast::RenderOptions::default();
+            let steps = ["voxelize", "dominant", "blend", "render", "vox", "vti"];
+            let timed = pool.install(|| {
+                time_alternating(a.repeats, &steps, |&step| -> Result<()> {
+                    let wo = voxkit_io::WriteOptions::default();
+                    match step {
+                        "voxelize" => drop(voxelize::fast(voxelize::Mode::Cover, mesh, &grid, &Options::default())),
+                        "dominant" | "blend" => {
+                            let rule = if step == "blend" { ColourRule::Blend } else { ColourRule::Dominant };
+                            drop(carry(mesh, &loaded.appearance, &grid, &bits, &CarryOptions { rule, normals: false }));
+                        }
+                        "render" => drop(voxkit::render::raycast::render_with(&bits, &render_opts, Some(&attrs), None)),
+                        f => {
+                            let format = voxkit_io::VoxelFormat::from_name(f).context("format")?;
+                            voxkit_io::write_voxels_with(&dir.join(format!("b.{f}")), format, &bits, &grid, Some(&attrs), &wo)?;
+                        }
+                    }
+                    Ok(())
+                })
+            });
+            let mut ms = Vec::new();
+            for (s, r) in timed {
+                r?;
+                ms.push(s * 1e3);
+            }
+            out += &format!(
+                "| {threads} | {res} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1}x |\n",
+                bits.count(),
+                ms[0],
+                ms[1],
+                ms[2],
+                ms[3],
+                ms[4],
+                ms[5],
+                ms[1] / ms[0]
+            );
+            json_rows.push(json!({"threads": threads, "resolution": res, "voxels": bits.count(), "voxelize_median_ms": ms[0],
+                "carry_dominant_median_ms": ms[1], "carry_blend_median_ms": ms[2], "render_median_ms": ms[3],
+                "write_vox_median_ms": ms[4], "write_vti_median_ms": ms[5]}));
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    if a.json {
+        for r in json_rows {
+            crate::print_stdout(&r.to_string())?;
+        }
+        return Ok(());
     }
     crate::print_stdout(out.trim_end())
 }
