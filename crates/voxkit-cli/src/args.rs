@@ -278,6 +278,10 @@ pub struct BenchArgs {
     /// against voxelization as the baseline (the mesh must have colours).
     #[arg(long)]
     pub attributes: bool,
+    /// Time `cover` on the GPU (upload, GPU, download separately) against
+    /// the CPU fast path as the baseline.
+    #[arg(long)]
+    pub gpu: bool,
     /// Print JSON lines instead of a Markdown table.
     #[arg(long)]
     pub json: bool,

@@ -99,6 +99,8 @@ pub fn core_mode(mode: Mode) -> Result<voxkit::voxelize::Mode> {
 pub enum SurfaceMethod {
     /// Brute force from the definition.
     Reference,
+    /// The GPU compute path (`voxkit-gpu`).
+    Gpu,
     /// The triangle-box path (parallel, sparse).
     Fast,
     /// The exact scanline path (cover, sep26, sep6).
@@ -112,6 +114,7 @@ impl SurfaceMethod {
             SurfaceMethod::Reference => "reference",
             SurfaceMethod::Fast => "fast",
             SurfaceMethod::Scanline => "scanline",
+            SurfaceMethod::Gpu => "gpu",
         }
     }
 }
@@ -128,7 +131,14 @@ pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::M
         Method::Scanline => {
             bail!("--method scanline exists for cover, sep26 and sep6, not {}; use auto, fast or reference", mode_name(mode))
         }
-        Method::Gpu => bail!("--method gpu is not implemented yet in this build (no GPU backend); use auto, fast or reference"),
+        Method::Gpu if !cfg!(feature = "gpu") => {
+            bail!("--method gpu: this voxkit was built without the `gpu` feature; use auto, fast or reference")
+        }
+        Method::Gpu if core == voxkit::voxelize::Mode::Cover => SurfaceMethod::Gpu,
+        Method::Gpu => bail!(
+            "--method gpu exists for cover so far; {} on the GPU is not built yet (use auto, fast, scanline or reference)",
+            mode_name(mode)
+        ),
         Method::Parity | Method::Winding => bail!("--method {} applies only to --mode solid", method_name(method)),
     };
     Ok((core, m))
@@ -139,10 +149,39 @@ pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::M
 /// `cover` and `sep26` on meshes whose triangles span a few voxels or
 /// more, `sep6` on meshes of very large faces), the fast path otherwise.
 pub fn auto_method(mode: voxkit::voxelize::Mode, mesh: voxkit::MeshRef<'_>, grid: &GridSpec) -> SurfaceMethod {
+    if gpu_preferred(mode, grid) {
+        return SurfaceMethod::Gpu;
+    }
     if !voxkit::voxelize::scanline::prefers(mode, mesh, grid) {
         return SurfaceMethod::Fast;
     }
     SurfaceMethod::Scanline
+}
+
+/// Grids from this many voxels on the longest side are offered to a
+/// hardware GPU by `--method auto`.
+pub const GPU_AUTO_MIN_SIDE: u32 = 512;
+
+/// `--method auto` on a large `cover` job: is there a hardware GPU adapter?
+/// Software adapters (lavapipe, WARP) are slower than the CPU paths, so
+/// they are not used unless asked for (`--method gpu`).
+#[cfg(feature = "gpu")]
+fn gpu_preferred(mode: voxkit::voxelize::Mode, grid: &GridSpec) -> bool {
+    if mode != voxkit::voxelize::Mode::Cover || grid.dims().iter().copied().max().unwrap_or(0) < GPU_AUTO_MIN_SIDE {
+        return false;
+    }
+    match voxkit_gpu::Gpu::new() {
+        Ok(g) => !g.is_software(),
+        Err(e) => {
+            eprintln!("voxkit: note: {e}; using the CPU");
+            false
+        }
+    }
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_preferred(_mode: voxkit::voxelize::Mode, _grid: &GridSpec) -> bool {
+    false
 }
 
 /// How a solid is made.
@@ -193,6 +232,9 @@ pub fn solid_plan(a: &crate::args::VoxelizeArgs) -> Result<Option<SolidPlan>> {
         (None, Method::Parity) => SolidMethod::Parity,
         (None, Method::Winding) => SolidMethod::Winding,
         (None, Method::Reference) => SolidMethod::Reference,
+        (None, Method::Gpu) => {
+            bail!("--method gpu does not do solid modes yet (GPU parity flips are not built); use auto, parity, winding or reference")
+        }
         (None, m) => bail!("--method {} does not apply to solid modes (use auto, parity, winding or reference)", method_name(m)),
     };
     let surface = (a.mode == Mode::SolidSurface || method == SolidMethod::Flood).then_some(surface_mode);

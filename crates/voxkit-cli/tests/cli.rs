@@ -483,3 +483,27 @@ fn textured_spot_goes_to_every_coloured_format_and_back() {
     let line = error_line(&["render", &vox, "-o", &tmp("x.png"), "--outline"]);
     assert!(line.contains("--outline") && line.contains("mesh"), "{line}");
 }
+
+#[test]
+fn method_gpu_writes_the_cpu_file_or_says_why_not() {
+    let cow = shared("cow.obj");
+    let line = error_line(&["voxelize", &cow, "-o", &tmp("g.npy"), "--method", "gpu", "--mode", "sep6"]);
+    assert!(line.contains("cover so far") && line.contains("sep6"), "{line}");
+    let line = error_line(&["voxelize", &cow, "-o", &tmp("g.npy"), "--method", "gpu", "--mode", "solid"]);
+    assert!(line.contains("gpu") && line.contains("solid"), "{line}");
+    let gpu = tmp("g.npy");
+    let out = voxkit(&["voxelize", &cow, "-o", &gpu, "--method", "gpu", "--resolution", "80", "--json"]);
+    if !out.status.success() {
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(err.contains("no GPU adapter") || err.contains("lacks"), "{err}");
+        assert!(std::env::var("VOXKIT_REQUIRE_GPU").as_deref() != Ok("1"), "VOXKIT_REQUIRE_GPU=1 but: {err}");
+        eprintln!("skipping: {err}");
+        return;
+    }
+    let s = json(&out);
+    assert_eq!(s["method"], "gpu");
+    assert!(s["gpu"]["gpu_triangles"].as_u64().unwrap() > 0);
+    let cpu = tmp("c.npy");
+    json(&voxkit(&["voxelize", &cow, "-o", &cpu, "--method", "fast", "--resolution", "80", "--json"]));
+    assert_eq!(std::fs::read(&gpu).unwrap(), std::fs::read(&cpu).unwrap());
+}

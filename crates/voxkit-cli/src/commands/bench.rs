@@ -133,6 +133,9 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     if a.attributes {
         return attributes(a, &loaded);
     }
+    if a.gpu {
+        return gpu(a, &loaded);
+    }
     let mut owned = loaded.mesh.clone();
     for _ in 0..a.subdivide {
         owned = subdivide(&owned);
@@ -327,6 +330,67 @@ fn attributes(a: &BenchArgs, loaded: &voxkit_io::LoadedMesh) -> Result<()> {
         return Ok(());
     }
     crate::print_stdout(out.trim_end())
+}
+
+/// `--gpu`: `cover` by the GPU compute path against the CPU fast path
+/// (timed in alternation), with the GPU's upload, run and download medians.
+#[cfg(feature = "gpu")]
+fn gpu(a: &BenchArgs, loaded: &voxkit_io::LoadedMesh) -> Result<()> {
+    let g = voxkit_gpu::Gpu::new()?;
+    let mut owned = loaded.mesh.clone();
+    for _ in 0..a.subdivide {
+        owned = subdivide(&owned);
+    }
+    let mesh = owned.as_ref();
+    let mut out = format!(
+        "mesh: {}{} ({} triangles); cover; median of {} repeats; GPU: {}\n\n| resolution | voxels | CPU fast, {} threads (ms) | GPU total (ms) | upload (ms) | GPU run (ms) | download (ms) | CPU share (ms) | GPU vs CPU |\n|---|---|---|---|---|---|---|---|---|\n",
+        a.mesh.display(),
+        if a.subdivide > 0 { format!(" subdivided {} times", a.subdivide) } else { String::new() },
+        mesh.triangles.len(),
+        a.repeats,
+        g.adapter(),
+        rayon::current_num_threads()
+    );
+    let mut json_rows = Vec::new();
+    for &res in &a.resolutions {
+        let grid = GridSpec::from_resolution(&loaded.report.bounds, res).context("invalid grid")?;
+        crate::plan::check_memory(&grid)?;
+        let mut parts: Vec<voxkit_gpu::Timings> = Vec::new();
+        let timed = time_alternating(a.repeats, &[false, true], |&on_gpu| -> Result<u64> {
+            if on_gpu {
+                let (bits, r) = g.cover(mesh, &grid)?;
+                parts.push(r.timings);
+                Ok(bits.count())
+            } else {
+                Ok(voxelize::fast(voxelize::Mode::Cover, mesh, &grid, &Options::default()).0.count())
+            }
+        });
+        let (cpu_s, cpu_n) = (timed[0].0, timed[0].1.as_ref().map_err(|e| anyhow::anyhow!("{e}"))?);
+        let (gpu_s, gpu_n) = (timed[1].0, timed[1].1.as_ref().map_err(|e| anyhow::anyhow!("{e}"))?);
+        anyhow::ensure!(cpu_n == gpu_n, "GPU and CPU voxel counts differ at {res}: {gpu_n} vs {cpu_n}");
+        let m = |f: fn(&voxkit_gpu::Timings) -> f64| median(parts.iter().map(f).collect()) * 1e3;
+        let (up, run, down, cpu_share) = (m(|t| t.upload_s), m(|t| t.voxelize_s), m(|t| t.download_s), m(|t| t.cpu_s));
+        out += &format!(
+            "| {res} | {cpu_n} | {:.1} | {:.1} | {up:.1} | {run:.1} | {down:.1} | {cpu_share:.1} | {:.2}x |\n",
+            cpu_s * 1e3,
+            gpu_s * 1e3,
+            cpu_s / gpu_s
+        );
+        json_rows.push(json!({"resolution": res, "voxels": cpu_n, "cpu_fast_median_ms": cpu_s * 1e3, "gpu_total_median_ms": gpu_s * 1e3,
+            "upload_median_ms": up, "gpu_run_median_ms": run, "download_median_ms": down, "cpu_share_median_ms": cpu_share, "adapter": g.adapter()}));
+    }
+    if a.json {
+        for r in json_rows {
+            crate::print_stdout(&r.to_string())?;
+        }
+        return Ok(());
+    }
+    crate::print_stdout(out.trim_end())
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu(_a: &BenchArgs, _loaded: &voxkit_io::LoadedMesh) -> Result<()> {
+    anyhow::bail!("bench --gpu: this voxkit was built without the `gpu` feature")
 }
 
 /// Splits every triangle into four at its edge midpoints (positions are

@@ -65,6 +65,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let t_vox = Instant::now();
     let mut method = method;
     let mut solid_facts = serde_json::Value::Null;
+    let mut gpu_facts = serde_json::Value::Null;
     let (bits, report): (Box<dyn VoxelSource + Send>, _) = if let Some(sp) = &solid_plan {
         let name = a.mesh.display().to_string();
         let out = pool.install(|| {
@@ -80,21 +81,28 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
         (Box::new(out.bits) as Box<dyn VoxelSource + Send>, report)
     } else {
         let opts = Options { progress: Some(&bar), ..Options::default() };
-        pool.install(|| match surface_method {
-            plan::SurfaceMethod::Reference => {
-                let (b, r) = voxelize::reference(mode, loaded.mesh.as_ref(), &grid);
-                (Box::new(b) as Box<dyn VoxelSource + Send>, r)
-            }
-            plan::SurfaceMethod::Scanline => {
-                let (b, r) = voxelize::scanline::scanline(mode, loaded.mesh.as_ref(), &grid, &opts)
-                    .expect("resolve_method allows scanline only for modes that have it");
-                (Box::new(b) as Box<dyn VoxelSource + Send>, r)
-            }
-            plan::SurfaceMethod::Fast => {
-                let (b, r) = voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &opts);
-                (Box::new(b) as Box<dyn VoxelSource + Send>, r)
-            }
-        })
+        pool.install(|| -> Result<_> {
+            Ok(match surface_method {
+                plan::SurfaceMethod::Reference => {
+                    let (b, r) = voxelize::reference(mode, loaded.mesh.as_ref(), &grid);
+                    (Box::new(b) as Box<dyn VoxelSource + Send>, r)
+                }
+                plan::SurfaceMethod::Scanline => {
+                    let (b, r) = voxelize::scanline::scanline(mode, loaded.mesh.as_ref(), &grid, &opts)
+                        .expect("resolve_method allows scanline only for modes that have it");
+                    (Box::new(b) as Box<dyn VoxelSource + Send>, r)
+                }
+                plan::SurfaceMethod::Fast => {
+                    let (b, r) = voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &opts);
+                    (Box::new(b) as Box<dyn VoxelSource + Send>, r)
+                }
+                plan::SurfaceMethod::Gpu => {
+                    let (b, r, facts) = gpu_cover(loaded.mesh.as_ref(), &grid)?;
+                    gpu_facts = facts;
+                    (Box::new(b) as Box<dyn VoxelSource + Send>, r)
+                }
+            })
+        })?
     };
     let voxelize_s = t_vox.elapsed().as_secs_f64();
 
@@ -176,6 +184,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
             })},
             "warnings": loaded.warnings,
             "solid": solid_facts,
+            "gpu": gpu_facts,
         });
         crate::print_stdout(&v.to_string())?;
     } else if !a.quiet {
@@ -202,6 +211,31 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
         ))?;
     }
     Ok(())
+}
+
+/// `cover` on the GPU: the voxels, the report, and facts for `--json`.
+#[cfg(feature = "gpu")]
+fn gpu_cover(mesh: voxkit::MeshRef<'_>, grid: &voxkit::GridSpec) -> Result<(voxkit::BrickBits, voxelize::Report, serde_json::Value)> {
+    let gpu = voxkit_gpu::Gpu::new().map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
+    let (bits, r) = gpu.cover(mesh, grid).map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
+    let t = r.timings;
+    let facts = json!({
+        "adapter": gpu.adapter(),
+        "software": gpu.is_software(),
+        "gpu_triangles": r.gpu_triangles,
+        "cpu_triangles": r.cpu_triangles,
+        "upload_s": t.upload_s,
+        "gpu_s": t.voxelize_s,
+        "download_s": t.download_s,
+        "cpu_share_s": t.cpu_s,
+        "slabs": t.slabs,
+    });
+    Ok((bits, r.report, facts))
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_cover(_mesh: voxkit::MeshRef<'_>, _grid: &voxkit::GridSpec) -> Result<(voxkit::BrickBits, voxelize::Report, serde_json::Value)> {
+    bail!("--method gpu: this voxkit was built without the `gpu` feature")
 }
 
 pub(crate) fn check_output_dir(out: &Path) -> Result<()> {

@@ -1,0 +1,205 @@
+//! The compute path: triangles on the lattice → bits in z-slabs on the GPU.
+
+use std::time::Instant;
+
+use voxkit::geom::fixed::ONE;
+use voxkit::geom::lattice::{prepare, LatticeTriangle};
+use voxkit::voxelize::{Options, Report};
+use voxkit::{BrickBits, GridSpec, MeshRef};
+use wgpu::util::DeviceExt;
+
+use crate::{Gpu, GpuError};
+
+/// Largest relative coordinate (lattice units) for which the shader's i64
+/// products cannot overflow: the separating axis test multiplies a normal
+/// component (≤ 2R²) by a coordinate (≤ R) and sums six such terms, and
+/// 12·(2^19)³ < 2^63.
+const LIMIT: i64 = 1 << 19;
+
+/// Seconds spent in each stage.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timings {
+    /// Snapping on the CPU, packing and uploading triangles.
+    pub upload_s: f64,
+    /// From submission until the GPU finished (all slabs).
+    pub voxelize_s: f64,
+    /// Reading the slabs back into bricks.
+    pub download_s: f64,
+    /// The CPU's share (triangles too large for the shader's i64 products).
+    pub cpu_s: f64,
+    /// Slabs the grid was cut into.
+    pub slabs: u32,
+}
+
+/// What [`Gpu::cover`] did.
+#[derive(Clone, Copy, Debug)]
+pub struct CoverReport {
+    /// Triangle counts and voxels, as the CPU paths report them.
+    pub report: Report,
+    /// Triangles voxelized on the GPU.
+    pub gpu_triangles: u64,
+    /// Triangles voxelized by the CPU fast path (too large for i64 on the GPU).
+    pub cpu_triangles: u64,
+    /// Where the time went.
+    pub timings: Timings,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct GpuTri {
+    origin: [i32; 4],
+    size: [u32; 4],
+    a: [i32; 4],
+    b: [i32; 4],
+    c: [i32; 4],
+}
+
+impl Gpu {
+    /// `cover` of `mesh` on `grid`: the same voxels as
+    /// [`voxkit::voxelize::cover::reference::cover`].
+    pub fn cover(&self, mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(BrickBits, CoverReport), GpuError> {
+        let t0 = Instant::now();
+        let (tris, prepare_stats) = prepare(mesh, grid);
+        let dims = grid.dims();
+        let mut on_gpu: Vec<(GpuTri, [i64; 2])> = Vec::with_capacity(tris.len());
+        let mut on_cpu: Vec<LatticeTriangle> = Vec::new();
+        for t in &tris {
+            let Some((lo, hi)) = t.voxel_bounds(dims) else { continue };
+            let base = lo.map(|c| c * ONE);
+            let rel = t.v.map(|p| [p[0] - base[0], p[1] - base[1], p[2] - base[2]]);
+            let box_reach = (0..3).map(|a| (hi[a] - lo[a] + 2) * ONE).max().unwrap_or(0);
+            let reach = rel.iter().flatten().map(|c| c.abs()).max().unwrap_or(0).max(box_reach);
+            if reach > LIMIT {
+                on_cpu.push(*t);
+                continue;
+            }
+            let v = |p: [i64; 3]| [p[0] as i32, p[1] as i32, p[2] as i32, 0];
+            let g = GpuTri {
+                origin: [lo[0] as i32, lo[1] as i32, lo[2] as i32, 0],
+                size: [(hi[0] - lo[0] + 1) as u32, (hi[1] - lo[1] + 1) as u32, (hi[2] - lo[2] + 1) as u32, 0],
+                a: v(rel[0]),
+                b: v(rel[1]),
+                c: v(rel[2]),
+            };
+            on_gpu.push((g, [lo[2], hi[2]]));
+        }
+        on_gpu.sort_by_key(|t| t.1[0]);
+        let mut timings = Timings { upload_s: t0.elapsed().as_secs_f64(), ..Timings::default() };
+
+        let words_per_row = dims[0].div_ceil(32) as u64;
+        let layer_bytes = words_per_row * dims[1] as u64 * 4;
+        if layer_bytes > self.max_slab_bytes {
+            return Err(GpuError::Unsupported(format!(
+                "grids whose single z-layer ({layer_bytes} bytes) exceeds the device's storage buffer limit ({} bytes)",
+                self.max_slab_bytes
+            )));
+        }
+        let nk_max = ((self.max_slab_bytes / layer_bytes) as u32).clamp(1, dims[2]);
+        let slab_bytes = layer_bytes * nk_max as u64;
+        let out = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("slab bits"),
+            size: slab_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("slab readback"),
+            size: slab_bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let max_batch = (self.max_slab_bytes / std::mem::size_of::<GpuTri>() as u64).clamp(1, 1 << 22) as usize;
+        self.check()?;
+        let mut bits = BrickBits::new(dims);
+        let mut k0 = 0u32;
+        while k0 < dims[2] {
+            let nk = nk_max.min(dims[2] - k0);
+            let (klo, khi) = (k0 as i64, (k0 + nk) as i64 - 1);
+            let t_up = Instant::now();
+            // Sorted by lowest layer: stop at the first triangle starting above the slab.
+            let slab: Vec<GpuTri> = on_gpu.iter().take_while(|t| t.1[0] <= khi).filter(|t| t.1[1] >= klo).map(|t| t.0).collect();
+            let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("slab") });
+            encoder.clear_buffer(&out, 0, None);
+            let mut keep = Vec::new();
+            for batch in slab.chunks(max_batch) {
+                let tri_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("triangles"),
+                    contents: bytemuck::cast_slice(batch),
+                    usage: wgpu::BufferUsages::STORAGE,
+                });
+                let params: [u32; 8] = [dims[0], dims[1], dims[2], k0, nk, words_per_row as u32, batch.len() as u32, 0];
+                let par_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("params"),
+                    contents: bytemuck::cast_slice(&params),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("cover"),
+                    layout: &self.layout,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: tri_buf.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: out.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 2, resource: par_buf.as_entire_binding() },
+                    ],
+                });
+                {
+                    let mut pass =
+                        encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("cover"), timestamp_writes: None });
+                    pass.set_pipeline(&self.cover);
+                    pass.set_bind_group(0, &bind, &[]);
+                    let n = batch.len() as u32;
+                    pass.dispatch_workgroups(n.min(65535), n.div_ceil(65535), 1);
+                }
+                keep.push((tri_buf, par_buf, bind));
+            }
+            let used = layer_bytes * nk as u64;
+            encoder.copy_buffer_to_buffer(&out, 0, &staging, 0, used);
+            timings.upload_s += t_up.elapsed().as_secs_f64();
+            let t_run = Instant::now();
+            self.queue.submit([encoder.finish()]);
+            let slice = staging.slice(0..used);
+            let (tx, rx) = std::sync::mpsc::channel();
+            slice.map_async(wgpu::MapMode::Read, move |r| {
+                let _ = tx.send(r);
+            });
+            self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Device(e.to_string()))?;
+            self.check()?;
+            rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+            timings.voxelize_s += t_run.elapsed().as_secs_f64();
+            let t_down = Instant::now();
+            {
+                let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
+                let words: &[u32] = bytemuck::cast_slice(&view);
+                for (row, chunk) in words.chunks_exact(words_per_row as usize).enumerate() {
+                    let (j, k) = (row as u32 % dims[1], k0 + row as u32 / dims[1]);
+                    for (w, &word) in chunk.iter().enumerate() {
+                        let mut m = word;
+                        while m != 0 {
+                            let b = m.trailing_zeros();
+                            m &= m - 1;
+                            bits.set(w as u32 * 32 + b, j, k);
+                        }
+                    }
+                }
+            }
+            staging.unmap();
+            timings.download_s += t_down.elapsed().as_secs_f64();
+            timings.slabs += 1;
+            k0 += nk;
+        }
+        let t_cpu = Instant::now();
+        if !on_cpu.is_empty() {
+            let cpu = voxkit::voxelize::cover::cover_lattice(&on_cpu, dims, &Options::default());
+            cpu.for_each_set(&mut |i, j, k| bits.set(i, j, k));
+        }
+        timings.cpu_s = t_cpu.elapsed().as_secs_f64();
+        let voxels = bits.count();
+        let report = CoverReport {
+            report: Report { prepare: prepare_stats, voxels },
+            gpu_triangles: on_gpu.len() as u64,
+            cpu_triangles: on_cpu.len() as u64,
+            timings,
+        };
+        Ok((bits, report))
+    }
+}

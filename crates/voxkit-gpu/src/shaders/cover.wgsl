@@ -1,0 +1,146 @@
+// Conservative surface voxelization (`cover`) on the GPU: one workgroup per
+// triangle, its threads striding over the columns of the triangle's
+// dominant-axis projection. Each column's candidate range along the
+// dominant axis is bounded in f32 (with a one-voxel margin, far wider than
+// the f32 error), and every candidate is decided by the exact 13-axis
+// separating axis test in i64 on lattice coordinates relative to the
+// triangle's box, the same predicate as the CPU reference
+// (`voxkit::voxelize::cover::reference::triangle_box_overlap`).
+// Triangles are sent only when the i64 products cannot overflow.
+
+struct Tri {
+    // Voxel index of the box's low corner; box size in voxels (inclusive count).
+    origin: vec3<i32>,
+    pad0: i32,
+    size: vec3<u32>,
+    pad1: u32,
+    // Vertices relative to origin * ONE, in lattice units.
+    a: vec3<i32>,
+    pad2: i32,
+    b: vec3<i32>,
+    pad3: i32,
+    c: vec3<i32>,
+    pad4: i32,
+};
+
+struct Params {
+    // Grid dims; the slab holds layers k0 .. k0 + nk.
+    dims: vec3<u32>,
+    k0: u32,
+    nk: u32,
+    words_per_row: u32,
+    count: u32,
+    pad: u32,
+};
+
+const ONE: i64 = 4096li;
+
+@group(0) @binding(0) var<storage, read> tris: array<Tri>;
+@group(0) @binding(1) var<storage, read_write> bits: array<atomic<u32>>;
+@group(0) @binding(2) var<uniform> params: Params;
+
+fn cross64(p: vec3<i64>, q: vec3<i64>) -> vec3<i64> {
+    return vec3<i64>(p.y * q.z - p.z * q.y, p.z * q.x - p.x * q.z, p.x * q.y - p.y * q.x);
+}
+
+fn dot64(p: vec3<i64>, q: vec3<i64>) -> i64 {
+    return p.x * q.x + p.y * q.y + p.z * q.z;
+}
+
+fn min0(v: i64) -> i64 { return select(v, 0li, v > 0li); }
+fn max0(v: i64) -> i64 { return select(v, 0li, v < 0li); }
+
+// Does the axis separate the triangle (v0, v1, v2) from the box [lo, lo + ONE]?
+fn separates(ax: vec3<i64>, v0: vec3<i64>, v1: vec3<i64>, v2: vec3<i64>, lo: vec3<i64>) -> bool {
+    let p0 = dot64(ax, v0);
+    let p1 = dot64(ax, v1);
+    let p2 = dot64(ax, v2);
+    let tmin = min(p0, min(p1, p2));
+    let tmax = max(p0, max(p1, p2));
+    let base = dot64(ax, lo);
+    let s = ax * ONE;
+    let bmin = base + min0(s.x) + min0(s.y) + min0(s.z);
+    let bmax = base + max0(s.x) + max0(s.y) + max0(s.z);
+    return tmax < bmin || tmin > bmax;
+}
+
+fn overlaps(v0: vec3<i64>, v1: vec3<i64>, v2: vec3<i64>, n: vec3<i64>, lo: vec3<i64>) -> bool {
+    // Box normals.
+    if (separates(vec3<i64>(1li, 0li, 0li), v0, v1, v2, lo)) { return false; }
+    if (separates(vec3<i64>(0li, 1li, 0li), v0, v1, v2, lo)) { return false; }
+    if (separates(vec3<i64>(0li, 0li, 1li), v0, v1, v2, lo)) { return false; }
+    // Triangle normal.
+    if (separates(n, v0, v1, v2, lo)) { return false; }
+    // Edge × box edge.
+    let e = array<vec3<i64>, 3>(v1 - v0, v2 - v1, v0 - v2);
+    for (var i = 0u; i < 3u; i++) {
+        let ei = e[i];
+        if (separates(vec3<i64>(0li, -ei.z, ei.y), v0, v1, v2, lo)) { return false; }
+        if (separates(vec3<i64>(ei.z, 0li, -ei.x), v0, v1, v2, lo)) { return false; }
+        if (separates(vec3<i64>(-ei.y, ei.x, 0li), v0, v1, v2, lo)) { return false; }
+    }
+    return true;
+}
+
+fn set_voxel(i: u32, j: u32, k: u32) {
+    let row = j + params.dims.y * (k - params.k0);
+    let word = row * params.words_per_row + i / 32u;
+    atomicOr(&bits[word], 1u << (i % 32u));
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let t_index = wg.x + wg.y * 65535u;
+    if (t_index >= params.count) { return; }
+    let t = tris[t_index];
+    let v0 = vec3<i64>(t.a);
+    let v1 = vec3<i64>(t.b);
+    let v2 = vec3<i64>(t.c);
+    let n = cross64(v1 - v0, v2 - v0);
+    // Dominant axis w of the normal; u, v the other two.
+    let an = abs(n);
+    var w = 2u;
+    if (an.x >= an.y && an.x >= an.z) { w = 0u; } else if (an.y >= an.z) { w = 1u; }
+    let u = (w + 1u) % 3u;
+    let v = (w + 2u) % 3u;
+    let size = vec3<i32>(t.size);
+    // Layers of the slab, relative to the triangle's box.
+    let k_lo = max(0, i32(params.k0) - t.origin.z);
+    let k_hi = min(size.z - 1, i32(params.k0 + params.nk) - 1 - t.origin.z);
+    if (k_lo > k_hi) { return; }
+    var lo_r = vec3<i32>(0, 0, k_lo);
+    var hi_r = vec3<i32>(size.x - 1, size.y - 1, k_hi);
+    let nu = size[u];
+    let columns = u32(size[u] * size[v]);
+    let nf = vec3<f32>(f32(n.x), f32(n.y), f32(n.z));
+    let d = f32(dot64(n, v0));
+    let one = 4096.0;
+    for (var col = lid; col < columns; col += 64u) {
+        let cu = i32(col) % nu;
+        let cv = i32(col) / nu;
+        // The plane's range along w over the column's four corner lines.
+        var wmin = 3.0e38;
+        var wmax = -3.0e38;
+        for (var q = 0; q < 4; q++) {
+            let xu = f32(cu + (q & 1)) * one;
+            let xv = f32(cv + (q >> 1)) * one;
+            let xw = (d - nf[u] * xu - nf[v] * xv) / nf[w];
+            wmin = min(wmin, xw);
+            wmax = max(wmax, xw);
+        }
+        let w0 = max(lo_r[w], i32(floor(wmin / one)) - 1);
+        let w1 = min(hi_r[w], i32(floor(wmax / one)) + 1);
+        for (var cw = w0; cw <= w1; cw++) {
+            var r = vec3<i32>(0, 0, 0);
+            r[u] = cu;
+            r[v] = cv;
+            r[w] = cw;
+            if (r.z < k_lo || r.z > k_hi) { continue; }
+            let lo = vec3<i64>(r) * ONE;
+            if (overlaps(v0, v1, v2, n, lo)) {
+                let g = t.origin + r;
+                set_voxel(u32(g.x), u32(g.y), u32(g.z));
+            }
+        }
+    }
+}

@@ -1,0 +1,104 @@
+//! The GPU `cover` equals the CPU reference voxel for voxel: every shared
+//! mesh, random rotations, random triangles (small, large enough to go to
+//! the CPU share, and on lattice planes), and grids cut into many slabs.
+//!
+//! Needs a GPU adapter with 64-bit shader integers (CI: Mesa's lavapipe).
+//! Without one the tests say so and pass, unless `VOXKIT_REQUIRE_GPU=1`
+//! (set by `.ci/run`), where a missing adapter fails them.
+
+use glam::DVec3;
+use proptest::prelude::*;
+use voxkit::voxelize::cover::reference;
+use voxkit::{GridSpec, Mesh};
+use voxkit_gpu::Gpu;
+use voxkit_testkit::{random_rotation, rng, rotated, shared_mesh, soup};
+
+fn gpu() -> Option<Gpu> {
+    match Gpu::new() {
+        Ok(g) => Some(g),
+        Err(e) if std::env::var("VOXKIT_REQUIRE_GPU").as_deref() == Ok("1") => panic!("VOXKIT_REQUIRE_GPU=1 but {e}"),
+        Err(e) => {
+            eprintln!("skipping GPU test: {e}");
+            None
+        }
+    }
+}
+
+fn check(g: &Gpu, mesh: &Mesh, grid: &GridSpec, what: &str) -> (u64, u64) {
+    let (bits, rep) = g.cover(mesh.as_ref(), grid).unwrap();
+    let (want, _) = reference::cover(mesh.as_ref(), grid);
+    if let Some(v) = bits.to_dense().first_difference(&want) {
+        panic!("{what}: GPU and CPU reference differ at voxel {v:?} (GPU {} voxels, CPU {})", bits.count(), want.count());
+    }
+    (rep.gpu_triangles, rep.cpu_triangles)
+}
+
+#[test]
+fn every_shared_mesh_equals_the_reference() {
+    let Some(g) = gpu() else { return };
+    eprintln!("adapter: {}", g.adapter());
+    for name in [
+        "alligator.obj",
+        "beetle.obj",
+        "cheburashka.obj",
+        "cow.obj",
+        "fandisk.obj",
+        "homer.obj",
+        "rocker-arm.obj",
+        "spot-textured.obj",
+        "stanford-bunny.obj",
+        "suzanne.obj",
+        "teapot.obj",
+        "woody.obj",
+    ] {
+        let mesh = shared_mesh(name);
+        let bounds = mesh.as_ref().bounds();
+        for res in [37, 128] {
+            let grid = GridSpec::from_resolution(&bounds, res).unwrap();
+            let (on_gpu, _) = check(&g, &mesh, &grid, &format!("{name} at {res}"));
+            assert!(on_gpu > 0);
+        }
+    }
+}
+
+#[test]
+fn rotated_meshes_and_many_slabs_equal_the_reference() {
+    let Some(mut g) = gpu() else { return };
+    let mut r = rng(7);
+    for name in ["stanford-bunny.obj", "fandisk.obj", "suzanne.obj"] {
+        let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
+        let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), 96).unwrap();
+        check(&g, &mesh, &grid, &format!("rotated {name}"));
+    }
+    // Slabs of 3 layers (and a last partial one).
+    let mesh = shared_mesh("cow.obj");
+    let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), 64).unwrap();
+    let layer = grid.dims()[0].div_ceil(32) as u64 * grid.dims()[1] as u64 * 4;
+    g.set_max_slab_bytes(3 * layer);
+    check(&g, &mesh, &grid, "cow in 3-layer slabs");
+}
+
+#[test]
+fn large_triangles_go_to_the_cpu_and_still_agree() {
+    let Some(g) = gpu() else { return };
+    // A box at 300: faces span 300 voxels, past the shader's i64 bound.
+    let mesh = voxkit_testkit::box_mesh(DVec3::new(0.1, 0.2, 0.3), DVec3::new(7.3, 5.1, 6.2));
+    let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), 300).unwrap();
+    let (on_gpu, on_cpu) = check(&g, &mesh, &grid, "box at 300");
+    assert!(on_cpu > 0 && on_gpu == 0, "gpu {on_gpu}, cpu {on_cpu}");
+    let rot = rotated(&mesh, random_rotation(&mut rng(3)));
+    let grid = GridSpec::from_resolution(&rot.as_ref().bounds(), 100).unwrap();
+    check(&g, &rot, &grid, "rotated box at 100");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_triangles_equal_the_reference(tris in proptest::collection::vec(voxkit_testkit::strategies::triangle(), 1..12)) {
+        let Some(g) = gpu() else { return Ok(()) };
+        let mesh = soup(&tris);
+        let grid = GridSpec::new(DVec3::splat(-2.0), 0.25, [48, 48, 48]).unwrap();
+        check(&g, &mesh, &grid, "random soup");
+    }
+}
