@@ -134,9 +134,11 @@ pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::M
         Method::Gpu if !cfg!(feature = "gpu") => {
             bail!("--method gpu: this voxkit was built without the `gpu` feature; use auto, fast or reference")
         }
-        Method::Gpu if core == voxkit::voxelize::Mode::Cover => SurfaceMethod::Gpu,
+        Method::Gpu if matches!(core, voxkit::voxelize::Mode::Cover | voxkit::voxelize::Mode::Sep26 | voxkit::voxelize::Mode::Sep6) => {
+            SurfaceMethod::Gpu
+        }
         Method::Gpu => bail!(
-            "--method gpu exists for cover so far; {} on the GPU is not built yet (use auto, fast, scanline or reference)",
+            "--method gpu exists for cover, sep26 and sep6 so far; {} on the GPU is not built yet (use auto, fast or reference)",
             mode_name(mode)
         ),
         Method::Parity | Method::Winding => bail!("--method {} applies only to --mode solid", method_name(method)),
@@ -162,12 +164,12 @@ pub fn auto_method(mode: voxkit::voxelize::Mode, mesh: voxkit::MeshRef<'_>, grid
 /// hardware GPU by `--method auto`.
 pub const GPU_AUTO_MIN_SIDE: u32 = 512;
 
-/// `--method auto` on a large `cover` job: is there a hardware GPU adapter?
+/// `--method auto` on a large `cover`, `sep26` or `sep6` job: is there a hardware GPU adapter?
 /// Software adapters (lavapipe, WARP) are slower than the CPU paths, so
 /// they are not used unless asked for (`--method gpu`).
 #[cfg(feature = "gpu")]
 fn gpu_preferred(mode: voxkit::voxelize::Mode, grid: &GridSpec) -> bool {
-    if mode != voxkit::voxelize::Mode::Cover || grid.dims().iter().copied().max().unwrap_or(0) < GPU_AUTO_MIN_SIDE {
+    if voxkit_gpu::GpuMode::of(mode).is_none() || grid.dims().iter().copied().max().unwrap_or(0) < GPU_AUTO_MIN_SIDE {
         return false;
     }
     match voxkit_gpu::Gpu::new() {

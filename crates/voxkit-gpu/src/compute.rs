@@ -11,10 +11,52 @@ use wgpu::util::DeviceExt;
 use crate::{Gpu, GpuError};
 
 /// Largest relative coordinate (lattice units) for which the shader's i64
-/// products cannot overflow: the separating axis test multiplies a normal
-/// component (≤ 2R²) by a coordinate (≤ R) and sums six such terms, and
-/// 12·(2^19)³ < 2^63.
-const LIMIT: i64 = 1 << 19;
+/// products cannot overflow in `cover`: the separating axis test multiplies
+/// a normal component (≤ 2R²) by a coordinate (≤ R) and sums six such
+/// terms, and 12·(2^19)³ < 2^63.
+const LIMIT_COVER: i64 = 1 << 19;
+
+/// The same for `sep26`/`sep6`, whose orientation determinants take
+/// differences of coordinates (≤ 2R) three at a time: 3·2·(2^19)³ < 2^63.
+const LIMIT_TARGETS: i64 = 1 << 18;
+
+/// The surface modes the GPU path runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GpuMode {
+    /// Conservative cover.
+    Cover,
+    /// Laine's minimal 26-separating (space diagonals).
+    Sep26,
+    /// Laine's thin 6-separating (crosshair).
+    Sep6,
+}
+
+impl GpuMode {
+    /// The GPU mode for a core mode, if the GPU path has it.
+    pub fn of(mode: voxkit::voxelize::Mode) -> Option<GpuMode> {
+        match mode {
+            voxkit::voxelize::Mode::Cover => Some(GpuMode::Cover),
+            voxkit::voxelize::Mode::Sep26 => Some(GpuMode::Sep26),
+            voxkit::voxelize::Mode::Sep6 => Some(GpuMode::Sep6),
+            _ => None,
+        }
+    }
+
+    fn code(self) -> u32 {
+        match self {
+            GpuMode::Cover => 0,
+            GpuMode::Sep26 => 1,
+            GpuMode::Sep6 => 2,
+        }
+    }
+
+    fn limit(self) -> i64 {
+        match self {
+            GpuMode::Cover => LIMIT_COVER,
+            _ => LIMIT_TARGETS,
+        }
+    }
+}
 
 /// Seconds spent in each stage.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -58,6 +100,11 @@ impl Gpu {
     /// `cover` of `mesh` on `grid`: the same voxels as
     /// [`voxkit::voxelize::cover::reference::cover`].
     pub fn cover(&self, mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(BrickBits, CoverReport), GpuError> {
+        self.voxelize(GpuMode::Cover, mesh, grid)
+    }
+
+    /// `mode` of `mesh` on `grid`: the same voxels as the mode's CPU reference.
+    pub fn voxelize(&self, mode: GpuMode, mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(BrickBits, CoverReport), GpuError> {
         let t0 = Instant::now();
         let (tris, prepare_stats) = prepare(mesh, grid);
         let dims = grid.dims();
@@ -69,7 +116,7 @@ impl Gpu {
             let rel = t.v.map(|p| [p[0] - base[0], p[1] - base[1], p[2] - base[2]]);
             let box_reach = (0..3).map(|a| (hi[a] - lo[a] + 2) * ONE).max().unwrap_or(0);
             let reach = rel.iter().flatten().map(|c| c.abs()).max().unwrap_or(0).max(box_reach);
-            if reach > LIMIT {
+            if reach > mode.limit() {
                 on_cpu.push(*t);
                 continue;
             }
@@ -127,7 +174,7 @@ impl Gpu {
                     contents: bytemuck::cast_slice(batch),
                     usage: wgpu::BufferUsages::STORAGE,
                 });
-                let params: [u32; 8] = [dims[0], dims[1], dims[2], k0, nk, words_per_row as u32, batch.len() as u32, 0];
+                let params: [u32; 8] = [dims[0], dims[1], dims[2], k0, nk, words_per_row as u32, batch.len() as u32, mode.code()];
                 let par_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("params"),
                     contents: bytemuck::cast_slice(&params),
@@ -189,7 +236,12 @@ impl Gpu {
         }
         let t_cpu = Instant::now();
         if !on_cpu.is_empty() {
-            let cpu = voxkit::voxelize::cover::cover_lattice(&on_cpu, dims, &Options::default());
+            let o = Options::default();
+            let cpu = match mode {
+                GpuMode::Cover => voxkit::voxelize::cover::cover_lattice(&on_cpu, dims, &o),
+                GpuMode::Sep26 => voxkit::voxelize::sep26::sep26_lattice(&on_cpu, dims, &o),
+                GpuMode::Sep6 => voxkit::voxelize::sep6::sep6_lattice(&on_cpu, dims, &o),
+            };
             cpu.for_each_set(&mut |i, j, k| bits.set(i, j, k));
         }
         timings.cpu_s = t_cpu.elapsed().as_secs_f64();

@@ -3,32 +3,34 @@
 //! GPU voxelization through wgpu (Vulkan, Metal, DX12), giving exactly the
 //! CPU's voxels.
 //!
-//! **What exists:** the triangle-parallel compute path for `cover`
-//! ([`Gpu::cover`], after M. Schwarz, H.-P. Seidel, "Fast Parallel Surface
+//! **What exists:** the triangle-parallel compute path for `cover`,
+//! `sep26` and `sep6` ([`Gpu::voxelize`], after M. Schwarz, H.-P. Seidel, "Fast Parallel Surface
 //! and Solid Voxelization on GPUs", 2010: per-triangle setup, the dominant
 //! axis projection bounding each triangle's candidates, bits set with
 //! `atomicOr`), large grids processed in z-slabs that fit the device's
 //! buffer limits.
 //!
 //! **Not built yet** (callers get [`GpuError::Unsupported`] naming it):
-//! `sep26`, `sep6` and `solid` on the GPU, the rasterizer path with
+//! `solid` on the GPU (parity flips), the rasterizer path with
 //! dominant-axis swizzle and conservative rasterization, and the MSAA
 //! approximation.
 //!
 //! **Exactness.** Vertices are snapped on the CPU to the lattice every
 //! voxkit path uses ([`voxkit::geom::lattice::prepare`]); the shader decides
 //! each candidate voxel by the exact separating axis test of the CPU
-//! reference, in 64-bit integers on coordinates relative to the triangle's
-//! box (the adapter must offer `SHADER_INT64`). A triangle whose relative
-//! coordinates could overflow those products (spanning more than about 126
-//! voxels) is voxelized by the CPU's exact fast path instead, and the two
-//! results are OR-ed. So the output equals the CPU reference voxel for
+//! reference, and for `sep26`/`sep6` by the modes' target tests with the
+//! same tie rule (Laine's perturbation, predicate for predicate), in 64-bit
+//! integers on coordinates relative to the triangle's box (the adapter
+//! must offer `SHADER_INT64`). A triangle whose relative coordinates could
+//! overflow those products (spanning more than about 126 voxels for
+//! `cover`, 62 for the others) is voxelized by the CPU's exact fast path
+//! instead, and the two results are OR-ed. So the output equals the CPU reference voxel for
 //! voxel; the tests check it on every shared mesh, rotations and random
 //! triangles.
 
 mod compute;
 
-pub use compute::{CoverReport, Timings};
+pub use compute::{CoverReport, GpuMode, Timings};
 
 use std::sync::{Arc, Mutex};
 

@@ -1,4 +1,4 @@
-//! The GPU `cover` equals the CPU reference voxel for voxel: every shared
+//! The GPU `cover`, `sep26` and `sep6` equal the CPU references voxel for voxel: every shared
 //! mesh, random rotations, random triangles (small, large enough to go to
 //! the CPU share, and on lattice planes), and grids cut into many slabs.
 //!
@@ -8,9 +8,9 @@
 
 use glam::DVec3;
 use proptest::prelude::*;
-use voxkit::voxelize::cover::reference;
+use voxkit::voxelize::{self, Mode};
 use voxkit::{GridSpec, Mesh};
-use voxkit_gpu::Gpu;
+use voxkit_gpu::{Gpu, GpuMode};
 use voxkit_testkit::{random_rotation, rng, rotated, shared_mesh, soup};
 
 fn gpu() -> Option<Gpu> {
@@ -24,13 +24,22 @@ fn gpu() -> Option<Gpu> {
     }
 }
 
+const MODES: [Mode; 3] = [Mode::Cover, Mode::Sep26, Mode::Sep6];
+
+/// Every GPU mode against its CPU reference; returns the cover run's (GPU, CPU) triangle counts.
 fn check(g: &Gpu, mesh: &Mesh, grid: &GridSpec, what: &str) -> (u64, u64) {
-    let (bits, rep) = g.cover(mesh.as_ref(), grid).unwrap();
-    let (want, _) = reference::cover(mesh.as_ref(), grid);
-    if let Some(v) = bits.to_dense().first_difference(&want) {
-        panic!("{what}: GPU and CPU reference differ at voxel {v:?} (GPU {} voxels, CPU {})", bits.count(), want.count());
+    let mut counts = (0, 0);
+    for mode in MODES {
+        let (bits, rep) = g.voxelize(GpuMode::of(mode).unwrap(), mesh.as_ref(), grid).unwrap();
+        let (want, _) = voxelize::reference(mode, mesh.as_ref(), grid);
+        if let Some(v) = bits.to_dense().first_difference(&want) {
+            panic!("{what}, {mode:?}: GPU and CPU reference differ at voxel {v:?} (GPU {} voxels, CPU {})", bits.count(), want.count());
+        }
+        if mode == Mode::Cover {
+            counts = (rep.gpu_triangles, rep.cpu_triangles);
+        }
     }
-    (rep.gpu_triangles, rep.cpu_triangles)
+    counts
 }
 
 #[test]

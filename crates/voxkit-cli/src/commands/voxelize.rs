@@ -97,7 +97,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
                     (Box::new(b) as Box<dyn VoxelSource + Send>, r)
                 }
                 plan::SurfaceMethod::Gpu => {
-                    let (b, r, facts) = gpu_cover(loaded.mesh.as_ref(), &grid)?;
+                    let (b, r, facts) = gpu_voxelize(mode, loaded.mesh.as_ref(), &grid)?;
                     gpu_facts = facts;
                     (Box::new(b) as Box<dyn VoxelSource + Send>, r)
                 }
@@ -213,11 +213,16 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     Ok(())
 }
 
-/// `cover` on the GPU: the voxels, the report, and facts for `--json`.
+/// A surface mode on the GPU: the voxels, the report, and facts for `--json`.
 #[cfg(feature = "gpu")]
-fn gpu_cover(mesh: voxkit::MeshRef<'_>, grid: &voxkit::GridSpec) -> Result<(voxkit::BrickBits, voxelize::Report, serde_json::Value)> {
+fn gpu_voxelize(
+    mode: voxelize::Mode,
+    mesh: voxkit::MeshRef<'_>,
+    grid: &voxkit::GridSpec,
+) -> Result<(voxkit::BrickBits, voxelize::Report, serde_json::Value)> {
+    let gm = voxkit_gpu::GpuMode::of(mode).ok_or_else(|| anyhow::anyhow!("--method gpu: {} on the GPU is not built yet", mode.name()))?;
     let gpu = voxkit_gpu::Gpu::new().map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
-    let (bits, r) = gpu.cover(mesh, grid).map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
+    let (bits, r) = gpu.voxelize(gm, mesh, grid).map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
     let t = r.timings;
     let facts = json!({
         "adapter": gpu.adapter(),
@@ -234,7 +239,11 @@ fn gpu_cover(mesh: voxkit::MeshRef<'_>, grid: &voxkit::GridSpec) -> Result<(voxk
 }
 
 #[cfg(not(feature = "gpu"))]
-fn gpu_cover(_mesh: voxkit::MeshRef<'_>, _grid: &voxkit::GridSpec) -> Result<(voxkit::BrickBits, voxelize::Report, serde_json::Value)> {
+fn gpu_voxelize(
+    _mode: voxelize::Mode,
+    _mesh: voxkit::MeshRef<'_>,
+    _grid: &voxkit::GridSpec,
+) -> Result<(voxkit::BrickBits, voxelize::Report, serde_json::Value)> {
     bail!("--method gpu: this voxkit was built without the `gpu` feature")
 }
 

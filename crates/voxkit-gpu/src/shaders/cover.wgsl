@@ -1,4 +1,4 @@
-// Conservative surface voxelization (`cover`) on the GPU: one workgroup per
+// Surface voxelization on the GPU (`cover`, `sep26`, `sep6`): one workgroup per
 // triangle, its threads striding over the columns of the triangle's
 // dominant-axis projection. Each column's candidate range along the
 // dominant axis is bounded in f32 (with a one-voxel margin, far wider than
@@ -6,6 +6,13 @@
 // separating axis test in i64 on lattice coordinates relative to the
 // triangle's box, the same predicate as the CPU reference
 // (`voxkit::voxelize::cover::reference::triangle_box_overlap`).
+// For `sep26` and `sep6` (subsets of `cover`) a voxel that passes the
+// cover test is then decided by the modes' definitions: does the triangle
+// meet one of the voxel's space diagonals (sep26) or crosshair segments
+// (sep6), displaced by Laine's infinitesimal δ = −(ε, ε², ε³)? That is
+// `voxkit::geom::perturb::segment_meets_triangle`, ported predicate for
+// predicate: five orientation signs, each the lexicographic sign of the
+// determinant at δ = 0 and its three partial differences.
 // Triangles are sent only when the i64 products cannot overflow.
 
 struct Tri {
@@ -30,7 +37,8 @@ struct Params {
     nk: u32,
     words_per_row: u32,
     count: u32,
-    pad: u32,
+    // 0 cover, 1 sep26, 2 sep6.
+    mode: u32,
 };
 
 const ONE: i64 = 4096li;
@@ -80,6 +88,69 @@ fn overlaps(v0: vec3<i64>, v1: vec3<i64>, v2: vec3<i64>, n: vec3<i64>, lo: vec3<
         if (separates(vec3<i64>(-ei.y, ei.x, 0li), v0, v1, v2, lo)) { return false; }
     }
     return true;
+}
+
+fn det3(a: vec3<i64>, b: vec3<i64>, c: vec3<i64>) -> i64 {
+    return dot64(a, cross64(b, c));
+}
+
+// det[p1 − p0, p2 − p0, p3 − p0] with the points whose flag is set moved by d.
+fn det_at(p0: vec3<i64>, p1: vec3<i64>, p2: vec3<i64>, p3: vec3<i64>, f: vec4<bool>, d: vec3<i64>) -> i64 {
+    let q0 = p0 + select(vec3<i64>(0li), d, f.x);
+    let q1 = p1 + select(vec3<i64>(0li), d, f.y);
+    let q2 = p2 + select(vec3<i64>(0li), d, f.z);
+    let q3 = p3 + select(vec3<i64>(0li), d, f.w);
+    return det3(q1 - q0, q2 - q0, q3 - q0);
+}
+
+fn sign64(v: i64) -> i32 {
+    return select(select(0, -1, v < 0li), 1, v > 0li);
+}
+
+// Sign of the orientation with the flagged points displaced by δ = −(ε, ε², ε³).
+fn orient(p0: vec3<i64>, p1: vec3<i64>, p2: vec3<i64>, p3: vec3<i64>, f: vec4<bool>) -> i32 {
+    let d0 = det_at(p0, p1, p2, p3, f, vec3<i64>(0li));
+    if (d0 != 0li) { return sign64(d0); }
+    let dx = det_at(p0, p1, p2, p3, f, vec3<i64>(-1li, 0li, 0li)) - d0;
+    if (dx != 0li) { return sign64(dx); }
+    let dy = det_at(p0, p1, p2, p3, f, vec3<i64>(0li, -1li, 0li)) - d0;
+    if (dy != 0li) { return sign64(dy); }
+    return sign64(det_at(p0, p1, p2, p3, f, vec3<i64>(0li, 0li, -1li)) - d0);
+}
+
+// Does the target segment [s0, s1] (displaced) meet the closed triangle?
+fn segment_meets_triangle(s0: vec3<i64>, s1: vec3<i64>, t0: vec3<i64>, t1: vec3<i64>, t2: vec3<i64>) -> bool {
+    let tri_pt = vec4<bool>(false, false, false, true);
+    let sp = orient(t0, t1, t2, s0, tri_pt);
+    let sq = orient(t0, t1, t2, s1, tri_pt);
+    if (sp == 0 || sp == sq) { return false; }
+    let seg = vec4<bool>(true, true, false, false);
+    let e0 = orient(s0, s1, t0, t1, seg);
+    let e1 = orient(s0, s1, t1, t2, seg);
+    let e2 = orient(s0, s1, t2, t0, seg);
+    return e0 != 0 && e0 == e1 && e1 == e2;
+}
+
+fn target_hit(v0: vec3<i64>, v1: vec3<i64>, v2: vec3<i64>, lo: vec3<i64>) -> bool {
+    let h = ONE / 2li;
+    if (params.mode == 1u) {
+        // The four space diagonals.
+        let o = array<vec3<i64>, 4>(vec3<i64>(0li, 0li, 0li), vec3<i64>(ONE, 0li, 0li), vec3<i64>(0li, ONE, 0li), vec3<i64>(0li, 0li, ONE));
+        let d = array<vec3<i64>, 4>(vec3<i64>(ONE, ONE, ONE), vec3<i64>(-ONE, ONE, ONE), vec3<i64>(ONE, -ONE, ONE), vec3<i64>(ONE, ONE, -ONE));
+        for (var q = 0u; q < 4u; q++) {
+            let p = lo + o[q];
+            if (segment_meets_triangle(p, p + d[q], v0, v1, v2)) { return true; }
+        }
+        return false;
+    }
+    // The three crosshair segments.
+    let o = array<vec3<i64>, 3>(vec3<i64>(0li, h, h), vec3<i64>(h, 0li, h), vec3<i64>(h, h, 0li));
+    let d = array<vec3<i64>, 3>(vec3<i64>(ONE, 0li, 0li), vec3<i64>(0li, ONE, 0li), vec3<i64>(0li, 0li, ONE));
+    for (var q = 0u; q < 3u; q++) {
+        let p = lo + o[q];
+        if (segment_meets_triangle(p, p + d[q], v0, v1, v2)) { return true; }
+    }
+    return false;
 }
 
 fn set_voxel(i: u32, j: u32, k: u32) {
@@ -137,7 +208,7 @@ fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
             r[w] = cw;
             if (r.z < k_lo || r.z > k_hi) { continue; }
             let lo = vec3<i64>(r) * ONE;
-            if (overlaps(v0, v1, v2, n, lo)) {
+            if (overlaps(v0, v1, v2, n, lo) && (params.mode == 0u || target_hit(v0, v1, v2, lo))) {
                 let g = t.origin + r;
                 set_voxel(u32(g.x), u32(g.y), u32(g.z));
             }

@@ -39,6 +39,12 @@ pub fn sep26(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBi
     (bits, Report { prepare: prepare_stats, voxels })
 }
 
+/// The fast path on already prepared triangles (the GPU path hands it the
+/// triangles too large for its 64-bit shader arithmetic).
+pub fn sep26_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> BrickBits {
+    run_slabs(&Sep26Kernel, tris, dims, opts).0
+}
+
 struct Sep26Kernel;
 
 impl Kernel<LatticeTriangle> for Sep26Kernel {

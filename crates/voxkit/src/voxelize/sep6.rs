@@ -44,6 +44,12 @@ pub fn sep6(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBit
     (bits, Report { prepare: prepare_stats, voxels })
 }
 
+/// The fast path on already prepared triangles (the GPU path hands it the
+/// triangles too large for its 64-bit shader arithmetic).
+pub fn sep6_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> BrickBits {
+    run_slabs(&Sep6Kernel, tris, dims, opts).0
+}
+
 struct Sep6Kernel;
 
 impl Kernel<LatticeTriangle> for Sep6Kernel {
