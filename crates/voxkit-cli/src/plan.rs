@@ -199,6 +199,8 @@ pub enum SolidMethod {
     Reference,
     /// Flood fill against a surface shell.
     Flood,
+    /// Ray parity on the GPU.
+    GpuParity,
 }
 
 /// A validated solid job.
@@ -234,9 +236,8 @@ pub fn solid_plan(a: &crate::args::VoxelizeArgs) -> Result<Option<SolidPlan>> {
         (None, Method::Parity) => SolidMethod::Parity,
         (None, Method::Winding) => SolidMethod::Winding,
         (None, Method::Reference) => SolidMethod::Reference,
-        (None, Method::Gpu) => {
-            bail!("--method gpu does not do solid modes yet (GPU parity flips are not built); use auto, parity, winding or reference")
-        }
+        (None, Method::Gpu) if !cfg!(feature = "gpu") => bail!("--method gpu: this voxkit was built without the `gpu` feature"),
+        (None, Method::Gpu) => SolidMethod::GpuParity,
         (None, m) => bail!("--method {} does not apply to solid modes (use auto, parity, winding or reference)", method_name(m)),
     };
     let surface = (a.mode == Mode::SolidSurface || method == SolidMethod::Flood).then_some(surface_mode);

@@ -29,8 +29,10 @@
 //! triangles.
 
 mod compute;
+mod solid;
 
 pub use compute::{CoverReport, GpuMode, Timings};
+pub use solid::SolidGpuReport;
 
 use std::sync::{Arc, Mutex};
 
@@ -61,6 +63,54 @@ pub enum GpuError {
     Unsupported(String),
 }
 
+/// The three passes of the parity solid and their bind group layout.
+pub(crate) struct SolidPipelines {
+    pub(crate) layout: wgpu::BindGroupLayout,
+    pub(crate) flips: wgpu::ComputePipeline,
+    pub(crate) xor_list: wgpu::ComputePipeline,
+    pub(crate) prefix: wgpu::ComputePipeline,
+}
+
+impl SolidPipelines {
+    fn new(device: &wgpu::Device) -> SolidPipelines {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("solid"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("shaders/solid.wgsl").into()),
+        });
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("solid"),
+            entries: &[
+                entry(0, wgpu::BufferBindingType::Storage { read_only: true }),
+                entry(1, wgpu::BufferBindingType::Storage { read_only: false }),
+                entry(2, wgpu::BufferBindingType::Uniform),
+                entry(3, wgpu::BufferBindingType::Storage { read_only: true }),
+            ],
+        });
+        let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("solid"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |name: &'static str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(name),
+                layout: Some(&pl),
+                module: &module,
+                entry_point: Some(name),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        SolidPipelines { flips: pipeline("flips"), xor_list: pipeline("xor_list"), prefix: pipeline("prefix"), layout }
+    }
+}
+
 /// An open GPU device with the voxelization pipelines.
 pub struct Gpu {
     device: wgpu::Device,
@@ -68,6 +118,7 @@ pub struct Gpu {
     info: wgpu::AdapterInfo,
     cover: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    solid: SolidPipelines,
     /// Largest storage buffer the output slab may use, in bytes.
     max_slab_bytes: u64,
     /// The first error the device reported outside a call's own checks
@@ -162,7 +213,8 @@ impl Gpu {
             compilation_options: Default::default(),
             cache: None,
         });
-        let gpu = Gpu { device, queue, info, cover, layout, max_slab_bytes, errors };
+        let solid = SolidPipelines::new(&device);
+        let gpu = Gpu { device, queue, info, cover, layout, solid, max_slab_bytes, errors };
         gpu.check()?;
         Ok(gpu)
     }

@@ -19,6 +19,19 @@ pub struct Outcome {
     pub warnings: Vec<String>,
 }
 
+/// Parity on the GPU (the same voxels as `--method parity`).
+#[cfg(feature = "gpu")]
+fn gpu_parity(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, solid::SolidReport)> {
+    let gpu = voxkit_gpu::Gpu::new().map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
+    let (bits, r) = gpu.solid_parity(mesh, grid).map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
+    Ok((bits, r.solid))
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_parity(_mesh: MeshRef<'_>, _grid: &GridSpec) -> Result<(DenseBits, solid::SolidReport)> {
+    anyhow::bail!("--method gpu: this voxkit was built without the `gpu` feature")
+}
+
 pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opts: &Options<'_>) -> Result<Outcome> {
     let mut warnings = Vec::new();
     let (mut bits, method, mut facts) = if plan.method == SolidMethod::Flood {
@@ -75,6 +88,13 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
                 let mut r = inspect;
                 r.voxels = b.count();
                 (b, r, "reference")
+            }
+            SolidMethod::GpuParity => {
+                if !watertight {
+                    warnings.push(format!("{}: ray parity may streak through holes", open()));
+                }
+                let (b, r) = gpu_parity(mesh, grid)?;
+                (b, r, "gpu-parity")
             }
             SolidMethod::Flood => unreachable!("handled above"),
         };
