@@ -130,6 +130,11 @@ pub struct VoxelizeArgs {
     pub hollow: Option<String>,
     #[command(flatten)]
     pub grid: GridArgs,
+    /// With --method gpu: `compute` (default), `raster` (the rasterizer path, same voxels), or
+    /// `msaa-approx` (rasterizer with 4x MSAA instead of conservative coverage: approximate, misses
+    /// voxels; the summary says how many).
+    #[arg(long, value_enum, default_value = "compute", value_name = "PATH")]
+    pub gpu_path: GpuPathArg,
     /// Output format: npy, npy-bool, binvox, vox, txt, schem, vti, ply, or obj / glb for a mesh of the voxels (default: from the extension).
     #[arg(long, value_name = "FORMAT")]
     pub format: Option<String>,
@@ -166,6 +171,18 @@ pub struct ExportArgs {
     /// .schem: a colour -> block table, `namespace:block R G B` per line (default: the built-in table).
     #[arg(long, value_name = "FILE")]
     pub block_palette: Option<PathBuf>,
+}
+
+/// `--gpu-path`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum GpuPathArg {
+    /// Compute shaders, one workgroup per triangle.
+    #[default]
+    Compute,
+    /// The rasterizer: dominant-axis projection, conservative coverage, exact tests per fragment.
+    Raster,
+    /// The rasterizer with 4x MSAA: approximate.
+    MsaaApprox,
 }
 
 /// `--colour-rule`.

@@ -504,6 +504,12 @@ fn method_gpu_writes_the_cpu_file_or_says_why_not() {
     let cpu = tmp("c.npy");
     json(&voxkit(&["voxelize", &cow, "-o", &cpu, "--method", "fast", "--resolution", "80", "--json"]));
     assert_eq!(std::fs::read(&gpu).unwrap(), std::fs::read(&cpu).unwrap());
+    let r = json(&voxkit(&["voxelize", &cow, "-o", &gpu, "--method", "gpu", "--gpu-path", "raster", "--resolution", "80", "--json"]));
+    assert_eq!(r["gpu"]["path"], "raster");
+    assert_eq!(std::fs::read(&gpu).unwrap(), std::fs::read(&cpu).unwrap(), "raster");
+    let m = json(&voxkit(&["voxelize", &cow, "-o", &gpu, "--method", "gpu", "--gpu-path", "msaa-approx", "--resolution", "80", "--json"]));
+    let missed = m["gpu"]["missed_voxels"].as_u64().unwrap();
+    assert_eq!(m["voxels"].as_u64().unwrap() + missed, s["voxels"].as_u64().unwrap());
     for (mode, cpu_method) in [("sep26", "fast"), ("sep6", "fast"), ("solid", "parity")] {
         json(&voxkit(&["voxelize", &cow, "-o", &gpu, "--method", "gpu", "--mode", mode, "--resolution", "80", "--json"]));
         json(&voxkit(&["voxelize", &cow, "-o", &cpu, "--method", cpu_method, "--mode", mode, "--resolution", "80", "--json"]));

@@ -20,6 +20,22 @@ const LIMIT_COVER: i64 = 1 << 19;
 /// differences of coordinates (≤ 2R) three at a time: 3·2·(2^19)³ < 2^63.
 const LIMIT_TARGETS: i64 = 1 << 18;
 
+/// How the GPU visits each triangle's voxel columns.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GpuPath {
+    /// Compute shaders: one workgroup per triangle (default).
+    #[default]
+    Compute,
+    /// The rasterizer: dominant-axis projection, conservative coverage
+    /// (hardware where the adapter has it, else triangles expanded in the
+    /// vertex shader), exact tests per fragment. Same voxels as `Compute`.
+    Raster,
+    /// The rasterizer with 4× MSAA and no conservative coverage:
+    /// **approximate** — it misses voxels whose pixel no sample of the
+    /// projected triangle covers (never sets a wrong one).
+    RasterMsaa,
+}
+
 /// The surface modes the GPU path runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GpuMode {
@@ -103,8 +119,20 @@ impl Gpu {
         self.voxelize(GpuMode::Cover, mesh, grid)
     }
 
-    /// `mode` of `mesh` on `grid`: the same voxels as the mode's CPU reference.
+    /// `mode` of `mesh` on `grid` by the compute path: the same voxels as the mode's CPU reference.
     pub fn voxelize(&self, mode: GpuMode, mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(BrickBits, CoverReport), GpuError> {
+        self.voxelize_with(mode, GpuPath::Compute, mesh, grid)
+    }
+
+    /// `mode` of `mesh` on `grid` by `path` (see [`GpuPath`]; all but
+    /// [`GpuPath::RasterMsaa`] give the reference's voxels).
+    pub fn voxelize_with(
+        &self,
+        mode: GpuMode,
+        path: GpuPath,
+        mesh: MeshRef<'_>,
+        grid: &GridSpec,
+    ) -> Result<(BrickBits, CoverReport), GpuError> {
         let t0 = Instant::now();
         let (tris, prepare_stats) = prepare(mesh, grid);
         let dims = grid.dims();
@@ -143,6 +171,12 @@ impl Gpu {
         }
         let nk_max = ((self.max_slab_bytes / layer_bytes) as u32).clamp(1, dims[2]);
         let slab_bytes = layer_bytes * nk_max as u64;
+        let side = dims.iter().copied().max().unwrap_or(1);
+        let target = match path {
+            GpuPath::Compute => None,
+            GpuPath::Raster | GpuPath::RasterMsaa => Some(self.raster_target(side, path == GpuPath::RasterMsaa)?),
+        };
+        let expand = if path == GpuPath::Raster && !self.raster.hardware_conservative { 16 } else { 0 };
         let out = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("slab bits"),
             size: slab_bytes,
@@ -174,7 +208,8 @@ impl Gpu {
                     contents: bytemuck::cast_slice(batch),
                     usage: wgpu::BufferUsages::STORAGE,
                 });
-                let params: [u32; 8] = [dims[0], dims[1], dims[2], k0, nk, words_per_row as u32, batch.len() as u32, mode.code()];
+                let params: [u32; 12] =
+                    [dims[0], dims[1], dims[2], k0, nk, words_per_row as u32, batch.len() as u32, mode.code() | expand, side, 0, 0, 0];
                 let par_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("params"),
                     contents: bytemuck::cast_slice(&params),
@@ -189,13 +224,37 @@ impl Gpu {
                         wgpu::BindGroupEntry { binding: 2, resource: par_buf.as_entire_binding() },
                     ],
                 });
-                {
-                    let mut pass =
-                        encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("cover"), timestamp_writes: None });
-                    pass.set_pipeline(&self.cover);
-                    pass.set_bind_group(0, &bind, &[]);
-                    let n = batch.len() as u32;
-                    pass.dispatch_workgroups(n.min(65535), n.div_ceil(65535), 1);
+                match &target {
+                    None => {
+                        let mut pass =
+                            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("cover"), timestamp_writes: None });
+                        pass.set_pipeline(&self.cover);
+                        pass.set_bind_group(0, &bind, &[]);
+                        let n = batch.len() as u32;
+                        pass.dispatch_workgroups(n.min(65535), n.div_ceil(65535), 1);
+                    }
+                    Some(view) => {
+                        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                            label: Some("raster"),
+                            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                                view,
+                                depth_slice: None,
+                                resolve_target: None,
+                                ops: wgpu::Operations {
+                                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                                    store: wgpu::StoreOp::Discard,
+                                },
+                            })],
+                            depth_stencil_attachment: None,
+                            timestamp_writes: None,
+                            occlusion_query_set: None,
+                            multiview_mask: None,
+                        });
+                        pass.set_pipeline(if path == GpuPath::RasterMsaa { &self.raster.msaa } else { &self.raster.conservative });
+                        pass.set_bind_group(0, &bind, &[]);
+                        let per = if expand != 0 { 6 } else { 3 };
+                        pass.draw(0..per * batch.len() as u32, 0..1);
+                    }
                 }
                 keep.push((tri_buf, par_buf, bind));
             }

@@ -31,7 +31,7 @@
 mod compute;
 mod solid;
 
-pub use compute::{CoverReport, GpuMode, Timings};
+pub use compute::{CoverReport, GpuMode, GpuPath, Timings};
 pub use solid::SolidGpuReport;
 
 use std::sync::{Arc, Mutex};
@@ -61,6 +61,82 @@ pub enum GpuError {
     /// A mode or feature the GPU path does not have yet.
     #[error("the GPU path does not support {0} yet")]
     Unsupported(String),
+}
+
+/// The rasterizer path's pipelines: conservative (hardware, or expansion
+/// in the vertex shader) and 4× MSAA.
+pub(crate) struct RasterPipelines {
+    pub(crate) conservative: wgpu::RenderPipeline,
+    pub(crate) msaa: wgpu::RenderPipeline,
+    pub(crate) hardware_conservative: bool,
+}
+
+/// Samples of the MSAA approximation.
+pub(crate) const MSAA_SAMPLES: u32 = 4;
+
+impl RasterPipelines {
+    fn new(device: &wgpu::Device, layout: &wgpu::PipelineLayout, hardware_conservative: bool) -> RasterPipelines {
+        let source = format!("{}\n{}", include_str!("shaders/cover.wgsl"), include_str!("shaders/raster.wgsl"));
+        let module = device
+            .create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("raster"), source: wgpu::ShaderSource::Wgsl(source.into()) });
+        let pipeline = |conservative: bool, samples: u32| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("raster"),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState { conservative, ..Default::default() },
+                depth_stencil: None,
+                multisample: wgpu::MultisampleState { count: samples, ..Default::default() },
+                // A colour target is required (ECOSYSTEM.md: lavapipe rejects attachment-less passes); nothing is written to it.
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: wgpu::TextureFormat::R8Unorm,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::empty(),
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        RasterPipelines { conservative: pipeline(hardware_conservative, 1), msaa: pipeline(false, MSAA_SAMPLES), hardware_conservative }
+    }
+}
+
+impl Gpu {
+    /// The rasterizer's colour target: `side`², never written.
+    pub(crate) fn raster_target(&self, side: u32, msaa: bool) -> Result<wgpu::TextureView, GpuError> {
+        if side > self.max_texture_side {
+            return Err(GpuError::Unsupported(format!(
+                "the rasterizer path on grids over {} voxels on a side (the adapter's largest viewport); use the compute path",
+                self.max_texture_side
+            )));
+        }
+        let tex = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("raster target"),
+            size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: if msaa { MSAA_SAMPLES } else { 1 },
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R8Unorm,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        Ok(tex.create_view(&wgpu::TextureViewDescriptor::default()))
+    }
+
+    /// True when the adapter rasterizes conservatively in hardware.
+    pub fn hardware_conservative(&self) -> bool {
+        self.raster.hardware_conservative
+    }
 }
 
 /// The three passes of the parity solid and their bind group layout.
@@ -119,6 +195,9 @@ pub struct Gpu {
     cover: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     solid: SolidPipelines,
+    raster: RasterPipelines,
+    /// Largest 2D texture side (the rasterizer's viewport).
+    max_texture_side: u32,
     /// Largest storage buffer the output slab may use, in bytes.
     max_slab_bytes: u64,
     /// The first error the device reported outside a call's own checks
@@ -144,10 +223,11 @@ impl Gpu {
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("voxkit"),
-            required_features: wgpu::Features::SHADER_INT64,
+            required_features: wgpu::Features::SHADER_INT64 | (adapter.features() & wgpu::Features::CONSERVATIVE_RASTERIZATION),
             required_limits: wgpu::Limits {
                 max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
                 max_buffer_size: limits.max_buffer_size,
+                max_texture_dimension_2d: limits.max_texture_dimension_2d,
                 ..wgpu::Limits::downlevel_defaults()
             },
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
@@ -173,9 +253,12 @@ impl Gpu {
             label: Some("cover"),
             source: wgpu::ShaderSource::Wgsl(include_str!("shaders/cover.wgsl").into()),
         });
+        // The rasterizer shares this layout: triangles and parameters are
+        // read in the vertex and fragment stages, bits written in fragments.
+        let all = wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
             binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
+            visibility: if read_only { all } else { wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT },
             ty: wgpu::BindingType::Buffer {
                 ty: wgpu::BufferBindingType::Storage { read_only },
                 has_dynamic_offset: false,
@@ -190,7 +273,7 @@ impl Gpu {
                 storage(1, false),
                 wgpu::BindGroupLayoutEntry {
                     binding: 2,
-                    visibility: wgpu::ShaderStages::COMPUTE,
+                    visibility: all,
                     ty: wgpu::BindingType::Buffer {
                         ty: wgpu::BufferBindingType::Uniform,
                         has_dynamic_offset: false,
@@ -214,7 +297,10 @@ impl Gpu {
             cache: None,
         });
         let solid = SolidPipelines::new(&device);
-        let gpu = Gpu { device, queue, info, cover, layout, solid, max_slab_bytes, errors };
+        let hardware_conservative = adapter.features().contains(wgpu::Features::CONSERVATIVE_RASTERIZATION);
+        let raster = RasterPipelines::new(&device, &pl, hardware_conservative);
+        let max_texture_side = limits.max_texture_dimension_2d;
+        let gpu = Gpu { device, queue, info, cover, layout, solid, raster, max_texture_side, max_slab_bytes, errors };
         gpu.check()?;
         Ok(gpu)
     }

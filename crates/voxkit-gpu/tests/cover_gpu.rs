@@ -151,3 +151,56 @@ fn solid_parity_equals_the_cpu_parity() {
     g.set_max_slab_bytes(5 * layer);
     check_solid(&g, &cow, &grid, "cow in 5-layer slabs");
 }
+
+#[test]
+fn the_rasterizer_path_equals_the_reference_and_msaa_only_misses() {
+    use voxkit_gpu::GpuPath;
+    let Some(g) = gpu() else { return };
+    eprintln!("hardware conservative rasterization: {}", g.hardware_conservative());
+    let mut r = rng(5);
+    let meshes = [
+        ("bunny", shared_mesh("stanford-bunny.obj"), 100),
+        ("fandisk", shared_mesh("fandisk.obj"), 64),
+        ("rotated suzanne", rotated(&shared_mesh("suzanne.obj"), random_rotation(&mut r)), 80),
+        ("rotated cow", rotated(&shared_mesh("cow.obj"), random_rotation(&mut r)), 57),
+        ("alligator", shared_mesh("alligator.obj"), 64),
+    ];
+    let mut missed_total = 0;
+    for (name, mesh, res) in &meshes {
+        let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), *res).unwrap();
+        for mode in MODES {
+            let gm = GpuMode::of(mode).unwrap();
+            let (want, _) = voxelize::reference(mode, mesh.as_ref(), &grid);
+            let (bits, _) = g.voxelize_with(gm, GpuPath::Raster, mesh.as_ref(), &grid).unwrap();
+            if let Some(v) = bits.to_dense().first_difference(&want) {
+                panic!("{name}, {mode:?}, rasterizer: differs from the reference at {v:?} ({} vs {})", bits.count(), want.count());
+            }
+            let (msaa, _) = g.voxelize_with(gm, GpuPath::RasterMsaa, mesh.as_ref(), &grid).unwrap();
+            let msaa = msaa.to_dense();
+            let mut extra = 0;
+            let mut missed = 0;
+            want.for_each_set(|i, j, k| missed += !msaa.get(i, j, k) as u64);
+            msaa.for_each_set(|i, j, k| extra += !want.get(i, j, k) as u64);
+            assert_eq!(extra, 0, "{name}, {mode:?}: MSAA set voxels the reference does not");
+            eprintln!("{name} at {res}, {mode:?}: MSAA misses {missed} of {} voxels", want.count());
+            missed_total += missed;
+        }
+    }
+    assert!(missed_total > 0, "MSAA is an approximation; it should miss some voxels on these meshes");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_triangles_rasterized_equal_the_reference(tris in proptest::collection::vec(voxkit_testkit::strategies::triangle(), 1..10)) {
+        let Some(g) = gpu() else { return Ok(()) };
+        let mesh = soup(&tris);
+        let grid = GridSpec::new(DVec3::splat(-2.0), 0.25, [48, 48, 48]).unwrap();
+        for mode in MODES {
+            let (bits, _) = g.voxelize_with(GpuMode::of(mode).unwrap(), voxkit_gpu::GpuPath::Raster, mesh.as_ref(), &grid).unwrap();
+            let (want, _) = voxelize::reference(mode, mesh.as_ref(), &grid);
+            prop_assert!(bits.to_dense().first_difference(&want).is_none(), "{:?}: {} vs {}", mode, bits.count(), want.count());
+        }
+    }
+}

@@ -97,7 +97,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
                     (Box::new(b) as Box<dyn VoxelSource + Send>, r)
                 }
                 plan::SurfaceMethod::Gpu => {
-                    let (b, r, facts) = gpu_voxelize(mode, loaded.mesh.as_ref(), &grid)?;
+                    let (b, r, facts) = gpu_voxelize(mode, a.gpu_path, loaded.mesh.as_ref(), &grid)?;
                     gpu_facts = facts;
                     (Box::new(b) as Box<dyn VoxelSource + Send>, r)
                 }
@@ -217,14 +217,35 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
 #[cfg(feature = "gpu")]
 fn gpu_voxelize(
     mode: voxelize::Mode,
+    path: crate::args::GpuPathArg,
     mesh: voxkit::MeshRef<'_>,
     grid: &voxkit::GridSpec,
 ) -> Result<(voxkit::BrickBits, voxelize::Report, serde_json::Value)> {
+    use crate::args::GpuPathArg;
+    use voxkit_gpu::GpuPath;
     let gm = voxkit_gpu::GpuMode::of(mode).ok_or_else(|| anyhow::anyhow!("--method gpu: {} on the GPU is not built yet", mode.name()))?;
     let gpu = voxkit_gpu::Gpu::new().map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
-    let (bits, r) = gpu.voxelize(gm, mesh, grid).map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
+    let gp = match path {
+        GpuPathArg::Compute => GpuPath::Compute,
+        GpuPathArg::Raster => GpuPath::Raster,
+        GpuPathArg::MsaaApprox => GpuPath::RasterMsaa,
+    };
+    let (bits, r) = gpu.voxelize_with(gm, gp, mesh, grid).map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
+    // The approximation says what it misses: the exact voxels by the compute path.
+    let missed = if gp == GpuPath::RasterMsaa {
+        let (exact, _) = gpu.voxelize(gm, mesh, grid).map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
+        let mut missed = 0u64;
+        exact.for_each_set(|i, j, k| missed += !bits.get(i, j, k) as u64);
+        eprintln!("voxkit: warning: --gpu-path msaa-approx is approximate: it missed {missed} of the mode's {} voxels", exact.count());
+        Some(missed)
+    } else {
+        None
+    };
     let t = r.timings;
     let facts = json!({
+        "path": match gp { GpuPath::Compute => "compute", GpuPath::Raster => "raster", GpuPath::RasterMsaa => "msaa-approx" },
+        "hardware_conservative": gpu.hardware_conservative(),
+        "missed_voxels": missed,
         "adapter": gpu.adapter(),
         "software": gpu.is_software(),
         "gpu_triangles": r.gpu_triangles,
@@ -241,6 +262,7 @@ fn gpu_voxelize(
 #[cfg(not(feature = "gpu"))]
 fn gpu_voxelize(
     _mode: voxelize::Mode,
+    _path: crate::args::GpuPathArg,
     _mesh: voxkit::MeshRef<'_>,
     _grid: &voxkit::GridSpec,
 ) -> Result<(voxkit::BrickBits, voxelize::Report, serde_json::Value)> {

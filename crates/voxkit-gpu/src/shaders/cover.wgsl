@@ -37,8 +37,13 @@ struct Params {
     nk: u32,
     words_per_row: u32,
     count: u32,
-    // 0 cover, 1 sep26, 2 sep6.
+    // 0 cover, 1 sep26, 2 sep6 (bit 4: the rasterizer expands triangles).
     mode: u32,
+    // The rasterizer's viewport side N.
+    pad_n: u32,
+    pad1: u32,
+    pad2: u32,
+    pad3: u32,
 };
 
 const ONE: i64 = 4096li;
@@ -133,7 +138,7 @@ fn segment_meets_triangle(s0: vec3<i64>, s1: vec3<i64>, t0: vec3<i64>, t1: vec3<
 
 fn target_hit(v0: vec3<i64>, v1: vec3<i64>, v2: vec3<i64>, lo: vec3<i64>) -> bool {
     let h = ONE / 2li;
-    if (params.mode == 1u) {
+    if ((params.mode & 3u) == 1u) {
         // The four space diagonals.
         let o = array<vec3<i64>, 4>(vec3<i64>(0li, 0li, 0li), vec3<i64>(ONE, 0li, 0li), vec3<i64>(0li, ONE, 0li), vec3<i64>(0li, 0li, ONE));
         let d = array<vec3<i64>, 4>(vec3<i64>(ONE, ONE, ONE), vec3<i64>(-ONE, ONE, ONE), vec3<i64>(ONE, -ONE, ONE), vec3<i64>(ONE, ONE, -ONE));
@@ -159,59 +164,77 @@ fn set_voxel(i: u32, j: u32, k: u32) {
     atomicOr(&bits[word], 1u << (i % 32u));
 }
 
+// A triangle set up for its columns: vertices and normal (i64), the
+// dominant axis w and the projection axes u, v after it.
+struct Setup {
+    v0: vec3<i64>,
+    v1: vec3<i64>,
+    v2: vec3<i64>,
+    n: vec3<i64>,
+    u: u32,
+    v: u32,
+    w: u32,
+};
+
+fn setup(t: Tri) -> Setup {
+    let v0 = vec3<i64>(t.a);
+    let v1 = vec3<i64>(t.b);
+    let v2 = vec3<i64>(t.c);
+    let n = cross64(v1 - v0, v2 - v0);
+    let an = abs(n);
+    var w = 2u;
+    if (an.x >= an.y && an.x >= an.z) { w = 0u; } else if (an.y >= an.z) { w = 1u; }
+    return Setup(v0, v1, v2, n, (w + 1u) % 3u, (w + 2u) % 3u, w);
+}
+
+// Every voxel of column (cu, cv) (relative to the triangle's box) that the
+// mode sets, within the slab's layers.
+fn column(t: Tri, s: Setup, cu: i32, cv: i32) {
+    let size = vec3<i32>(t.size);
+    let k_lo = max(0, i32(params.k0) - t.origin.z);
+    let k_hi = min(size.z - 1, i32(params.k0 + params.nk) - 1 - t.origin.z);
+    if (k_lo > k_hi) { return; }
+    let lo_r = vec3<i32>(0, 0, k_lo);
+    let hi_r = vec3<i32>(size.x - 1, size.y - 1, k_hi);
+    let nf = vec3<f32>(f32(s.n.x), f32(s.n.y), f32(s.n.z));
+    let d = f32(dot64(s.n, s.v0));
+    let one = 4096.0;
+    // The plane's range along w over the column's four corner lines.
+    var wmin = 3.0e38;
+    var wmax = -3.0e38;
+    for (var q = 0; q < 4; q++) {
+        let xu = f32(cu + (q & 1)) * one;
+        let xv = f32(cv + (q >> 1)) * one;
+        let xw = (d - nf[s.u] * xu - nf[s.v] * xv) / nf[s.w];
+        wmin = min(wmin, xw);
+        wmax = max(wmax, xw);
+    }
+    let w0 = max(lo_r[s.w], i32(floor(wmin / one)) - 1);
+    let w1 = min(hi_r[s.w], i32(floor(wmax / one)) + 1);
+    for (var cw = w0; cw <= w1; cw++) {
+        var r = vec3<i32>(0, 0, 0);
+        r[s.u] = cu;
+        r[s.v] = cv;
+        r[s.w] = cw;
+        if (r.z < k_lo || r.z > k_hi) { continue; }
+        let lo = vec3<i64>(r) * ONE;
+        if (overlaps(s.v0, s.v1, s.v2, s.n, lo) && ((params.mode & 3u) == 0u || target_hit(s.v0, s.v1, s.v2, lo))) {
+            let g = t.origin + r;
+            set_voxel(u32(g.x), u32(g.y), u32(g.z));
+        }
+    }
+}
+
 @compute @workgroup_size(64)
 fn main(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let t_index = wg.x + wg.y * 65535u;
     if (t_index >= params.count) { return; }
     let t = tris[t_index];
-    let v0 = vec3<i64>(t.a);
-    let v1 = vec3<i64>(t.b);
-    let v2 = vec3<i64>(t.c);
-    let n = cross64(v1 - v0, v2 - v0);
-    // Dominant axis w of the normal; u, v the other two.
-    let an = abs(n);
-    var w = 2u;
-    if (an.x >= an.y && an.x >= an.z) { w = 0u; } else if (an.y >= an.z) { w = 1u; }
-    let u = (w + 1u) % 3u;
-    let v = (w + 2u) % 3u;
+    let s = setup(t);
     let size = vec3<i32>(t.size);
-    // Layers of the slab, relative to the triangle's box.
-    let k_lo = max(0, i32(params.k0) - t.origin.z);
-    let k_hi = min(size.z - 1, i32(params.k0 + params.nk) - 1 - t.origin.z);
-    if (k_lo > k_hi) { return; }
-    var lo_r = vec3<i32>(0, 0, k_lo);
-    var hi_r = vec3<i32>(size.x - 1, size.y - 1, k_hi);
-    let nu = size[u];
-    let columns = u32(size[u] * size[v]);
-    let nf = vec3<f32>(f32(n.x), f32(n.y), f32(n.z));
-    let d = f32(dot64(n, v0));
-    let one = 4096.0;
+    let nu = size[s.u];
+    let columns = u32(size[s.u] * size[s.v]);
     for (var col = lid; col < columns; col += 64u) {
-        let cu = i32(col) % nu;
-        let cv = i32(col) / nu;
-        // The plane's range along w over the column's four corner lines.
-        var wmin = 3.0e38;
-        var wmax = -3.0e38;
-        for (var q = 0; q < 4; q++) {
-            let xu = f32(cu + (q & 1)) * one;
-            let xv = f32(cv + (q >> 1)) * one;
-            let xw = (d - nf[u] * xu - nf[v] * xv) / nf[w];
-            wmin = min(wmin, xw);
-            wmax = max(wmax, xw);
-        }
-        let w0 = max(lo_r[w], i32(floor(wmin / one)) - 1);
-        let w1 = min(hi_r[w], i32(floor(wmax / one)) + 1);
-        for (var cw = w0; cw <= w1; cw++) {
-            var r = vec3<i32>(0, 0, 0);
-            r[u] = cu;
-            r[v] = cv;
-            r[w] = cw;
-            if (r.z < k_lo || r.z > k_hi) { continue; }
-            let lo = vec3<i64>(r) * ONE;
-            if (overlaps(v0, v1, v2, n, lo) && (params.mode == 0u || target_hit(v0, v1, v2, lo))) {
-                let g = t.origin + r;
-                set_voxel(u32(g.x), u32(g.y), u32(g.z));
-            }
-        }
+        column(t, s, i32(col) % nu, i32(col) / nu);
     }
 }
