@@ -162,6 +162,7 @@ pub fn auto_method(mode: voxkit::voxelize::Mode, mesh: voxkit::MeshRef<'_>, grid
 
 /// Grids from this many voxels on the longest side are offered to a
 /// hardware GPU by `--method auto`.
+#[cfg(feature = "gpu")]
 pub const GPU_AUTO_MIN_SIDE: u32 = 512;
 
 /// `--method auto` on a large `cover`, `sep26` or `sep6` job: is there a hardware GPU adapter?
