@@ -161,36 +161,15 @@ impl Gpu {
         on_gpu.sort_by_key(|t| t.1[0]);
         let mut timings = Timings { upload_s: t0.elapsed().as_secs_f64(), ..Timings::default() };
 
-        let words_per_row = dims[0].div_ceil(32) as u64;
-        let layer_bytes = words_per_row * dims[1] as u64 * 4;
-        if layer_bytes > self.max_slab_bytes {
-            return Err(GpuError::Unsupported(format!(
-                "grids whose single z-layer ({layer_bytes} bytes) exceeds the device's storage buffer limit ({} bytes)",
-                self.max_slab_bytes
-            )));
-        }
-        let nk_max = ((self.max_slab_bytes / layer_bytes) as u32).clamp(1, dims[2]);
-        let slab_bytes = layer_bytes * nk_max as u64;
+        let slabs = self.slabs(dims)?;
+        let (words_per_row, nk_max, out) = (slabs.words_per_row, slabs.nk_max, &slabs.out);
         let side = dims.iter().copied().max().unwrap_or(1);
         let target = match path {
             GpuPath::Compute => None,
             GpuPath::Raster | GpuPath::RasterMsaa => Some(self.raster_target(side, path == GpuPath::RasterMsaa)?),
         };
         let expand = if path == GpuPath::Raster && !self.raster.hardware_conservative { 16 } else { 0 };
-        let out = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("slab bits"),
-            size: slab_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("slab readback"),
-            size: slab_bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let max_batch = (self.max_slab_bytes / std::mem::size_of::<GpuTri>() as u64).clamp(1, 1 << 22) as usize;
-        self.check()?;
         let mut bits = BrickBits::new(dims);
         let mut k0 = 0u32;
         while k0 < dims[2] {
@@ -200,7 +179,7 @@ impl Gpu {
             // Sorted by lowest layer: stop at the first triangle starting above the slab.
             let slab: Vec<GpuTri> = on_gpu.iter().take_while(|t| t.1[0] <= khi).filter(|t| t.1[1] >= klo).map(|t| t.0).collect();
             let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("slab") });
-            encoder.clear_buffer(&out, 0, None);
+            encoder.clear_buffer(out, 0, None);
             let mut keep = Vec::new();
             for batch in slab.chunks(max_batch) {
                 let tri_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -258,24 +237,8 @@ impl Gpu {
                 }
                 keep.push((tri_buf, par_buf, bind));
             }
-            let used = layer_bytes * nk as u64;
-            encoder.copy_buffer_to_buffer(&out, 0, &staging, 0, used);
             timings.upload_s += t_up.elapsed().as_secs_f64();
-            let t_run = Instant::now();
-            self.queue.submit([encoder.finish()]);
-            let slice = staging.slice(0..used);
-            let (tx, rx) = std::sync::mpsc::channel();
-            slice.map_async(wgpu::MapMode::Read, move |r| {
-                let _ = tx.send(r);
-            });
-            self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Device(e.to_string()))?;
-            self.check()?;
-            rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
-            timings.voxelize_s += t_run.elapsed().as_secs_f64();
-            let t_down = Instant::now();
-            {
-                let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-                let words: &[u32] = bytemuck::cast_slice(&view);
+            let (run_s, read_s) = self.finish_slab(&slabs, encoder, nk, |words| {
                 for (row, chunk) in words.chunks_exact(words_per_row as usize).enumerate() {
                     let (j, k) = (row as u32 % dims[1], k0 + row as u32 / dims[1]);
                     for (w, &word) in chunk.iter().enumerate() {
@@ -287,9 +250,9 @@ impl Gpu {
                         }
                     }
                 }
-            }
-            staging.unmap();
-            timings.download_s += t_down.elapsed().as_secs_f64();
+            })?;
+            timings.voxelize_s += run_s;
+            timings.download_s += read_s;
             timings.slabs += 1;
             k0 += nk;
         }

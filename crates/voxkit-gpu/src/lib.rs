@@ -29,6 +29,7 @@
 //! triangles.
 
 mod compute;
+mod slabs;
 mod solid;
 
 pub use compute::{CoverReport, GpuMode, GpuPath, Timings};
@@ -63,6 +64,16 @@ pub enum GpuError {
     Unsupported(String),
 }
 
+/// A shader's source: `common.wgsl` followed by `parts`.
+fn shader(parts: &[&str]) -> String {
+    let mut s = include_str!("shaders/common.wgsl").to_string();
+    for p in parts {
+        s.push('\n');
+        s.push_str(p);
+    }
+    s
+}
+
 /// The rasterizer path's pipelines: conservative (hardware, or expansion
 /// in the vertex shader) and 4× MSAA.
 pub(crate) struct RasterPipelines {
@@ -76,7 +87,7 @@ pub(crate) const MSAA_SAMPLES: u32 = 4;
 
 impl RasterPipelines {
     fn new(device: &wgpu::Device, layout: &wgpu::PipelineLayout, hardware_conservative: bool) -> RasterPipelines {
-        let source = format!("{}\n{}", include_str!("shaders/cover.wgsl"), include_str!("shaders/raster.wgsl"));
+        let source = shader(&[include_str!("shaders/cover.wgsl"), include_str!("shaders/raster.wgsl")]);
         let module = device
             .create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("raster"), source: wgpu::ShaderSource::Wgsl(source.into()) });
         let pipeline = |conservative: bool, samples: u32| {
@@ -151,7 +162,7 @@ impl SolidPipelines {
     fn new(device: &wgpu::Device) -> SolidPipelines {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("solid"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("shaders/solid.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/solid.wgsl")]).into()),
         });
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
@@ -251,7 +262,7 @@ impl Gpu {
         let max_slab_bytes = (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size).min(1 << 30);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("cover"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("shaders/cover.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/cover.wgsl")]).into()),
         });
         // The rasterizer shares this layout: triangles and parameters are
         // read in the vertex and fragment stages, bits written in fragments.

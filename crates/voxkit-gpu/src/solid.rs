@@ -66,33 +66,12 @@ impl Gpu {
         let cpu_flips: Vec<(u32, u32)> = row_crossings(&on_cpu, dims).into_iter().filter(|h| h.1 < dims[0]).map(|h| (h.0, h.1)).collect();
         let mut timings = Timings { upload_s: t0.elapsed().as_secs_f64(), ..Timings::default() };
 
-        let words_per_row = dims[0].div_ceil(32) as u64;
-        let layer_bytes = words_per_row * dims[1] as u64 * 4;
-        if layer_bytes > self.max_slab_bytes {
-            return Err(GpuError::Unsupported(format!(
-                "grids whose single z-layer ({layer_bytes} bytes) exceeds the device's storage buffer limit ({} bytes)",
-                self.max_slab_bytes
-            )));
-        }
-        let nk_max = ((self.max_slab_bytes / layer_bytes) as u32).clamp(1, dims[2]);
-        let slab_bytes = layer_bytes * nk_max as u64;
-        let out = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("solid slab"),
-            size: slab_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("solid readback"),
-            size: slab_bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let slabs = self.slabs(dims)?;
+        let (words_per_row, nk_max, out) = (slabs.words_per_row, slabs.nk_max, &slabs.out);
         let max_batch = (self.max_slab_bytes / std::mem::size_of::<STri>() as u64).clamp(1, 1 << 22) as usize;
         let mut bits = DenseBits::new(dims);
         let wpr64 = bits.words_per_row();
         let mut k0 = 0u32;
-        self.check()?;
         while k0 < dims[2] {
             let nk = nk_max.min(dims[2] - k0);
             let (klo, khi) = (k0 as i64, (k0 + nk) as i64 - 1);
@@ -110,7 +89,7 @@ impl Gpu {
                 })
                 .collect();
             let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("solid slab") });
-            encoder.clear_buffer(&out, 0, None);
+            encoder.clear_buffer(out, 0, None);
             let list_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("cpu flips"),
                 contents: if list.is_empty() { bytemuck::cast_slice(&[[0u32; 2]]) } else { bytemuck::cast_slice(&list) },
@@ -125,7 +104,7 @@ impl Gpu {
                         contents: bytemuck::cast_slice(if tris.is_empty() { &empty_tris[..] } else { tris }),
                         usage: wgpu::BufferUsages::STORAGE,
                     });
-                    let params: [u32; 8] = [dims[0], dims[1], dims[2], k0, nk, words_per_row as u32, count, 0];
+                    let params: [u32; 12] = [dims[0], dims[1], dims[2], k0, nk, words_per_row as u32, count, 0, 0, 0, 0, 0];
                     let par_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: Some("solid params"),
                         contents: bytemuck::cast_slice(&params),
@@ -158,36 +137,19 @@ impl Gpu {
             }
             let rows = dims[1] * nk;
             pass_with(&mut encoder, &self.solid.prefix, &[], 0, rows.div_ceil(64));
-            let used = layer_bytes * nk as u64;
-            encoder.copy_buffer_to_buffer(&out, 0, &staging, 0, used);
             timings.upload_s += t_up.elapsed().as_secs_f64();
-            let t_run = Instant::now();
-            self.queue.submit([encoder.finish()]);
-            let slice = staging.slice(0..used);
-            let (tx, rx) = std::sync::mpsc::channel();
-            slice.map_async(wgpu::MapMode::Read, move |r| {
-                let _ = tx.send(r);
-            });
-            self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Device(e.to_string()))?;
-            self.check()?;
-            rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
-            timings.voxelize_s += t_run.elapsed().as_secs_f64();
-            let t_down = Instant::now();
-            {
-                let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-                let words: &[u32] = bytemuck::cast_slice(&view);
-                let start = k0 as usize * dims[1] as usize;
-                for (r, (src, dst)) in words.chunks_exact(words_per_row as usize).zip(bits.rows_mut().skip(start)).enumerate() {
-                    let _ = r;
+            let start = k0 as usize * dims[1] as usize;
+            let (run_s, read_s) = self.finish_slab(&slabs, encoder, nk, |words| {
+                for (src, dst) in words.chunks_exact(words_per_row as usize).zip(bits.rows_mut().skip(start)) {
                     for (w, d) in dst.iter_mut().enumerate().take(wpr64) {
                         let lo = src.get(2 * w).copied().unwrap_or(0) as u64;
                         let hi = src.get(2 * w + 1).copied().unwrap_or(0) as u64;
                         *d = lo | hi << 32;
                     }
                 }
-            }
-            staging.unmap();
-            timings.download_s += t_down.elapsed().as_secs_f64();
+            })?;
+            timings.voxelize_s += run_s;
+            timings.download_s += read_s;
             timings.slabs += 1;
             k0 += nk;
         }

@@ -46,20 +46,7 @@ fn check(g: &Gpu, mesh: &Mesh, grid: &GridSpec, what: &str) -> (u64, u64) {
 fn every_shared_mesh_equals_the_reference() {
     let Some(g) = gpu() else { return };
     eprintln!("adapter: {}", g.adapter());
-    for name in [
-        "alligator.obj",
-        "beetle.obj",
-        "cheburashka.obj",
-        "cow.obj",
-        "fandisk.obj",
-        "homer.obj",
-        "rocker-arm.obj",
-        "spot-textured.obj",
-        "stanford-bunny.obj",
-        "suzanne.obj",
-        "teapot.obj",
-        "woody.obj",
-    ] {
+    for name in voxkit_testkit::SHARED_MESHES {
         let mesh = shared_mesh(name);
         let bounds = mesh.as_ref().bounds();
         for res in [37, 128] {

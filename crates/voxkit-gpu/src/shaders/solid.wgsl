@@ -22,26 +22,13 @@ struct STri {
     pad2: i32,
 };
 
-struct Params {
-    dims: vec3<u32>,
-    k0: u32,
-    nk: u32,
-    words_per_row: u32,
-    count: u32,
-    mode: u32,
-};
 
-const ONE: i64 = 4096li;
 const H: i64 = 2048li;
 
 @group(0) @binding(0) var<storage, read> tris: array<STri>;
 @group(0) @binding(1) var<storage, read_write> bits: array<atomic<u32>>;
 @group(0) @binding(2) var<uniform> params: Params;
 @group(0) @binding(3) var<storage, read> list: array<vec2<u32>>;
-
-fn cross64(p: vec3<i64>, q: vec3<i64>) -> vec3<i64> {
-    return vec3<i64>(p.y * q.z - p.z * q.y, p.z * q.x - p.x * q.z, p.x * q.y - p.y * q.x);
-}
 
 // Laine's tie bias for a gradient g (δ = −(ε, ε², ε³)): 1 if the first
 // non-zero component is positive, else 0.
