@@ -145,7 +145,19 @@ fn bad_input_gives_one_line_errors() {
             ],
             "exists for cover, sep26 and sep6",
         ),
-        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--method".into(), "gpu".into(), "--mode".into(), "line6".into()], "not built yet"),
+        (
+            vec![
+                "voxelize".into(),
+                shared("cow.obj"),
+                "-o".into(),
+                out.clone(),
+                "--method".into(),
+                "gpu".into(),
+                "--mode".into(),
+                "line6".into(),
+            ],
+            "not built yet",
+        ),
         (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--origin".into(), "0,0,0".into()], "explicit grid needs"),
         (
             vec![

@@ -90,53 +90,58 @@ impl Gpu {
                 .collect();
             let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("solid slab") });
             encoder.clear_buffer(out, 0, None);
-            let list_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("cpu flips"),
-                contents: if list.is_empty() { bytemuck::cast_slice(&[[0u32; 2]]) } else { bytemuck::cast_slice(&list) },
-                usage: wgpu::BufferUsages::STORAGE,
-            });
             let empty_tris = [STri { a: [0; 4], b: [0; 4], c: [0; 4] }];
             let mut keep = Vec::new();
-            let mut pass_with =
-                |encoder: &mut wgpu::CommandEncoder, pipeline: &wgpu::ComputePipeline, tris: &[STri], count: u32, groups: u32| {
-                    let tri_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("solid triangles"),
-                        contents: bytemuck::cast_slice(if tris.is_empty() { &empty_tris[..] } else { tris }),
-                        usage: wgpu::BufferUsages::STORAGE,
-                    });
-                    let params: [u32; 12] = [dims[0], dims[1], dims[2], k0, nk, words_per_row as u32, count, 0, 0, 0, 0, 0];
-                    let par_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("solid params"),
-                        contents: bytemuck::cast_slice(&params),
-                        usage: wgpu::BufferUsages::UNIFORM,
-                    });
-                    let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("solid"),
-                        layout: &self.solid.layout,
-                        entries: &[
-                            wgpu::BindGroupEntry { binding: 0, resource: tri_buf.as_entire_binding() },
-                            wgpu::BindGroupEntry { binding: 1, resource: out.as_entire_binding() },
-                            wgpu::BindGroupEntry { binding: 2, resource: par_buf.as_entire_binding() },
-                            wgpu::BindGroupEntry { binding: 3, resource: list_buf.as_entire_binding() },
-                        ],
-                    });
-                    {
-                        let mut pass =
-                            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("solid"), timestamp_writes: None });
-                        pass.set_pipeline(pipeline);
-                        pass.set_bind_group(0, &bind, &[]);
-                        pass.dispatch_workgroups(groups.clamp(1, 65535), groups.div_ceil(65535).max(1), 1);
-                    }
-                    keep.push((tri_buf, par_buf, bind));
-                };
+            let mut pass_with = |encoder: &mut wgpu::CommandEncoder,
+                                 pipeline: &wgpu::ComputePipeline,
+                                 tris: &[STri],
+                                 flips: &[[u32; 2]],
+                                 count: u32,
+                                 groups: u32| {
+                let list_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("cpu flips"),
+                    contents: bytemuck::cast_slice(if flips.is_empty() { &[[0u32; 2]][..] } else { flips }),
+                    usage: wgpu::BufferUsages::STORAGE,
+                });
+                let tri_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("solid triangles"),
+                    contents: bytemuck::cast_slice(if tris.is_empty() { &empty_tris[..] } else { tris }),
+                    usage: wgpu::BufferUsages::STORAGE,
+                });
+                let params: [u32; 12] = [dims[0], dims[1], dims[2], k0, nk, words_per_row as u32, count, 0, 0, 0, 0, 0];
+                let par_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("solid params"),
+                    contents: bytemuck::cast_slice(&params),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("solid"),
+                    layout: &self.solid.layout,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: tri_buf.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: out.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 2, resource: par_buf.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 3, resource: list_buf.as_entire_binding() },
+                    ],
+                });
+                {
+                    let mut pass =
+                        encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("solid"), timestamp_writes: None });
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, &bind, &[]);
+                    pass.dispatch_workgroups(groups.clamp(1, 65535), groups.div_ceil(65535).max(1), 1);
+                }
+                keep.push((tri_buf, par_buf, list_buf, bind));
+            };
             for batch in slab.chunks(max_batch) {
-                pass_with(&mut encoder, &self.solid.flips, batch, batch.len() as u32, batch.len() as u32);
+                pass_with(&mut encoder, &self.solid.flips, batch, &[], batch.len() as u32, batch.len() as u32);
             }
-            if !list.is_empty() {
-                pass_with(&mut encoder, &self.solid.xor_list, &[], list.len() as u32, (list.len() as u32).div_ceil(64));
+            // The CPU's flips, in chunks within the storage binding limit.
+            for chunk in list.chunks((self.max_slab_bytes / 8).max(1) as usize) {
+                pass_with(&mut encoder, &self.solid.xor_list, &[], chunk, chunk.len() as u32, (chunk.len() as u32).div_ceil(64));
             }
             let rows = dims[1] * nk;
-            pass_with(&mut encoder, &self.solid.prefix, &[], 0, rows.div_ceil(64));
+            pass_with(&mut encoder, &self.solid.prefix, &[], &[], 0, rows.div_ceil(64));
             timings.upload_s += t_up.elapsed().as_secs_f64();
             let start = k0 as usize * dims[1] as usize;
             let (run_s, read_s) = self.finish_slab(&slabs, encoder, nk, |words| {

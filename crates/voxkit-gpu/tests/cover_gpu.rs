@@ -137,6 +137,10 @@ fn solid_parity_equals_the_cpu_parity() {
     let layer = grid.dims()[0].div_ceil(32) as u64 * grid.dims()[1] as u64 * 4;
     g.set_max_slab_bytes(5 * layer);
     check_solid(&g, &cow, &grid, "cow in 5-layer slabs");
+    // CPU flips (oversized triangles) routed to one-layer slabs in small chunks.
+    let grid = GridSpec::from_resolution(&big.as_ref().bounds(), 200).unwrap();
+    g.set_max_slab_bytes(grid.dims()[0].div_ceil(32) as u64 * grid.dims()[1] as u64 * 4);
+    check_solid(&g, &big, &grid, "box at 200 in one-layer slabs");
 }
 
 #[test]
