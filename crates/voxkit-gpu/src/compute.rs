@@ -87,6 +87,9 @@ pub struct Timings {
     pub cpu_s: f64,
     /// Slabs the grid was cut into.
     pub slabs: u32,
+    /// GPU time of the voxelization passes by timestamp queries (None when
+    /// the adapter has none).
+    pub gpu_s: Option<f64>,
 }
 
 /// What [`Gpu::cover`] did.
@@ -181,6 +184,7 @@ impl Gpu {
             let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("slab") });
             encoder.clear_buffer(out, 0, None);
             let mut keep = Vec::new();
+            let mut passes = 0u32;
             for batch in slab.chunks(max_batch) {
                 let tri_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("triangles"),
@@ -225,7 +229,7 @@ impl Gpu {
                                 },
                             })],
                             depth_stencil_attachment: None,
-                            timestamp_writes: None,
+                            timestamp_writes: slabs.render_timestamps(passes),
                             occlusion_query_set: None,
                             multiview_mask: None,
                         });
@@ -235,10 +239,11 @@ impl Gpu {
                         pass.draw(0..per * batch.len() as u32, 0..1);
                     }
                 }
+                passes += 1;
                 keep.push((tri_buf, par_buf, bind));
             }
             timings.upload_s += t_up.elapsed().as_secs_f64();
-            let (run_s, read_s) = self.finish_slab(&slabs, encoder, nk, |words| {
+            let (run_s, read_s, gpu_s) = self.finish_slab(&slabs, encoder, nk, passes, |words| {
                 for (row, chunk) in words.chunks_exact(words_per_row as usize).enumerate() {
                     let (j, k) = (row as u32 % dims[1], k0 + row as u32 / dims[1]);
                     for (w, &word) in chunk.iter().enumerate() {
@@ -253,6 +258,11 @@ impl Gpu {
             })?;
             timings.voxelize_s += run_s;
             timings.download_s += read_s;
+            timings.gpu_s = match (timings.gpu_s, gpu_s, timings.slabs) {
+                (None, Some(g), 0) => Some(g),
+                (Some(t), Some(g), _) => Some(t + g),
+                _ => None,
+            };
             timings.slabs += 1;
             k0 += nk;
         }

@@ -209,6 +209,8 @@ pub struct Gpu {
     raster: RasterPipelines,
     /// Largest 2D texture side (the rasterizer's viewport).
     max_texture_side: u32,
+    /// The adapter writes timestamps around passes (GPU time is reported).
+    timestamps: bool,
     /// Largest storage buffer the output slab may use, in bytes.
     max_slab_bytes: u64,
     /// The first error the device reported outside a call's own checks
@@ -234,7 +236,8 @@ impl Gpu {
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("voxkit"),
-            required_features: wgpu::Features::SHADER_INT64 | (adapter.features() & wgpu::Features::CONSERVATIVE_RASTERIZATION),
+            required_features: wgpu::Features::SHADER_INT64
+                | (adapter.features() & (wgpu::Features::CONSERVATIVE_RASTERIZATION | wgpu::Features::TIMESTAMP_QUERY)),
             required_limits: wgpu::Limits {
                 max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
                 max_buffer_size: limits.max_buffer_size,
@@ -311,7 +314,8 @@ impl Gpu {
         let hardware_conservative = adapter.features().contains(wgpu::Features::CONSERVATIVE_RASTERIZATION);
         let raster = RasterPipelines::new(&device, &pl, hardware_conservative);
         let max_texture_side = limits.max_texture_dimension_2d;
-        let gpu = Gpu { device, queue, info, cover, layout, solid, raster, max_texture_side, max_slab_bytes, errors };
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let gpu = Gpu { device, queue, info, cover, layout, solid, raster, max_texture_side, timestamps, max_slab_bytes, errors };
         gpu.check()?;
         Ok(gpu)
     }

@@ -15,6 +15,41 @@ pub(crate) struct Slabs {
     pub nk_max: u32,
     pub out: wgpu::Buffer,
     pub staging: wgpu::Buffer,
+    /// GPU timestamps around each pass, where the adapter has them.
+    pub queries: Option<Queries>,
+}
+
+/// Passes per slab that get timestamps (more are run untimed, and the
+/// slab's GPU time is then not reported).
+pub(crate) const TIMED_PASSES: u32 = 32;
+
+/// A query set of begin/end timestamps per pass and its readback.
+pub(crate) struct Queries {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    read: wgpu::Buffer,
+}
+
+impl Slabs {
+    /// Timestamp writes for compute pass `pass` of the current slab.
+    pub fn compute_timestamps(&self, pass: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        let q = self.queries.as_ref().filter(|_| pass < TIMED_PASSES)?;
+        Some(wgpu::ComputePassTimestampWrites {
+            query_set: &q.set,
+            beginning_of_pass_write_index: Some(2 * pass),
+            end_of_pass_write_index: Some(2 * pass + 1),
+        })
+    }
+
+    /// Timestamp writes for render pass `pass` of the current slab.
+    pub fn render_timestamps(&self, pass: u32) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        let q = self.queries.as_ref().filter(|_| pass < TIMED_PASSES)?;
+        Some(wgpu::RenderPassTimestampWrites {
+            query_set: &q.set,
+            beginning_of_pass_write_index: Some(2 * pass),
+            end_of_pass_write_index: Some(2 * pass + 1),
+        })
+    }
 }
 
 impl Gpu {
@@ -35,22 +70,52 @@ impl Gpu {
         };
         let out = buffer("slab bits", wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST);
         let staging = buffer("slab readback", wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+        let queries = self.timestamps.then(|| {
+            let bytes = 16 * TIMED_PASSES as u64;
+            Queries {
+                set: self.device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("pass timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 2 * TIMED_PASSES,
+                }),
+                resolve: self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("timestamps"),
+                    size: bytes,
+                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                }),
+                read: self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("timestamps readback"),
+                    size: bytes,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }),
+            }
+        });
         self.check()?;
-        Ok(Slabs { words_per_row, layer_bytes, nk_max, out, staging })
+        Ok(Slabs { words_per_row, layer_bytes, nk_max, out, staging, queries })
     }
 
     /// Copies the first `nk` layers of the slab to the readback buffer,
-    /// submits `encoder`, waits, and hands the words to `read`. Returns the
-    /// seconds spent running (submit to finish) and reading.
+    /// submits `encoder` (which ran `passes` passes), waits, and hands the
+    /// words to `read`. Returns the seconds spent running (submit to
+    /// finish), reading, and the passes' GPU time by timestamps (when the
+    /// adapter has them and every pass was timed).
     pub(crate) fn finish_slab(
         &self,
         s: &Slabs,
         mut encoder: wgpu::CommandEncoder,
         nk: u32,
+        passes: u32,
         read: impl FnOnce(&[u32]),
-    ) -> Result<(f64, f64), GpuError> {
+    ) -> Result<(f64, f64, Option<f64>), GpuError> {
         let used = s.layer_bytes * nk as u64;
         encoder.copy_buffer_to_buffer(&s.out, 0, &s.staging, 0, used);
+        let timed = s.queries.as_ref().filter(|_| passes > 0 && passes <= TIMED_PASSES);
+        if let Some(q) = timed {
+            encoder.resolve_query_set(&q.set, 0..2 * passes, &q.resolve, 0);
+            encoder.copy_buffer_to_buffer(&q.resolve, 0, &q.read, 0, 16 * passes as u64);
+        }
         let t_run = Instant::now();
         self.queue.submit([encoder.finish()]);
         let slice = s.staging.slice(0..used);
@@ -58,16 +123,36 @@ impl Gpu {
         slice.map_async(wgpu::MapMode::Read, move |r| {
             let _ = tx.send(r);
         });
+        let stamps = timed.map(|q| {
+            let ts = q.read.slice(0..16 * passes as u64);
+            let (ttx, trx) = std::sync::mpsc::channel();
+            ts.map_async(wgpu::MapMode::Read, move |r| {
+                let _ = ttx.send(r);
+            });
+            (q, ts, trx)
+        });
         self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Device(e.to_string()))?;
         self.check()?;
         rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
         let run_s = t_run.elapsed().as_secs_f64();
+        let mut gpu_s = None;
+        if let Some((q, ts, trx)) = stamps {
+            trx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+            {
+                let view = ts.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
+                let t: &[u64] = bytemuck::cast_slice(&view);
+                let ticks: u64 = t.chunks_exact(2).map(|p| p[1].saturating_sub(p[0])).sum();
+                // Some drivers (lavapipe) offer the feature but write zeros: no time, not zero time.
+                gpu_s = (ticks > 0).then(|| ticks as f64 * self.queue.get_timestamp_period() as f64 * 1e-9);
+            }
+            q.read.unmap();
+        }
         let t_read = Instant::now();
         {
             let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
             read(bytemuck::cast_slice(&view));
         }
         s.staging.unmap();
-        Ok((run_s, t_read.elapsed().as_secs_f64()))
+        Ok((run_s, t_read.elapsed().as_secs_f64(), gpu_s))
     }
 }

@@ -92,6 +92,7 @@ impl Gpu {
             encoder.clear_buffer(out, 0, None);
             let empty_tris = [STri { a: [0; 4], b: [0; 4], c: [0; 4] }];
             let mut keep = Vec::new();
+            let mut passes = 0u32;
             let mut pass_with = |encoder: &mut wgpu::CommandEncoder,
                                  pipeline: &wgpu::ComputePipeline,
                                  tris: &[STri],
@@ -125,12 +126,15 @@ impl Gpu {
                     ],
                 });
                 {
-                    let mut pass =
-                        encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("solid"), timestamp_writes: None });
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("solid"),
+                        timestamp_writes: slabs.compute_timestamps(passes),
+                    });
                     pass.set_pipeline(pipeline);
                     pass.set_bind_group(0, &bind, &[]);
                     pass.dispatch_workgroups(groups.clamp(1, 65535), groups.div_ceil(65535).max(1), 1);
                 }
+                passes += 1;
                 keep.push((tri_buf, par_buf, list_buf, bind));
             };
             for batch in slab.chunks(max_batch) {
@@ -144,7 +148,7 @@ impl Gpu {
             pass_with(&mut encoder, &self.solid.prefix, &[], &[], 0, rows.div_ceil(64));
             timings.upload_s += t_up.elapsed().as_secs_f64();
             let start = k0 as usize * dims[1] as usize;
-            let (run_s, read_s) = self.finish_slab(&slabs, encoder, nk, |words| {
+            let (run_s, read_s, gpu_s) = self.finish_slab(&slabs, encoder, nk, passes, |words| {
                 for (src, dst) in words.chunks_exact(words_per_row as usize).zip(bits.rows_mut().skip(start)) {
                     for (w, d) in dst.iter_mut().enumerate().take(wpr64) {
                         let lo = src.get(2 * w).copied().unwrap_or(0) as u64;
@@ -155,6 +159,11 @@ impl Gpu {
             })?;
             timings.voxelize_s += run_s;
             timings.download_s += read_s;
+            timings.gpu_s = match (timings.gpu_s, gpu_s, timings.slabs) {
+                (None, Some(g), 0) => Some(g),
+                (Some(t), Some(g), _) => Some(t + g),
+                _ => None,
+            };
             timings.slabs += 1;
             k0 += nk;
         }

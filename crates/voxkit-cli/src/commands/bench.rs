@@ -343,7 +343,7 @@ fn gpu(a: &BenchArgs, loaded: &voxkit_io::LoadedMesh) -> Result<()> {
     }
     let mesh = owned.as_ref();
     let mut out = format!(
-        "mesh: {}{} ({} triangles); cover; median of {} repeats; GPU: {}\n\n| resolution | voxels | CPU fast, {} threads (ms) | GPU total (ms) | upload (ms) | GPU run (ms) | download (ms) | CPU share (ms) | GPU vs CPU |\n|---|---|---|---|---|---|---|---|---|\n",
+        "mesh: {}{} ({} triangles); cover; median of {} repeats; GPU: {}\n\n| resolution | voxels | CPU fast, {} threads (ms) | GPU total (ms) | upload (ms) | GPU run (ms) | GPU time, timestamps (ms) | download (ms) | CPU share (ms) | GPU vs CPU |\n|---|---|---|---|---|---|---|---|---|---|\n",
         a.mesh.display(),
         if a.subdivide > 0 { format!(" subdivided {} times", a.subdivide) } else { String::new() },
         mesh.triangles.len(),
@@ -370,14 +370,17 @@ fn gpu(a: &BenchArgs, loaded: &voxkit_io::LoadedMesh) -> Result<()> {
         anyhow::ensure!(cpu_n == gpu_n, "GPU and CPU voxel counts differ at {res}: {gpu_n} vs {cpu_n}");
         let m = |f: fn(&voxkit_gpu::Timings) -> f64| median(parts.iter().map(f).collect()) * 1e3;
         let (up, run, down, cpu_share) = (m(|t| t.upload_s), m(|t| t.voxelize_s), m(|t| t.download_s), m(|t| t.cpu_s));
+        let stamped = parts.iter().all(|t| t.gpu_s.is_some());
+        let gpu_time = stamped.then(|| m(|t| t.gpu_s.unwrap_or(0.0)));
+        let gpu_time_cell = gpu_time.map(|g| format!("{g:.3}")).unwrap_or_else(|| "-".into());
         out += &format!(
-            "| {res} | {cpu_n} | {:.1} | {:.1} | {up:.1} | {run:.1} | {down:.1} | {cpu_share:.1} | {:.2}x |\n",
+            "| {res} | {cpu_n} | {:.1} | {:.1} | {up:.1} | {run:.1} | {gpu_time_cell} | {down:.1} | {cpu_share:.1} | {:.2}x |\n",
             cpu_s * 1e3,
             gpu_s * 1e3,
             cpu_s / gpu_s
         );
         json_rows.push(json!({"resolution": res, "voxels": cpu_n, "cpu_fast_median_ms": cpu_s * 1e3, "gpu_total_median_ms": gpu_s * 1e3,
-            "upload_median_ms": up, "gpu_run_median_ms": run, "download_median_ms": down, "cpu_share_median_ms": cpu_share, "adapter": g.adapter()}));
+            "upload_median_ms": up, "gpu_run_median_ms": run, "gpu_timestamps_median_ms": gpu_time, "download_median_ms": down, "cpu_share_median_ms": cpu_share, "adapter": g.adapter()}));
     }
     if a.json {
         for r in json_rows {

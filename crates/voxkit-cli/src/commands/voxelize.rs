@@ -252,6 +252,7 @@ fn gpu_voxelize(
         "cpu_triangles": r.cpu_triangles,
         "upload_s": t.upload_s,
         "gpu_s": t.voxelize_s,
+        "gpu_time_s": t.gpu_s,
         "download_s": t.download_s,
         "cpu_share_s": t.cpu_s,
         "slabs": t.slabs,
