@@ -209,8 +209,10 @@ impl Gpu {
                 });
                 match &target {
                     None => {
-                        let mut pass =
-                            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("cover"), timestamp_writes: None });
+                        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                            label: Some("cover"),
+                            timestamp_writes: slabs.compute_timestamps(passes),
+                        });
                         pass.set_pipeline(&self.cover);
                         pass.set_bind_group(0, &bind, &[]);
                         let n = batch.len() as u32;
