@@ -8,6 +8,7 @@ use voxkit::voxelize::{Options, Report};
 use voxkit::{BrickBits, GridSpec, MeshRef};
 use wgpu::util::DeviceExt;
 
+use crate::slabs::in_slab;
 use crate::{Gpu, GpuError};
 
 /// Largest relative coordinate (lattice units) for which the shader's i64
@@ -165,7 +166,7 @@ impl Gpu {
         let mut timings = Timings { upload_s: t0.elapsed().as_secs_f64(), ..Timings::default() };
 
         let slabs = self.slabs(dims)?;
-        let (words_per_row, nk_max, out) = (slabs.words_per_row, slabs.nk_max, &slabs.out);
+        let (words_per_row, out) = (slabs.words_per_row, &slabs.out);
         let side = dims.iter().copied().max().unwrap_or(1);
         let target = match path {
             GpuPath::Compute => None,
@@ -174,13 +175,9 @@ impl Gpu {
         let expand = if path == GpuPath::Raster && !self.raster.hardware_conservative { 16 } else { 0 };
         let max_batch = (self.max_slab_bytes / std::mem::size_of::<GpuTri>() as u64).clamp(1, 1 << 22) as usize;
         let mut bits = BrickBits::new(dims);
-        let mut k0 = 0u32;
-        while k0 < dims[2] {
-            let nk = nk_max.min(dims[2] - k0);
-            let (klo, khi) = (k0 as i64, (k0 + nk) as i64 - 1);
+        for (k0, nk) in slabs.layers(dims[2]) {
             let t_up = Instant::now();
-            // Sorted by lowest layer: stop at the first triangle starting above the slab.
-            let slab: Vec<GpuTri> = on_gpu.iter().take_while(|t| t.1[0] <= khi).filter(|t| t.1[1] >= klo).map(|t| t.0).collect();
+            let slab = in_slab(&on_gpu, k0, nk);
             let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("slab") });
             encoder.clear_buffer(out, 0, None);
             let mut keep = Vec::new();
@@ -191,13 +188,7 @@ impl Gpu {
                     contents: bytemuck::cast_slice(batch),
                     usage: wgpu::BufferUsages::STORAGE,
                 });
-                let params: [u32; 12] =
-                    [dims[0], dims[1], dims[2], k0, nk, words_per_row as u32, batch.len() as u32, mode.code() | expand, side, 0, 0, 0];
-                let par_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("params"),
-                    contents: bytemuck::cast_slice(&params),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
+                let par_buf = self.params(dims, &slabs, (k0, nk), batch.len() as u32, mode.code() | expand, side);
                 let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("cover"),
                     layout: &self.layout,
@@ -208,16 +199,7 @@ impl Gpu {
                     ],
                 });
                 match &target {
-                    None => {
-                        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                            label: Some("cover"),
-                            timestamp_writes: slabs.compute_timestamps(passes),
-                        });
-                        pass.set_pipeline(&self.cover);
-                        pass.set_bind_group(0, &bind, &[]);
-                        let n = batch.len() as u32;
-                        pass.dispatch_workgroups(n.min(65535), n.div_ceil(65535), 1);
-                    }
+                    None => self.compute_pass(&mut encoder, &slabs, passes, &self.cover, &bind, batch.len() as u32),
                     Some(view) => {
                         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                             label: Some("raster"),
@@ -245,7 +227,7 @@ impl Gpu {
                 keep.push((tri_buf, par_buf, bind));
             }
             timings.upload_s += t_up.elapsed().as_secs_f64();
-            let (run_s, read_s, gpu_s) = self.finish_slab(&slabs, encoder, nk, passes, |words| {
+            let done = self.finish_slab(&slabs, encoder, nk, passes, |words| {
                 for (row, chunk) in words.chunks_exact(words_per_row as usize).enumerate() {
                     let (j, k) = (row as u32 % dims[1], k0 + row as u32 / dims[1]);
                     for (w, &word) in chunk.iter().enumerate() {
@@ -258,15 +240,7 @@ impl Gpu {
                     }
                 }
             })?;
-            timings.voxelize_s += run_s;
-            timings.download_s += read_s;
-            timings.gpu_s = match (timings.gpu_s, gpu_s, timings.slabs) {
-                (None, Some(g), 0) => Some(g),
-                (Some(t), Some(g), _) => Some(t + g),
-                _ => None,
-            };
-            timings.slabs += 1;
-            k0 += nk;
+            timings.add_slab(done);
         }
         let t_cpu = Instant::now();
         if !on_cpu.is_empty() {

@@ -4,6 +4,8 @@
 
 use std::time::Instant;
 
+use wgpu::util::DeviceExt;
+
 use crate::{Gpu, GpuError};
 
 /// The grid cut into z-slabs of 32-bit words (bit `i % 32` of word
@@ -31,6 +33,12 @@ pub(crate) struct Queries {
 }
 
 impl Slabs {
+    /// The slabs of a grid `nz` layers deep: `(first layer, layers)`.
+    pub fn layers(&self, nz: u32) -> impl Iterator<Item = (u32, u32)> {
+        let step = self.nk_max;
+        (0..nz).step_by(step as usize).map(move |k0| (k0, step.min(nz - k0)))
+    }
+
     /// Timestamp writes for compute pass `pass` of the current slab.
     pub fn compute_timestamps(&self, pass: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
         let q = self.queries.as_ref().filter(|_| pass < TIMED_PASSES)?;
@@ -52,7 +60,59 @@ impl Slabs {
     }
 }
 
+/// The items of `sorted` (by lowest layer, each with its inclusive layer
+/// range) that reach into layers `k0 .. k0 + nk`.
+pub(crate) fn in_slab<T: Copy>(sorted: &[(T, [i64; 2])], k0: u32, nk: u32) -> Vec<T> {
+    let (klo, khi) = (k0 as i64, (k0 + nk) as i64 - 1);
+    // Stop at the first item starting above the slab.
+    sorted.iter().take_while(|t| t.1[0] <= khi).filter(|t| t.1[1] >= klo).map(|t| t.0).collect()
+}
+
+impl crate::Timings {
+    /// Adds one slab's run, read and timestamped GPU seconds (the GPU time
+    /// stays known only while every slab has it).
+    pub(crate) fn add_slab(&mut self, (run_s, read_s, gpu_s): (f64, f64, Option<f64>)) {
+        self.voxelize_s += run_s;
+        self.download_s += read_s;
+        self.gpu_s = match (self.gpu_s, gpu_s, self.slabs) {
+            (None, Some(g), 0) => Some(g),
+            (Some(t), Some(g), _) => Some(t + g),
+            _ => None,
+        };
+        self.slabs += 1;
+    }
+}
+
 impl Gpu {
+    /// The uniform parameters of one pass (`Params` in `common.wgsl`).
+    pub(crate) fn params(&self, dims: [u32; 3], s: &Slabs, (k0, nk): (u32, u32), count: u32, mode: u32, side: u32) -> wgpu::Buffer {
+        let params: [u32; 12] = [dims[0], dims[1], dims[2], k0, nk, s.words_per_row as u32, count, mode, side, 0, 0, 0];
+        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("params"),
+            contents: bytemuck::cast_slice(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        })
+    }
+
+    /// Records one compute pass of `groups` workgroups (spread over a
+    /// second dimension past 65 535, as the shaders expect), timed as pass
+    /// `pass` of the slab.
+    pub(crate) fn compute_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        s: &Slabs,
+        pass: u32,
+        pipeline: &wgpu::ComputePipeline,
+        bind: &wgpu::BindGroup,
+        groups: u32,
+    ) {
+        let mut p = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("voxkit"), timestamp_writes: s.compute_timestamps(pass) });
+        p.set_pipeline(pipeline);
+        p.set_bind_group(0, bind, &[]);
+        p.dispatch_workgroups(groups.clamp(1, 65535), groups.div_ceil(65535).max(1), 1);
+    }
+
     /// Slabs for a grid of `dims`, or an error if one layer is already too large.
     pub(crate) fn slabs(&self, dims: [u32; 3]) -> Result<Slabs, GpuError> {
         let words_per_row = dims[0].div_ceil(32) as u64;

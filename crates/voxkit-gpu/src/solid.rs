@@ -11,6 +11,7 @@ use voxkit::voxelize::solid::{inspect, SolidReport};
 use voxkit::{GridSpec, MeshRef};
 use wgpu::util::DeviceExt;
 
+use crate::slabs::in_slab;
 use crate::{Gpu, GpuError, Timings};
 
 /// Largest triangle extent + 2 voxels (lattice units) whose row-crossing
@@ -67,16 +68,13 @@ impl Gpu {
         let mut timings = Timings { upload_s: t0.elapsed().as_secs_f64(), ..Timings::default() };
 
         let slabs = self.slabs(dims)?;
-        let (words_per_row, nk_max, out) = (slabs.words_per_row, slabs.nk_max, &slabs.out);
+        let (words_per_row, out) = (slabs.words_per_row, &slabs.out);
         let max_batch = (self.max_slab_bytes / std::mem::size_of::<STri>() as u64).clamp(1, 1 << 22) as usize;
         let mut bits = DenseBits::new(dims);
         let wpr64 = bits.words_per_row();
-        let mut k0 = 0u32;
-        while k0 < dims[2] {
-            let nk = nk_max.min(dims[2] - k0);
-            let (klo, khi) = (k0 as i64, (k0 + nk) as i64 - 1);
+        for (k0, nk) in slabs.layers(dims[2]) {
             let t_up = Instant::now();
-            let slab: Vec<STri> = on_gpu.iter().take_while(|t| t.1[0] <= khi).filter(|t| t.1[1] >= klo).map(|t| t.0).collect();
+            let slab = in_slab(&on_gpu, k0, nk);
             let list: Vec<[u32; 2]> = cpu_flips
                 .iter()
                 .filter(|f| {
@@ -109,12 +107,7 @@ impl Gpu {
                     contents: bytemuck::cast_slice(if tris.is_empty() { &empty_tris[..] } else { tris }),
                     usage: wgpu::BufferUsages::STORAGE,
                 });
-                let params: [u32; 12] = [dims[0], dims[1], dims[2], k0, nk, words_per_row as u32, count, 0, 0, 0, 0, 0];
-                let par_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("solid params"),
-                    contents: bytemuck::cast_slice(&params),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
+                let par_buf = self.params(dims, &slabs, (k0, nk), count, 0, 0);
                 let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("solid"),
                     layout: &self.solid.layout,
@@ -125,15 +118,7 @@ impl Gpu {
                         wgpu::BindGroupEntry { binding: 3, resource: list_buf.as_entire_binding() },
                     ],
                 });
-                {
-                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some("solid"),
-                        timestamp_writes: slabs.compute_timestamps(passes),
-                    });
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, &bind, &[]);
-                    pass.dispatch_workgroups(groups.clamp(1, 65535), groups.div_ceil(65535).max(1), 1);
-                }
+                self.compute_pass(encoder, &slabs, passes, pipeline, &bind, groups);
                 passes += 1;
                 keep.push((tri_buf, par_buf, list_buf, bind));
             };
@@ -148,7 +133,7 @@ impl Gpu {
             pass_with(&mut encoder, &self.solid.prefix, &[], &[], 0, rows.div_ceil(64));
             timings.upload_s += t_up.elapsed().as_secs_f64();
             let start = k0 as usize * dims[1] as usize;
-            let (run_s, read_s, gpu_s) = self.finish_slab(&slabs, encoder, nk, passes, |words| {
+            let done = self.finish_slab(&slabs, encoder, nk, passes, |words| {
                 for (src, dst) in words.chunks_exact(words_per_row as usize).zip(bits.rows_mut().skip(start)) {
                     for (w, d) in dst.iter_mut().enumerate().take(wpr64) {
                         let lo = src.get(2 * w).copied().unwrap_or(0) as u64;
@@ -157,15 +142,7 @@ impl Gpu {
                     }
                 }
             })?;
-            timings.voxelize_s += run_s;
-            timings.download_s += read_s;
-            timings.gpu_s = match (timings.gpu_s, gpu_s, timings.slabs) {
-                (None, Some(g), 0) => Some(g),
-                (Some(t), Some(g), _) => Some(t + g),
-                _ => None,
-            };
-            timings.slabs += 1;
-            k0 += nk;
+            timings.add_slab(done);
         }
         solid.voxels = bits.count();
         let report = SolidGpuReport { solid, gpu_triangles: on_gpu.len() as u64, cpu_triangles: on_cpu.len() as u64, timings };
