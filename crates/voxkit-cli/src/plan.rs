@@ -134,9 +134,7 @@ pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::M
         Method::Gpu if !cfg!(feature = "gpu") => {
             bail!("--method gpu: this voxkit was built without the `gpu` feature; use auto, fast or reference")
         }
-        Method::Gpu if matches!(core, voxkit::voxelize::Mode::Cover | voxkit::voxelize::Mode::Sep26 | voxkit::voxelize::Mode::Sep6) => {
-            SurfaceMethod::Gpu
-        }
+        Method::Gpu if gpu_has(core) => SurfaceMethod::Gpu,
         Method::Gpu => bail!(
             "--method gpu exists for cover, sep26 and sep6 so far; {} on the GPU is not built yet (use auto, fast or reference)",
             mode_name(mode)
@@ -170,16 +168,27 @@ pub const GPU_AUTO_MIN_SIDE: u32 = 512;
 /// they are not used unless asked for (`--method gpu`).
 #[cfg(feature = "gpu")]
 fn gpu_preferred(mode: voxkit::voxelize::Mode, grid: &GridSpec) -> bool {
-    if voxkit_gpu::GpuMode::of(mode).is_none() || grid.dims().iter().copied().max().unwrap_or(0) < GPU_AUTO_MIN_SIDE {
+    if !gpu_has(mode) || grid.dims().iter().copied().max().unwrap_or(0) < GPU_AUTO_MIN_SIDE {
         return false;
     }
-    match voxkit_gpu::Gpu::new() {
-        Ok(g) => !g.is_software(),
+    match voxkit_gpu::hardware_adapter() {
+        Ok(hardware) => hardware,
         Err(e) => {
             eprintln!("voxkit: note: {e}; using the CPU");
             false
         }
     }
+}
+
+/// Does the GPU path have this surface mode?
+#[cfg(feature = "gpu")]
+fn gpu_has(mode: voxkit::voxelize::Mode) -> bool {
+    voxkit_gpu::GpuMode::of(mode).is_some()
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_has(_mode: voxkit::voxelize::Mode) -> bool {
+    false
 }
 
 #[cfg(not(feature = "gpu"))]

@@ -198,6 +198,29 @@ impl SolidPipelines {
     }
 }
 
+/// The default adapter (high performance preferred), if it has what the
+/// exact path needs.
+fn adapter() -> Result<wgpu::Adapter, GpuError> {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter =
+        pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        }))
+        .map_err(|_| GpuError::NoAdapter)?;
+    if !adapter.features().contains(wgpu::Features::SHADER_INT64) {
+        return Err(GpuError::MissingFeature { adapter: adapter.get_info().name, what: "64-bit integers in shaders (SHADER_INT64)" });
+    }
+    Ok(adapter)
+}
+
+/// Is the adapter [`Gpu::new`] would open a hardware one (not lavapipe or
+/// WARP)? Asks for the adapter only: no device, no pipelines, so a caller
+/// deciding whether to use the GPU pays little.
+pub fn hardware_adapter() -> Result<bool, GpuError> {
+    Ok(adapter()?.get_info().device_type != wgpu::DeviceType::Cpu)
+}
+
 /// An open GPU device with the voxelization pipelines.
 pub struct Gpu {
     device: wgpu::Device,
@@ -223,16 +246,8 @@ impl Gpu {
     /// Opens the default adapter (high performance preferred) with the
     /// features the exact path needs.
     pub fn new() -> Result<Gpu, GpuError> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            ..Default::default()
-        }))
-        .map_err(|_| GpuError::NoAdapter)?;
+        let adapter = adapter()?;
         let info = adapter.get_info();
-        if !adapter.features().contains(wgpu::Features::SHADER_INT64) {
-            return Err(GpuError::MissingFeature { adapter: info.name.clone(), what: "64-bit integers in shaders (SHADER_INT64)" });
-        }
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("voxkit"),
@@ -333,7 +348,7 @@ impl Gpu {
         format!("{} ({:?})", self.info.name, self.info.backend)
     }
 
-    /// True for software adapters (lavapipe, WARP): correct, not fast.
+    /// True for software adapters (lavapipe, WARP): correct, not fast (see also [`hardware_adapter`]).
     pub fn is_software(&self) -> bool {
         self.info.device_type == wgpu::DeviceType::Cpu
     }
