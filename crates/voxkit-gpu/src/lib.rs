@@ -277,7 +277,7 @@ impl Gpu {
                 slot.get_or_insert_with(|| format!("device lost ({reason:?}): {msg}"));
             }
         });
-        let max_slab_bytes = (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size).min(1 << 30);
+        let max_slab_bytes = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size).min(1 << 30);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("cover"),
             source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/cover.wgsl")]).into()),
