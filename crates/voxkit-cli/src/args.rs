@@ -57,6 +57,13 @@ pub enum Mode {
     Pos,
 }
 
+/// Extra baselines of `voxkit bench`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Baseline {
+    /// The brute-force loop: bounding box × f64 triangle/box test, one thread.
+    Brute,
+}
+
 /// Solid filling strategies other than the inside test.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Fill {
@@ -286,6 +293,12 @@ pub struct BenchArgs {
     /// Resolution at which the reference path is timed as the baseline.
     #[arg(long, default_value_t = 128)]
     pub reference_resolution: u64,
+    /// A second baseline: `brute` times, at every resolution and in
+    /// alternation with the measured paths, the brute-force loop a short C
+    /// program would be (every voxel of each triangle's bounding box, the
+    /// f64 triangle/box test, one thread), and adds a "vs brute" column.
+    #[arg(long, value_enum)]
+    pub baseline: Option<Baseline>,
     /// Split every triangle into four this many times before measuring
     /// (e.g. 2 turns the 69k-triangle bunny into 1.1M triangles).
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=5))]

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 
 use glam::{DMat3, DQuat, DVec3};
 use rand::{Rng, SeedableRng};
+use voxkit::voxelize::driver::Driver;
 use voxkit::voxelize::{self, Mode, Options, Traversal};
 use voxkit::{DenseBits, GridSpec, Mesh};
 
@@ -132,18 +133,23 @@ pub fn agree_mode(mode: Mode, mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits,
     }
     for threads in [1, 2, 8] {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
-        for (slab_height, traversal) in
-            [(0, Traversal::Auto), (1, Traversal::WalkRows), (7, Traversal::ScanBoxes), (0, Traversal::WalkRows)]
-        {
-            let (fast, frep) =
-                pool.install(|| voxelize::fast(mode, mesh.as_ref(), grid, &Options { slab_height, traversal, ..Options::default() }));
+        for (slab_height, traversal, driver) in [
+            (0, Traversal::Auto, Driver::Auto),
+            (0, Traversal::Auto, Driver::Slabs),
+            (0, Traversal::Auto, Driver::Triangles),
+            (1, Traversal::WalkRows, Driver::Slabs),
+            (7, Traversal::ScanBoxes, Driver::Slabs),
+            (0, Traversal::WalkRows, Driver::Triangles),
+        ] {
+            let opts = Options { slab_height, traversal, driver, ..Options::default() };
+            let (fast, frep) = pool.install(|| voxelize::fast(mode, mesh.as_ref(), grid, &opts));
             if fast.count() != frep.voxels {
                 return Err(format!("fast report says {} voxels, grid has {}", frep.voxels, fast.count()));
             }
             let fast = fast.to_dense();
             if let Some(v) = reference.first_difference(&fast) {
                 return Err(format!(
-                    "{} fast (threads {threads}, slab height {slab_height}, {traversal:?}) differs from reference at voxel {v:?}: reference {}, fast {}",
+                    "{} fast (threads {threads}, slab height {slab_height}, {traversal:?}, {driver:?}) differs from reference at voxel {v:?}: reference {}, fast {}",
                     mode.name(),
                     reference.get(v[0], v[1], v[2]),
                     fast.get(v[0], v[1], v[2])
@@ -153,8 +159,8 @@ pub fn agree_mode(mode: Mode, mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits,
                 return Err(format!("fast report {frep:?} differs from reference report {rep:?}"));
             }
         }
-        for slab_height in [0, 1, 7] {
-            let opts = Options { slab_height, ..Options::default() };
+        for (slab_height, driver) in [(0, Driver::Auto), (1, Driver::Slabs), (7, Driver::Slabs), (0, Driver::Triangles)] {
+            let opts = Options { slab_height, driver, ..Options::default() };
             let Some((scan, srep)) = pool.install(|| voxelize::scanline::scanline(mode, mesh.as_ref(), grid, &opts)) else { break };
             let scan = scan.to_dense();
             if let Some(v) = reference.first_difference(&scan) {
@@ -229,6 +235,21 @@ pub mod strategies {
     /// A point of [`coord`]s.
     pub fn point() -> impl Strategy<Value = DVec3> {
         (coord(), coord(), coord()).prop_map(|(x, y, z)| DVec3::new(x, y, z))
+    }
+
+    /// A small offset in `[-3, 3]` voxels: whole and half voxels, a few
+    /// ulps off them, or arbitrary.
+    pub fn offset() -> impl Strategy<Value = f64> {
+        prop_oneof![(-3i32..=3).prop_map(|i| i as f64), (-6i32..=6).prop_map(|i| i as f64 * 0.5), (-3.0f64..3.0), (0.0f64..0.3),]
+    }
+
+    /// A triangle spanning at most a few voxels — what the short paths for
+    /// small triangles take: a vertex from [`point`] (often on a grid
+    /// plane), the others offset from it by [`offset`]s, so vertices share
+    /// planes, straddle them by ulps or lie exactly on them.
+    pub fn small_triangle() -> impl Strategy<Value = [DVec3; 3]> {
+        (point(), (offset(), offset(), offset()), (offset(), offset(), offset()))
+            .prop_map(|(a, (x1, y1, z1), (x2, y2, z2))| [a, a + DVec3::new(x1, y1, z1), a + DVec3::new(x2, y2, z2)])
     }
 
     /// A triangle: general, axis-aligned (one coordinate shared), sliver

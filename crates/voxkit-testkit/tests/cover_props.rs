@@ -3,10 +3,11 @@
 
 use glam::DVec3;
 use proptest::prelude::*;
+use voxkit::voxelize::Mode;
 use voxkit::voxelize::{cover, Options};
 use voxkit::{DenseBits, GridSpec, Mesh};
-use voxkit_testkit::strategies::triangle;
-use voxkit_testkit::{agree, soup};
+use voxkit_testkit::strategies::{small_triangle, triangle};
+use voxkit_testkit::{agree, agree_mode, soup};
 
 fn unit_grid(n: u64) -> GridSpec {
     GridSpec::new(DVec3::ZERO, 1.0, [n, n, n]).unwrap()
@@ -77,6 +78,19 @@ proptest! {
         let m = soup(&tris);
         if let Err(e) = agree(&m, &unit_grid(8)) {
             prop_assert!(false, "{e}\ntriangles: {tris:?}");
+        }
+    }
+
+    /// Triangles of a few voxels, through every surface mode: the short
+    /// paths (one voxel, one run, one 2D projection, the tiny-box test)
+    /// against the definitions, on both drivers.
+    #[test]
+    fn small_triangles_in_every_surface_mode(tris in prop::collection::vec(small_triangle(), 1..5)) {
+        let m = soup(&tris);
+        for mode in [Mode::Cover, Mode::Sep26, Mode::Sep6, Mode::Ss6] {
+            if let Err(e) = agree_mode(mode, &m, &unit_grid(8)) {
+                prop_assert!(false, "{e}\ntriangles: {tris:?}");
+            }
         }
     }
 

@@ -8,7 +8,8 @@ use serde_json::json;
 use voxkit::voxelize::{self, solid, winding, Options};
 use voxkit::{GridSpec, MeshRef};
 
-use crate::args::BenchArgs;
+use super::brute;
+use crate::args::{Baseline, BenchArgs};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -145,6 +146,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     let mut rows = Vec::new();
 
     let mut ref_s = std::collections::HashMap::new();
+    let mut brute_s = std::collections::HashMap::new();
     let groups: Vec<Vec<Engine>> = a.modes.iter().map(|&m| Engine::new(m)).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect();
     for group in &groups {
         // Baseline: the reference path (serial by construction), capped for
@@ -166,14 +168,38 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             with_loading_s: None,
         });
 
-        for &threads in &a.threads {
+        for (n_threads, &threads) in a.threads.iter().enumerate() {
             let pool = crate::thread_pool(Some(threads))?;
             for &res in &a.resolutions {
                 let grid = GridSpec::from_resolution(&bounds, res).context("invalid grid")?;
                 crate::plan::check_memory(&grid)?;
-                let timed = pool.install(|| time_alternating(a.repeats, group, |e| e.fast(mesh, &grid)));
-                for (engine, (vox_s, voxels)) in group.iter().zip(timed) {
+                // The brute-force baseline runs on one thread whatever the
+                // pool, so it is timed (in alternation) with the first thread
+                // count of each resolution only.
+                let with_brute = a.baseline == Some(Baseline::Brute) && n_threads == 0 && !brute_s.contains_key(&res);
+                let items: Vec<Option<&Engine>> = group.iter().map(Some).chain(with_brute.then_some(None)).collect();
+                let timed = pool.install(|| {
+                    time_alternating(a.repeats, &items, |e| match e {
+                        Some(e) => e.fast(mesh, &grid),
+                        None => Ok(brute::cover(mesh, &grid).iter().map(|w| w.count_ones() as u64).sum()),
+                    })
+                });
+                for (item, (vox_s, voxels)) in items.iter().zip(timed) {
                     let voxels = voxels?;
+                    let Some(engine) = item else {
+                        brute_s.insert(res, vox_s);
+                        rows.push(Row {
+                            mode: "(any)",
+                            method: "brute",
+                            threads: 1,
+                            resolution: res,
+                            dims: grid.dims(),
+                            voxels,
+                            voxelize_s: vox_s,
+                            with_loading_s: None,
+                        });
+                        continue;
+                    };
                     // With loading: only for the file as it is (a subdivided
                     // mesh is built in memory).
                     let load_s = if a.subdivide == 0 {
@@ -207,7 +233,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
     if a.json {
         for r in &rows {
             let v = json!({"mode": r.mode, "method": r.method, "threads": r.threads, "resolution": r.resolution, "dims": r.dims, "voxels": r.voxels,
-                "voxelize_median_s": r.voxelize_s, "with_loading_median_s": r.with_loading_s, "repeats": a.repeats});
+                "voxelize_median_s": r.voxelize_s, "with_loading_median_s": r.with_loading_s, "repeats": a.repeats,
+                "brute_median_s": brute_s.get(&r.resolution)});
             crate::print_stdout(&v.to_string())?;
         }
         return Ok(());
@@ -221,7 +248,12 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         a.repeats.min(5),
         std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
     );
-    out += "| mode | method | threads | resolution | grid | voxels | voxelize (ms) | with loading (ms) | vs reference | vs fast |\n|---|---|---|---|---|---|---|---|---|---|\n";
+    let brute_col = a.baseline == Some(Baseline::Brute);
+    out += &format!(
+        "| mode | method | threads | resolution | grid | voxels | voxelize (ms) | with loading (ms) | vs reference | vs fast |{}\n|---|---|---|---|---|---|---|---|---|---|{}\n",
+        if brute_col { " vs brute |" } else { "" },
+        if brute_col { "---|" } else { "" }
+    );
     for r in &rows {
         let vs_fast = rows
             .iter()
@@ -231,10 +263,17 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             .unwrap_or_else(|| "-".into());
         let d = r.dims;
         let load = r.with_loading_s.map(|s| format!("{:.1}", s * 1e3)).unwrap_or_else(|| "-".into());
-        let (rr, rs) = ref_s[r.mode];
-        let speed = if r.resolution == rr { format!("{:.1}x", rs / r.voxelize_s) } else { "-".into() };
+        let speed = match ref_s.get(r.mode) {
+            Some(&(rr, rs)) if r.resolution == rr => format!("{:.1}x", rs / r.voxelize_s),
+            _ => "-".into(),
+        };
+        let vs_brute = match brute_s.get(&r.resolution) {
+            Some(b) if brute_col && r.method != "brute" && r.method != "reference" => format!(" {:.2}x |", b / r.voxelize_s),
+            _ if brute_col => " - |".into(),
+            _ => String::new(),
+        };
         out += &format!(
-            "| {} | {} | {} | {} | {}x{}x{} | {} | {:.2} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {}x{}x{} | {} | {:.2} | {} | {} | {} |{}\n",
             r.mode,
             r.method,
             r.threads,
@@ -246,7 +285,8 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             r.voxelize_s * 1e3,
             load,
             speed,
-            vs_fast
+            vs_fast,
+            vs_brute
         );
     }
     crate::print_stdout(out.trim_end())

@@ -1,6 +1,7 @@
 //! One file per subcommand.
 
 pub mod bench;
+mod brute;
 pub mod check;
 pub mod convert;
 pub mod export;

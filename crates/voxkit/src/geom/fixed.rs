@@ -31,7 +31,13 @@ pub const DIRECT_LIMIT_VOXELS: f64 = 65_536.0 * 1.5;
 #[inline]
 pub fn snap(u: f64) -> i64 {
     debug_assert!(u.is_finite() && u.abs() <= DIRECT_LIMIT_VOXELS + 2.0);
-    (u * ONE as f64).round() as i64
+    // `f64::round` (half away from zero) without the libm call baseline
+    // x86-64 makes for it: truncate, then correct by the exact remainder
+    // (`x - trunc(x)` is exact for |x| < 2^52).
+    let x = u * ONE as f64;
+    let t = x as i64;
+    let f = x - t as f64;
+    t + (f >= 0.5) as i64 - (f <= -0.5) as i64
 }
 
 /// The voxel indices `i` whose closed extent `[i*ONE, (i+1)*ONE]` meets the
@@ -120,5 +126,23 @@ mod tests {
         assert_eq!(snap(-0.5), -ONE / 2);
         assert_eq!(snap(1.0 + 1e-9), ONE);
         assert_eq!(snap(0.3 / 4096.0), 0);
+    }
+
+    #[test]
+    fn snap_is_f64_round() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut cases = vec![0.5, -0.5, 1.5, -1.5, 2.5, -2.5, 0.49999999999999994, -0.49999999999999994, 1e5, -1e5];
+        for _ in 0..100_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let u = (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0e5 - 1.0e5;
+            cases.push(u);
+            // Exact halves of the lattice.
+            cases.push(((u * 8192.0).round() + 1.0) / 8192.0);
+        }
+        for u in cases {
+            assert_eq!(snap(u), (u * ONE as f64).round() as i64, "{u}");
+        }
     }
 }

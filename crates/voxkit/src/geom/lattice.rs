@@ -147,6 +147,7 @@ impl PrepareStats {
 /// The output order follows the input order, whatever the thread count.
 pub fn prepare(mesh: MeshRef<'_>, grid: &GridSpec) -> (Vec<LatticeTriangle>, PrepareStats) {
     const CHUNK: usize = 4096;
+    let snapped = SnappedMesh::new(mesh, grid);
     let parts: Vec<(Vec<LatticeTriangle>, PrepareStats)> = mesh
         .triangles
         .par_chunks(CHUNK)
@@ -154,7 +155,7 @@ pub fn prepare(mesh: MeshRef<'_>, grid: &GridSpec) -> (Vec<LatticeTriangle>, Pre
             let mut out = Vec::with_capacity(chunk.len());
             let mut st = PrepareStats::default();
             for tri in chunk {
-                prepare_one(mesh.positions, tri, grid, &mut out, &mut st);
+                snapped.triangle(tri, &mut st, |t, _, _| out.push(*t));
             }
             (out, st)
         })
@@ -204,21 +205,29 @@ fn prepare_one(positions: &[DVec3], tri: &[u32; 3], grid: &GridSpec, out: &mut V
     if fits {
         push_snapped(g[0], g[1], g[2], grid.dims(), out, st);
     } else {
-        st.clipped += 1;
-        let poly = clip_polygon_to_box(&g, DVec3::splat(-1.0), dims + DVec3::ONE);
-        if poly.len() < 3 {
-            st.outside += 1;
-            return;
-        }
-        for w in 1..poly.len() - 1 {
-            push_snapped(poly[0], poly[w], poly[w + 1], grid.dims(), out, st);
-        }
-        // A clipped polygon whose fan is entirely degenerate counts once.
+        clip_and_push(&g, grid.dims(), out, st);
         if out.len() == before {
             return;
         }
     }
     st.output += (out.len() - before) as u64;
+}
+
+/// The far branch of [`prepare_one`]: `g` (grid units, finite, not culled)
+/// reaches beyond the lattice range, so it is clipped to the grid grown by
+/// one voxel, fanned and snapped. Counts `clipped` and, if nothing is left,
+/// `outside`; the caller counts `output`.
+fn clip_and_push(g: &[DVec3; 3], dims_u: [u32; 3], out: &mut Vec<LatticeTriangle>, st: &mut PrepareStats) {
+    let dims = DVec3::new(dims_u[0] as f64, dims_u[1] as f64, dims_u[2] as f64);
+    st.clipped += 1;
+    let poly = clip_polygon_to_box(g, DVec3::splat(-1.0), dims + DVec3::ONE);
+    if poly.len() < 3 {
+        st.outside += 1;
+        return;
+    }
+    for w in 1..poly.len() - 1 {
+        push_snapped(poly[0], poly[w], poly[w + 1], dims_u, out, st);
+    }
 }
 
 fn push_snapped(a: DVec3, b: DVec3, c: DVec3, dims: [u32; 3], out: &mut Vec<LatticeTriangle>, st: &mut PrepareStats) {
@@ -234,6 +243,110 @@ fn push_snapped(a: DVec3, b: DVec3, c: DVec3, dims: [u32; 3], out: &mut Vec<Latt
         return;
     }
     out.push(t);
+}
+
+/// A mesh vertex in grid units, snapped once for all the triangles that
+/// use it, with what [`prepare`]'s per-triangle tests need to know of it.
+#[derive(Clone, Copy, Debug, Default)]
+struct SnappedVertex {
+    /// The snapped coordinates (valid when `flags & (NON_FINITE | FAR) == 0`;
+    /// `|c| <= MAX_ABS < 2^31`).
+    p: [i32; 3],
+    /// [`NON_FINITE`], [`FAR`], and per axis `a` bit `BELOW << a` (grid
+    /// units `< -1`) and `ABOVE << a` (`> dims + 1`).
+    flags: u32,
+}
+
+const NON_FINITE: u32 = 1;
+const FAR: u32 = 2;
+const BELOW: u32 = 4;
+const ABOVE: u32 = 32;
+const CULL: u32 = 0b111 * BELOW | 0b111 * ABOVE;
+
+/// A mesh whose vertices are snapped to a grid's lattice, once each; its
+/// triangles are then prepared exactly as [`prepare`] defines, without a
+/// second conversion per corner. The triangle-parallel driver prepares
+/// triangles through it one at a time, without storing them.
+pub struct SnappedMesh<'a> {
+    positions: &'a [DVec3],
+    grid: GridSpec,
+    verts: Vec<SnappedVertex>,
+}
+
+impl<'a> SnappedMesh<'a> {
+    /// Snaps every vertex of `mesh` (in parallel).
+    pub fn new(mesh: MeshRef<'a>, grid: &GridSpec) -> SnappedMesh<'a> {
+        let g = *grid;
+        let lim = DVec3::new(grid.dims()[0] as f64, grid.dims()[1] as f64, grid.dims()[2] as f64) + DVec3::ONE;
+        let mut verts = vec![SnappedVertex::default(); mesh.positions.len()];
+        verts.par_chunks_mut(8192).zip(mesh.positions.par_chunks(8192)).for_each(|(out, pos)| {
+            for (o, p) in out.iter_mut().zip(pos) {
+                let u = g.to_grid_units(*p);
+                *o = if !u.is_finite() {
+                    SnappedVertex { p: [0; 3], flags: NON_FINITE }
+                } else {
+                    let mut flags = 0;
+                    for a in 0..3 {
+                        flags |= (u[a] < -1.0) as u32 * (BELOW << a) | (u[a] > lim[a]) as u32 * (ABOVE << a);
+                    }
+                    if u.abs().max_element() > DIRECT_LIMIT_VOXELS {
+                        SnappedVertex { p: [0; 3], flags: flags | FAR }
+                    } else {
+                        SnappedVertex { p: [snap(u.x) as i32, snap(u.y) as i32, snap(u.z) as i32], flags }
+                    }
+                };
+            }
+        });
+        SnappedMesh { positions: mesh.positions, grid: *grid, verts }
+    }
+
+    /// Prepares triangle `tri` as [`prepare`] does: counts it in `st` and
+    /// calls `emit(triangle, lo, hi)` for each lattice triangle it yields
+    /// (none if it is skipped, several if it was clipped), with its
+    /// inclusive voxel box clamped to the grid.
+    #[inline]
+    pub fn triangle(&self, tri: &[u32; 3], st: &mut PrepareStats, mut emit: impl FnMut(&LatticeTriangle, [i64; 3], [i64; 3])) {
+        let (Some(a), Some(b), Some(c)) =
+            (self.verts.get(tri[0] as usize), self.verts.get(tri[1] as usize), self.verts.get(tri[2] as usize))
+        else {
+            st.input += 1;
+            st.invalid_index += 1;
+            return;
+        };
+        let any = a.flags | b.flags | c.flags;
+        if any & (NON_FINITE | FAR | CULL) != 0 {
+            if any & NON_FINITE == 0 && a.flags & b.flags & c.flags & CULL != 0 {
+                // Every corner beyond the grid's margin on one side of one axis.
+                st.input += 1;
+                st.outside += 1;
+                return;
+            }
+            if any & (NON_FINITE | FAR) != 0 {
+                // Rare: the per-corner definition decides (and counts).
+                let mut out = Vec::new();
+                prepare_one(self.positions, tri, &self.grid, &mut out, st);
+                let dims = self.grid.dims();
+                for t in &out {
+                    if let Some((lo, hi)) = t.voxel_bounds(dims) {
+                        emit(t, lo, hi);
+                    }
+                }
+                return;
+            }
+        }
+        st.input += 1;
+        let t = LatticeTriangle { v: [a.p.map(i64::from), b.p.map(i64::from), c.p.map(i64::from)] };
+        if t.is_degenerate() {
+            st.degenerate += 1;
+            return;
+        }
+        let Some((lo, hi)) = t.voxel_bounds(self.grid.dims()) else {
+            st.outside += 1;
+            return;
+        };
+        st.output += 1;
+        emit(&t, lo, hi);
+    }
 }
 
 /// A world-space segment on the lattice of a grid, or why it is not.

@@ -184,6 +184,49 @@ impl BrickBits {
         }
     }
 
+    /// The union of grids of the same dims, with bricks numbered in index
+    /// order, so the result does not depend on how the voxels were split
+    /// among `parts` (the triangle-parallel driver's merge). Returns the
+    /// grid and its voxel count. Panics if `parts` is empty or dims differ.
+    pub fn union_canonical(parts: &[BrickBits]) -> (BrickBits, u64) {
+        let dims = parts[0].dims;
+        assert!(parts.iter().all(|p| p.dims == dims), "union of grids of different dims");
+        let mut out = BrickBits::new(dims);
+        let chunk = 1 << 14;
+        let pools: Vec<((usize, Vec<Brick>), u64)> = out
+            .index
+            .par_chunks_mut(chunk)
+            .enumerate()
+            .map(|(c, idx)| {
+                let base = c * chunk;
+                let mut pool = Vec::new();
+                let mut count = 0;
+                for (e, slot) in idx.iter_mut().enumerate() {
+                    let mut b: Brick = [0; 8];
+                    let mut any = false;
+                    for p in parts {
+                        let id = p.index[base + e];
+                        if id != 0 {
+                            any = true;
+                            for (w, x) in b.iter_mut().zip(&p.bricks[id as usize - 1]) {
+                                *w |= x;
+                            }
+                        }
+                    }
+                    if any {
+                        count += super::count_bits(b.iter());
+                        pool.push(b);
+                        *slot = pool.len() as u32;
+                    }
+                }
+                ((idx.len(), pool), count)
+            })
+            .collect();
+        let count = pools.iter().map(|p| p.1).sum();
+        out.merge_slabs(pools.into_iter().map(|p| p.0).collect());
+        (out, count)
+    }
+
     /// The set voxels in order of `k`, then `j`, then `i`.
     pub fn for_each_set(&self, mut f: impl FnMut(u32, u32, u32)) {
         let [bx, by, bz] = self.bdims;

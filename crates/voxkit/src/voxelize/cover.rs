@@ -28,7 +28,7 @@
 //! **Reference:** [`reference::cover`], the separating axis test on all
 //! thirteen axes for every voxel of each triangle's bounding box.
 
-use super::driver::{run_slabs, Kernel, Sink};
+use super::driver::{run_mesh, run_slabs, Kernel, Sink};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{prepare, LatticeTriangle};
@@ -40,9 +40,7 @@ use crate::mesh::MeshRef;
 /// Conservative surface voxelization, fast path (parallel over z-slabs),
 /// into sparse brick storage (`.to_dense()` for a dense grid).
 pub fn cover(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBits, Report) {
-    let (tris, prepare_stats) = prepare(mesh, grid);
-    let (bits, voxels) = run_slabs(&CoverKernel { traversal: opts.traversal }, &tris, grid.dims(), opts);
-    (bits, Report { prepare: prepare_stats, voxels })
+    run_mesh(&CoverKernel { traversal: opts.traversal }, mesh, grid, opts)
 }
 
 /// The fast path on already prepared triangles.
@@ -150,6 +148,9 @@ impl Kernel<LatticeTriangle> for CoverKernel {
 /// use it to enumerate candidates.
 pub(crate) fn cover_triangle<O: Sink>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], traversal: Traversal, out: &mut O) {
     let (blo, bhi) = tri.bounds();
+    if traversal == Traversal::Auto && small_triangle(tri, (blo, bhi), lo, hi, out) {
+        return;
+    }
     let extent = (0..3).map(|a| bhi[a] - blo[a]).max().unwrap_or(0);
     if extent + 2 * ONE <= I64_PLANE_LIMIT {
         let s = Setup::<i64>::new(tri, lo);
@@ -170,6 +171,113 @@ pub(crate) fn cover_triangle<O: Sink>(tri: &LatticeTriangle, lo: [i64; 3], hi: [
         }
     } else {
         dispatch::<i128, O, false>(&Setup::new(tri, lo), lo, hi, out);
+    }
+}
+
+/// The short paths of [`cover_triangle`] for triangles whose own voxel
+/// span (unclamped) is a single voxel on at least one axis; returns `false`
+/// for the others, which take the general traversal.
+///
+/// - One voxel on two or three axes: every point of the triangle lies
+///   strictly inside those voxels' slabs, and the triangle (connected)
+///   projects onto the remaining axis as its whole span, so every voxel of
+///   the box is met: the box is emitted as one run, with no test.
+/// - One voxel on one axis `r`: every point lies strictly inside that slab,
+///   so voxel `(p, q, r)` is met iff the projection onto the `(p, q)` plane
+///   meets its square: the three projected edge functions (the separating
+///   axis test in 2D; the square's own axes hold inside the span).
+#[inline(always)]
+fn small_triangle<O: Sink>(tri: &LatticeTriangle, (blo, bhi): ([i64; 3], [i64; 3]), lo: [i64; 3], hi: [i64; 3], out: &mut O) -> bool {
+    let span: [(i64, i64); 3] = std::array::from_fn(|a| crate::geom::fixed::voxel_span(blo[a], bhi[a]));
+    let single: [bool; 3] = std::array::from_fn(|a| span[a].0 == span[a].1);
+    match single.iter().filter(|&&b| b).count() {
+        3 => out.set(lo[0] as u32, lo[1] as u32, lo[2] as u32),
+        2 => {
+            let a = (0..3).find(|&a| !single[a]).unwrap_or(0);
+            out.set_run(a, lo.map(|c| c as u32), (hi[a] - lo[a] + 1) as u32);
+        }
+        1 => {
+            let r = (0..3).find(|&a| single[a]).unwrap_or(0);
+            let (p, q) = ((r + 1) % 3, (r + 2) % 3);
+            let n = tri.normal();
+            let e = edges_2d(tri, p, q, if n[r] >= 0 { 1 } else { -1 });
+            let mut ijk = [0u32; 3];
+            ijk[r] = lo[r] as u32;
+            for iq in lo[q]..=hi[q] {
+                let row: [i64; 3] = std::array::from_fn(|i| e[i].b * iq + e[i].c);
+                for ip in lo[p]..=hi[p] {
+                    if (e[0].a * ip + row[0]) | (e[1].a * ip + row[1]) | (e[2].a * ip + row[2]) >= 0 {
+                        ijk[p] = ip as u32;
+                        ijk[q] = iq as u32;
+                        out.set(ijk[0], ijk[1], ijk[2]);
+                    }
+                }
+            }
+        }
+        _ if (0..3).all(|a| span[a].1 - span[a].0 < TINY) => {
+            tiny_box(tri, span.map(|s| s.0), span.map(|s| (s.1 - s.0 + 1) as usize), lo, hi, out)
+        }
+        _ => return false,
+    }
+    true
+}
+
+/// Largest voxel span per axis that [`tiny_box`] takes.
+const TINY: i64 = 4;
+
+/// The full separating axis test for a triangle whose voxel span is at
+/// most [`TINY`] voxels on every axis, in small integers relative to the
+/// span's low corner: the three projections' edge tests are evaluated once
+/// per square of each face of the span (a bit mask per projection), the
+/// plane test once per voxel, and a voxel is set iff its three squares and
+/// its plane test pass. The box axes hold inside the span; these are the
+/// other ten axes, so this is the definition, not an approximation. Only
+/// voxels of `[lo, hi]` are emitted.
+#[inline(never)]
+fn tiny_box<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], n: [usize; 3], lo: [i64; 3], hi: [i64; 3], out: &mut O) {
+    let rel = LatticeTriangle { v: tri.v.map(|p| std::array::from_fn(|a| p[a] - base[a] * ONE)) };
+    let nrm = rel.normal();
+    // mask[r] bit (ip * TINY + iq): the square (ip, iq) of the projection
+    // along r, on axes p = r + 1, q = r + 2, passes its three edge tests.
+    let mut mask = [0u32; 3];
+    for r in 0..3 {
+        let (p, q) = ((r + 1) % 3, (r + 2) % 3);
+        let e = edges_2d(&rel, p, q, if nrm[r] >= 0 { 1 } else { -1 });
+        for ip in 0..n[p] as i64 {
+            for iq in 0..n[q] as i64 {
+                if (e[0].a * ip + e[0].b * iq + e[0].c) | (e[1].a * ip + e[1].b * iq + e[1].c) | (e[2].a * ip + e[2].b * iq + e[2].c) >= 0 {
+                    mask[r] |= 1 << (ip * TINY + iq);
+                }
+            }
+        }
+    }
+    // Plane values at each voxel's lowest and highest corners along n.
+    let n0 = nrm[0] * rel.v[0][0] + nrm[1] * rel.v[0][1] + nrm[2] * rel.v[0][2];
+    let (mut dmin, mut dmax) = (-n0, -n0);
+    for c in nrm {
+        if c < 0 {
+            dmin += c * ONE;
+        } else {
+            dmax += c * ONE;
+        }
+    }
+    let bit = |r: usize, ip: usize, iq: usize| (mask[r] >> (ip as i64 * TINY + iq as i64)) & 1 == 1;
+    for k in 0..n[2] {
+        for j in 0..n[1] {
+            for i in 0..n[0] {
+                // Projections: along x (y, z), along y (z, x), along z (x, y).
+                if !(bit(2, i, j) && bit(0, j, k) && bit(1, k, i)) {
+                    continue;
+                }
+                let g = (nrm[0] * i as i64 + nrm[1] * j as i64 + nrm[2] * k as i64) * ONE;
+                if g + dmin <= 0 && g + dmax >= 0 {
+                    let (gi, gj, gk) = (base[0] + i as i64, base[1] + j as i64, base[2] + k as i64);
+                    if gi >= lo[0] && gi <= hi[0] && gj >= lo[1] && gj <= hi[1] && gk >= lo[2] && gk <= hi[2] {
+                        out.set(gi as u32, gj as u32, gk as u32);
+                    }
+                }
+            }
+        }
     }
 }
 

@@ -10,9 +10,105 @@
 
 use rayon::prelude::*;
 
-use super::Options;
-use crate::geom::lattice::LatticeTriangle;
+use super::{Options, Report};
+use crate::geom::lattice::{prepare, LatticeTriangle, PrepareStats, SnappedMesh};
 use crate::grid::bricks::{BrickBits, BrickSlab, BRICK};
+use crate::grid::spec::GridSpec;
+use crate::mesh::MeshRef;
+
+/// Which parallel driver runs a mode's fast path. Every choice gives the
+/// same voxels; the choice exists so tests can pin each driver and
+/// benchmarks can compare them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Driver {
+    /// [`Driver::Triangles`] on grids of at most [`TRIANGLES_MAX_BRICKS`]
+    /// bricks, [`Driver::Slabs`] on larger ones (default).
+    #[default]
+    Auto,
+    /// Prepare every triangle, bin them into z-slabs, one task per slab
+    /// ([`run_slabs`]).
+    Slabs,
+    /// Contiguous ranges of triangles in parallel, each prepared and
+    /// voxelized as it is read into a whole-grid brick set of its own; the
+    /// sets are merged by union ([`run_triangles`]). Chosen explicitly, it
+    /// gives every thread a part however few triangles there are (so tests
+    /// exercise the union on small meshes).
+    Triangles,
+}
+
+/// Largest grid (in 8³ bricks: 2^15 is 256³ voxels) on which
+/// [`Driver::Auto`] runs triangles in parallel. On such grids a per-thread
+/// whole-grid brick index is small and its union costs little, and
+/// skipping the stored triangle list and the slab binning is what makes
+/// small grids fast; on larger ones slabs keep each thread's bricks in its
+/// own cache.
+pub const TRIANGLES_MAX_BRICKS: u64 = 1 << 15;
+
+/// Runs `kernel` over the triangles of `mesh` on `grid` with the driver
+/// `opts.driver` asks for.
+pub fn run_mesh<K: Kernel<LatticeTriangle>>(kernel: &K, mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBits, Report) {
+    let bricks: u64 = grid.dims().iter().map(|&d| d.div_ceil(BRICK) as u64).product();
+    let triangles = match opts.driver {
+        Driver::Auto => bricks <= TRIANGLES_MAX_BRICKS,
+        Driver::Slabs => false,
+        Driver::Triangles => true,
+    };
+    if triangles {
+        run_triangles(kernel, mesh, grid, opts)
+    } else {
+        let (tris, prepare) = prepare(mesh, grid);
+        let (bits, voxels) = run_slabs(kernel, &tris, grid.dims(), opts);
+        (bits, Report { prepare, voxels })
+    }
+}
+
+/// Fewest triangles worth a part of their own in [`run_triangles`].
+const MIN_PART: usize = 8192;
+
+/// The triangle-parallel driver: the mesh's vertices are snapped once,
+/// then each of up to one part per thread takes a contiguous range of
+/// triangles, prepares each as it reads it (exactly as [`prepare`] does)
+/// and runs `kernel` on it over the whole grid, into a brick set of its
+/// own. The parts are merged by [`BrickBits::union_canonical`], so the
+/// result does not depend on the number of parts.
+pub fn run_triangles<K: Kernel<LatticeTriangle>>(
+    kernel: &K,
+    mesh: MeshRef<'_>,
+    grid: &GridSpec,
+    opts: &Options<'_>,
+) -> (BrickBits, Report) {
+    let snapped = SnappedMesh::new(mesh, grid);
+    let dims = grid.dims();
+    let n = mesh.triangles.len();
+    let min_part = if opts.driver == Driver::Triangles { 1 } else { MIN_PART };
+    let parts = rayon::current_num_threads().min(n.div_ceil(min_part)).max(1);
+    if let Some(p) = opts.progress {
+        p.set_total(parts as u64);
+    }
+    let done: Vec<(BrickBits, PrepareStats)> = (0..parts)
+        .into_par_iter()
+        .map(|part| {
+            let mut bits = BrickBits::new(dims);
+            let mut st = PrepareStats::default();
+            let layers = bits.brick_dims()[2];
+            let mut slabs = bits.slabs_mut(layers);
+            let mut slab = slabs.pop().expect("one slab holds the whole grid");
+            for tri in &mesh.triangles[part * n / parts..(part + 1) * n / parts] {
+                snapped.triangle(tri, &mut st, |t, lo, hi| kernel.run(t, lo, hi, &mut slab));
+            }
+            let pool = slab.into_pool();
+            bits.merge_slabs(vec![pool]);
+            if let Some(p) = opts.progress {
+                p.advance(1);
+            }
+            (bits, st)
+        })
+        .collect();
+    let prepare = done.iter().fold(PrepareStats::default(), |a, d| a.merge(d.1));
+    let grids: Vec<BrickBits> = done.into_iter().map(|d| d.0).collect();
+    let (bits, voxels) = BrickBits::union_canonical(&grids);
+    (bits, Report { prepare, voxels })
+}
 
 /// An input primitive on the lattice: it knows which voxels it may touch.
 pub trait Primitive: Sync {

@@ -163,6 +163,9 @@ pub struct Options<'a> {
     /// Traversal of the fast `cover` path. Default: [`Traversal::Auto`].
     /// The result does not depend on it.
     pub traversal: Traversal,
+    /// Parallel driver of the fast paths. Default: [`driver::Driver::Auto`].
+    /// The result does not depend on it.
+    pub driver: driver::Driver,
 }
 
 /// What a voxelization did.

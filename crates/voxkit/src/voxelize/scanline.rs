@@ -48,11 +48,11 @@
 //! tests compare voxel for voxel.
 
 use super::cover::{cover_triangle_runs, div_floor, edges_2d, run, set};
-use super::driver::{run_slabs, Filter, Kernel, Sink};
+use super::driver::{run_mesh, Filter, Kernel, Sink};
 use super::targets::{fits_i64, DirSetup, TriSetup, CROSSHAIR, DIAGONALS};
 use super::{Mode, Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
-use crate::geom::lattice::{prepare, LatticeTriangle};
+use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::P3;
 use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
@@ -69,9 +69,7 @@ pub fn scanline(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'
     if !supports(mode) {
         return None;
     }
-    let (tris, prepare_stats) = prepare(mesh, grid);
-    let (bits, voxels) = run_slabs(&ScanKernel { mode }, &tris, grid.dims(), opts);
-    Some((bits, Report { prepare: prepare_stats, voxels }))
+    Some(run_mesh(&ScanKernel { mode }, mesh, grid, opts))
 }
 
 /// Whether the scanline path is expected to beat the triangle-box fast path

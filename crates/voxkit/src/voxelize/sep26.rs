@@ -21,11 +21,11 @@
 //! **Reference:** [`reference::sep26`], the definition evaluated with the
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
-use super::driver::{run_slabs, Kernel};
+use super::driver::{run_mesh, run_slabs, Kernel};
 use super::targets::{dominant_axes, fits_i64, PixelTest, TriSetup, DIAGONALS};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
-use crate::geom::lattice::{prepare, LatticeTriangle};
+use crate::geom::lattice::LatticeTriangle;
 use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
@@ -34,9 +34,7 @@ const H: i64 = ONE / 2;
 
 /// 26-separating voxelization, fast path, into sparse brick storage.
 pub fn sep26(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBits, Report) {
-    let (tris, prepare_stats) = prepare(mesh, grid);
-    let (bits, voxels) = run_slabs(&Sep26Kernel, &tris, grid.dims(), opts);
-    (bits, Report { prepare: prepare_stats, voxels })
+    run_mesh(&Sep26Kernel, mesh, grid, opts)
 }
 
 /// The fast path on already prepared triangles (the GPU path hands it the

@@ -31,11 +31,11 @@
 //! triangle's bounding box.
 
 use super::cover::cover_triangle;
-use super::driver::{run_slabs, Filter, Kernel};
+use super::driver::{run_mesh, Filter, Kernel};
 use super::targets::fits_i64;
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
-use crate::geom::lattice::{prepare, LatticeTriangle};
+use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::bias;
 use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
@@ -45,9 +45,7 @@ const H: i64 = ONE / 2;
 
 /// Schwarz–Seidel 6-separating voxelization, fast path, into sparse bricks.
 pub fn ss6(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBits, Report) {
-    let (tris, prepare_stats) = prepare(mesh, grid);
-    let (bits, voxels) = run_slabs(&Ss6Kernel { traversal: opts.traversal }, &tris, grid.dims(), opts);
-    (bits, Report { prepare: prepare_stats, voxels })
+    run_mesh(&Ss6Kernel { traversal: opts.traversal }, mesh, grid, opts)
 }
 
 struct Ss6Kernel {
