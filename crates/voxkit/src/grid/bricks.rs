@@ -154,7 +154,7 @@ impl BrickBits {
             .map(|(n, index)| {
                 let bk0 = n as u32 * h;
                 let k0 = bk0 * BRICK;
-                SlabView { k0, k1: ((bk0 + h) * BRICK).min(nz), bk0, bx, by, index, pool: Vec::new(), last: (usize::MAX, 0) }
+                SlabView { k0, k1: ((bk0 + h) * BRICK).min(nz), bk0, bx, by, index, pool: Vec::new(), last: (u64::MAX, 0) }
             })
             .collect()
     }
@@ -319,8 +319,17 @@ pub struct SlabView<'a> {
     by: u32,
     index: &'a mut [u32],
     pool: Vec<Brick>,
-    /// The brick-index entry and pool slot of the last voxel set.
-    last: (usize, usize),
+    /// The brick coordinates (packed by [`brick_key`]) and pool slot of
+    /// the last voxel set: consecutive voxels mostly share a brick, and the
+    /// key costs shifts where the index entry costs multiplications.
+    last: (u64, usize),
+}
+
+/// The brick coordinates of voxel `(i, j, k)` packed into one word
+/// (`i >> 3` in bits 0–20, `j >> 3` in 21–41, `k >> 3` in 42–62).
+#[inline(always)]
+fn brick_key(i: u32, j: u32, k: u32) -> u64 {
+    (i >> SHIFT) as u64 | ((j >> SHIFT) as u64) << 21 | ((k >> SHIFT) as u64) << 42
 }
 
 /// The slab type handed to kernels.
@@ -331,8 +340,7 @@ impl SlabView<'_> {
     #[inline(always)]
     pub fn set(&mut self, i: u32, j: u32, k: u32) {
         debug_assert!(k >= self.k0 && k < self.k1);
-        let b = (((k >> SHIFT) - self.bk0) as usize * self.by as usize + (j >> SHIFT) as usize) * self.bx as usize + (i >> SHIFT) as usize;
-        let slot = self.slot(b);
+        let slot = self.slot(i, j, k);
         self.pool[slot][(k & 7) as usize] |= 1u64 << (((j & 7) << 3) | (i & 7));
     }
 
@@ -346,9 +354,7 @@ impl SlabView<'_> {
         while p[axis] < end {
             let at = p[axis] & 7;
             let n = (8 - at).min(end - p[axis]);
-            let b = (((p[2] >> SHIFT) - self.bk0) as usize * self.by as usize + (p[1] >> SHIFT) as usize) * self.bx as usize
-                + (p[0] >> SHIFT) as usize;
-            let slot = self.slot(b);
+            let slot = self.slot(p[0], p[1], p[2]);
             let ones = (1u64 << n) - 1;
             let brick = &mut self.pool[slot];
             match axis {
@@ -369,19 +375,27 @@ impl SlabView<'_> {
         }
     }
 
-    /// The pool slot of brick-index entry `b`, allocating it if needed.
+    /// The pool slot of the brick holding voxel `(i, j, k)`, allocating it
+    /// if needed.
     #[inline(always)]
-    fn slot(&mut self, b: usize) -> usize {
-        if self.last.0 == b {
+    fn slot(&mut self, i: u32, j: u32, k: u32) -> usize {
+        let key = brick_key(i, j, k);
+        if self.last.0 == key {
             return self.last.1;
         }
+        self.slot_miss(i, j, k, key)
+    }
+
+    #[inline(never)]
+    fn slot_miss(&mut self, i: u32, j: u32, k: u32, key: u64) -> usize {
+        let b = (((k >> SHIFT) - self.bk0) as usize * self.by as usize + (j >> SHIFT) as usize) * self.bx as usize + (i >> SHIFT) as usize;
         let mut id = self.index[b];
         if id == 0 {
             self.pool.push([0; 8]);
             id = self.pool.len() as u32;
             self.index[b] = id;
         }
-        self.last = (b, id as usize - 1);
+        self.last = (key, id as usize - 1);
         id as usize - 1
     }
 

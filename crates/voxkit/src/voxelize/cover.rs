@@ -428,12 +428,32 @@ impl<T: PlaneInt> PlaneRange<T> {
         r
     }
 
-    /// Moves to the next column along `u`.
+    /// Moves to the next column along `u`. Since `|n_u| <= n_w`, each end
+    /// of the range moves by at most one: one conditional step each way,
+    /// without loops.
     #[inline(always)]
     fn next_column(&mut self, nu: T, nw: T) {
-        self.g0 = self.g0 + nu;
-        self.g1 = self.g1 + nu;
-        self.correct(nw);
+        let (g0, g1) = (self.g0 + nu, self.g1 + nu);
+        // g0 was in [0, n_w): now in [-n_w, 2 n_w).
+        let (down, up) = (g0 >= nw, g0 < T::ZERO);
+        self.t0 += up as i64 - down as i64;
+        self.g0 = if down {
+            g0 - nw
+        } else if up {
+            g0 + nw
+        } else {
+            g0
+        };
+        // g1 was in (-n_w, 0]: now in (-2 n_w, n_w].
+        let (up, down) = (g1 <= -nw, g1 > T::ZERO);
+        self.t1 += up as i64 - down as i64;
+        self.g1 = if up {
+            g1 + nw
+        } else if down {
+            g1 - nw
+        } else {
+            g1
+        };
     }
 
     #[inline(always)]

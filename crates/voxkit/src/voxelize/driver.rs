@@ -36,13 +36,13 @@ pub enum Driver {
     Triangles,
 }
 
-/// Largest grid (in 8³ bricks: 2^15 is 256³ voxels) on which
+/// Largest grid (in 8³ bricks: 2^18 is 512³ voxels) on which
 /// [`Driver::Auto`] runs triangles in parallel. On such grids a per-thread
 /// whole-grid brick index is small and its union costs little, and
 /// skipping the stored triangle list and the slab binning is what makes
 /// small grids fast; on larger ones slabs keep each thread's bricks in its
 /// own cache.
-pub const TRIANGLES_MAX_BRICKS: u64 = 1 << 15;
+pub const TRIANGLES_MAX_BRICKS: u64 = 1 << 18;
 
 /// Runs `kernel` over the triangles of `mesh` on `grid` with the driver
 /// `opts.driver` asks for.
