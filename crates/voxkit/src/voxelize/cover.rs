@@ -86,7 +86,7 @@ const I64_PLANE_LIMIT: i64 = 1 << 19;
 /// `origin` (the low corner of the box being traversed), which keeps them
 /// small enough for `i64` on all but huge triangles.
 #[derive(Clone, Copy, Debug)]
-struct Setup<T> {
+pub(crate) struct Setup<T> {
     w: usize,
     uv: [Edge2; 3],
     vw: [Edge2; 3],
@@ -103,7 +103,7 @@ struct Setup<T> {
 }
 
 impl<T: PlaneInt> Setup<T> {
-    fn new(tri: &LatticeTriangle, origin: [i64; 3]) -> Setup<T> {
+    pub(crate) fn new(tri: &LatticeTriangle, origin: [i64; 3]) -> Setup<T> {
         let n = tri.normal();
         let w = (0..3).fold(0, |best, a| if n[a].abs() > n[best].abs() { a } else { best });
         let (u, v) = ((w + 1) % 3, (w + 2) % 3);
@@ -129,6 +129,27 @@ impl<T: PlaneInt> Setup<T> {
         let (tlo, thi) = tri.bounds();
         let span_w = crate::geom::fixed::voxel_span(tlo[w], thi[w]);
         Setup { w, uv, vw, wu, origin, n: n_idx, d_min, d_max, inv_nw: 1.0 / n_idx[w].to_f64(), span_w }
+    }
+}
+
+impl<T: PlaneInt> Setup<T> {
+    /// The dominant axis `w` (`(u, v, w)` cyclic).
+    pub(crate) fn w(&self) -> usize {
+        self.w
+    }
+
+    /// `n_u` and `n_w` scaled as [`PlaneRange`] steps them.
+    pub(crate) fn steps(&self) -> (T, T) {
+        (self.n[(self.w + 1) % 3], self.n[self.w])
+    }
+
+    /// Moves the plane range's thresholds: afterwards [`PlaneRange`] gives
+    /// the voxels whose corners' highest plane value (relative to the
+    /// first vertex, with `n` oriented so `n_w > 0`) is `>= hi` and lowest
+    /// `<= lo`, instead of `>= 0` and `<= 0`.
+    pub(crate) fn shift_plane(&mut self, hi: T, lo: T) {
+        self.d_max = self.d_max - hi;
+        self.d_min = self.d_min - lo;
     }
 }
 
@@ -403,9 +424,9 @@ fn clip3(w: &[Walker; 3], mut lo: i64, mut hi: i64) -> (i64, i64) {
 /// by `n_u`, and the range by at most one since `|n_u| <= n_w`, so the
 /// correction loops run a step or two: additions and comparisons only.
 #[derive(Clone, Copy)]
-struct PlaneRange<T> {
-    t0: i64,
-    t1: i64,
+pub(crate) struct PlaneRange<T> {
+    pub(crate) t0: i64,
+    pub(crate) t1: i64,
     g0: T,
     g1: T,
 }
@@ -414,7 +435,7 @@ impl<T: PlaneInt> PlaneRange<T> {
     /// The range at column `(iu, iv)`: an f64 estimate (clamped to the
     /// triangle's span) made exact by the correction loops.
     #[inline(always)]
-    fn at<const W: usize>(s: &Setup<T>, iu: i64, iv: i64) -> PlaneRange<T> {
+    pub(crate) fn at<const W: usize>(s: &Setup<T>, iu: i64, iv: i64) -> PlaneRange<T> {
         let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
         let o = s.origin;
         let est = |x: f64| x.clamp((s.span_w.0 - 1) as f64, (s.span_w.1 + 1) as f64) as i64;
@@ -432,7 +453,7 @@ impl<T: PlaneInt> PlaneRange<T> {
     /// of the range moves by at most one: one conditional step each way,
     /// without loops.
     #[inline(always)]
-    fn next_column(&mut self, nu: T, nw: T) {
+    pub(crate) fn next_column(&mut self, nu: T, nw: T) {
         let (g0, g1) = (self.g0 + nu, self.g1 + nu);
         // g0 was in [0, n_w): now in [-n_w, 2 n_w).
         let (down, up) = (g0 >= nw, g0 < T::ZERO);

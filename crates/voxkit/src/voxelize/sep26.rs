@@ -21,6 +21,7 @@
 //! **Reference:** [`reference::sep26`], the definition evaluated with the
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
+use super::cover::{PlaneRange, Setup as CoverSetup};
 use super::driver::{run_mesh, run_slabs, Kernel};
 use super::targets::{dominant_axes, fits_i64, PixelTest, TriSetup, DIAGONALS};
 use super::{Options, Report};
@@ -56,33 +57,39 @@ impl Kernel<LatticeTriangle> for Sep26Kernel {
 }
 
 /// One triangle, restricted to the voxel box `[lo, hi]`: the columns of
-/// the dominant-axis projection whose pixel meets the projected triangle,
-/// the few voxels of each around the plane's depth, a corner-sign test,
-/// then the diagonal tests for the edges the pixel is not strictly inside.
+/// the dominant-axis projection whose pixel meets the projected triangle;
+/// in each, exactly the voxels whose corners straddle the displaced plane
+/// (tracked along the row by `cover`'s exact plane range, with its
+/// thresholds moved by the perturbation's bias); then the diagonal tests
+/// for the edges the pixel is not strictly inside.
 fn project<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+    match dominant_axes(tri).2 {
+        0 => project_w::<T, 0>(tri, lo, hi, slab),
+        1 => project_w::<T, 1>(tri, lo, hi, slab),
+        _ => project_w::<T, 2>(tri, lo, hi, slab),
+    }
+}
+
+#[inline(always)]
+fn project_w<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     let s = TriSetup::<T>::new(tri);
     let dirs = DIAGONALS.map(|(o, d)| {
         let o = o.map(T::from_i64);
         (o, s.plane(o), s.dir(tri, d))
     });
-    // Plane values of a voxel's corners span [vc + vlo, vc + vhi], vc at
-    // its low corner.
-    let (mut vlo, mut vhi) = (T::ZERO, T::ZERO);
-    for c in s.n {
-        let x = c * T::from_i64(ONE);
-        if x < T::ZERO {
-            vlo = vlo + x;
-        } else {
-            vhi = vhi + x;
-        }
-    }
-    let n = tri.normal();
-    let (u, v, w) = dominant_axes(tri);
+    let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
+    debug_assert_eq!(dominant_axes(tri), (u, v, w));
     let pix = PixelTest::new(&s, tri, (u, v, w));
-    let step_w = s.n[w] * T::from_i64(ONE);
-    let (nu, nv) = (T::from_i64(n[u]), T::from_i64(n[v]));
-    let inv_nw = 1.0 / n[w] as f64;
-    let one = T::from_i64(ONE);
+    // Some corner's displaced copy is on each side of the plane: with n
+    // oriented so n_w > 0 (`flip`), the corners' values relative to the
+    // first vertex reach `>= hi` and `<= lo` (the bias is 0 or 1).
+    let n = tri.normal();
+    let bn = s.bn;
+    let (shift_hi, shift_lo) = if n[w] > 0 { (bn, bn - T::from_i64(1)) } else { (T::from_i64(1) - bn, -bn) };
+    let mut range = CoverSetup::<T>::new(tri, lo);
+    debug_assert_eq!(range.w(), w);
+    range.shift_plane(shift_hi, shift_lo);
+    let (nu, nw) = range.steps();
     // Edge values of the w-line are affine in the pixel centre: step them along u.
     let mut c0 = s.a;
     (c0[u], c0[v]) = (lo[u] * ONE + H, lo[v] * ONE + H);
@@ -93,56 +100,41 @@ fn project<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab:
     for iv in lo[v]..=hi[v] {
         let mut c = s.a;
         (c[u], c[v]) = (lo[u] * ONE + H, iv * ONE + H);
-        let mut pc = s.local(c);
-        let mut o = s.line_values(&pix.dw, pc);
-        for iu in lo[u]..=hi[u] {
-            if iu > lo[u] {
-                pc[u] = pc[u] + one;
-                for i in 0..3 {
-                    o[i] = o[i] + step[i];
+        let mut o = s.line_values(&pix.dw, s.local(c));
+        let mut plane = PlaneRange::at::<W>(&range, lo[u], iv);
+        let mut iu = lo[u];
+        loop {
+            let (ta, tb) = (plane.t0.max(lo[w]), plane.t1.min(hi[w]));
+            if ta <= tb && !pix.misses(&o) {
+                // Edges the pixel lies strictly inside of: a diagonal's
+                // crossing with the plane lies in the voxel, so projects into
+                // the pixel, and those edges' tests are known to pass.
+                let safe = pix.strictly_inside_edges(&o);
+                for t in ta..=tb {
+                    // The corners straddle the plane, so some opposite pair does
+                    // (opposite corners average to the centre's value).
+                    let hit = safe == [true; 3] || {
+                        let mut corner = [0i64; 3];
+                        (corner[u], corner[v], corner[w]) = (iu * ONE, iv * ONE, t * ONE);
+                        let p = s.local(corner);
+                        let vc = s.plane(p);
+                        dirs.iter()
+                            .any(|(o, vo, ds)| s.segment_hits_unsafe_edges(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]], vc + *vo, safe))
+                    };
+                    if hit {
+                        let mut ijk = [0u32; 3];
+                        (ijk[u], ijk[v], ijk[w]) = (iu as u32, iv as u32, t as u32);
+                        slab.set(ijk[0], ijk[1], ijk[2]);
+                    }
                 }
             }
-            if pix.misses(&o) {
-                continue;
+            if iu == hi[u] {
+                break;
             }
-            // Edges the pixel lies strictly inside of: a diagonal's crossing
-            // with the plane lies in the voxel, so projects into the pixel,
-            // and those edges' tests are known to pass.
-            let safe = pix.strictly_inside_edges(&o);
-            // Over the pixel the plane's depth moves by at most one voxel
-            // from the centre's (|n_u|, |n_v| <= |n_w|); the f64 estimate
-            // (truncated) is within two lattice units of it. The corner test
-            // is exact.
-            let depth = s.a[w] - ((nu * pc[u] + nv * pc[v]).to_f64() * inv_nw) as i64;
-            let t0 = (depth - ONE - 2).div_euclid(ONE).max(lo[w]);
-            let t1 = (depth + ONE + 2).div_euclid(ONE).min(hi[w]);
-            if t0 > t1 {
-                continue;
-            }
-            let mut corner = [0i64; 3];
-            (corner[u], corner[v], corner[w]) = (iu * ONE, iv * ONE, t0 * ONE);
-            let mut p = s.local(corner);
-            let mut vc = s.plane(p);
-            for t in t0..=t1 {
-                if t > t0 {
-                    vc = vc + step_w;
-                    p[w] = p[w] + T::from_i64(ONE);
-                }
-                // Corners all on one side: no diagonal straddles the plane.
-                if vc + vlo >= s.bn || vc + vhi < s.bn {
-                    continue;
-                }
-                // Otherwise some opposite pair straddles (opposite corners
-                // average to the centre's value).
-                let hit = safe == [true; 3]
-                    || dirs
-                        .iter()
-                        .any(|(o, vo, ds)| s.segment_hits_unsafe_edges(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]], vc + *vo, safe));
-                if hit {
-                    let mut ijk = [0u32; 3];
-                    (ijk[u], ijk[v], ijk[w]) = (iu as u32, iv as u32, t as u32);
-                    slab.set(ijk[0], ijk[1], ijk[2]);
-                }
+            iu += 1;
+            plane.next_column(nu, nw);
+            for i in 0..3 {
+                o[i] = o[i] + step[i];
             }
         }
     }
