@@ -93,3 +93,37 @@ fn tri_box(c: V, t: [V; 3]) -> bool {
     let r = H * (n[0].abs() + n[1].abs() + n[2].abs());
     d.abs() <= r
 }
+
+/// What the brute-force program would load an OBJ with: one serial pass
+/// over the lines, `v` records (three numbers) and `f` records (the vertex
+/// index of each corner, 1-based, fanned); everything else skipped, no
+/// validation. `None` if the file is unreadable or not an OBJ.
+pub fn load_obj(path: &std::path::Path) -> Option<voxkit::Mesh> {
+    if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
+        return None;
+    }
+    let text = std::fs::read(path).ok()?;
+    let mut m = voxkit::Mesh::default();
+    let mut corners = Vec::new();
+    for line in text.split(|&b| b == b'\n') {
+        let mut w = line.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty());
+        match w.next() {
+            Some(b"v") => {
+                let mut c = [0.0; 3];
+                for x in &mut c {
+                    *x = w.next().and_then(|s| std::str::from_utf8(s).ok()?.parse().ok()).unwrap_or(0.0);
+                }
+                m.positions.push(glam::DVec3::from_array(c));
+            }
+            Some(b"f") => {
+                corners.clear();
+                corners.extend(w.filter_map(|s| std::str::from_utf8(s.split(|&b| b == b'/').next()?).ok()?.parse::<u32>().ok()));
+                for k in 1..corners.len().saturating_sub(1) {
+                    m.triangles.push([corners[0] - 1, corners[k] - 1, corners[k + 1] - 1]);
+                }
+            }
+            _ => {}
+        }
+    }
+    Some(m)
+}
