@@ -82,9 +82,9 @@ fn tri_box(c: V, t: [V; 3]) -> bool {
             }
         }
     }
-    for a in 0..3 {
-        let (mn, mx) = (v[0][a].min(v[1][a]).min(v[2][a]), v[0][a].max(v[1][a]).max(v[2][a]));
-        if mn > H || mx < -H {
+    let [a, b, c] = v;
+    for ((x, y), z) in a.iter().zip(&b).zip(&c) {
+        if x.min(*y).min(*z) > H || x.max(*y).max(*z) < -H {
             return false;
         }
     }

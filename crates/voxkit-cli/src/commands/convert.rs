@@ -6,16 +6,15 @@ use voxkit::glam::DVec3;
 use voxkit::GridSpec;
 
 use crate::args::ConvertArgs;
-use crate::plan;
 
 pub fn run(a: &ConvertArgs) -> Result<()> {
-    let format = plan::output_format(a.format.as_deref(), &a.output)?;
-    crate::commands::voxelize::check_output_dir(&a.output)?;
+    let format = voxkit_job::output::output_format(a.format.as_deref(), &a.output)?;
+    voxkit_job::output::check_output_path(&a.output)?;
     let write_opts = crate::commands::export::writer_options(&a.export)?;
     let loaded = voxkit_io::read_voxels(&a.input)?;
     let dims = loaded.bits.dims();
     let (grid, source) = placement(a, &loaded)?;
-    let facts = crate::commands::export::write(&a.output, format, &loaded.bits, &grid, loaded.attributes.as_ref(), &write_opts)?;
+    let facts = voxkit_job::output::write(&a.output, format, &loaded.bits, &grid, loaded.attributes.as_ref(), &write_opts)?;
     let voxels = loaded.bits.count();
     if a.json {
         let o = grid.origin();

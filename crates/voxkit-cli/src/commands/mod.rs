@@ -8,5 +8,4 @@ pub mod export;
 pub mod gaps;
 pub mod info;
 pub mod render;
-pub mod solid;
 pub mod voxelize;

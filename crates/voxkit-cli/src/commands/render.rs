@@ -14,7 +14,7 @@ use voxkit::voxelize::{self, Options};
 use voxkit::{BrickBits, VoxelSource};
 
 use crate::args::{PictureArgs, RenderArgs};
-use crate::plan::{self, GridRequest};
+use crate::plan;
 
 /// Largest picture side and pixel count accepted.
 const MAX_SIDE: u32 = 16_384;
@@ -80,7 +80,7 @@ pub fn check_png_path(path: &Path) -> Result<()> {
     if path.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("png")) != Some(true) {
         bail!("{}: pictures are written as PNG; give a .png file name", path.display());
     }
-    crate::commands::voxelize::check_output_dir(path)
+    Ok(voxkit_job::output::check_output_path(path)?)
 }
 
 pub fn run(a: &RenderArgs) -> Result<()> {
@@ -95,10 +95,10 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         let loaded = voxkit_io::read_voxels(&a.input)?;
         (Box::new(loaded.bits), "voxel file", loaded.attributes, None)
     } else {
-        let (mode, _) = plan::resolve_method(a.mode, crate::args::Method::Fast)
+        let (mode, _) = voxkit_job::resolve_method(a.mode.into(), voxkit_job::Method::Fast)
             .context("render voxelizes meshes with a surface or line mode; voxelize solids to a file first")?;
         let loaded = voxkit_io::read_mesh(&a.input)?;
-        let grid = GridRequest::from_args(&a.grid)?.fit(&loaded.report.bounds)?;
+        let grid = plan::grid_request(&a.grid)?.fit(&loaded.report.bounds)?;
         plan::check_memory(&grid)?;
         for w in &loaded.warnings {
             eprintln!("voxkit: warning: {}: {w}", a.input.display());

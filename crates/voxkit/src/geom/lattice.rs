@@ -261,7 +261,7 @@ const NON_FINITE: u32 = 1;
 const FAR: u32 = 2;
 const BELOW: u32 = 4;
 const ABOVE: u32 = 32;
-const CULL: u32 = 0b111 * BELOW | 0b111 * ABOVE;
+const CULL: u32 = (0b111 * BELOW) | (0b111 * ABOVE);
 
 /// A mesh whose vertices are snapped to a grid's lattice, once each; its
 /// triangles are then prepared exactly as [`prepare`] defines, without a
@@ -287,7 +287,7 @@ impl<'a> SnappedMesh<'a> {
                 } else {
                     let mut flags = 0;
                     for a in 0..3 {
-                        flags |= (u[a] < -1.0) as u32 * (BELOW << a) | (u[a] > lim[a]) as u32 * (ABOVE << a);
+                        flags |= ((u[a] < -1.0) as u32 * (BELOW << a)) | ((u[a] > lim[a]) as u32 * (ABOVE << a));
                     }
                     if u.abs().max_element() > DIRECT_LIMIT_VOXELS {
                         SnappedVertex { p: [0; 3], flags: flags | FAR }

@@ -1,37 +1,40 @@
-//! The solid modes of `voxkit voxelize`: choosing the method, running it,
-//! and the `solid+surface`, `--fill flood` and `--hollow` variants.
+//! The solid modes: choosing the method, running it, and the
+//! `solid+surface`, `fill flood` and `hollow` variants.
 
-use anyhow::Result;
 use serde_json::{json, Value};
 use voxkit::grid::dense::DenseBits;
 use voxkit::voxelize::{self, fill, solid, winding, Options};
 use voxkit::{GridSpec, MeshRef};
 
+use crate::error::{JobError, Result};
 use crate::plan::{SolidMethod, SolidPlan};
 
 /// A solid and what was done to get it.
 pub struct Outcome {
+    /// The voxels.
     pub bits: DenseBits,
     /// The method that ran.
     pub method: &'static str,
     /// Facts for the summary and JSON.
     pub facts: Value,
+    /// Things the user should know (an open mesh under parity, a leaking shell).
     pub warnings: Vec<String>,
 }
 
 /// Parity on the GPU (the same voxels as `--method parity`).
 #[cfg(feature = "gpu")]
 fn gpu_parity(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, solid::SolidReport)> {
-    let gpu = voxkit_gpu::Gpu::new().map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
-    let (bits, r) = gpu.solid_parity(mesh, grid).map_err(|e| anyhow::anyhow!("--method gpu: {e}"))?;
+    let gpu = voxkit_gpu::Gpu::new().map_err(|e| JobError::failed(format!("--method gpu: {e}")))?;
+    let (bits, r) = gpu.solid_parity(mesh, grid).map_err(|e| JobError::failed(format!("--method gpu: {e}")))?;
     Ok((bits, r.solid))
 }
 
 #[cfg(not(feature = "gpu"))]
 fn gpu_parity(_mesh: MeshRef<'_>, _grid: &GridSpec) -> Result<(DenseBits, solid::SolidReport)> {
-    anyhow::bail!("--method gpu: this voxkit was built without the `gpu` feature")
+    Err(JobError::invalid("--method gpu: this voxkit was built without the `gpu` feature"))
 }
 
+/// Makes the solid `plan` asks for; `name` names the mesh in warnings.
 pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opts: &Options<'_>) -> Result<Outcome> {
     let mut warnings = Vec::new();
     let (mut bits, method, mut facts) = if plan.method == SolidMethod::Flood {
@@ -47,7 +50,7 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         (bits, "flood", json!({"shell": surface.name(), "shell_voxels": rep.shell, "enclosed_voxels": rep.enclosed}))
     } else {
         // Snapped once: the closedness test and whichever method runs share it.
-        let snapped = voxkit::topology::inside::snap_all(mesh, grid)?;
+        let snapped = voxkit::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
         let inspect = solid::inspect(&snapped);
         let dims = grid.dims();
         let watertight = inspect.watertight();
@@ -80,11 +83,11 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
                 (b, r.solid, "winding")
             }
             SolidMethod::Reference if watertight => {
-                let (b, r) = solid::reference::solid(mesh, grid)?;
+                let (b, r) = solid::reference::solid(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
                 (b, r, "reference")
             }
             SolidMethod::Reference => {
-                let b = winding::reference::winding(mesh, grid)?;
+                let b = winding::reference::winding(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
                 let mut r = inspect;
                 r.voxels = b.count();
                 (b, r, "reference")

@@ -1,0 +1,36 @@
+//! # voxkit-job
+//!
+//! A voxelization job as the `voxkit` command line, the Python package and
+//! `voxkit batch` run it, so all three take the same options, fit the same
+//! grids, pick the same paths and produce the same voxels, bit for bit:
+//!
+//! - [`GridOptions`] → [`GridRequest`] (validated before the mesh is read)
+//!   → a [`voxkit::GridSpec`] fitted to the mesh;
+//! - [`Request`] (mode, method, solid options) → [`Plan`] (validated) →
+//!   [`voxelize`] on a mesh → [`Voxelized`] (voxels, grid, the path that
+//!   ran, facts for summaries);
+//! - [`attributes`] carries colours into them; [`output::write`] writes
+//!   any format; [`check::report`] certifies them.
+//!
+//! Errors are one [`JobError`]: bad options ([`JobError::Invalid`]), file
+//! problems naming the file ([`JobError::Io`]), or failures while running.
+
+mod error;
+mod grid;
+mod memory;
+mod plan;
+mod run;
+mod solid;
+
+pub mod check;
+pub mod output;
+
+pub use error::{JobError, Result};
+pub use grid::{GridOptions, GridRequest};
+pub use memory::{available_memory, bytes, check_memory};
+pub use plan::{
+    auto_method, gpu_has, resolve_method, Fill, GpuPath, Method, Mode, Plan, Request, SolidMethod, SolidPlan, SurfaceMethod,
+    GPU_AUTO_MIN_SIDE,
+};
+pub use run::{attributes, voxelize, Voxelized, Voxels};
+pub use solid::Outcome as SolidOutcome;

@@ -1,0 +1,133 @@
+//! Outputs: which format a path names, and writing voxels with their
+//! attributes in it — every voxel format, and the mesh of the voxels
+//! (`.obj`, `.glb`).
+
+use std::path::Path;
+
+use serde_json::{json, Value};
+use voxkit::attributes::{quantize, VoxelAttributes};
+use voxkit::export::greedy::greedy_quads_by_class;
+use voxkit::{DenseBits, GridSpec, VoxelSource};
+use voxkit_io::{VoxelFormat, WriteOptions};
+
+use crate::error::{JobError, Result};
+
+/// What an output file holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// A voxel format.
+    Voxels(VoxelFormat),
+    /// A mesh of the voxels (greedy quads).
+    Mesh(MeshKind),
+}
+
+/// Mesh formats for the voxels' boundary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshKind {
+    /// Wavefront OBJ (+ MTL with colours).
+    Obj,
+    /// Binary glTF.
+    Glb,
+}
+
+impl Output {
+    /// The `--format` name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Output::Voxels(f) => f.name(),
+            Output::Mesh(MeshKind::Obj) => "obj",
+            Output::Mesh(MeshKind::Glb) => "glb",
+        }
+    }
+
+    /// True when the output stores colours.
+    pub fn has_colour(self) -> bool {
+        match self {
+            Output::Voxels(f) => f.has_colour(),
+            Output::Mesh(_) => true,
+        }
+    }
+
+    /// The format called `name` (a voxel format, `obj` or `glb`).
+    pub fn from_name(name: &str) -> Option<Output> {
+        match name.to_ascii_lowercase().as_str() {
+            "obj" => Some(Output::Mesh(MeshKind::Obj)),
+            "glb" => Some(Output::Mesh(MeshKind::Glb)),
+            n => VoxelFormat::from_name(n).map(Output::Voxels),
+        }
+    }
+
+    /// Every output format name, for messages.
+    pub fn names() -> String {
+        format!("{}, obj, glb", VoxelFormat::NAMES)
+    }
+}
+
+/// The output format: `format` if given, else the extension of `output`.
+pub fn output_format(format: Option<&str>, output: &Path) -> Result<Output> {
+    match format {
+        Some(f) => {
+            Output::from_name(f).ok_or_else(|| JobError::invalid(format!("unknown --format {f:?} (expected one of: {})", Output::names())))
+        }
+        None => output.extension().and_then(|e| e.to_str()).and_then(Output::from_name).ok_or_else(|| {
+            JobError::invalid(format!(
+                "{}: cannot tell the output format from the extension (use one of: {}, or --format)",
+                output.display(),
+                Output::names()
+            ))
+        }),
+    }
+}
+
+/// Checks, before any work, that `out` can be created: its folder exists
+/// and it is not a folder itself.
+pub fn check_output_path(out: &Path) -> Result<()> {
+    let dir = match out.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(JobError::invalid(format!("{}: cannot write: directory {} does not exist", out.display(), dir.display())));
+    }
+    if out.is_dir() {
+        return Err(JobError::invalid(format!("{}: cannot write: it is a directory", out.display())));
+    }
+    Ok(())
+}
+
+/// Writes `bits` (with `attrs`) to `out` as `target`; returns facts for
+/// the summaries.
+pub fn write(
+    out: &Path,
+    target: Output,
+    bits: &dyn VoxelSource,
+    grid: &GridSpec,
+    attrs: Option<&VoxelAttributes>,
+    opts: &WriteOptions,
+) -> Result<Value> {
+    match target {
+        Output::Voxels(f) => {
+            voxkit_io::write_voxels_with(out, f, bits, grid, attrs, opts)?;
+            Ok(json!({"colours": attrs.and_then(|a| a.colour.as_ref()).is_some() && f.has_colour()}))
+        }
+        Output::Mesh(kind) => {
+            let mut dense = DenseBits::new(bits.dims());
+            bits.for_each_set(&mut |i, j, k| dense.set(i, j, k));
+            let coloured = attrs.and_then(|a| a.colour.as_ref().map(|c| (a, c)));
+            let (palette, quads) = match coloured {
+                Some((a, colours)) => {
+                    let palette = quantize::palette(colours, 255);
+                    let index = quantize::map_to_palette(colours, &palette);
+                    let class = move |i: u32, j: u32, k: u32| a.slot(i, j, k).map(|s| index[s] as u32 + 1).unwrap_or(0);
+                    (Some(palette), greedy_quads_by_class(&dense, &class))
+                }
+                None => (None, voxkit::export::greedy::greedy_quads(&dense)),
+            };
+            let vertices = match kind {
+                MeshKind::Obj => voxkit_io::voxel_mesh::write_quads_obj(out, &quads, grid, palette.as_deref())?,
+                MeshKind::Glb => voxkit_io::voxel_mesh::write_quads_glb(out, &quads, grid, palette.as_deref())?,
+            };
+            Ok(json!({"quads": quads.len(), "vertices": vertices, "colours": palette.as_ref().map(|p| p.len())}))
+        }
+    }
+}

@@ -1,0 +1,366 @@
+//! Modes, methods and solid options by the names users give them, and the
+//! validated plan of a job: which core mode and which path will run.
+
+use voxkit::topology::runs::Connectivity;
+use voxkit::GridSpec;
+
+use crate::error::Result;
+use crate::grid::GridRequest;
+use crate::invalid;
+
+/// A voxelization mode as the CLI and the Python package name it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Mode {
+    /// Conservative surface.
+    Cover,
+    /// Laine's 26-separating surface.
+    Sep26,
+    /// Laine's thin 6-separating surface.
+    Sep6,
+    /// Schwarz–Seidel 6-separating surface.
+    Ss6,
+    /// Voxels whose centre is inside.
+    Solid,
+    /// The solid united with a surface mode.
+    SolidSurface,
+    /// 6-connected polylines.
+    Line6,
+    /// 26-connected polylines.
+    Line26,
+    /// The published projected optimal scanline algorithm.
+    Pos,
+}
+
+impl Mode {
+    /// Every mode, in documentation order.
+    pub const ALL: [Mode; 9] =
+        [Mode::Cover, Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Solid, Mode::SolidSurface, Mode::Line6, Mode::Line26, Mode::Pos];
+
+    /// The user-facing name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Cover => "cover",
+            Mode::Sep26 => "sep26",
+            Mode::Sep6 => "sep6",
+            Mode::Ss6 => "ss6",
+            Mode::Solid => "solid",
+            Mode::SolidSurface => "solid+surface",
+            Mode::Line6 => "line6",
+            Mode::Line26 => "line26",
+            Mode::Pos => "pos",
+        }
+    }
+
+    /// The mode called `name`.
+    pub fn parse(name: &str) -> Result<Mode> {
+        match Mode::ALL.into_iter().find(|m| m.name() == name) {
+            Some(m) => Ok(m),
+            None => invalid!("unknown mode {name:?} (expected one of: {})", Mode::ALL.map(Mode::name).join(", ")),
+        }
+    }
+
+    /// Whether this is a solid mode.
+    pub fn is_solid(self) -> bool {
+        matches!(self, Mode::Solid | Mode::SolidSurface)
+    }
+
+    /// The core surface/line mode (solid modes have none).
+    pub fn core(self) -> Result<voxkit::voxelize::Mode> {
+        use voxkit::voxelize::Mode as Core;
+        Ok(match self {
+            Mode::Cover => Core::Cover,
+            Mode::Sep26 => Core::Sep26,
+            Mode::Sep6 => Core::Sep6,
+            Mode::Ss6 => Core::Ss6,
+            Mode::Line26 => Core::Line26,
+            Mode::Line6 => Core::Line6,
+            Mode::Pos => Core::Pos,
+            Mode::Solid | Mode::SolidSurface => invalid!("mode '{}' is a solid mode", self.name()),
+        })
+    }
+}
+
+/// A method as users name it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// The fastest correct method for the mode.
+    #[default]
+    Auto,
+    /// The brute-force reference.
+    Reference,
+    /// The triangle-box fast path.
+    Fast,
+    /// The exact scanline path.
+    Scanline,
+    /// The GPU.
+    Gpu,
+    /// Solid by ray parity.
+    Parity,
+    /// Solid by the generalized winding number.
+    Winding,
+}
+
+impl Method {
+    /// Every method.
+    pub const ALL: [Method; 7] =
+        [Method::Auto, Method::Reference, Method::Fast, Method::Scanline, Method::Gpu, Method::Parity, Method::Winding];
+
+    /// The user-facing name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Auto => "auto",
+            Method::Reference => "reference",
+            Method::Fast => "fast",
+            Method::Scanline => "scanline",
+            Method::Gpu => "gpu",
+            Method::Parity => "parity",
+            Method::Winding => "winding",
+        }
+    }
+
+    /// The method called `name`.
+    pub fn parse(name: &str) -> Result<Method> {
+        match Method::ALL.into_iter().find(|m| m.name() == name) {
+            Some(m) => Ok(m),
+            None => invalid!("unknown method {name:?} (expected one of: {})", Method::ALL.map(Method::name).join(", ")),
+        }
+    }
+}
+
+/// The GPU path of `method gpu`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum GpuPath {
+    /// Compute shaders.
+    #[default]
+    Compute,
+    /// The rasterizer, exact.
+    Raster,
+    /// The rasterizer with 4x MSAA: approximate.
+    MsaaApprox,
+}
+
+/// The surface/line paths a method can name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SurfaceMethod {
+    /// Brute force from the definition.
+    Reference,
+    /// The GPU compute path (`voxkit-gpu`).
+    Gpu,
+    /// The triangle-box path (parallel, sparse).
+    Fast,
+    /// The exact scanline path (cover, sep26, sep6).
+    Scanline,
+}
+
+impl SurfaceMethod {
+    /// The name printed in summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            SurfaceMethod::Reference => "reference",
+            SurfaceMethod::Fast => "fast",
+            SurfaceMethod::Scanline => "scanline",
+            SurfaceMethod::Gpu => "gpu",
+        }
+    }
+}
+
+/// The core mode and the path that will run, or an error saying why none can.
+/// `auto` resolves to the fast path here; once the mesh and grid are known,
+/// [`auto_method`] may pick the scanline path or the GPU instead.
+pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::Mode, SurfaceMethod)> {
+    let core = mode.core()?;
+    let m = match method {
+        Method::Auto | Method::Fast => SurfaceMethod::Fast,
+        Method::Reference => SurfaceMethod::Reference,
+        Method::Scanline if voxkit::voxelize::scanline::supports(core) => SurfaceMethod::Scanline,
+        Method::Scanline => {
+            invalid!("--method scanline exists for cover, sep26 and sep6, not {}; use auto, fast or reference", mode.name())
+        }
+        Method::Gpu if !cfg!(feature = "gpu") => {
+            invalid!("--method gpu: this voxkit was built without the `gpu` feature; use auto, fast or reference")
+        }
+        Method::Gpu if gpu_has(core) => SurfaceMethod::Gpu,
+        Method::Gpu => invalid!(
+            "--method gpu exists for cover, sep26 and sep6 so far; {} on the GPU is not built yet (use auto, fast or reference)",
+            mode.name()
+        ),
+        Method::Parity | Method::Winding => invalid!("--method {} applies only to --mode solid", method.name()),
+    };
+    Ok((core, m))
+}
+
+/// What `method auto` runs for a surface mode on this mesh and grid: a
+/// hardware GPU on large grids of the modes it has, the scanline path
+/// where it measured faster ([`voxkit::voxelize::scanline::prefers`]), the
+/// fast path otherwise. Also returns a note when probing for a GPU failed
+/// in a way worth telling (never on a plain machine without one).
+pub fn auto_method(mode: voxkit::voxelize::Mode, mesh: voxkit::MeshRef<'_>, grid: &GridSpec) -> (SurfaceMethod, Option<String>) {
+    let (gpu, note) = gpu_preferred(mode, grid);
+    if gpu {
+        return (SurfaceMethod::Gpu, note);
+    }
+    if voxkit::voxelize::scanline::prefers(mode, mesh, grid) {
+        return (SurfaceMethod::Scanline, note);
+    }
+    (SurfaceMethod::Fast, note)
+}
+
+/// Grids from this many voxels on the longest side are offered to a
+/// hardware GPU by `method auto`.
+pub const GPU_AUTO_MIN_SIDE: u32 = 512;
+
+/// `method auto` on a large `cover`, `sep26` or `sep6` job: is there a
+/// hardware GPU adapter? Software adapters (lavapipe, WARP) are slower
+/// than the CPU paths, so they are not used unless asked for.
+#[cfg(feature = "gpu")]
+fn gpu_preferred(mode: voxkit::voxelize::Mode, grid: &GridSpec) -> (bool, Option<String>) {
+    if !gpu_has(mode) || grid.dims().iter().copied().max().unwrap_or(0) < GPU_AUTO_MIN_SIDE {
+        return (false, None);
+    }
+    match voxkit_gpu::hardware_adapter() {
+        Ok(hardware) => (hardware, None),
+        Err(e) => (false, Some(format!("{e}; using the CPU"))),
+    }
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_preferred(_mode: voxkit::voxelize::Mode, _grid: &GridSpec) -> (bool, Option<String>) {
+    (false, None)
+}
+
+/// Does the GPU path have this surface mode?
+#[cfg(feature = "gpu")]
+pub fn gpu_has(mode: voxkit::voxelize::Mode) -> bool {
+    voxkit_gpu::GpuMode::of(mode).is_some()
+}
+
+/// Does the GPU path have this surface mode?
+#[cfg(not(feature = "gpu"))]
+pub fn gpu_has(_mode: voxkit::voxelize::Mode) -> bool {
+    false
+}
+
+/// How a solid is made.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SolidMethod {
+    /// Parity if the mesh is closed and consistently oriented, else winding.
+    Auto,
+    /// Ray parity.
+    Parity,
+    /// Winding number.
+    Winding,
+    /// Brute-force exact winding number.
+    Reference,
+    /// Flood fill against a surface shell.
+    Flood,
+    /// Ray parity on the GPU.
+    GpuParity,
+}
+
+/// A validated solid job.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SolidPlan {
+    /// How the inside is decided.
+    pub method: SolidMethod,
+    /// The surface united with the solid (`solid+surface`), or the shell of a flood fill.
+    pub surface: Option<voxkit::voxelize::Mode>,
+    /// Keep only the skin, 6- or 26-connected to the outside.
+    pub hollow: Option<Connectivity>,
+}
+
+/// Solid filling strategies other than the inside test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Fill {
+    /// Everything a surface shell encloses.
+    Flood,
+}
+
+/// Everything a voxelization job is asked to do, before the mesh is read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Request {
+    /// The mode.
+    pub mode: Mode,
+    /// The method.
+    pub method: Method,
+    /// The grid.
+    pub grid: GridRequest,
+    /// Solid modes: the surface of `solid+surface` and of a flood fill's shell.
+    pub surface: Option<Mode>,
+    /// Solid modes: fill by flood instead of the inside test.
+    pub fill: Option<Fill>,
+    /// Solid modes: keep only the skin (6 or 26).
+    pub hollow: Option<u32>,
+    /// `method gpu`: which GPU path.
+    pub gpu_path: GpuPath,
+}
+
+impl Request {
+    /// A request for `mode` with every other option at its default.
+    pub fn new(mode: Mode, grid: GridRequest) -> Request {
+        Request { mode, method: Method::Auto, grid, surface: None, fill: None, hollow: None, gpu_path: GpuPath::Compute }
+    }
+}
+
+/// A validated request.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    /// What was asked.
+    pub request: Request,
+    /// For solid modes, how the solid is made.
+    pub solid: Option<SolidPlan>,
+    /// For surface and line modes, the core mode.
+    pub core: voxkit::voxelize::Mode,
+    /// For surface and line modes, the path (before `auto` sees the mesh).
+    pub surface_method: SurfaceMethod,
+}
+
+impl Plan {
+    /// Validates everything that does not need the mesh.
+    pub fn new(request: Request) -> Result<Plan> {
+        let solid = solid_plan(&request)?;
+        let (core, surface_method) = match solid {
+            Some(_) => (voxkit::voxelize::Mode::Cover, SurfaceMethod::Fast),
+            None => resolve_method(request.mode, request.method)?,
+        };
+        Ok(Plan { request, solid, core, surface_method })
+    }
+
+    /// Whether the job voxelizes polylines (line modes).
+    pub fn is_line(&self) -> bool {
+        self.solid.is_none() && matches!(self.core, voxkit::voxelize::Mode::Line26 | voxkit::voxelize::Mode::Line6)
+    }
+}
+
+/// Validates the solid options: `None` for a surface or line mode (where
+/// they are refused if given).
+fn solid_plan(a: &Request) -> Result<Option<SolidPlan>> {
+    if !a.mode.is_solid() {
+        if a.fill.is_some() || a.hollow.is_some() || a.surface.is_some() {
+            invalid!("--fill, --hollow and --surface apply to --mode solid and solid+surface");
+        }
+        return Ok(None);
+    }
+    let surface_mode = match a.surface.unwrap_or(Mode::Cover) {
+        m @ (Mode::Cover | Mode::Sep26 | Mode::Sep6 | Mode::Ss6) => m.core()?,
+        m => invalid!("--surface takes cover, sep26, sep6 or ss6, not {}", m.name()),
+    };
+    let method = match (a.fill, a.method) {
+        (Some(Fill::Flood), Method::Auto) => SolidMethod::Flood,
+        (Some(_), m) => invalid!("--fill flood replaces the inside test; it cannot be combined with --method {}", m.name()),
+        (None, Method::Auto) => SolidMethod::Auto,
+        (None, Method::Parity) => SolidMethod::Parity,
+        (None, Method::Winding) => SolidMethod::Winding,
+        (None, Method::Reference) => SolidMethod::Reference,
+        (None, Method::Gpu) if !cfg!(feature = "gpu") => invalid!("--method gpu: this voxkit was built without the `gpu` feature"),
+        (None, Method::Gpu) => SolidMethod::GpuParity,
+        (None, m) => invalid!("--method {} does not apply to solid modes (use auto, parity, winding or reference)", m.name()),
+    };
+    let surface = (a.mode == Mode::SolidSurface || method == SolidMethod::Flood).then_some(surface_mode);
+    let hollow = match a.hollow {
+        None => None,
+        Some(6) => Some(Connectivity::Six),
+        Some(26) => Some(Connectivity::TwentySix),
+        Some(n) => invalid!("--hollow takes 6 or 26, not {n}"),
+    };
+    Ok(Some(SolidPlan { method, surface, hollow }))
+}

@@ -1,0 +1,236 @@
+//! Running a planned job on a loaded mesh: the voxels, and the facts the
+//! summaries report.
+
+use std::time::Instant;
+
+use serde_json::{json, Value};
+use voxkit::attributes::carry::{carry, CarryOptions};
+use voxkit::attributes::{Appearance, VoxelAttributes};
+use voxkit::grid::bricks::BrickBits;
+use voxkit::voxelize::{self, Options, Progress, Report};
+use voxkit::{DenseBits, GridSpec, MeshRef, VoxelSource};
+
+use crate::error::{JobError, Result};
+use crate::plan::{GpuPath, Plan, SurfaceMethod};
+
+/// A voxel set in whichever storage the path produced.
+#[derive(Clone, Debug)]
+pub enum Voxels {
+    /// One bit per voxel (references, solids).
+    Dense(DenseBits),
+    /// Sparse 8³ bricks (the fast paths).
+    Bricks(BrickBits),
+}
+
+impl Voxels {
+    /// The voxels as a [`VoxelSource`].
+    pub fn source(&self) -> &(dyn VoxelSource + Send + Sync) {
+        match self {
+            Voxels::Dense(d) => d,
+            Voxels::Bricks(b) => b,
+        }
+    }
+
+    /// The same voxels, dense.
+    pub fn to_dense(&self) -> DenseBits {
+        match self {
+            Voxels::Dense(d) => d.clone(),
+            Voxels::Bricks(b) => b.to_dense(),
+        }
+    }
+}
+
+impl VoxelSource for Voxels {
+    fn dims(&self) -> [u32; 3] {
+        self.source().dims()
+    }
+    fn count(&self) -> u64 {
+        self.source().count()
+    }
+    fn for_each_set(&self, f: &mut dyn FnMut(u32, u32, u32)) {
+        self.source().for_each_set(f)
+    }
+    fn fill_i_planes(&self, i0: u32, count: u32, k_fastest: bool, out: &mut [u8]) {
+        self.source().fill_i_planes(i0, count, k_fastest, out)
+    }
+}
+
+/// What a job made.
+#[derive(Debug)]
+pub struct Voxelized {
+    /// The voxels.
+    pub voxels: Voxels,
+    /// The grid they are on.
+    pub grid: GridSpec,
+    /// The path that ran (`fast`, `scanline`, `reference`, `gpu`, `parity`, …).
+    pub method: &'static str,
+    /// Triangle preparation counts (zero for solids) and the voxel count.
+    pub report: Report,
+    /// Solid modes: closedness, the winding number's work, fill and hollow facts.
+    pub solid: Value,
+    /// The GPU path: adapter, timings, triangles on each side.
+    pub gpu: Value,
+    /// Things the user should know.
+    pub warnings: Vec<String>,
+    /// Seconds spent voxelizing (the mesh loaded, the voxels in memory).
+    pub voxelize_s: f64,
+}
+
+/// Runs `plan` on `mesh` (named `name` in messages) on the grid its request
+/// fits to `bounds`. Runs on the current rayon pool.
+pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dyn Progress>) -> Result<Voxelized> {
+    let mut warnings = Vec::new();
+    let is_line = plan.is_line();
+    if !is_line && mesh.triangles.is_empty() {
+        return Err(JobError::invalid(format!(
+            "{name}: has only line segments; surface modes need triangles (use --mode line26 or line6)"
+        )));
+    }
+    if !is_line && !mesh.segments.is_empty() {
+        warnings.push(format!(
+            "{name}: {} line segments ignored by surface mode {} (line26 and line6 voxelize them)",
+            mesh.segments.len(),
+            plan.request.mode.name()
+        ));
+    }
+    let grid = plan.request.grid.fit(&mesh.bounds())?;
+    crate::memory::check_memory(&grid)?;
+    let surface_method = if plan.request.method == crate::plan::Method::Auto && plan.solid.is_none() {
+        crate::plan::auto_method(plan.core, mesh, &grid).0
+    } else {
+        plan.surface_method
+    };
+    let opts = Options { progress, ..Options::default() };
+    let t = Instant::now();
+    let mut gpu = Value::Null;
+    let (voxels, report, method, solid) = if let Some(sp) = &plan.solid {
+        let out = crate::solid::run(sp, mesh, name, &grid, &opts)?;
+        warnings.extend(out.warnings);
+        let voxels = out.bits.count();
+        (Voxels::Dense(out.bits), Report { voxels, prepare: Default::default() }, out.method, out.facts)
+    } else {
+        let mode = plan.core;
+        let (v, r) = match surface_method {
+            SurfaceMethod::Reference => {
+                let (b, r) = voxelize::reference(mode, mesh, &grid);
+                (Voxels::Dense(b), r)
+            }
+            SurfaceMethod::Scanline => {
+                let (b, r) = voxelize::scanline::scanline(mode, mesh, &grid, &opts)
+                    .ok_or_else(|| JobError::invalid(format!("--method scanline exists for cover, sep26 and sep6, not {}", mode.name())))?;
+                (Voxels::Bricks(b), r)
+            }
+            SurfaceMethod::Fast => {
+                let (b, r) = voxelize::fast(mode, mesh, &grid, &opts);
+                (Voxels::Bricks(b), r)
+            }
+            SurfaceMethod::Gpu => {
+                let (b, r, facts, w) = gpu_voxelize(mode, plan.request.gpu_path, mesh, &grid)?;
+                gpu = facts;
+                warnings.extend(w);
+                (Voxels::Bricks(b), r)
+            }
+        };
+        (v, r, surface_method.name(), Value::Null)
+    };
+    let voxelize_s = t.elapsed().as_secs_f64();
+    let p = report.prepare;
+    if p.non_finite + p.invalid_index > 0 {
+        warnings.push(format!("{name}: skipped {} primitives with invalid vertices", p.non_finite + p.invalid_index));
+    }
+    Ok(Voxelized { voxels, grid, method, report, solid, gpu, warnings, voxelize_s })
+}
+
+/// Carries the mesh's colours, materials, normals and coverage into the
+/// voxels (see [`voxkit::attributes::carry`]); `None` for line modes.
+pub fn attributes(plan: &Plan, mesh: MeshRef<'_>, appearance: &Appearance, v: &Voxelized, opts: &CarryOptions) -> Option<VoxelAttributes> {
+    (!plan.is_line()).then(|| carry(mesh, appearance, &v.grid, v.voxels.source(), opts))
+}
+
+impl Voxelized {
+    /// The facts `voxkit voxelize --json` reports about the voxelization
+    /// (mode, method, grid, counts, triangles, solid and GPU facts).
+    pub fn facts(&self, plan: &Plan) -> Value {
+        let o = self.grid.origin();
+        let p = self.report.prepare;
+        json!({
+            "mode": plan.request.mode.name(),
+            "method": self.method,
+            "origin": [o.x, o.y, o.z],
+            "voxel_size": self.grid.voxel_size(),
+            "dims": self.grid.dims(),
+            "voxels": self.report.voxels,
+            "voxelize_s": self.voxelize_s,
+            "triangles": if plan.solid.is_some() { Value::Null } else { json!({
+                "input": p.input,
+                "voxelized": p.output,
+                "skipped_degenerate": p.degenerate,
+                "skipped_non_finite": p.non_finite,
+                "skipped_invalid_index": p.invalid_index,
+                "outside_grid": p.outside,
+                "clipped": p.clipped,
+            })},
+            "solid": self.solid,
+            "gpu": self.gpu,
+        })
+    }
+}
+
+/// A surface mode on the GPU: the voxels, the report, facts, warnings.
+#[cfg(feature = "gpu")]
+fn gpu_voxelize(
+    mode: voxelize::Mode,
+    path: GpuPath,
+    mesh: MeshRef<'_>,
+    grid: &GridSpec,
+) -> Result<(BrickBits, Report, Value, Vec<String>)> {
+    use voxkit_gpu::GpuPath as P;
+    let fail = |e: voxkit_gpu::GpuError| JobError::failed(format!("--method gpu: {e}"));
+    let gm = voxkit_gpu::GpuMode::of(mode)
+        .ok_or_else(|| JobError::invalid(format!("--method gpu: {} on the GPU is not built yet", mode.name())))?;
+    let gpu = voxkit_gpu::Gpu::new().map_err(fail)?;
+    let gp = match path {
+        GpuPath::Compute => P::Compute,
+        GpuPath::Raster => P::Raster,
+        GpuPath::MsaaApprox => P::RasterMsaa,
+    };
+    let (bits, r) = gpu.voxelize_with(gm, gp, mesh, grid).map_err(fail)?;
+    let mut warnings = Vec::new();
+    // The approximation says what it misses: the exact voxels by the compute path.
+    let missed = if gp == P::RasterMsaa {
+        let (exact, _) = gpu.voxelize(gm, mesh, grid).map_err(fail)?;
+        let mut missed = 0u64;
+        exact.for_each_set(|i, j, k| missed += !bits.get(i, j, k) as u64);
+        warnings.push(format!("--gpu-path msaa-approx is approximate: it missed {missed} of the mode's {} voxels", exact.count()));
+        Some(missed)
+    } else {
+        None
+    };
+    let t = r.timings;
+    let facts = json!({
+        "path": match gp { P::Compute => "compute", P::Raster => "raster", P::RasterMsaa => "msaa-approx" },
+        "hardware_conservative": gpu.hardware_conservative(),
+        "missed_voxels": missed,
+        "adapter": gpu.adapter(),
+        "software": gpu.is_software(),
+        "gpu_triangles": r.gpu_triangles,
+        "cpu_triangles": r.cpu_triangles,
+        "upload_s": t.upload_s,
+        "gpu_s": t.voxelize_s,
+        "gpu_time_s": t.gpu_s,
+        "download_s": t.download_s,
+        "cpu_share_s": t.cpu_s,
+        "slabs": t.slabs,
+    });
+    Ok((bits, r.report, facts, warnings))
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_voxelize(
+    _mode: voxelize::Mode,
+    _path: GpuPath,
+    _mesh: MeshRef<'_>,
+    _grid: &GridSpec,
+) -> Result<(BrickBits, Report, Value, Vec<String>)> {
+    Err(JobError::invalid("--method gpu: this voxkit was built without the `gpu` feature"))
+}
