@@ -31,6 +31,9 @@ pub enum Command {
     Render(RenderArgs),
     /// Convert a voxel file to another voxel format, or to a mesh of the voxels (.obj, greedy quads).
     Convert(ConvertArgs),
+    /// Voxelize whole datasets: one output per input mesh, a manifest of
+    /// JSON lines, resumable, a bad mesh recorded without stopping the rest.
+    Batch(BatchArgs),
 }
 
 /// Voxelization modes.
@@ -356,4 +359,54 @@ pub struct ConvertArgs {
     /// Print one JSON object on stdout instead of the summary line.
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct BatchArgs {
+    /// Input meshes, or folders searched (recursively) for them.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Output folder: each output mirrors its input's path below the
+    /// inputs' common folder, with the format's extension; the manifest is
+    /// `manifest.jsonl` in it.
+    #[arg(short, long, value_name = "OUT_DIR")]
+    pub output: PathBuf,
+    /// Which files of the input folders to take, e.g. '**/*.obj' (default:
+    /// every mesh extension voxkit reads).
+    #[arg(long, value_name = "PATTERN")]
+    pub glob: Option<String>,
+    /// Output format: npy, npy-bool, binvox, vox, txt, schem, vti, ply, obj or glb.
+    #[arg(long, default_value = "npy", value_name = "FORMAT")]
+    pub format: String,
+    /// Voxelization mode.
+    #[arg(long, value_enum, default_value = "cover")]
+    pub mode: Mode,
+    /// Method.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub method: Method,
+    /// Solid modes: the surface mode of `solid+surface` and of the `--fill flood` shell.
+    #[arg(long, value_enum, value_name = "MODE")]
+    pub surface: Option<Mode>,
+    /// Solid modes: `flood` fills everything a surface shell encloses.
+    #[arg(long, value_enum)]
+    pub fill: Option<Fill>,
+    /// Solid modes: keep only the voxels touching the outside through a face (6) or also an edge or corner (26).
+    #[arg(long, value_name = "6|26", value_parser = clap::builder::PossibleValuesParser::new(["6", "26"]))]
+    pub hollow: Option<String>,
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// With --method gpu: compute, raster or msaa-approx.
+    #[arg(long, value_enum, default_value = "compute", value_name = "PATH")]
+    pub gpu_path: GpuPathArg,
+    #[command(flatten)]
+    pub export: ExportArgs,
+    /// Meshes processed at once (default: all cores); each is voxelized on the same threads.
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress bar and no summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
 }

@@ -30,6 +30,7 @@ fn main() -> ExitCode {
         Command::Gaps(a) => commands::gaps::run(a),
         Command::Render(a) => commands::render::run(a),
         Command::Convert(a) => commands::convert::run(a),
+        Command::Batch(a) => commands::batch::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

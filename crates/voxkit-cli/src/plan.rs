@@ -52,22 +52,40 @@ pub fn grid_request(g: &GridArgs) -> Result<GridRequest> {
 
 /// The validated plan of `voxkit voxelize`.
 pub fn voxelize_plan(a: &VoxelizeArgs) -> Result<voxkit_job::Plan> {
+    plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path)
+}
+
+/// A validated plan from the voxelization options of `voxelize` and `batch`.
+pub fn plan_from(
+    mode: Mode,
+    method: Method,
+    grid: &GridArgs,
+    surface: Option<Mode>,
+    fill: Option<Fill>,
+    hollow: Option<&str>,
+    gpu_path: GpuPathArg,
+) -> Result<voxkit_job::Plan> {
     let request = voxkit_job::Request {
-        mode: a.mode.into(),
-        method: a.method.into(),
-        grid: grid_request(&a.grid)?,
-        surface: a.surface.map(Into::into),
-        fill: a.fill.map(|f| match f {
+        mode: mode.into(),
+        method: method.into(),
+        grid: grid_request(grid)?,
+        surface: surface.map(Into::into),
+        fill: fill.map(|f| match f {
             Fill::Flood => voxkit_job::Fill::Flood,
         }),
-        hollow: a.hollow.as_deref().map(|h| if h == "6" { 6 } else { 26 }),
-        gpu_path: match a.gpu_path {
-            GpuPathArg::Compute => voxkit_job::GpuPath::Compute,
-            GpuPathArg::Raster => voxkit_job::GpuPath::Raster,
-            GpuPathArg::MsaaApprox => voxkit_job::GpuPath::MsaaApprox,
-        },
+        hollow: hollow.map(|h| if h == "6" { 6 } else { 26 }),
+        gpu_path: gpu_path_name(gpu_path).1,
     };
     Ok(voxkit_job::Plan::new(request)?)
+}
+
+/// The name and the job's value of `--gpu-path`.
+pub fn gpu_path_name(p: GpuPathArg) -> (&'static str, voxkit_job::GpuPath) {
+    match p {
+        GpuPathArg::Compute => ("compute", voxkit_job::GpuPath::Compute),
+        GpuPathArg::Raster => ("raster", voxkit_job::GpuPath::Raster),
+        GpuPathArg::MsaaApprox => ("msaa-approx", voxkit_job::GpuPath::MsaaApprox),
+    }
 }
 
 /// The core surface/line mode of a CLI mode.

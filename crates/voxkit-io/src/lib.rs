@@ -32,7 +32,7 @@ pub mod vti;
 use std::path::Path;
 
 pub use error::{ErrorKind, IoError};
-pub use mesh_report::{LoadedMesh, MeshReport};
+pub use mesh_report::{validate_mesh, LoadedMesh, MeshReport};
 pub use png::write_png;
 use voxkit::attributes::VoxelAttributes;
 use voxkit::{DenseBits, GridSpec, VoxelSource};

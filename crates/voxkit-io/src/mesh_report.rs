@@ -42,6 +42,13 @@ pub(crate) fn finish(positions: Vec<DVec3>, triangles: Vec<[i64; 3]>, warnings: 
     finish_with_segments(positions, triangles, Vec::new(), warnings)
 }
 
+/// A mesh built by a caller from arrays (the Python package's numpy input),
+/// validated as every reader's output is: every coordinate finite, every
+/// index in range, at least one triangle or segment.
+pub fn validate_mesh(positions: Vec<DVec3>, triangles: Vec<[i64; 3]>, segments: Vec<[i64; 2]>) -> Result<LoadedMesh, ErrorKind> {
+    finish_with_segments(positions, triangles, segments, Vec::new())
+}
+
 /// [`finish`] for input that may carry line segments: at least one
 /// triangle or segment.
 pub(crate) fn finish_with_segments(

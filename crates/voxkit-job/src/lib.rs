@@ -22,6 +22,7 @@ mod plan;
 mod run;
 mod solid;
 
+pub mod batch;
 pub mod check;
 pub mod output;
 
@@ -32,5 +33,28 @@ pub use plan::{
     auto_method, gpu_has, resolve_method, Fill, GpuPath, Method, Mode, Plan, Request, SolidMethod, SolidPlan, SurfaceMethod,
     GPU_AUTO_MIN_SIDE,
 };
-pub use run::{attributes, voxelize, Voxelized, Voxels};
+pub use run::{attributes, attributes_for, voxelize, Voxelized, Voxels};
 pub use solid::Outcome as SolidOutcome;
+
+/// A rayon pool of `threads` workers, made once per count and kept (jobs
+/// that ask for a thread count run on it).
+pub fn pool(threads: usize) -> Result<std::sync::Arc<rayon::ThreadPool>> {
+    use std::collections::HashMap;
+    use std::sync::{Arc, Mutex, OnceLock};
+    static POOLS: OnceLock<Mutex<HashMap<usize, Arc<rayon::ThreadPool>>>> = OnceLock::new();
+    if threads == 0 {
+        return Err(JobError::invalid("threads must be at least 1"));
+    }
+    let mut pools = POOLS.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(p) = pools.get(&threads) {
+        return Ok(p.clone());
+    }
+    let p = Arc::new(
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| JobError::failed(format!("cannot start {threads} threads: {e}")))?,
+    );
+    pools.insert(threads, p.clone());
+    Ok(p)
+}

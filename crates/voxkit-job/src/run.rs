@@ -147,6 +147,26 @@ pub fn attributes(plan: &Plan, mesh: MeshRef<'_>, appearance: &Appearance, v: &V
     (!plan.is_line()).then(|| carry(mesh, appearance, &v.grid, v.voxels.source(), opts))
 }
 
+/// The attributes an output needs: colours where the format stores them
+/// (or a `preview` picture shows them) and the mesh has them, every array
+/// for `.vti`; `None` otherwise.
+pub fn attributes_for(
+    plan: &Plan,
+    loaded: &voxkit_io::LoadedMesh,
+    v: &Voxelized,
+    format: crate::output::Output,
+    preview: bool,
+    opts: &CarryOptions,
+) -> Option<VoxelAttributes> {
+    let is_vti = format == crate::output::Output::Voxels(voxkit_io::VoxelFormat::Vti);
+    let want_colour = loaded.appearance.has_colour() && (format.has_colour() || preview);
+    if want_colour || is_vti {
+        attributes(plan, loaded.mesh.as_ref(), &loaded.appearance, v, opts)
+    } else {
+        None
+    }
+}
+
 impl Voxelized {
     /// The facts `voxkit voxelize --json` reports about the voxelization
     /// (mode, method, grid, counts, triangles, solid and GPU facts).

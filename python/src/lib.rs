@@ -1,0 +1,826 @@
+//! `voxkit._voxkit`: the native half of the voxkit Python package.
+//!
+//! Everything here runs what the `voxkit` command line runs (the
+//! `voxkit-job` crate), so a Python call and a CLI call with the same
+//! options give the same voxels, bit for bit. The Python half
+//! (`python/voxkit/__init__.py`) accepts mesh-like objects, documents the
+//! API and adds `to_trimesh`, Dask and Ray.
+//!
+//! - Arrays in are copied once, into the voxelizer's own types; arrays out
+//!   are new NumPy arrays.
+//! - The GIL is released while meshes load, voxelize, carry colours, write
+//!   and check (`Python::detach`).
+//! - Errors are Python exceptions with the CLI's one-line messages:
+//!   `ValueError` for bad arguments and bad arrays, `OSError` subclasses
+//!   for files (`FileNotFoundError`, `PermissionError`, or
+//!   `voxkit.FileFormatError` for malformed content), `RuntimeError` for
+//!   failures while running (no GPU, not enough memory).
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use glam::DVec3;
+use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use serde_json::Value;
+use voxkit::attributes::carry::CarryOptions;
+use voxkit::attributes::{ColourRule, VoxelAttributes, NO_MATERIAL};
+use voxkit::{GridSpec, VoxelSource};
+use voxkit_io::LoadedMesh;
+use voxkit_job::{GridOptions, GridRequest, JobError, Voxels};
+
+pyo3::create_exception!(_voxkit, FileFormatError, PyOSError, "A file's content does not follow its format (the message names the file).");
+
+/// A [`JobError`] as the Python exception the package documents.
+fn py_err(e: JobError) -> PyErr {
+    match e {
+        JobError::Invalid(m) => PyValueError::new_err(m),
+        JobError::Failed(m) => PyRuntimeError::new_err(m),
+        JobError::Io(io) => io_err(io),
+    }
+}
+
+fn io_err(e: voxkit_io::IoError) -> PyErr {
+    use std::io::ErrorKind as K;
+    let msg = e.to_string();
+    match &e.kind {
+        voxkit_io::ErrorKind::Read(x) | voxkit_io::ErrorKind::Write(x) => match x.kind() {
+            K::NotFound => PyFileNotFoundError::new_err(msg),
+            K::PermissionDenied => PyPermissionError::new_err(msg),
+            K::IsADirectory => PyIsADirectoryError::new_err(msg),
+            _ => PyOSError::new_err(msg),
+        },
+        _ => FileFormatError::new_err(msg),
+    }
+}
+
+fn value_err(msg: impl Into<String>) -> PyErr {
+    PyValueError::new_err(msg.into())
+}
+
+/// A triangle mesh (and polylines), as read from a file or built from arrays.
+#[pyclass(module = "voxkit._voxkit", name = "Mesh", frozen)]
+struct Mesh {
+    inner: Arc<LoadedMesh>,
+    path: Option<PathBuf>,
+}
+
+/// Copies an `(n, 3)` float array (float64 or float32, any strides) into
+/// points.
+fn points_from(name: &str, a: &Bound<'_, PyAny>) -> PyResult<Vec<DVec3>> {
+    fn rows<T: numpy::Element + Copy + Into<f64>>(name: &str, a: PyReadonlyArray2<'_, T>) -> PyResult<Vec<DVec3>> {
+        let v = a.as_array();
+        if v.ncols() != 3 {
+            return Err(value_err(format!("{name} must have shape (n, 3); got {}", shape(v.shape()))));
+        }
+        Ok(v.rows().into_iter().map(|r| DVec3::new(r[0].into(), r[1].into(), r[2].into())).collect())
+    }
+    if let Ok(x) = a.extract::<PyReadonlyArray2<'_, f64>>() {
+        return rows(name, x);
+    }
+    if let Ok(x) = a.extract::<PyReadonlyArray2<'_, f32>>() {
+        return rows(name, x);
+    }
+    Err(shape_or_dtype(name, a, "(n, 3) float64 or float32"))
+}
+
+/// Copies an `(n, K)` integer array (int64, int32, uint32, uint64) into index tuples.
+fn indices_from<const K: usize>(name: &str, a: &Bound<'_, PyAny>) -> PyResult<Vec<[i64; K]>> {
+    fn rows<T: numpy::Element + Copy + TryInto<i64>, const K: usize>(name: &str, a: PyReadonlyArray2<'_, T>) -> PyResult<Vec<[i64; K]>> {
+        let v = a.as_array();
+        if v.ncols() != K {
+            return Err(value_err(format!("{name} must have shape (n, {K}); got {}", shape(v.shape()))));
+        }
+        v.rows()
+            .into_iter()
+            .enumerate()
+            .map(|(n, r)| {
+                let mut out = [0i64; K];
+                for (o, x) in out.iter_mut().zip(r.iter()) {
+                    *o = (*x).try_into().map_err(|_| value_err(format!("{name}: row {n} has an index beyond int64")))?;
+                }
+                Ok(out)
+            })
+            .collect()
+    }
+    if let Ok(x) = a.extract::<PyReadonlyArray2<'_, i64>>() {
+        return rows(name, x);
+    }
+    if let Ok(x) = a.extract::<PyReadonlyArray2<'_, i32>>() {
+        return rows(name, x);
+    }
+    if let Ok(x) = a.extract::<PyReadonlyArray2<'_, u32>>() {
+        return rows(name, x);
+    }
+    if let Ok(x) = a.extract::<PyReadonlyArray2<'_, u64>>() {
+        return rows(name, x);
+    }
+    Err(shape_or_dtype(name, a, &format!("(n, {K}) int64, int32, uint32 or uint64")))
+}
+
+/// A shape as Python prints it: `(3, 2)`, `(5,)`.
+fn shape(s: &[usize]) -> String {
+    match s {
+        [one] => format!("({one},)"),
+        _ => format!("({})", s.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")),
+    }
+}
+
+fn shape_or_dtype(name: &str, a: &Bound<'_, PyAny>, want: &str) -> PyErr {
+    match a.cast::<numpy::PyUntypedArray>() {
+        Ok(arr) => value_err(format!("{name} must be a {want} array; got shape {}, dtype {}", shape(arr.shape()), arr.dtype())),
+        Err(_) => value_err(format!("{name} must be a {want} NumPy array")),
+    }
+}
+
+#[pymethods]
+impl Mesh {
+    /// Mesh(vertices, faces, segments=None): a mesh from arrays, validated
+    /// like a file (finite coordinates, indices in range).
+    #[new]
+    #[pyo3(signature = (vertices, faces=None, segments=None))]
+    fn new(
+        py: Python<'_>,
+        vertices: &Bound<'_, PyAny>,
+        faces: Option<&Bound<'_, PyAny>>,
+        segments: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Mesh> {
+        let positions = points_from("vertices", vertices)?;
+        let triangles = faces.map(|f| indices_from::<3>("faces", f)).transpose()?.unwrap_or_default();
+        let segs = segments.map(|s| indices_from::<2>("segments", s)).transpose()?.unwrap_or_default();
+        let loaded = py.detach(|| voxkit_io::validate_mesh(positions, triangles, segs)).map_err(|k| value_err(k.to_string()))?;
+        Ok(Mesh { inner: Arc::new(loaded), path: None })
+    }
+
+    /// Vertex positions, `(n, 3)` float64 (a copy).
+    #[getter]
+    fn vertices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let p = &self.inner.mesh.positions;
+        Array2::from_shape_fn((p.len(), 3), |(i, c)| p[i][c]).into_pyarray(py)
+    }
+
+    /// Triangles, `(m, 3)` int64 indices into `vertices` (polygons fan-triangulated).
+    #[getter]
+    fn faces<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
+        let t = &self.inner.mesh.triangles;
+        Array2::from_shape_fn((t.len(), 3), |(i, c)| t[i][c] as i64).into_pyarray(py)
+    }
+
+    /// Polyline segments, `(k, 2)` int64 indices into `vertices`.
+    #[getter]
+    fn segments<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
+        let s = &self.inner.mesh.segments;
+        Array2::from_shape_fn((s.len(), 2), |(i, c)| s[i][c] as i64).into_pyarray(py)
+    }
+
+    /// Per-vertex sRGB colours, `(n, 3)` uint8, or None.
+    #[getter]
+    fn vertex_colours<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<u8>>> {
+        let c = &self.inner.appearance.vertex_colour;
+        (!c.is_empty()).then(|| Array2::from_shape_fn((c.len(), 3), |(i, k)| c[i][k]).into_pyarray(py))
+    }
+
+    /// Per-triangle corner texture coordinates, `(m, 3, 2)` float32 (v = 0
+    /// at the top of the image; NaN where a corner has none), or None.
+    #[getter]
+    fn uvs<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray3<f32>>> {
+        let u = &self.inner.appearance.triangle_uv;
+        (!u.is_empty()).then(|| Array3::from_shape_fn((u.len(), 3, 2), |(i, c, k)| u[i][c][k]).into_pyarray(py))
+    }
+
+    /// Per-triangle material index into `materials` (-1: none), `(m,)` int64, or None.
+    #[getter]
+    fn face_materials<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<i64>>> {
+        let m = &self.inner.appearance.triangle_material;
+        (!m.is_empty()).then(|| m.iter().map(|&x| if x == NO_MATERIAL { -1 } else { x as i64 }).collect::<Array1<i64>>().into_pyarray(py))
+    }
+
+    /// Materials: a list of dicts with `name`, `colour` (linear RGB
+    /// factor) and `texture` (its name, or None).
+    #[getter]
+    fn materials<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let app = &self.inner.appearance;
+        let list = PyList::empty(py);
+        for m in &app.materials {
+            let d = PyDict::new(py);
+            d.set_item("name", &m.name)?;
+            d.set_item("colour", m.factor.to_vec())?;
+            d.set_item("texture", m.texture.and_then(|t| app.textures.get(t as usize)).map(|t| t.name.clone()))?;
+            list.append(d)?;
+        }
+        Ok(list)
+    }
+
+    /// Warnings from reading the file (a missing material library, …).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner.warnings.clone()
+    }
+
+    /// The file it was read from, or None.
+    #[getter]
+    fn path(&self) -> Option<String> {
+        self.path.as_ref().map(|p| p.display().to_string())
+    }
+
+    /// Bounding box of the used vertices, `(2, 3)` float64: min, max.
+    #[getter]
+    fn bounds<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let b = self.inner.report.bounds;
+        Array2::from_shape_fn((2, 3), |(r, c)| if r == 0 { b.min[c] } else { b.max[c] }).into_pyarray(py)
+    }
+
+    fn __repr__(&self) -> String {
+        let r = &self.inner.report;
+        let from = self.path.as_ref().map(|p| format!(" from {:?}", p.display().to_string())).unwrap_or_default();
+        format!("<voxkit.Mesh {} vertices, {} triangles, {} segments{from}>", r.vertices, r.triangles, r.segments)
+    }
+}
+
+/// load_mesh(path) -> Mesh
+#[pyfunction]
+fn load_mesh(py: Python<'_>, path: PathBuf) -> PyResult<Mesh> {
+    let p = path.clone();
+    let loaded = py.detach(move || voxkit_io::read_mesh(&p)).map_err(io_err)?;
+    Ok(Mesh { inner: Arc::new(loaded), path: Some(path) })
+}
+
+/// A voxel grid: where the voxels are, which are set, and what they carry.
+#[pyclass(module = "voxkit._voxkit", name = "VoxelGrid", frozen)]
+struct VoxelGrid {
+    inner: Arc<GridData>,
+}
+
+struct GridData {
+    voxels: Voxels,
+    grid: GridSpec,
+    attrs: Option<VoxelAttributes>,
+    facts: Value,
+}
+
+/// A JSON value as Python objects.
+fn to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match v {
+        Value::Null => py.None().into_bound(py),
+        Value::Bool(b) => b.into_pyobject(py)?.to_owned().into_any(),
+        Value::Number(n) => match (n.as_i64(), n.as_u64(), n.as_f64()) {
+            (Some(i), _, _) => i.into_pyobject(py)?.into_any(),
+            (_, Some(u), _) => u.into_pyobject(py)?.into_any(),
+            (_, _, f) => f.unwrap_or(f64::NAN).into_pyobject(py)?.into_any(),
+        },
+        Value::String(s) => s.into_pyobject(py)?.into_any(),
+        Value::Array(a) => {
+            let l = PyList::empty(py);
+            for x in a {
+                l.append(to_py(py, x)?)?;
+            }
+            l.into_any()
+        }
+        Value::Object(o) => {
+            let d = PyDict::new(py);
+            for (k, x) in o {
+                d.set_item(k, to_py(py, x)?)?;
+            }
+            d.into_any()
+        }
+    })
+}
+
+impl GridData {
+    /// Set voxels in the order of `numpy.argwhere(occupancy)` (i, then j,
+    /// then k), each with its slot in key order (the attributes' order).
+    fn ordered(&self) -> Vec<([u32; 3], usize)> {
+        let mut v = Vec::with_capacity(self.voxels.count() as usize);
+        let mut slot = 0usize;
+        self.voxels.for_each_set(&mut |i, j, k| {
+            v.push(([i, j, k], slot));
+            slot += 1;
+        });
+        v.sort_unstable_by_key(|e| e.0);
+        v
+    }
+}
+
+#[pymethods]
+impl VoxelGrid {
+    /// Voxels along x, y, z.
+    #[getter]
+    fn dims(&self) -> (u32, u32, u32) {
+        let d = self.inner.grid.dims();
+        (d[0], d[1], d[2])
+    }
+
+    /// World position of the grid's low corner.
+    #[getter]
+    fn origin(&self) -> (f64, f64, f64) {
+        let o = self.inner.grid.origin();
+        (o.x, o.y, o.z)
+    }
+
+    /// Edge length of a voxel.
+    #[getter]
+    fn voxel_size(&self) -> f64 {
+        self.inner.grid.voxel_size()
+    }
+
+    /// Number of set voxels.
+    #[getter]
+    fn count(&self) -> u64 {
+        self.inner.voxels.count()
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.voxels.count() as usize
+    }
+
+    /// What made it: mode, method, grid, counts, times, solid and GPU facts.
+    #[getter]
+    fn facts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, &self.inner.facts)
+    }
+
+    /// Dense occupancy, `(nx, ny, nz)` bool, element `[i, j, k]` = voxel `(i, j, k)`.
+    #[getter]
+    fn occupancy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<bool>>> {
+        let [nx, ny, nz] = self.inner.grid.dims().map(|d| d as usize);
+        let bytes = nx.checked_mul(ny).and_then(|n| n.checked_mul(nz)).ok_or_else(|| value_err("grid too large to densify"))?;
+        if voxkit_job::available_memory().is_some_and(|m| bytes as u64 > m / 2) {
+            return Err(PyRuntimeError::new_err(format!(
+                "a dense {nx}x{ny}x{nz} occupancy needs {}; use .indices() for the set voxels",
+                voxkit_job::bytes(bytes as u64)
+            )));
+        }
+        let inner = self.inner.clone();
+        let dense = py.detach(move || {
+            let mut a = vec![false; bytes];
+            inner.voxels.for_each_set(&mut |i, j, k| a[(i as usize * ny + j as usize) * nz + k as usize] = true);
+            a
+        });
+        let arr = Array3::from_shape_vec((nx, ny, nz), dense).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        Ok(arr.into_pyarray(py))
+    }
+
+    /// indices() -> (k, 3) int64: the set voxels, in the order of
+    /// `numpy.argwhere(occupancy)`; sparse, for grids too big to densify.
+    fn indices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
+        let inner = self.inner.clone();
+        let v = py.detach(move || inner.ordered());
+        Array2::from_shape_fn((v.len(), 3), |(n, c)| v[n].0[c] as i64).into_pyarray(py)
+    }
+
+    /// Per set voxel sRGB colour, `(k, 3)` uint8, aligned with `indices()`; None without attributes.
+    #[getter]
+    fn colours<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<u8>>> {
+        let c = self.inner.attrs.as_ref()?.colour.as_ref()?;
+        let order = self.inner.ordered();
+        Some(Array2::from_shape_fn((order.len(), 3), |(n, k)| c[order[n].1][k]).into_pyarray(py))
+    }
+
+    /// Per set voxel material index (-1: none), `(k,)` int64, aligned with `indices()`; None without.
+    #[getter]
+    fn materials<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<i64>>> {
+        let m = self.inner.attrs.as_ref()?.material.as_ref()?;
+        let order = self.inner.ordered();
+        Some(order.iter().map(|o| if m[o.1] == NO_MATERIAL { -1 } else { m[o.1] as i64 }).collect::<Array1<i64>>().into_pyarray(py))
+    }
+
+    /// Per set voxel mean surface normal, `(k, 3)` float32, aligned with `indices()`; None without (`normals=True`).
+    #[getter]
+    fn normals<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<f32>>> {
+        let nrm = self.inner.attrs.as_ref()?.normal.as_ref()?;
+        let order = self.inner.ordered();
+        Some(Array2::from_shape_fn((order.len(), 3), |(n, k)| nrm[order[n].1][k]).into_pyarray(py))
+    }
+
+    /// Per set voxel surface area inside it / voxel_size², `(k,)` float32, aligned with `indices()`; None without.
+    #[getter]
+    fn coverage<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f32>>> {
+        let c = self.inner.attrs.as_ref()?.coverage.as_ref()?;
+        let order = self.inner.ordered();
+        Some(order.iter().map(|o| c[o.1]).collect::<Array1<f32>>().into_pyarray(py))
+    }
+
+    /// save(path, format=None, dither=False, block_palette=None): writes
+    /// any format the CLI writes (by extension or `format`), atomically.
+    #[pyo3(signature = (path, format=None, dither=false, block_palette=None))]
+    fn save(&self, py: Python<'_>, path: PathBuf, format: Option<String>, dither: bool, block_palette: Option<PathBuf>) -> PyResult<()> {
+        let target = voxkit_job::output::output_format(format.as_deref(), &path).map_err(py_err)?;
+        voxkit_job::output::check_output_path(&path).map_err(py_err)?;
+        let blocks = block_palette.as_deref().map(voxkit_io::schem::BlockPalette::read).transpose().map_err(io_err)?;
+        let opts = voxkit_io::WriteOptions { dither, blocks };
+        let inner = self.inner.clone();
+        py.detach(move || voxkit_job::output::write(&path, target, &inner.voxels, &inner.grid, inner.attrs.as_ref(), &opts))
+            .map_err(py_err)?;
+        Ok(())
+    }
+
+    /// check(mesh=None) -> dict: the `voxkit check` report (components,
+    /// thick voxels; with the mesh: closedness, separation with witnesses,
+    /// thinness, tunnels).
+    #[pyo3(signature = (mesh=None))]
+    fn check<'py>(&self, py: Python<'py>, mesh: Option<&Mesh>) -> PyResult<Bound<'py, PyAny>> {
+        let inner = self.inner.clone();
+        let m = mesh.map(|m| m.inner.clone());
+        let v = py
+            .detach(move || {
+                let dense = inner.voxels.to_dense();
+                voxkit_job::check::report(&dense, m.as_ref().map(|m| (m.mesh.as_ref(), &inner.grid, "grid")))
+            })
+            .map_err(py_err)?;
+        to_py(py, &v)
+    }
+
+    /// world_to_index(points) -> (n, 3) int64: the voxel holding each point
+    /// (`floor((p - origin) / voxel_size)`; may lie outside the grid).
+    fn world_to_index<'py>(&self, py: Python<'py>, points: &Bound<'_, PyAny>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let p = points_from("points", points)?;
+        let g = self.inner.grid;
+        Ok(Array2::from_shape_fn((p.len(), 3), |(n, c)| g.to_grid_units(p[n])[c].floor() as i64).into_pyarray(py))
+    }
+
+    /// index_to_world(indices) -> (n, 3) float64: the centre of each voxel.
+    fn index_to_world<'py>(&self, py: Python<'py>, indices: &Bound<'_, PyAny>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let ijk = indices_from::<3>("indices", indices)?;
+        let g = self.inner.grid;
+        let (o, s) = (g.origin(), g.voxel_size());
+        Ok(Array2::from_shape_fn((ijk.len(), 3), |(n, c)| o[c] + (ijk[n][c] as f64 + 0.5) * s).into_pyarray(py))
+    }
+
+    /// The mesh of the voxels (boundary faces merged into greedy quads,
+    /// split into triangles): `(vertices (n, 3) float64, faces (m, 3) int64,
+    /// face_colours (m, 3) uint8 or None)`.
+    fn greedy_mesh<'py>(&self, py: Python<'py>) -> MeshArrays<'py> {
+        let inner = self.inner.clone();
+        let (verts, faces, colours) = py.detach(move || greedy_triangles(&inner));
+        let v = Array2::from_shape_fn((verts.len(), 3), |(n, c)| verts[n][c]).into_pyarray(py);
+        let f = Array2::from_shape_fn((faces.len(), 3), |(n, c)| faces[n][c] as i64).into_pyarray(py);
+        let c = colours.map(|c| Array2::from_shape_fn((c.len(), 3), |(n, k)| c[n][k]).into_pyarray(py));
+        (v, f, c)
+    }
+
+    /// to_trimesh() -> trimesh.Trimesh: the mesh of the voxels (boundary
+    /// faces merged into greedy quads, two triangles each), coloured per
+    /// face when the grid carries colours. Needs `trimesh`.
+    fn to_trimesh<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let trimesh = py.import("trimesh").map_err(|e| {
+            pyo3::exceptions::PyImportError::new_err(format!("VoxelGrid.to_trimesh needs trimesh (pip install trimesh): {e}"))
+        })?;
+        let (v, f, c) = self.greedy_mesh(py);
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("vertices", v)?;
+        kwargs.set_item("faces", f)?;
+        kwargs.set_item("process", false)?;
+        if let Some(c) = c {
+            let rgba = c.readonly().as_array().map(|&x| x);
+            let n = rgba.nrows();
+            let with_alpha = Array2::from_shape_fn((n, 4), |(i, k)| if k < 3 { rgba[[i, k]] } else { 255u8 });
+            kwargs.set_item("face_colors", with_alpha.into_pyarray(py))?;
+        }
+        trimesh.getattr("Trimesh")?.call((), Some(&kwargs))
+    }
+
+    fn __repr__(&self) -> String {
+        let [x, y, z] = self.inner.grid.dims();
+        let mode = self.inner.facts.get("mode").and_then(Value::as_str).map(|m| format!(" {m}")).unwrap_or_default();
+        format!("<voxkit.VoxelGrid{mode} {x}x{y}x{z}, {} voxels, voxel size {}>", self.inner.voxels.count(), self.inner.grid.voxel_size())
+    }
+}
+
+/// Vertices, faces and optional face colours of a mesh of the voxels.
+type MeshArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>, Option<Bound<'py, PyArray2<u8>>>);
+
+/// `(input, output, done)` per mesh of a batch, and the options' fingerprint.
+type BatchListing<'py> = (Vec<(String, String, bool)>, Bound<'py, PyAny>);
+
+type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>, Option<Vec<[u8; 3]>>);
+
+/// Greedy quads of the voxels (coloured when the grid has colours), as
+/// world-space triangles sharing vertices within each quad.
+fn greedy_triangles(g: &GridData) -> Triangles {
+    use voxkit::attributes::quantize;
+    use voxkit::export::greedy::{greedy_quads, greedy_quads_by_class};
+    let dense = g.voxels.to_dense();
+    let coloured = g.attrs.as_ref().and_then(|a| a.colour.as_ref().map(|c| (a, c)));
+    let (palette, quads) = match coloured {
+        Some((a, colours)) => {
+            let palette = quantize::palette(colours, 255);
+            let index = quantize::map_to_palette(colours, &palette);
+            let class = move |i: u32, j: u32, k: u32| a.slot(i, j, k).map(|s| index[s] as u32 + 1).unwrap_or(0);
+            (Some(palette), greedy_quads_by_class(&dense, &class))
+        }
+        None => (None, greedy_quads(&dense)),
+    };
+    let (o, s) = (g.grid.origin(), g.grid.voxel_size());
+    let mut verts = Vec::with_capacity(quads.len() * 4);
+    let mut faces = Vec::with_capacity(quads.len() * 2);
+    let mut colours = palette.as_ref().map(|_| Vec::with_capacity(quads.len() * 2));
+    for q in &quads {
+        let base = verts.len() as u32;
+        for c in q.corners() {
+            verts.push([o.x + c[0] as f64 * s, o.y + c[1] as f64 * s, o.z + c[2] as f64 * s]);
+        }
+        faces.push([base, base + 1, base + 2]);
+        faces.push([base, base + 2, base + 3]);
+        if let (Some(out), Some(p)) = (colours.as_mut(), palette.as_ref()) {
+            let c = q.class.checked_sub(1).and_then(|i| p.get(i as usize)).copied().unwrap_or(voxkit::attributes::carry::DEFAULT_COLOUR);
+            out.push(c);
+            out.push(c);
+        }
+    }
+    (verts, faces, colours)
+}
+
+fn grid_options(
+    resolution: Option<u64>,
+    voxel_size: Option<f64>,
+    origin: Option<Vec<f64>>,
+    dims: Option<Vec<u64>>,
+    pad: Option<u32>,
+) -> GridOptions {
+    GridOptions { resolution, voxel_size, origin, dims, pad }
+}
+
+/// The voxelization options of `voxelize` and `batch`, validated.
+#[allow(clippy::too_many_arguments)]
+fn plan_of(
+    mode: &str,
+    method: &str,
+    grid: &GridOptions,
+    surface: Option<&str>,
+    fill: Option<&str>,
+    hollow: Option<u32>,
+    gpu_path: &str,
+) -> Result<voxkit_job::Plan, JobError> {
+    let request = voxkit_job::Request {
+        mode: voxkit_job::Mode::parse(mode)?,
+        method: voxkit_job::Method::parse(method)?,
+        grid: GridRequest::new(grid)?,
+        surface: surface.map(voxkit_job::Mode::parse).transpose()?,
+        fill: match fill {
+            None => None,
+            Some("flood") => Some(voxkit_job::Fill::Flood),
+            Some(f) => return Err(JobError::invalid(format!("unknown fill {f:?} (expected \"flood\")"))),
+        },
+        hollow,
+        gpu_path: match gpu_path {
+            "compute" => voxkit_job::GpuPath::Compute,
+            "raster" => voxkit_job::GpuPath::Raster,
+            "msaa-approx" => voxkit_job::GpuPath::MsaaApprox,
+            p => return Err(JobError::invalid(format!("unknown gpu_path {p:?} (expected compute, raster or msaa-approx)"))),
+        },
+    };
+    voxkit_job::Plan::new(request)
+}
+
+fn colour_rule(rule: &str) -> Result<ColourRule, JobError> {
+    match rule {
+        "dominant" => Ok(ColourRule::Dominant),
+        "blend" => Ok(ColourRule::Blend),
+        r => Err(JobError::invalid(format!("unknown colour_rule {r:?} (expected dominant or blend)"))),
+    }
+}
+
+/// The native voxelize: see `voxkit.voxelize` for the documentation.
+#[pyfunction]
+#[pyo3(signature = (mesh, *, mode="cover", resolution=None, voxel_size=None, origin=None, dims=None, pad=None, method="auto", threads=None,
+    attributes=false, colour_rule="dominant", normals=false, surface=None, fill=None, hollow=None, gpu_path="compute"))]
+#[allow(clippy::too_many_arguments)]
+fn voxelize(
+    py: Python<'_>,
+    mesh: &Mesh,
+    mode: &str,
+    resolution: Option<u64>,
+    voxel_size: Option<f64>,
+    origin: Option<Vec<f64>>,
+    dims: Option<Vec<u64>>,
+    pad: Option<u32>,
+    method: &str,
+    threads: Option<usize>,
+    attributes: bool,
+    colour_rule: &str,
+    normals: bool,
+    surface: Option<&str>,
+    fill: Option<&str>,
+    hollow: Option<u32>,
+    gpu_path: &str,
+) -> PyResult<VoxelGrid> {
+    let grid = grid_options(resolution, voxel_size, origin, dims, pad);
+    let plan = plan_of(mode, method, &grid, surface, fill, hollow, gpu_path).map_err(py_err)?;
+    let carry = CarryOptions { rule: self::colour_rule(colour_rule).map_err(py_err)?, normals };
+    let pool = threads.map(voxkit_job::pool).transpose().map_err(py_err)?;
+    let inner = mesh.inner.clone();
+    let name = mesh.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into());
+    let data = py
+        .detach(move || {
+            let run = || -> Result<GridData, JobError> {
+                let v = voxkit_job::voxelize(&plan, inner.mesh.as_ref(), &name, None)?;
+                let attrs =
+                    if attributes { voxkit_job::attributes(&plan, inner.mesh.as_ref(), &inner.appearance, &v, &carry) } else { None };
+                let mut facts = v.facts(&plan);
+                facts["warnings"] = serde_json::json!(v.warnings);
+                Ok(GridData { voxels: v.voxels, grid: v.grid, attrs, facts })
+            };
+            match pool {
+                Some(p) => p.install(run),
+                None => run(),
+            }
+        })
+        .map_err(py_err)?;
+    Ok(VoxelGrid { inner: Arc::new(data) })
+}
+
+/// load_voxels(path, origin=None, voxel_size=None) -> VoxelGrid
+#[pyfunction]
+#[pyo3(signature = (path, origin=None, voxel_size=None))]
+fn load_voxels(py: Python<'_>, path: PathBuf, origin: Option<Vec<f64>>, voxel_size: Option<f64>) -> PyResult<VoxelGrid> {
+    let p = path.clone();
+    let loaded = py.detach(move || voxkit_io::read_voxels(&p)).map_err(io_err)?;
+    let dims = loaded.bits.dims();
+    let o = match origin {
+        Some(o) if o.len() == 3 => DVec3::new(o[0], o[1], o[2]),
+        Some(o) => return Err(value_err(format!("origin must have 3 values; got {}", o.len()))),
+        None => loaded.placement.map(|p| p.0).unwrap_or(DVec3::ZERO),
+    };
+    let s = voxel_size.or(loaded.placement.map(|p| p.1)).unwrap_or(1.0);
+    let grid = GridSpec::new(o, s, dims.map(u64::from)).map_err(|e| value_err(format!("invalid grid: {e}")))?;
+    let facts = serde_json::json!({"input": path.display().to_string(), "voxels": loaded.bits.count(), "placement_from_file": loaded.placement.is_some()});
+    Ok(VoxelGrid { inner: Arc::new(GridData { voxels: Voxels::Dense(loaded.bits), grid, attrs: loaded.attributes, facts }) })
+}
+
+/// The options of a batch, validated, and its fingerprint.
+#[allow(clippy::too_many_arguments)]
+fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_job::batch::BatchOptions, Option<usize>)> {
+    let get_str = |k: &str| -> PyResult<Option<String>> { options.get_item(k)?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose() };
+    let get_u64 = |k: &str| -> PyResult<Option<u64>> { options.get_item(k)?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose() };
+    let known = [
+        "mode",
+        "method",
+        "resolution",
+        "voxel_size",
+        "origin",
+        "dims",
+        "pad",
+        "surface",
+        "fill",
+        "hollow",
+        "gpu_path",
+        "colour_rule",
+        "normals",
+        "dither",
+        "threads",
+        "jobs",
+    ];
+    for k in options.keys() {
+        let k: String = k.extract()?;
+        if !known.contains(&k.as_str()) {
+            return Err(value_err(format!("unknown batch option {k:?} (expected one of: {})", known.join(", "))));
+        }
+    }
+    let grid = grid_options(
+        get_u64("resolution")?,
+        options.get_item("voxel_size")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?,
+        options.get_item("origin")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?,
+        options.get_item("dims")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?,
+        get_u64("pad")?.map(|p| p as u32),
+    );
+    let mode = get_str("mode")?.unwrap_or_else(|| "cover".into());
+    let method = get_str("method")?.unwrap_or_else(|| "auto".into());
+    let gpu_path = get_str("gpu_path")?.unwrap_or_else(|| "compute".into());
+    let rule = get_str("colour_rule")?.unwrap_or_else(|| "dominant".into());
+    let normals: bool = options.get_item("normals")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
+    let dither: bool = options.get_item("dither")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
+    let (surface, fill) = (get_str("surface")?, get_str("fill")?);
+    let hollow = get_u64("hollow")?.map(|h| h as u32);
+    let plan = plan_of(&mode, &method, &grid, surface.as_deref(), fill.as_deref(), hollow, &gpu_path).map_err(py_err)?;
+    let target = voxkit_job::output::Output::from_name(format)
+        .ok_or_else(|| value_err(format!("unknown format {format:?} (expected one of: {})", voxkit_job::output::Output::names())))?;
+    let threads = get_u64("threads")?.map(|t| t as usize);
+    let jobs = get_u64("jobs")?.map(|t| t as usize);
+    let fingerprint = voxkit_job::batch::fingerprint(&voxkit_job::batch::FingerprintParts {
+        mode: &mode,
+        method: &method,
+        grid: &grid,
+        surface: surface.as_deref(),
+        fill: fill.as_deref(),
+        hollow,
+        gpu_path: &gpu_path,
+        format: target.name(),
+        colour_rule: &rule,
+        normals,
+        dither,
+    });
+    let opts = voxkit_job::batch::BatchOptions {
+        plan,
+        format: target,
+        carry: CarryOptions { rule: self::colour_rule(&rule).map_err(py_err)?, normals },
+        write: voxkit_io::WriteOptions { dither, blocks: None },
+        threads,
+        fingerprint,
+    };
+    Ok((opts, jobs))
+}
+
+/// The native batch: see `voxkit.batch`.
+#[pyfunction]
+#[pyo3(signature = (inputs, out_dir, format="npy", glob=None, options=None))]
+fn batch<'py>(
+    py: Python<'py>,
+    inputs: Vec<PathBuf>,
+    out_dir: PathBuf,
+    format: &str,
+    glob: Option<String>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let empty = PyDict::new(py);
+    let (opts, jobs) = batch_options(options.unwrap_or(&empty), format)?;
+    let summary = py
+        .detach(move || -> Result<voxkit_job::batch::Summary, JobError> {
+            let files = voxkit_job::batch::collect_inputs(&inputs, glob.as_deref())?;
+            let ext = opts.format.name().replace("npy-bool", "npy");
+            let items = voxkit_job::batch::plan_items(&files, &out_dir, &ext)?;
+            let pool = voxkit_job::pool(jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)))?;
+            pool.install(|| voxkit_job::batch::run(&items, &out_dir, &opts, &voxkit_job::batch::Silent))
+        })
+        .map_err(py_err)?;
+    to_py(py, &summary.to_json())
+}
+
+/// The batch plan without running it: `[(input, output), ...]` and the
+/// options' fingerprint (for the Dask and Ray helpers, which run
+/// [`process_one`] per mesh and write the same manifest).
+#[pyfunction]
+#[pyo3(signature = (inputs, out_dir, format="npy", glob=None, options=None))]
+fn batch_plan<'py>(
+    py: Python<'py>,
+    inputs: Vec<PathBuf>,
+    out_dir: PathBuf,
+    format: &str,
+    glob: Option<String>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<BatchListing<'py>> {
+    let empty = PyDict::new(py);
+    let (opts, _) = batch_options(options.unwrap_or(&empty), format)?;
+    let files = voxkit_job::batch::collect_inputs(&inputs, glob.as_deref()).map_err(py_err)?;
+    let ext = opts.format.name().replace("npy-bool", "npy");
+    let items = voxkit_job::batch::plan_items(&files, &out_dir, &ext).map_err(py_err)?;
+    std::fs::create_dir_all(&out_dir).map_err(|e| io_err(voxkit_io::IoError::new(&out_dir, voxkit_io::ErrorKind::Write(e))))?;
+    let manifest = voxkit_job::batch::Manifest::open(&out_dir).map_err(py_err)?;
+    let listed = items
+        .iter()
+        .map(|i| (i.input.display().to_string(), i.output.display().to_string(), manifest.is_done(i, &opts.fingerprint)))
+        .collect();
+    Ok((listed, to_py(py, &opts.fingerprint)?))
+}
+
+/// One mesh of a batch: voxelizes `input`, writes `output`, returns the
+/// manifest record (a dict; failures are its `error`, never exceptions).
+#[pyfunction]
+#[pyo3(signature = (input, output, format="npy", options=None))]
+fn process_one<'py>(
+    py: Python<'py>,
+    input: PathBuf,
+    output: PathBuf,
+    format: &str,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let empty = PyDict::new(py);
+    let (mut opts, _) = batch_options(options.unwrap_or(&empty), format)?;
+    opts.threads = opts.threads.or(Some(1));
+    let item = voxkit_job::batch::Item { input, output };
+    let record = py.detach(move || voxkit_job::batch::process_one(&item, &opts));
+    to_py(py, &record)
+}
+
+/// Appends records (dicts or JSON strings) to `out_dir`'s manifest, one
+/// line each.
+#[pyfunction]
+fn append_manifest(py: Python<'_>, out_dir: PathBuf, records: Vec<String>) -> PyResult<()> {
+    py.detach(move || -> Result<(), JobError> {
+        let m = voxkit_job::batch::Manifest::open(&out_dir)?;
+        for r in records {
+            let v: Value = serde_json::from_str(&r).map_err(|e| JobError::invalid(format!("manifest record is not JSON: {e}")))?;
+            m.append(&v)?;
+        }
+        Ok(())
+    })
+    .map_err(py_err)
+}
+
+#[pymodule]
+fn _voxkit(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("FileFormatError", m.py().get_type::<FileFormatError>())?;
+    m.add_class::<Mesh>()?;
+    m.add_class::<VoxelGrid>()?;
+    m.add_function(wrap_pyfunction!(load_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(voxelize, m)?)?;
+    m.add_function(wrap_pyfunction!(load_voxels, m)?)?;
+    m.add_function(wrap_pyfunction!(batch, m)?)?;
+    m.add_function(wrap_pyfunction!(batch_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(process_one, m)?)?;
+    m.add_function(wrap_pyfunction!(append_manifest, m)?)?;
+    Ok(())
+}

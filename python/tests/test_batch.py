@@ -1,0 +1,148 @@
+"""Whole datasets: `voxkit batch`, `voxkit.batch`, and the Dask and Ray
+helpers write the same outputs and manifest lines, and resume each other."""
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+import voxkit
+from conftest import run_cli
+
+MESHES = ["cow.obj", "suzanne.obj", "teapot.obj", "woody.obj", "beetle.obj", "alligator.obj"]
+
+
+@pytest.fixture()
+def dataset(tmp_path, meshes):
+    """A small tree of meshes, a broken one among them."""
+    root = tmp_path / "in"
+    for n, name in enumerate(MESHES):
+        d = root / ("a" if n % 2 else "b") / ("deep" if n % 3 == 0 else "")
+        d.mkdir(parents=True, exist_ok=True)
+        shutil.copy(meshes / name, d / name)
+    (root / "b" / "broken.obj").write_text("v 0 0 0\nf 1 2 3\n")
+    (root / "notes.txt").write_text("not a mesh")
+    return root
+
+
+def manifest(out):
+    """The manifest's records; a torn line (a crash mid-write) is skipped, as voxkit does."""
+    records = []
+    for line in (out / "manifest.jsonl").read_text().splitlines():
+        try:
+            records.append(json.loads(line))
+        except json.JSONDecodeError:
+            pass
+    return records
+
+
+def outputs(out):
+    return {p.relative_to(out).as_posix(): np.load(p) for p in sorted(out.rglob("*.npy"))}
+
+
+def test_python_batch_equals_cli_batch_and_resumes(tmp_path, dataset, cli):
+    cli_out, py_out = tmp_path / "cli", tmp_path / "py"
+    r = run_cli(cli, "batch", dataset, "-o", cli_out, "--resolution", 32, "--mode", "sep6", "--json", check=False)
+    assert r.returncode == 1 and "1 of 7 meshes failed" in r.stderr
+    summary = json.loads(r.stdout)
+    assert (summary["done"], summary["failed"], summary["skipped"]) == (6, 1, 0)
+    s = voxkit.batch(dataset, py_out, resolution=32, mode="sep6")
+    assert (s["done"], s["failed"], s["skipped"]) == (6, 1, 0)
+    a, b = outputs(cli_out), outputs(py_out)
+    assert a.keys() == b.keys() and len(a) == 6
+    assert "b/deep/cow.npy" in a  # the input tree is mirrored
+    for k in a:
+        assert np.array_equal(a[k], b[k]), k
+    # The same voxels as voxelize().
+    one = voxkit.voxelize(voxkit.load_mesh(dataset / "b" / "deep" / "cow.obj"), mode="sep6", resolution=32).occupancy
+    assert np.array_equal(b["b/deep/cow.npy"].astype(bool), one)
+    lines = manifest(py_out)
+    assert {line["status"] for line in lines} == {"done", "failed"}
+    failed = [line for line in lines if line["status"] == "failed"]
+    assert len(failed) == 1 and "broken.obj" in failed[0]["input"] and failed[0]["error"]
+    done = [line for line in lines if line["status"] == "done"][0]
+    assert set(done) >= {"input", "output", "grid", "voxels", "times", "options", "error"}
+    # Resuming: the done ones are skipped, the failed one is tried again.
+    s2 = voxkit.batch(dataset, py_out, resolution=32, mode="sep6")
+    assert (s2["done"], s2["failed"], s2["skipped"]) == (0, 1, 6)
+    # The CLI resumes the Python run (same options, same manifest).
+    r2 = json.loads(run_cli(cli, "batch", dataset, "-o", py_out, "--resolution", 32, "--mode", "sep6", "--json", check=False).stdout)
+    assert r2["skipped"] == 6
+    # Other options redo everything.
+    s3 = voxkit.batch(dataset, py_out, resolution=16, mode="sep6")
+    assert s3["done"] == 6
+
+
+def test_a_deleted_or_torn_output_is_redone(tmp_path, dataset):
+    out = tmp_path / "o"
+    voxkit.batch(dataset, out, resolution=16, glob="**/*.obj")
+    victim = out / "a" / "suzanne.npy"
+    victim.unlink()
+    # A torn manifest line (a crash mid-write) is ignored.
+    with open(out / "manifest.jsonl", "a") as f:
+        f.write('{"input": "x", "status": "do')
+    s = voxkit.batch(dataset, out, resolution=16, glob="**/*.obj")
+    assert (s["done"], s["skipped"]) == (1, 5) and victim.exists()
+    # The next record starts on a line of its own.
+    assert manifest(out)[-1]["input"].endswith("suzanne.obj")
+
+
+def test_batch_errors(tmp_path, dataset, meshes):
+    with pytest.raises(ValueError, match="no input meshes found"):
+        voxkit.batch(dataset, tmp_path / "o", glob="**/*.stl")
+    clash = tmp_path / "clash"
+    clash.mkdir()
+    shutil.copy(meshes / "cow.obj", clash / "m.obj")
+    (clash / "m.stl").write_bytes(b"solid x\nendsolid x\n")
+    with pytest.raises(ValueError, match="would both be written to"):
+        voxkit.batch(clash, tmp_path / "o2")
+    with pytest.raises(ValueError, match="unknown batch option"):
+        voxkit.batch(dataset, tmp_path / "o3", resolutoin=3)
+    with pytest.raises(FileNotFoundError):
+        voxkit.batch(tmp_path / "missing", tmp_path / "o4")
+
+
+def test_dask_local_cluster_writes_what_batch_writes(tmp_path, dataset):
+    dask = pytest.importorskip("dask")
+    distributed = pytest.importorskip("dask.distributed")
+    import voxkit.dask as vd
+
+    ref = tmp_path / "ref"
+    voxkit.batch(dataset, ref, resolution=24, glob="**/*.obj")
+    out = tmp_path / "dask"
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with distributed.Client(cluster):
+            bag = vd.voxelize_paths([dataset], out, resolution=24, glob="**/*.obj")
+            assert isinstance(bag, dask.bag.Bag) and bag.npartitions >= 2
+            records = bag.compute()
+    assert sorted(r["status"] for r in records) == ["done"] * 6 + ["failed"]
+    a, b = outputs(ref), outputs(out)
+    assert a.keys() == b.keys()
+    for k in a:
+        assert np.array_equal(a[k], b[k]), k
+    assert len(manifest(out)) == 7
+    # voxkit batch resumes the Dask run.
+    s = voxkit.batch(dataset, out, resolution=24, glob="**/*.obj")
+    assert s["skipped"] == 6
+
+
+def test_ray_tasks_write_what_batch_writes(tmp_path, dataset):
+    ray = pytest.importorskip("ray")
+    import voxkit.ray as vr
+
+    ref = tmp_path / "ref"
+    voxkit.batch(dataset, ref, resolution=24, glob="**/*.obj")
+    out = tmp_path / "ray"
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, ignore_reinit_error=True)
+    try:
+        records = vr.voxelize_paths([dataset], out, resolution=24, glob="**/*.obj")
+    finally:
+        ray.shutdown()
+    assert sorted(r["status"] for r in records) == ["done"] * 6 + ["failed"]
+    a, b = outputs(ref), outputs(out)
+    assert a.keys() == b.keys()
+    for k in a:
+        assert np.array_equal(a[k], b[k]), k
+    s = voxkit.batch(dataset, out, resolution=24, glob="**/*.obj")
+    assert s["skipped"] == 6
