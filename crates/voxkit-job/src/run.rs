@@ -72,7 +72,8 @@ pub struct Voxelized {
     pub gpu: Value,
     /// Things the user should know.
     pub warnings: Vec<String>,
-    /// Seconds spent voxelizing (the mesh loaded, the voxels in memory).
+    /// Seconds spent voxelizing: from the loaded mesh to the voxels in
+    /// memory (fitting the grid and choosing the path included).
     pub voxelize_s: f64,
 }
 
@@ -93,6 +94,7 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
             plan.request.mode.name()
         ));
     }
+    let t = Instant::now();
     let grid = plan.request.grid.fit(&mesh.bounds())?;
     crate::memory::check_memory(&grid)?;
     let surface_method = if plan.request.method == crate::plan::Method::Auto && plan.solid.is_none() {
@@ -101,7 +103,6 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
         plan.surface_method
     };
     let opts = Options { progress, ..Options::default() };
-    let t = Instant::now();
     let mut gpu = Value::Null;
     let (voxels, report, method, solid) = if let Some(sp) = &plan.solid {
         let out = crate::solid::run(sp, mesh, name, &grid, &opts)?;

@@ -97,9 +97,8 @@ pub fn prefers(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec) -> bool {
         .iter()
         .step_by(step)
         .filter_map(|t| {
-            let p: Option<Vec<_>> = t.iter().map(|&i| mesh.positions.get(i as usize).copied()).collect();
-            let p = p?;
-            let e = (p[0].max(p[1]).max(p[2]) - p[0].min(p[1]).min(p[2])).max_element() / grid.voxel_size();
+            let [a, b, c] = [mesh.positions.get(t[0] as usize)?, mesh.positions.get(t[1] as usize)?, mesh.positions.get(t[2] as usize)?];
+            let e = (a.max(*b).max(*c) - a.min(*b).min(*c)).max_element() / grid.voxel_size();
             e.is_finite().then_some(e)
         })
         .collect();
