@@ -240,11 +240,12 @@ impl Mesh {
     }
 }
 
-/// load_mesh(path) -> Mesh
+/// load_mesh(path, allow_external_paths=False) -> Mesh
 #[pyfunction]
-fn load_mesh(py: Python<'_>, path: PathBuf) -> PyResult<Mesh> {
+#[pyo3(signature = (path, allow_external_paths=false))]
+fn load_mesh(py: Python<'_>, path: PathBuf, allow_external_paths: bool) -> PyResult<Mesh> {
     let p = path.clone();
-    let loaded = py.detach(move || voxkit_io::read_mesh(&p)).map_err(io_err)?;
+    let loaded = py.detach(move || voxkit_io::read_mesh_with(&p, &voxkit_io::ReadOptions { allow_external_paths })).map_err(io_err)?;
     Ok(Mesh { inner: Arc::new(loaded), path: Some(path) })
 }
 
@@ -718,6 +719,14 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
         carry: CarryOptions { rule: self::colour_rule(&rule).map_err(py_err)?, normals },
         write: voxkit_io::WriteOptions { dither, blocks: None },
         threads,
+        read: voxkit_io::ReadOptions {
+            allow_external_paths: options
+                .get_item("allow_external_paths")?
+                .filter(|v| !v.is_none())
+                .map(|v| v.extract())
+                .transpose()?
+                .unwrap_or(false),
+        },
         fingerprint,
     };
     Ok((opts, jobs))

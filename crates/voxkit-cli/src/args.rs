@@ -117,7 +117,13 @@ pub struct GridArgs {
 pub struct VoxelizeArgs {
     /// Input mesh (.obj, .stl, .ply, .gltf, .glb).
     pub mesh: PathBuf,
-    /// Output voxel file; the format comes from the extension unless --format is given.
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder: absolute paths,
+    /// `../`, links leading out. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
+    /// Output voxel file; the format comes from the extension unless
+    /// --format is given. `-` writes to standard output (with --format).
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Voxelization mode.
@@ -224,6 +230,11 @@ pub struct PictureArgs {
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder: absolute paths,
+    /// `../`, links leading out. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
     /// A voxel file (.npy, .binvox, .vox, .txt) or a mesh (voxelized first, with --mode and the grid options).
     pub input: PathBuf,
     /// Output picture (.png).
@@ -249,6 +260,11 @@ pub struct RenderArgs {
 
 #[derive(Args, Debug)]
 pub struct CheckArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder: absolute paths,
+    /// `../`, links leading out. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
     /// Voxel file written by voxkit (.npy, .binvox, .vox, .txt).
     pub voxels: PathBuf,
     /// The source mesh (a closed surface for the separation checks).
@@ -269,6 +285,11 @@ pub struct CheckArgs {
 
 #[derive(Args, Debug)]
 pub struct InfoArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder: absolute paths,
+    /// `../`, links leading out. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
     /// Input mesh.
     pub mesh: PathBuf,
     /// Print one JSON object.
@@ -363,6 +384,11 @@ pub struct ConvertArgs {
 
 #[derive(Args, Debug)]
 pub struct BatchArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder: absolute paths,
+    /// `../`, links leading out. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
     /// Input meshes, or folders searched (recursively) for them.
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,

@@ -218,7 +218,25 @@ fn adapter() -> Result<wgpu::Adapter, GpuError> {
 /// WARP)? Asks for the adapter only: no device, no pipelines, so a caller
 /// deciding whether to use the GPU pays little.
 pub fn hardware_adapter() -> Result<bool, GpuError> {
+    if !hardware_plausible() {
+        return Ok(false);
+    }
     Ok(adapter()?.get_info().device_type != wgpu::DeviceType::Cpu)
+}
+
+/// On Linux a hardware GPU is reached through a DRM render node or the
+/// NVIDIA device files; without either there is none to find, and asking
+/// the Vulkan loader would only wake Mesa's software driver and its
+/// device-selection layer, which prints to stderr when no display is set
+/// up (`XDG_RUNTIME_DIR is invalid`). Elsewhere (Metal, DX12), ask.
+fn hardware_plausible() -> bool {
+    if !cfg!(target_os = "linux") {
+        return true;
+    }
+    let any_in = |dir: &str, prefix: &str| {
+        std::fs::read_dir(dir).is_ok_and(|d| d.flatten().any(|e| e.file_name().to_string_lossy().starts_with(prefix)))
+    };
+    any_in("/dev/dri", "renderD") || any_in("/dev", "nvidia")
 }
 
 /// An open GPU device with the voxelization pipelines.

@@ -17,13 +17,24 @@ use voxkit::attributes::{Appearance, Material, Texture, Wrap};
 
 use crate::error::ErrorKind;
 use crate::mesh_report::{finish, LoadedMesh};
+use crate::resources::Resources;
 
-/// Parses glTF JSON or GLB bytes; `base_dir` resolves external buffer URIs.
-pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKind> {
+/// Parses glTF JSON or GLB bytes; `res` resolves external buffer and
+/// image URIs (a buffer outside the model's folder is an error, an image a
+/// warning).
+pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKind> {
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(bytes).map_err(|e| ErrorKind::malformed("glTF", e))?;
+    for b in document.buffers() {
+        if let gltf::buffer::Source::Uri(uri) = b.source() {
+            if let Some(reference) = Resources::uri_path(uri) {
+                res.resolve(&reference).map_err(|why| ErrorKind::malformed("glTF", format!("buffer {}: {why}", b.index())))?;
+            }
+        }
+    }
+    let base_dir = res.base();
     let buffers = gltf::import_buffers(&document, base_dir, blob).map_err(|e| ErrorKind::malformed("glTF", format!("buffer: {e}")))?;
     let mut out = Builder::default();
-    out.materials(&document, &buffers, base_dir);
+    out.materials(&document, &buffers, base_dir, res);
     let scene = document.default_scene().or_else(|| document.scenes().next());
     match scene {
         Some(scene) => {
@@ -65,7 +76,7 @@ struct Builder {
 
 impl Builder {
     /// Every material of the document, plus glTF's default material (white, last).
-    fn materials(&mut self, document: &gltf::Document, buffers: &[gltf::buffer::Data], base_dir: Option<&Path>) {
+    fn materials(&mut self, document: &gltf::Document, buffers: &[gltf::buffer::Data], base_dir: Option<&Path>, res: &Resources) {
         let mut decoded: Vec<Option<Option<u32>>> = vec![None; document.textures().len()];
         for m in document.materials() {
             let pbr = m.pbr_metallic_roughness();
@@ -75,7 +86,7 @@ impl Builder {
             if let Some(info) = pbr.base_color_texture() {
                 set = info.tex_coord();
                 let t = info.texture();
-                texture = *decoded[t.index()].get_or_insert_with(|| match self.texture(&t, buffers, base_dir) {
+                texture = *decoded[t.index()].get_or_insert_with(|| match self.texture(&t, buffers, base_dir, res) {
                     Ok(tex) => {
                         self.app.textures.push(tex);
                         Some(self.app.textures.len() as u32 - 1)
@@ -94,7 +105,18 @@ impl Builder {
         self.tex_coord.push(0);
     }
 
-    fn texture(&self, t: &gltf::Texture<'_>, buffers: &[gltf::buffer::Data], base_dir: Option<&Path>) -> Result<Texture, String> {
+    fn texture(
+        &self,
+        t: &gltf::Texture<'_>,
+        buffers: &[gltf::buffer::Data],
+        base_dir: Option<&Path>,
+        res: &Resources,
+    ) -> Result<Texture, String> {
+        if let gltf::image::Source::Uri { uri, .. } = t.source().source() {
+            if let Some(reference) = Resources::uri_path(uri) {
+                res.resolve(&reference).map_err(|why| format!("image {why}"))?;
+            }
+        }
         let wrap = |m: WrappingMode| match m {
             WrappingMode::ClampToEdge => Wrap::ClampToEdge,
             WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,

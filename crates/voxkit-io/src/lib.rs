@@ -21,6 +21,7 @@ pub mod ply;
 pub mod png;
 pub mod points;
 pub mod polyline;
+mod resources;
 pub mod schem;
 pub mod stl;
 pub mod text;
@@ -34,6 +35,7 @@ use std::path::Path;
 pub use error::{ErrorKind, IoError};
 pub use mesh_report::{validate_mesh, LoadedMesh, MeshReport};
 pub use png::write_png;
+pub use resources::ReadOptions;
 use voxkit::attributes::VoxelAttributes;
 use voxkit::{DenseBits, GridSpec, VoxelSource};
 
@@ -66,20 +68,36 @@ impl MeshFormat {
     }
 }
 
-/// Reads a mesh file, choosing the format from its extension.
+/// Reads a mesh file, choosing the format from its extension; external
+/// files it names are read only from inside its folder.
 pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
+    read_mesh_with(path, &ReadOptions::default())
+}
+
+/// [`read_mesh`] with options (external paths allowed or not). The
+/// result's `sources` lists the mesh file and every file it led to.
+pub fn read_mesh_with(path: &Path, opts: &ReadOptions) -> Result<LoadedMesh, IoError> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     let format = MeshFormat::from_extension(ext).ok_or_else(|| {
         IoError::new(path, ErrorKind::UnknownFormat { ext: ext.to_string(), expected: "obj, stl, ply, gltf, glb, lines" })
     })?;
     let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
     let base = path.parent().unwrap_or(Path::new("."));
-    read_mesh_bytes(&bytes, format, Some(base)).map_err(|kind| IoError::new(path, kind))
+    let res = resources::Resources::new(Some(base), opts);
+    let mut loaded = read_with(&bytes, format, &res).map_err(|kind| IoError::new(path, kind))?;
+    loaded.sources.push(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()));
+    loaded.sources.extend(res.used());
+    Ok(loaded)
 }
 
 /// Parses a mesh from memory. `base_dir` resolves relative references
-/// (OBJ material libraries, glTF external buffers); `None` disables them.
+/// (OBJ material libraries and textures, glTF external buffers and images),
+/// inside that folder only; `None` disables them.
 pub fn read_mesh_bytes(bytes: &[u8], format: MeshFormat, base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKind> {
+    read_with(bytes, format, &resources::Resources::new(base_dir, &ReadOptions::default()))
+}
+
+fn read_with(bytes: &[u8], format: MeshFormat, res: &resources::Resources) -> Result<LoadedMesh, ErrorKind> {
     let name = match format {
         MeshFormat::Obj => "OBJ",
         MeshFormat::Stl => "STL",
@@ -88,10 +106,10 @@ pub fn read_mesh_bytes(bytes: &[u8], format: MeshFormat, base_dir: Option<&Path>
         MeshFormat::Polyline => "polyline",
     };
     fence(name, || match format {
-        MeshFormat::Obj => obj::read(bytes, base_dir),
+        MeshFormat::Obj => obj::read(bytes, res),
         MeshFormat::Stl => stl::read(bytes),
         MeshFormat::Ply => ply::read(bytes),
-        MeshFormat::Gltf => gltf::read(bytes, base_dir),
+        MeshFormat::Gltf => gltf::read(bytes, res),
         MeshFormat::Polyline => polyline::read(bytes),
     })
 }

@@ -34,6 +34,10 @@ pub struct LoadedMesh {
     /// Materials, textures, UVs and vertex colours, aligned with the
     /// triangles and vertices of `mesh` (empty lists where the file has none).
     pub appearance: Appearance,
+    /// The files it was read from: the mesh file and every file it named
+    /// that was read (material libraries, textures, buffers), resolved.
+    /// Writers refuse to write over any of them.
+    pub sources: Vec<std::path::PathBuf>,
 }
 
 /// Validates and packages reader output: every coordinate finite, every
@@ -77,7 +81,7 @@ pub(crate) fn finish_with_segments(
         segments: mesh.segments.len(),
         bounds: r.bounds(),
     };
-    Ok(LoadedMesh { mesh, report, warnings, appearance: Appearance::default() })
+    Ok(LoadedMesh { mesh, report, warnings, appearance: Appearance::default(), sources: Vec::new() })
 }
 
 /// Converts index tuples to `u32`, or the error `bad(element, index)` for

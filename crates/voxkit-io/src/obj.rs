@@ -27,6 +27,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::error::ErrorKind;
+use crate::resources::Resources;
 use voxkit::attributes::{Appearance, Material, NO_MATERIAL};
 
 use crate::mesh_report::{finish_with_segments, LoadedMesh};
@@ -67,8 +68,8 @@ struct Counts {
     lines: usize,
 }
 
-/// Parses OBJ bytes; `base_dir` is where `mtllib` files are looked up.
-pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKind> {
+/// Parses OBJ bytes; `res` resolves `mtllib` and `map_Kd` files.
+pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKind> {
     let chunks = split_at_lines(bytes, rayon::current_num_threads() * 4);
     let counts: Vec<Counts> = chunks.par_iter().map(|c| count(c)).collect();
     let mut before = Vec::with_capacity(chunks.len());
@@ -91,11 +92,15 @@ pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKi
     }
     let mut materials: Vec<tobj::Material> = Vec::new();
     for lib in libs {
-        let Some(dir) = base_dir else { continue };
-        let full = dir.join(lib);
-        match tobj::load_mtl(&full) {
-            Ok((mats, _)) => materials.extend(mats),
-            Err(_) => warnings.push(format!("material library {} could not be read; materials ignored", full.display())),
+        if res.base().is_none() {
+            continue;
+        }
+        match res.resolve(Path::new(lib)) {
+            Ok(full) => match tobj::load_mtl(&full) {
+                Ok((mats, _)) => materials.extend(mats),
+                Err(_) => warnings.push(format!("material library {} could not be read; materials ignored", full.display())),
+            },
+            Err(why) => warnings.push(format!("material library {why}; materials ignored")),
         }
     }
     let by_name: HashMap<&str, u32> = materials.iter().enumerate().rev().map(|(i, m)| (m.name.as_str(), i as u32)).collect();
@@ -131,12 +136,12 @@ pub fn read(bytes: &[u8], base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKi
     }
 
     let mut app = Appearance::default();
-    if let Some(dir) = base_dir {
+    if res.base().is_some() {
         for (index, mat) in materials.iter().enumerate() {
             let factor = mat.diffuse.unwrap_or([1.0; 3]);
             let texture = mat.diffuse_texture.as_deref().filter(|t| !t.trim().is_empty()).and_then(|statement| {
-                let (path, wrap) = crate::texture::parse_map_statement(statement, dir);
-                match crate::texture::load(&path, wrap) {
+                let (reference, wrap) = crate::texture::parse_map_statement(statement);
+                match res.resolve(&reference).and_then(|path| crate::texture::load(&path, wrap)) {
                     Ok(t) => {
                         app.textures.push(t);
                         Some(app.textures.len() as u32 - 1)
@@ -352,7 +357,7 @@ mod tests {
         text += "usemtl blue\nf 1 2 3\n";
         let chunks = split_at_lines(text.as_bytes(), 8);
         assert!(chunks.len() > 2, "{}", chunks.len());
-        let m = read(text.as_bytes(), None).unwrap();
+        let m = read(text.as_bytes(), &Resources::new(None, &Default::default())).unwrap();
         assert_eq!(m.mesh.triangles.len(), 60_001);
         assert_eq!(m.mesh.triangles[59_999], [179_997, 179_998, 179_999]);
         assert_eq!(m.mesh.triangles[60_000], [0, 1, 2]);
@@ -360,9 +365,9 @@ mod tests {
 
     #[test]
     fn errors_name_the_line() {
-        let e = read(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", None).unwrap_err().to_string();
+        let e = read(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", &Resources::new(None, &Default::default())).unwrap_err().to_string();
         assert!(e.contains("line 4"), "{e}");
-        let e = read(b"v 0 0 0\nf 0 1 2\n", None).unwrap_err().to_string();
+        let e = read(b"v 0 0 0\nf 0 1 2\n", &Resources::new(None, &Default::default())).unwrap_err().to_string();
         assert!(e.contains("index 0"), "{e}");
     }
 }

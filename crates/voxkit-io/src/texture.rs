@@ -30,9 +30,10 @@ pub fn decode(bytes: &[u8], name: &str, wrap: [Wrap; 2]) -> Result<Texture, Stri
     Ok(Texture { name: name.to_string(), width: img.width(), height: img.height(), rgba: img.into_raw(), wrap })
 }
 
-/// An MTL texture statement (`map_Kd [options] file`): the file and the
-/// wrap mode (`-clamp on` clamps; the default repeats). Other options are skipped.
-pub fn parse_map_statement(statement: &str, base: &Path) -> (PathBuf, [Wrap; 2]) {
+/// An MTL texture statement (`map_Kd [options] file`): the file (as
+/// written, relative to the model's folder unless absolute) and the wrap
+/// mode (`-clamp on` clamps; the default repeats). Other options are skipped.
+pub fn parse_map_statement(statement: &str) -> (PathBuf, [Wrap; 2]) {
     let words: Vec<&str> = statement.split_whitespace().collect();
     let mut wrap = Wrap::Repeat;
     let mut at = 0;
@@ -55,7 +56,7 @@ pub fn parse_map_statement(statement: &str, base: &Path) -> (PathBuf, [Wrap; 2])
             taken += 1;
         }
     }
-    (base.join(words[at.min(words.len().saturating_sub(1))..].join(" ")), [wrap; 2])
+    (PathBuf::from(words[at.min(words.len().saturating_sub(1))..].join(" ")), [wrap; 2])
 }
 
 #[cfg(test)]
@@ -64,10 +65,9 @@ mod tests {
 
     #[test]
     fn map_statements() {
-        let b = Path::new("/m");
-        assert_eq!(parse_map_statement("tex.png", b), (PathBuf::from("/m/tex.png"), [Wrap::Repeat; 2]));
-        assert_eq!(parse_map_statement("-clamp on a b.png", b), (PathBuf::from("/m/a b.png"), [Wrap::ClampToEdge; 2]));
-        assert_eq!(parse_map_statement("-s 1 1 1 -o 0 0 t.jpg", b), (PathBuf::from("/m/t.jpg"), [Wrap::Repeat; 2]));
-        assert_eq!(parse_map_statement("-bm 0.5 -imfchan r x.png", b).0, PathBuf::from("/m/x.png"));
+        assert_eq!(parse_map_statement("tex.png"), (PathBuf::from("tex.png"), [Wrap::Repeat; 2]));
+        assert_eq!(parse_map_statement("-clamp on a b.png"), (PathBuf::from("a b.png"), [Wrap::ClampToEdge; 2]));
+        assert_eq!(parse_map_statement("-s 1 1 1 -o 0 0 t.jpg"), (PathBuf::from("t.jpg"), [Wrap::Repeat; 2]));
+        assert_eq!(parse_map_statement("-bm 0.5 -imfchan r x.png").0, PathBuf::from("x.png"));
     }
 }

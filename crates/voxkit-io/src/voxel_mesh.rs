@@ -38,6 +38,14 @@ pub fn write_quads_obj(path: &Path, quads: &[Quad], grid: &GridSpec, palette: Op
         })
         .collect();
     let (o, s) = (grid.origin(), grid.voxel_size());
+    if palette.is_some() && !matches!(crate::atomic::target(path), crate::atomic::Target::Regular(_)) {
+        return Err(IoError::new(
+            path,
+            crate::error::ErrorKind::Write(std::io::Error::other(
+                "a coloured .obj needs its .mtl file beside it; write it to a regular file (or use .glb, which holds its colours)",
+            )),
+        ));
+    }
     let mtl = palette.map(|p| (path.with_extension("mtl"), p));
     if let Some((mtl_path, p)) = &mtl {
         write_atomically(mtl_path, |w| {

@@ -54,6 +54,8 @@ pub struct BatchOptions {
     pub write: WriteOptions,
     /// Worker threads per mesh (`None`: share the batch's pool).
     pub threads: Option<usize>,
+    /// How meshes are read (external paths allowed or not).
+    pub read: voxkit_io::ReadOptions,
     /// The options as the user gave them, recorded in each manifest line
     /// and compared on resume.
     pub fingerprint: Value,
@@ -232,8 +234,9 @@ pub fn process_one(item: &Item, opts: &BatchOptions) -> Value {
             std::fs::create_dir_all(dir).map_err(|e| JobError::Io(voxkit_io::IoError::new(dir, voxkit_io::ErrorKind::Write(e))))?;
         }
         let t = Instant::now();
-        let loaded = voxkit_io::read_mesh(&item.input)?;
+        let loaded = voxkit_io::read_mesh_with(&item.input, &opts.read)?;
         let load_s = t.elapsed().as_secs_f64();
+        crate::output::refuse_overwriting(&item.output, opts.format, &loaded.sources)?;
         let name = item.input.display().to_string();
         let run = || -> Result<Value> {
             let v = crate::voxelize(&opts.plan, loaded.mesh.as_ref(), &name, None)?;

@@ -79,9 +79,32 @@ pub fn output_format(format: Option<&str>, output: &Path) -> Result<Output> {
     }
 }
 
+/// Every file writing `out` as `target` creates: the output, and for an
+/// `.obj` the `.mtl` beside it (named after the output's stem).
+pub fn files_written(out: &Path, target: Output) -> Vec<std::path::PathBuf> {
+    let mut v = vec![out.to_path_buf()];
+    if target == Output::Mesh(MeshKind::Obj) && out.as_os_str() != "-" {
+        v.push(out.with_extension("mtl"));
+    }
+    v
+}
+
+/// Refuses, before anything is written, an output (or a file written beside
+/// it) that is one of `inputs` by identity — the same file by any name,
+/// link or hard link: one line naming both.
+pub fn refuse_overwriting(out: &Path, target: Output, inputs: &[std::path::PathBuf]) -> Result<()> {
+    for f in files_written(out, target) {
+        voxkit_io::atomic::refuse_overwriting_inputs(&f, inputs)?;
+    }
+    Ok(())
+}
+
 /// Checks, before any work, that `out` can be created: its folder exists
-/// and it is not a folder itself.
+/// and it is not a folder itself (`-` is standard output).
 pub fn check_output_path(out: &Path) -> Result<()> {
+    if out.as_os_str() == "-" {
+        return Ok(());
+    }
     let dir = match out.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),

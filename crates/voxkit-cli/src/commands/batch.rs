@@ -55,6 +55,7 @@ pub fn run(a: &BatchArgs) -> Result<()> {
         carry: CarryOptions { rule: crate::commands::export::colour_rule(a.export.colour_rule), normals: a.export.normals },
         write,
         threads: None,
+        read: voxkit_io::ReadOptions { allow_external_paths: a.allow_external_paths },
         fingerprint,
     };
     let files = batch::collect_inputs(&a.inputs, a.glob.as_deref())?;

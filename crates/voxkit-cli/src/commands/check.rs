@@ -14,7 +14,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     let dims = loaded.bits.dims();
     let mesh = match &a.mesh {
         Some(path) => {
-            let m = voxkit_io::read_mesh(path)?;
+            let m = voxkit_io::read_mesh_with(path, &voxkit_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
             for w in &m.warnings {
                 eprintln!("voxkit: warning: {}: {w}", path.display());
             }

@@ -10,6 +10,7 @@ use crate::args::ConvertArgs;
 pub fn run(a: &ConvertArgs) -> Result<()> {
     let format = voxkit_job::output::output_format(a.format.as_deref(), &a.output)?;
     voxkit_job::output::check_output_path(&a.output)?;
+    voxkit_job::output::refuse_overwriting(&a.output, format, std::slice::from_ref(&a.input))?;
     let write_opts = crate::commands::export::writer_options(&a.export)?;
     let loaded = voxkit_io::read_voxels(&a.input)?;
     let dims = loaded.bits.dims();

@@ -6,7 +6,7 @@ use serde_json::json;
 use crate::args::InfoArgs;
 
 pub fn run(a: &InfoArgs) -> Result<()> {
-    let loaded = voxkit_io::read_mesh(&a.mesh)?;
+    let loaded = voxkit_io::read_mesh_with(&a.mesh, &voxkit_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
     let r = &loaded.report;
     let (mn, mx) = (r.bounds.min, r.bounds.max);
     let app = &loaded.appearance;

@@ -88,6 +88,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let o = options(&a.picture)?;
     check_png_path(&a.output)?;
     let pool = crate::thread_pool(a.threads)?;
+    voxkit_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.input))?;
     let (bits, what, colours, outline): (Box<dyn VoxelSource + Send>, &str, _, _) = if voxkit_io::is_voxel_file(&a.input) {
         if a.picture.outline {
             bail!("--outline draws the source mesh's silhouette; it needs a mesh input (or voxelize --preview)");
@@ -97,7 +98,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     } else {
         let (mode, _) = voxkit_job::resolve_method(a.mode.into(), voxkit_job::Method::Fast)
             .context("render voxelizes meshes with a surface or line mode; voxelize solids to a file first")?;
-        let loaded = voxkit_io::read_mesh(&a.input)?;
+        let loaded = voxkit_io::read_mesh_with(&a.input, &voxkit_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
+        voxkit_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
         let grid = plan::grid_request(&a.grid)?.fit(&loaded.report.bounds)?;
         plan::check_memory(&grid)?;
         for w in &loaded.warnings {

@@ -17,6 +17,11 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let plan = plan::voxelize_plan(a)?;
     let format = output_format(a.format.as_deref(), &a.output)?;
     check_output_path(&a.output)?;
+    // Nothing is read or written before we know no output is an input.
+    voxkit_job::output::refuse_overwriting(&a.output, format, std::slice::from_ref(&a.mesh))?;
+    if let Some(p) = &a.preview {
+        voxkit_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.mesh))?;
+    }
     let write_opts = crate::commands::export::writer_options(&a.export)?;
     let preview = match &a.preview {
         Some(p) => {
@@ -31,8 +36,13 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let bar = Bar::new(a.quiet || a.json);
     bar.phase("loading mesh");
     let t_load = Instant::now();
-    let loaded = voxkit_io::read_mesh(&a.mesh)?;
+    let loaded = voxkit_io::read_mesh_with(&a.mesh, &voxkit_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
     let load_s = t_load.elapsed().as_secs_f64();
+    // Nor any file the mesh led to (its .mtl, textures, buffers).
+    voxkit_job::output::refuse_overwriting(&a.output, format, &loaded.sources)?;
+    if let Some(p) = &a.preview {
+        voxkit_io::atomic::refuse_overwriting_inputs(p, &loaded.sources)?;
+    }
     for w in &loaded.warnings {
         eprintln!("voxkit: warning: {}: {w}", a.mesh.display());
     }
@@ -75,6 +85,8 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
 
     let o = grid.origin();
     let dims = grid.dims();
+    // With `-o -` the voxels are on stdout: the summary goes to stderr.
+    let to_stdout = a.output.as_os_str() == "-";
     if a.json {
         let mut j = v.facts(&plan);
         let extra = json!({
@@ -106,29 +118,42 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
         if let (Some(obj), Some(add)) = (j.as_object_mut(), extra.as_object()) {
             obj.extend(add.clone());
         }
-        crate::print_stdout(&j.to_string())?;
+        summary(to_stdout, &j.to_string())?;
     } else if !a.quiet {
         let method = match v.solid.get("closed").and_then(|c| c.as_bool()) {
             Some(true) => format!("{} (mesh closed)", v.method),
             Some(false) => format!("{} (mesh not closed)", v.method),
             None => v.method.to_string(),
         };
-        crate::print_stdout(&format!(
-            "{}: {} voxels set on grid {}x{}x{} (origin {}, {}, {}; voxel size {}) by {} in {:.1} ms; total {:.2} s -> {}",
-            plan::mode_name(a.mode),
-            v.report.voxels,
-            dims[0],
-            dims[1],
-            dims[2],
-            o.x,
-            o.y,
-            o.z,
-            grid.voxel_size(),
-            method,
-            v.voxelize_s * 1e3,
-            total_s,
-            a.output.display()
-        ))?;
+        summary(
+            to_stdout,
+            &format!(
+                "{}: {} voxels set on grid {}x{}x{} (origin {}, {}, {}; voxel size {}) by {} in {:.1} ms; total {:.2} s -> {}",
+                plan::mode_name(a.mode),
+                v.report.voxels,
+                dims[0],
+                dims[1],
+                dims[2],
+                o.x,
+                o.y,
+                o.z,
+                grid.voxel_size(),
+                method,
+                v.voxelize_s * 1e3,
+                total_s,
+                a.output.display()
+            ),
+        )?;
     }
     Ok(())
+}
+
+/// Prints the summary on stdout, or on stderr when the voxels went to stdout.
+fn summary(voxels_on_stdout: bool, line: &str) -> Result<()> {
+    if voxels_on_stdout {
+        eprintln!("{line}");
+        Ok(())
+    } else {
+        crate::print_stdout(line)
+    }
 }
