@@ -113,21 +113,33 @@ with tempfile.TemporaryDirectory() as d:
     root = sch["Schematic"] if "Schematic" in sch else sch
     check("schem version 2 (nbtlib)", int(root["Version"]) == 2)
     w, h, l = int(root["Width"]), int(root["Height"]), int(root["Length"])
-    check("schem size (x=i, y=k, z=j)", (w, h, l) == (nx, nz, ny), (w, h, l))
+    # --up y (the default): the mesh's y is Minecraft's height, block (x, y, z) = voxel (i, j, k).
+    check("schem size: Height = the y extent (up y)", (w, h, l) == (nx, ny, nz), (w, h, l))
+    meta = root.get("Metadata")
+    check("schem Metadata WEOffsetX/Y/Z (mcschematic)", meta is not None and all(k in meta for k in ("WEOffsetX", "WEOffsetY", "WEOffsetZ")))
     pal = {str(k): int(v) for k, v in root["Palette"].items()}
     check("schem palette max", int(root["PaletteMax"]) == len(pal))
-    data = bytes(np.asarray(root["BlockData"], dtype=np.int8).astype(np.uint8))
-    ids, v, shift = [], 0, 0
-    for byte in data:
-        v |= (byte & 0x7F) << shift
-        shift += 7
-        if byte < 0x80:
-            ids.append(v)
-            v, shift = 0, 0
-    ids = np.array(ids).reshape(h, l, w)
-    air = pal["minecraft:air"]
-    blocks = (ids != air).transpose(2, 0, 1)  # [x][y][z] = [i][k][ny-1-j]
-    check("schem blocks = npy voxels", np.array_equal(blocks[:, :, ::-1].transpose(0, 2, 1), occ))
+
+    def schem_blocks(root, pal):
+        w, h, l = int(root["Width"]), int(root["Height"]), int(root["Length"])
+        data = bytes(np.asarray(root["BlockData"], dtype=np.int8).astype(np.uint8))
+        ids, v, shift = [], 0, 0
+        for byte in data:
+            v |= (byte & 0x7F) << shift
+            shift += 7
+            if byte < 0x80:
+                ids.append(v)
+                v, shift = 0, 0
+        ids = np.array(ids).reshape(h, l, w)
+        return (ids != pal["minecraft:air"]).transpose(2, 0, 1)  # [x][y][z]
+
+    check("schem blocks = npy voxels (up y: [x][y][z] = [i][j][k])", np.array_equal(schem_blocks(root, pal), occ))
+    # --up z: block (x, y, z) = voxel (i, k, ny-1-j), a rotation about x.
+    voxelize(spot, d / "z.schem", "--resolution", "64", "--up", "z")
+    rz = nbtlib.load(str(d / "z.schem"))
+    rz = rz["Schematic"] if "Schematic" in rz else rz
+    bz = schem_blocks(rz, {str(k): int(v) for k, v in rz["Palette"].items()})
+    check("schem up z: [x][y][z] = [i][k][ny-1-j]", np.array_equal(bz[:, :, ::-1].transpose(0, 2, 1), occ))
 
     from pygltflib import GLTF2
     g = GLTF2().load(str(d / "s.glb"))
@@ -151,19 +163,40 @@ with tempfile.TemporaryDirectory() as d:
     xyzis = [c for i, c in chunks if i == b"XYZI"]
     rgba = [c for i, c in chunks if i == b"RGBA"]
     check("vox has one SIZE per XYZI and a 256-entry RGBA", len(sizes) == len(xyzis) == 1 and len(rgba) == 1 and len(rgba[0]) == 1024)
-    check("vox model size = grid", sizes[0] == (nx, ny, nz), sizes[0])
-    check("vox has a scene graph (nTRN, nGRP, nSHP)", {i for i, _ in chunks} >= {b"nTRN", b"nGRP", b"nSHP"})
+    # --up y (the default): MagicaVoxel (x, y, z) = voxel (i, nz-1-k, j), z up.
+    check("vox model size = grid rotated to z up", sizes[0] == (nx, nz, ny), sizes[0])
+    check("vox of one model has no scene graph", not ({i for i, _ in chunks} & {b"nTRN", b"nGRP", b"nSHP"}))
     pal = np.frombuffer(rgba[0], dtype=np.uint8).reshape(256, 4)
     n = struct.unpack("<i", xyzis[0][:4])[0]
     vx = np.frombuffer(xyzis[0][4:4 + 4 * n], dtype=np.uint8).reshape(n, 4).astype(int)
     check("vox colour indices in 1..255", bool((vx[:, 3] >= 1).all()))
+    ijk = np.stack([vx[:, 0], vx[:, 2], nz - 1 - vx[:, 1]], 1)
     vocc2 = np.zeros_like(occ)
-    vocc2[vx[:, 0], vx[:, 1], vx[:, 2]] = True
+    vocc2[ijk[:, 0], ijk[:, 1], ijk[:, 2]] = True
     check("vox voxels = npy", n == occ.sum() and np.array_equal(vocc2, occ))
     # RGBA entry k is colour index k + 1.
     vox_rgb = pal[vx[:, 3] - 1, :3]
-    want_rgb = vcol[vx[:, 0], vx[:, 1], vx[:, 2]]
+    want_rgb = vcol[ijk[:, 0], ijk[:, 1], ijk[:, 2]]
     check("vox colours = vti colours (fewer than 256 colours: exact palette)", np.array_equal(vox_rgb, want_rgb))
+    # py-vox-io (which reads single-model files) sees the same model.
+    from pyvox.parser import VoxParser
+    dense = VoxParser(str(d / "s.vox")).parse().to_dense()
+    check("vox read by py-vox-io", int((dense > 0).sum()) == int(occ.sum()) and sorted(dense.shape) == sorted((nx, ny, nz)), dense.shape)
+
+    # The mesh of the voxels is watertight (trimesh, vertices merged): no
+    # edge used by a single face; a solid box is watertight outright.
+    import trimesh
+    voxelize(MESHES / "stanford-bunny.obj", d / "b.obj", "--resolution", "128")
+    tm = trimesh.load(str(d / "b.obj"), force="mesh", process=True)
+    counts = np.unique(tm.edges_sorted, axis=0, return_counts=True)[1]
+    check("bunny voxel mesh: no edge used once (trimesh)", int((counts == 1).sum()) == 0, int((counts == 1).sum()))
+    voxelize(MESHES / "cow.obj", d / "c.obj", "--resolution", "32", "--mode", "solid", "--triangulate")
+    tc = trimesh.load(str(d / "c.obj"), force="mesh", process=True)
+    counts = np.unique(tc.edges_sorted, axis=0, return_counts=True)[1]
+    check("cow solid voxel mesh, triangulated: every edge used an even number of times", bool((counts % 2 == 0).all()))
+    cs = voxelize(MESHES / "cow.obj", d / "c.npy", "--resolution", "32", "--mode", "solid")
+    vol = cs["voxels"] * cs["voxel_size"] ** 3
+    check("cow solid voxel mesh encloses exactly the voxels' volume (trimesh)", abs(tc.volume - vol) < 1e-9 + 1e-6 * vol, (tc.volume, vol))
 
 print(f"{passed} passed, {failed} failed")
 sys.exit(1 if failed else 0)

@@ -1,10 +1,11 @@
 //! Fuzzes every surface and line mode: triangles (and the same points as
-//! segments) from raw bytes on a small grid; each fast path, and each
-//! scanline path, must equal its reference.
+//! segments) from raw bytes on a small grid; each fast path (on both
+//! drivers), and each scanline path, must equal its reference.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use voxkit::glam::DVec3;
+use voxkit::voxelize::driver::Driver;
 use voxkit::voxelize::{self, Mode, Options};
 use voxkit::{GridSpec, Mesh};
 
@@ -22,9 +23,11 @@ fuzz_target!(|data: &[u8]| {
             triangles: if is_line { Vec::new() } else { triangles.clone() },
             segments: if is_line { segments.clone() } else { Vec::new() },
         };
-        let (fast, _) = voxelize::fast(mode, mesh.as_ref(), &grid, &Options::default());
         let (slow, _) = voxelize::reference(mode, mesh.as_ref(), &grid);
-        assert_eq!(fast.to_dense().first_difference(&slow), None, "{mode:?}");
+        for driver in [Driver::Triangles, Driver::Slabs] {
+            let (fast, _) = voxelize::fast(mode, mesh.as_ref(), &grid, &Options { driver, ..Options::default() });
+            assert_eq!(fast.to_dense().first_difference(&slow), None, "{mode:?} {driver:?}");
+        }
         if let Some((scan, _)) = voxelize::scanline::scanline(mode, mesh.as_ref(), &grid, &Options::default()) {
             assert_eq!(scan.to_dense().first_difference(&slow), None, "{mode:?} scanline");
         }

@@ -404,14 +404,33 @@ impl VoxelGrid {
         Some(order.iter().map(|o| c[o.1]).collect::<Array1<f32>>().into_pyarray(py))
     }
 
-    /// save(path, format=None, dither=False, block_palette=None): writes
-    /// any format the CLI writes (by extension or `format`), atomically.
-    #[pyo3(signature = (path, format=None, dither=false, block_palette=None))]
-    fn save(&self, py: Python<'_>, path: PathBuf, format: Option<String>, dither: bool, block_palette: Option<PathBuf>) -> PyResult<()> {
+    /// save(path, format=None, dither=False, block_palette=None, up="y",
+    /// watertight=True, triangulate=False): writes any format the CLI
+    /// writes (by extension or `format`), atomically; `up` is the data's up
+    /// axis for .vox and .schem, `watertight` and `triangulate` shape .obj
+    /// and .glb meshes of the voxels.
+    #[pyo3(signature = (path, format=None, dither=false, block_palette=None, up="y", watertight=true, triangulate=false))]
+    #[allow(clippy::too_many_arguments)]
+    fn save(
+        &self,
+        py: Python<'_>,
+        path: PathBuf,
+        format: Option<String>,
+        dither: bool,
+        block_palette: Option<PathBuf>,
+        up: &str,
+        watertight: bool,
+        triangulate: bool,
+    ) -> PyResult<()> {
         let target = voxkit_job::output::output_format(format.as_deref(), &path).map_err(py_err)?;
         voxkit_job::output::check_output_path(&path).map_err(py_err)?;
         let blocks = block_palette.as_deref().map(voxkit_io::schem::BlockPalette::read).transpose().map_err(io_err)?;
-        let opts = voxkit_io::WriteOptions { dither, blocks };
+        let opts = voxkit_io::WriteOptions {
+            dither,
+            blocks,
+            up: up_of(up)?,
+            mesh: voxkit_io::voxel_mesh::MeshOptions { watertight, triangulate },
+        };
         let inner = self.inner.clone();
         py.detach(move || voxkit_job::output::write(&path, target, &inner.voxels, &inner.grid, inner.attrs.as_ref(), &opts))
             .map_err(py_err)?;
@@ -451,7 +470,8 @@ impl VoxelGrid {
     }
 
     /// The mesh of the voxels (boundary faces merged into greedy quads,
-    /// split into triangles): `(vertices (n, 3) float64, faces (m, 3) int64,
+    /// T-junctions split so it is watertight, as triangles with shared
+    /// vertices): `(vertices (n, 3) float64, faces (m, 3) int64,
     /// face_colours (m, 3) uint8 or None)`.
     fn greedy_mesh<'py>(&self, py: Python<'py>) -> MeshArrays<'py> {
         let inner = self.inner.clone();
@@ -498,8 +518,8 @@ type BatchListing<'py> = (Vec<(String, String, bool)>, Bound<'py, PyAny>);
 
 type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>, Option<Vec<[u8; 3]>>);
 
-/// Greedy quads of the voxels (coloured when the grid has colours), as
-/// world-space triangles sharing vertices within each quad.
+/// Greedy quads of the voxels (coloured when the grid has colours), with
+/// their T-junctions split (watertight), as world-space triangles.
 fn greedy_triangles(g: &GridData) -> Triangles {
     use voxkit::attributes::quantize;
     use voxkit::export::greedy::{greedy_quads, greedy_quads_by_class};
@@ -514,21 +534,29 @@ fn greedy_triangles(g: &GridData) -> Triangles {
         }
         None => (None, greedy_quads(&dense)),
     };
-    let (o, s) = (g.grid.origin(), g.grid.voxel_size());
-    let mut verts = Vec::with_capacity(quads.len() * 4);
-    let mut faces = Vec::with_capacity(quads.len() * 2);
-    let mut colours = palette.as_ref().map(|_| Vec::with_capacity(quads.len() * 2));
-    for q in &quads {
-        let base = verts.len() as u32;
-        for c in q.corners() {
-            verts.push([o.x + c[0] as f64 * s, o.y + c[1] as f64 * s, o.z + c[2] as f64 * s]);
-        }
-        faces.push([base, base + 1, base + 2]);
-        faces.push([base, base + 2, base + 3]);
-        if let (Some(out), Some(p)) = (colours.as_mut(), palette.as_ref()) {
-            let c = q.class.checked_sub(1).and_then(|i| p.get(i as usize)).copied().unwrap_or(voxkit::attributes::carry::DEFAULT_COLOUR);
-            out.push(c);
-            out.push(c);
+    let (o, s) = (g.grid.origin(), g.grid.voxel_size() / 2.0);
+    let mut index: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::with_capacity(quads.len() * 2);
+    let mut verts = Vec::with_capacity(quads.len() * 2);
+    let mut faces = Vec::with_capacity(quads.len() * 3);
+    let mut colours = palette.as_ref().map(|_| Vec::with_capacity(quads.len() * 3));
+    for f in voxkit::export::watertight::conform(&quads) {
+        let ids: Vec<u32> = f
+            .vertices
+            .iter()
+            .map(|&c| {
+                *index.entry(c).or_insert_with(|| {
+                    verts.push([o.x + c[0] as f64 * s, o.y + c[1] as f64 * s, o.z + c[2] as f64 * s]);
+                    verts.len() as u32 - 1
+                })
+            })
+            .collect();
+        for t in 1..ids.len() - 1 {
+            faces.push([ids[0], ids[t], ids[t + 1]]);
+            if let (Some(out), Some(p)) = (colours.as_mut(), palette.as_ref()) {
+                out.push(
+                    f.class.checked_sub(1).and_then(|i| p.get(i as usize)).copied().unwrap_or(voxkit::attributes::carry::DEFAULT_COLOUR),
+                );
+            }
         }
     }
     (verts, faces, colours)
@@ -633,12 +661,18 @@ fn voxelize(
     Ok(VoxelGrid { inner: Arc::new(data) })
 }
 
-/// load_voxels(path, origin=None, voxel_size=None) -> VoxelGrid
+/// `x`, `y` or `z` as an up axis.
+fn up_of(up: &str) -> PyResult<voxkit_io::orient::Up> {
+    voxkit_io::orient::Up::from_name(up).ok_or_else(|| value_err(format!("up must be \"x\", \"y\" or \"z\"; got {up:?}")))
+}
+
+/// load_voxels(path, origin=None, voxel_size=None, up="y") -> VoxelGrid
 #[pyfunction]
-#[pyo3(signature = (path, origin=None, voxel_size=None))]
-fn load_voxels(py: Python<'_>, path: PathBuf, origin: Option<Vec<f64>>, voxel_size: Option<f64>) -> PyResult<VoxelGrid> {
+#[pyo3(signature = (path, origin=None, voxel_size=None, up="y"))]
+fn load_voxels(py: Python<'_>, path: PathBuf, origin: Option<Vec<f64>>, voxel_size: Option<f64>, up: &str) -> PyResult<VoxelGrid> {
     let p = path.clone();
-    let loaded = py.detach(move || voxkit_io::read_voxels(&p)).map_err(io_err)?;
+    let up = up_of(up)?;
+    let loaded = py.detach(move || voxkit_io::read_voxels_with(&p, up)).map_err(io_err)?;
     let dims = loaded.bits.dims();
     let o = match origin {
         Some(o) if o.len() == 3 => DVec3::new(o[0], o[1], o[2]),
@@ -693,6 +727,10 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
     let rule = get_str("colour_rule")?.unwrap_or_else(|| "dominant".into());
     let normals: bool = options.get_item("normals")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
     let dither: bool = options.get_item("dither")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
+    let watertight: bool = options.get_item("watertight")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(true);
+    let triangulate: bool = options.get_item("triangulate")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
+    let up = get_str("up")?.unwrap_or_else(|| "y".into());
+    let up_axis = up_of(&up)?;
     let (surface, fill) = (get_str("surface")?, get_str("fill")?);
     let hollow = get_u64("hollow")?.map(|h| h as u32);
     let plan = plan_of(&mode, &method, &grid, surface.as_deref(), fill.as_deref(), hollow, &gpu_path).map_err(py_err)?;
@@ -712,12 +750,20 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
         colour_rule: &rule,
         normals,
         dither,
+        up: up_axis.name(),
+        watertight,
+        triangulate,
     });
     let opts = voxkit_job::batch::BatchOptions {
         plan,
         format: target,
         carry: CarryOptions { rule: self::colour_rule(&rule).map_err(py_err)?, normals },
-        write: voxkit_io::WriteOptions { dither, blocks: None },
+        write: voxkit_io::WriteOptions {
+            dither,
+            blocks: None,
+            up: up_axis,
+            mesh: voxkit_io::voxel_mesh::MeshOptions { watertight, triangulate },
+        },
         threads,
         read: voxkit_io::ReadOptions {
             allow_external_paths: options

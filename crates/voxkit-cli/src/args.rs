@@ -122,8 +122,10 @@ pub struct VoxelizeArgs {
     /// `../`, links leading out. Off by default.
     #[arg(long)]
     pub allow_external_paths: bool,
-    /// Output voxel file; the format comes from the extension unless
-    /// --format is given. `-` writes to standard output (with --format).
+    /// Output file: .npy, .binvox, .vox, .txt, .schem, .vti, .ply (voxels),
+    /// or .obj / .glb (a mesh of the voxels); the format comes from the
+    /// extension unless --format is given. `-` writes to standard output
+    /// (with --format).
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Voxelization mode.
@@ -187,6 +189,21 @@ pub struct ExportArgs {
     /// .schem: a colour -> block table, `namespace:block R G B` per line (default: the built-in table).
     #[arg(long, value_name = "FILE")]
     pub block_palette: Option<PathBuf>,
+    /// The axis of the mesh (and the voxel grid) that points up: .vox and
+    /// .schem are rotated (never mirrored) so the model stands upright in
+    /// MagicaVoxel (z-up) and Minecraft (y-up), and --preview draws it up.
+    /// Default: y, as for most OBJ, glTF, PLY and STL models.
+    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
+    pub up: Option<String>,
+    /// .obj and .glb meshes of the voxels: `on` (default) splits the greedy
+    /// quads at T-junctions so every edge is shared (watertight, for 3D
+    /// printing and booleans); `off` keeps the plain quads.
+    #[arg(long, value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub watertight: Option<String>,
+    /// .obj meshes of the voxels: triangles only (quads split in two); for
+    /// readers that take only triangles, such as Open3D.
+    #[arg(long)]
+    pub triangulate: bool,
 }
 
 /// `--gpu-path`.
@@ -220,9 +237,6 @@ pub struct PictureArgs {
     /// Picture size in pixels, WIDTHxHEIGHT.
     #[arg(long, default_value = "1024x768", value_name = "WxH")]
     pub size: String,
-    /// The world axis drawn pointing up: x, y or z (OBJ and glTF models are usually y-up).
-    #[arg(long, default_value = "y", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
-    pub up: String,
     /// Draw the outline of the source mesh's silhouette over the voxels (mesh inputs and --preview).
     #[arg(long)]
     pub outline: bool,
@@ -242,6 +256,11 @@ pub struct RenderArgs {
     pub output: PathBuf,
     #[command(flatten)]
     pub picture: PictureArgs,
+    /// The axis drawn pointing up: x, y or z (default y: OBJ and glTF
+    /// models are usually y-up). For .vox and .schem inputs, also the axis
+    /// they were written with (`--up` of voxelize), unless they record it.
+    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
+    pub up: Option<String>,
     /// For a mesh: the surface mode to voxelize with.
     #[arg(long, value_enum, default_value = "cover")]
     pub mode: Mode,
@@ -275,6 +294,10 @@ pub struct CheckArgs {
     /// grid at resolution = the largest dimension.
     #[command(flatten)]
     pub grid: GridArgs,
+    /// .vox and .schem files: the up axis they were written with (`--up` of
+    /// voxelize; default y), when the file does not record it.
+    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
+    pub up: Option<String>,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,

@@ -17,6 +17,7 @@ pub mod gltf;
 pub mod mesh_report;
 pub mod npy;
 pub mod obj;
+pub mod orient;
 pub mod ply;
 pub mod png;
 pub mod points;
@@ -221,6 +222,11 @@ pub struct WriteOptions {
     pub dither: bool,
     /// `.schem`: the colour → block table (default: the built-in one).
     pub blocks: Option<schem::BlockPalette>,
+    /// `.vox` and `.schem`: the data's up axis, rotated to point up in
+    /// MagicaVoxel and Minecraft (default y; see [`orient`]).
+    pub up: orient::Up,
+    /// `.obj` and `.glb` meshes of the voxels: watertight, triangles.
+    pub mesh: voxel_mesh::MeshOptions,
 }
 
 /// [`write_voxels`] with per-voxel attributes (colours for `.vox`,
@@ -237,9 +243,9 @@ pub fn write_voxels_with(
         VoxelFormat::Npy => npy::write(w, bits, npy::Dtype::U8),
         VoxelFormat::NpyBool => npy::write(w, bits, npy::Dtype::Bool),
         VoxelFormat::Binvox => binvox::write(w, bits, grid),
-        VoxelFormat::Vox => vox::write(w, bits, attrs, opts.dither),
+        VoxelFormat::Vox => vox::write(w, bits, attrs, opts.dither, opts.up),
         VoxelFormat::Text => text::write(w, bits, grid),
-        VoxelFormat::Schem => schem::write(w, bits, attrs, opts.blocks.as_ref().unwrap_or(&schem::BlockPalette::default())),
+        VoxelFormat::Schem => schem::write(w, bits, attrs, opts.blocks.as_ref().unwrap_or(&schem::BlockPalette::default()), opts.up),
         VoxelFormat::Vti => vti::write(w, bits, grid, attrs),
         VoxelFormat::Ply => points::write(w, bits, grid, attrs),
     })
@@ -274,6 +280,12 @@ pub fn is_voxel_file(path: &Path) -> bool {
 
 /// Reads any voxel file voxkit writes, choosing the format from the extension.
 pub fn read_voxels(path: &Path) -> Result<LoadedVoxels, IoError> {
+    read_voxels_with(path, orient::Up::default())
+}
+
+/// [`read_voxels`], `.vox` and `.schem` files without a recorded up axis
+/// being rotated back by `up` (see [`orient`]).
+pub fn read_voxels_with(path: &Path, up: orient::Up) -> Result<LoadedVoxels, IoError> {
     let format = VoxelFormat::from_path(path).ok_or_else(|| {
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_string();
         IoError::new(path, ErrorKind::UnknownFormat { ext, expected: VoxelFormat::NAMES })
@@ -285,17 +297,23 @@ pub fn read_voxels(path: &Path) -> Result<LoadedVoxels, IoError> {
         return npy::read_stream(&mut r, total).map_err(|k| IoError::new(path, k));
     }
     let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
-    read_voxels_bytes(&bytes, format).map_err(|k| IoError::new(path, k))
+    read_voxels_bytes_with(&bytes, format, up).map_err(|k| IoError::new(path, k))
 }
 
 /// Parses a voxel file from memory.
 pub fn read_voxels_bytes(bytes: &[u8], format: VoxelFormat) -> Result<LoadedVoxels, ErrorKind> {
+    read_voxels_bytes_with(bytes, format, orient::Up::default())
+}
+
+/// [`read_voxels_bytes`] with the up axis of `.vox` and `.schem` files that
+/// do not record one.
+pub fn read_voxels_bytes_with(bytes: &[u8], format: VoxelFormat, up: orient::Up) -> Result<LoadedVoxels, ErrorKind> {
     fence("voxel", || match format {
         VoxelFormat::Npy | VoxelFormat::NpyBool => npy::read(bytes),
         VoxelFormat::Binvox => binvox::read(bytes),
-        VoxelFormat::Vox => vox::read(bytes),
+        VoxelFormat::Vox => vox::read(bytes, up),
         VoxelFormat::Text => text::read(bytes),
-        VoxelFormat::Schem => schem::read(bytes),
+        VoxelFormat::Schem => schem::read(bytes, up),
         VoxelFormat::Vti => vti::read(bytes),
         VoxelFormat::Ply => points::read(bytes),
     })

@@ -1,9 +1,12 @@
 //! Minecraft Sponge schematic `.schem`, version 2 (read: versions 2 and 3),
 //! written as gzip-compressed NBT through the `fastnbt` and `flate2` crates.
 //!
-//! Axes: Minecraft is y-up, voxkit's exports are z-up (as in `.vox`), so
-//! voxel `(i, j, k)` becomes block `(x, y, z) = (i, k, ny − 1 − j)` — a
-//! rotation, not a mirror. Every set voxel becomes the solid block whose
+//! Axes: Minecraft is y-up; the grid is rotated so the data's up axis
+//! (`--up`, default y) points up there ([`crate::orient`]: with up = y,
+//! voxel `(i, j, k)` is block `(i, j, k)`; with up = z, block
+//! `(i, k, ny − 1 − j)`) — a rotation, not a mirror — and the up axis is
+//! recorded in the metadata (`VoxkitUp`, beside WorldEdit's `WEOffsetX/Y/Z`)
+//! so voxkit reads it back unrotated. Every set voxel becomes the solid block whose
 //! average colour is nearest to the voxel's colour in Oklab: from a
 //! built-in table of 67 blocks (concrete, wool, terracotta and a few
 //! common solids; average colours of their textures, approximate) or from a
@@ -21,6 +24,7 @@ use voxkit::attributes::{quantize, VoxelAttributes};
 use voxkit::{DenseBits, VoxelSource};
 
 use crate::error::{ErrorKind, IoError};
+use crate::orient::{Orientation, Up};
 use crate::LoadedVoxels;
 
 /// Minecraft data version written (Java Edition 1.20.4).
@@ -152,9 +156,25 @@ struct V2 {
     height: i16,
     length: i16,
     offset: IntArray,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    metadata: Option<Metadata>,
     palette_max: i32,
     palette: BTreeMap<String, i32>,
     block_data: ByteArray,
+}
+
+/// The schematic's metadata: WorldEdit's paste offset (which tools such as
+/// mcschematic expect), and the data's up axis, so reading needs no `--up`.
+#[derive(Serialize, Deserialize, Default)]
+struct Metadata {
+    #[serde(rename = "WEOffsetX", default)]
+    we_offset_x: i32,
+    #[serde(rename = "WEOffsetY", default)]
+    we_offset_y: i32,
+    #[serde(rename = "WEOffsetZ", default)]
+    we_offset_z: i32,
+    #[serde(rename = "VoxkitUp", default, skip_serializing_if = "Option::is_none")]
+    voxkit_up: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -179,13 +199,22 @@ struct V3Blocks {
     data: ByteArray,
 }
 
-/// Writes `bits` as a Sponge schematic (version 2), blocks chosen by colour.
-pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, attrs: Option<&VoxelAttributes>, blocks: &BlockPalette) -> std::io::Result<()> {
+/// Writes `bits` as a Sponge schematic (version 2), blocks chosen by
+/// colour, rotated so `up` points up (Minecraft is y-up).
+pub fn write(
+    w: &mut dyn Write,
+    bits: &dyn VoxelSource,
+    attrs: Option<&VoxelAttributes>,
+    blocks: &BlockPalette,
+    up: Up,
+) -> std::io::Result<()> {
     let [nx, ny, nz] = bits.dims();
     if [nx, ny, nz].iter().any(|&d| d > u16::MAX as u32) {
         return Err(std::io::Error::other(format!("a schematic holds at most {} blocks on a side; the grid is {nx}x{ny}x{nz}", u16::MAX)));
     }
-    let (width, height, length) = (nx as usize, nz as usize, ny as usize);
+    let orient = Orientation::minecraft(up);
+    let src_dims = [nx, ny, nz];
+    let [width, height, length] = orient.dims(src_dims).map(|d| d as usize);
     let labs: Vec<[f32; 3]> = blocks.blocks.iter().map(|b| oklab(b.1)).collect();
     let mut palette: BTreeMap<String, i32> = BTreeMap::from([("minecraft:air".to_string(), 0)]);
     let mut ids: BTreeMap<u32, u16> = BTreeMap::new();
@@ -203,7 +232,7 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, attrs: Option<&VoxelAttr
             Some(c) => *ids.entry(pack(c)).or_insert_with(|| id_of(&blocks.blocks[quantize::nearest(&labs, oklab(c))].0, &mut palette)),
             None => plain,
         };
-        let (x, y, z) = (i as usize, k as usize, (ny - 1 - j) as usize);
+        let [x, y, z] = orient.apply([i, j, k], src_dims).map(|c| c as usize);
         cells[x + z * width + y * width * length] = id;
     });
     let mut data = Vec::with_capacity(cells.len());
@@ -226,6 +255,7 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, attrs: Option<&VoxelAttr
         height: height as u16 as i16,
         length: length as u16 as i16,
         offset: IntArray::new(vec![0, 0, 0]),
+        metadata: Some(Metadata { we_offset_x: 0, we_offset_y: 0, we_offset_z: 0, voxkit_up: Some(up.name().to_string()) }),
         palette_max: palette.len() as i32,
         palette,
         block_data: ByteArray::new(data),
@@ -238,15 +268,17 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, attrs: Option<&VoxelAttr
 }
 
 /// Reads a Sponge schematic (version 2 or 3): every non-air block is a
-/// voxel, coloured from the built-in table where the block is in it.
-pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
+/// voxel, coloured from the built-in table where the block is in it,
+/// rotated back from Minecraft's y-up by the up axis the file records
+/// (voxkit's), else by `up`.
+pub fn read(bytes: &[u8], up: Up) -> Result<LoadedVoxels, ErrorKind> {
     let bad = |m: String| ErrorKind::malformed("schem", m);
     let mut nbt = Vec::new();
     flate2::read::GzDecoder::new(bytes).take(1 << 31).read_to_end(&mut nbt).map_err(|e| bad(format!("not gzip-compressed NBT ({e})")))?;
-    let (w, h, l, palette, data) = match fastnbt::from_bytes::<V2>(&nbt) {
-        Ok(v) => (v.width, v.height, v.length, v.palette, v.block_data),
+    let (w, h, l, palette, data, recorded) = match fastnbt::from_bytes::<V2>(&nbt) {
+        Ok(v) => (v.width, v.height, v.length, v.palette, v.block_data, v.metadata.and_then(|m| m.voxkit_up)),
         Err(e2) => match fastnbt::from_bytes::<V3Root>(&nbt) {
-            Ok(r) => (r.schematic.width, r.schematic.height, r.schematic.length, r.schematic.blocks.palette, r.schematic.blocks.data),
+            Ok(r) => (r.schematic.width, r.schematic.height, r.schematic.length, r.schematic.blocks.palette, r.schematic.blocks.data, None),
             Err(e3) => return Err(bad(format!("neither a version 2 ({e2}) nor a version 3 ({e3}) schematic"))),
         },
     };
@@ -269,7 +301,9 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         };
         by_id.insert(*id, colour);
     }
-    let dims = [width as u32, length as u32, height as u32];
+    let orient = Orientation::minecraft(recorded.as_deref().and_then(Up::from_name).unwrap_or(up));
+    let tdims = [width as u32, height as u32, length as u32];
+    let dims = orient.source_dims(tdims);
     let mut bits = DenseBits::new(dims);
     let mut coloured = Vec::new();
     let (mut at, mut cell) = (0usize, 0usize);
@@ -290,7 +324,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         let colour = by_id.get(&(v as i32)).ok_or_else(|| bad(format!("block {cell} uses id {v}, not in the palette")))?;
         if let Some(c) = colour {
             let (x, z, y) = (cell % width, cell / width % length, cell / (width * length));
-            let p = [x as u32, (length - 1 - z) as u32, y as u32];
+            let p = orient.invert([x as u32, y as u32, z as u32], tdims);
             bits.set(p[0], p[1], p[2]);
             coloured.push((p, *c));
         }

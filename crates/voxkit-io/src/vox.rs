@@ -1,13 +1,18 @@
 //! MagicaVoxel `.vox`, through the `dot_vox` crate.
 //!
-//! MagicaVoxel models hold at most 256 voxels on a side, so the grid is cut
-//! into 256³ blocks; block `(bx, by, bz)` becomes one model, placed in the
-//! scene graph (root transform → group → one transform + shape per model).
-//! A model's world minimum corner is its transform's translation `_t` minus
-//! `floor(size / 2)` (MagicaVoxel pivots models on their centre), so `_t` is
-//! set to `256·(bx,by,bz) + floor(size/2)` and the whole grid opens in
-//! MagicaVoxel in one piece. Axes map directly: voxkit `(i, j, k)` →
-//! MagicaVoxel `(x, y, z)`, z up.
+//! MagicaVoxel is z-up: the grid is first rotated so the data's up axis
+//! (`--up`, default y) points up there ([`crate::orient`]).
+//!
+//! A grid of at most 256 voxels on a side is one model and nothing else
+//! (no scene graph: the simplest files, which every reader takes).
+//! Larger grids are cut into 256³ blocks; block `(bx, by, bz)` becomes one
+//! model, placed in the scene graph (root transform → group → one
+//! transform + shape per model). A model's world minimum corner is its
+//! transform's translation `_t` minus `floor(size / 2)` (MagicaVoxel pivots
+//! models on their centre), so `_t` is set to `256·(bx,by,bz) +
+//! floor(size/2)` and the whole grid opens in MagicaVoxel in one piece. The
+//! root transform records the up axis (`_voxkit_up`), so reading needs no
+//! `--up`; single models are read with the `up` given.
 //!
 //! Colours: with voxel colours, the palette is at most 255 colours of the
 //! voxels themselves ([`voxkit::attributes::quantize`]: exact when there
@@ -23,13 +28,17 @@ use voxkit::attributes::{quantize, VoxelAttributes};
 use voxkit::{DenseBits, VoxelSource};
 
 use crate::error::ErrorKind;
+use crate::orient::{Orientation, Up};
 use crate::LoadedVoxels;
 
 const BLOCK: u32 = 256;
 
-/// Writes `bits` as a `.vox` file, coloured by `attrs` when it has colours.
-pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, attrs: Option<&VoxelAttributes>, dither: bool) -> std::io::Result<()> {
-    let dims = bits.dims();
+/// Writes `bits` as a `.vox` file, coloured by `attrs` when it has colours,
+/// rotated so `up` points up.
+pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, attrs: Option<&VoxelAttributes>, dither: bool, up: Up) -> std::io::Result<()> {
+    let orient = Orientation::magicavoxel(up);
+    let src_dims = bits.dims();
+    let dims = orient.dims(src_dims);
     let coloured = attrs.and_then(|a| a.colour.as_ref().map(|c| (a, c)));
     let (palette_rgb, index) = match coloured {
         Some((a, colours)) => {
@@ -47,19 +56,22 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, attrs: Option<&VoxelAttr
     };
     let mut blocks: BTreeMap<[u32; 3], Vec<Voxel>> = BTreeMap::new();
     bits.for_each_set(&mut |i, j, k| {
-        blocks.entry([i / BLOCK, j / BLOCK, k / BLOCK]).or_default().push(Voxel {
-            x: (i % BLOCK) as u8,
-            y: (j % BLOCK) as u8,
-            z: (k % BLOCK) as u8,
+        let [x, y, z] = orient.apply([i, j, k], src_dims);
+        blocks.entry([x / BLOCK, y / BLOCK, z / BLOCK]).or_default().push(Voxel {
+            x: (x % BLOCK) as u8,
+            y: (y % BLOCK) as u8,
+            z: (z % BLOCK) as u8,
             i: palette_index(i, j, k),
         });
     });
     if blocks.is_empty() {
         blocks.insert([0, 0, 0], Vec::new());
     }
+    let single = blocks.len() == 1 && dims.iter().all(|&d| d <= BLOCK);
     let mut models = Vec::with_capacity(blocks.len());
+    let root = Dict::from_iter([("_voxkit_up".to_string(), up.name().to_string())]);
     let mut scenes = vec![
-        SceneNode::Transform { attributes: Dict::new(), frames: vec![Frame::new(Dict::new())], child: 1, layer_id: u32::MAX },
+        SceneNode::Transform { attributes: root, frames: vec![Frame::new(Dict::new())], child: 1, layer_id: u32::MAX },
         SceneNode::Group { attributes: Dict::new(), children: Vec::new() },
     ];
     let mut children = Vec::new();
@@ -82,22 +94,21 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, attrs: Option<&VoxelAttr
     for (p, c) in palette.iter_mut().zip(&palette_rgb) {
         *p = Color { r: c[0], g: c[1], b: c[2], a: 255 };
     }
-    let data = DotVoxData {
-        version: 150,
-        index_map: Vec::new(),
-        models,
-        palette,
-        materials: Vec::new(),
-        scenes,
-        layers: vec![Layer { attributes: Dict::from_iter([("_name".to_string(), "voxkit".to_string())]) }],
+    let (scenes, layers) = if single {
+        (Vec::new(), Vec::new())
+    } else {
+        (scenes, vec![Layer { attributes: Dict::from_iter([("_name".to_string(), "voxkit".to_string())]) }])
     };
+    let data = DotVoxData { version: 150, index_map: Vec::new(), models, palette, materials: Vec::new(), scenes, layers };
     data.write_vox(&mut &mut *w)
 }
 
 /// Reads a `.vox` file: every model placed by the translations of the
 /// transforms above it (rotations are not supported), shifted so the
-/// smallest model corner is voxel `(0,0,0)`.
-pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
+/// smallest model corner is voxel `(0,0,0)`, then rotated back from
+/// MagicaVoxel's z-up to the data's axes: by the up axis the file records
+/// (voxkit's multi-model files), else by `up`.
+pub fn read(bytes: &[u8], up: Up) -> Result<LoadedVoxels, ErrorKind> {
     let data = dot_vox::load_bytes(bytes).map_err(|e| ErrorKind::malformed("vox", e))?;
     let mut placed: Vec<(u32, [i64; 3])> = Vec::new();
     if data.scenes.is_empty() {
@@ -127,14 +138,20 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if dims.iter().any(|&d| d > voxkit::grid::spec::MAX_DIM as u64) {
         return Err(ErrorKind::malformed("vox", format!("scene spans {dims:?} voxels")));
     }
-    let dims = dims.map(|d| d as u32);
+    let tdims = dims.map(|d| d as u32);
+    let recorded = match data.scenes.first() {
+        Some(SceneNode::Transform { attributes, .. }) => attributes.get("_voxkit_up").and_then(|u| Up::from_name(u)),
+        _ => None,
+    };
+    let orient = Orientation::magicavoxel(recorded.unwrap_or(up));
+    let dims = orient.source_dims(tdims);
     let mut bits = DenseBits::new(dims);
     let mut coloured = Vec::new();
     for (model, min) in boxes {
         for v in &model.voxels {
             let p = [v.x as i64 + min[0] - lo[0], v.y as i64 + min[1] - lo[1], v.z as i64 + min[2] - lo[2]];
-            if (0..3).all(|a| p[a] >= 0 && p[a] < dims[a] as i64) {
-                let p = p.map(|c| c as u32);
+            if (0..3).all(|a| p[a] >= 0 && p[a] < tdims[a] as i64) {
+                let p = orient.invert(p.map(|c| c as u32), tdims);
                 bits.set(p[0], p[1], p[2]);
                 let c = data.palette.get(v.i as usize).map(|c| [c.r, c.g, c.b]).unwrap_or([255; 3]);
                 coloured.push((p, c));

@@ -17,27 +17,75 @@ use voxkit::GridSpec;
 use crate::atomic::write_atomically;
 use crate::error::IoError;
 
-/// Writes `quads` on `grid` (world coordinates) as an OBJ of quad faces,
-/// counter-clockwise seen from outside, corners shared; with a `palette`,
-/// also `<name>.mtl` with one material per colour. Returns the number of vertices.
-pub fn write_quads_obj(path: &Path, quads: &[Quad], grid: &GridSpec, palette: Option<&[[u8; 3]]>) -> Result<usize, IoError> {
+/// How a mesh of the voxels is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MeshOptions {
+    /// Split every T-junction of the greedy quads, so each edge is shared by
+    /// the faces on both sides ([`voxkit::export::watertight`]): what 3D
+    /// printing and booleans need. Default: on.
+    pub watertight: bool,
+    /// Write triangles only (OBJ: quads become two triangles; some readers,
+    /// Open3D among them, read only triangles). Default: off (GLB is
+    /// always triangles).
+    pub triangulate: bool,
+}
+
+impl Default for MeshOptions {
+    fn default() -> Self {
+        MeshOptions { watertight: true, triangulate: false }
+    }
+}
+
+/// The faces to write: quads and triangles in doubled voxel-corner
+/// coordinates, with their class and the axis/side of their quad.
+fn faces(quads: &[Quad], opts: &MeshOptions) -> Vec<(u32, usize, Vec<[u32; 3]>)> {
+    let faces: Vec<(u32, usize, Vec<[u32; 3]>)> = if opts.watertight {
+        voxkit::export::watertight::conform(quads).into_iter().map(|f| (f.class, f.quad, f.vertices)).collect()
+    } else {
+        quads.iter().enumerate().map(|(i, q)| (q.class, i, q.corners().map(|c| c.map(|x| 2 * x)).to_vec())).collect()
+    };
+    if !opts.triangulate {
+        return faces;
+    }
+    faces
+        .into_iter()
+        .flat_map(
+            |(c, q, v)| if v.len() == 4 { vec![(c, q, vec![v[0], v[1], v[2]]), (c, q, vec![v[0], v[2], v[3]])] } else { vec![(c, q, v)] },
+        )
+        .collect()
+}
+
+/// Writes `quads` on `grid` (world coordinates) as an OBJ: quads and
+/// triangles (see [`MeshOptions`]), counter-clockwise seen from outside,
+/// vertices shared; with a `palette`, also `<output stem>.mtl` with one
+/// material per colour. Returns the number of vertices.
+pub fn write_quads_obj(
+    path: &Path,
+    quads: &[Quad],
+    grid: &GridSpec,
+    palette: Option<&[[u8; 3]]>,
+    opts: &MeshOptions,
+) -> Result<usize, IoError> {
     let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity(quads.len() * 2);
     let mut order: Vec<[u32; 3]> = Vec::with_capacity(quads.len() * 2);
-    let mut sorted: Vec<&Quad> = quads.iter().collect();
-    sorted.sort_by_key(|q| q.class);
-    let faces: Vec<(u32, [u32; 4])> = sorted
+    let mut all = faces(quads, opts);
+    all.sort_by_key(|f| f.0);
+    let faces: Vec<(u32, Vec<u32>)> = all
         .iter()
-        .map(|q| {
-            let f = q.corners().map(|c| {
-                *index.entry(c).or_insert_with(|| {
-                    order.push(c);
-                    order.len() as u32
+        .map(|(class, _, vs)| {
+            let f = vs
+                .iter()
+                .map(|&c| {
+                    *index.entry(c).or_insert_with(|| {
+                        order.push(c);
+                        order.len() as u32
+                    })
                 })
-            });
-            (q.class, f)
+                .collect();
+            (*class, f)
         })
         .collect();
-    let (o, s) = (grid.origin(), grid.voxel_size());
+    let (o, s) = (grid.origin(), grid.voxel_size() / 2.0);
     if palette.is_some() && !matches!(crate::atomic::target(path), crate::atomic::Target::Regular(_)) {
         return Err(IoError::new(
             path,
@@ -58,7 +106,13 @@ pub fn write_quads_obj(path: &Path, quads: &[Quad], grid: &GridSpec, palette: Op
         })?;
     }
     write_atomically(path, |w| {
-        writeln!(w, "# voxkit: {} greedy quads of the voxels' boundary faces", quads.len())?;
+        writeln!(
+            w,
+            "# voxkit: {} faces from {} greedy quads of the voxels' boundary faces{}",
+            faces.len(),
+            quads.len(),
+            if opts.watertight { ", T-junctions split (watertight)" } else { "" }
+        )?;
         if let Some((m, _)) = &mtl {
             writeln!(w, "mtllib {}", m.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default())?;
         }
@@ -71,29 +125,43 @@ pub fn write_quads_obj(path: &Path, quads: &[Quad], grid: &GridSpec, palette: Op
                 writeln!(w, "usemtl c{}", class - 1)?;
                 current = *class;
             }
-            writeln!(w, "f {} {} {} {}", f[0], f[1], f[2], f[3])?;
+            write!(w, "f")?;
+            for v in f {
+                write!(w, " {v}")?;
+            }
+            writeln!(w)?;
         }
         Ok(())
     })?;
     Ok(order.len())
 }
 
-/// Writes `quads` as a binary glTF 2.0 file: two triangles per quad, four
-/// vertices per quad (flat normals), `COLOR_0` from `palette` when given.
-/// Returns the number of vertices.
-pub fn write_quads_glb(path: &Path, quads: &[Quad], grid: &GridSpec, palette: Option<&[[u8; 3]]>) -> Result<usize, IoError> {
-    let (o, s) = (grid.origin(), grid.voxel_size());
-    let nv = quads.len() * 4;
+/// Writes `quads` as a binary glTF 2.0 file: triangles (T-junctions split
+/// when [`MeshOptions::watertight`]), vertices per face (flat normals),
+/// `COLOR_0` from `palette` when given. Returns the number of vertices.
+pub fn write_quads_glb(
+    path: &Path,
+    quads: &[Quad],
+    grid: &GridSpec,
+    palette: Option<&[[u8; 3]]>,
+    opts: &MeshOptions,
+) -> Result<usize, IoError> {
+    let (o, s) = (grid.origin(), grid.voxel_size() / 2.0);
+    let faces = faces(quads, &MeshOptions { triangulate: false, ..*opts });
+    let nv: usize = faces.iter().map(|f| f.2.len()).sum();
+    let ni: usize = faces.iter().map(|f| 3 * (f.2.len() - 2)).sum();
     let mut pos = Vec::with_capacity(nv * 12);
     let mut nrm = Vec::with_capacity(nv * 12);
     let mut col = Vec::with_capacity(if palette.is_some() { nv * 12 } else { 0 });
-    let mut idx = Vec::with_capacity(quads.len() * 24);
+    let mut idx = Vec::with_capacity(ni * 4);
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for (qi, q) in quads.iter().enumerate() {
+    let mut base = 0u32;
+    for (class, qi, vs) in &faces {
+        let q = &quads[*qi];
         let mut n = [0f32; 3];
         n[q.axis] = if q.positive { 1.0 } else { -1.0 };
-        let colour = palette.map(|p| p.get(q.class.wrapping_sub(1) as usize).copied().unwrap_or([255; 3]).map(|c| to_linear(c) as f32));
-        for c in q.corners() {
+        let colour = palette.map(|p| p.get(class.wrapping_sub(1) as usize).copied().unwrap_or([255; 3]).map(|c| to_linear(c) as f32));
+        for c in vs {
             let p = [o.x + c[0] as f64 * s, o.y + c[1] as f64 * s, o.z + c[2] as f64 * s].map(|v| v as f32);
             for a in 0..3 {
                 lo[a] = lo[a].min(p[a]);
@@ -105,8 +173,10 @@ pub fn write_quads_glb(path: &Path, quads: &[Quad], grid: &GridSpec, palette: Op
                 col.extend(c.iter().flat_map(|v| v.to_le_bytes()));
             }
         }
-        let b = (qi * 4) as u32;
-        idx.extend([b, b + 1, b + 2, b, b + 2, b + 3].iter().flat_map(|v| v.to_le_bytes()));
+        for t in 1..vs.len() as u32 - 1 {
+            idx.extend([base, base + t, base + t + 1].iter().flat_map(|v| v.to_le_bytes()));
+        }
+        base += vs.len() as u32;
     }
     let mut bin = Vec::new();
     let mut views = Vec::new();
@@ -121,7 +191,7 @@ pub fn write_quads_glb(path: &Path, quads: &[Quad], grid: &GridSpec, palette: Op
         }
     }
     let mut accessors = vec![
-        json!({"bufferView": 0, "componentType": 5125, "count": quads.len() * 6, "type": "SCALAR"}),
+        json!({"bufferView": 0, "componentType": 5125, "count": ni, "type": "SCALAR"}),
         json!({"bufferView": 1, "componentType": 5126, "count": nv, "type": "VEC3", "min": lo, "max": hi}),
         json!({"bufferView": 2, "componentType": 5126, "count": nv, "type": "VEC3"}),
     ];

@@ -50,7 +50,7 @@ fn vox_keeps_up_to_255_colours_exactly_and_quantizes_more() {
 
     let (b, a) = scene([50, 40, 30], 2000, 8000);
     for dither in [false, true] {
-        write_voxels_with(&p, VoxelFormat::Vox, &b, &grid, Some(&a), &WriteOptions { dither, blocks: None }).unwrap();
+        write_voxels_with(&p, VoxelFormat::Vox, &b, &grid, Some(&a), &WriteOptions { dither, blocks: None, ..Default::default() }).unwrap();
         let back = read_voxels(&p).unwrap().attributes.unwrap();
         let got: std::collections::HashSet<_> = back.colour.as_ref().unwrap().iter().copied().collect();
         let input: std::collections::HashSet<_> = a.colour.as_ref().unwrap().iter().copied().collect();
@@ -108,14 +108,40 @@ fn schem_is_valid_nbt_and_round_trips_voxels() {
     let v: fastnbt::Value = fastnbt::from_bytes(&nbt).unwrap();
     let fastnbt::Value::Compound(root) = v else { panic!("root is not a compound") };
     assert_eq!(root.get("Version"), Some(&fastnbt::Value::Int(2)));
+    // Up = y (the default): the grid's y is Minecraft's height.
     assert_eq!(root.get("Width"), Some(&fastnbt::Value::Short(20)));
-    assert_eq!(root.get("Height"), Some(&fastnbt::Value::Short(7)));
-    assert_eq!(root.get("Length"), Some(&fastnbt::Value::Short(12)));
+    assert_eq!(root.get("Height"), Some(&fastnbt::Value::Short(12)));
+    assert_eq!(root.get("Length"), Some(&fastnbt::Value::Short(7)));
+    // WorldEdit's offsets (mcschematic needs them) and the recorded up axis.
+    let Some(fastnbt::Value::Compound(meta)) = root.get("Metadata") else { panic!("no Metadata") };
+    for k in ["WEOffsetX", "WEOffsetY", "WEOffsetZ"] {
+        assert_eq!(meta.get(k), Some(&fastnbt::Value::Int(0)), "{k}");
+    }
+    assert_eq!(meta.get("VoxkitUp"), Some(&fastnbt::Value::String("y".into())));
+    // Up = z: z is the height; read back through the recorded axis (even
+    // when the reader is told otherwise).
+    let pz = tmp("cz.schem");
+    let up_z = WriteOptions { up: voxkit_io::orient::Up::Z, ..Default::default() };
+    write_voxels_with(&pz, VoxelFormat::Schem, &b, &grid, Some(&a), &up_z).unwrap();
+    let mut nbt = Vec::new();
+    std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(&std::fs::read(&pz).unwrap()[..]), &mut nbt).unwrap();
+    let fastnbt::Value::Compound(rz) = fastnbt::from_bytes::<fastnbt::Value>(&nbt).unwrap() else { panic!() };
+    assert_eq!(rz.get("Height"), Some(&fastnbt::Value::Short(7)));
+    let back = voxkit_io::read_voxels_with(&pz, voxkit_io::orient::Up::X).unwrap();
+    assert!(back.bits.first_difference(&b).is_none());
     // A user palette with two blocks: only those (and air) appear.
     let pal = tmp("blocks.txt");
     std::fs::write(&pal, "# two blocks\nminecraft:black_wool 0 0 0\nwhite_wool 255 255 255\n").unwrap();
     let blocks = voxkit_io::schem::BlockPalette::read(&pal).unwrap();
-    write_voxels_with(&p, VoxelFormat::Schem, &b, &grid, Some(&a), &WriteOptions { dither: false, blocks: Some(blocks) }).unwrap();
+    write_voxels_with(
+        &p,
+        VoxelFormat::Schem,
+        &b,
+        &grid,
+        Some(&a),
+        &WriteOptions { dither: false, blocks: Some(blocks), ..Default::default() },
+    )
+    .unwrap();
     let gz = std::fs::read(&p).unwrap();
     let mut nbt = Vec::new();
     std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(&gz[..]), &mut nbt).unwrap();
@@ -146,8 +172,10 @@ fn coloured_greedy_meshes_load_in_gltf_and_tobj() {
         palette.iter().position(|&p| p == c).unwrap() as u32 + 1
     };
     let quads = greedy_quads_by_class(&b, &class);
+    // The quads as they are (the watertight split has its own tests).
+    let plain = voxkit_io::voxel_mesh::MeshOptions { watertight: false, triangulate: false };
     let glb = tmp("m.glb");
-    let nv = voxkit_io::voxel_mesh::write_quads_glb(&glb, &quads, &grid, Some(&palette)).unwrap();
+    let nv = voxkit_io::voxel_mesh::write_quads_glb(&glb, &quads, &grid, Some(&palette), &plain).unwrap();
     let (doc, buffers, _) = gltf::import(&glb).unwrap();
     let prim = doc.meshes().next().unwrap().primitives().next().unwrap();
     let reader = prim.reader(|buf| buffers.get(buf.index()).map(|d| &d.0[..]));
@@ -164,7 +192,7 @@ fn coloured_greedy_meshes_load_in_gltf_and_tobj() {
     let loaded = voxkit_io::read_mesh(&glb).unwrap();
     assert_eq!(loaded.appearance.vertex_colour.len(), nv);
     let obj = tmp("m.obj");
-    voxkit_io::voxel_mesh::write_quads_obj(&obj, &quads, &grid, Some(&palette)).unwrap();
+    voxkit_io::voxel_mesh::write_quads_obj(&obj, &quads, &grid, Some(&palette), &plain).unwrap();
     let (models, mats) = tobj::load_obj(&obj, &tobj::LoadOptions { triangulate: true, ..Default::default() }).unwrap();
     assert_eq!(mats.unwrap().len(), palette.len());
     assert_eq!(models.iter().map(|m| m.mesh.indices.len()).sum::<usize>(), quads.len() * 6);

@@ -378,6 +378,12 @@ pub struct FingerprintParts<'a> {
     pub normals: bool,
     /// `.vox` dithering.
     pub dither: bool,
+    /// `.vox`/`.schem` up axis.
+    pub up: &'a str,
+    /// `.obj`/`.glb` T-junctions split.
+    pub watertight: bool,
+    /// `.obj` triangles only.
+    pub triangulate: bool,
 }
 
 /// The options as one JSON object (keys sorted, defaults filled in), the
@@ -401,5 +407,8 @@ pub fn fingerprint(p: &FingerprintParts<'_>) -> Value {
         "colour_rule": p.colour_rule,
         "normals": p.normals,
         "dither": p.dither,
+        "up": p.up,
+        "watertight": p.watertight,
+        "triangulate": p.triangulate,
     })
 }

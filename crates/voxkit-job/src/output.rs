@@ -147,10 +147,11 @@ pub fn write(
                 None => (None, voxkit::export::greedy::greedy_quads(&dense)),
             };
             let vertices = match kind {
-                MeshKind::Obj => voxkit_io::voxel_mesh::write_quads_obj(out, &quads, grid, palette.as_deref())?,
-                MeshKind::Glb => voxkit_io::voxel_mesh::write_quads_glb(out, &quads, grid, palette.as_deref())?,
+                MeshKind::Obj => voxkit_io::voxel_mesh::write_quads_obj(out, &quads, grid, palette.as_deref(), &opts.mesh)?,
+                MeshKind::Glb => voxkit_io::voxel_mesh::write_quads_glb(out, &quads, grid, palette.as_deref(), &opts.mesh)?,
             };
-            Ok(json!({"quads": quads.len(), "vertices": vertices, "colours": palette.as_ref().map(|p| p.len())}))
+            Ok(json!({"quads": quads.len(), "vertices": vertices, "colours": palette.as_ref().map(|p| p.len()),
+                "watertight": opts.mesh.watertight, "triangulated": opts.mesh.triangulate}))
         }
     }
 }

@@ -136,6 +136,13 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
     };
     let voxelize_s = t.elapsed().as_secs_f64();
     let p = report.prepare;
+    if report.voxels == 0 {
+        warnings.push(if plan.solid.is_none() && p.input > 0 && p.outside + p.degenerate + p.non_finite + p.invalid_index == p.input {
+            format!("{name}: the result is empty: every triangle lies outside the grid (or is degenerate)")
+        } else {
+            format!("{name}: the result is empty: no voxel is set")
+        });
+    }
     if p.non_finite + p.invalid_index > 0 {
         warnings.push(format!("{name}: skipped {} primitives with invalid vertices", p.non_finite + p.invalid_index));
     }

@@ -48,6 +48,9 @@ pub fn run(a: &BatchArgs) -> Result<()> {
         colour_rule: &colour_rule,
         normals: a.export.normals,
         dither: a.export.dither,
+        up: crate::commands::export::up(&a.export).name(),
+        watertight: a.export.watertight.as_deref() != Some("off"),
+        triangulate: a.export.triangulate,
     });
     let opts = BatchOptions {
         plan,

@@ -10,7 +10,8 @@ use crate::args::CheckArgs;
 pub fn run(a: &CheckArgs) -> Result<()> {
     let t0 = Instant::now();
     let pool = crate::thread_pool(a.threads)?;
-    let loaded = voxkit_io::read_voxels(&a.voxels)?;
+    let up = a.up.as_deref().and_then(voxkit_io::orient::Up::from_name).unwrap_or_default();
+    let loaded = voxkit_io::read_voxels_with(&a.voxels, up)?;
     let dims = loaded.bits.dims();
     let mesh = match &a.mesh {
         Some(path) => {

@@ -12,7 +12,11 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
     voxkit_job::output::check_output_path(&a.output)?;
     voxkit_job::output::refuse_overwriting(&a.output, format, std::slice::from_ref(&a.input))?;
     let write_opts = crate::commands::export::writer_options(&a.export)?;
-    let loaded = voxkit_io::read_voxels(&a.input)?;
+    let input_has_up =
+        matches!(voxkit_io::VoxelFormat::from_path(&a.input), Some(voxkit_io::VoxelFormat::Vox | voxkit_io::VoxelFormat::Schem));
+    crate::commands::export::warn_unused(&a.export, format, &a.output, false, input_has_up);
+    // The up axis is the data's: .vox and .schem files are read back with it too.
+    let loaded = voxkit_io::read_voxels_with(&a.input, crate::commands::export::up(&a.export))?;
     let dims = loaded.bits.dims();
     let (grid, source) = placement(a, &loaded)?;
     let facts = voxkit_job::output::write(&a.output, format, &loaded.bits, &grid, loaded.attributes.as_ref(), &write_opts)?;

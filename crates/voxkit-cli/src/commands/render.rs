@@ -21,7 +21,7 @@ const MAX_SIDE: u32 = 16_384;
 const MAX_PIXELS: u64 = 64 << 20;
 
 /// Validates the picture options.
-pub fn options(p: &PictureArgs) -> Result<RenderOptions> {
+pub fn options(p: &PictureArgs, up: Option<&str>) -> Result<RenderOptions> {
     let view = match p.view.as_str() {
         "iso" => View::Iso,
         "x" => View::Axis(0),
@@ -41,9 +41,9 @@ pub fn options(p: &PictureArgs) -> Result<RenderOptions> {
     if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE || width as u64 * height as u64 > MAX_PIXELS {
         bail!("--size {width}x{height}: each side must be 1..={MAX_SIDE} and the picture at most {MAX_PIXELS} pixels");
     }
-    let up = match p.up.as_str() {
-        "x" => 0,
-        "z" => 2,
+    let up = match up {
+        Some("x") => 0,
+        Some("z") => 2,
         _ => 1,
     };
     Ok(RenderOptions { width, height, view, up, ..RenderOptions::default() })
@@ -85,7 +85,7 @@ pub fn check_png_path(path: &Path) -> Result<()> {
 
 pub fn run(a: &RenderArgs) -> Result<()> {
     let t0 = Instant::now();
-    let o = options(&a.picture)?;
+    let o = options(&a.picture, a.up.as_deref())?;
     check_png_path(&a.output)?;
     let pool = crate::thread_pool(a.threads)?;
     voxkit_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.input))?;
@@ -93,7 +93,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         if a.picture.outline {
             bail!("--outline draws the source mesh's silhouette; it needs a mesh input (or voxelize --preview)");
         }
-        let loaded = voxkit_io::read_voxels(&a.input)?;
+        // .vox and .schem are rotated back so the --up axis is up again.
+        let up = a.up.as_deref().and_then(voxkit_io::orient::Up::from_name).unwrap_or_default();
+        let loaded = voxkit_io::read_voxels_with(&a.input, up)?;
         (Box::new(loaded.bits), "voxel file", loaded.attributes, None)
     } else {
         let (mode, _) = voxkit_job::resolve_method(a.mode.into(), voxkit_job::Method::Fast)

@@ -23,10 +23,13 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
         voxkit_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.mesh))?;
     }
     let write_opts = crate::commands::export::writer_options(&a.export)?;
+    if !a.quiet && !a.json {
+        crate::commands::export::warn_unused(&a.export, format, &a.output, true, a.preview.is_some());
+    }
     let preview = match &a.preview {
         Some(p) => {
             crate::commands::render::check_png_path(p)?;
-            Some((p, crate::commands::render::options(&a.picture)?))
+            Some((p, crate::commands::render::options(&a.picture, a.export.up.as_deref())?))
         }
         None => None,
     };
