@@ -582,6 +582,7 @@ fn plan_of(
     fill: Option<&str>,
     hollow: Option<u32>,
     gpu_path: &str,
+    seed: u64,
 ) -> Result<voxkit_job::Plan, JobError> {
     let request = voxkit_job::Request {
         mode: voxkit_job::Mode::parse(mode)?,
@@ -600,6 +601,7 @@ fn plan_of(
             "msaa-approx" => voxkit_job::GpuPath::MsaaApprox,
             p => return Err(JobError::invalid(format!("unknown gpu_path {p:?} (expected compute, raster or msaa-approx)"))),
         },
+        seed,
     };
     voxkit_job::Plan::new(request)
 }
@@ -615,7 +617,7 @@ fn colour_rule(rule: &str) -> Result<ColourRule, JobError> {
 /// The native voxelize: see `voxkit.voxelize` for the documentation.
 #[pyfunction]
 #[pyo3(signature = (mesh, *, mode="cover", resolution=None, voxel_size=None, origin=None, dims=None, pad=None, method="auto", threads=None,
-    attributes=false, colour_rule="dominant", normals=false, surface=None, fill=None, hollow=None, gpu_path="compute"))]
+    attributes=false, colour_rule="dominant", normals=false, surface=None, fill=None, hollow=None, gpu_path="compute", seed=0))]
 #[allow(clippy::too_many_arguments)]
 fn voxelize(
     py: Python<'_>,
@@ -635,9 +637,10 @@ fn voxelize(
     fill: Option<&str>,
     hollow: Option<u32>,
     gpu_path: &str,
+    seed: u64,
 ) -> PyResult<VoxelGrid> {
     let grid = grid_options(resolution, voxel_size, origin, dims, pad);
-    let plan = plan_of(mode, method, &grid, surface, fill, hollow, gpu_path).map_err(py_err)?;
+    let plan = plan_of(mode, method, &grid, surface, fill, hollow, gpu_path, seed).map_err(py_err)?;
     let carry = CarryOptions { rule: self::colour_rule(colour_rule).map_err(py_err)?, normals };
     let pool = threads.map(voxkit_job::pool).transpose().map_err(py_err)?;
     let inner = mesh.inner.clone();
@@ -733,7 +736,8 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
     let up_axis = up_of(&up)?;
     let (surface, fill) = (get_str("surface")?, get_str("fill")?);
     let hollow = get_u64("hollow")?.map(|h| h as u32);
-    let plan = plan_of(&mode, &method, &grid, surface.as_deref(), fill.as_deref(), hollow, &gpu_path).map_err(py_err)?;
+    let seed = get_u64("seed")?.unwrap_or(0);
+    let plan = plan_of(&mode, &method, &grid, surface.as_deref(), fill.as_deref(), hollow, &gpu_path, seed).map_err(py_err)?;
     let target = voxkit_job::output::Output::from_name(format)
         .ok_or_else(|| value_err(format!("unknown format {format:?} (expected one of: {})", voxkit_job::output::Output::names())))?;
     let threads = get_u64("threads")?.map(|t| t as usize);
@@ -753,6 +757,7 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
         up: up_axis.name(),
         watertight,
         triangulate,
+        seed,
     });
     let opts = voxkit_job::batch::BatchOptions {
         plan,

@@ -16,6 +16,10 @@ Modes (``mode=``):
 - ``sep26``: Laine's space-diagonal target (26-separating, subset of cover).
 - ``sep6``: Laine's 3D crosshair (6-separating, thin).
 - ``ss6``: Schwarz-Seidel's 6-separating test.
+- ``tunnel18``, ``tunnel26``: 18- and 26-tunnel-free (Laine's targets from
+  the centre to face centres and edge midpoints, and corners).
+- ``bubble``: randomized 6-separating targets (``seed=``).
+- ``diagonal``: one alternating body diagonal per voxel (6-separating).
 - ``line26``, ``line6``: polylines, 26- or 6-connected.
 - ``pos``: the published projected optimal scanline algorithm (no guarantee).
 - ``solid``: voxels whose centre is inside (winding number; ray parity on
@@ -61,7 +65,7 @@ __all__ = [
 ]
 
 #: Every mode, as ``voxelize(mode=...)`` takes it.
-MODES = ("cover", "sep26", "sep6", "ss6", "solid", "solid+surface", "line6", "line26", "pos")
+MODES = ("cover", "sep26", "sep6", "ss6", "tunnel18", "tunnel26", "bubble", "diagonal", "solid", "solid+surface", "line6", "line26", "pos")
 #: Every method, as ``voxelize(method=...)`` takes it.
 METHODS = ("auto", "reference", "fast", "scanline", "gpu", "parity", "winding")
 #: Every output format ``VoxelGrid.save`` and ``batch`` write.
@@ -130,6 +134,7 @@ def voxelize(
     fill: Optional[str] = None,
     hollow: Optional[int] = None,
     gpu_path: str = "compute",
+    seed: int = 0,
 ) -> VoxelGrid:
     """Voxelizes a mesh; returns a :class:`VoxelGrid`.
 
@@ -159,6 +164,8 @@ def voxelize(
         hollow: solid modes: keep the voxels 6- or 26-adjacent to the outside.
         gpu_path: with ``method="gpu"``: ``compute``, ``raster`` or
             ``msaa-approx``.
+        seed: ``bubble``: the seed of the random target points (same seed,
+            same voxels).
 
     The GIL is released while voxelizing, so threads voxelize in parallel.
 
@@ -185,6 +192,7 @@ def voxelize(
         fill=fill,
         hollow=None if hollow is None else _count(hollow, "hollow"),
         gpu_path=gpu_path,
+        seed=_count(seed, "seed"),
     )
 
 
@@ -203,7 +211,7 @@ def _options(options: dict) -> dict:
             v = [float(x) for x in v]
         elif k in ("dims",):
             v = [_count(d, "dims") for d in v]
-        elif k in ("resolution", "pad", "threads", "jobs", "hollow"):
+        elif k in ("resolution", "pad", "threads", "jobs", "hollow", "seed"):
             v = _count(v, k)
         elif k == "voxel_size":
             v = float(v)

@@ -90,6 +90,7 @@ def voxelize(
     fill: Optional[str] = None,
     hollow: Optional[int] = None,
     gpu_path: str = "compute",
+    seed: int = 0,
 ) -> VoxelGrid: ...
 def batch(inputs: Sequence[str], out_dir: str, format: str = "npy", glob: Optional[str] = None, options: Optional[Dict[str, Any]] = None) -> Dict[str, Any]: ...
 def batch_plan(

@@ -58,6 +58,14 @@ pub enum Mode {
     Line26,
     /// Projected optimal scanline, as published.
     Pos,
+    /// 18-tunnel-free surface: targets from the centre to face centres and edge midpoints.
+    Tunnel18,
+    /// 26-tunnel-free surface: also from the centre to the corners.
+    Tunnel26,
+    /// Randomized 6-separating surface: the crosshair's joins at random points (--seed).
+    Bubble,
+    /// 6-separating surface from one alternating body diagonal per voxel.
+    Diagonal,
 }
 
 /// Extra baselines of `voxkit bench`.
@@ -134,6 +142,9 @@ pub struct VoxelizeArgs {
     /// Method.
     #[arg(long, value_enum, default_value = "auto")]
     pub method: Method,
+    /// `bubble`: the seed of its random points (same seed, same voxels; default 0).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
     /// Solid modes: the surface mode of `solid+surface` and of the
     /// `--fill flood` shell (default cover).
     #[arg(long, value_enum, value_name = "MODE")]
@@ -433,6 +444,9 @@ pub struct BatchArgs {
     /// Method.
     #[arg(long, value_enum, default_value = "auto")]
     pub method: Method,
+    /// `bubble`: the seed of its random points (same seed, same voxels; default 0).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
     /// Solid modes: the surface mode of `solid+surface` and of the `--fill flood` shell.
     #[arg(long, value_enum, value_name = "MODE")]
     pub surface: Option<Mode>,

@@ -21,6 +21,10 @@ impl From<Mode> for voxkit_job::Mode {
             Mode::Line6 => J::Line6,
             Mode::Line26 => J::Line26,
             Mode::Pos => J::Pos,
+            Mode::Tunnel18 => J::Tunnel18,
+            Mode::Tunnel26 => J::Tunnel26,
+            Mode::Bubble => J::Bubble,
+            Mode::Diagonal => J::Diagonal,
         }
     }
 }
@@ -52,10 +56,11 @@ pub fn grid_request(g: &GridArgs) -> Result<GridRequest> {
 
 /// The validated plan of `voxkit voxelize`.
 pub fn voxelize_plan(a: &VoxelizeArgs) -> Result<voxkit_job::Plan> {
-    plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path)
+    plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path, a.seed)
 }
 
 /// A validated plan from the voxelization options of `voxelize` and `batch`.
+#[allow(clippy::too_many_arguments)]
 pub fn plan_from(
     mode: Mode,
     method: Method,
@@ -64,6 +69,7 @@ pub fn plan_from(
     fill: Option<Fill>,
     hollow: Option<&str>,
     gpu_path: GpuPathArg,
+    seed: u64,
 ) -> Result<voxkit_job::Plan> {
     let request = voxkit_job::Request {
         mode: mode.into(),
@@ -75,6 +81,7 @@ pub fn plan_from(
         }),
         hollow: hollow.map(|h| if h == "6" { 6 } else { 26 }),
         gpu_path: gpu_path_name(gpu_path).1,
+        seed,
     };
     Ok(voxkit_job::Plan::new(request)?)
 }

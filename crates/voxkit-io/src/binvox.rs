@@ -20,7 +20,7 @@
 use std::io::Write;
 
 use glam::DVec3;
-use voxkit::{DenseBits, GridSpec, VoxelSource};
+use voxkit::{GridSpec, VoxelSource};
 
 use crate::error::ErrorKind;
 use crate::LoadedVoxels;
@@ -151,7 +151,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     }
     let d = a as u64;
     let total = d * d * d;
-    let mut bits = DenseBits::new([a, a, a]);
+    let mut bits = crate::dense_grid([a, a, a])?;
     let mut idx = 0u64;
     for pair in bytes[pos..].chunks(2) {
         let [v, n] = pair else { return Err(bad("odd number of data bytes".into())) };

@@ -78,6 +78,17 @@ pub enum ErrorKind {
     /// The data is valid but uses something voxkit does not support.
     #[error("unsupported: {0}")]
     Unsupported(String),
+    /// The file describes a grid whose dense storage does not fit in memory
+    /// (a few bytes can claim billions of voxels).
+    #[error("its {dims:?} grid needs {need} of memory, but only {available} is available")]
+    TooLarge {
+        /// The grid's dims.
+        dims: [u32; 3],
+        /// Bytes needed, human-readable.
+        need: String,
+        /// Bytes available, human-readable.
+        available: String,
+    },
 }
 
 impl ErrorKind {

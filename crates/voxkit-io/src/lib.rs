@@ -318,3 +318,43 @@ pub fn read_voxels_bytes_with(bytes: &[u8], format: VoxelFormat, up: orient::Up)
         VoxelFormat::Ply => points::read(bytes),
     })
 }
+
+/// Memory available to this process, from `/proc/meminfo` (None if unknown).
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Human-readable byte count.
+pub fn bytes(n: u64) -> String {
+    const U: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = n as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u < U.len() - 1 {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{n} B")
+    } else {
+        format!("{v:.1} {}", U[u])
+    }
+}
+
+/// A dense grid for a reader, refused when the file claims one that would
+/// not fit in memory (a hostile file of a few bytes can claim billions of
+/// voxels; allocating them would abort the process).
+pub(crate) fn dense_grid(dims: [u32; 3]) -> Result<voxkit::DenseBits, ErrorKind> {
+    let need = (dims[0] as u64).div_ceil(64) * 8 * dims[1] as u64 * dims[2] as u64;
+    // Small grids are never refused: reading /proc per file costs more.
+    if need > 64 << 20 {
+        if let Some(avail) = available_memory() {
+            if need > avail / 10 * 9 {
+                return Err(ErrorKind::TooLarge { dims, need: bytes(need), available: bytes(avail) });
+            }
+        }
+    }
+    Ok(voxkit::DenseBits::new(dims))
+}

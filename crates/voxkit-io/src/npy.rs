@@ -67,7 +67,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if data.len() < n {
         return Err(truncated(data.len(), n));
     }
-    let mut bits = DenseBits::new(dims.map(|d| d as u32));
+    let mut bits = crate::dense_grid(dims.map(|d| d as u32))?;
     fill(&mut bits, &data[..n], 0);
     Ok(LoadedVoxels { bits, placement: None, attributes: None })
 }
@@ -109,7 +109,7 @@ pub fn read_stream(r: &mut impl std::io::Read, total: u64) -> Result<LoadedVoxel
     if have < n as u64 {
         return Err(truncated(have as usize, n));
     }
-    let mut bits = DenseBits::new(dims.map(|d| d as u32));
+    let mut bits = crate::dense_grid(dims.map(|d| d as u32))?;
     let mut buf = vec![0u8; 1 << 22];
     let mut at = 0usize;
     while at < n {

@@ -9,7 +9,7 @@ use std::io::Write;
 
 use glam::DVec3;
 use voxkit::attributes::VoxelAttributes;
-use voxkit::{DenseBits, GridSpec, VoxelSource};
+use voxkit::{GridSpec, VoxelSource};
 
 use crate::error::ErrorKind;
 use crate::LoadedVoxels;
@@ -86,7 +86,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if dims.iter().map(|&d| d as u64).product::<u64>() > 1 << 35 {
         return Err(bad(format!("the recorded grid {dims:?} is too large to read back densely")));
     }
-    let mut bits = DenseBits::new(dims);
+    let mut bits = crate::dense_grid(dims)?;
     let mut coloured = Vec::new();
     let mut has_colour = false;
     use ply_rs_bw::ply::Property;

@@ -21,7 +21,7 @@ use fastnbt::{ByteArray, IntArray};
 use serde::{Deserialize, Serialize};
 use voxkit::attributes::colour::{oklab, pack};
 use voxkit::attributes::{quantize, VoxelAttributes};
-use voxkit::{DenseBits, VoxelSource};
+use voxkit::VoxelSource;
 
 use crate::error::{ErrorKind, IoError};
 use crate::orient::{Orientation, Up};
@@ -304,7 +304,7 @@ pub fn read(bytes: &[u8], up: Up) -> Result<LoadedVoxels, ErrorKind> {
     let orient = Orientation::minecraft(recorded.as_deref().and_then(Up::from_name).unwrap_or(up));
     let tdims = [width as u32, height as u32, length as u32];
     let dims = orient.source_dims(tdims);
-    let mut bits = DenseBits::new(dims);
+    let mut bits = crate::dense_grid(dims)?;
     let mut coloured = Vec::new();
     let (mut at, mut cell) = (0usize, 0usize);
     while cell < n {

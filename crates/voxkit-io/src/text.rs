@@ -10,7 +10,7 @@
 use std::io::Write;
 
 use glam::DVec3;
-use voxkit::{DenseBits, GridSpec, VoxelSource};
+use voxkit::{GridSpec, VoxelSource};
 
 use crate::error::ErrorKind;
 use crate::LoadedVoxels;
@@ -76,7 +76,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if dims.iter().any(|&d| d == 0 || d > voxkit::grid::spec::MAX_DIM) {
         return Err(ErrorKind::malformed("text", format!("grid dims {dims:?} out of range")));
     }
-    let mut bits = DenseBits::new(dims);
+    let mut bits = crate::dense_grid(dims)?;
     for v in voxels {
         if (0..3).any(|a| v[a] >= dims[a]) {
             return Err(ErrorKind::malformed("text", format!("voxel {v:?} outside dims {dims:?}")));

@@ -25,7 +25,7 @@ use std::io::Write;
 
 use dot_vox::{Color, Dict, DotVoxData, Frame, Layer, Model, SceneNode, ShapeModel, Size, Voxel};
 use voxkit::attributes::{quantize, VoxelAttributes};
-use voxkit::{DenseBits, VoxelSource};
+use voxkit::VoxelSource;
 
 use crate::error::ErrorKind;
 use crate::orient::{Orientation, Up};
@@ -145,7 +145,7 @@ pub fn read(bytes: &[u8], up: Up) -> Result<LoadedVoxels, ErrorKind> {
     };
     let orient = Orientation::magicavoxel(recorded.unwrap_or(up));
     let dims = orient.source_dims(tdims);
-    let mut bits = DenseBits::new(dims);
+    let mut bits = crate::dense_grid(dims)?;
     let mut coloured = Vec::new();
     for (model, min) in boxes {
         for v in &model.voxels {

@@ -19,7 +19,7 @@ use flate2::write::ZlibEncoder;
 use glam::DVec3;
 use rayon::prelude::*;
 use voxkit::attributes::{VoxelAttributes, NO_MATERIAL};
-use voxkit::{DenseBits, GridSpec, VoxelSource};
+use voxkit::{GridSpec, VoxelSource};
 
 use crate::error::ErrorKind;
 use crate::LoadedVoxels;
@@ -280,7 +280,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         arrays.push((name, ty, comps as usize, raw));
     }
     let occ = arrays.iter().find(|a| a.0 == "occupancy").or(arrays.first()).ok_or_else(|| bad("no cell arrays".into()))?;
-    let mut bits = DenseBits::new(dims);
+    let mut bits = crate::dense_grid(dims)?;
     let (ow, ot) = (occ.3.len() / cells as usize / occ.2, occ.1.clone());
     let nonzero = |b: &[u8]| if ot.starts_with("Float") { b.iter().any(|&x| x != 0 && x != 0x80) } else { b.iter().any(|&x| x != 0) };
     let mut keys = Vec::new();

@@ -67,3 +67,21 @@ fn random_bytes_never_panic_any_reader() {
         }
     }
 }
+
+/// A voxel file of a few bytes can claim a grid of billions of voxels; one
+/// beyond memory is refused with one line instead of aborting the process
+/// on the allocation (found by fuzzing `voxels_txt`).
+#[test]
+fn voxel_files_claiming_grids_beyond_memory_are_refused() {
+    let dir = std::env::temp_dir().join(format!("voxkit-huge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let txt = dir.join("huge.txt");
+    std::fs::write(&txt, "# voxkit voxels dims 60000 60000 60000\n1 2 3\n").unwrap();
+    let binvox = dir.join("huge.binvox");
+    std::fs::write(&binvox, b"#binvox 1\ndim 60000 60000 60000\ntranslate 0 0 0\nscale 1\ndata\n\x00\xff").unwrap();
+    for p in [txt, binvox] {
+        let e = voxkit_io::read_voxels(&p).unwrap_err().to_string();
+        assert!(e.contains("of memory") || e.contains("malformed"), "{}: {e}", p.display());
+        assert!(e.contains(&p.file_name().unwrap().to_string_lossy().into_owned()), "{e}");
+    }
+}

@@ -384,6 +384,8 @@ pub struct FingerprintParts<'a> {
     pub watertight: bool,
     /// `.obj` triangles only.
     pub triangulate: bool,
+    /// `bubble`'s seed.
+    pub seed: u64,
 }
 
 /// The options as one JSON object (keys sorted, defaults filled in), the
@@ -410,5 +412,6 @@ pub fn fingerprint(p: &FingerprintParts<'_>) -> Value {
         "up": p.up,
         "watertight": p.watertight,
         "triangulate": p.triangulate,
+        "seed": p.seed,
     })
 }

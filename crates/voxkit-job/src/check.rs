@@ -67,8 +67,10 @@ pub fn report(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec, &str)>) ->
         "inside_voxels": sep.map(|s| s.inside_voxels),
         "thin_removable": sep.map(|s| s.thin_removable),
         "tunnels_6": facts.map(|f| f.tunnels_6),
+        "tunnels_18": facts.map(|f| f.tunnels_18),
         "tunnels_26": facts.map(|f| f.tunnels_26),
         "tunnel_free_6": facts.map(|f| f.tunnels_6 == 0),
+        "tunnel_free_18": facts.map(|f| f.tunnels_18 == 0),
         "tunnel_free_26": facts.map(|f| f.tunnels_26 == 0),
         "columns": facts.map(|f| {
             let c = f.columns;

@@ -4,29 +4,7 @@ use voxkit::GridSpec;
 
 use crate::error::{JobError, Result};
 
-/// Memory available to this process, from `/proc/meminfo` (None if unknown).
-pub fn available_memory() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
-}
-
-/// Human-readable byte count.
-pub fn bytes(n: u64) -> String {
-    const U: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
-    let mut v = n as f64;
-    let mut u = 0;
-    while v >= 1024.0 && u < U.len() - 1 {
-        v /= 1024.0;
-        u += 1;
-    }
-    if u == 0 {
-        format!("{n} B")
-    } else {
-        format!("{v:.1} {}", U[u])
-    }
-}
+pub use voxkit_io::{available_memory, bytes};
 
 /// Grids whose dense storage is below this are not checked (every machine
 /// voxkit runs on has that much; reading `/proc/meminfo` per job would cost

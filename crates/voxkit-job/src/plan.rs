@@ -29,12 +29,33 @@ pub enum Mode {
     Line26,
     /// The published projected optimal scanline algorithm.
     Pos,
+    /// 18-tunnel-free surface.
+    Tunnel18,
+    /// 26-tunnel-free surface.
+    Tunnel26,
+    /// Randomized 6-separating surface (seeded).
+    Bubble,
+    /// Alternating single-diagonal 6-separating surface.
+    Diagonal,
 }
 
 impl Mode {
     /// Every mode, in documentation order.
-    pub const ALL: [Mode; 9] =
-        [Mode::Cover, Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Solid, Mode::SolidSurface, Mode::Line6, Mode::Line26, Mode::Pos];
+    pub const ALL: [Mode; 13] = [
+        Mode::Cover,
+        Mode::Sep26,
+        Mode::Sep6,
+        Mode::Ss6,
+        Mode::Tunnel18,
+        Mode::Tunnel26,
+        Mode::Bubble,
+        Mode::Diagonal,
+        Mode::Solid,
+        Mode::SolidSurface,
+        Mode::Line6,
+        Mode::Line26,
+        Mode::Pos,
+    ];
 
     /// The user-facing name.
     pub fn name(self) -> &'static str {
@@ -48,6 +69,10 @@ impl Mode {
             Mode::Line6 => "line6",
             Mode::Line26 => "line26",
             Mode::Pos => "pos",
+            Mode::Tunnel18 => "tunnel18",
+            Mode::Tunnel26 => "tunnel26",
+            Mode::Bubble => "bubble",
+            Mode::Diagonal => "diagonal",
         }
     }
 
@@ -64,8 +89,13 @@ impl Mode {
         matches!(self, Mode::Solid | Mode::SolidSurface)
     }
 
-    /// The core surface/line mode (solid modes have none).
+    /// The core surface/line mode (solid modes have none); `bubble` with seed 0.
     pub fn core(self) -> Result<voxkit::voxelize::Mode> {
+        self.core_seeded(0)
+    }
+
+    /// The core surface/line mode, `bubble` drawing its points from `seed`.
+    pub fn core_seeded(self, seed: u64) -> Result<voxkit::voxelize::Mode> {
         use voxkit::voxelize::Mode as Core;
         Ok(match self {
             Mode::Cover => Core::Cover,
@@ -75,6 +105,10 @@ impl Mode {
             Mode::Line26 => Core::Line26,
             Mode::Line6 => Core::Line6,
             Mode::Pos => Core::Pos,
+            Mode::Tunnel18 => Core::Tunnel18,
+            Mode::Tunnel26 => Core::Tunnel26,
+            Mode::Bubble => Core::Bubble { seed },
+            Mode::Diagonal => Core::Diagonal,
             Mode::Solid | Mode::SolidSurface => invalid!("mode '{}' is a solid mode", self.name()),
         })
     }
@@ -168,7 +202,12 @@ impl SurfaceMethod {
 /// `auto` resolves to the fast path here; once the mesh and grid are known,
 /// [`auto_method`] may pick the scanline path or the GPU instead.
 pub fn resolve_method(mode: Mode, method: Method) -> Result<(voxkit::voxelize::Mode, SurfaceMethod)> {
-    let core = mode.core()?;
+    resolve_method_seeded(mode, method, 0)
+}
+
+/// [`resolve_method`] with the seed of `bubble`.
+pub fn resolve_method_seeded(mode: Mode, method: Method, seed: u64) -> Result<(voxkit::voxelize::Mode, SurfaceMethod)> {
+    let core = mode.core_seeded(seed)?;
     let m = match method {
         Method::Auto | Method::Fast => SurfaceMethod::Fast,
         Method::Reference => SurfaceMethod::Reference,
@@ -292,12 +331,14 @@ pub struct Request {
     pub hollow: Option<u32>,
     /// `method gpu`: which GPU path.
     pub gpu_path: GpuPath,
+    /// `bubble`: the seed of its random points.
+    pub seed: u64,
 }
 
 impl Request {
     /// A request for `mode` with every other option at its default.
     pub fn new(mode: Mode, grid: GridRequest) -> Request {
-        Request { mode, method: Method::Auto, grid, surface: None, fill: None, hollow: None, gpu_path: GpuPath::Compute }
+        Request { mode, method: Method::Auto, grid, surface: None, fill: None, hollow: None, gpu_path: GpuPath::Compute, seed: 0 }
     }
 }
 
@@ -320,7 +361,7 @@ impl Plan {
         let solid = solid_plan(&request)?;
         let (core, surface_method) = match solid {
             Some(_) => (voxkit::voxelize::Mode::Cover, SurfaceMethod::Fast),
-            None => resolve_method(request.mode, request.method)?,
+            None => resolve_method_seeded(request.mode, request.method, request.seed)?,
         };
         Ok(Plan { request, solid, core, surface_method })
     }

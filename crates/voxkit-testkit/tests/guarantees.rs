@@ -1,8 +1,10 @@
 //! The topological guarantees, checked by the exact certifier on closed
 //! shared meshes (and random rotations), generated shapes and random input:
-//! `cover` and `sep26` are 26-separating, `sep6` and `ss6` 6-separating,
-//! `sep26 ⊆ cover`, `sep6 ⊆ ss6`, `sep6` is thin and 6-tunnel-free, and
-//! polylines give 6- / 26-connected runs.
+//! `cover` and `sep26` are 26-separating, `sep6`, `ss6`, `bubble` and
+//! `diagonal` 6-separating, `tunnel18` 18-tunnel-free and `tunnel26`
+//! 26-tunnel-free (and 26-separating), `sep26 ⊆ cover`, `sep6 ⊆ ss6`,
+//! `sep6 ⊆ tunnel18 ⊆ tunnel26`, `diagonal ⊆ sep26`, `sep6` is thin and
+//! 6-tunnel-free, and polylines give 6- / 26-connected runs.
 
 use glam::DVec3;
 use proptest::prelude::*;
@@ -21,9 +23,12 @@ fn is_subset(a: &DenseBits, b: &DenseBits) -> bool {
     a.words().iter().zip(b.words()).all(|(x, y)| x & !y == 0)
 }
 
+const MODES: [Mode; 8] =
+    [Mode::Cover, Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Tunnel18, Mode::Tunnel26, Mode::Bubble { seed: 3 }, Mode::Diagonal];
+
 /// Checks every guarantee of the surface modes on one closed mesh and grid.
 fn surface_guarantees(name: &str, mesh: &Mesh, grid: &GridSpec) {
-    let bits: Vec<(Mode, DenseBits)> = [Mode::Cover, Mode::Sep26, Mode::Sep6, Mode::Ss6].map(|m| (m, run(m, mesh, grid))).into();
+    let bits: Vec<(Mode, DenseBits)> = MODES.map(|m| (m, run(m, mesh, grid))).into();
     for (mode, b) in &bits {
         let r = certify(b, Some((mesh.as_ref(), grid))).unwrap();
         let f = r.mesh.unwrap();
@@ -31,21 +36,34 @@ fn surface_guarantees(name: &str, mesh: &Mesh, grid: &GridSpec) {
         let s = f.separation.unwrap();
         assert!(s.inside_voxels > 0, "{name}: nothing inside");
         assert_eq!(s.witness_6, None, "{name} {mode:?}: not 6-separating");
-        if matches!(mode, Mode::Cover | Mode::Sep26) {
+        if matches!(mode, Mode::Cover | Mode::Sep26 | Mode::Tunnel26) {
             assert_eq!(s.witness_26, None, "{name} {mode:?}: not 26-separating");
         }
-        if *mode == Mode::Sep6 {
-            assert_eq!(f.tunnels_6, 0, "{name}: sep6 has 6-tunnels");
+        if matches!(mode, Mode::Sep6 | Mode::Tunnel18 | Mode::Tunnel26) {
+            assert_eq!(f.tunnels_6, 0, "{name} {mode:?}: 6-tunnels");
         }
-        if *mode != Mode::Sep26 {
+        if matches!(mode, Mode::Tunnel18 | Mode::Tunnel26) {
+            assert_eq!(f.tunnels_18, 0, "{name} {mode:?}: 18-tunnels");
+        }
+        if *mode == Mode::Tunnel26 {
+            assert_eq!(f.tunnels_26, 0, "{name} {mode:?}: 26-tunnels");
+        }
+        if matches!(mode, Mode::Cover | Mode::Sep6 | Mode::Ss6 | Mode::Tunnel18 | Mode::Tunnel26) {
             // sep6 ⊆ ss6 ⊆ cover, and sep6 sets every column's crossing voxel.
             assert_eq!(f.columns.empty, 0, "{name} {mode:?}: holes in columns");
             assert!(f.columns.samples > 0);
         }
     }
-    assert!(is_subset(&bits[1].1, &bits[0].1), "{name}: sep26 not within cover");
-    assert!(is_subset(&bits[2].1, &bits[3].1), "{name}: sep6 not within ss6");
-    assert!(bits[2].1.count() <= bits[3].1.count());
+    let get = |m: Mode| &bits.iter().find(|b| b.0 == m).unwrap().1;
+    assert!(is_subset(get(Mode::Sep26), get(Mode::Cover)), "{name}: sep26 not within cover");
+    assert!(is_subset(get(Mode::Sep6), get(Mode::Ss6)), "{name}: sep6 not within ss6");
+    assert!(is_subset(get(Mode::Sep6), get(Mode::Tunnel18)), "{name}: sep6 not within tunnel18");
+    assert!(is_subset(get(Mode::Tunnel18), get(Mode::Tunnel26)), "{name}: tunnel18 not within tunnel26");
+    assert!(is_subset(get(Mode::Sep26), get(Mode::Tunnel26)), "{name}: sep26 not within tunnel26");
+    assert!(is_subset(get(Mode::Tunnel26), get(Mode::Cover)), "{name}: tunnel26 not within cover");
+    assert!(is_subset(get(Mode::Diagonal), get(Mode::Sep26)), "{name}: diagonal not within sep26");
+    assert!(is_subset(get(Mode::Bubble { seed: 3 }), get(Mode::Cover)), "{name}: bubble not within cover");
+    assert!(get(Mode::Sep6).count() <= get(Mode::Ss6).count());
 }
 
 #[test]

@@ -27,7 +27,7 @@ impl BatchProgress for Bar {
 }
 
 pub fn run(a: &BatchArgs) -> Result<()> {
-    let plan = crate::plan::plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path)?;
+    let plan = crate::plan::plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path, a.seed)?;
     let Some(format) = voxkit_job::output::Output::from_name(&a.format) else {
         bail!("unknown --format {:?} (expected one of: {})", a.format, voxkit_job::output::Output::names());
     };
@@ -51,6 +51,7 @@ pub fn run(a: &BatchArgs) -> Result<()> {
         up: crate::commands::export::up(&a.export).name(),
         watertight: a.export.watertight.as_deref() != Some("off"),
         triangulate: a.export.triangulate,
+        seed: a.seed,
     });
     let opts = BatchOptions {
         plan,

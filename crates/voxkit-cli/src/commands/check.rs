@@ -78,9 +78,11 @@ fn text(v: &Value, a: &CheckArgs) -> String {
             c["one"], c["two"], c["three_or_more"], c["max"], c["empty"]
         );
         s += &format!(
-            "\n  6-tunnel-free: {} ({} tunnels)\n  26-tunnel-free: {} ({} tunnels)",
+            "\n  6-tunnel-free: {} ({} tunnels)\n  18-tunnel-free: {} ({} tunnels)\n  26-tunnel-free: {} ({} tunnels)",
             yes_no(&v["tunnel_free_6"]),
             v["tunnels_6"],
+            yes_no(&v["tunnel_free_18"]),
+            v["tunnels_18"],
             yes_no(&v["tunnel_free_26"]),
             v["tunnels_26"]
         );

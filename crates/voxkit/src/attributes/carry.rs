@@ -29,7 +29,7 @@ use rayon::prelude::*;
 
 use super::colour::{from_linear, linear_to_rgb, pack, to_linear, unpack};
 use super::{Appearance, ColourRule, Texture, VoxelAttributes, NO_MATERIAL};
-use crate::geom::clip::clip_polygon_to_box;
+use crate::geom::clip::{clip_triangle_to_box, CLIPPED_MAX};
 use crate::geom::lattice::prepare_triangle;
 use crate::voxelize::cover::cover_triangle;
 use crate::voxelize::driver::Sink;
@@ -60,7 +60,39 @@ struct Contribution {
     /// Blend: weighted linear RGB.
     lin: [f64; 3],
     /// Dominant: area per `0xRRGGBB`.
-    hist: Vec<(u32, f64)>,
+    hist: Hist,
+}
+
+/// Area per packed colour of one contribution: a few colours inline (a
+/// voxel's piece of one triangle rarely covers more), the rest on the heap.
+#[derive(Clone, Debug, Default)]
+struct Hist {
+    inline: [(u32, f64); HIST_INLINE],
+    len: u8,
+    more: Vec<(u32, f64)>,
+}
+
+const HIST_INLINE: usize = 4;
+
+impl Hist {
+    #[inline]
+    fn add(&mut self, c: u32, w: f64) {
+        let n = self.len as usize;
+        if let Some(h) = self.inline[..n].iter_mut().find(|h| h.0 == c) {
+            h.1 += w;
+        } else if let Some(h) = self.more.iter_mut().find(|h| h.0 == c) {
+            h.1 += w;
+        } else if n < HIST_INLINE {
+            self.inline[n] = (c, w);
+            self.len += 1;
+        } else {
+            self.more.push((c, w));
+        }
+    }
+
+    fn iter(&self) -> impl Iterator<Item = &(u32, f64)> {
+        self.inline[..self.len as usize].iter().chain(&self.more)
+    }
 }
 
 /// Attributes of the set voxels of `voxels` (on `grid`) from the triangles of `mesh`.
@@ -253,8 +285,10 @@ impl Ctx<'_> {
         for v in voxels {
             let Ok(slot) = self.keys.binary_search(&VoxelAttributes::key(dims, v[0], v[1], v[2])) else { continue };
             let lo = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
-            let poly = clip_polygon_to_box(&p, lo, lo + DVec3::ONE);
-            let mut c = Contribution { slot, tri: t as u32, area: 0.0, w: 0.0, lin: [0.0; 3], hist: Vec::new() };
+            let mut clipped = [DVec3::ZERO; CLIPPED_MAX];
+            let n = clip_triangle_to_box(&p, lo, lo + DVec3::ONE, &mut clipped);
+            let poly = &clipped[..n];
+            let mut c = Contribution { slot, tri: t as u32, area: 0.0, w: 0.0, lin: [0.0; 3], hist: Hist::default() };
             for w in 1..poly.len().saturating_sub(1) {
                 let (a, b, d) = (poly[0], poly[w], poly[w + 1]);
                 let area = 0.5 * (b - a).cross(d - a).length();
@@ -268,7 +302,7 @@ impl Ctx<'_> {
             if c.area <= 0.0 && self.colour {
                 // A touch: one point sample where it touches (or, if the f64
                 // clip lost it, the voxel's nearest point of the triangle's plane).
-                let at = if poly.is_empty() { closest_point(&p, lo + DVec3::splat(0.5)) } else { centroid(&poly) };
+                let at = if poly.is_empty() { closest_point(&p, lo + DVec3::splat(0.5)) } else { centroid(poly) };
                 shader.add(at, 1.0, &mut c);
             }
             out.push(c);
@@ -403,11 +437,7 @@ impl<'a> Shader<'a> {
         out.w += w;
         match self.rule {
             ColourRule::Dominant => {
-                let c = pack(self.dominant_colour(b));
-                match out.hist.iter_mut().find(|h| h.0 == c) {
-                    Some(h) => h.1 += w,
-                    None => out.hist.push((c, w)),
-                }
+                out.hist.add(pack(self.dominant_colour(b)), w);
             }
             ColourRule::Blend => {
                 let l = self.linear_colour(b);

@@ -38,6 +38,42 @@ pub fn clip_polygon_to_box(poly: &[DVec3], lo: DVec3, hi: DVec3) -> Vec<DVec3> {
 /// Largest input polygon clipped without allocating.
 const MAX_IN: usize = 8;
 
+/// Most vertices [`clip_triangle_to_box`] can return (3 + one per plane).
+pub const CLIPPED_MAX: usize = 9;
+
+/// [`clip_polygon_to_box`] for a triangle, into a fixed array (no
+/// allocation: the attribute carrier clips one triangle per voxel it
+/// touches). Returns the number of vertices in `out`.
+#[inline]
+pub fn clip_triangle_to_box(tri: &[DVec3; 3], lo: DVec3, hi: DVec3, out: &mut [DVec3; CLIPPED_MAX]) -> usize {
+    let mut a = [DVec3::ZERO; CLIPPED_MAX];
+    a[..3].copy_from_slice(tri);
+    let mut n = 3;
+    let mut src = true;
+    for axis in 0..3 {
+        for (bound, keep_below) in [(lo[axis], false), (hi[axis], true)] {
+            if n == 0 {
+                return 0;
+            }
+            // Skip planes the polygon lies entirely on the kept side of.
+            let (from, to) = if src { (&a, &mut *out) } else { (&*out, &mut a) };
+            let inside = from[..n].iter().all(|p| if keep_below { p[axis] <= bound } else { p[axis] >= bound });
+            if inside {
+                continue;
+            }
+            let mut buf = [DVec3::ZERO; CLIPPED_MAX + 1];
+            let m = clip_plane(&from[..n], axis, bound, keep_below, &mut buf);
+            to[..m.min(CLIPPED_MAX)].copy_from_slice(&buf[..m.min(CLIPPED_MAX)]);
+            n = m.min(CLIPPED_MAX);
+            src = !src;
+        }
+    }
+    if src {
+        out[..n].copy_from_slice(&a[..n]);
+    }
+    n
+}
+
 fn clip_general(poly: &[DVec3], lo: DVec3, hi: DVec3) -> Vec<DVec3> {
     let mut cur: Vec<DVec3> = poly.to_vec();
     for axis in 0..3 {

@@ -10,8 +10,8 @@
 //!   the grid.
 //! - *Thin removable*: set voxels whose removal alone keeps the set
 //!   6-separating — those whose unset 6-neighbours all share their class.
-//! - A *6-tunnel* (26-tunnel) is a segment joining the centres of two
-//!   6-adjacent (26-adjacent) unset voxels that meets the surface; a set is
+//! - A *6-tunnel* (18-, 26-tunnel) is a segment joining the centres of two
+//!   6-adjacent (18-, 26-adjacent) unset voxels that meets the surface; a set is
 //!   tunnel-free iff there is none. This needs no closed surface.
 //! - *Thick voxels*: set voxels with a set neighbour along each of the three
 //!   axes (zero for a voxelization that is one voxel thin along some axis
@@ -59,6 +59,8 @@ pub struct MeshFacts {
     pub closed: bool,
     /// Segments between centres of 6-adjacent unset voxels that meet the surface.
     pub tunnels_6: u64,
+    /// Segments between centres of 18-adjacent (face or edge) unset voxels that meet the surface.
+    pub tunnels_18: u64,
     /// Segments between centres of 26-adjacent unset voxels that meet the surface.
     pub tunnels_26: u64,
     /// Runs along each triangle's dominant axis where it crosses a column.
@@ -133,8 +135,9 @@ pub fn certify(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec)>) -> Resu
         report.mesh = Some(MeshFacts {
             boundary_edges: snapped.boundary_edges,
             closed,
-            tunnels_6: tunnels(bits, &tris, Connectivity::Six),
-            tunnels_26: tunnels(bits, &tris, Connectivity::TwentySix),
+            tunnels_6: tunnels(bits, &tris, 1),
+            tunnels_18: tunnels(bits, &tris, 2),
+            tunnels_26: tunnels(bits, &tris, 3),
             columns: columns(bits, &tris),
             separation,
         });
@@ -151,6 +154,22 @@ fn forward_offsets(conn: Connectivity) -> Vec<[i64; 3]> {
                 let n = di.abs() + dj.abs() + dk.abs();
                 let forward = (dk, dj, di) > (0, 0, 0);
                 if forward && (conn == Connectivity::TwentySix || n == 1) {
+                    out.push([di, dj, dk]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The forward neighbour offsets with `|di| + |dj| + |dk| <= order`.
+fn forward_offsets_upto(order: i64) -> Vec<[i64; 3]> {
+    let mut out = Vec::new();
+    for dk in -1..=1i64 {
+        for dj in -1..=1i64 {
+            for di in -1..=1i64 {
+                let n = di.abs() + dj.abs() + dk.abs();
+                if (dk, dj, di) > (0, 0, 0) && n <= order {
                     out.push([di, dj, dk]);
                 }
             }
@@ -348,9 +367,11 @@ fn columns_of<T: crate::geom::fixed::PlaneInt>(bits: &DenseBits, t: &LatticeTria
 
 /// Distinct segments between centres of adjacent unset voxels that meet a
 /// triangle (the segments displaced like every target).
-fn tunnels(bits: &DenseBits, tris: &[LatticeTriangle], conn: Connectivity) -> u64 {
+/// `order` is the largest `|di| + |dj| + |dk|` of the neighbours: 1 for
+/// 6-adjacency, 2 for 18, 3 for 26.
+fn tunnels(bits: &DenseBits, tris: &[LatticeTriangle], order: i64) -> u64 {
     let dims = bits.dims();
-    let offsets = forward_offsets(conn);
+    let offsets = forward_offsets_upto(order);
     let mut found: Vec<(u64, u8)> = tris
         .par_chunks(256)
         .flat_map_iter(|chunk| {

@@ -7,13 +7,18 @@
 //! | `sep26` | [`sep26`] | a triangle meets a space diagonal (26-separating, ⊆ `cover`) |
 //! | `sep6` | [`sep6`] | a triangle meets the 3D crosshair (6-separating, thin) |
 //! | `ss6` | [`ss6`] | Schwarz–Seidel plane + diamond tests (6-separating, ⊇ `sep6`) |
+//! | `tunnel18`, `tunnel26` | [`tunnel`](mod@tunnel) | a triangle meets a segment from the centre to a face centre or edge midpoint (and corner) (18- / 26-tunnel-free) |
+//! | `bubble` | [`bubble`](mod@bubble) | a triangle meets the randomized crosshair (6-separating, irregular) |
+//! | `diagonal` | [`diagonal`](mod@diagonal) | a triangle meets the voxel's alternating body diagonal (6-separating) |
 //! | `line26`, `line6` | [`line`](mod@line) | an element meets the bisecting squares / the surface (26- / 6-connected) |
 //! | `pos` | [`pos`](mod@pos) | none: the published projected-optimal-scanline algorithm, kept to measure its gaps |
 //! | `solid` | [`solid`] | the voxel's centre is inside (winding number); ray parity for watertight meshes |
 //!
 //! [`Mode`] with [`fast()`] and [`reference()`] dispatches over all of them.
 
+pub mod bubble;
 pub mod cover;
+pub mod diagonal;
 pub mod driver;
 pub mod fill;
 pub mod ilv;
@@ -25,6 +30,7 @@ pub mod sep6;
 pub mod solid;
 pub mod ss6;
 pub mod targets;
+pub mod tunnel;
 pub mod winding;
 
 use crate::geom::lattice::{prepare, LatticeTriangle, PrepareStats};
@@ -81,11 +87,34 @@ pub enum Mode {
     Line6,
     /// The published projected optimal scanline algorithm (no guarantee).
     Pos,
+    /// 18-tunnel-free (centre to face centres and edge midpoints).
+    Tunnel18,
+    /// 26-tunnel-free (centre to face centres, edge midpoints and corners).
+    Tunnel26,
+    /// Randomized crosshair (6-separating), from a seed.
+    Bubble {
+        /// The seed of the random points: same seed, same voxels.
+        seed: u64,
+    },
+    /// Alternating single body diagonal (6-separating).
+    Diagonal,
 }
 
 impl Mode {
     /// Every mode, in documentation order.
-    pub const ALL: [Mode; 7] = [Mode::Cover, Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Line26, Mode::Line6, Mode::Pos];
+    pub const ALL: [Mode; 11] = [
+        Mode::Cover,
+        Mode::Sep26,
+        Mode::Sep6,
+        Mode::Ss6,
+        Mode::Line26,
+        Mode::Line6,
+        Mode::Pos,
+        Mode::Tunnel18,
+        Mode::Tunnel26,
+        Mode::Bubble { seed: 0 },
+        Mode::Diagonal,
+    ];
 
     /// The CLI name.
     pub fn name(self) -> &'static str {
@@ -97,6 +126,10 @@ impl Mode {
             Mode::Line26 => "line26",
             Mode::Line6 => "line6",
             Mode::Pos => "pos",
+            Mode::Tunnel18 => "tunnel18",
+            Mode::Tunnel26 => "tunnel26",
+            Mode::Bubble { .. } => "bubble",
+            Mode::Diagonal => "diagonal",
         }
     }
 }
@@ -111,6 +144,10 @@ pub fn fast(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) 
         Mode::Line26 => line::line(mesh, grid, line::LineTarget::Squares26, opts),
         Mode::Line6 => line::line(mesh, grid, line::LineTarget::Surface6, opts),
         Mode::Pos => pos::pos(mesh, grid, opts),
+        Mode::Tunnel18 => tunnel::tunnel(mesh, grid, tunnel::TunnelTarget::Eighteen, opts),
+        Mode::Tunnel26 => tunnel::tunnel(mesh, grid, tunnel::TunnelTarget::TwentySix, opts),
+        Mode::Bubble { seed } => bubble::bubble(mesh, grid, seed, opts),
+        Mode::Diagonal => diagonal::diagonal(mesh, grid, opts),
     }
 }
 
@@ -124,6 +161,10 @@ pub fn reference(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec) -> (DenseBits, 
         Mode::Line26 => line::reference::line(mesh, grid, line::LineTarget::Squares26),
         Mode::Line6 => line::reference::line(mesh, grid, line::LineTarget::Surface6),
         Mode::Pos => pos::reference::pos(mesh, grid),
+        Mode::Tunnel18 => tunnel::reference::tunnel(mesh, grid, tunnel::TunnelTarget::Eighteen),
+        Mode::Tunnel26 => tunnel::reference::tunnel(mesh, grid, tunnel::TunnelTarget::TwentySix),
+        Mode::Bubble { seed } => bubble::reference::bubble(mesh, grid, seed),
+        Mode::Diagonal => diagonal::reference::diagonal(mesh, grid),
     }
 }
 
