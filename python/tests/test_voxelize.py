@@ -27,6 +27,10 @@ from conftest import run_cli
         ("cow.obj", "solid", ["--hollow", "6"]),
         ("teapot.obj", "cover", ["--method", "reference"]),
         ("rocker-arm.obj", "sep6", ["--method", "scanline"]),
+        ("cow.obj", "tunnel18", []),
+        ("fandisk.obj", "tunnel26", []),
+        ("cow.obj", "bubble", ["--seed", "5"]),
+        ("stanford-bunny.obj", "diagonal", []),
     ],
 )
 def test_numpy_equals_the_cli_file(tmp_path, meshes, cli, mesh, mode, extra):
@@ -38,7 +42,7 @@ def test_numpy_equals_the_cli_file(tmp_path, meshes, cli, mesh, mode, extra):
     for flag in it:
         value = next(it, None) if flag != "--quiet" else None
         key = flag.lstrip("-").replace("-", "_")
-        kw[key] = int(value) if key in ("pad", "hollow") else value
+        kw[key] = int(value) if key in ("pad", "hollow", "seed") else value
     got = voxkit.voxelize(voxkit.load_mesh(meshes / mesh), mode=mode, resolution=64, **kw)
     assert got.occupancy.shape == want.shape
     assert np.array_equal(got.occupancy, want), f"{mode} {extra}: {np.sum(got.occupancy != want)} voxels differ"

@@ -34,6 +34,9 @@ pub enum Command {
     /// Voxelize whole datasets: one output per input mesh, a manifest of
     /// JSON lines, resumable, a bad mesh recorded without stopping the rest.
     Batch(BatchArgs),
+    /// Rasterize an SVG's outlines in 2D with a connectivity guarantee
+    /// (curve4, curve8, diamond) or fill them (nonzero rule).
+    Raster(RasterArgs),
 }
 
 /// Voxelization modes.
@@ -472,4 +475,51 @@ pub struct BatchArgs {
     /// No progress bar and no summary line.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+/// 2D rasterization modes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum RasterModeArg {
+    /// 4-connected, 8-separating curves (the two pixel diagonals).
+    Curve4,
+    /// 8-connected, 4-separating curves (the crosshair).
+    Curve8,
+    /// The diamond target: the rule graphics APIs use for lines.
+    Diamond,
+    /// Filled outlines, nonzero winding at the pixel centre.
+    Fill,
+}
+
+#[derive(Args, Debug)]
+pub struct RasterArgs {
+    /// Input SVG: <path>, <polyline>, <polygon>, <line>, <rect>, <circle>, <ellipse>.
+    pub input: PathBuf,
+    /// Output: .png (black on white) or .npy (uint8, shape (W, H), [i, j]).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Rasterization mode.
+    #[arg(long, value_enum, default_value = "curve8")]
+    pub mode: RasterModeArg,
+    /// Fit the grid so the longest side of the drawing spans N pixels (default 128).
+    #[arg(long, value_name = "N")]
+    pub resolution: Option<u64>,
+    /// Pixel size in SVG user units; alone, fits the grid to the drawing.
+    #[arg(long, value_name = "S")]
+    pub pixel_size: Option<f64>,
+    /// Explicit grid origin X,Y (with --pixel-size and --dims).
+    #[arg(long, value_name = "X,Y", value_delimiter = ',', allow_hyphen_values = true)]
+    pub origin: Option<Vec<f64>>,
+    /// Explicit grid dims W,H (with --origin and --pixel-size).
+    #[arg(long, value_name = "W,H", value_delimiter = ',')]
+    pub dims: Option<Vec<u64>>,
+    /// Curves and arcs are flattened until every chord lies within this
+    /// distance of the curve (SVG user units; default 1e-5 of the drawing's extent).
+    #[arg(long, value_name = "T")]
+    pub tolerance: Option<f64>,
+    /// `fast` (default) or `reference` (brute force from the definition; the same pixels).
+    #[arg(long, default_value = "fast", value_parser = clap::builder::PossibleValuesParser::new(["fast", "reference"]))]
+    pub method: String,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
 }

@@ -31,6 +31,7 @@ fn main() -> ExitCode {
         Command::Render(a) => commands::render::run(a),
         Command::Convert(a) => commands::convert::run(a),
         Command::Batch(a) => commands::batch::run(a),
+        Command::Raster(a) => commands::raster::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -18,6 +18,7 @@ pub mod mesh_report;
 pub mod npy;
 pub mod obj;
 pub mod orient;
+pub mod pixels;
 pub mod ply;
 pub mod png;
 pub mod points;
@@ -25,6 +26,7 @@ pub mod polyline;
 mod resources;
 pub mod schem;
 pub mod stl;
+pub mod svg;
 pub mod text;
 pub mod texture;
 pub mod vox;
@@ -357,4 +359,10 @@ pub(crate) fn dense_grid(dims: [u32; 3]) -> Result<voxkit::DenseBits, ErrorKind>
         }
     }
     Ok(voxkit::DenseBits::new(dims))
+}
+
+/// Reads an SVG file's outlines (see [`svg`]).
+pub fn read_svg(path: &Path, opts: &svg::SvgOptions) -> Result<svg::LoadedSvg, IoError> {
+    let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+    fence("SVG", || svg::read(&bytes, opts)).map_err(|k| IoError::new(path, k))
 }

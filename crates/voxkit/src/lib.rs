@@ -13,6 +13,7 @@
 //!   mode ([`voxelize::Mode`]): `cover`, Laine's `sep26` and `sep6`,
 //!   Schwarz–Seidel `ss6`, `line26`, `line6`; one file per mode, each with
 //!   its brute-force reference (the definition).
+//! - [`raster`] — the same in 2D: curves (4-/8-connected) and fills.
 //! - [`topology::certify()`] — components, separation (with a witness),
 //!   thinness and tunnels of a voxel set.
 //! - [`BrickBits`] (sparse, the fast paths' result) and [`DenseBits`]
@@ -30,6 +31,7 @@ pub mod export;
 pub mod geom;
 pub mod grid;
 pub mod mesh;
+pub mod raster;
 pub mod render;
 pub mod topology;
 pub mod voxelize;

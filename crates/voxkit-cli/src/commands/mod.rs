@@ -8,5 +8,6 @@ pub mod convert;
 pub mod export;
 pub mod gaps;
 pub mod info;
+pub mod raster;
 pub mod render;
 pub mod voxelize;
