@@ -7,8 +7,8 @@
 use std::io::Cursor;
 
 use glam::DVec3;
-use ply_rs_bw::parser::Parser;
-use ply_rs_bw::ply::{DefaultElement, Property};
+use ply_rs_bw::parser::{Parser, Reader};
+use ply_rs_bw::ply::{DefaultElement, Encoding, Header, Property, PropertyType, ScalarType};
 
 use crate::error::ErrorKind;
 use crate::mesh_report::{fan, finish, LoadedMesh};
@@ -42,8 +42,12 @@ fn list(p: &Property) -> Option<Vec<i64>> {
 /// Parses PLY bytes.
 pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
     let parser = Parser::<DefaultElement>::new();
-    let ply = parser.read_ply(&mut Cursor::new(bytes)).map_err(|e| ErrorKind::malformed("PLY", e))?;
-    let verts = ply.payload.get("vertex").ok_or_else(|| ErrorKind::malformed("PLY", "no 'vertex' element"))?;
+    let mut reader = Reader::new(Cursor::new(bytes));
+    let header = parser.read_header(&mut reader).map_err(|e| ErrorKind::malformed("PLY", e))?;
+    let payload_len = bytes.len() as u64 - reader.get_ref().position();
+    check_counts(&header, payload_len)?;
+    let payload = parser.read_payload(&mut reader, &header).map_err(|e| ErrorKind::malformed("PLY", e))?;
+    let verts = payload.get("vertex").ok_or_else(|| ErrorKind::malformed("PLY", "no 'vertex' element"))?;
     let mut positions = Vec::with_capacity(verts.len());
     let mut colours = Vec::new();
     for (n, v) in verts.iter().enumerate() {
@@ -61,7 +65,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
         positions.push(DVec3::from(c));
     }
     let mut triangles = Vec::new();
-    if let Some(faces) = ply.payload.get("face") {
+    if let Some(faces) = payload.get("face") {
         for (n, f) in faces.iter().enumerate() {
             let idx = f
                 .get("vertex_indices")
@@ -77,6 +81,43 @@ pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
     let mut loaded = finish(positions, triangles, Vec::new())?;
     loaded.appearance.vertex_colour = colours;
     Ok(loaded)
+}
+
+/// Refuses a header whose element counts cannot fit in the bytes after it:
+/// each entry takes at least one byte (an ASCII line, or the sizes of its
+/// binary scalars and list counts). Without this a 100-byte file claiming
+/// 400 million property-less vertices keeps the parser busy for minutes.
+fn check_counts(header: &Header, payload_len: u64) -> Result<(), ErrorKind> {
+    let mut need: u64 = 0;
+    for (name, el) in header.elements.iter() {
+        let per_entry: u64 = el
+            .properties
+            .values()
+            .map(|p| match (&header.encoding, &p.data_type) {
+                (Encoding::Ascii, _) => 2,
+                (_, PropertyType::Scalar(t)) | (_, PropertyType::List(t, _)) => scalar_size(t),
+            })
+            .sum::<u64>()
+            .max(1);
+        need = need.saturating_add((el.count as u64).saturating_mul(per_entry));
+        // One byte of slack: the last ASCII line may lack its newline.
+        if need > payload_len + 1 {
+            return Err(ErrorKind::malformed(
+                "PLY",
+                format!("the header claims {} '{name}' entries, more than the {payload_len} bytes after it can hold", el.count),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn scalar_size(t: &ScalarType) -> u64 {
+    match t {
+        ScalarType::Char | ScalarType::UChar => 1,
+        ScalarType::Short | ScalarType::UShort => 2,
+        ScalarType::Int | ScalarType::UInt | ScalarType::Float => 4,
+        ScalarType::Double => 8,
+    }
 }
 
 /// A vertex's `red green blue` (or `r g b`, or `diffuse_red` …): bytes, or
