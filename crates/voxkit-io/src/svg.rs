@@ -95,6 +95,7 @@ pub fn read(bytes: &[u8], opts: &SvgOptions) -> Result<LoadedSvg, ErrorKind> {
         None => 1e-9,
     };
     let mut outlines = Vec::new();
+    let mut total = 0usize;
     for pieces in paths {
         let mut cur = Outline::default();
         let mut at = DVec2::ZERO;
@@ -125,8 +126,16 @@ pub fn read(bytes: &[u8], opts: &SvgOptions) -> Result<LoadedSvg, ErrorKind> {
                     if cur.points.is_empty() {
                         cur.points.push(at);
                     }
+                    let before = cur.points.len();
                     flatten_cubic(at, c1, c2, a, tol, 0, &mut cur.points);
                     at = a;
+                    total += cur.points.len() - before;
+                    if total > MAX_POINTS {
+                        return Err(ErrorKind::malformed(
+                            "SVG",
+                            format!("flattening the curves needs more than {MAX_POINTS} points at tolerance {tol}; raise --tolerance"),
+                        ));
+                    }
                 }
                 Piece::Close => {
                     cur.closed = true;
@@ -151,13 +160,46 @@ pub fn read(bytes: &[u8], opts: &SvgOptions) -> Result<LoadedSvg, ErrorKind> {
     Ok(LoadedSvg { outlines, warnings })
 }
 
+/// Largest magnitude of a number in path data. Arcs become cubics inside
+/// `svgtypes`, which splits an arc more finely the larger it is against a
+/// fixed tolerance: an arc to 1e110 took minutes (found by fuzzing).
+const MAX_PATH_NUMBER: f64 = 1e12;
+
+/// Refuses path data holding a number beyond [`MAX_PATH_NUMBER`].
+fn check_path_numbers(d: &str) -> Result<(), ErrorKind> {
+    use svgtypes::PathSegment as P;
+    for seg in svgtypes::PathParser::from(d) {
+        let Ok(seg) = seg else { break }; // the simplifying parser reports it
+        let nums: &[f64] = match &seg {
+            P::MoveTo { x, y, .. } | P::LineTo { x, y, .. } | P::SmoothQuadratic { x, y, .. } => &[*x, *y],
+            P::HorizontalLineTo { x, .. } => &[*x],
+            P::VerticalLineTo { y, .. } => &[*y],
+            P::CurveTo { x1, y1, x2, y2, x, y, .. } => &[*x1, *y1, *x2, *y2, *x, *y],
+            P::SmoothCurveTo { x2, y2, x, y, .. } => &[*x2, *y2, *x, *y],
+            P::Quadratic { x1, y1, x, y, .. } => &[*x1, *y1, *x, *y],
+            P::EllipticalArc { rx, ry, x, y, .. } => &[*rx, *ry, *x, *y],
+            P::ClosePath { .. } => &[],
+        };
+        if let Some(v) = nums.iter().find(|v| v.is_nan() || v.abs() > MAX_PATH_NUMBER) {
+            return Err(ErrorKind::malformed("SVG", format!("<path> d: number {v} beyond {MAX_PATH_NUMBER:e}")));
+        }
+    }
+    Ok(())
+}
+
+/// Most points the flattened curves of one file may have (a hostile file's
+/// curves at a tiny tolerance would otherwise take minutes and gigabytes).
+const MAX_POINTS: usize = 1 << 24;
+
 /// Appends the points after `p0` of the cubic `p0 c1 c2 p3`, split until
 /// the control points lie within `tol` of the chord.
 fn flatten_cubic(p0: DVec2, c1: DVec2, c2: DVec2, p3: DVec2, tol: f64, depth: u32, out: &mut Vec<DVec2>) {
     let chord = p3 - p0;
     let len = chord.length();
     let dist = |q: DVec2| if len > 0.0 { (q - p0).perp_dot(chord).abs() / len } else { (q - p0).length() };
-    if depth >= 24 || (dist(c1) <= tol && dist(c2) <= tol) {
+    // A non-finite point ends the split (the outline is refused below).
+    let finite = p0.is_finite() && c1.is_finite() && c2.is_finite() && p3.is_finite();
+    if depth >= 24 || !finite || (dist(c1) <= tol && dist(c2) <= tol) {
         out.push(p3);
         return;
     }
@@ -198,6 +240,7 @@ fn walk(node: roxmltree::Node<'_, '_>, parent: Affine, out: &mut Vec<Vec<Piece>>
     match name {
         "path" => {
             let d = node.attribute("d").unwrap_or("");
+            check_path_numbers(d)?;
             let mut pieces = Vec::new();
             // The current point and the subpath's start, in plane coordinates.
             let (mut at, mut start) = (DVec2::ZERO, DVec2::ZERO);
@@ -308,6 +351,18 @@ mod tests {
         );
         assert_eq!(o[0].points, vec![DVec2::new(10., 0.), DVec2::new(12., 0.), DVec2::new(10., 2.)]);
         assert!(o[0].closed && !o[1].closed);
+    }
+
+    #[test]
+    fn huge_arcs_end_quickly() {
+        // Fuzzing found this: arcs to 1e31 and 1e110 split to the depth
+        // limit on every piece (non-finite distances), for minutes.
+        let svg = br#"<svg><path d="M0 8 L4 4 h3 v-3 z m1 1 c 1 1 2 2 3 0 s 1 1 2 2 q 1 1 2 0 t 0 1 a 2 2 0 0 1 99999999999999999999999999999992 3 0 s 1 1 2 2 q 1 1 2 0 t 0 1 a 2 2 0 0 1 9999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999993 3"/></svg>"#;
+        let t = std::time::Instant::now();
+        let _ = read(svg, &SvgOptions::default());
+        assert!(t.elapsed().as_secs_f64() < 5.0, "took {:?}", t.elapsed());
+        let tiny = br#"<svg><circle cx="0" cy="0" r="10"/></svg>"#;
+        assert!(read(tiny, &SvgOptions { tolerance: Some(1e-300) }).is_err());
     }
 
     #[test]
