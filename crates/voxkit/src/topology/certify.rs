@@ -132,12 +132,13 @@ pub fn certify(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec)>) -> Resu
                 thin_removable: thin_removable(bits, &parity),
             }
         });
+        let tunnels = tunnels(bits, &tris);
         report.mesh = Some(MeshFacts {
             boundary_edges: snapped.boundary_edges,
             closed,
-            tunnels_6: tunnels(bits, &tris, 1),
-            tunnels_18: tunnels(bits, &tris, 2),
-            tunnels_26: tunnels(bits, &tris, 3),
+            tunnels_6: tunnels[0],
+            tunnels_18: tunnels[1],
+            tunnels_26: tunnels[2],
             columns: columns(bits, &tris),
             separation,
         });
@@ -366,12 +367,13 @@ fn columns_of<T: crate::geom::fixed::PlaneInt>(bits: &DenseBits, t: &LatticeTria
 }
 
 /// Distinct segments between centres of adjacent unset voxels that meet a
-/// triangle (the segments displaced like every target).
-/// `order` is the largest `|di| + |dj| + |dk|` of the neighbours: 1 for
-/// 6-adjacency, 2 for 18, 3 for 26.
-fn tunnels(bits: &DenseBits, tris: &[LatticeTriangle], order: i64) -> u64 {
+/// triangle (the segments displaced like every target), counted for
+/// 6-, 18- and 26-adjacency (neighbours with `|di| + |dj| + |dk|` at most
+/// 1, 2 and 3): one pass over the 26-neighbour segments, each found
+/// segment counted for every adjacency that contains it.
+fn tunnels(bits: &DenseBits, tris: &[LatticeTriangle]) -> [u64; 3] {
     let dims = bits.dims();
-    let offsets = forward_offsets_upto(order);
+    let offsets = forward_offsets_upto(3);
     let mut found: Vec<(u64, u8)> = tris
         .par_chunks(256)
         .flat_map_iter(|chunk| {
@@ -388,7 +390,14 @@ fn tunnels(bits: &DenseBits, tris: &[LatticeTriangle], order: i64) -> u64 {
         .collect();
     found.par_sort_unstable();
     found.dedup();
-    found.len() as u64
+    let mut counts = [0u64; 3];
+    for &(_, di) in &found {
+        let order = offsets[di as usize].iter().map(|x| x.abs()).sum::<i64>() as usize;
+        for c in &mut counts[order - 1..] {
+            *c += 1;
+        }
+    }
+    counts
 }
 
 fn tunnels_of<T: crate::geom::fixed::PlaneInt>(
@@ -401,9 +410,11 @@ fn tunnels_of<T: crate::geom::fixed::PlaneInt>(
     let (lo, hi) = t.bounds();
     let s = TriSetup::<T>::new(t);
     let h = ONE / 2;
-    for (di, d) in offsets.iter().enumerate() {
-        // Voxels v whose segment [centre(v), centre(v) + d] has a bounding
-        // box meeting the triangle's.
+    // Per offset d: the voxels v whose segment [centre(v), centre(v) + d]
+    // has a bounding box meeting the triangle's, and the segment's setup.
+    let mut boxes = Vec::with_capacity(offsets.len());
+    let (mut all_lo, mut all_hi) = ([i64::MAX; 3], [i64::MIN; 3]);
+    for d in offsets {
         let mut r = [(0i64, 0i64); 3];
         for a in 0..3 {
             let (smin, smax) = (d[a].min(0) * ONE, d[a].max(0) * ONE);
@@ -413,17 +424,48 @@ fn tunnels_of<T: crate::geom::fixed::PlaneInt>(
             r[a] = (first, last);
         }
         if (0..3).any(|a| r[a].0 > r[a].1) {
+            boxes.push(None);
             continue;
         }
-        let ds = s.dir(t, d.map(|x| x * ONE));
-        for k in r[2].0..=r[2].1 {
-            for j in r[1].0..=r[1].1 {
-                for i in r[0].0..=r[0].1 {
-                    let (q0, q1, q2) = ((i + d[0]) as u32, (j + d[1]) as u32, (k + d[2]) as u32);
-                    if bits.get(i as u32, j as u32, k as u32) || bits.get(q0, q1, q2) {
+        for a in 0..3 {
+            all_lo[a] = all_lo[a].min(r[a].0);
+            all_hi[a] = all_hi[a].max(r[a].1);
+        }
+        boxes.push(Some((r, s.dir(t, d.map(|x| x * ONE)))));
+    }
+    if all_lo[0] > all_hi[0] {
+        return;
+    }
+    // A segment from a centre with plane value vp crosses the plane iff
+    // vp and vp + n·d fall on different sides of bn: only centres with vp
+    // in [bn − max n·d, bn − min n·d) can start one.
+    let (mut nd_lo, mut nd_hi) = (T::ZERO, T::ZERO);
+    for (_, ds) in boxes.iter().flatten() {
+        if ds.nd < nd_lo {
+            nd_lo = ds.nd;
+        }
+        if ds.nd > nd_hi {
+            nd_hi = ds.nd;
+        }
+    }
+    let (vp_lo, vp_hi) = (s.bn - nd_hi, s.bn - nd_lo);
+    for k in all_lo[2]..=all_hi[2] {
+        for j in all_lo[1]..=all_hi[1] {
+            for i in all_lo[0]..=all_hi[0] {
+                let pc = s.local([i * ONE + h, j * ONE + h, k * ONE + h]);
+                let vp = s.plane(pc);
+                if vp < vp_lo || vp >= vp_hi || bits.get(i as u32, j as u32, k as u32) {
+                    continue;
+                }
+                for (di, (d, b)) in offsets.iter().zip(&boxes).enumerate() {
+                    let Some((r, ds)) = b else { continue };
+                    if i < r[0].0 || i > r[0].1 || j < r[1].0 || j > r[1].1 || k < r[2].0 || k > r[2].1 {
                         continue;
                     }
-                    if s.segment_hits(&ds, s.local([i * ONE + h, j * ONE + h, k * ONE + h])) {
+                    if bits.get((i + d[0]) as u32, (j + d[1]) as u32, (k + d[2]) as u32) {
+                        continue;
+                    }
+                    if s.segment_hits_with(ds, pc, vp) {
                         let idx = (k as u64 * dims[1] as u64 + j as u64) * dims[0] as u64 + i as u64;
                         out.push((idx, di as u8));
                     }
