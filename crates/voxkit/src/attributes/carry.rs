@@ -109,9 +109,14 @@ pub fn carry(
     let mut keys = Vec::with_capacity(voxels.count() as usize);
     voxels.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
     let ctx = Ctx { mesh, app: appearance, grid, keys: &keys, rule: opts.rule, colour: appearance.has_colour() };
-    let mut contribs: Vec<Contribution> =
+    let contribs: Vec<Contribution> =
         (0..mesh.triangles.len()).into_par_iter().with_min_len(64).flat_map_iter(|t| ctx.triangle(t)).collect();
-    contribs.par_sort_unstable_by_key(|c| (c.slot, c.tri));
+    // Reduce in (voxel, triangle) order: contributions come in triangle
+    // order, so sorting `slot << 32 | index` (8 bytes, not the contributions
+    // themselves) orders them by voxel, then triangle.
+    assert!(contribs.len() < 1 << 32, "too many (triangle, voxel) pairs to carry attributes");
+    let mut order: Vec<u64> = contribs.par_iter().enumerate().map(|(i, c)| (c.slot as u64) << 32 | i as u64).collect();
+    order.par_sort_unstable();
 
     let n = keys.len();
     let materials = appearance.has_materials();
@@ -122,11 +127,15 @@ pub fn carry(
     let mut coverage = vec![0f32; n];
     let mut hist: Vec<(u32, f64)> = Vec::new();
     let mut mats: Vec<(u32, f64)> = Vec::new();
-    for group in contribs.chunk_by(|a, b| a.slot == b.slot) {
+    let mut group: Vec<&Contribution> = Vec::new();
+    for run in order.chunk_by(|a, b| a >> 32 == b >> 32) {
+        group.clear();
+        group.extend(run.iter().map(|o| &contribs[(o & 0xffff_ffff) as usize]));
+        let group = &group[..];
         let slot = group[0].slot;
         has[slot] = true;
         let any_area = group.iter().any(|c| c.area > 0.0);
-        let used = || group.iter().filter(move |c| !any_area || c.area > 0.0);
+        let used = || group.iter().copied().filter(move |c| !any_area || c.area > 0.0);
         let weight = |c: &Contribution| if any_area { c.area } else { 1.0 };
         coverage[slot] = group.iter().map(|c| c.area).sum::<f64>() as f32;
         if ctx.colour {
