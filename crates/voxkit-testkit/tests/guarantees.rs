@@ -182,3 +182,69 @@ proptest! {
         }
     }
 }
+
+/// `check`'s tunnel counts equal the definition, brute force: every pair of
+/// adjacent unset voxels whose centre segment meets some triangle (with
+/// the segment displaced), on voxels with tunnels of every kind (sep6 has
+/// 18- and 26-tunnels, diagonal and bubble all three) and on a rotation.
+#[test]
+fn tunnel_counts_equal_brute_force() {
+    use voxkit::geom::fixed::ONE;
+    use voxkit::geom::perturb::segment_meets_triangle;
+    use voxkit::topology::inside::snap_all;
+    let mut r = rng(41);
+    let monkey = shared_mesh("suzanne.obj");
+    let turned = rotated(&shared_mesh("cow.obj"), random_rotation(&mut r));
+    for (mesh, n) in [(&monkey, 24), (&turned, 18)] {
+        let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), n).unwrap();
+        let tris = snap_all(mesh.as_ref(), &grid).unwrap().crossing_triangles();
+        // (Bounding boxes only skip triangles that cannot meet a segment.)
+        let boxes: Vec<_> = tris.iter().map(|t| t.bounds()).collect();
+        for mode in [Mode::Sep6, Mode::Diagonal, Mode::Bubble { seed: 9 }] {
+            let bits = run(mode, mesh, &grid);
+            let [nx, ny, nz] = bits.dims().map(i64::from);
+            let unset =
+                |p: [i64; 3]| (0..3).all(|a| p[a] >= 0 && p[a] < [nx, ny, nz][a]) && !bits.get(p[0] as u32, p[1] as u32, p[2] as u32);
+            let centre = |p: [i64; 3]| p.map(|x| x * ONE + ONE / 2);
+            let mut counts = [0u64; 3];
+            for k in 0..nz {
+                for j in 0..ny {
+                    for i in 0..nx {
+                        for d in [
+                            [1, 0, 0],
+                            [0, 1, 0],
+                            [0, 0, 1],
+                            [1, 1, 0],
+                            [1, -1, 0],
+                            [1, 0, 1],
+                            [1, 0, -1],
+                            [0, 1, 1],
+                            [0, 1, -1],
+                            [1, 1, 1],
+                            [1, 1, -1],
+                            [1, -1, 1],
+                            [1, -1, -1],
+                        ] {
+                            let (p, q) = ([i, j, k], [i + d[0], j + d[1], k + d[2]]);
+                            if !unset(p) || !unset(q) {
+                                continue;
+                            }
+                            let s = [centre(p), centre(q)];
+                            let meets = tris.iter().zip(&boxes).any(|(t, (lo, hi))| {
+                                (0..3).all(|a| s[0][a].min(s[1][a]) <= hi[a] && s[0][a].max(s[1][a]) >= lo[a])
+                                    && segment_meets_triangle(s, t.v, true)
+                            });
+                            if meets {
+                                let order = d.iter().map(|x: &i64| x.abs()).sum::<i64>() as usize;
+                                counts[order - 1..].iter_mut().for_each(|c| *c += 1);
+                            }
+                        }
+                    }
+                }
+            }
+            let f = certify(&bits, Some((mesh.as_ref(), &grid))).unwrap().mesh.unwrap();
+            assert_eq!([f.tunnels_6, f.tunnels_18, f.tunnels_26], counts, "{mode:?} at {n}");
+            assert!(counts[2] > 0, "{mode:?} at {n}: no tunnels to count");
+        }
+    }
+}
