@@ -275,6 +275,16 @@ impl VoxelSource for BrickBits {
         BrickBits::for_each_set(self, f)
     }
 
+    fn for_each_brick(&self, f: &mut dyn FnMut([u32; 3], &Brick)) {
+        let [bx, by, _] = self.bdims;
+        for (n, &id) in self.index.iter().enumerate() {
+            if id != 0 {
+                let n = n as u32;
+                f([n % bx, (n / bx) % by, n / (bx * by)], &self.bricks[id as usize - 1]);
+            }
+        }
+    }
+
     fn fill_i_planes(&self, i0: u32, count: u32, k_fastest: bool, out: &mut [u8]) {
         let (ny, nz) = (self.dims[1] as usize, self.dims[2] as usize);
         let plane = ny * nz;
@@ -289,21 +299,29 @@ impl VoxelSource for BrickBits {
                     if id == 0 {
                         continue;
                     }
-                    for (z, &w) in self.bricks[id as usize - 1].iter().enumerate() {
-                        let mut w = w;
-                        while w != 0 {
-                            let bit = w.trailing_zeros();
-                            w &= w - 1;
-                            let (i, j, k) = (bi * 8 + (bit & 7), bj * 8 + (bit >> 3), bk * 8 + z as u32);
-                            if i < i0 || i >= i0 + count {
-                                continue;
-                            }
-                            let pos = if k_fastest { j as usize * nz + k as usize } else { k as usize * ny + j as usize };
-                            out[(i - i0) as usize * plane + pos] = 1;
-                        }
-                    }
+                    brick_to_planes([bi, bj, bk], &self.bricks[id as usize - 1], i0, count, k_fastest, [ny, nz], out);
                 }
             }
+        }
+    }
+}
+
+/// Sets in `out` (laid out as [`VoxelSource::fill_i_planes`] says, for a
+/// grid of `ny × nz` planes) the voxels of brick `b` in planes `i0 ..
+/// i0 + count`.
+pub(crate) fn brick_to_planes(b: [u32; 3], brick: &Brick, i0: u32, count: u32, k_fastest: bool, [ny, nz]: [usize; 2], out: &mut [u8]) {
+    let plane = ny * nz;
+    for (z, &w) in brick.iter().enumerate() {
+        let mut w = w;
+        while w != 0 {
+            let bit = w.trailing_zeros();
+            w &= w - 1;
+            let (i, j, k) = (b[0] * 8 + (bit & 7), b[1] * 8 + (bit >> 3), b[2] * 8 + z as u32);
+            if i < i0 || i >= i0 + count {
+                continue;
+            }
+            let pos = if k_fastest { j as usize * nz + k as usize } else { k as usize * ny + j as usize };
+            out[(i - i0) as usize * plane + pos] = 1;
         }
     }
 }
@@ -375,6 +393,27 @@ impl SlabView<'_> {
         }
     }
 
+    /// Is voxel `(i, j, k)` set (by this slab)? Allocates nothing.
+    #[inline(always)]
+    pub fn get(&self, i: u32, j: u32, k: u32) -> bool {
+        debug_assert!(k >= self.k0 && k < self.k1);
+        let key = brick_key(i, j, k);
+        let slot = if self.last.0 == key {
+            self.last.1
+        } else {
+            match self.index[self.entry(i, j, k)] {
+                0 => return false,
+                id => id as usize - 1,
+            }
+        };
+        self.pool[slot][(k & 7) as usize] >> (((j & 7) << 3) | (i & 7)) & 1 == 1
+    }
+
+    /// Are all voxels of the inclusive box `[lo, hi]` set (by this slab)?
+    pub fn all_set(&self, lo: [i64; 3], hi: [i64; 3]) -> bool {
+        (lo[2]..=hi[2]).all(|k| (lo[1]..=hi[1]).all(|j| (lo[0]..=hi[0]).all(|i| self.get(i as u32, j as u32, k as u32))))
+    }
+
     /// The pool slot of the brick holding voxel `(i, j, k)`, allocating it
     /// if needed.
     #[inline(always)]
@@ -386,9 +425,15 @@ impl SlabView<'_> {
         self.slot_miss(i, j, k, key)
     }
 
+    /// The slab's brick-index entry of the brick holding voxel `(i, j, k)`.
+    #[inline(always)]
+    fn entry(&self, i: u32, j: u32, k: u32) -> usize {
+        (((k >> SHIFT) - self.bk0) as usize * self.by as usize + (j >> SHIFT) as usize) * self.bx as usize + (i >> SHIFT) as usize
+    }
+
     #[inline(never)]
     fn slot_miss(&mut self, i: u32, j: u32, k: u32, key: u64) -> usize {
-        let b = (((k >> SHIFT) - self.bk0) as usize * self.by as usize + (j >> SHIFT) as usize) * self.bx as usize + (i >> SHIFT) as usize;
+        let b = self.entry(i, j, k);
         let mut id = self.index[b];
         if id == 0 {
             self.pool.push([0; 8]);

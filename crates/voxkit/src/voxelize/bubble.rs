@@ -35,9 +35,10 @@
 //! of each triangle's bounding box.
 
 use super::cover::cover_triangle;
-use super::driver::{run_mesh, Filter, Kernel};
+use super::driver::{run_mesh, FilterUnset, Kernel};
+use super::targets::{fits_i64, segment_may_meet_box, TriSetup};
 use super::{Options, Report, Traversal};
-use crate::geom::fixed::ONE;
+use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::{segment_meets_triangle, P3};
 use crate::grid::bricks::{BrickBits, BrickSlab};
@@ -99,19 +100,58 @@ pub fn hit(t: &LatticeTriangle, ijk: [i64; 3], seed: u64) -> bool {
 
 /// Randomized 6-separating voxelization, fast path, into sparse bricks.
 pub fn bubble(mesh: MeshRef<'_>, grid: &GridSpec, seed: u64, opts: &Options<'_>) -> (BrickBits, Report) {
-    run_mesh(&BubbleKernel { seed, traversal: opts.traversal }, mesh, grid, opts)
+    run_mesh(&BubbleKernel { seed, traversal: opts.traversal, offset: [0; 3] }, mesh, grid, opts)
+}
+
+/// The fast path on prepared triangles translated by `-offset` voxels (a
+/// tile of a larger grid whose voxel `offset` is this grid's voxel 0): the
+/// random points are drawn for the voxels' indices in the whole grid.
+pub fn bubble_lattice(tris: &[LatticeTriangle], dims: [u32; 3], seed: u64, offset: [i64; 3], opts: &Options<'_>) -> BrickBits {
+    super::driver::run_slabs(&BubbleKernel { seed, traversal: opts.traversal, offset }, tris, dims, opts).0
 }
 
 struct BubbleKernel {
     seed: u64,
     traversal: Traversal,
+    /// Index in the whole grid of this grid's voxel 0.
+    offset: [i64; 3],
 }
 
 impl Kernel<LatticeTriangle> for BubbleKernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
-        let keep = |ijk: [i64; 3]| hit(tri, ijk, self.seed);
-        cover_triangle(tri, lo, hi, self.traversal, &mut Filter { slab, keep });
+        if fits_i64(tri) {
+            filtered::<i64>(tri, self.seed, self.offset, lo, hi, self.traversal, slab);
+        } else {
+            filtered::<i128>(tri, self.seed, self.offset, lo, hi, self.traversal, slab);
+        }
     }
+}
+
+/// The definition over `cover`'s voxels: each random target first past the
+/// box filter, then the exact segment test of [`TriSetup`] (the same
+/// decision as [`segment_meets_triangle`], without its generic 128-bit
+/// determinants).
+#[allow(clippy::too_many_arguments)]
+fn filtered<T: PlaneInt>(
+    tri: &LatticeTriangle,
+    seed: u64,
+    offset: [i64; 3],
+    lo: [i64; 3],
+    hi: [i64; 3],
+    traversal: Traversal,
+    slab: &mut BrickSlab<'_>,
+) {
+    let (blo, bhi) = tri.bounds();
+    let s = TriSetup::<T>::new(tri);
+    let shift: [i64; 3] = offset.map(|o| o * ONE);
+    let keep = |ijk: [i64; 3]| {
+        targets(seed, std::array::from_fn(|a| ijk[a] + offset[a])).iter().any(|seg| {
+            let a: P3 = std::array::from_fn(|c| seg[0][c] - shift[c]);
+            let d = std::array::from_fn(|c| seg[1][c] - seg[0][c]);
+            segment_may_meet_box(a, d, blo, bhi) && s.segment_hits(&s.dir(tri, d), s.local(a))
+        })
+    };
+    cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
 }
 
 /// The slow, obviously correct definition.

@@ -26,7 +26,7 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, Filter, Kernel};
-use super::targets::{fits_i64, TriSetup, DIAGONALS};
+use super::targets::{fits_i64, LazyTargets, DIAGONALS};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -68,6 +68,13 @@ pub fn diagonal(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (Bric
     run_mesh(&DiagonalKernel { traversal: opts.traversal }, mesh, grid, opts)
 }
 
+/// The fast path on already prepared triangles. The pattern repeats every
+/// 2 voxels, so triangles translated by an even number of voxels (the tiled
+/// driver's tiles) get the same voxels, translated.
+pub fn diagonal_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> BrickBits {
+    super::driver::run_slabs(&DiagonalKernel { traversal: opts.traversal }, tris, dims, opts).0
+}
+
 struct DiagonalKernel {
     traversal: Traversal,
 }
@@ -83,13 +90,8 @@ impl Kernel<LatticeTriangle> for DiagonalKernel {
 }
 
 fn filtered<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], traversal: Traversal, slab: &mut BrickSlab<'_>) {
-    let s = TriSetup::<T>::new(tri);
-    let dirs = DIAGONALS.map(|(o, d)| (o.map(T::from_i64), s.dir(tri, d)));
-    let keep = |ijk: [i64; 3]| {
-        let (o, ds) = &dirs[which(ijk)];
-        let p = s.local(ijk.map(|c| c * ONE));
-        s.segment_hits(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]])
-    };
+    let mut targets = LazyTargets::<T, 4>::new(tri, &DIAGONALS);
+    let keep = |ijk: [i64; 3]| targets.hits(which(ijk), ijk);
     cover_triangle(tri, lo, hi, traversal, &mut Filter { slab, keep });
 }
 

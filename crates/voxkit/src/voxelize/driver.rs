@@ -94,7 +94,7 @@ pub fn run_triangles<K: Kernel<LatticeTriangle>>(
             let mut slabs = bits.slabs_mut(layers);
             let mut slab = slabs.pop().expect("one slab holds the whole grid");
             for tri in &mesh.triangles[part * n / parts..(part + 1) * n / parts] {
-                snapped.triangle(tri, &mut st, |t, lo, hi| kernel.run(t, lo, hi, &mut slab));
+                snapped.triangle(tri, &mut st, |t, lo, hi| run_unless_full(kernel, t, lo, hi, &mut slab));
             }
             let pool = slab.into_pool();
             bits.merge_slabs(vec![pool]);
@@ -108,6 +108,28 @@ pub fn run_triangles<K: Kernel<LatticeTriangle>>(
     let grids: Vec<BrickBits> = done.into_iter().map(|d| d.0).collect();
     let (bits, voxels) = BrickBits::union_canonical(&grids);
     (bits, Report { prepare, voxels })
+}
+
+/// Voxels in the inclusive box `[lo, hi]` (not empty).
+#[inline(always)]
+pub(crate) fn box_volume(lo: [i64; 3], hi: [i64; 3]) -> i64 {
+    (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1)
+}
+
+/// Largest voxel box checked for being already set before its primitive's
+/// kernel runs.
+const FULL_CHECK_MAX: i64 = 8;
+
+/// Runs `kernel` on `prim` unless its (small) box is already all set: a
+/// kernel only sets voxels of its box, so it could add nothing. At small
+/// resolutions most triangles lie in a voxel or two that earlier triangles
+/// have set, and the exact setup of the modes' targets is skipped for them.
+#[inline(always)]
+fn run_unless_full<P, K: Kernel<P>>(kernel: &K, prim: &P, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+    if box_volume(lo, hi) <= FULL_CHECK_MAX && slab.all_set(lo, hi) {
+        return;
+    }
+    kernel.run(prim, lo, hi, slab);
 }
 
 /// An input primitive on the lattice: it knows which voxels it may touch.
@@ -184,6 +206,24 @@ impl<F: FnMut([i64; 3]) -> bool> Sink for Filter<'_, '_, F> {
     }
 }
 
+/// [`Filter`] for expensive predicates: asks `keep` only about voxels
+/// not yet set (a triangle's neighbours have set most of its voxels).
+pub struct FilterUnset<'s, 'b, F> {
+    /// Destination.
+    pub slab: &'s mut BrickSlab<'b>,
+    /// The mode's exact per-voxel predicate.
+    pub keep: F,
+}
+
+impl<F: FnMut([i64; 3]) -> bool> Sink for FilterUnset<'_, '_, F> {
+    #[inline(always)]
+    fn set(&mut self, i: u32, j: u32, k: u32) {
+        if !self.slab.get(i, j, k) && (self.keep)([i as i64, j as i64, k as i64]) {
+            self.slab.set(i, j, k);
+        }
+    }
+}
+
 /// Runs `kernel` over `tris` on a grid of `dims`, in parallel over z-slabs
 /// (whole brick layers). Returns the grid and the number of voxels set
 /// (counted by each slab's task while its bricks are still in cache).
@@ -219,7 +259,7 @@ pub fn run_slabs<P: Primitive, K: Kernel<P>>(kernel: &K, tris: &[P], dims: [u32;
                 lo[2] = lo[2].max(slab.k0 as i64);
                 hi[2] = hi[2].min(slab.k1 as i64 - 1);
                 if lo[2] <= hi[2] {
-                    kernel.run(&tris[idx as usize], lo, hi, &mut slab);
+                    run_unless_full(kernel, &tris[idx as usize], lo, hi, &mut slab);
                 }
             }
             if let Some(p) = opts.progress {

@@ -54,6 +54,11 @@ pub fn pos(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBits
     (bits, Report { prepare: prepare_stats, voxels })
 }
 
+/// `pos` on already prepared triangles.
+pub fn pos_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> BrickBits {
+    run_slabs(&PosKernel, tris, dims, opts).0
+}
+
 struct PosKernel;
 
 impl Kernel<LatticeTriangle> for PosKernel {

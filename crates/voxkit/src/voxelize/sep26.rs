@@ -23,7 +23,7 @@
 
 use super::cover::{PlaneRange, Setup as CoverSetup};
 use super::driver::{run_mesh, run_slabs, Kernel};
-use super::targets::{dominant_axes, fits_i64, PixelTest, TriSetup, DIAGONALS};
+use super::targets::{dominant_axes, fits_i64, is_tiny, targets_in_box, PixelTest, TriSetup, DIAGONALS};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -48,10 +48,12 @@ struct Sep26Kernel;
 
 impl Kernel<LatticeTriangle> for Sep26Kernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
-        if fits_i64(tri) {
-            project::<i64>(tri, lo, hi, slab);
-        } else {
+        if !fits_i64(tri) {
             project::<i128>(tri, lo, hi, slab);
+        } else if is_tiny(lo, hi) {
+            targets_in_box(tri, &DIAGONALS, lo, hi, slab);
+        } else {
+            project::<i64>(tri, lo, hi, slab);
         }
     }
 }

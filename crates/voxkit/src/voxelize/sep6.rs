@@ -27,7 +27,7 @@
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
 use super::driver::{run_mesh, run_slabs, Kernel};
-use super::targets::{dominant_axes, fits_i64, PixelTest, TriSetup};
+use super::targets::{dominant_axes, fits_i64, is_tiny, targets_in_box, PixelTest, TriSetup, CROSSHAIR};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -52,10 +52,12 @@ struct Sep6Kernel;
 
 impl Kernel<LatticeTriangle> for Sep6Kernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
-        if fits_i64(tri) {
-            project::<i64>(tri, lo, hi, slab);
-        } else {
+        if !fits_i64(tri) {
             project::<i128>(tri, lo, hi, slab);
+        } else if is_tiny(lo, hi) {
+            targets_in_box(tri, &CROSSHAIR, lo, hi, slab);
+        } else {
+            project::<i64>(tri, lo, hi, slab);
         }
     }
 }

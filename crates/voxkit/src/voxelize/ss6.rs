@@ -48,6 +48,11 @@ pub fn ss6(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBits
     run_mesh(&Ss6Kernel { traversal: opts.traversal }, mesh, grid, opts)
 }
 
+/// The fast path on already prepared triangles.
+pub fn ss6_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> BrickBits {
+    super::driver::run_slabs(&Ss6Kernel { traversal: opts.traversal }, tris, dims, opts).0
+}
+
 struct Ss6Kernel {
     traversal: Traversal,
 }
@@ -75,10 +80,11 @@ fn filtered<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], trav
     let n = tri.normal();
     let r = H * n.iter().map(|c| c.abs()).max().unwrap_or(0);
     let t = T::from_i64;
-    let mut tests: Vec<Lin<T>> = Vec::with_capacity(11);
+    // On the stack: at small grids a heap allocation per triangle shows.
+    let mut tests = [Lin { g: [T::ZERO; 3], c: T::ZERO }; 11];
     // Plane: n·d + r >= bias(n) and −n·d + r >= bias(−n).
-    tests.push(Lin { g: n.map(t), c: t(r - bias(n)) });
-    tests.push(Lin { g: n.map(|c| t(-c)), c: t(r - bias(n.map(|c| -c))) });
+    tests[0] = Lin { g: n.map(t), c: t(r - bias(n)) };
+    tests[1] = Lin { g: n.map(|c| t(-c)), c: t(r - bias(n.map(|c| -c))) };
     for (c, &nc) in n.iter().enumerate() {
         let (p, q) = ((c + 1) % 3, (c + 2) % 3);
         let sgn = if nc >= 0 { 1 } else { -1 };
@@ -91,7 +97,7 @@ fn filtered<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], trav
             let vi = tri.v[i];
             let off = g[p] * (vi[p] - a[p]) + g[q] * (vi[q] - a[q]);
             let c0 = H * g[p].abs().max(g[q].abs()) - off - bias(g);
-            tests.push(Lin { g: g.map(t), c: t(c0) });
+            tests[2 + 3 * c + i] = Lin { g: g.map(t), c: t(c0) };
         }
     }
     let keep = |ijk: [i64; 3]| {

@@ -21,9 +21,13 @@
 //! orientation predicate; `TriSetup` is the same test specialised for one
 //! triangle and a fixed segment direction, for the fast paths.
 
+use super::cover::cover_triangle;
+use super::driver::{box_volume, FilterUnset};
+use super::Traversal;
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{LatticeSegment, LatticeTriangle};
 use crate::geom::perturb::{bias, segment_meets_square, segment_meets_triangle, triangle_meets_square, P3};
+use crate::grid::bricks::BrickSlab;
 
 const H: i64 = ONE / 2;
 
@@ -148,7 +152,7 @@ pub(crate) struct TriSetup<T> {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct DirSetup<T> {
     /// `n·d`: the plane value's change from a segment's start to its end.
-    nd: T,
+    pub nd: T,
     /// Edge orientation `O_e(p) = c_e − p·m_e` with `m_e = e × d` and
     /// `c_e = d·(A × B)` (`A`, `B` the edge's end points relative to `a`).
     m: [[T; 3]; 3],
@@ -181,12 +185,10 @@ impl<T: PlaneInt> TriSetup<T> {
     /// Setup for target segments of direction `d` (lattice units).
     pub fn dir(&self, t: &LatticeTriangle, d: P3) -> DirSetup<T> {
         // orient(p+δ, q+δ, A, B) = O − δ·(e × d): its tie is decided by −(e × d).
-        let be = std::array::from_fn(|i| {
-            let m = crate::geom::lattice::cross(t.edge(i), d);
-            T::from_i64(bias([-m[0], -m[1], -m[2]]))
-        });
+        let m64: [[i64; 3]; 3] = std::array::from_fn(|i| crate::geom::lattice::cross(t.edge(i), d));
+        let be = m64.map(|m| T::from_i64(bias([-m[0], -m[1], -m[2]])));
         let dt = d.map(T::from_i64);
-        let m = std::array::from_fn(|i| crate::geom::lattice::cross(t.edge(i), d).map(T::from_i64));
+        let m = m64.map(|m| m.map(T::from_i64));
         let c = std::array::from_fn(|i| dot(dt, crs(self.rel[i], self.rel[(i + 1) % 3])));
         let nd = dot(self.n, dt);
         DirSetup { nd, m, c, be, pos: nd > T::ZERO }
@@ -318,12 +320,176 @@ pub(crate) fn fits_i64(t: &LatticeTriangle) -> bool {
     (0..3).map(|a| hi[a] - lo[a]).max().unwrap_or(0) + 2 * ONE <= I64_TARGET_LIMIT
 }
 
+/// Can the target segment from `a` to `a + d` (lattice coordinates),
+/// displaced by the tie rule, meet a triangle whose vertices lie in the
+/// closed box `[lo, hi]`? Conservative: `false` only where it cannot. The
+/// segment's parameter interval inside the box grown by one lattice unit
+/// on every side (the displacement is infinitesimal), in `f64` with a
+/// relative margin far above its rounding error. Rejects most targets of
+/// triangles smaller than a voxel before any exact setup.
+#[inline]
+pub(crate) fn segment_may_meet_box(a: P3, d: P3, lo: P3, hi: P3) -> bool {
+    segment_may_meet_box_inv(a, d, reciprocals(d), lo, hi)
+}
+
+/// `1 / d` per axis (0 where `d` is 0), for [`segment_may_meet_box_inv`].
+#[inline]
+pub(crate) fn reciprocals(d: P3) -> [f64; 3] {
+    d.map(|c| if c == 0 { 0.0 } else { 1.0 / c as f64 })
+}
+
+/// [`segment_may_meet_box`] given `inv = reciprocals(d)`.
+#[inline]
+pub(crate) fn segment_may_meet_box_inv(a: P3, d: P3, inv: [f64; 3], lo: P3, hi: P3) -> bool {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for c in 0..3 {
+        let (l, h) = ((lo[c] - 1 - a[c]) as f64, (hi[c] + 1 - a[c]) as f64);
+        if d[c] == 0 {
+            if l > 0.0 || h < 0.0 {
+                return false;
+            }
+            continue;
+        }
+        let (x, y) = if d[c] > 0 { (l * inv[c], h * inv[c]) } else { (h * inv[c], l * inv[c]) };
+        t0 = t0.max(x);
+        t1 = t1.min(y);
+    }
+    t0 <= t1 + 1e-9 * (1.0 + t0.abs().max(t1.abs()))
+}
+
+/// One triangle against a fixed set of target segments (start offset from
+/// the voxel's low corner, direction), each direction's exact setup made
+/// on its first use after [`segment_may_meet_box`] lets a segment through:
+/// a small triangle is decided by a few comparisons for most targets.
+pub(crate) struct LazyTargets<'t, T, const N: usize> {
+    tri: &'t LatticeTriangle,
+    s: TriSetup<T>,
+    lo: P3,
+    hi: P3,
+    /// Box-filter targets first (small triangles), with each direction's
+    /// reciprocals.
+    filter: bool,
+    inv: [[f64; 3]; N],
+    targets: &'t [(P3, P3)],
+    setups: [Option<DirSetup<T>>; N],
+}
+
+impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
+    /// Setup for `tri` against `targets` (at most `N`: the cache is sized
+    /// by the caller, as a few bytes per triangle matter at small grids).
+    /// Triangles wider than two voxels meet most targets' boxes, so theirs
+    /// are set up at once and the filter is skipped.
+    pub fn new(tri: &'t LatticeTriangle, targets: &'t [(P3, P3)]) -> Self {
+        assert!(targets.len() <= N, "at most {N} targets");
+        let (lo, hi) = tri.bounds();
+        let s = TriSetup::new(tri);
+        let mut setups = [None; N];
+        let filter = (0..3).all(|c| hi[c] - lo[c] <= 2 * ONE);
+        let mut inv = [[0.0; 3]; N];
+        if filter {
+            for (r, (_, d)) in inv.iter_mut().zip(targets) {
+                *r = reciprocals(*d);
+            }
+        } else {
+            for (slot, (_, d)) in setups.iter_mut().zip(targets) {
+                *slot = Some(s.dir(tri, *d));
+            }
+        }
+        LazyTargets { tri, s, lo, hi, filter, inv, targets, setups }
+    }
+
+    /// Does the displaced target `n` of voxel `ijk` meet the triangle?
+    /// The same decision as [`segment_meets_triangle`].
+    #[inline]
+    pub fn hits(&mut self, n: usize, ijk: [i64; 3]) -> bool {
+        let (o, d) = self.targets[n];
+        let a = add(corner(ijk), o);
+        if self.filter && !segment_may_meet_box_inv(a, d, self.inv[n], self.lo, self.hi) {
+            return false;
+        }
+        let (s, tri) = (&self.s, self.tri);
+        let ds = self.setups[n].get_or_insert_with(|| s.dir(tri, d));
+        s.segment_hits(ds, s.local(a))
+    }
+
+    /// Does any of the voxel's targets meet the triangle?
+    #[inline]
+    pub fn any(&mut self, ijk: [i64; 3]) -> bool {
+        (0..self.targets.len()).any(|n| self.hits(n, ijk))
+    }
+}
+
+/// Largest voxel box a kernel decides voxel by voxel with
+/// [`targets_in_box`] instead of its projection: for a triangle about a
+/// voxel in size, a few box filters beat setting up the projection.
+pub(crate) const TINY_BOX: i64 = 27;
+
+/// Is the inclusive box `[lo, hi]` at most [`TINY_BOX`] voxels?
+#[inline(always)]
+pub(crate) fn is_tiny(lo: [i64; 3], hi: [i64; 3]) -> bool {
+    box_volume(lo, hi) <= TINY_BOX
+}
+
+/// Sets the voxels of `[lo, hi]` one of whose `targets` (start offset from
+/// the low corner, direction) meets `tri`: the definition of a target
+/// mode, voxel by voxel, for triangles whose box [`is_tiny`]. Voxels
+/// already set are skipped.
+pub(crate) fn targets_in_box<const N: usize>(
+    tri: &LatticeTriangle,
+    targets: &[(P3, P3); N],
+    lo: [i64; 3],
+    hi: [i64; 3],
+    slab: &mut BrickSlab<'_>,
+) {
+    debug_assert!(fits_i64(tri));
+    // Every target lies in its closed voxel: only `cover`'s voxels can hit.
+    let mut lazy = LazyTargets::<i64, N>::new(tri, targets);
+    let keep = |ijk: [i64; 3]| lazy.any(ijk);
+    cover_triangle(tri, lo, hi, Traversal::Auto, &mut FilterUnset { slab, keep });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn lt(v: [[i64; 3]; 3]) -> LatticeTriangle {
         LatticeTriangle { v }
+    }
+
+    proptest::proptest! {
+        /// The box filter never rejects a segment that meets the triangle:
+        /// coordinates on a coarse lattice, so segments touch the box's
+        /// faces, edges and corners and the tie rule decides.
+        #[test]
+        fn box_filter_is_conservative(
+            v in proptest::array::uniform3(proptest::array::uniform3(-4i64..=4)),
+            d in proptest::array::uniform3(-12i64..=12),
+            through in 0usize..5,
+            back in 0i64..=3,
+            scale in proptest::prop_oneof![proptest::strategy::Just(1i64), proptest::strategy::Just(H), proptest::strategy::Just(ONE << 20)],
+        ) {
+            // Segments through a vertex, the centroid or near the
+            // triangle: the box's corners, faces and inside.
+            let v = v.map(|p| p.map(|c| 3 * c));
+            let target: [i64; 3] = match through {
+                0..=2 => v[through],
+                3 => std::array::from_fn(|c| (v[0][c] + v[1][c] + v[2][c]) / 3),
+                _ => std::array::from_fn(|c| v[0][c] + 1),
+            };
+            let a: [i64; 3] = std::array::from_fn(|c| target[c] - d[c] * back / 3);
+            let t = lt(v.map(|p| p.map(|c| c * scale)));
+            let (a, d) = (a.map(|c| c * scale), d.map(|c| c * scale));
+            let seg = [a, add(a, d)];
+            let (lo, hi) = t.bounds();
+            if segment_meets_triangle(seg, t.v, true) {
+                proptest::prop_assert!(segment_may_meet_box(a, d, lo, hi));
+            }
+            if t.normal() != [0, 0, 0] && fits_i64(&t) {
+                let targets = [(a, d)];
+                let mut lazy = LazyTargets::<i64, 1>::new(&t, &targets);
+                proptest::prop_assert_eq!(lazy.hits(0, [0, 0, 0]), segment_meets_triangle(seg, t.v, true));
+            }
+        }
     }
 
     #[test]

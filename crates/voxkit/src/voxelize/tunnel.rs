@@ -30,8 +30,8 @@
 //! triangle's bounding box with the generic `i128` predicate.
 
 use super::cover::cover_triangle;
-use super::driver::{run_mesh, Filter, Kernel};
-use super::targets::{fits_i64, DirSetup, TriSetup};
+use super::driver::{run_mesh, FilterUnset, Kernel};
+use super::targets::{fits_i64, LazyTargets};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -77,6 +77,11 @@ pub fn tunnel(mesh: MeshRef<'_>, grid: &GridSpec, target: TunnelTarget, opts: &O
     run_mesh(&TunnelKernel { dirs: targets(target), traversal: opts.traversal }, mesh, grid, opts)
 }
 
+/// The fast path on already prepared triangles.
+pub fn tunnel_lattice(tris: &[LatticeTriangle], dims: [u32; 3], target: TunnelTarget, opts: &Options<'_>) -> BrickBits {
+    super::driver::run_slabs(&TunnelKernel { dirs: targets(target), traversal: opts.traversal }, tris, dims, opts).0
+}
+
 struct TunnelKernel {
     dirs: Vec<(P3, P3)>,
     traversal: Traversal,
@@ -100,13 +105,9 @@ fn filtered<T: PlaneInt>(
     traversal: Traversal,
     slab: &mut BrickSlab<'_>,
 ) {
-    let s = TriSetup::<T>::new(tri);
-    let setups: Vec<([T; 3], DirSetup<T>)> = dirs.iter().map(|(o, d)| (o.map(T::from_i64), s.dir(tri, *d))).collect();
-    let keep = |ijk: [i64; 3]| {
-        let p = s.local(ijk.map(|c| c * ONE));
-        setups.iter().any(|(o, ds)| s.segment_hits(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]]))
-    };
-    cover_triangle(tri, lo, hi, traversal, &mut Filter { slab, keep });
+    let mut targets = LazyTargets::<T, 26>::new(tri, dirs);
+    let keep = |ijk: [i64; 3]| targets.any(ijk);
+    cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
 }
 
 /// The slow, obviously correct definition.
