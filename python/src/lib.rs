@@ -583,6 +583,8 @@ fn plan_of(
     hollow: Option<u32>,
     gpu_path: &str,
     seed: u64,
+    tile: Option<u32>,
+    max_memory: Option<&str>,
 ) -> Result<voxkit_job::Plan, JobError> {
     let request = voxkit_job::Request {
         mode: voxkit_job::Mode::parse(mode)?,
@@ -602,6 +604,8 @@ fn plan_of(
             p => return Err(JobError::invalid(format!("unknown gpu_path {p:?} (expected compute, raster or msaa-approx)"))),
         },
         seed,
+        tile,
+        max_memory: max_memory.map(voxkit_job::parse_size).transpose()?,
     };
     voxkit_job::Plan::new(request)
 }
@@ -617,7 +621,8 @@ fn colour_rule(rule: &str) -> Result<ColourRule, JobError> {
 /// The native voxelize: see `voxkit.voxelize` for the documentation.
 #[pyfunction]
 #[pyo3(signature = (mesh, *, mode="cover", resolution=None, voxel_size=None, origin=None, dims=None, pad=None, method="auto", threads=None,
-    attributes=false, colour_rule="dominant", normals=false, surface=None, fill=None, hollow=None, gpu_path="compute", seed=0))]
+    attributes=false, colour_rule="dominant", normals=false, surface=None, fill=None, hollow=None, gpu_path="compute", seed=0,
+    tile=None, max_memory=None))]
 #[allow(clippy::too_many_arguments)]
 fn voxelize(
     py: Python<'_>,
@@ -638,9 +643,11 @@ fn voxelize(
     hollow: Option<u32>,
     gpu_path: &str,
     seed: u64,
+    tile: Option<u32>,
+    max_memory: Option<&str>,
 ) -> PyResult<VoxelGrid> {
     let grid = grid_options(resolution, voxel_size, origin, dims, pad);
-    let plan = plan_of(mode, method, &grid, surface, fill, hollow, gpu_path, seed).map_err(py_err)?;
+    let plan = plan_of(mode, method, &grid, surface, fill, hollow, gpu_path, seed, tile, max_memory).map_err(py_err)?;
     let carry = CarryOptions { rule: self::colour_rule(colour_rule).map_err(py_err)?, normals };
     let pool = threads.map(voxkit_job::pool).transpose().map_err(py_err)?;
     let inner = mesh.inner.clone();
@@ -737,7 +744,7 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
     let (surface, fill) = (get_str("surface")?, get_str("fill")?);
     let hollow = get_u64("hollow")?.map(|h| h as u32);
     let seed = get_u64("seed")?.unwrap_or(0);
-    let plan = plan_of(&mode, &method, &grid, surface.as_deref(), fill.as_deref(), hollow, &gpu_path, seed).map_err(py_err)?;
+    let plan = plan_of(&mode, &method, &grid, surface.as_deref(), fill.as_deref(), hollow, &gpu_path, seed, None, None).map_err(py_err)?;
     let target = voxkit_job::output::Output::from_name(format)
         .ok_or_else(|| value_err(format!("unknown format {format:?} (expected one of: {})", voxkit_job::output::Output::names())))?;
     let threads = get_u64("threads")?.map(|t| t as usize);

@@ -202,7 +202,7 @@ def test_attributes_colours_materials_normals_coverage(meshes, tmp_path, cli):
     assert np.array_equal(back.colours, g.colours)
 
 
-@pytest.mark.parametrize("fmt", ["npy", "npy-bool", "binvox", "vox", "txt", "schem", "vti", "ply"])
+@pytest.mark.parametrize("fmt", ["npy", "npy-bool", "binvox", "vox", "txt", "schem", "vti", "ply", "vdb", "zarr"])
 def test_save_and_load_every_voxel_format(tmp_path, meshes, fmt):
     g = voxkit.voxelize(voxkit.load_mesh(meshes / "cow.obj"), resolution=40)
     ext = "npy" if fmt == "npy-bool" else fmt
@@ -267,3 +267,16 @@ def test_mesh_from_arrays_and_properties(meshes):
     assert np.array_equal(m.bounds, [[0, 0, 0], [1, 1, 1]])
     help_text = voxkit.voxelize.__doc__
     assert "resolution" in help_text and "mode" in help_text
+
+
+def test_tiled_runs_give_the_same_voxels(meshes):
+    m = voxkit.load_mesh(meshes / "stanford-bunny.obj")
+    for mode in ["cover", "sep6", "bubble"]:
+        a = voxkit.voxelize(m, mode=mode, resolution=150)
+        b = voxkit.voxelize(m, mode=mode, resolution=150, tile=64, max_memory="2G")
+        assert b.facts["method"] == "tiled" and b.facts["tile"] == 64
+        assert np.array_equal(a.indices(), b.indices())
+    with pytest.raises(ValueError, match="multiple of 8"):
+        voxkit.voxelize(m, tile=12)
+    with pytest.raises(ValueError, match="not a size|unknown unit"):
+        voxkit.voxelize(m, max_memory="lots")

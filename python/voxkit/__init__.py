@@ -135,6 +135,8 @@ def voxelize(
     hollow: Optional[int] = None,
     gpu_path: str = "compute",
     seed: int = 0,
+    tile: Optional[int] = None,
+    max_memory: Optional[Union[int, str]] = None,
 ) -> VoxelGrid:
     """Voxelizes a mesh; returns a :class:`VoxelGrid`.
 
@@ -166,6 +168,13 @@ def voxelize(
             ``msaa-approx``.
         seed: ``bubble``: the seed of the random target points (same seed,
             same voxels).
+        tile: run the surface mode tile by tile with tiles of this many
+            voxels (a multiple of 8); same voxels. By default only grids
+            that do not fit in ``max_memory`` run tiled.
+        max_memory: memory the run may use, bytes or a string such as
+            ``"8G"`` (default: nine tenths of what is available). Tiled
+            grids are sparse: use :meth:`VoxelGrid.indices` or
+            ``save("x.vdb")`` / ``save("x.zarr")`` rather than ``occupancy``.
 
     The GIL is released while voxelizing, so threads voxelize in parallel.
 
@@ -193,6 +202,8 @@ def voxelize(
         hollow=None if hollow is None else _count(hollow, "hollow"),
         gpu_path=gpu_path,
         seed=_count(seed, "seed"),
+        tile=None if tile is None else _count(tile, "tile"),
+        max_memory=None if max_memory is None else str(max_memory),
     )
 
 

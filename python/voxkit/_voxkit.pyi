@@ -91,6 +91,8 @@ def voxelize(
     hollow: Optional[int] = None,
     gpu_path: str = "compute",
     seed: int = 0,
+    tile: Optional[int] = None,
+    max_memory: Optional[str] = None,
 ) -> VoxelGrid: ...
 def batch(inputs: Sequence[str], out_dir: str, format: str = "npy", glob: Optional[str] = None, options: Optional[Dict[str, Any]] = None) -> Dict[str, Any]: ...
 def batch_plan(

@@ -124,6 +124,21 @@ pub struct GridArgs {
     pub pad: Option<u32>,
 }
 
+/// Grids past memory: the tiled path and the memory it may use.
+#[derive(Args, Debug, Default)]
+pub struct MemoryArgs {
+    /// Memory the run may use, e.g. 8G or 512M (default: nine tenths of
+    /// what is available). Surface modes on grids that do not fit densely
+    /// run tile by tile into sparse storage; write those to .vdb, .txt or .ply.
+    #[arg(long, value_name = "SIZE")]
+    pub max_memory: Option<String>,
+    /// Run the surface mode tile by tile with tiles of N voxels (a multiple
+    /// of 8; default: only when the grid does not fit in --max-memory, with
+    /// tiles of 512). Same voxels either way.
+    #[arg(long, value_name = "N")]
+    pub tile: Option<u32>,
+}
+
 #[derive(Args, Debug)]
 pub struct VoxelizeArgs {
     /// Input mesh (.obj, .stl, .ply, .gltf, .glb).
@@ -162,6 +177,8 @@ pub struct VoxelizeArgs {
     pub hollow: Option<String>,
     #[command(flatten)]
     pub grid: GridArgs,
+    #[command(flatten)]
+    pub memory: MemoryArgs,
     /// With --method gpu: `compute` (default), `raster` (the rasterizer path, same voxels), or
     /// `msaa-approx` (rasterizer with 4x MSAA instead of conservative coverage: approximate, misses
     /// voxels; the summary says how many).
@@ -461,6 +478,8 @@ pub struct BatchArgs {
     pub hollow: Option<String>,
     #[command(flatten)]
     pub grid: GridArgs,
+    #[command(flatten)]
+    pub memory: MemoryArgs,
     /// With --method gpu: compute, raster or msaa-approx.
     #[arg(long, value_enum, default_value = "compute", value_name = "PATH")]
     pub gpu_path: GpuPathArg,

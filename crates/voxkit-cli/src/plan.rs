@@ -4,9 +4,13 @@
 use anyhow::Result;
 use voxkit_job::{GridOptions, GridRequest};
 
-use crate::args::{Fill, GpuPathArg, GridArgs, Method, Mode, VoxelizeArgs};
+use crate::args::{Fill, GpuPathArg, GridArgs, MemoryArgs, Method, Mode, VoxelizeArgs};
 
-pub use voxkit_job::check_memory;
+/// Fails if a dense grid of `grid` would not fit in the memory available
+/// (the commands that need one: render, bench, gaps).
+pub fn check_memory(grid: &voxkit::GridSpec) -> voxkit_job::Result<()> {
+    voxkit_job::check_memory(grid, voxkit_job::budget(None), "this command")
+}
 
 impl From<Mode> for voxkit_job::Mode {
     fn from(m: Mode) -> voxkit_job::Mode {
@@ -56,7 +60,7 @@ pub fn grid_request(g: &GridArgs) -> Result<GridRequest> {
 
 /// The validated plan of `voxkit voxelize`.
 pub fn voxelize_plan(a: &VoxelizeArgs) -> Result<voxkit_job::Plan> {
-    plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path, a.seed)
+    plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path, a.seed, &a.memory)
 }
 
 /// A validated plan from the voxelization options of `voxelize` and `batch`.
@@ -70,6 +74,7 @@ pub fn plan_from(
     hollow: Option<&str>,
     gpu_path: GpuPathArg,
     seed: u64,
+    memory: &MemoryArgs,
 ) -> Result<voxkit_job::Plan> {
     let request = voxkit_job::Request {
         mode: mode.into(),
@@ -82,6 +87,8 @@ pub fn plan_from(
         hollow: hollow.map(|h| if h == "6" { 6 } else { 26 }),
         gpu_path: gpu_path_name(gpu_path).1,
         seed,
+        tile: memory.tile,
+        max_memory: memory.max_memory.as_deref().map(voxkit_job::parse_size).transpose()?,
     };
     Ok(voxkit_job::Plan::new(request)?)
 }

@@ -131,7 +131,10 @@ fn bad_input_gives_one_line_errors() {
             vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--voxel-size".into(), "1e-9".into()],
             "at most 65536 per axis",
         ),
-        (vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--resolution".into(), "60000".into()], "needs"),
+        (
+            vec!["voxelize".into(), shared("cow.obj"), "-o".into(), out.clone(), "--resolution".into(), "60000".into()],
+            "cannot be held densely",
+        ),
         (
             vec![
                 "voxelize".into(),
@@ -526,5 +529,58 @@ fn method_gpu_writes_the_cpu_file_or_says_why_not() {
         json(&voxkit(&["voxelize", &cow, "-o", &gpu, "--method", "gpu", "--mode", mode, "--resolution", "80", "--json"]));
         json(&voxkit(&["voxelize", &cow, "-o", &cpu, "--method", cpu_method, "--mode", mode, "--resolution", "80", "--json"]));
         assert_eq!(std::fs::read(&gpu).unwrap(), std::fs::read(&cpu).unwrap(), "{mode}");
+    }
+}
+
+#[test]
+fn tiled_runs_write_the_same_files_and_vdb_reads_back() {
+    let bunny = shared("stanford-bunny.obj");
+    for mode in ["cover", "sep6", "diagonal"] {
+        let (a, b) = (tmp(&format!("dense-{mode}.npy")), tmp(&format!("tiled-{mode}.npy")));
+        json(&voxkit(&["voxelize", &bunny, "-o", &a, "--resolution", "200", "--mode", mode, "--json"]));
+        let t = json(&voxkit(&["voxelize", &bunny, "-o", &b, "--resolution", "200", "--mode", mode, "--tile", "64", "--json"]));
+        assert_eq!(t["method"], "tiled");
+        assert_eq!(t["tile"], 64);
+        assert!(t["peak_memory_bytes"].as_u64().unwrap() > 0);
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{mode}: tiled .npy differs");
+    }
+    // .vdb: what voxkit writes it reads back (convert to .npy: the same file).
+    let (v, n) = (tmp("tiled.vdb"), tmp("from-vdb.npy"));
+    json(&voxkit(&["voxelize", &bunny, "-o", &v, "--resolution", "200", "--tile", "64", "--json"]));
+    let c = voxkit(&["convert", &v, &n]);
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    assert_eq!(std::fs::read(&n).unwrap(), std::fs::read(tmp("dense-cover.npy")).unwrap());
+    // .zarr: the same, through a directory of chunks.
+    let (z, zn) = (tmp("tiled.zarr"), tmp("from-zarr.npy"));
+    json(&voxkit(&["voxelize", &bunny, "-o", &z, "--resolution", "200", "--tile", "64", "--json"]));
+    json(&voxkit(&["voxelize", &bunny, "-o", &z, "--resolution", "200", "--tile", "64", "--json"])); // replaces it
+    let c = voxkit(&["convert", &z, &zn]);
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    assert_eq!(std::fs::read(&zn).unwrap(), std::fs::read(tmp("dense-cover.npy")).unwrap());
+    let chk = voxkit(&["check", &v, "--mesh", &bunny, "--json"]);
+    assert!(chk.status.success(), "{}", String::from_utf8_lossy(&chk.stderr));
+}
+
+#[test]
+fn grids_past_memory_errors() {
+    let cow = shared("cow.obj");
+    for (args, says) in [
+        (vec!["--resolution", "16384", "--max-memory", "1G"], ".vdb"),
+        (vec!["--tile", "12"], "multiple of 8"),
+        (vec!["--tile", "64", "--mode", "solid"], "solid modes"),
+        (vec!["--tile", "64", "--method", "reference"], "fast path"),
+        (vec!["--tile", "64", "--mode", "line26"], "line26"),
+        (vec!["--max-memory", "lots"], "unknown unit"),
+        (vec!["--max-memory", "1.2.3G"], "not a size"),
+        (vec!["--resolution", "16384", "--max-memory", "1G", "--mode", "solid"], "solid modes"),
+    ] {
+        let mut a = vec!["voxelize", &cow, "-o"];
+        let out = tmp(if args.contains(&"solid") { "past.vdb" } else { "past.npy" });
+        a.push(&out);
+        a.extend(args.iter().copied());
+        let o = voxkit(&a);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert!(err.contains(says) && err.trim_end().lines().count() == 1, "{args:?}: {err}");
     }
 }

@@ -29,9 +29,11 @@ pub mod stl;
 pub mod svg;
 pub mod text;
 pub mod texture;
+pub mod vdb;
 pub mod vox;
 pub mod voxel_mesh;
 pub mod vti;
+pub mod zarr;
 
 use std::path::Path;
 
@@ -166,11 +168,15 @@ pub enum VoxelFormat {
     Vti,
     /// PLY point cloud of voxel centres.
     Ply,
+    /// OpenVDB bool grid (sparse; see [`vdb`]).
+    Vdb,
+    /// Zarr v3 array, a directory of gzip chunks (see [`zarr`]).
+    Zarr,
 }
 
 impl VoxelFormat {
     /// Names accepted by `--format`.
-    pub const NAMES: &'static str = "npy, npy-bool, binvox, vox, txt, schem, vti, ply";
+    pub const NAMES: &'static str = "npy, npy-bool, binvox, vox, txt, schem, vti, ply, vdb, zarr";
 
     /// The format for a `--format` name or a file extension.
     pub fn from_name(name: &str) -> Option<VoxelFormat> {
@@ -183,6 +189,8 @@ impl VoxelFormat {
             "schem" => Some(VoxelFormat::Schem),
             "vti" => Some(VoxelFormat::Vti),
             "ply" => Some(VoxelFormat::Ply),
+            "vdb" => Some(VoxelFormat::Vdb),
+            "zarr" => Some(VoxelFormat::Zarr),
             _ => None,
         }
     }
@@ -198,6 +206,8 @@ impl VoxelFormat {
             VoxelFormat::Schem => "schem",
             VoxelFormat::Vti => "vti",
             VoxelFormat::Ply => "ply",
+            VoxelFormat::Vdb => "vdb",
+            VoxelFormat::Zarr => "zarr",
         }
     }
 
@@ -241,6 +251,16 @@ pub fn write_voxels_with(
     attrs: Option<&VoxelAttributes>,
     opts: &WriteOptions,
 ) -> Result<(), IoError> {
+    if format == VoxelFormat::Zarr {
+        // A directory: built under a temporary name and renamed (see [`zarr`]).
+        if matches!(atomic::target(path), atomic::Target::Stdout | atomic::Target::Special(_)) {
+            return Err(IoError::new(
+                path,
+                ErrorKind::Write(std::io::Error::other("a Zarr array is a directory; give a path ending in .zarr")),
+            ));
+        }
+        return zarr::write(path, bits, grid);
+    }
     atomic::write_atomically(path, |w| match format {
         VoxelFormat::Npy => npy::write(w, bits, npy::Dtype::U8),
         VoxelFormat::NpyBool => npy::write(w, bits, npy::Dtype::Bool),
@@ -250,6 +270,8 @@ pub fn write_voxels_with(
         VoxelFormat::Schem => schem::write(w, bits, attrs, opts.blocks.as_ref().unwrap_or(&schem::BlockPalette::default()), opts.up),
         VoxelFormat::Vti => vti::write(w, bits, grid, attrs),
         VoxelFormat::Ply => points::write(w, bits, grid, attrs),
+        VoxelFormat::Vdb => vdb::write(w, bits, grid),
+        VoxelFormat::Zarr => unreachable!("Zarr arrays are written above"),
     })
 }
 
@@ -292,6 +314,9 @@ pub fn read_voxels_with(path: &Path, up: orient::Up) -> Result<LoadedVoxels, IoE
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_string();
         IoError::new(path, ErrorKind::UnknownFormat { ext, expected: VoxelFormat::NAMES })
     })?;
+    if format == VoxelFormat::Zarr {
+        return zarr::read(path);
+    }
     if matches!(format, VoxelFormat::Npy | VoxelFormat::NpyBool) {
         let file = std::fs::File::open(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
         let total = file.metadata().map_err(|e| IoError::new(path, ErrorKind::Read(e)))?.len();
@@ -318,6 +343,8 @@ pub fn read_voxels_bytes_with(bytes: &[u8], format: VoxelFormat, up: orient::Up)
         VoxelFormat::Schem => schem::read(bytes, up),
         VoxelFormat::Vti => vti::read(bytes),
         VoxelFormat::Ply => points::read(bytes),
+        VoxelFormat::Vdb => vdb::read(bytes),
+        VoxelFormat::Zarr => Err(ErrorKind::malformed("Zarr", "a Zarr array is a directory; read it by path")),
     })
 }
 
@@ -349,13 +376,14 @@ pub fn bytes(n: u64) -> String {
 /// not fit in memory (a hostile file of a few bytes can claim billions of
 /// voxels; allocating them would abort the process).
 pub(crate) fn dense_grid(dims: [u32; 3]) -> Result<voxkit::DenseBits, ErrorKind> {
-    let need = (dims[0] as u64).div_ceil(64) * 8 * dims[1] as u64 * dims[2] as u64;
+    // In u128: three u32 extents overflow u64.
+    let need = u64::try_from((dims[0] as u128).div_ceil(64) * 8 * dims[1] as u128 * dims[2] as u128).unwrap_or(u64::MAX);
     // Small grids are never refused: reading /proc per file costs more.
+    // Where the available memory cannot be read, 1 TiB stands for it.
     if need > 64 << 20 {
-        if let Some(avail) = available_memory() {
-            if need > avail / 10 * 9 {
-                return Err(ErrorKind::TooLarge { dims, need: bytes(need), available: bytes(avail) });
-            }
+        let avail = available_memory().unwrap_or(1 << 40);
+        if need > avail / 10 * 9 {
+            return Err(ErrorKind::TooLarge { dims, need: bytes(need), available: bytes(avail) });
         }
     }
     Ok(voxkit::DenseBits::new(dims))

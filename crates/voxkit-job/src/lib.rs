@@ -28,7 +28,7 @@ pub mod output;
 
 pub use error::{JobError, Result};
 pub use grid::{GridOptions, GridRequest};
-pub use memory::{available_memory, bytes, check_memory};
+pub use memory::{available_memory, budget, bytes, check_memory, dense_fits, parse_size, peak_memory};
 pub use plan::{
     auto_method, gpu_has, resolve_method, Fill, GpuPath, Method, Mode, Plan, Request, SolidMethod, SolidPlan, SurfaceMethod,
     GPU_AUTO_MIN_SIDE,

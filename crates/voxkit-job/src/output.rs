@@ -79,6 +79,29 @@ pub fn output_format(format: Option<&str>, output: &Path) -> Result<Output> {
     }
 }
 
+/// True for the formats written from the set voxels alone (no dense
+/// buffer of the grid): `.vdb`, `.zarr` (only chunks holding voxels),
+/// `.txt`, `.ply`.
+pub fn is_sparse(target: Output) -> bool {
+    matches!(target, Output::Voxels(VoxelFormat::Vdb | VoxelFormat::Zarr | VoxelFormat::Text | VoxelFormat::Ply))
+}
+
+/// Refuses a dense format for a grid that cannot be dense in the memory
+/// the run may use (`max_memory`, else nine tenths of what is available).
+pub fn check_fits(target: Output, grid: &GridSpec, max_memory: Option<u64>) -> Result<()> {
+    let budget = crate::memory::budget(max_memory);
+    if is_sparse(target) || crate::memory::dense_fits(grid, budget) {
+        return Ok(());
+    }
+    let [x, y, z] = grid.dims();
+    Err(JobError::invalid(format!(
+        "grid {x}x{y}x{z} cannot be held densely ({} at 1 bit per voxel, more than the {} this run may use) and .{} is a dense format; write .vdb (OpenVDB), .zarr (Zarr v3), .txt or .ply, which hold only the set voxels",
+        crate::memory::bytes(grid.dense_bytes()),
+        crate::memory::bytes(budget),
+        target.name()
+    )))
+}
+
 /// Every file writing `out` as `target` creates: the output, and for an
 /// `.obj` the `.mtl` beside it (named after the output's stem).
 pub fn files_written(out: &Path, target: Output) -> Vec<std::path::PathBuf> {
@@ -112,7 +135,8 @@ pub fn check_output_path(out: &Path) -> Result<()> {
     if !dir.is_dir() {
         return Err(JobError::invalid(format!("{}: cannot write: directory {} does not exist", out.display(), dir.display())));
     }
-    if out.is_dir() {
+    let zarr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("zarr"));
+    if out.is_dir() && !(zarr && out.join("zarr.json").is_file()) {
         return Err(JobError::invalid(format!("{}: cannot write: it is a directory", out.display())));
     }
     Ok(())

@@ -4,7 +4,7 @@
 use voxkit::topology::runs::Connectivity;
 use voxkit::GridSpec;
 
-use crate::error::Result;
+use crate::error::{JobError, Result};
 use crate::grid::GridRequest;
 use crate::invalid;
 
@@ -333,12 +333,28 @@ pub struct Request {
     pub gpu_path: GpuPath,
     /// `bubble`: the seed of its random points.
     pub seed: u64,
+    /// Run the surface mode tile by tile with tiles of this many voxels (a
+    /// multiple of 8); `None`: only when the grid does not fit densely.
+    pub tile: Option<u32>,
+    /// Memory the run may use (bytes); `None`: nine tenths of what is available.
+    pub max_memory: Option<u64>,
 }
 
 impl Request {
     /// A request for `mode` with every other option at its default.
     pub fn new(mode: Mode, grid: GridRequest) -> Request {
-        Request { mode, method: Method::Auto, grid, surface: None, fill: None, hollow: None, gpu_path: GpuPath::Compute, seed: 0 }
+        Request {
+            mode,
+            method: Method::Auto,
+            grid,
+            surface: None,
+            fill: None,
+            hollow: None,
+            gpu_path: GpuPath::Compute,
+            seed: 0,
+            tile: None,
+            max_memory: None,
+        }
     }
 }
 
@@ -359,6 +375,17 @@ impl Plan {
     /// Validates everything that does not need the mesh.
     pub fn new(request: Request) -> Result<Plan> {
         let solid = solid_plan(&request)?;
+        if let Some(t) = request.tile {
+            if t == 0 || t % 8 != 0 || t > 1 << 20 {
+                return Err(JobError::invalid(format!("--tile {t}: must be a multiple of 8 from 8 to 1048576")));
+            }
+            if solid.is_some() {
+                return Err(JobError::invalid("--tile: solid modes do not run tiled yet (surface modes do)"));
+            }
+            if !matches!(request.method, Method::Auto | Method::Fast) {
+                return Err(JobError::invalid("--tile runs the fast path: use --method auto or fast"));
+            }
+        }
         let (core, surface_method) = match solid {
             Some(_) => (voxkit::voxelize::Mode::Cover, SurfaceMethod::Fast),
             None => resolve_method_seeded(request.mode, request.method, request.seed)?,

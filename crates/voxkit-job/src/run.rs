@@ -7,6 +7,7 @@ use serde_json::{json, Value};
 use voxkit::attributes::carry::{carry, CarryOptions};
 use voxkit::attributes::{Appearance, VoxelAttributes};
 use voxkit::grid::bricks::BrickBits;
+use voxkit::grid::sparse::SparseBricks;
 use voxkit::voxelize::{self, Options, Progress, Report};
 use voxkit::{DenseBits, GridSpec, MeshRef, VoxelSource};
 
@@ -20,6 +21,8 @@ pub enum Voxels {
     Dense(DenseBits),
     /// Sparse 8³ bricks (the fast paths).
     Bricks(BrickBits),
+    /// Sorted non-empty bricks (the tiled path, grids past a brick index).
+    Sparse(SparseBricks),
 }
 
 impl Voxels {
@@ -28,6 +31,7 @@ impl Voxels {
         match self {
             Voxels::Dense(d) => d,
             Voxels::Bricks(b) => b,
+            Voxels::Sparse(s) => s,
         }
     }
 
@@ -36,6 +40,7 @@ impl Voxels {
         match self {
             Voxels::Dense(d) => d.clone(),
             Voxels::Bricks(b) => b.to_dense(),
+            Voxels::Sparse(s) => s.to_dense(),
         }
     }
 }
@@ -52,6 +57,9 @@ impl VoxelSource for Voxels {
     }
     fn fill_i_planes(&self, i0: u32, count: u32, k_fastest: bool, out: &mut [u8]) {
         self.source().fill_i_planes(i0, count, k_fastest, out)
+    }
+    fn for_each_brick(&self, f: &mut dyn FnMut([u32; 3], &voxkit::grid::bricks::Brick)) {
+        self.source().for_each_brick(f)
     }
 }
 
@@ -75,6 +83,8 @@ pub struct Voxelized {
     /// Seconds spent voxelizing: from the loaded mesh to the voxels in
     /// memory (fitting the grid and choosing the path included).
     pub voxelize_s: f64,
+    /// The tile edge when the tiled path ran.
+    pub tile: Option<u32>,
 }
 
 /// Runs `plan` on `mesh` (named `name` in messages) on the grid its request
@@ -96,7 +106,18 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
     }
     let t = Instant::now();
     let grid = plan.request.grid.fit(&mesh.bounds())?;
-    crate::memory::check_memory(&grid)?;
+    let budget = crate::memory::budget(plan.request.max_memory);
+    let tile = tile_for(plan, &grid, budget);
+    if tile.is_none() {
+        let why = if plan.solid.is_some() {
+            "solid modes (not tiled yet)"
+        } else if is_line {
+            "line modes (not tiled yet)"
+        } else {
+            "--method reference, scanline and gpu (only the fast path is tiled)"
+        };
+        crate::memory::check_memory(&grid, budget, why)?;
+    }
     let surface_method = if plan.request.method == crate::plan::Method::Auto && plan.solid.is_none() {
         crate::plan::auto_method(plan.core, mesh, &grid).0
     } else {
@@ -104,7 +125,10 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
     };
     let opts = Options { progress, ..Options::default() };
     let mut gpu = Value::Null;
-    let (voxels, report, method, solid) = if let Some(sp) = &plan.solid {
+    let (voxels, report, method, solid) = if let Some(t) = tile {
+        let (s, r) = voxelize::tiled::tiled(plan.core, mesh, &grid, t, &opts).map_err(|e| JobError::invalid(e.to_string()))?;
+        (Voxels::Sparse(s), r, "tiled", Value::Null)
+    } else if let Some(sp) = &plan.solid {
         let out = crate::solid::run(sp, mesh, name, &grid, &opts)?;
         warnings.extend(out.warnings);
         let voxels = out.bits.count();
@@ -146,13 +170,30 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
     if p.non_finite + p.invalid_index > 0 {
         warnings.push(format!("{name}: skipped {} primitives with invalid vertices", p.non_finite + p.invalid_index));
     }
-    Ok(Voxelized { voxels, grid, method, report, solid, gpu, warnings, voxelize_s })
+    Ok(Voxelized { voxels, grid, method, report, solid, gpu, warnings, voxelize_s, tile })
+}
+
+/// The tile edge of the tiled path, when it runs: asked for with `--tile`,
+/// or chosen for a surface mode on the fast path whose grid does not fit
+/// densely in `budget` or whose whole-grid brick index (4 bytes per 8³
+/// voxels) would take more than a quarter of it.
+fn tile_for(plan: &Plan, grid: &GridSpec, budget: u64) -> Option<u32> {
+    if plan.request.tile.is_some() {
+        return plan.request.tile;
+    }
+    let fast = matches!(plan.request.method, crate::plan::Method::Auto | crate::plan::Method::Fast);
+    if plan.solid.is_some() || plan.is_line() || !fast {
+        return None;
+    }
+    let index: u64 = grid.dims().iter().map(|&d| d.div_ceil(8) as u64).product::<u64>() * 4;
+    (!crate::memory::dense_fits(grid, budget) || index > budget / 4).then_some(voxelize::tiled::DEFAULT_TILE)
 }
 
 /// Carries the mesh's colours, materials, normals and coverage into the
 /// voxels (see [`voxkit::attributes::carry`]); `None` for line modes.
 pub fn attributes(plan: &Plan, mesh: MeshRef<'_>, appearance: &Appearance, v: &Voxelized, opts: &CarryOptions) -> Option<VoxelAttributes> {
-    (!plan.is_line()).then(|| carry(mesh, appearance, &v.grid, v.voxels.source(), opts))
+    // Not on tiled grids yet: carrying needs a whole-grid brick index.
+    (!plan.is_line() && !matches!(v.voxels, Voxels::Sparse(_))).then(|| carry(mesh, appearance, &v.grid, v.voxels.source(), opts))
 }
 
 /// The attributes an output needs: colours where the format stores them
@@ -189,6 +230,8 @@ impl Voxelized {
             "dims": self.grid.dims(),
             "voxels": self.report.voxels,
             "voxelize_s": self.voxelize_s,
+            "tile": self.tile,
+            "peak_memory_bytes": crate::memory::peak_memory(),
             "triangles": if plan.solid.is_some() { Value::Null } else { json!({
                 "input": p.input,
                 "voxelized": p.output,

@@ -159,6 +159,25 @@ pub fn agree_mode(mode: Mode, mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits,
                 return Err(format!("fast report {frep:?} differs from reference report {rep:?}"));
             }
         }
+        if threads != 2 {
+            for tile in [8, 24, 64] {
+                let Ok((tiled, trep)) = pool.install(|| voxelize::tiled::tiled(mode, mesh.as_ref(), grid, tile, &Options::default()))
+                else {
+                    break;
+                };
+                if let Some(v) = reference.first_difference(&tiled.to_dense()) {
+                    return Err(format!(
+                        "{} tiled (threads {threads}, tile {tile}) differs from reference at voxel {v:?}: reference {}, tiled {}",
+                        mode.name(),
+                        reference.get(v[0], v[1], v[2]),
+                        tiled.get(v[0], v[1], v[2])
+                    ));
+                }
+                if trep != rep || tiled.count() != rep.voxels {
+                    return Err(format!("tiled report {trep:?} differs from reference report {rep:?}"));
+                }
+            }
+        }
         for (slab_height, driver) in [(0, Driver::Auto), (1, Driver::Slabs), (7, Driver::Slabs), (0, Driver::Triangles)] {
             let opts = Options { slab_height, driver, ..Options::default() };
             let Some((scan, srep)) = pool.install(|| voxelize::scanline::scanline(mode, mesh.as_ref(), grid, &opts)) else { break };

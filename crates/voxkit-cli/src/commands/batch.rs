@@ -27,7 +27,7 @@ impl BatchProgress for Bar {
 }
 
 pub fn run(a: &BatchArgs) -> Result<()> {
-    let plan = crate::plan::plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path, a.seed)?;
+    let plan = crate::plan::plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path, a.seed, &a.memory)?;
     let Some(format) = voxkit_job::output::Output::from_name(&a.format) else {
         bail!("unknown --format {:?} (expected one of: {})", a.format, voxkit_job::output::Output::names());
     };

@@ -49,6 +49,9 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     for w in &loaded.warnings {
         eprintln!("voxkit: warning: {}: {w}", a.mesh.display());
     }
+    // A dense format for a grid past memory is refused before any work.
+    let fitted = plan.request.grid.fit(&loaded.mesh.as_ref().bounds())?;
+    voxkit_job::output::check_fits(format, &fitted, plan.request.max_memory)?;
     bar.phase(if plan.surface_method == voxkit_job::SurfaceMethod::Reference { "voxelizing (reference, serial)" } else { "voxelizing" });
     let name = a.mesh.display().to_string();
     let v = pool.install(|| voxkit_job::voxelize(&plan, loaded.mesh.as_ref(), &name, Some(&bar)))?;
@@ -63,7 +66,12 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let app = &loaded.appearance;
     let want_colour = app.has_colour() && (format.has_colour() || preview.is_some());
     let t_attr = Instant::now();
-    let attrs = (want_colour || is_vti).then(|| {
+    let tiled = matches!(v.voxels, voxkit_job::Voxels::Sparse(_));
+    if tiled && (want_colour || is_vti || preview.is_some()) && !a.quiet && !a.json {
+        eprintln!("voxkit: warning: colours, .vti arrays and --preview are not made for tiled grids yet; writing the voxels alone");
+    }
+    let preview = preview.filter(|_| !tiled);
+    let attrs = (!tiled && (want_colour || is_vti)).then(|| {
         bar.phase("carrying colours into voxels");
         let opts = CarryOptions { rule: crate::commands::export::colour_rule(a.export.colour_rule), normals: a.export.normals };
         pool.install(|| voxkit_job::attributes(&plan, loaded.mesh.as_ref(), app, &v, &opts))

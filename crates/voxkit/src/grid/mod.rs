@@ -2,6 +2,7 @@
 
 pub mod bricks;
 pub mod dense;
+pub mod sparse;
 pub mod spec;
 
 /// Set bits in `words`. Most words of a surface voxelization are zero;
@@ -23,4 +24,19 @@ pub trait VoxelSource: Sync {
     /// plane `p` occupies `out[p*ny*nz .. (p+1)*ny*nz]`, laid out `[j][k]`
     /// (k fastest) when `k_fastest`, else `[k][j]`.
     fn fill_i_planes(&self, i0: u32, count: u32, k_fastest: bool, out: &mut [u8]);
+
+    /// Calls `f([bi, bj, bk], bits)` for every 8×8×8 brick holding a set
+    /// voxel, in order of `bk`, then `bj`, then `bi` (bit layout of
+    /// [`bricks::Brick`]). The sparse storages hand out their bricks; the
+    /// default gathers them from [`VoxelSource::for_each_set`].
+    fn for_each_brick(&self, f: &mut dyn FnMut([u32; 3], &bricks::Brick)) {
+        let mut map: std::collections::BTreeMap<[u32; 3], bricks::Brick> = std::collections::BTreeMap::new();
+        self.for_each_set(&mut |i, j, k| {
+            let b = map.entry([k / 8, j / 8, i / 8]).or_insert([0; 8]);
+            b[(k % 8) as usize] |= 1 << ((j % 8) * 8 + i % 8);
+        });
+        for (kji, b) in &map {
+            f([kji[2], kji[1], kji[0]], b);
+        }
+    }
 }

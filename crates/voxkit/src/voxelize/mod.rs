@@ -30,6 +30,7 @@ pub mod sep6;
 pub mod solid;
 pub mod ss6;
 pub mod targets;
+pub mod tiled;
 pub mod tunnel;
 pub mod winding;
 

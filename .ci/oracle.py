@@ -1,0 +1,29 @@
+"""Shared by the interoperability checks: run voxkit, count checks."""
+import json
+import subprocess
+import sys
+
+
+class Oracle:
+    def __init__(self, voxkit):
+        self.voxkit = voxkit
+        self.passed = 0
+        self.failed = 0
+
+    def check(self, name, cond, detail=""):
+        if cond:
+            self.passed += 1
+            print(f"ok   {name}")
+        else:
+            self.failed += 1
+            print(f"FAIL {name} {detail}")
+
+    def voxelize(self, mesh, out, *extra):
+        r = subprocess.run([self.voxkit, "voxelize", str(mesh), "-o", str(out), "--json", *extra], capture_output=True, text=True)
+        if r.returncode != 0:
+            raise SystemExit(f"voxkit failed: {r.stderr}")
+        return json.loads(r.stdout)
+
+    def finish(self):
+        print(f"{self.passed} passed, {self.failed} failed")
+        sys.exit(1 if self.failed else 0)

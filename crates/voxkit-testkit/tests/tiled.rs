@@ -1,0 +1,96 @@
+//! The tiled driver gives the dense fast path's voxels: every shared mesh at
+//! 256–1024 with tiles of 64, every mode on rotated meshes, and a cropped
+//! window of a large grid equals the same window run alone.
+//! (`agree_mode` also runs tiles of 8, 24 and 64 against every reference.)
+
+use glam::DVec3;
+use voxkit::voxelize::{self, tiled::tiled, Mode, Options};
+use voxkit::GridSpec;
+use voxkit_testkit::{random_rotation, rng, rotated, shared_mesh, SHARED_MESHES};
+
+const MODES: [Mode; 9] =
+    [Mode::Cover, Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Pos, Mode::Tunnel18, Mode::Tunnel26, Mode::Bubble { seed: 3 }, Mode::Diagonal];
+
+fn same(mode: Mode, mesh: &voxkit::Mesh, grid: &GridSpec, tile: u32, what: &str) {
+    let (dense, drep) = voxelize::fast(mode, mesh.as_ref(), grid, &Options::default());
+    let (sparse, trep) = tiled(mode, mesh.as_ref(), grid, tile, &Options::default()).unwrap();
+    assert_eq!(trep, drep, "{what} {}: reports differ", mode.name());
+    let d = dense.to_dense();
+    if let Some(v) = d.first_difference(&sparse.to_dense()) {
+        panic!("{what} {} tile {tile}: differs at {v:?} (dense {})", mode.name(), d.get(v[0], v[1], v[2]));
+    }
+}
+
+#[test]
+fn every_shared_mesh_cover_at_256_and_512_with_tiles_of_64() {
+    for name in SHARED_MESHES {
+        let mesh = shared_mesh(name);
+        for res in [256, 512] {
+            let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), res).unwrap();
+            same(Mode::Cover, &mesh, &grid, 64, &format!("{name} at {res}"));
+        }
+    }
+}
+
+#[test]
+fn bunny_at_1024_with_tiles_of_64() {
+    let mesh = shared_mesh("stanford-bunny.obj");
+    let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), 1024).unwrap();
+    for mode in [Mode::Cover, Mode::Sep6] {
+        same(mode, &mesh, &grid, 64, "bunny at 1024");
+    }
+}
+
+#[test]
+fn every_mode_on_rotated_meshes_at_256() {
+    let mut r = rng(0x711e);
+    for name in ["stanford-bunny.obj", "fandisk.obj", "teapot.obj"] {
+        let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
+        let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), 256).unwrap();
+        for mode in MODES {
+            same(mode, &mesh, &grid, 64, &format!("rotated {name} at 256"));
+        }
+    }
+}
+
+#[test]
+fn a_window_of_a_large_grid_equals_the_window_run_alone() {
+    // The whole grid is 4096³ (a dense index would be 512 MiB of bricks'
+    // entries; the tiled run never allocates it); the window is 200³ of it.
+    let mesh = shared_mesh("cheburashka.obj");
+    let big = GridSpec::from_resolution(&mesh.as_ref().bounds(), 4096).unwrap();
+    let (whole, _) = tiled(Mode::Sep26, mesh.as_ref(), &big, 512, &Options::default()).unwrap();
+    let s = big.voxel_size();
+    // A window around the middle voxel of the surface, in a corner of
+    // tiles (it spans 8 of them).
+    let mut all = Vec::new();
+    voxkit::VoxelSource::for_each_set(&whole, &mut |i, j, k| all.push([i, j, k]));
+    let corner = |c: u32| (c + 256) / 512 * 512;
+    let off = |v: &[u32; 3]| v.iter().map(|&c| (c as i64 - corner(c) as i64).abs()).max().unwrap();
+    let near = *all.iter().filter(|v| v.iter().all(|&c| corner(c) >= 100)).min_by_key(|v| off(v)).unwrap();
+    assert!(off(&near) < 100, "a surface voxel within 100 of a tile corner");
+    let lo = near.map(|c| corner(c) - 100);
+    let window = GridSpec::new(big.origin() + DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64) * s, s, [200, 200, 200]).unwrap();
+    let (part, _) = voxelize::fast(Mode::Sep26, mesh.as_ref(), &window, &Options::default());
+    let part = part.to_dense();
+    assert!(part.count() > 1000, "the window holds surface");
+    let mut inside = 0;
+    voxkit::VoxelSource::for_each_set(&whole, &mut |i, j, k| {
+        let (a, b, c) = (i.wrapping_sub(lo[0]), j.wrapping_sub(lo[1]), k.wrapping_sub(lo[2]));
+        if a < 200 && b < 200 && c < 200 {
+            inside += 1;
+            assert!(part.get(a, b, c), "voxel {i} {j} {k} of the whole grid is not in the window's run");
+        }
+    });
+    assert_eq!(inside, part.count());
+}
+
+#[test]
+fn line_modes_and_bad_tiles_are_refused() {
+    let mesh = shared_mesh("suzanne.obj");
+    let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), 64).unwrap();
+    let e = tiled(Mode::Line26, mesh.as_ref(), &grid, 64, &Options::default()).unwrap_err();
+    assert!(e.to_string().contains("line26"), "{e}");
+    let e = tiled(Mode::Cover, mesh.as_ref(), &grid, 12, &Options::default()).unwrap_err();
+    assert!(e.to_string().contains("multiple of 8"), "{e}");
+}

@@ -1,0 +1,263 @@
+//! Whole-grid sparse storage without a brick index: a sorted list of the
+//! 8×8×8 bricks that hold a set voxel.
+//!
+//! [`super::bricks::BrickBits`] keeps a dense index of 4 bytes per brick,
+//! which at 16384³ is 32 GiB before a single voxel is set. `SparseBricks`
+//! stores only the non-empty bricks (8 bytes of key and 64 of bits each),
+//! so its size follows the surface, not the grid: the tiled driver
+//! ([`crate::voxelize::tiled`]) fills one tile's `BrickBits` at a time and
+//! moves its bricks here.
+
+use super::bricks::{Brick, BrickBits, BRICK};
+use super::dense::DenseBits;
+use super::VoxelSource;
+
+/// Bits per brick coordinate in a key (grids up to 2^24 voxels per axis).
+const KEY_BITS: u32 = 21;
+const KEY_MASK: u64 = (1 << KEY_BITS) - 1;
+
+/// The key of brick `(bi, bj, bk)`: ordered by `bk`, then `bj`, then `bi`.
+#[inline]
+fn key(b: [u32; 3]) -> u64 {
+    ((b[2] as u64) << (2 * KEY_BITS)) | ((b[1] as u64) << KEY_BITS) | b[0] as u64
+}
+
+#[inline]
+fn unkey(k: u64) -> [u32; 3] {
+    [(k & KEY_MASK) as u32, ((k >> KEY_BITS) & KEY_MASK) as u32, (k >> (2 * KEY_BITS)) as u32]
+}
+
+/// A sparse grid of bits: the non-empty 8³ bricks, sorted by `(bk, bj, bi)`.
+///
+/// # Guarantees
+/// Keys are strictly increasing (each brick once), no stored brick is
+/// empty, and no bit outside `dims` is set.
+#[derive(Clone, Debug, Default)]
+pub struct SparseBricks {
+    dims: [u32; 3],
+    keys: Vec<u64>,
+    bricks: Vec<Brick>,
+}
+
+impl SparseBricks {
+    /// Largest voxels per axis: brick coordinates fit in 21 bits.
+    pub const MAX_DIM: u32 = (1 << KEY_BITS) * BRICK;
+
+    /// An empty grid. Panics if an axis exceeds [`SparseBricks::MAX_DIM`].
+    pub fn new(dims: [u32; 3]) -> SparseBricks {
+        assert!(dims.iter().all(|&d| d <= Self::MAX_DIM), "grid {dims:?} beyond the sparse key range");
+        SparseBricks { dims, keys: Vec::new(), bricks: Vec::new() }
+    }
+
+    /// Builds a grid from bricks in any order; bricks given twice are
+    /// merged by union, empty ones dropped. Brick coordinates must lie in
+    /// the grid and bits outside `dims` must be clear.
+    pub fn from_bricks(dims: [u32; 3], bricks: impl IntoIterator<Item = ([u32; 3], Brick)>) -> SparseBricks {
+        let mut out = SparseBricks::new(dims);
+        for (b, bits) in bricks {
+            out.keys.push(key(b));
+            out.bricks.push(bits);
+        }
+        out.finish();
+        out
+    }
+
+    /// Appends the bricks of `tile`, a grid whose voxel `(0,0,0)` is this
+    /// grid's voxel `origin` (a multiple of 8 on every axis). Call
+    /// [`SparseBricks::finish`] after the last tile.
+    pub fn push_tile(&mut self, origin: [u32; 3], tile: &BrickBits) {
+        debug_assert!(origin.iter().all(|o| o % BRICK == 0));
+        let base = origin.map(|o| o / BRICK);
+        tile.for_each_brick(&mut |b, bits| {
+            self.keys.push(key([b[0] + base[0], b[1] + base[1], b[2] + base[2]]));
+            self.bricks.push(*bits);
+        });
+    }
+
+    /// Restores the order after [`SparseBricks::push_tile`] (tiles pushed
+    /// in key order need no sort): sorts by key, merges repeated keys,
+    /// drops empty bricks.
+    pub fn finish(&mut self) {
+        if !self.keys.windows(2).all(|w| w[0] < w[1]) {
+            let mut order: Vec<u32> = (0..self.keys.len() as u32).collect();
+            order.sort_by_key(|&n| (self.keys[n as usize], n));
+            let mut keys = Vec::with_capacity(order.len());
+            let mut bricks: Vec<Brick> = Vec::with_capacity(order.len());
+            for n in order {
+                let (k, b) = (self.keys[n as usize], self.bricks[n as usize]);
+                if keys.last() == Some(&k) {
+                    let last = bricks.last_mut().expect("a brick per key");
+                    for (w, x) in last.iter_mut().zip(b) {
+                        *w |= x;
+                    }
+                } else {
+                    keys.push(k);
+                    bricks.push(b);
+                }
+            }
+            self.keys = keys;
+            self.bricks = bricks;
+        }
+        let keep: Vec<bool> = self.bricks.iter().map(|b| b.iter().any(|&w| w != 0)).collect();
+        if keep.iter().any(|&k| !k) {
+            let mut n = 0;
+            self.keys.retain(|_| (keep[n], n += 1).0);
+            let mut n = 0;
+            self.bricks.retain(|_| (keep[n], n += 1).0);
+        }
+    }
+
+    /// Voxels along x, y, z.
+    pub fn dims(&self) -> [u32; 3] {
+        self.dims
+    }
+
+    /// Stored (non-empty) bricks.
+    pub fn brick_count(&self) -> usize {
+        self.bricks.len()
+    }
+
+    /// Bytes used by keys and bricks.
+    pub fn memory_bytes(&self) -> usize {
+        self.keys.len() * 8 + self.bricks.len() * 64
+    }
+
+    /// Number of set voxels.
+    pub fn count(&self) -> u64 {
+        super::count_bits(self.bricks.iter().flatten())
+    }
+
+    /// Is voxel `(i, j, k)` set?
+    pub fn get(&self, i: u32, j: u32, k: u32) -> bool {
+        match self.keys.binary_search(&key([i / BRICK, j / BRICK, k / BRICK])) {
+            Ok(n) => self.bricks[n][(k % BRICK) as usize] >> ((j % BRICK) * 8 + i % BRICK) & 1 == 1,
+            Err(_) => false,
+        }
+    }
+
+    /// Calls `f(brick coordinates, bits)` for every stored brick, in order
+    /// of `bk`, then `bj`, then `bi`.
+    pub fn for_each_brick(&self, mut f: impl FnMut([u32; 3], &Brick)) {
+        for (k, b) in self.keys.iter().zip(&self.bricks) {
+            f(unkey(*k), b);
+        }
+    }
+
+    /// The same voxels, dense.
+    pub fn to_dense(&self) -> DenseBits {
+        let mut d = DenseBits::new(self.dims);
+        VoxelSource::for_each_set(self, &mut |i, j, k| d.set(i, j, k));
+        d
+    }
+}
+
+impl VoxelSource for SparseBricks {
+    fn dims(&self) -> [u32; 3] {
+        self.dims
+    }
+
+    fn count(&self) -> u64 {
+        SparseBricks::count(self)
+    }
+
+    fn for_each_set(&self, f: &mut dyn FnMut(u32, u32, u32)) {
+        // Bricks of one layer `bk` are contiguous, and within it those of
+        // one row `bj`, in order of `bi`: walk each layer voxel row by row.
+        let mut start = 0;
+        while start < self.keys.len() {
+            let bk = unkey(self.keys[start])[2];
+            let end = start + self.keys[start..].iter().take_while(|&&k| unkey(k)[2] == bk).count();
+            for z in 0..BRICK {
+                let k = bk * BRICK + z;
+                let mut row = start;
+                while row < end {
+                    let bj = unkey(self.keys[row])[1];
+                    let row_end = row + self.keys[row..end].iter().take_while(|&&k| unkey(k)[1] == bj).count();
+                    for y in 0..BRICK {
+                        for n in row..row_end {
+                            let bi = unkey(self.keys[n])[0];
+                            let mut byte = (self.bricks[n][z as usize] >> (y * 8)) & 0xff;
+                            while byte != 0 {
+                                let x = byte.trailing_zeros();
+                                byte &= byte - 1;
+                                f(bi * BRICK + x, bj * BRICK + y, k);
+                            }
+                        }
+                    }
+                    row = row_end;
+                }
+            }
+            start = end;
+        }
+    }
+
+    fn fill_i_planes(&self, i0: u32, count: u32, k_fastest: bool, out: &mut [u8]) {
+        let (ny, nz) = (self.dims[1] as usize, self.dims[2] as usize);
+        let plane = ny * nz;
+        assert!(count > 0 && i0 + count <= self.dims[0] && out.len() >= plane * count as usize);
+        out[..plane * count as usize].fill(0);
+        let (b0, b1) = (i0 / BRICK, (i0 + count - 1) / BRICK);
+        for (key, brick) in self.keys.iter().zip(&self.bricks) {
+            let [bi, bj, bk] = unkey(*key);
+            if bi < b0 || bi > b1 {
+                continue;
+            }
+            super::bricks::brick_to_planes([bi, bj, bk], brick, i0, count, k_fastest, [ny, nz], out);
+        }
+    }
+
+    fn for_each_brick(&self, f: &mut dyn FnMut([u32; 3], &Brick)) {
+        SparseBricks::for_each_brick(self, f)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiles_and_any_order_give_the_same_grid() {
+        let dims = [40, 33, 17];
+        let mut dense = DenseBits::new(dims);
+        let mut state = 12345u64;
+        for _ in 0..600 {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let (i, j, k) = ((state >> 20) as u32 % dims[0], (state >> 35) as u32 % dims[1], (state >> 50) as u32 % dims[2]);
+            dense.set(i, j, k);
+        }
+        // Two tiles along x, pushed in reverse order.
+        let mut sparse = SparseBricks::new(dims);
+        for x0 in [32u32, 0] {
+            let w = (dims[0] - x0).min(32);
+            let mut tile = BrickBits::new([w, dims[1], dims[2]]);
+            dense.for_each_set(|i, j, k| {
+                if i >= x0 && i < x0 + w {
+                    tile.set(i - x0, j, k);
+                }
+            });
+            sparse.push_tile([x0, 0, 0], &tile);
+        }
+        sparse.finish();
+        assert_eq!(sparse.to_dense(), dense);
+        assert_eq!(sparse.count(), dense.count());
+        let mut order = Vec::new();
+        VoxelSource::for_each_set(&sparse, &mut |i, j, k| order.push((i, j, k)));
+        let mut expect = Vec::new();
+        dense.for_each_set(|i, j, k| expect.push((i, j, k)));
+        assert_eq!(order, expect, "for_each_set is in (k, j, i) order");
+        for (i, j, k) in [(0, 0, 0), (39, 32, 16), (17, 5, 9)] {
+            assert_eq!(sparse.get(i, j, k), dense.get(i, j, k));
+        }
+        let (mut a, mut b) = (vec![0u8; 3 * 33 * 17], vec![0u8; 3 * 33 * 17]);
+        for k_fastest in [false, true] {
+            sparse.fill_i_planes(30, 3, k_fastest, &mut a);
+            dense.fill_i_planes(30, 3, k_fastest, &mut b);
+            assert_eq!(a, b);
+        }
+        let twice = SparseBricks::from_bricks(
+            dims,
+            sparse.keys.iter().zip(&sparse.bricks).chain(sparse.keys.iter().zip(&sparse.bricks)).map(|(k, b)| (unkey(*k), *b)),
+        );
+        assert_eq!(twice.to_dense(), dense);
+    }
+}
