@@ -21,17 +21,7 @@ fn folder() -> &'static PathBuf {
 }
 
 fuzz_target!(
-    init: {
-        // Third-party parsers that panic on malformed input run inside
-        // voxkit-io's fence, which turns the panic into an error (as the CLI
-        // does); only panics outside it are crashes.
-        let abort = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if !voxkit_io::panic_is_fenced() {
-                abort(info)
-            }
-        }));
-    },
+    init: voxkit_fuzz::fence_panics(),
     |data: &[u8]| {
     let mut parts = data.split(|&b| b == 0xFF);
     let (obj, mtl, png) = (parts.next().unwrap_or(&[]), parts.next().unwrap_or(&[]), parts.next().unwrap_or(&[]));

@@ -8,14 +8,7 @@ use voxkit::glam::DVec2;
 use voxkit::raster::{self, Grid2, RasterMode};
 
 fuzz_target!(
-    init: {
-        let abort = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if !voxkit_io::panic_is_fenced() {
-                abort(info)
-            }
-        }));
-    },
+    init: voxkit_fuzz::fence_panics(),
     |data: &[u8]| {
     let Ok(svg) = voxkit_io::svg::read(data, &voxkit_io::svg::SvgOptions { tolerance: Some(0.05) }) else { return };
     assert!(svg.outlines.iter().flat_map(|o| &o.points).all(|p| p.is_finite()));

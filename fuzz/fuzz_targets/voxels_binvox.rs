@@ -5,30 +5,4 @@
 
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(
-    init: {
-        // Third-party parsers that panic on malformed input run inside
-        // voxkit-io's fence, which turns the panic into an error (as the CLI
-        // does); only panics outside it are crashes.
-        let abort = std::panic::take_hook();
-        std::panic::set_hook(Box::new(move |info| {
-            if !voxkit_io::panic_is_fenced() {
-                abort(info)
-            }
-        }));
-    },
-    |data: &[u8]| {
-    if let Ok(v) = voxkit_io::read_voxels_bytes(data, voxkit_io::VoxelFormat::Binvox) {
-        let [nx, ny, nz] = v.bits.dims();
-        let mut n = 0u64;
-        v.bits.for_each_set(|i, j, k| {
-            assert!(i < nx && j < ny && k < nz);
-            n += 1;
-        });
-        assert_eq!(n, v.bits.count());
-        if let Some(a) = &v.attributes {
-            assert!(a.keys.len() as u64 <= n);
-        }
-    }
-    }
-);
+fuzz_target!(init: voxkit_fuzz::fence_panics(), |data: &[u8]| voxkit_fuzz::check_voxels(data, voxkit_io::VoxelFormat::Binvox));
