@@ -190,6 +190,7 @@ with tempfile.TemporaryDirectory() as d:
     voxelize(MESHES / "stanford-bunny.obj", d / "b.npy", "--resolution", "300")
     z = zarr.open_array(str(d / "b.zarr"), mode="r")
     check("zarr: shape, bool, 64³ chunks", z.shape == tuple(s["dims"]) and z.dtype == bool and z.chunks == (64, 64, 64), (z.shape, z.dtype, z.chunks))
+    check("zarr: sharded, shards of at most 512 in whole chunks", all(c % 64 == 0 and c <= 512 for c in z.shards), z.shards)
     check("zarr: every voxel = the .npy", np.array_equal(z[:], np.load(d / "b.npy") > 0))
     check("zarr: grid placement in attributes", z.attrs["voxkit"]["voxel_size"] == s["voxel_size"] and z.attrs["voxkit"]["origin"] == s["origin"])
     s = voxelize(MESHES / "stanford-bunny.obj", d / "t.zarr", "--resolution", "2048", "--mode", "sep6", "--tile", "256")

@@ -18,7 +18,7 @@ pub fn fence_panics() {
 /// Largest grid (in 64-bit words) whose every voxel the checks visit. A file
 /// may claim any grid that fits in memory and the reader allocates it
 /// untouched; visiting gigabytes of it would only measure the memory.
-const MAX_VISITED_WORDS: u64 = 1 << 24;
+const MAX_VISITED_WORDS: u64 = 1 << 20;
 
 /// Reads `data` as `format`: any bytes give voxels or an error, never a
 /// panic; the voxels read are inside their grid, counted right, and carry at

@@ -2,21 +2,31 @@
 //!
 //! **Why by hand.** The `zarrs` crate, even without default features,
 //! builds zlib from C and pulls async runtimes and caches; the part of the
-//! format voxkit needs — one array, regular chunks, the `bytes` and `gzip`
-//! codecs — is a JSON document and one gzip stream per chunk (`flate2`,
-//! already a dependency). Sharding is not written yet.
+//! format voxkit needs — one array, regular chunks, the `bytes`, `gzip` and
+//! `sharding_indexed` codecs — is a JSON document and, per shard, gzip
+//! streams (`flate2`, already a dependency) followed by an index.
 //!
 //! **Layout.** `zarr.json`: `zarr_format` 3, `node_type` `array`, `shape`
-//! `[nx, ny, nz]`, `data_type` `bool`, `chunk_grid` regular with
-//! `chunk_shape` `[64, 64, 64]`, `chunk_key_encoding` `default` with `/`
-//! (chunk `(a, b, c)` at `c/a/b/c`), `fill_value` `false`, codecs
-//! `bytes` then `gzip` (level 1), `dimension_names` `["i", "j", "k"]`, and
-//! `attributes.voxkit` with the grid's `origin` and `voxel_size`. Element
+//! `[nx, ny, nz]`, `data_type` `bool`, `chunk_grid` regular whose
+//! `chunk_shape` is the shard (512 voxels a side, less on an axis shorter
+//! than that, rounded up to 64), `chunk_key_encoding` `default` with `/`
+//! (shard `(a, b, c)` at `c/a/b/c`), `fill_value` `false`, one codec,
+//! `sharding_indexed`: inner chunks of 64³ encoded by `bytes` then `gzip`
+//! (level 1), the index (`bytes`, little-endian) at the end of the shard,
+//! without a checksum. `dimension_names` are `["i", "j", "k"]`, and
+//! `attributes.voxkit` holds the grid's `origin` and `voxel_size`. Element
 //! `[i, j, k]` is voxel `(i, j, k)` (C order, `k` fastest, as `.npy`).
-//! Chunks holding no set voxel are not written (the fill value stands for
-//! them), so a sparse surface on a huge grid stays small; edge chunks are
-//! whole chunks, padded with `false`. The Python `zarr` package (and Dask,
+//! Chunks holding no set voxel are not written (the index marks them empty
+//! and the fill value stands for them), nor are shards without any, so a
+//! sparse surface on a huge grid stays small: a 16384³ grid has at most
+//! 32³ shard files instead of 256³ chunk files. Edge chunks are whole
+//! chunks, padded with `false`. The Python `zarr` package (and Dask,
 //! `dask.array.from_zarr`) opens it as one array; CI checks every voxel.
+//!
+//! The reader takes voxkit's arrays and plain (unsharded) ones with the
+//! `bytes` and `gzip` codecs, as the `zarr` package writes them; a shard
+//! index's `crc32c` checksum, where present, is skipped, not verified
+//! (every offset is still bounds-checked).
 //!
 //! The directory is built beside the output under a temporary name and
 //! renamed into place; an existing Zarr array at the output is replaced
@@ -38,6 +48,18 @@ use crate::LoadedVoxels;
 /// Chunk edge in voxels (8 bricks).
 pub const CHUNK: u32 = 64;
 
+/// Largest shard edge in voxels (8 chunks, the tiled driver's default tile).
+pub const SHARD: u32 = 512;
+
+/// The shard shape of a grid: [`SHARD`], or the axis rounded up to
+/// [`CHUNK`] where it is shorter.
+fn shard_shape(dims: [u32; 3]) -> [u32; 3] {
+    dims.map(|d| d.next_multiple_of(CHUNK).clamp(CHUNK, SHARD))
+}
+
+/// An empty inner chunk's index entry (offset and size both all ones).
+const EMPTY: u64 = u64::MAX;
+
 /// The array's metadata document.
 fn metadata(grid: &GridSpec) -> Value {
     let o = grid.origin();
@@ -46,10 +68,15 @@ fn metadata(grid: &GridSpec) -> Value {
         "node_type": "array",
         "shape": grid.dims(),
         "data_type": "bool",
-        "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": [CHUNK, CHUNK, CHUNK]}},
+        "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": shard_shape(grid.dims())}},
         "chunk_key_encoding": {"name": "default", "configuration": {"separator": "/"}},
         "fill_value": false,
-        "codecs": [{"name": "bytes"}, {"name": "gzip", "configuration": {"level": 1}}],
+        "codecs": [{"name": "sharding_indexed", "configuration": {
+            "chunk_shape": [CHUNK, CHUNK, CHUNK],
+            "codecs": [{"name": "bytes"}, {"name": "gzip", "configuration": {"level": 1}}],
+            "index_codecs": [{"name": "bytes", "configuration": {"endian": "little"}}],
+            "index_location": "end",
+        }}],
         "dimension_names": ["i", "j", "k"],
         "attributes": {"voxkit": {"origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size()}},
     })
@@ -92,30 +119,54 @@ pub fn write(path: &Path, bits: &dyn VoxelSource, grid: &GridSpec) -> Result<(),
     result.map_err(|e| io(path, e))
 }
 
+/// Consecutive runs of `items` with the same `key`.
+fn runs<T, K: PartialEq>(items: &[T], key: impl Fn(&T) -> K) -> Vec<std::ops::Range<usize>> {
+    let mut out = Vec::new();
+    let mut s = 0;
+    while s < items.len() {
+        let k = key(&items[s]);
+        let e = s + items[s..].iter().take_while(|x| key(x) == k).count();
+        out.push(s..e);
+        s = e;
+    }
+    out
+}
+
 fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     std::fs::write(dir.join("zarr.json"), serde_json::to_vec_pretty(&metadata(grid)).map_err(std::io::Error::other)?)?;
-    // Bricks grouped by chunk (8³ bricks per chunk).
+    // Bricks grouped by shard, then by chunk within it (C order of chunks).
+    let shard = shard_shape(grid.dims());
+    let inner = shard.map(|s| s / CHUNK);
     let per = CHUNK / 8;
     let mut bricks: Vec<([u32; 3], Brick)> = Vec::new();
     bits.for_each_brick(&mut |b, bits| bricks.push((b, *bits)));
     let chunk_of = |b: &[u32; 3]| b.map(|v| v / per);
-    bricks.par_sort_unstable_by_key(|(b, _)| chunk_of(b));
-    let mut groups: Vec<std::ops::Range<usize>> = Vec::new();
-    let mut s = 0;
-    while s < bricks.len() {
-        let c = chunk_of(&bricks[s].0);
-        let e = s + bricks[s..].iter().take_while(|(b, _)| chunk_of(b) == c).count();
-        groups.push(s..e);
-        s = e;
-    }
-    groups.par_iter().try_for_each(|g| -> std::io::Result<()> {
-        let c = chunk_of(&bricks[g.start].0);
-        let d = dir.join("c").join(c[0].to_string()).join(c[1].to_string());
+    let shard_of = |c: [u32; 3]| std::array::from_fn::<u32, 3, _>(|a| c[a] / inner[a]);
+    bricks.par_sort_unstable_by_key(|(b, _)| {
+        let c = chunk_of(b);
+        (shard_of(c), c)
+    });
+    let shards = runs(&bricks, |(b, _)| shard_of(chunk_of(b)));
+    shards.par_iter().try_for_each(|r| -> std::io::Result<()> {
+        let s = shard_of(chunk_of(&bricks[r.start].0));
+        let mut body = Vec::new();
+        let mut index = vec![EMPTY; 2 * (inner[0] * inner[1] * inner[2]) as usize];
+        for g in runs(&bricks[r.clone()], |(b, _)| chunk_of(b)) {
+            let g = r.start + g.start..r.start + g.end;
+            let c = chunk_of(&bricks[g.start].0);
+            let n = (((c[0] % inner[0]) * inner[1] + c[1] % inner[1]) * inner[2] + c[2] % inner[2]) as usize;
+            let mut enc = GzEncoder::new(Vec::new(), flate2::Compression::new(1));
+            enc.write_all(&chunk_bytes(&bricks[g]))?;
+            let z = enc.finish()?;
+            index[2 * n] = body.len() as u64;
+            index[2 * n + 1] = z.len() as u64;
+            body.extend_from_slice(&z);
+        }
+        body.extend(index.iter().flat_map(|v| v.to_le_bytes()));
+        let d = dir.join("c").join(s[0].to_string()).join(s[1].to_string());
         std::fs::create_dir_all(&d)?;
-        let mut enc = GzEncoder::new(Vec::new(), flate2::Compression::new(1));
-        enc.write_all(&chunk_bytes(&bricks[g.clone()]))?;
-        std::fs::write(d.join(c[2].to_string()), enc.finish()?)
+        std::fs::write(d.join(s[2].to_string()), body)
     })
 }
 
@@ -146,9 +197,65 @@ const MAX_CHUNK_ELEMENTS: u64 = 1 << 30;
 /// Most chunks voxkit looks for (each is a file lookup).
 const MAX_CHUNKS: u64 = 1 << 24;
 
+/// How an array's chunk files are encoded.
+#[derive(Clone, Copy)]
+enum Layout {
+    /// One chunk per file: `bytes`, then `gzip` or not.
+    Plain { gzip: bool },
+    /// One shard per file: inner chunks of `inner` (`bytes`, `gzip` or
+    /// not) and an index of (offset, size) pairs, with a 4-byte checksum or
+    /// not, at the end or the start.
+    Sharded { inner: [u64; 3], gzip: bool, checksum: bool, at_end: bool },
+}
+
+/// Whether chunk codecs `bytes` (and optionally `gzip`) ask for gzip.
+fn chunk_codecs(codecs: &[Value]) -> Result<bool, ErrorKind> {
+    let mut gzip = false;
+    for c in codecs {
+        match c["name"].as_str() {
+            Some("bytes") => {}
+            Some("gzip") => gzip = true,
+            other => return Err(bad(format!("codec {other:?} (voxkit reads bytes, gzip and sharding_indexed)"))),
+        }
+    }
+    Ok(gzip)
+}
+
+/// Decodes one chunk of `shape` into `buf` (one byte per element).
+fn decode(raw: &[u8], gzip: bool, shape: [u64; 3], buf: &mut Vec<u8>) -> Result<(), ErrorKind> {
+    let len = shape.iter().product::<u64>();
+    buf.clear();
+    if gzip {
+        GzDecoder::new(raw).take(len + 1).read_to_end(buf).map_err(|x| bad(x.to_string()))?;
+    } else {
+        buf.extend_from_slice(raw);
+    }
+    if buf.len() as u64 != len {
+        return Err(bad(format!("{} bytes, a chunk holds {len}", buf.len())));
+    }
+    Ok(())
+}
+
+/// Sets the voxels of a decoded chunk of `shape` at `origin` (elements
+/// past the array's `dims` are padding).
+fn place(bits: &mut voxkit::DenseBits, buf: &[u8], origin: [u64; 3], shape: [u64; 3], dims: [u64; 3]) {
+    for (idx, &v) in buf.iter().enumerate() {
+        if v == 0 {
+            continue;
+        }
+        let idx = idx as u64;
+        let q = [idx / (shape[1] * shape[2]), (idx / shape[2]) % shape[1], idx % shape[2]];
+        let g: [u64; 3] = std::array::from_fn(|x| origin[x] + q[x]);
+        if g[0] < dims[0] && g[1] < dims[1] && g[2] < dims[2] {
+            bits.set(g[0] as u32, g[1] as u32, g[2] as u32);
+        }
+    }
+}
+
 /// Reads a Zarr v3 array of `bool` or `uint8` (non-zero = set) with
-/// regular chunks, the `bytes` codec and optionally `gzip`: voxkit's own
-/// arrays and those written the same way by the `zarr` package.
+/// regular chunks, the `bytes` codec and optionally `gzip`, sharded
+/// (`sharding_indexed`) or not: voxkit's own arrays and those written the
+/// same way by the `zarr` package.
 pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
     let e = |k| IoError::new(path, k);
     let meta_path = path.join("zarr.json");
@@ -184,47 +291,77 @@ pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
         Some("default") => m["chunk_key_encoding"]["configuration"]["separator"].as_str().unwrap_or("/").to_string(),
         other => return Err(e(bad(format!("chunk_key_encoding {other:?} (voxkit reads default)")))),
     };
-    let mut gzip = false;
-    for c in m["codecs"].as_array().ok_or_else(|| e(bad("no codecs")))? {
-        match c["name"].as_str() {
-            Some("bytes") => {}
-            Some("gzip") => gzip = true,
-            other => return Err(e(bad(format!("codec {other:?} (voxkit reads bytes and gzip)")))),
+    let codecs = m["codecs"].as_array().ok_or_else(|| e(bad("no codecs")))?;
+    let layout = match &codecs[..] {
+        [c] if c["name"] == "sharding_indexed" => {
+            let conf = &c["configuration"];
+            let inner = dims3(&conf["chunk_shape"], "sharding chunk_shape")?;
+            if (0..3).any(|a| chunk[a] % inner[a] != 0) {
+                return Err(e(bad(format!("shard shape {chunk:?} is not a multiple of its chunk shape {inner:?}"))));
+            }
+            let gzip = chunk_codecs(conf["codecs"].as_array().ok_or_else(|| e(bad("sharding without codecs")))?).map_err(e)?;
+            let mut checksum = false;
+            for c in conf["index_codecs"].as_array().ok_or_else(|| e(bad("sharding without index_codecs")))? {
+                match c["name"].as_str() {
+                    Some("bytes") if c["configuration"]["endian"].as_str().unwrap_or("little") == "little" => {}
+                    Some("crc32c") => checksum = true,
+                    other => return Err(e(bad(format!("index codec {other:?} (voxkit reads little-endian bytes and crc32c)")))),
+                }
+            }
+            let at_end = match conf["index_location"].as_str().unwrap_or("end") {
+                "end" => true,
+                "start" => false,
+                other => return Err(e(bad(format!("index_location {other:?}")))),
+            };
+            Layout::Sharded { inner, gzip, checksum, at_end }
         }
-    }
+        _ => Layout::Plain { gzip: chunk_codecs(codecs).map_err(e)? },
+    };
     let n = [0, 1, 2].map(|a| shape[a].div_ceil(chunk[a]));
     if n.iter().product::<u64>() > MAX_CHUNKS {
         return Err(e(bad(format!("{n:?} chunks, more than voxkit looks for ({MAX_CHUNKS})"))));
     }
     let dims = shape.map(|d| d as u32);
     let mut bits = crate::dense_grid(dims).map_err(e)?;
-    let len = chunk.iter().product::<u64>() as usize;
-    let mut buf = Vec::with_capacity(len);
+    let mut buf = Vec::new();
     for a in 0..n[0] {
         for b in 0..n[1] {
             for c in 0..n[2] {
                 let key = format!("c{sep}{a}{sep}{b}{sep}{c}");
-                let p = path.join(&key);
-                let Ok(raw) = std::fs::read(&p) else { continue };
-                buf.clear();
-                if gzip {
-                    GzDecoder::new(&raw[..]).take(len as u64 + 1).read_to_end(&mut buf).map_err(|x| e(bad(format!("{key}: {x}"))))?;
-                } else {
-                    buf.extend_from_slice(&raw);
-                }
-                if buf.len() != len {
-                    return Err(e(bad(format!("{key}: {} bytes, a chunk holds {len}", buf.len()))));
-                }
+                let Ok(raw) = std::fs::read(path.join(&key)) else { continue };
                 let o = [a * chunk[0], b * chunk[1], c * chunk[2]];
-                for (idx, &v) in buf.iter().enumerate() {
-                    if v == 0 {
-                        continue;
+                let at = |x: ErrorKind| match x {
+                    ErrorKind::Malformed { format, detail } => e(ErrorKind::Malformed { format, detail: format!("{key}: {detail}") }),
+                    x => e(x),
+                };
+                match layout {
+                    Layout::Plain { gzip } => {
+                        decode(&raw, gzip, chunk, &mut buf).map_err(at)?;
+                        place(&mut bits, &buf, o, chunk, shape);
                     }
-                    let idx = idx as u64;
-                    let q = [idx / (chunk[1] * chunk[2]), (idx / chunk[2]) % chunk[1], idx % chunk[2]];
-                    let g: [u64; 3] = std::array::from_fn(|x| o[x] + q[x]);
-                    if g[0] < shape[0] && g[1] < shape[1] && g[2] < shape[2] {
-                        bits.set(g[0] as u32, g[1] as u32, g[2] as u32);
+                    Layout::Sharded { inner, gzip, checksum, at_end } => {
+                        let per = [0, 1, 2].map(|x| chunk[x] / inner[x]);
+                        let count = per.iter().product::<u64>() as usize;
+                        let index_len = 16 * count + if checksum { 4 } else { 0 };
+                        if index_len > raw.len() {
+                            return Err(at(bad(format!("{} bytes, less than its shard index ({index_len})", raw.len()))));
+                        }
+                        let index = if at_end { &raw[raw.len() - index_len..] } else { &raw[..index_len] };
+                        let word = |x: usize| u64::from_le_bytes(index[8 * x..8 * x + 8].try_into().expect("8 bytes"));
+                        for q in 0..count {
+                            let (off, len) = (word(2 * q), word(2 * q + 1));
+                            if off == EMPTY && len == EMPTY {
+                                continue;
+                            }
+                            let Some(bytes) =
+                                off.checked_add(len).filter(|&end| end <= raw.len() as u64).map(|end| &raw[off as usize..end as usize])
+                            else {
+                                return Err(at(bad(format!("inner chunk {q} at bytes {off}+{len}, outside the shard"))));
+                            };
+                            decode(bytes, gzip, inner, &mut buf).map_err(at)?;
+                            let qi = [q as u64 / (per[1] * per[2]), (q as u64 / per[2]) % per[1], q as u64 % per[2]];
+                            place(&mut bits, &buf, std::array::from_fn(|x| o[x] + qi[x] * inner[x]), inner, shape);
+                        }
                     }
                 }
             }
@@ -261,8 +398,8 @@ mod tests {
         let back = read(&out).unwrap();
         assert_eq!(back.bits, d);
         assert_eq!(back.placement, Some((grid.origin(), 0.25)));
-        // Chunk (1, 0, 0) exists, chunk (1, 1, 0) (no voxel) does not.
-        assert!(out.join("c/1/0/0").is_file() && !out.join("c/1/1/0").exists());
+        // One shard (192 × 128 × 64 voxels) holds the whole grid.
+        assert!(out.join("c/0/0/0").is_file() && !out.join("c/1").exists());
         // Writing again replaces the array; a non-Zarr directory is refused.
         let mut e = DenseBits::new(dims);
         e.set(5, 5, 5);
@@ -273,6 +410,71 @@ mod tests {
         std::fs::write(other.join("keep.txt"), "mine").unwrap();
         assert!(write(&other, &e, &grid).is_err());
         assert_eq!(std::fs::read_to_string(other.join("keep.txt")).unwrap(), "mine");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("voxkit-zarr-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// Shards of 512 along a long axis; shards and chunks without voxels
+    /// are not written, and the index marks the empty chunks.
+    #[test]
+    fn shards_split_long_axes_and_skip_empty_ones() {
+        let dims = [1100, 70, 8];
+        let mut d = DenseBits::new(dims);
+        for (i, j, k) in [(0, 0, 0), (511, 69, 7), (1099, 3, 4)] {
+            d.set(i, j, k);
+        }
+        let grid = GridSpec::new(glam::DVec3::ZERO, 1.0, dims.map(|x| x as u64)).unwrap();
+        let dir = scratch("shards");
+        let out = dir.join("v.zarr");
+        write(&out, &d, &grid).unwrap();
+        assert_eq!(read(&out).unwrap().bits, d);
+        assert!(out.join("c/0/0/0").is_file() && !out.join("c/1/0/0").exists() && out.join("c/2/0/0").is_file());
+        // Shard (0, 0, 0): 8 × 2 × 1 chunks, of which (0, 0, 0) and (7, 1, 0) hold voxels.
+        let shard = std::fs::read(out.join("c/0/0/0")).unwrap();
+        let index: Vec<u64> = shard[shard.len() - 16 * 16..].chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().unwrap())).collect();
+        let used: Vec<usize> = (0..16).filter(|&q| index[2 * q] != EMPTY).collect();
+        assert_eq!(used, [0, 15]);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Arrays without sharding (as `zarr` writes by default) are read; a
+    /// shard index pointing outside its shard is an error, not a panic.
+    #[test]
+    fn plain_chunks_and_broken_shard_indexes() {
+        let dir = scratch("plain");
+        let out = dir.join("p.zarr");
+        std::fs::create_dir_all(out.join("c/1/0")).unwrap();
+        let meta = json!({"zarr_format": 3, "node_type": "array", "shape": [5, 2, 2], "data_type": "uint8",
+            "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": [3, 2, 2]}},
+            "chunk_key_encoding": {"name": "default"}, "fill_value": 0,
+            "codecs": [{"name": "bytes"}, {"name": "gzip", "configuration": {"level": 5}}]});
+        std::fs::write(out.join("zarr.json"), meta.to_string()).unwrap();
+        let mut enc = GzEncoder::new(Vec::new(), flate2::Compression::new(5));
+        enc.write_all(&[0, 0, 0, 7, 1, 0, 0, 0, 0, 0, 0, 0]).unwrap();
+        std::fs::write(out.join("c/1/0/0"), enc.finish().unwrap()).unwrap();
+        let back = read(&out).unwrap().bits;
+        let mut set = Vec::new();
+        back.for_each_set(|i, j, k| set.push([i, j, k]));
+        assert_eq!(set, [[4, 0, 0], [3, 1, 1]]);
+
+        let mut d = DenseBits::new([8, 8, 8]);
+        d.set(1, 1, 1);
+        let grid = GridSpec::new(glam::DVec3::ZERO, 1.0, [8, 8, 8]).unwrap();
+        let sharded = dir.join("s.zarr");
+        write(&sharded, &d, &grid).unwrap();
+        let f = sharded.join("c/0/0/0");
+        let mut shard = std::fs::read(&f).unwrap();
+        let n = shard.len();
+        shard[n - 16..n - 8].copy_from_slice(&(u64::MAX - 3).to_le_bytes());
+        std::fs::write(&f, &shard).unwrap();
+        let e = read(&sharded).unwrap_err().to_string();
+        assert!(e.contains("c/0/0/0") && e.contains("outside the shard"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

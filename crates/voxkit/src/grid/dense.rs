@@ -98,6 +98,19 @@ impl DenseBits {
         row[w1] |= hi_mask;
     }
 
+    /// Sets every voxel of the inclusive box `[lo, hi]`, a row of words at
+    /// a time. The box must lie inside the grid.
+    pub fn fill_box(&mut self, lo: [u32; 3], hi: [u32; 3]) {
+        assert!((0..3).all(|a| lo[a] <= hi[a] && hi[a] < self.dims[a]), "box {lo:?}..={hi:?} outside the grid {:?}", self.dims);
+        let wpr = self.words_per_row;
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                let row = (k as usize * self.dims[1] as usize + j as usize) * wpr;
+                Self::fill_row(&mut self.words[row..row + wpr], lo[0], hi[0]);
+            }
+        }
+    }
+
     /// Is `(i, j, k)` inside the grid and set? Signed coordinates, so
     /// neighbour lookups need no bounds checks of their own.
     #[inline]
