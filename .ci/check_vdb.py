@@ -65,6 +65,27 @@ with tempfile.TemporaryDirectory() as d:
         r = subprocess.run([VOXKIT, "convert", str(d / "v.vdb"), str(d / "back.txt")], capture_output=True, text=True)
         check(f"{name}: voxkit convert reads the .vdb", r.returncode == 0 and (text_voxels(d / "back.txt") == want).all(), r.stderr)
 
+    # Sparse solids: interiors written as active tiles (8³, and 128³ where
+    # a whole 16³ node is inside), equal to the dense run's .npy.
+    cube = d / "cube.obj"
+    cube.write_text("".join(f"v {x} {y} {z}\n" for z in (0, 1) for y in (0, 1) for x in (0, 1))
+                    + "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n")
+    for mesh, res, extra in [
+        (cube, 160, ["--mode", "solid"]),
+        (MESHES / "stanford-bunny.obj", 150, ["--mode", "solid", "--method", "parity"]),
+        (MESHES / "teapot.obj", 130, ["--mode", "solid+surface", "--method", "parity", "--surface", "sep26"]),
+    ]:
+        name = f"{mesh.name} {res} {' '.join(extra)} tiled"
+        s = voxelize(mesh, d / "s.vdb", "--resolution", str(res), "--tile", "64", *extra)
+        voxelize(mesh, d / "s.npy", "--resolution", str(res), *extra)
+        g, got = active(d / "s.vdb")
+        want = np.argwhere(np.load(d / "s.npy") > 0)
+        tiles = sum(1 for it in g.citerOnValues() if tuple(it["min"]) != tuple(it["max"]))
+        check(f"{name}: runs tiled with full bricks", s["tile"] == 64 and s["solid"]["full_bricks"] > 0, s)
+        check(f"{name}: the interior is active tiles", tiles > 0, tiles)
+        check(f"{name}: every active voxel = the dense run's .npy", got.shape == want.shape and (got == want).all(), (got.shape, want.shape))
+        check(f"{name}: activeVoxelCount = voxkit's count", g.activeVoxelCount() == s["voxels"], (g.activeVoxelCount(), s["voxels"]))
+
     # A grid past the memory given: tiled automatically, sparse output.
     s = voxelize(MESHES / "stanford-bunny.obj", d / "big.vdb", "--resolution", "4096", "--max-memory", "1G")
     g = vdb.read(str(d / "big.vdb"), "voxels")

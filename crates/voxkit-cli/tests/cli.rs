@@ -561,18 +561,40 @@ fn tiled_runs_write_the_same_files_and_vdb_reads_back() {
     assert!(chk.status.success(), "{}", String::from_utf8_lossy(&chk.stderr));
 }
 
+/// Solids past memory: parity and winding run brick row by brick row into
+/// sparse bricks with full runs, and write the dense run's files.
+#[test]
+fn sparse_solids_write_the_same_files() {
+    let bunny = shared("stanford-bunny.obj");
+    let cow = shared("cow.obj");
+    for (mesh, mode, method) in
+        [(&bunny, "solid", "parity"), (&bunny, "solid+surface", "parity"), (&cow, "solid", "winding"), (&cow, "solid", "auto")]
+    {
+        let (a, b) = (tmp(&format!("dense-{mode}-{method}.npy")), tmp(&format!("sparse-{mode}-{method}.npy")));
+        let common = ["--resolution", "150", "--mode", mode, "--method", method, "--json"];
+        let d = json(&voxkit(&[&["voxelize", mesh.as_str(), "-o", &a][..], &common[..]].concat()));
+        let t = json(&voxkit(&[&["voxelize", mesh.as_str(), "-o", &b, "--tile", "64"][..], &common[..]].concat()));
+        assert_eq!(t["tile"], 64);
+        assert_eq!(t["method"], d["method"]);
+        assert_eq!(t["voxels"], d["voxels"]);
+        assert!(t["solid"]["full_bricks"].as_u64().unwrap() > 0, "{mode}: no full bricks");
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{mode} {method}: sparse .npy differs");
+    }
+}
+
 #[test]
 fn grids_past_memory_errors() {
     let cow = shared("cow.obj");
     for (args, says) in [
         (vec!["--resolution", "16384", "--max-memory", "1G"], ".vdb"),
         (vec!["--tile", "12"], "multiple of 8"),
-        (vec!["--tile", "64", "--mode", "solid"], "solid modes"),
+        (vec!["--tile", "64", "--mode", "solid", "--fill", "flood"], "flood fills"),
+        (vec!["--tile", "64", "--mode", "solid", "--hollow", "6"], "hollow"),
         (vec!["--tile", "64", "--method", "reference"], "fast path"),
         (vec!["--tile", "64", "--mode", "line26"], "line26"),
         (vec!["--max-memory", "lots"], "unknown unit"),
         (vec!["--max-memory", "1.2.3G"], "not a size"),
-        (vec!["--resolution", "16384", "--max-memory", "1G", "--mode", "solid"], "solid modes"),
+        (vec!["--resolution", "16384", "--max-memory", "1G", "--mode", "solid", "--fill", "flood"], "flood fills"),
     ] {
         let mut a = vec!["voxelize", &cow, "-o"];
         let out = tmp(if args.contains(&"solid") { "past.vdb" } else { "past.npy" });

@@ -10,9 +10,12 @@
 //! Grid metadata: `file_bbox_min`/`file_bbox_max`/`file_voxel_count` (as
 //! OpenVDB writes them), and `voxkit_dims`, `voxkit_origin`,
 //! `voxkit_voxel_size`, which the reader uses to restore the exact grid.
-//! Internal-node values use OpenVDB's active-mask compression (only active
-//! tile values are stored; there are none), leaves are uncompressed bit
-//! masks, so the file needs no compression library. The byte layout
+//! Full 8³ bricks are active tiles of their 16³ node (value `true`), and
+//! 16³ nodes whose 4096 bricks are all full are active tiles of 128³ in
+//! their 32³ node: a solid's interior costs bits per brick, not voxels.
+//! Internal-node values use OpenVDB's active-mask compression (only the
+//! active tiles' values are stored), leaves are uncompressed bit masks, so
+//! the file needs no compression library. The byte layout
 //! follows OpenVDB's `Archive::writeGrid`, `RootNode`/`InternalNode::
 //! writeTopology` and `LeafNode<bool>::writeBuffers`; CI reads every file
 //! back with OpenVDB's own reader (`pyopenvdb`) and compares every active
@@ -26,12 +29,13 @@
 //! Sizes are computed before anything is written, so the file streams
 //! through one pass (the grid offsets OpenVDB puts before each grid are
 //! known in advance) and memory is the sorted leaf list, 72 bytes per
-//! non-empty brick.
+//! partial brick, and 512 bytes per 16³ node holding tiles.
 
 use std::io::Write;
 
 use glam::DVec3;
 use voxkit::grid::bricks::Brick;
+use voxkit::grid::sparse::FULL;
 use voxkit::{GridSpec, VoxelSource};
 
 use crate::error::ErrorKind;
@@ -141,12 +145,12 @@ fn vec3d(v: [f64; 3]) -> Vec<u8> {
 }
 
 /// The grid's metadata and transform.
-fn put_grid_head(o: &mut dyn Out, leaves: &[Leaf], count: u64, grid: &GridSpec) -> std::io::Result<()> {
+fn put_grid_head(o: &mut dyn Out, tree: &Tree, count: u64, grid: &GridSpec) -> std::io::Result<()> {
     o.put(&COMPRESS_ACTIVE_MASK.to_le_bytes())?;
-    // Bounds of the active voxels, leaf by leaf: x from the non-zero
-    // words, y and z from the bytes and bits of their union.
-    let mut bbox: Option<([i32; 3], [i32; 3])> = None;
-    for l in leaves {
+    // Bounds of the active voxels: the tiles' boxes, then leaf by leaf: x
+    // from the non-zero words, y and z from the bytes and bits of their union.
+    let mut bbox: Option<([i32; 3], [i32; 3])> = tree.tile_box;
+    for l in &tree.leaves {
         let Some(x0) = l.mask.iter().position(|&w| w != 0) else { continue };
         let x1 = l.mask.iter().rposition(|&w| w != 0).unwrap_or(x0);
         let all = l.mask.iter().fold(0u64, |a, &w| a | w);
@@ -187,70 +191,165 @@ fn put_grid_head(o: &mut dyn Out, leaves: &[Leaf], count: u64, grid: &GridSpec) 
     Ok(())
 }
 
-/// Groups of `leaves[range]` sharing a key.
-fn groups(leaves: &[Leaf], range: std::ops::Range<usize>, key: impl Fn(&Leaf) -> u64) -> Vec<std::ops::Range<usize>> {
-    let mut out = Vec::new();
-    let mut s = range.start;
-    while s < range.end {
-        let k = key(&leaves[s]);
-        let e = s + leaves[s..range.end].iter().take_while(|l| key(l) == k).count();
-        out.push(s..e);
-        s = e;
+/// A lower internal node (128³ voxels): its leaves, and its active tiles
+/// (full 8³ bricks) as a mask over its 16³ children.
+struct Lower {
+    /// `(upper x, y, z, index in the upper node)`: OpenVDB's order.
+    key: (u32, u32, u32, u32),
+    leaves: std::ops::Range<usize>,
+    tiles: Box<[u64; 64]>,
+}
+
+/// The tree to write: leaves (partial bricks) in OpenVDB's order, lower
+/// nodes holding leaves or tiles, and the lower nodes wholly full, which
+/// become active tiles of their upper node.
+struct Tree {
+    leaves: Vec<Leaf>,
+    lowers: Vec<Lower>,
+    /// Full lower nodes as `(upper x, y, z, index)`, sorted.
+    full_lowers: Vec<(u32, u32, u32, u32)>,
+    /// Bounds of the tiles' voxels.
+    tile_box: Option<([i32; 3], [i32; 3])>,
+}
+
+fn upper_of(k: &(u32, u32, u32, u32)) -> (u32, u32, u32) {
+    (k.0, k.1, k.2)
+}
+
+impl Tree {
+    /// Gathers the bricks of `bits`: partial ones as leaves, runs of full
+    /// ones as tiles (never one by one: a solid's interior is a few runs
+    /// per brick row), lower nodes all of whose 4096 bricks are full as
+    /// tiles of 128³.
+    fn of(bits: &dyn VoxelSource) -> Tree {
+        use rayon::slice::ParallelSliceMut;
+        let mut leaves = Vec::new();
+        let mut full: std::collections::HashMap<(u32, u32, u32, u32), Box<[u64; 64]>> = std::collections::HashMap::new();
+        let mut tile_box: Option<([i32; 3], [i32; 3])> = None;
+        bits.for_each_brick_run(&mut |b, brick, n| {
+            if *brick != FULL {
+                leaves.push(Leaf { origin: b.map(|c| c << LEAF), mask: to_vdb(brick) });
+                return;
+            }
+            let lo = b.map(|c| (c << LEAF) as i32);
+            let hi = [((b[0] + n) << LEAF) as i32 - 1, lo[1] + 7, lo[2] + 7];
+            let bb = tile_box.get_or_insert((lo, hi));
+            for a in 0..3 {
+                bb.0[a] = bb.0[a].min(lo[a]);
+                bb.1[a] = bb.1[a].max(hi[a]);
+            }
+            // The run, cut where it crosses lower nodes (16 bricks each).
+            let mut x = b[0];
+            while x < b[0] + n {
+                let end = (b[0] + n).min((x / 16 + 1) * 16);
+                let first = Leaf { origin: [x << LEAF, b[1] << LEAF, b[2] << LEAF], mask: [0; 8] }.order();
+                let mask = full.entry((first.0, first.1, first.2, first.3)).or_insert_with(|| Box::new([0; 64]));
+                for xx in x..end {
+                    let idx = (((xx & 15) << 8) | (first.4 & 0xff)) as usize;
+                    mask[idx / 64] |= 1 << (idx % 64);
+                }
+                x = end;
+            }
+        });
+        leaves.par_sort_unstable_by_key(Leaf::order);
+        // Lower nodes: those of leaves, with their tiles, then tile-only ones.
+        let mut lowers: Vec<Lower> = Vec::new();
+        let mut s = 0;
+        while s < leaves.len() {
+            let o = leaves[s].order();
+            let key = (o.0, o.1, o.2, o.3);
+            let e = s + leaves[s..]
+                .iter()
+                .take_while(|l| {
+                    let p = l.order();
+                    (p.0, p.1, p.2, p.3) == key
+                })
+                .count();
+            let tiles = full.remove(&key).unwrap_or_else(|| Box::new([0; 64]));
+            lowers.push(Lower { key, leaves: s..e, tiles });
+            s = e;
+        }
+        let mut full_lowers = Vec::new();
+        for (key, tiles) in full {
+            if tiles.iter().all(|&w| w == u64::MAX) {
+                full_lowers.push(key);
+            } else {
+                lowers.push(Lower { key, leaves: 0..0, tiles });
+            }
+        }
+        lowers.sort_unstable_by_key(|l| l.key);
+        full_lowers.sort_unstable();
+        Tree { leaves, lowers, full_lowers, tile_box }
     }
-    out
 }
 
-fn root_key(l: &Leaf) -> u64 {
-    let (x, y, z, _, _) = l.order();
-    (x as u64) << 40 | (y as u64) << 20 | z as u64
-}
-
-fn lower_key(l: &Leaf) -> u64 {
-    l.order().3 as u64
+/// An internal node's values after its masks: the metadata byte saying no
+/// inactive value differs from the background, then one `true` byte per
+/// active tile (mask compression stores only active values).
+fn put_tile_values(o: &mut dyn Out, tiles: &[u64]) -> std::io::Result<()> {
+    o.put(&[0])?;
+    let n: u32 = tiles.iter().map(|w| w.count_ones()).sum();
+    let ones = [1u8; 512];
+    let mut left = n as usize;
+    while left > 0 {
+        let k = left.min(ones.len());
+        o.put(&ones[..k])?;
+        left -= k;
+    }
+    Ok(())
 }
 
 /// The tree: topology, then buffers.
-fn put_tree(o: &mut dyn Out, leaves: &[Leaf]) -> std::io::Result<()> {
+fn put_tree(o: &mut dyn Out, tree: &Tree) -> std::io::Result<()> {
     o.put(&1i32.to_le_bytes())?; // buffer count
     o.put(&[0])?; // background: false
-    let roots = groups(leaves, 0..leaves.len(), root_key);
+                  // Upper nodes: those of lower nodes and of full lower nodes, in order.
+    let mut uppers: Vec<(u32, u32, u32)> =
+        tree.lowers.iter().map(|l| upper_of(&l.key)).chain(tree.full_lowers.iter().map(upper_of)).collect();
+    uppers.sort_unstable();
+    uppers.dedup();
     o.put(&0u32.to_le_bytes())?; // tiles
-    o.put(&(roots.len() as u32).to_le_bytes())?;
-    for r in &roots {
-        let origin = leaves[r.start].origin.map(|c| (c >> UPPER << UPPER) as i32);
-        o.put(&vec3i(origin))?;
-        let lowers = groups(leaves, r.clone(), lower_key);
+    o.put(&(uppers.len() as u32).to_le_bytes())?;
+    let (mut l, mut f) = (0, 0);
+    for up in &uppers {
+        o.put(&vec3i([up.0, up.1, up.2].map(|c| (c << UPPER) as i32)))?;
+        let l_end = l + tree.lowers[l..].iter().take_while(|x| upper_of(&x.key) == *up).count();
+        let f_end = f + tree.full_lowers[f..].iter().take_while(|x| upper_of(x) == *up).count();
         let mut child = vec![0u64; 32 * 32 * 32 / 64];
-        for g in &lowers {
-            let n = lower_key(&leaves[g.start]) as usize;
-            child[n / 64] |= 1 << (n % 64);
+        for x in &tree.lowers[l..l_end] {
+            child[x.key.3 as usize / 64] |= 1 << (x.key.3 % 64);
+        }
+        let mut value = vec![0u64; child.len()];
+        for x in &tree.full_lowers[f..f_end] {
+            value[x.3 as usize / 64] |= 1 << (x.3 % 64);
         }
         put_words(o, &child)?;
-        put_words(o, &vec![0u64; child.len()])?; // no active tiles
-        o.put(&[0])?; // compressed values: none stored (no active tiles)
-        for g in &lowers {
+        put_words(o, &value)?;
+        put_tile_values(o, &value)?;
+        for x in &tree.lowers[l..l_end] {
             let mut child = [0u64; 16 * 16 * 16 / 64];
-            for l in &leaves[g.clone()] {
-                let n = l.order().4 as usize;
+            for leaf in &tree.leaves[x.leaves.clone()] {
+                let n = leaf.order().4 as usize;
                 child[n / 64] |= 1 << (n % 64);
             }
             put_words(o, &child)?;
-            put_words(o, &[0u64; 64])?;
-            o.put(&[0])?;
-            for l in &leaves[g.clone()] {
-                put_words(o, &l.mask)?;
+            put_words(o, &x.tiles[..])?;
+            put_tile_values(o, &x.tiles[..])?;
+            for leaf in &tree.leaves[x.leaves.clone()] {
+                put_words(o, &leaf.mask)?;
             }
         }
+        (l, f) = (l_end, f_end);
     }
     let mut buf = [0u8; 140];
-    for l in leaves {
+    for leaf in &tree.leaves {
         // Value mask (active), origin, values.
-        for (n, w) in l.mask.iter().enumerate() {
+        for (n, w) in leaf.mask.iter().enumerate() {
             buf[8 * n..8 * n + 8].copy_from_slice(&w.to_le_bytes());
             buf[76 + 8 * n..84 + 8 * n].copy_from_slice(&w.to_le_bytes());
         }
         for a in 0..3 {
-            buf[64 + 4 * a..68 + 4 * a].copy_from_slice(&(l.origin[a] as i32).to_le_bytes());
+            buf[64 + 4 * a..68 + 4 * a].copy_from_slice(&(leaf.origin[a] as i32).to_le_bytes());
         }
         o.put(&buf)?;
     }
@@ -272,10 +371,7 @@ fn uuid(grid: &GridSpec, count: u64) -> String {
 /// per axis cannot be indexed by OpenVDB's 32-bit coordinates and are
 /// refused by the caller's grid limits long before.
 pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
-    use rayon::slice::ParallelSliceMut;
-    let mut leaves = Vec::new();
-    bits.for_each_brick(&mut |b, brick| leaves.push(Leaf { origin: b.map(|c| c << LEAF), mask: to_vdb(brick) }));
-    leaves.par_sort_unstable_by_key(Leaf::order);
+    let tree = Tree::of(bits);
     let count = bits.count();
     let mut header = Vec::new();
     let mut o = Stream(&mut header);
@@ -296,15 +392,15 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std:
     // The grid head (metadata, transform) is small: built once, in memory.
     // The tree is streamed, after a first pass that only counts its bytes.
     let mut head = Vec::new();
-    put_grid_head(&mut Stream(&mut head), &leaves, count, grid)?;
-    let mut tree = Count(0);
-    put_tree(&mut tree, &leaves)?;
+    put_grid_head(&mut Stream(&mut head), &tree, count, grid)?;
+    let mut tree_len = Count(0);
+    put_tree(&mut tree_len, &tree)?;
     let grid_pos = header.len() as u64 + desc.0 + 24;
     w.write_all(&header)?;
     let mut o = Stream(w);
     let o: &mut dyn Out = &mut o;
     let block_pos = grid_pos + head.len() as u64;
-    let end_pos = block_pos + tree.0;
+    let end_pos = block_pos + tree_len.0;
     put_str(o, "voxels")?;
     put_str(o, GRID_TYPE)?;
     put_str(o, "")?;
@@ -312,7 +408,7 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std:
         o.put(&(p as i64).to_le_bytes())?;
     }
     o.put(&head)?;
-    put_tree(o, &leaves)
+    put_tree(o, &tree)
 }
 
 /// A cursor over untrusted bytes: every read is bounds-checked.
@@ -674,6 +770,42 @@ mod tests {
         for n in (0..buf.len()).step_by(97) {
             assert!(read(&buf[..n]).is_err());
         }
+    }
+
+    /// Full runs become tiles (of 8³, and of 128³ where a whole 16³ node is
+    /// full), read back voxel for voxel; the file stays small.
+    #[test]
+    fn full_runs_are_written_as_tiles() {
+        use voxkit::grid::sparse::SparseBricks;
+        let dims = [300, 140, 136];
+        // Bricks 0..16 × 0..16 × 0..16 (one whole 128³ node) and a run of 3
+        // further along x, plus partial bricks either side of a run.
+        let mut full = Vec::new();
+        for bk in 0..16 {
+            for bj in 0..16 {
+                full.push(([0, bj, bk], if (bj, bk) == (2, 3) { 20 } else { 16 }));
+            }
+        }
+        full.sort_by_key(|(b, _)| (b[2], b[1], b[0]));
+        let mut partial = [0u64; 8];
+        partial[3] = 0x81;
+        let bricks = vec![([20, 2, 3], partial), ([30, 16, 16], partial)];
+        let mut all: Vec<([u32; 3], Brick)> = bricks.clone();
+        let sparse = SparseBricks::from_sorted(
+            dims,
+            {
+                all.sort_by_key(|(b, _)| (b[2], b[1], b[0]));
+                all
+            },
+            full,
+        );
+        let grid = GridSpec::new(DVec3::ZERO, 0.5, dims.map(|x| x as u64)).unwrap();
+        let mut buf = Vec::new();
+        write(&mut buf, &sparse, &grid).unwrap();
+        assert!(buf.len() < 20_000, "{} bytes", buf.len());
+        let back = read(&buf).unwrap();
+        assert_eq!(back.bits, sparse.to_dense());
+        assert_eq!(back.bits.count(), 128 * 128 * 128 + 4 * 512 + 4);
     }
 
     /// Active tiles are filled whole, quickly (the file fuzzing found

@@ -379,10 +379,13 @@ impl Plan {
             if t == 0 || t % 8 != 0 || t > 1 << 20 {
                 return Err(JobError::invalid(format!("--tile {t}: must be a multiple of 8 from 8 to 1048576")));
             }
-            if solid.is_some() {
-                return Err(JobError::invalid("--tile: solid modes do not run tiled yet (surface modes do)"));
-            }
-            if !matches!(request.method, Method::Auto | Method::Fast) {
+            if let Some(sp) = &solid {
+                if !crate::solid::has_sparse_path(sp) {
+                    return Err(JobError::invalid(
+                        "--tile: flood fills, hollow solids and the reference and gpu solids do not run tiled yet (parity and winding do)",
+                    ));
+                }
+            } else if !matches!(request.method, Method::Auto | Method::Fast) {
                 return Err(JobError::invalid("--tile runs the fast path: use --method auto or fast"));
             }
         }

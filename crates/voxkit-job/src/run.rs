@@ -110,7 +110,7 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
     let tile = tile_for(plan, &grid, budget);
     if tile.is_none() {
         let why = if plan.solid.is_some() {
-            "solid modes (not tiled yet)"
+            "flood fills, hollow solids, the reference and gpu solids (not tiled yet; parity and winding on closed meshes are)"
         } else if is_line {
             "line modes (not tiled yet)"
         } else {
@@ -125,7 +125,12 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
     };
     let opts = Options { progress, ..Options::default() };
     let mut gpu = Value::Null;
-    let (voxels, report, method, solid) = if let Some(t) = tile {
+    let (voxels, report, method, solid) = if let (Some(t), Some(sp)) = (tile, &plan.solid) {
+        let out = crate::solid::run_sparse(sp, mesh, name, &grid, t, &opts)?;
+        warnings.extend(out.warnings);
+        let voxels = out.bits.count();
+        (Voxels::Sparse(out.bits), Report { voxels, prepare: Default::default() }, out.method, out.facts)
+    } else if let Some(t) = tile {
         let (s, r) = voxelize::tiled::tiled(plan.core, mesh, &grid, t, &opts).map_err(|e| JobError::invalid(e.to_string()))?;
         (Voxels::Sparse(s), r, "tiled", Value::Null)
     } else if let Some(sp) = &plan.solid {
@@ -182,7 +187,8 @@ fn tile_for(plan: &Plan, grid: &GridSpec, budget: u64) -> Option<u32> {
         return plan.request.tile;
     }
     let fast = matches!(plan.request.method, crate::plan::Method::Auto | crate::plan::Method::Fast);
-    if plan.solid.is_some() || plan.is_line() || !fast {
+    let sparse_solid = plan.solid.as_ref().is_some_and(crate::solid::has_sparse_path);
+    if plan.is_line() || !(fast || sparse_solid) || (plan.solid.is_some() && !sparse_solid) {
         return None;
     }
     let index: u64 = grid.dims().iter().map(|&d| d.div_ceil(8) as u64).product::<u64>() * 4;

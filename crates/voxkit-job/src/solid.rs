@@ -3,6 +3,7 @@
 
 use serde_json::{json, Value};
 use voxkit::grid::dense::DenseBits;
+use voxkit::grid::sparse::SparseBricks;
 use voxkit::voxelize::{self, fill, solid, winding, Options};
 use voxkit::{GridSpec, MeshRef};
 
@@ -121,4 +122,91 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         facts["hollow"] = json!(if conn == voxkit::topology::runs::Connectivity::Six { 6 } else { 26 });
     }
     Ok(Outcome { bits, method, facts, warnings })
+}
+
+/// Whether `plan` has a sparse path (for grids past memory): parity or the
+/// closed winding number, alone or with a surface; not flood fills,
+/// `hollow`, the brute-force reference or the GPU.
+pub fn has_sparse_path(plan: &SolidPlan) -> bool {
+    matches!(plan.method, SolidMethod::Auto | SolidMethod::Parity | SolidMethod::Winding) && plan.hollow.is_none()
+}
+
+/// A sparse solid and what was done to get it (see [`run_sparse`]).
+pub struct SparseOutcome {
+    /// The voxels: sparse bricks, the interior as runs of full bricks.
+    pub bits: SparseBricks,
+    /// The method that ran.
+    pub method: &'static str,
+    /// Facts for the summary and JSON.
+    pub facts: Value,
+    /// Things the user should know.
+    pub warnings: Vec<String>,
+}
+
+/// Makes the solid `plan` asks for without a dense grid: rows of crossings
+/// turned brick row by brick row into sparse bricks and full runs, united
+/// with the tiled surface (tiles of `tile`) for `solid+surface`. Parity and
+/// the closed winding number only: an open mesh, which needs the
+/// generalized winding number over the whole grid, is an error.
+pub fn run_sparse(
+    plan: &SolidPlan,
+    mesh: MeshRef<'_>,
+    name: &str,
+    grid: &GridSpec,
+    tile: u32,
+    opts: &Options<'_>,
+) -> Result<SparseOutcome> {
+    if !has_sparse_path(plan) {
+        return Err(JobError::invalid(format!(
+            "{name}: this solid (flood fill, hollow, reference or gpu) has no sparse path yet; parity and winding on closed meshes do"
+        )));
+    }
+    let snapped = voxkit::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+    let inspect = solid::inspect(&snapped);
+    let mut warnings = Vec::new();
+    let open = format!(
+        "{name}: not closed and consistently oriented ({} boundary edges, {} inconsistently oriented edges)",
+        inspect.boundary_edges, inspect.unbalanced_edges
+    );
+    let dims = grid.dims();
+    let (bits, rep, method) = match plan.method {
+        SolidMethod::Parity => {
+            if !inspect.watertight() {
+                warnings.push(format!("{open}: ray parity may streak through holes"));
+            }
+            let (b, r) = solid::parity_sparse(&snapped, dims);
+            (b, r, "parity")
+        }
+        _ if !inspect.watertight() => {
+            return Err(JobError::invalid(format!(
+            "{open}: the generalized winding number has no sparse path yet (grids past memory); use --method parity, or a grid that fits"
+        )))
+        }
+        SolidMethod::Winding => {
+            let (b, r) = solid::winding_closed_sparse(&snapped, dims);
+            (b, r, "winding")
+        }
+        _ => {
+            let (b, r) = solid::parity_sparse(&snapped, dims);
+            (b, r, "parity")
+        }
+    };
+    drop(snapped);
+    let mut facts = json!({
+        "generalized_winding": Value::Null,
+        "closed": rep.boundary_edges == 0,
+        "consistently_oriented": rep.unbalanced_edges == 0,
+        "boundary_edges": rep.boundary_edges,
+        "inconsistent_edges": rep.unbalanced_edges,
+        "full_bricks": bits.full_bricks(),
+    });
+    let bits = match plan.surface {
+        Some(surface) => {
+            let (shell, _) = voxelize::tiled::tiled(surface, mesh, grid, tile, opts).map_err(|e| JobError::invalid(e.to_string()))?;
+            facts["surface"] = json!(surface.name());
+            bits.union(&shell)
+        }
+        None => bits,
+    };
+    Ok(SparseOutcome { bits, method, facts, warnings })
 }

@@ -39,4 +39,12 @@ pub trait VoxelSource: Sync {
             f([kji[2], kji[1], kji[0]], b);
         }
     }
+
+    /// [`VoxelSource::for_each_brick`], except that a run of `n` full
+    /// bricks along `bi` may come as one call `f(first brick, full, n)`
+    /// (sparse solids keep their interiors as such runs; sparse writers
+    /// store them as constant tiles). Other bricks come with `n = 1`.
+    fn for_each_brick_run(&self, f: &mut dyn FnMut([u32; 3], &bricks::Brick, u32)) {
+        self.for_each_brick(&mut |b, bits| f(b, bits, 1))
+    }
 }

@@ -27,16 +27,25 @@ fn unkey(k: u64) -> [u32; 3] {
     [(k & KEY_MASK) as u32, ((k >> KEY_BITS) & KEY_MASK) as u32, (k >> (2 * KEY_BITS)) as u32]
 }
 
-/// A sparse grid of bits: the non-empty 8³ bricks, sorted by `(bk, bj, bi)`.
+/// Every bit of a brick set.
+pub const FULL: Brick = [u64::MAX; 8];
+
+/// A sparse grid of bits: the non-empty 8³ bricks, sorted by `(bk, bj, bi)`,
+/// and runs of full bricks along `bi` stored as constant tiles (a solid's
+/// interior is a few runs per brick row, never its voxels).
 ///
 /// # Guarantees
 /// Keys are strictly increasing (each brick once), no stored brick is
-/// empty, and no bit outside `dims` is set.
+/// empty, full runs are sorted, within one brick row and disjoint from the
+/// stored bricks, and no bit outside `dims` is set (a full brick lies
+/// wholly inside the grid).
 #[derive(Clone, Debug, Default)]
 pub struct SparseBricks {
     dims: [u32; 3],
     keys: Vec<u64>,
     bricks: Vec<Brick>,
+    /// Runs of full bricks: the key of the first and how many follow along `bi`.
+    full: Vec<(u64, u32)>,
 }
 
 impl SparseBricks {
@@ -46,7 +55,51 @@ impl SparseBricks {
     /// An empty grid. Panics if an axis exceeds [`SparseBricks::MAX_DIM`].
     pub fn new(dims: [u32; 3]) -> SparseBricks {
         assert!(dims.iter().all(|&d| d <= Self::MAX_DIM), "grid {dims:?} beyond the sparse key range");
-        SparseBricks { dims, keys: Vec::new(), bricks: Vec::new() }
+        SparseBricks { dims, keys: Vec::new(), bricks: Vec::new(), full: Vec::new() }
+    }
+
+    /// A grid from bricks and runs of full bricks already in key order
+    /// (runs as `(first brick, length along bi)`), as a solid's brick rows
+    /// produce them. Panics if the order or the grid is violated.
+    pub fn from_sorted(dims: [u32; 3], bricks: Vec<([u32; 3], Brick)>, full: Vec<([u32; 3], u32)>) -> SparseBricks {
+        let mut out = SparseBricks::new(dims);
+        out.keys = bricks.iter().map(|(b, _)| key(*b)).collect();
+        out.bricks = bricks.into_iter().map(|(_, b)| b).collect();
+        out.full = full.iter().map(|&(b, n)| (key(b), n)).collect();
+        assert!(out.keys.windows(2).all(|w| w[0] < w[1]), "bricks out of order");
+        assert!(out.full.windows(2).all(|w| w[0].0 + w[0].1 as u64 <= w[1].0), "full runs out of order");
+        for &(b, n) in &full {
+            assert!(n > 0 && (0..3).all(|a| (b[a] + if a == 0 { n } else { 1 }) * BRICK <= dims[a]), "full run outside the grid");
+        }
+        assert!(out.keys.iter().all(|k| out.full_at(*k).is_none()), "a brick inside a full run");
+        out
+    }
+
+    /// The full run holding brick `k`, if any.
+    fn full_at(&self, k: u64) -> Option<usize> {
+        let n = self.full.partition_point(|r| r.0 <= k);
+        (n > 0 && k < self.full[n - 1].0 + self.full[n - 1].1 as u64).then(|| n - 1)
+    }
+
+    /// Bricks in full runs.
+    pub fn full_bricks(&self) -> u64 {
+        self.full.iter().map(|r| r.1 as u64).sum()
+    }
+
+    /// The runs of full bricks: `(first brick, length along bi)`, in key order.
+    pub fn full_runs(&self) -> impl Iterator<Item = ([u32; 3], u32)> + '_ {
+        self.full.iter().map(|&(k, n)| (unkey(k), n))
+    }
+
+    /// The union of this grid and `surface`, a grid without full runs (a
+    /// solid and its surface shell): bricks inside a full run are dropped,
+    /// bricks at the same key are merged.
+    pub fn union(&self, surface: &SparseBricks) -> SparseBricks {
+        assert!(surface.full.is_empty() && surface.dims == self.dims, "union with a grid of full runs or another shape");
+        let extra = surface.keys.iter().zip(&surface.bricks).filter(|(k, _)| self.full_at(**k).is_none());
+        let mut out = SparseBricks::from_bricks(self.dims, self.keys.iter().zip(&self.bricks).chain(extra).map(|(k, b)| (unkey(*k), *b)));
+        out.full = self.full.clone();
+        out
     }
 
     /// Builds a grid from bricks in any order; bricks given twice are
@@ -112,34 +165,49 @@ impl SparseBricks {
         self.dims
     }
 
-    /// Stored (non-empty) bricks.
+    /// Stored bricks (not counting those of full runs).
     pub fn brick_count(&self) -> usize {
         self.bricks.len()
     }
 
-    /// Bytes used by keys and bricks.
+    /// Bytes used by keys, bricks and full runs.
     pub fn memory_bytes(&self) -> usize {
-        self.keys.len() * 8 + self.bricks.len() * 64
+        self.keys.len() * 8 + self.bricks.len() * 64 + self.full.len() * 16
     }
 
     /// Number of set voxels.
     pub fn count(&self) -> u64 {
-        super::count_bits(self.bricks.iter().flatten())
+        super::count_bits(self.bricks.iter().flatten()) + self.full_bricks() * (BRICK * BRICK * BRICK) as u64
     }
 
     /// Is voxel `(i, j, k)` set?
     pub fn get(&self, i: u32, j: u32, k: u32) -> bool {
-        match self.keys.binary_search(&key([i / BRICK, j / BRICK, k / BRICK])) {
+        let kb = key([i / BRICK, j / BRICK, k / BRICK]);
+        match self.keys.binary_search(&kb) {
             Ok(n) => self.bricks[n][(k % BRICK) as usize] >> ((j % BRICK) * 8 + i % BRICK) & 1 == 1,
-            Err(_) => false,
+            Err(_) => self.full_at(kb).is_some(),
         }
     }
 
-    /// Calls `f(brick coordinates, bits)` for every stored brick, in order
-    /// of `bk`, then `bj`, then `bi`.
+    /// Calls `f(brick coordinates, bits)` for every non-empty brick, full
+    /// runs brick by brick, in order of `bk`, then `bj`, then `bi`.
     pub fn for_each_brick(&self, mut f: impl FnMut([u32; 3], &Brick)) {
+        self.for_each_brick_run(|b, bits, n| (0..n).for_each(|x| f([b[0] + x, b[1], b[2]], bits)));
+    }
+
+    /// Calls `f(first brick, bits, n)` for every stored brick (`n = 1`) and
+    /// every run of `n` full bricks, in key order.
+    pub fn for_each_brick_run(&self, mut f: impl FnMut([u32; 3], &Brick, u32)) {
+        let mut runs = self.full.iter().peekable();
         for (k, b) in self.keys.iter().zip(&self.bricks) {
-            f(unkey(*k), b);
+            while let Some(&&(r, n)) = runs.peek().filter(|r| r.0 < *k) {
+                f(unkey(r), &FULL, n);
+                runs.next();
+            }
+            f(unkey(*k), b, 1);
+        }
+        for &(r, n) in runs {
+            f(unkey(r), &FULL, n);
         }
     }
 
@@ -161,34 +229,24 @@ impl VoxelSource for SparseBricks {
     }
 
     fn for_each_set(&self, f: &mut dyn FnMut(u32, u32, u32)) {
-        // Bricks of one layer `bk` are contiguous, and within it those of
-        // one row `bj`, in order of `bi`: walk each layer voxel row by row.
-        let mut start = 0;
-        while start < self.keys.len() {
-            let bk = unkey(self.keys[start])[2];
-            let end = start + self.keys[start..].iter().take_while(|&&k| unkey(k)[2] == bk).count();
-            for z in 0..BRICK {
-                let k = bk * BRICK + z;
-                let mut row = start;
-                while row < end {
-                    let bj = unkey(self.keys[row])[1];
-                    let row_end = row + self.keys[row..end].iter().take_while(|&&k| unkey(k)[1] == bj).count();
-                    for y in 0..BRICK {
-                        for n in row..row_end {
-                            let bi = unkey(self.keys[n])[0];
-                            let mut byte = (self.bricks[n][z as usize] >> (y * 8)) & 0xff;
-                            while byte != 0 {
-                                let x = byte.trailing_zeros();
-                                byte &= byte - 1;
-                                f(bi * BRICK + x, bj * BRICK + y, k);
-                            }
-                        }
-                    }
-                    row = row_end;
-                }
-            }
-            start = end;
+        if self.full.is_empty() {
+            layer_voxels(&self.keys, &self.bricks, f);
+            return;
         }
+        // With full runs: each layer's bricks gathered, then walked alike.
+        let (mut keys, mut bricks) = (Vec::new(), Vec::new());
+        let mut layer = None;
+        self.for_each_brick(|b, bits| {
+            if layer != Some(b[2]) {
+                layer_voxels(&keys, &bricks, f);
+                keys.clear();
+                bricks.clear();
+                layer = Some(b[2]);
+            }
+            keys.push(key(b));
+            bricks.push(*bits);
+        });
+        layer_voxels(&keys, &bricks, f);
     }
 
     fn fill_i_planes(&self, i0: u32, count: u32, k_fastest: bool, out: &mut [u8]) {
@@ -197,17 +255,52 @@ impl VoxelSource for SparseBricks {
         assert!(count > 0 && i0 + count <= self.dims[0] && out.len() >= plane * count as usize);
         out[..plane * count as usize].fill(0);
         let (b0, b1) = (i0 / BRICK, (i0 + count - 1) / BRICK);
-        for (key, brick) in self.keys.iter().zip(&self.bricks) {
-            let [bi, bj, bk] = unkey(*key);
-            if bi < b0 || bi > b1 {
-                continue;
+        self.for_each_brick(|[bi, bj, bk], brick| {
+            if bi >= b0 && bi <= b1 {
+                super::bricks::brick_to_planes([bi, bj, bk], brick, i0, count, k_fastest, [ny, nz], out);
             }
-            super::bricks::brick_to_planes([bi, bj, bk], brick, i0, count, k_fastest, [ny, nz], out);
-        }
+        });
     }
 
     fn for_each_brick(&self, f: &mut dyn FnMut([u32; 3], &Brick)) {
         SparseBricks::for_each_brick(self, f)
+    }
+
+    fn for_each_brick_run(&self, f: &mut dyn FnMut([u32; 3], &Brick, u32)) {
+        SparseBricks::for_each_brick_run(self, f)
+    }
+}
+
+/// Calls `f(i, j, k)` for the set voxels of sorted bricks, in order of `k`,
+/// then `j`, then `i`: bricks of one layer `bk` are contiguous, and within
+/// it those of one row `bj`, in order of `bi`, so each layer is walked
+/// voxel row by voxel row.
+fn layer_voxels(keys: &[u64], bricks: &[Brick], f: &mut dyn FnMut(u32, u32, u32)) {
+    let mut start = 0;
+    while start < keys.len() {
+        let bk = unkey(keys[start])[2];
+        let end = start + keys[start..].iter().take_while(|&&k| unkey(k)[2] == bk).count();
+        for z in 0..BRICK {
+            let k = bk * BRICK + z;
+            let mut row = start;
+            while row < end {
+                let bj = unkey(keys[row])[1];
+                let row_end = row + keys[row..end].iter().take_while(|&&k| unkey(k)[1] == bj).count();
+                for y in 0..BRICK {
+                    for n in row..row_end {
+                        let bi = unkey(keys[n])[0];
+                        let mut byte = (bricks[n][z as usize] >> (y * 8)) & 0xff;
+                        while byte != 0 {
+                            let x = byte.trailing_zeros();
+                            byte &= byte - 1;
+                            f(bi * BRICK + x, bj * BRICK + y, k);
+                        }
+                    }
+                }
+                row = row_end;
+            }
+        }
+        start = end;
     }
 }
 

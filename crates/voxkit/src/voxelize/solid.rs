@@ -34,7 +34,9 @@
 use rayon::prelude::*;
 
 use crate::geom::fixed::ONE;
+use crate::grid::bricks::{Brick, BRICK};
 use crate::grid::dense::DenseBits;
+use crate::grid::sparse::SparseBricks;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
 use crate::topology::inside::{row_crossings, row_starts, snap_all, ClassifyError, Snapped};
@@ -104,6 +106,45 @@ enum Rule {
     Winding,
 }
 
+/// Calls `span(from, to)` (inclusive) for each maximal run of a row's
+/// voxels that `rule` puts inside, from the row's sorted crossings.
+fn row_spans(row_hits: &[(u32, u32, i8)], nx: u32, rule: Rule, mut span: impl FnMut(u32, u32)) {
+    // State before the first voxel, then the changes voxel by voxel.
+    let mut w = 0i64;
+    let mut inside = false;
+    let mut from = 0u32;
+    let mut h = 0;
+    while h < row_hits.len() {
+        let at = row_hits[h].1;
+        let mut e = h;
+        while e < row_hits.len() && row_hits[e].1 == at {
+            e += 1;
+        }
+        let group = &row_hits[h..e];
+        h = e;
+        if at >= nx {
+            break;
+        }
+        let now = match rule {
+            Rule::Winding => {
+                w += group.iter().map(|c| c.2 as i64).sum::<i64>();
+                w != 0
+            }
+            Rule::Parity => inside ^ (group.len() % 2 == 1),
+        };
+        if now != inside {
+            if inside && at > from {
+                span(from, at - 1);
+            }
+            inside = now;
+            from = at;
+        }
+    }
+    if inside && from < nx {
+        span(from, nx - 1);
+    }
+}
+
 /// Shared row filler: per row, walks the crossings in order and fills the
 /// spans where `rule` says inside.
 fn fill(snapped: &Snapped, dims: [u32; 3], rule: Rule) -> (DenseBits, SolidReport) {
@@ -113,45 +154,174 @@ fn fill(snapped: &Snapped, dims: [u32; 3], rule: Rule) -> (DenseBits, SolidRepor
     // Row r's crossings are hits[start[r] .. start[r + 1]].
     let start = row_starts(dims[1] as usize * dims[2] as usize, hits.iter().map(|h| h.0 as usize));
     bits.par_rows_mut().enumerate().for_each(|(r, row)| {
-        let row_hits = &hits[start[r]..start[r + 1]];
-        // State before the first voxel, then the changes voxel by voxel.
-        let mut w = 0i64;
-        let mut inside = false;
-        let mut from = 0u32;
-        let mut h = 0;
-        while h < row_hits.len() {
-            let at = row_hits[h].1;
-            let mut e = h;
-            while e < row_hits.len() && row_hits[e].1 == at {
-                e += 1;
-            }
-            let group = &row_hits[h..e];
-            h = e;
-            if at >= nx {
-                break;
-            }
-            let now = match rule {
-                Rule::Winding => {
-                    w += group.iter().map(|c| c.2 as i64).sum::<i64>();
-                    w != 0
-                }
-                Rule::Parity => inside ^ (group.len() % 2 == 1),
-            };
-            if now != inside {
-                if inside && at > from {
-                    DenseBits::fill_row(row, from, at - 1);
-                }
-                inside = now;
-                from = at;
-            }
-        }
-        if inside && from < nx {
-            DenseBits::fill_row(row, from, nx - 1);
-        }
+        row_spans(&hits[start[r]..start[r + 1]], nx, rule, |a, b| DenseBits::fill_row(row, a, b));
     });
     let mut rep = inspect(snapped);
     rep.voxels = bits.count();
     (bits, rep)
+}
+
+/// [`parity_snapped`] without a dense grid: the same voxels as sparse
+/// bricks, the interior as runs of full bricks (constant tiles), so memory
+/// follows the surface (the crossings and the bricks it cuts), not the
+/// volume.
+pub fn parity_sparse(snapped: &Snapped, dims: [u32; 3]) -> (SparseBricks, SolidReport) {
+    fill_sparse(snapped, dims, Rule::Parity)
+}
+
+/// [`winding_closed_snapped`] without a dense grid (see [`parity_sparse`]).
+pub fn winding_closed_sparse(snapped: &Snapped, dims: [u32; 3]) -> (SparseBricks, SolidReport) {
+    fill_sparse(snapped, dims, Rule::Winding)
+}
+
+/// Inclusive intervals, sorted and coalesced (overlapping or adjacent).
+fn coalesce(mut v: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
+    v.sort_unstable();
+    let mut out: Vec<(u32, u32)> = Vec::with_capacity(v.len());
+    for (a, b) in v {
+        match out.last_mut() {
+            Some(l) if a <= l.1.saturating_add(1) => l.1 = l.1.max(b),
+            _ => out.push((a, b)),
+        }
+    }
+    out
+}
+
+/// The intersection of two sorted, disjoint lists of inclusive intervals.
+fn intersect(a: &[(u32, u32)], b: &[(u32, u32)]) -> Vec<(u32, u32)> {
+    let (mut x, mut y, mut out) = (0, 0, Vec::new());
+    while x < a.len() && y < b.len() {
+        let (lo, hi) = (a[x].0.max(b[y].0), a[x].1.min(b[y].1));
+        if lo <= hi {
+            out.push((lo, hi));
+        }
+        if a[x].1 < b[y].1 {
+            x += 1;
+        } else {
+            y += 1;
+        }
+    }
+    out
+}
+
+/// `a` without `b` (sorted, disjoint inclusive intervals; `b` within `a`'s span or not).
+fn subtract(a: &[(u32, u32)], b: &[(u32, u32)]) -> Vec<(u32, u32)> {
+    let mut out = Vec::new();
+    let mut y = 0;
+    for &(lo, hi) in a {
+        let mut lo = lo as u64;
+        while y < b.len() && (b[y].1 as u64) < lo {
+            y += 1;
+        }
+        let mut z = y;
+        while z < b.len() && b[z].0 as u64 <= hi as u64 {
+            if (b[z].0 as u64) > lo {
+                out.push((lo as u32, b[z].0 - 1));
+            }
+            lo = lo.max(b[z].1 as u64 + 1);
+            z += 1;
+        }
+        if lo <= hi as u64 {
+            out.push((lo as u32, hi));
+        }
+    }
+    out
+}
+
+/// Bricks and full runs of one brick row `(bj, bk)`, in order of `bi`.
+type BrickRow = (Vec<([u32; 3], Brick)>, Vec<([u32; 3], u32)>);
+
+/// One brick row of the solid: the spans of its 64 voxel rows; bricks
+/// every row covers wholly form full runs; the other bricks any span
+/// touches are built bit by bit.
+fn brick_row(hits: &[(u32, u32, i8)], dims: [u32; 3], bj: u32, bk: u32, rule: Rule) -> BrickRow {
+    let [nx, ny, nz] = dims;
+    let b = BRICK;
+    // spans[dk · 8 + dj]: the inside spans of voxel row (bj·8 + dj, bk·8 + dk).
+    let mut spans: [Vec<(u32, u32)>; 64] = std::array::from_fn(|_| Vec::new());
+    // A row of this brick row outside the grid: no brick of it is full.
+    let mut edge = bj * b + b > ny || bk * b + b > nz;
+    let j0 = bj * b;
+    let j1 = (j0 + b).min(ny);
+    for dk in 0..b.min(nz - bk * b) {
+        let k = (bk * b + dk) as u64;
+        let (r0, r1) = (k * ny as u64 + j0 as u64, k * ny as u64 + j1 as u64);
+        let mut h = hits.partition_point(|x| (x.0 as u64) < r0);
+        let end = h + hits[h..].partition_point(|x| (x.0 as u64) < r1);
+        while h < end {
+            let r = hits[h].0;
+            let e = h + hits[h..end].partition_point(|x| x.0 == r);
+            let dj = (r as u64 - k * ny as u64) as u32 - j0;
+            let out = &mut spans[(dk * b + dj) as usize];
+            row_spans(&hits[h..e], nx, rule, |f, t| out.push((f, t)));
+            h = e;
+        }
+    }
+    if spans.iter().all(Vec::is_empty) {
+        return (Vec::new(), Vec::new());
+    }
+    let touched = coalesce(spans.iter().flatten().map(|&(f, t)| (f / b, t / b)).collect());
+    let mut full: Vec<(u32, u32)> = Vec::new();
+    for (n, row) in spans.iter().enumerate() {
+        // Bricks this row covers wholly (the last, partial brick of a row
+        // ending at nx is not whole).
+        let whole: Vec<(u32, u32)> =
+            row.iter().filter_map(|&(f, t)| (f.div_ceil(b) < (t + 1) / b).then(|| (f.div_ceil(b), (t + 1) / b - 1))).collect();
+        full = if n == 0 { whole } else { intersect(&full, &whole) };
+        if full.is_empty() {
+            edge = true;
+        }
+        if edge {
+            full.clear();
+            break;
+        }
+    }
+    let mut bricks = Vec::new();
+    let mut cursor = [0usize; 64];
+    for (lo, hi) in subtract(&touched, &full) {
+        for bi in lo..=hi {
+            let (x0, x1) = (bi * b, bi * b + b - 1);
+            let mut brick = [0u64; 8];
+            for (n, row) in spans.iter().enumerate() {
+                let c = &mut cursor[n];
+                while *c < row.len() && row[*c].1 < x0 {
+                    *c += 1;
+                }
+                let mut byte = 0u64;
+                for &(f, t) in row[*c..].iter().take_while(|s| s.0 <= x1) {
+                    let (a, z) = (f.max(x0) - x0, t.min(x1) - x0);
+                    byte |= (0xffu64 >> (7 - (z - a))) << a;
+                }
+                brick[n / 8] |= byte << ((n % 8) * 8);
+            }
+            if brick != [0; 8] {
+                bricks.push(([bi, bj, bk], brick));
+            }
+        }
+    }
+    (bricks, full.iter().map(|&(lo, hi)| ([lo, bj, bk], hi - lo + 1)).collect())
+}
+
+/// Shared sparse filler: brick rows in parallel, each from its 64 voxel
+/// rows' crossings (found by binary search in the sorted crossings).
+fn fill_sparse(snapped: &Snapped, dims: [u32; 3], rule: Rule) -> (SparseBricks, SolidReport) {
+    let hits = row_crossings(&snapped.crossing_triangles(), dims);
+    let (by, bz) = (dims[1].div_ceil(BRICK) as u64, dims[2].div_ceil(BRICK) as u64);
+    let rows: Vec<BrickRow> = (0..(by * bz) as usize)
+        .into_par_iter()
+        .with_min_len(16)
+        .map(|r| brick_row(&hits, dims, (r as u64 % by) as u32, (r as u64 / by) as u32, rule))
+        .collect();
+    drop(hits);
+    let (mut bricks, mut full) = (Vec::new(), Vec::new());
+    for (b, f) in rows {
+        bricks.extend(b);
+        full.extend(f);
+    }
+    let out = SparseBricks::from_sorted(dims, bricks, full);
+    let mut rep = inspect(snapped);
+    rep.voxels = out.count();
+    (out, rep)
 }
 
 /// The slow, obviously correct definition for closed meshes.
