@@ -181,7 +181,8 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
 /// The tile edge of the tiled path, when it runs: asked for with `--tile`,
 /// or chosen for a surface mode on the fast path whose grid does not fit
 /// densely in `budget` or whose whole-grid brick index (4 bytes per 8³
-/// voxels) would take more than a quarter of it.
+/// voxels) would take more than a quarter of it, and for a solid with a
+/// sparse path whose dense grid would take more than a quarter of it.
 fn tile_for(plan: &Plan, grid: &GridSpec, budget: u64) -> Option<u32> {
     if plan.request.tile.is_some() {
         return plan.request.tile;
@@ -190,6 +191,11 @@ fn tile_for(plan: &Plan, grid: &GridSpec, budget: u64) -> Option<u32> {
     let sparse_solid = plan.solid.as_ref().is_some_and(crate::solid::has_sparse_path);
     if plan.is_line() || !(fast || sparse_solid) || (plan.solid.is_some() && !sparse_solid) {
         return None;
+    }
+    if sparse_solid {
+        // A dense solid past a quarter of the budget: the sparse one keeps
+        // only the bricks the surface cuts and runs for the interior.
+        return (!crate::memory::dense_fits(grid, budget / 4)).then_some(voxelize::tiled::DEFAULT_TILE);
     }
     let index: u64 = grid.dims().iter().map(|&d| d.div_ceil(8) as u64).product::<u64>() * 4;
     (!crate::memory::dense_fits(grid, budget) || index > budget / 4).then_some(voxelize::tiled::DEFAULT_TILE)

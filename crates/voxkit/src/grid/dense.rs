@@ -212,6 +212,35 @@ impl super::VoxelSource for DenseBits {
     fn fill_i_planes(&self, i0: u32, count: u32, k_fastest: bool, out: &mut [u8]) {
         DenseBits::fill_i_planes(self, i0, count, k_fastest, out)
     }
+
+    /// Brick by brick from the words: each brick's 64 row bytes are read
+    /// directly (a row's byte `bi` holds voxels `8·bi .. 8·bi + 7`).
+    fn for_each_brick(&self, f: &mut dyn FnMut([u32; 3], &super::bricks::Brick)) {
+        let [nx, ny, nz] = self.dims;
+        let wpr = self.words_per_row;
+        let byte = |j: u32, k: u32, bi: u32| -> u64 {
+            if j >= ny || k >= nz {
+                return 0;
+            }
+            let w = self.words[(k as usize * ny as usize + j as usize) * wpr + bi as usize / 8];
+            (w >> ((bi % 8) * 8)) & 0xff
+        };
+        for bk in 0..nz.div_ceil(8) {
+            for bj in 0..ny.div_ceil(8) {
+                for bi in 0..nx.div_ceil(8) {
+                    let mut brick = [0u64; 8];
+                    for (z, w) in brick.iter_mut().enumerate() {
+                        for y in 0..8 {
+                            *w |= byte(bj * 8 + y, bk * 8 + z as u32, bi) << (y * 8);
+                        }
+                    }
+                    if brick != [0; 8] {
+                        f([bi, bj, bk], &brick);
+                    }
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -250,5 +279,30 @@ mod tests {
         assert_eq!(out[4 + 3], 1);
         g.fill_i_planes(1, 2, false, &mut out);
         assert_eq!(out[3 * 2 + 1], 1);
+    }
+}
+
+#[cfg(test)]
+mod brick_tests {
+    use super::*;
+    use crate::grid::sparse::SparseBricks;
+
+    /// Bricks read from the words give back the same grid, each brick once,
+    /// in key order, on dims that are not multiples of 8 or 64.
+    #[test]
+    fn for_each_brick_reads_every_voxel_once() {
+        let dims = [131, 21, 17];
+        let mut d = DenseBits::new(dims);
+        let mut s = 99u64;
+        for _ in 0..2000 {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            d.set((s >> 20) as u32 % dims[0], (s >> 35) as u32 % dims[1], (s >> 50) as u32 % dims[2]);
+        }
+        d.fill_box([64, 8, 8], [71, 15, 15]);
+        let mut bricks = Vec::new();
+        crate::grid::VoxelSource::for_each_brick(&d, &mut |b, bits| bricks.push((b, *bits)));
+        assert!(bricks.windows(2).all(|w| (w[0].0[2], w[0].0[1], w[0].0[0]) < (w[1].0[2], w[1].0[1], w[1].0[0])));
+        assert!(bricks.contains(&([8, 1, 1], crate::grid::sparse::FULL)));
+        assert_eq!(SparseBricks::from_bricks(dims, bricks).to_dense(), d);
     }
 }

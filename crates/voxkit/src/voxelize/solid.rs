@@ -266,7 +266,7 @@ fn brick_row(hits: &[(u32, u32, i8)], dims: [u32; 3], bj: u32, bk: u32, rule: Ru
         // Bricks this row covers wholly (the last, partial brick of a row
         // ending at nx is not whole).
         let whole: Vec<(u32, u32)> =
-            row.iter().filter_map(|&(f, t)| (f.div_ceil(b) < (t + 1) / b).then(|| (f.div_ceil(b), (t + 1) / b - 1))).collect();
+            row.iter().filter(|&&(f, t)| f.div_ceil(b) < (t + 1) / b).map(|&(f, t)| (f.div_ceil(b), (t + 1) / b - 1)).collect();
         full = if n == 0 { whole } else { intersect(&full, &whole) };
         if full.is_empty() {
             edge = true;
