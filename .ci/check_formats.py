@@ -13,18 +13,13 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from oracle import Oracle
+from oracle import Oracle, text_voxels
 from binvox import Binvox
 
 VOXKIT = sys.argv[1]
 MESHES = Path(sys.argv[2])
 ORACLE = Oracle(VOXKIT)
 check, voxelize = ORACLE.check, ORACLE.voxelize
-
-
-def text_voxels(path):
-    rows = [l.split() for l in Path(path).read_text().splitlines() if l and not l.startswith("#")]
-    return {(int(a), int(b), int(c)) for a, b, c in rows}
 
 
 with tempfile.TemporaryDirectory() as d:
@@ -35,7 +30,7 @@ with tempfile.TemporaryDirectory() as d:
         voxelize(m, d / "b.npy", "--resolution", str(res), "--format", "npy-bool")
         voxelize(m, d / "v.binvox", "--resolution", str(res))
         voxelize(m, d / "v.txt", "--resolution", str(res))
-        want = text_voxels(d / "v.txt")
+        want = set(map(tuple, text_voxels(d / "v.txt").tolist()))
         nx, ny, nz = summary["dims"]
 
         a = np.load(d / "v.npy")

@@ -12,18 +12,13 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from oracle import Oracle
+from oracle import Oracle, text_voxels
 import pyopenvdb as vdb
 
 VOXKIT = sys.argv[1]
 MESHES = Path(sys.argv[2])
 ORACLE = Oracle(VOXKIT)
 check, voxelize = ORACLE.check, ORACLE.voxelize
-
-
-def text_voxels(path):
-    rows = [l.split() for l in Path(path).read_text().splitlines() if l and not l.startswith("#")]
-    return np.array(sorted((int(a), int(b), int(c)) for a, b, c in rows), dtype=np.int64).reshape(-1, 3)
 
 
 def active(path):

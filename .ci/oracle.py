@@ -2,6 +2,9 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
+
+import numpy as np
 
 
 class Oracle:
@@ -27,3 +30,9 @@ class Oracle:
     def finish(self):
         print(f"{self.passed} passed, {self.failed} failed")
         sys.exit(1 if self.failed else 0)
+
+
+def text_voxels(path):
+    """voxkit's text list of voxels as a sorted (n, 3) int64 array."""
+    rows = [l.split() for l in Path(path).read_text().splitlines() if l and not l.startswith("#")]
+    return np.array(sorted((int(a), int(b), int(c)) for a, b, c in rows), dtype=np.int64).reshape(-1, 3)

@@ -253,21 +253,15 @@ impl Tree {
         });
         leaves.par_sort_unstable_by_key(Leaf::order);
         // Lower nodes: those of leaves, with their tiles, then tile-only ones.
+        let lower_key = |l: &Leaf| {
+            let o = l.order();
+            (o.0, o.1, o.2, o.3)
+        };
         let mut lowers: Vec<Lower> = Vec::new();
-        let mut s = 0;
-        while s < leaves.len() {
-            let o = leaves[s].order();
-            let key = (o.0, o.1, o.2, o.3);
-            let e = s + leaves[s..]
-                .iter()
-                .take_while(|l| {
-                    let p = l.order();
-                    (p.0, p.1, p.2, p.3) == key
-                })
-                .count();
+        for range in crate::runs(&leaves, lower_key) {
+            let key = lower_key(&leaves[range.start]);
             let tiles = full.remove(&key).unwrap_or_else(|| Box::new([0; 64]));
-            lowers.push(Lower { key, leaves: s..e, tiles });
-            s = e;
+            lowers.push(Lower { key, leaves: range, tiles });
         }
         let mut full_lowers = Vec::new();
         for (key, tiles) in full {
@@ -700,19 +694,23 @@ fn read_grid(c: &mut Cur<'_>) -> Result<LoadedVoxels, ErrorKind> {
         _ => (lo, std::array::from_fn(|a| u32::try_from(hi[a] - lo[a] + 1).unwrap_or(u32::MAX))),
     };
     let mut bits = crate::dense_grid(dims)?;
-    let mut set = |p: [i64; 3]| -> Result<(), ErrorKind> {
+    let inside = |p: [i64; 3]| -> Result<[u32; 3], ErrorKind> {
         let q: [i64; 3] = std::array::from_fn(|a| p[a] - offset[a]);
         if (0..3).any(|a| q[a] < 0 || q[a] >= dims[a] as i64) {
             return Err(bad(format!("active voxel {p:?} outside the recorded grid {dims:?}")));
         }
-        bits.set(q[0] as u32, q[1] as u32, q[2] as u32);
-        Ok(())
+        Ok(q.map(|c| c as u32))
     };
+    let mut tiles = Vec::with_capacity(found.tiles.len());
     for (o, e) in &found.tiles {
         // A tile is inside the grid when its two corners are.
-        set(*o)?;
-        set(o.map(|c| c + e - 1))?;
+        tiles.push((inside(*o)?, inside(o.map(|c| c + e - 1))?));
     }
+    let mut set = |p: [i64; 3]| -> Result<(), ErrorKind> {
+        let q = inside(p)?;
+        bits.set(q[0], q[1], q[2]);
+        Ok(())
+    };
     for (o, m) in &leaves {
         for (x, &w) in m.iter().enumerate() {
             let mut w = w;
@@ -723,9 +721,8 @@ fn read_grid(c: &mut Cur<'_>) -> Result<LoadedVoxels, ErrorKind> {
             }
         }
     }
-    for (o, e) in &found.tiles {
-        let lo = std::array::from_fn(|a| (o[a] - offset[a]) as u32);
-        bits.fill_box(lo, lo.map(|c| c + *e as u32 - 1));
+    for (lo, hi) in tiles {
+        bits.fill_box(lo, hi);
     }
     let origin_meta = get("voxkit_origin").filter(|v| v.len() == 24).map(|v| {
         let d: [f64; 3] = std::array::from_fn(|a| f64::from_le_bytes(v[8 * a..8 * a + 8].try_into().expect("8 bytes")));

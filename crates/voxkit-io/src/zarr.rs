@@ -119,19 +119,6 @@ pub fn write(path: &Path, bits: &dyn VoxelSource, grid: &GridSpec) -> Result<(),
     result.map_err(|e| io(path, e))
 }
 
-/// Consecutive runs of `items` with the same `key`.
-fn runs<T, K: PartialEq>(items: &[T], key: impl Fn(&T) -> K) -> Vec<std::ops::Range<usize>> {
-    let mut out = Vec::new();
-    let mut s = 0;
-    while s < items.len() {
-        let k = key(&items[s]);
-        let e = s + items[s..].iter().take_while(|x| key(x) == k).count();
-        out.push(s..e);
-        s = e;
-    }
-    out
-}
-
 fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     std::fs::write(dir.join("zarr.json"), serde_json::to_vec_pretty(&metadata(grid)).map_err(std::io::Error::other)?)?;
@@ -147,12 +134,12 @@ fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<
         let c = chunk_of(b);
         (shard_of(c), c)
     });
-    let shards = runs(&bricks, |(b, _)| shard_of(chunk_of(b)));
+    let shards = crate::runs(&bricks, |(b, _)| shard_of(chunk_of(b)));
     shards.par_iter().try_for_each(|r| -> std::io::Result<()> {
         let s = shard_of(chunk_of(&bricks[r.start].0));
         let mut body = Vec::new();
         let mut index = vec![EMPTY; 2 * (inner[0] * inner[1] * inner[2]) as usize];
-        for g in runs(&bricks[r.clone()], |(b, _)| chunk_of(b)) {
+        for g in crate::runs(&bricks[r.clone()], |(b, _)| chunk_of(b)) {
             let g = r.start + g.start..r.start + g.end;
             let c = chunk_of(&bricks[g.start].0);
             let n = (((c[0] % inner[0]) * inner[1] + c[1] % inner[1]) * inner[2] + c[2] % inner[2]) as usize;

@@ -102,13 +102,8 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
             }
             SolidMethod::Flood => unreachable!("handled above"),
         };
-        let facts = json!({
-            "generalized_winding": gwn,
-            "closed": rep.boundary_edges == 0,
-            "consistently_oriented": rep.unbalanced_edges == 0,
-            "boundary_edges": rep.boundary_edges,
-            "inconsistent_edges": rep.unbalanced_edges,
-        });
+        let mut facts = mesh_facts(&rep);
+        facts["generalized_winding"] = gwn.unwrap_or(Value::Null);
         (bits, method, facts)
     };
     if plan.surface.is_some() && plan.method != SolidMethod::Flood {
@@ -192,14 +187,9 @@ pub fn run_sparse(
         }
     };
     drop(snapped);
-    let mut facts = json!({
-        "generalized_winding": Value::Null,
-        "closed": rep.boundary_edges == 0,
-        "consistently_oriented": rep.unbalanced_edges == 0,
-        "boundary_edges": rep.boundary_edges,
-        "inconsistent_edges": rep.unbalanced_edges,
-        "full_bricks": bits.full_bricks(),
-    });
+    let mut facts = mesh_facts(&rep);
+    facts["generalized_winding"] = Value::Null;
+    facts["full_bricks"] = json!(bits.full_bricks());
     let bits = match plan.surface {
         Some(surface) => {
             let (shell, _) = voxelize::tiled::tiled(surface, mesh, grid, tile, opts).map_err(|e| JobError::invalid(e.to_string()))?;
@@ -209,4 +199,15 @@ pub fn run_sparse(
         None => bits,
     };
     Ok(SparseOutcome { bits, method, facts, warnings })
+}
+
+/// What the solid learned about the mesh's closedness, as the JSON summary
+/// reports it (dense and sparse runs alike).
+fn mesh_facts(rep: &solid::SolidReport) -> Value {
+    json!({
+        "closed": rep.boundary_edges == 0,
+        "consistently_oriented": rep.unbalanced_edges == 0,
+        "boundary_edges": rep.boundary_edges,
+        "inconsistent_edges": rep.unbalanced_edges,
+    })
 }

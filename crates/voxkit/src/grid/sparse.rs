@@ -96,8 +96,31 @@ impl SparseBricks {
     /// bricks at the same key are merged.
     pub fn union(&self, surface: &SparseBricks) -> SparseBricks {
         assert!(surface.full.is_empty() && surface.dims == self.dims, "union with a grid of full runs or another shape");
-        let extra = surface.keys.iter().zip(&surface.bricks).filter(|(k, _)| self.full_at(**k).is_none());
-        let mut out = SparseBricks::from_bricks(self.dims, self.keys.iter().zip(&self.bricks).chain(extra).map(|(k, b)| (unkey(*k), *b)));
+        // Both brick lists are sorted by key: one merge, as in merge sort.
+        let mut out = SparseBricks::new(self.dims);
+        out.keys.reserve(self.keys.len() + surface.keys.len());
+        out.bricks.reserve(self.keys.len() + surface.keys.len());
+        let (mut a, mut b) = (0, 0);
+        while a < self.keys.len() || b < surface.keys.len() {
+            let ka = self.keys.get(a).copied().unwrap_or(u64::MAX);
+            let kb = surface.keys.get(b).copied().unwrap_or(u64::MAX);
+            if ka < kb {
+                out.keys.push(ka);
+                out.bricks.push(self.bricks[a]);
+                a += 1;
+            } else if kb < ka {
+                if self.full_at(kb).is_none() {
+                    out.keys.push(kb);
+                    out.bricks.push(surface.bricks[b]);
+                }
+                b += 1;
+            } else {
+                out.keys.push(ka);
+                out.bricks.push(std::array::from_fn(|w| self.bricks[a][w] | surface.bricks[b][w]));
+                a += 1;
+                b += 1;
+            }
+        }
         out.full = self.full.clone();
         out
     }
@@ -352,5 +375,26 @@ mod tests {
             sparse.keys.iter().zip(&sparse.bricks).chain(sparse.keys.iter().zip(&sparse.bricks)).map(|(k, b)| (unkey(*k), *b)),
         );
         assert_eq!(twice.to_dense(), dense);
+    }
+
+    #[test]
+    fn union_with_a_surface_equals_the_dense_union() {
+        let dims = [48, 24, 16];
+        let one = |n: u32| -> Brick { std::array::from_fn(|w| if w as u32 == n % 8 { 1 << (n % 64) } else { 0 }) };
+        // A solid: one full run of three bricks, bricks before, inside its row after it, and in another row.
+        let solid =
+            SparseBricks::from_sorted(dims, vec![([0, 0, 0], one(1)), ([5, 0, 0], one(2)), ([1, 2, 1], one(3))], vec![([1, 0, 0], 3)]);
+        // A surface: bricks at the solid's keys, inside the full run, and elsewhere, before and after.
+        let surface = SparseBricks::from_bricks(
+            dims,
+            [([0, 0, 0], one(9)), ([2, 0, 0], one(4)), ([4, 0, 0], one(5)), ([0, 1, 0], one(6)), ([5, 2, 1], one(7))],
+        );
+        let mut expect = solid.to_dense();
+        VoxelSource::for_each_set(&surface, &mut |i, j, k| expect.set(i, j, k));
+        let got = solid.union(&surface);
+        assert_eq!(got.to_dense(), expect);
+        assert_eq!(got.count(), expect.count());
+        assert_eq!(got.full_bricks(), 3);
+        assert!(got.keys.windows(2).all(|w| w[0] < w[1]));
     }
 }
