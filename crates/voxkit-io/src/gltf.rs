@@ -13,7 +13,7 @@ use gltf::image::Format;
 use gltf::mesh::Mode;
 use gltf::texture::WrappingMode;
 use voxkit::attributes::colour::from_linear;
-use voxkit::attributes::{Appearance, Material, Texture, Wrap};
+use voxkit::attributes::{Appearance, Material, Texture, Wrap, DEFAULT_ROUGHNESS};
 
 use crate::error::ErrorKind;
 use crate::mesh_report::{finish, LoadedMesh};
@@ -98,10 +98,18 @@ impl Builder {
                 });
             }
             let name = format!("material {}", m.index().unwrap_or(0));
-            self.app.materials.push(Material { name, factor: [f[0], f[1], f[2]], texture });
+            let e = m.emissive_factor();
+            let roughness = pbr.roughness_factor().clamp(0.0, 1.0);
+            self.app.materials.push(Material { name, factor: [f[0], f[1], f[2]], texture, emission: e.map(|x| x.max(0.0)), roughness });
             self.tex_coord.push(set);
         }
-        self.app.materials.push(Material { name: "default".into(), factor: [1.0; 3], texture: None });
+        self.app.materials.push(Material {
+            name: "default".into(),
+            factor: [1.0; 3],
+            texture: None,
+            emission: [0.0; 3],
+            roughness: DEFAULT_ROUGHNESS,
+        });
         self.tex_coord.push(0);
     }
 

@@ -28,7 +28,7 @@ use rayon::prelude::*;
 
 use crate::error::ErrorKind;
 use crate::resources::Resources;
-use voxkit::attributes::{Appearance, Material, NO_MATERIAL};
+use voxkit::attributes::{Appearance, Material, DEFAULT_ROUGHNESS, NO_MATERIAL};
 
 use crate::mesh_report::{finish_with_segments, LoadedMesh};
 
@@ -153,7 +153,7 @@ pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKin
                 }
             });
             let name = if mat.name.is_empty() { format!("material {index}") } else { mat.name.clone() };
-            app.materials.push(Material { name, factor, texture });
+            app.materials.push(Material { name, factor, texture, emission: obj_emission(mat), roughness: obj_roughness(mat) });
         }
     }
     if !app.materials.is_empty() {
@@ -334,6 +334,22 @@ fn parse_chunk(chunk: &[u8], before: Counts) -> Result<Chunk, ErrorKind> {
     Ok(out)
 }
 
+/// A material's `Ke` (emitted colour), non-negative; zero when absent or not finite.
+fn obj_emission(mat: &tobj::Material) -> [f32; 3] {
+    mat.emissive.unwrap_or([0.0; 3]).map(|e| if e.is_finite() { e.max(0.0) } else { 0.0 })
+}
+
+/// A material's roughness: `Pr` (PBR extension) if given, else from the
+/// Phong exponent `Ns` by `r = sqrt(2 / (Ns + 2))`, else the default.
+fn obj_roughness(mat: &tobj::Material) -> f32 {
+    let pr = mat.unknown_param.get("Pr").and_then(|v| v.trim().parse::<f32>().ok()).filter(|v| v.is_finite());
+    match (pr, mat.shininess.filter(|s| s.is_finite() && *s >= 0.0)) {
+        (Some(r), _) => r.clamp(0.0, 1.0),
+        (None, Some(ns)) => (2.0 / (ns + 2.0)).sqrt(),
+        _ => DEFAULT_ROUGHNESS,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -361,6 +377,25 @@ mod tests {
         assert_eq!(m.mesh.triangles.len(), 60_001);
         assert_eq!(m.mesh.triangles[59_999], [179_997, 179_998, 179_999]);
         assert_eq!(m.mesh.triangles[60_000], [0, 1, 2]);
+    }
+
+    #[test]
+    fn emission_and_roughness_come_from_the_mtl() {
+        let dir = std::env::temp_dir().join(format!("voxkit-obj-mtl-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("m.mtl"), "newmtl lamp\nKd 1 1 1\nKe 4 2 0\nNs 48\nnewmtl pbr\nPr 0.25\nKe nan 1 -3\nnewmtl plain\n")
+            .unwrap();
+        let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl lamp\nf 1 2 3\nusemtl pbr\nf 1 2 3\nusemtl plain\nf 1 2 3\n";
+        let m = read(obj.as_bytes(), &Resources::new(Some(&dir), &Default::default())).unwrap();
+        let mats = &m.appearance.materials;
+        assert_eq!(mats.len(), 3);
+        assert_eq!(mats[0].emission, [4.0, 2.0, 0.0]);
+        assert!((mats[0].roughness - 0.2).abs() < 1e-6, "Ns 48: sqrt(2 / 50)");
+        assert_eq!(mats[1].roughness, 0.25);
+        assert!(mats[1].emission.iter().all(|e| e.is_finite() && *e >= 0.0));
+        assert_eq!(mats[2].emission, [0.0; 3]);
+        assert_eq!(mats[2].roughness, DEFAULT_ROUGHNESS);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -84,7 +84,16 @@ pub struct Material {
     pub factor: [f32; 3],
     /// Index into [`Appearance::textures`].
     pub texture: Option<u32>,
+    /// Emitted linear RGB (OBJ `Ke`, glTF `emissiveFactor`); zero for most.
+    pub emission: [f32; 3],
+    /// Roughness in 0..=1 (glTF `roughnessFactor`; OBJ `Pr`, or `Ns`
+    /// converted by `r = sqrt(2 / (Ns + 2))`, the inverse of the viewer's
+    /// Blinn–Phong exponent `2 / r² − 2`). Default 0.6 when unset.
+    pub roughness: f32,
 }
+
+/// Roughness of a material that does not say.
+pub const DEFAULT_ROUGHNESS: f32 = 0.6;
 
 /// Marks a triangle without a material.
 pub const NO_MATERIAL: u32 = u32::MAX;
