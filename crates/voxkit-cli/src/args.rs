@@ -27,8 +27,12 @@ pub enum Command {
     /// missing and extra, and whether `check` certifies 6-separation (the
     /// gap table of the published `pos` algorithm).
     Gaps(GapsArgs),
-    /// Render a voxel file or a mesh to a PNG picture (CPU ray casting).
+    /// Render a voxel file or a mesh to a PNG picture (CPU ray casting; with
+    /// --gpu, the GPU renderer: clusters, one multi-draw-indirect call, GPU
+    /// frustum culling, light grid, Blinn–Phong).
     Render(RenderArgs),
+    /// Write a bundled test scene (OBJ + MTL): the Cornell box.
+    Scene(SceneArgs),
     /// Convert a voxel file to another voxel format, or to a mesh of the voxels (.obj, greedy quads).
     Convert(ConvertArgs),
     /// Voxelize whole datasets: one output per input mesh, a manifest of
@@ -306,6 +310,45 @@ pub struct RenderArgs {
     /// Print one JSON object on stdout instead of the summary line.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub gpu: GpuRenderArgs,
+}
+
+/// The GPU renderer's options (`render --gpu`).
+#[derive(Args, Debug)]
+pub struct GpuRenderArgs {
+    /// Draw the input itself (a mesh with its materials, or a voxel file's
+    /// greedy quads) with the GPU renderer instead of ray casting voxels.
+    #[arg(long)]
+    pub gpu: bool,
+    /// --gpu: camera eye, target and vertical field of view in degrees
+    /// (default: the whole scene from above-front-right, 45°).
+    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
+    pub camera: Option<String>,
+    /// --gpu: cluster culling. `occlusion` (Hi-Z) is not built yet.
+    #[arg(long, default_value = "frustum", value_name = "none|frustum|occlusion",
+          value_parser = clap::builder::PossibleValuesParser::new(["none", "frustum", "occlusion"]))]
+    pub culling: String,
+    /// --gpu: a depth-only pass before shading.
+    #[arg(long, default_value = "off", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub prepass: String,
+    /// --gpu: linear to sRGB on output.
+    #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub gamma: String,
+    /// --gpu: write the frame's statistics (clusters kept, triangles
+    /// drawn, lights, light grid, the draw call, frame times) as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub stats_json: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+pub struct SceneArgs {
+    /// Which scene: cornell.
+    #[arg(value_parser = clap::builder::PossibleValuesParser::new(["cornell"]))]
+    pub name: String,
+    /// Output OBJ; its MTL is written beside it with the same stem.
+    #[arg(short, long, value_name = "OBJ")]
+    pub output: PathBuf,
 }
 
 #[derive(Args, Debug)]

@@ -29,6 +29,10 @@ fn main() -> ExitCode {
         Command::Check(a) => commands::check::run(a),
         Command::Gaps(a) => commands::gaps::run(a),
         Command::Render(a) => commands::render::run(a),
+        #[cfg(feature = "gpu")]
+        Command::Scene(a) => commands::scene::run(a),
+        #[cfg(not(feature = "gpu"))]
+        Command::Scene(_) => anyhow::bail!("this voxkit was built without the gpu feature, which holds the scene generators"),
         Command::Convert(a) => commands::convert::run(a),
         Command::Batch(a) => commands::batch::run(a),
         Command::Raster(a) => commands::raster::run(a),

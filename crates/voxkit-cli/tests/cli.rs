@@ -606,3 +606,67 @@ fn grids_past_memory_errors() {
         assert!(err.contains(says) && err.trim_end().lines().count() == 1, "{args:?}: {err}");
     }
 }
+
+/// `render --gpu` needs an adapter: without one it must fail with the
+/// lavapipe hint (and CI, which sets VOXKIT_REQUIRE_GPU=1, must have one).
+fn gpu_available(out: &Output) -> bool {
+    if out.status.success() {
+        return true;
+    }
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no GPU adapter found") && err.contains("lavapipe"), "unexpected failure: {err}");
+    assert!(std::env::var("VOXKIT_REQUIRE_GPU").as_deref() != Ok("1"), "VOXKIT_REQUIRE_GPU=1 but {err}");
+    false
+}
+
+#[test]
+fn the_gpu_renderer_draws_the_cornell_box_and_reports_its_frame() {
+    let obj = tmp("cornell.obj");
+    let out = voxkit(&["scene", "cornell", "-o", &obj]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::read_to_string(tmp("cornell.mtl")).unwrap().contains("Ke 12 12 12"));
+    let (png, stats) = (tmp("cornell-gpu.png"), tmp("cornell-stats.json"));
+    let out = voxkit(&["render", &obj, "--gpu", "-o", &png, "--size", "64x48", "--stats-json", &stats, "--prepass", "on", "--json"]);
+    if !gpu_available(&out) {
+        return;
+    }
+    let v = json(&out);
+    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert_eq!(v, s, "--json and --stats-json say the same");
+    for key in ["clusters", "clusters_after_frustum", "triangles_drawn", "lights", "multi_draw", "frame_ms"] {
+        assert!(s.get(key).is_some(), "{key} missing");
+    }
+    assert_eq!(s["triangles"], 36);
+    assert_eq!(s["multi_draw"], "multi_draw_indexed_indirect");
+    assert!(s["lights"].as_u64().unwrap() >= 1);
+    assert!(s["light_grid"]["total"].as_u64().unwrap() > 0);
+    assert!(s["clusters_after_frustum"].as_u64().unwrap() <= s["clusters"].as_u64().unwrap());
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    // A voxel file is drawn as its greedy quads.
+    let npy = tmp("cornell-vox.npy");
+    assert!(voxkit(&["voxelize", &obj, "-o", &npy, "--resolution", "16"]).status.success());
+    let out = voxkit(&["render", &npy, "--gpu", "-o", &tmp("vox-gpu.png"), "--size", "32x32", "--json", "--culling", "none"]);
+    let v = json(&out);
+    assert_eq!(v["kind"], "voxel file");
+    assert_eq!(v["clusters_after_frustum"], v["clusters"]);
+}
+
+#[test]
+fn gpu_renderer_options_give_one_line_errors() {
+    let obj = unit_cube_obj("gpu-opts.obj");
+    let png = tmp("gpu-opts.png");
+    for (args, says) in [
+        (vec!["--gpu", "--culling", "occlusion"], "not built yet"),
+        (vec!["--gpu", "--camera", "1,2,3"], "--camera takes"),
+        (vec!["--gpu", "--camera", "1,1,1,1,1,1"], "must differ"),
+        (vec!["--gpu", "--camera", "0,0,5,0,0,0,200"], "field of view"),
+        (vec!["--camera", "0,0,5,0,0,0"], "add --gpu"),
+        (vec!["--gpu", "--view", "x"], "not --view"),
+    ] {
+        let mut all = vec!["render", obj.as_str(), "-o", png.as_str()];
+        all.extend(args.iter().copied());
+        let e = error_line(&all);
+        assert!(e.contains(says), "{args:?}: {e}");
+    }
+    assert!(!std::path::Path::new(&png).exists());
+}

@@ -10,4 +10,8 @@ pub mod gaps;
 pub mod info;
 pub mod raster;
 pub mod render;
+#[cfg(feature = "gpu")]
+pub mod render_gpu;
+#[cfg(feature = "gpu")]
+pub mod scene;
 pub mod voxelize;

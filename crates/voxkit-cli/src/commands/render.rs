@@ -84,6 +84,16 @@ pub fn check_png_path(path: &Path) -> Result<()> {
 }
 
 pub fn run(a: &RenderArgs) -> Result<()> {
+    if a.gpu.gpu {
+        #[cfg(feature = "gpu")]
+        return crate::commands::render_gpu::run(a);
+        #[cfg(not(feature = "gpu"))]
+        bail!("--gpu: this voxkit was built without the gpu feature");
+    }
+    let g = &a.gpu;
+    if g.camera.is_some() || g.stats_json.is_some() || g.culling != "frustum" || g.prepass != "off" || g.gamma != "on" {
+        bail!("--camera, --culling, --prepass, --gamma and --stats-json belong to the GPU renderer; add --gpu");
+    }
     let t0 = Instant::now();
     let o = options(&a.picture, a.up.as_deref())?;
     check_png_path(&a.output)?;

@@ -1,0 +1,588 @@
+//! The frame on the GPU (wgpu): a compute pass culls cluster boxes and
+//! writes the indirect commands, an optional depth-only Z-prepass, then
+//! the shading pass; both draw passes draw the whole scene with one
+//! `multi_draw_indexed_indirect` call over the clusters' commands.
+//!
+//! **Culled clusters keep their slot** with an instance count of zero
+//! (rather than being compacted). The command buffer then holds one
+//! command per cluster in cluster order whatever the camera, so the draw
+//! order, and with it the picture, is the same with culling on or off
+//! (byte for byte, which the tests check), and the call needs no count
+//! buffer. `multi_draw_indexed_indirect_count` would only pay with
+//! compaction, which atomics would make order-dependent; it is not used
+//! (the statistics name the call that ran).
+
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use crate::camera::{frustum_box, Camera};
+use crate::lights::{lights, LightGrid, LightReport};
+use crate::partition::{Cluster, Partition};
+use crate::scene::{Scene, Vertex};
+use crate::ViewError;
+
+/// Which clusters are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Culling {
+    /// Every cluster.
+    None,
+    /// Clusters whose box meets the view frustum (compute pass).
+    Frustum,
+}
+
+/// What one frame is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameOptions {
+    /// Picture width in pixels.
+    pub width: u32,
+    /// Picture height in pixels.
+    pub height: u32,
+    /// The camera.
+    pub camera: Camera,
+    /// Cluster culling.
+    pub culling: Culling,
+    /// Depth-only pass first, then shading with an equal depth test.
+    pub prepass: bool,
+    /// Linear to sRGB on output.
+    pub gamma: bool,
+}
+
+/// Per-pass GPU time in milliseconds (timestamp queries), where the
+/// adapter writes them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PassTimes {
+    /// The culling compute pass.
+    pub cull_ms: f64,
+    /// The Z-prepass (0 when off).
+    pub prepass_ms: f64,
+    /// The shading pass.
+    pub shade_ms: f64,
+}
+
+/// What a frame drew and how long it took.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameStats {
+    /// Clusters in the scene.
+    pub clusters: u32,
+    /// Clusters kept by the frustum test (all of them without culling).
+    pub clusters_after_frustum: u32,
+    /// Triangles in the scene.
+    pub triangles: u64,
+    /// Triangles of the kept clusters.
+    pub triangles_drawn: u64,
+    /// The draw call that ran.
+    pub multi_draw: &'static str,
+    /// Wall time from encoding to the picture read back.
+    pub cpu_ms: f64,
+    /// GPU time per pass, if the adapter has timestamps.
+    pub gpu: Option<PassTimes>,
+}
+
+/// A rendered frame: RGBA8 rows top to bottom, and which clusters the GPU kept.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width × height × 4` bytes.
+    pub rgba: Vec<u8>,
+    /// Per cluster, whether its command was drawn.
+    pub kept: Vec<bool>,
+    /// Counts and times.
+    pub stats: FrameStats,
+}
+
+/// The frame's uniform block (`frame.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct FrameUniform {
+    view_proj: [[f32; 4]; 4],
+    eye: [f32; 4],
+    f_lo: [f32; 4],
+    f_hi: [f32; 4],
+    grid_lo: [f32; 4],
+    grid_cell: [f32; 4],
+    params: [u32; 4],
+}
+
+/// A cluster box as `cull.wgsl` reads it.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ClusterBox {
+    lo: [f32; 4],
+    hi: [f32; 4],
+}
+
+/// A scene on the device: its buffers and what the CPU knows of it.
+pub struct GpuScene {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    commands: wgpu::Buffer,
+    commands_init: Vec<u32>,
+    counters: wgpu::Buffer,
+    cull_group: wgpu::BindGroup,
+    shade_group: wgpu::BindGroup,
+    uniform: wgpu::Buffer,
+    /// The clusters, in command order.
+    pub clusters: Vec<Cluster>,
+    /// The light grid (CPU build).
+    pub grid: LightGrid,
+    /// Lights and the emissive triangles they came from.
+    pub lights: LightReport,
+    /// Scene box.
+    pub bounds: (Vec3, Vec3),
+    /// Triangles.
+    pub triangles: u64,
+}
+
+/// An open device with the frame's pipelines.
+pub struct Renderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    cull: wgpu::ComputePipeline,
+    cull_layout: wgpu::BindGroupLayout,
+    shade_layout: wgpu::BindGroupLayout,
+    prepass: wgpu::RenderPipeline,
+    shade: wgpu::RenderPipeline,
+    shade_equal: wgpu::RenderPipeline,
+    timestamps: bool,
+    max_side: u32,
+    errors: Arc<Mutex<Option<String>>>,
+}
+
+const COLOUR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Background, written as is (not gamma corrected).
+const BACKGROUND: wgpu::Color = wgpu::Color { r: 0.10, g: 0.10, b: 0.12, a: 1.0 };
+
+fn shader(parts: &[&str]) -> String {
+    let mut s = include_str!("shaders/frame.wgsl").to_string();
+    for p in parts {
+        s.push('\n');
+        s.push_str(p);
+    }
+    s
+}
+
+impl Renderer {
+    /// Opens the default adapter (high performance preferred).
+    pub fn new() -> Result<Renderer, ViewError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        }))
+        .map_err(|_| ViewError::NoAdapter)?;
+        let info = adapter.get_info();
+        let limits = adapter.limits();
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("voxkit view"),
+            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
+            required_limits: wgpu::Limits {
+                max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
+                max_buffer_size: limits.max_buffer_size,
+                max_texture_dimension_2d: limits.max_texture_dimension_2d,
+                ..wgpu::Limits::downlevel_defaults()
+            },
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .map_err(|e| ViewError::Device(e.to_string()))?;
+        let errors: Arc<Mutex<Option<String>>> = Arc::default();
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut slot) = sink.lock() {
+                slot.get_or_insert_with(|| e.to_string().lines().next().unwrap_or("unknown error").to_string());
+            }
+        }));
+
+        let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        };
+        use wgpu::BufferBindingType::{Storage, Uniform};
+        use wgpu::ShaderStages as S;
+        let cull_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cull"),
+            entries: &[
+                entry(0, S::COMPUTE, Uniform),
+                entry(1, S::COMPUTE, Storage { read_only: true }),
+                entry(2, S::COMPUTE, Storage { read_only: false }),
+                entry(3, S::COMPUTE, Storage { read_only: false }),
+            ],
+        });
+        let shade_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shade"),
+            entries: &[
+                entry(0, S::VERTEX | S::FRAGMENT, Uniform),
+                entry(4, S::FRAGMENT, Storage { read_only: true }),
+                entry(5, S::FRAGMENT, Storage { read_only: true }),
+                entry(6, S::FRAGMENT, Storage { read_only: true }),
+                entry(7, S::FRAGMENT, Storage { read_only: true }),
+            ],
+        });
+        let pipeline_layout = |l: &wgpu::BindGroupLayout| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: None,
+                bind_group_layouts: &[Some(l)],
+                immediate_size: 0,
+            })
+        };
+        let cull_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("cull"),
+            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/cull.wgsl")]).into()),
+        });
+        let cull = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("cull"),
+            layout: Some(&pipeline_layout(&cull_layout)),
+            module: &cull_module,
+            entry_point: Some("cull"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("shade"),
+            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/shade.wgsl")]).into()),
+        });
+        let shade_pl = pipeline_layout(&shade_layout);
+        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x3];
+        let draw = |label, colour: bool, write: bool, compare| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&shade_pl),
+                vertex: wgpu::VertexState {
+                    module: &shade_module,
+                    entry_point: Some("vs"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: std::mem::size_of::<Vertex>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &attributes,
+                    })],
+                },
+                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH,
+                    depth_write_enabled: Some(write),
+                    depth_compare: Some(compare),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: colour.then(|| wgpu::FragmentState {
+                    module: &shade_module,
+                    entry_point: Some("fs"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState { format: COLOUR, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let prepass = draw("prepass", false, true, wgpu::CompareFunction::Less);
+        let shade = draw("shade", true, true, wgpu::CompareFunction::Less);
+        let shade_equal = draw("shade after prepass", true, false, wgpu::CompareFunction::Equal);
+        let r = Renderer {
+            device,
+            queue,
+            info,
+            cull,
+            cull_layout,
+            shade_layout,
+            prepass,
+            shade,
+            shade_equal,
+            timestamps,
+            max_side: limits.max_texture_dimension_2d,
+            errors,
+        };
+        r.check()?;
+        Ok(r)
+    }
+
+    /// The adapter's name and backend.
+    pub fn adapter(&self) -> String {
+        format!("{} ({:?})", self.info.name, self.info.backend)
+    }
+
+    fn check(&self) -> Result<(), ViewError> {
+        match self.errors.lock().ok().and_then(|mut e| e.take()) {
+            Some(e) => Err(ViewError::Device(e)),
+            None => Ok(()),
+        }
+    }
+
+    /// Partitions the scene, builds its lights and light grid, and uploads it.
+    pub fn upload(&self, scene: &Scene) -> Result<GpuScene, ViewError> {
+        let bounds = scene.bounds().ok_or(ViewError::EmptyScene)?;
+        let part = Partition::new(scene);
+        let (lights, report) = lights(scene);
+        let grid = LightGrid::build(scene, &lights);
+        let init = |label, contents: &[u8], usage| {
+            self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        // Bindings may not be empty: one zeroed element stands for none.
+        fn nonempty<T: Pod + Zeroable>(v: &[T]) -> Vec<T> {
+            if v.is_empty() {
+                vec![T::zeroed()]
+            } else {
+                v.to_vec()
+            }
+        }
+        use wgpu::BufferUsages as U;
+        let vertices = init("vertices", bytemuck::cast_slice(&scene.vertices), U::VERTEX);
+        let indices = init("indices", bytemuck::cast_slice(&part.indices), U::INDEX);
+        let boxes: Vec<ClusterBox> =
+            part.clusters.iter().map(|c| ClusterBox { lo: c.lo.extend(0.0).to_array(), hi: c.hi.extend(0.0).to_array() }).collect();
+        let commands_init: Vec<u32> = part.clusters.iter().flat_map(|c| [c.index_count, 1, c.first_index, 0, 0]).collect();
+        let boxes = init("cluster boxes", bytemuck::cast_slice(&boxes), U::STORAGE);
+        let commands = init("commands", bytemuck::cast_slice(&commands_init), U::STORAGE | U::INDIRECT | U::COPY_DST | U::COPY_SRC);
+        let counters = init("counters", &[0u8; 16], U::STORAGE | U::COPY_DST | U::COPY_SRC);
+        let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame"),
+            size: std::mem::size_of::<FrameUniform>() as u64,
+            usage: U::UNIFORM | U::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let materials = init("materials", bytemuck::cast_slice(&nonempty(&scene.materials)), U::STORAGE);
+        let light_buf = init("lights", bytemuck::cast_slice(&nonempty(&lights)), U::STORAGE);
+        let ranges = init("light ranges", bytemuck::cast_slice(&grid.ranges), U::STORAGE);
+        let light_indices = init("light indices", bytemuck::cast_slice(&nonempty(&grid.indices)), U::STORAGE);
+        let group = |layout, entries: &[(u32, &wgpu::Buffer)]| {
+            let entries: Vec<wgpu::BindGroupEntry> =
+                entries.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
+            self.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout, entries: &entries })
+        };
+        let cull_group = group(&self.cull_layout, &[(0, &uniform), (1, &boxes), (2, &commands), (3, &counters)]);
+        let shade_group = group(&self.shade_layout, &[(0, &uniform), (4, &materials), (5, &light_buf), (6, &ranges), (7, &light_indices)]);
+        self.check()?;
+        Ok(GpuScene {
+            vertices,
+            indices,
+            commands,
+            commands_init,
+            counters,
+            cull_group,
+            shade_group,
+            uniform,
+            clusters: part.clusters,
+            grid,
+            lights: report,
+            bounds,
+            triangles: scene.triangles() as u64,
+        })
+    }
+
+    /// Renders one frame and reads it back.
+    pub fn render(&self, s: &GpuScene, o: &FrameOptions) -> Result<Frame, ViewError> {
+        if o.width == 0 || o.height == 0 || o.width > self.max_side || o.height > self.max_side {
+            return Err(ViewError::Size { width: o.width, height: o.height, max: self.max_side });
+        }
+        let t0 = Instant::now();
+        let (lo, hi) = s.bounds;
+        let (near, far) = o.camera.depth_range(lo, hi);
+        let view_proj = o.camera.view_proj(o.width as f32 / o.height as f32, near, far);
+        let (f_lo, f_hi) = frustum_box(view_proj);
+        let n = s.clusters.len() as u32;
+        let flags = u32::from(o.gamma) | if s.lights.lights == 0 { 2 } else { 0 };
+        let u = FrameUniform {
+            view_proj: view_proj.to_cols_array_2d(),
+            eye: o.camera.eye.extend(1.0).to_array(),
+            f_lo: f_lo.extend(0.0).to_array(),
+            f_hi: f_hi.extend(0.0).to_array(),
+            grid_lo: s.grid.lo.extend(s.grid.unit).to_array(),
+            grid_cell: s.grid.cell.extend(0.0).to_array(),
+            params: [n, u32::from(o.culling == Culling::Frustum), flags, 0],
+        };
+        self.queue.write_buffer(&s.uniform, 0, bytemuck::bytes_of(&u));
+        self.queue.write_buffer(&s.commands, 0, bytemuck::cast_slice(&s.commands_init));
+        self.queue.write_buffer(&s.counters, 0, &[0u8; 16]);
+
+        let queries = self.timestamps.then(|| {
+            self.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("pass times"), ty: wgpu::QueryType::Timestamp, count: 6 })
+        });
+        let stamp = |i: u32| {
+            queries.as_ref().map(|q| wgpu::RenderPassTimestampWrites {
+                query_set: q,
+                beginning_of_pass_write_index: Some(2 * i),
+                end_of_pass_write_index: Some(2 * i + 1),
+            })
+        };
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("cull"),
+                timestamp_writes: queries.as_ref().map(|q| wgpu::ComputePassTimestampWrites {
+                    query_set: q,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                }),
+            });
+            pass.set_pipeline(&self.cull);
+            pass.set_bind_group(0, &s.cull_group, &[]);
+            pass.dispatch_workgroups(n.div_ceil(64).max(1), 1, 1);
+        }
+        let texture = |format, usage| {
+            self.device.create_texture(&wgpu::TextureDescriptor {
+                label: None,
+                size: wgpu::Extent3d { width: o.width, height: o.height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let colour = texture(COLOUR, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
+        let depth = texture(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let (cview, dview) = (colour.create_view(&Default::default()), depth.create_view(&Default::default()));
+        let draw_all = |pass: &mut wgpu::RenderPass<'_>| {
+            pass.set_bind_group(0, &s.shade_group, &[]);
+            pass.set_vertex_buffer(0, s.vertices.slice(..));
+            pass.set_index_buffer(s.indices.slice(..), wgpu::IndexFormat::Uint32);
+            if n > 0 {
+                pass.multi_draw_indexed_indirect(&s.commands, 0, n);
+            }
+        };
+        if o.prepass {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("prepass"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &dview,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: stamp(1),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.prepass);
+            draw_all(&mut pass);
+        }
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shade"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &cview,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(BACKGROUND), store: wgpu::StoreOp::Store },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &dview,
+                    depth_ops: Some(wgpu::Operations {
+                        load: if o.prepass { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(1.0) },
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: stamp(2),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(if o.prepass { &self.shade_equal } else { &self.shade });
+            draw_all(&mut pass);
+        }
+        let row = (4 * o.width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let readback = |label, size| {
+            self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let pixels = readback("picture", row as u64 * o.height as u64);
+        enc.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo { texture: &colour, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &pixels,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(o.height) },
+            },
+            wgpu::Extent3d { width: o.width, height: o.height, depth_or_array_layers: 1 },
+        );
+        let cmd_bytes = 20 * n.max(1) as u64;
+        let cmds = readback("commands", cmd_bytes);
+        enc.copy_buffer_to_buffer(&s.commands, 0, &cmds, 0, cmd_bytes);
+        let counts = readback("counters", 16);
+        enc.copy_buffer_to_buffer(&s.counters, 0, &counts, 0, 16);
+        let times = queries.as_ref().map(|q| {
+            let resolve = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamps"),
+                size: 48,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let read = readback("timestamps readback", 48);
+            enc.resolve_query_set(q, 0..6, &resolve, 0);
+            enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, 48);
+            read
+        });
+        self.queue.submit([enc.finish()]);
+        let mapped: Vec<_> = [Some(&pixels), Some(&cmds), Some(&counts), times.as_ref()]
+            .into_iter()
+            .flatten()
+            .map(|b| {
+                let (tx, rx) = std::sync::mpsc::channel();
+                b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+                    let _ = tx.send(r);
+                });
+                rx
+            })
+            .collect();
+        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| ViewError::Device(e.to_string()))?;
+        self.check()?;
+        for rx in mapped {
+            rx.recv().map_err(|e| ViewError::Readback(e.to_string()))?.map_err(|e| ViewError::Readback(e.to_string()))?;
+        }
+        let mut rgba = Vec::with_capacity(4 * o.width as usize * o.height as usize);
+        {
+            let data = pixels.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
+            for y in 0..o.height as usize {
+                rgba.extend_from_slice(&data[y * row as usize..y * row as usize + 4 * o.width as usize]);
+            }
+        }
+        let kept: Vec<bool> = {
+            let data = cmds.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
+            let words: &[u32] = bytemuck::cast_slice(&data);
+            (0..n as usize).map(|c| words[5 * c + 1] != 0).collect()
+        };
+        let [after, drawn] = {
+            let data = counts.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
+            let w: &[u32] = bytemuck::cast_slice(&data);
+            [w[0], w[1]]
+        };
+        let gpu = match times {
+            Some(t) => {
+                let data = t.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
+                let w: &[u64] = bytemuck::cast_slice(&data);
+                let period = self.queue.get_timestamp_period() as f64 * 1e-6;
+                let span = |i: usize| w[2 * i + 1].saturating_sub(w[2 * i]) as f64 * period;
+                Some(PassTimes { cull_ms: span(0), prepass_ms: if o.prepass { span(1) } else { 0.0 }, shade_ms: span(2) })
+            }
+            None => None,
+        };
+        let stats = FrameStats {
+            clusters: n,
+            clusters_after_frustum: after,
+            triangles: s.triangles,
+            triangles_drawn: drawn as u64,
+            multi_draw: "multi_draw_indexed_indirect",
+            cpu_ms: t0.elapsed().as_secs_f64() * 1e3,
+            gpu,
+        };
+        Ok(Frame { width: o.width, height: o.height, rgba, kept, stats })
+    }
+}

@@ -1,0 +1,62 @@
+//! # voxkit-view
+//!
+//! voxkit's GPU renderer of meshes and voxel grids, built after the
+//! real-time renderer of seed 002 (`shared/seeds/002_*.txt`) on wgpu:
+//!
+//! - [`partition`]: the 8×8×8 scene partition into clusters, one indirect
+//!   command each, the whole scene drawn by one
+//!   `multi_draw_indexed_indirect` call;
+//! - [`camera`]: the camera and the CPU reference of the GPU frustum test
+//!   (world-space and clip-space separating axes), run in a compute pass
+//!   (`shaders/cull.wgsl`);
+//! - [`lights`]: lights merged from emissive triangles, attenuation
+//!   `i / (d³ + 1)`, the 32³ light grid (CPU build);
+//! - [`gpu`]: the frame — culling pass, optional Z-prepass, Blinn–Phong
+//!   shading over the fragment's light-grid cell, gamma — rendered
+//!   headless and read back;
+//! - [`scenes`]: deterministic test scenes (the Cornell box).
+//!
+//! **Not built yet** (the CLI says so when asked): Hi-Z occlusion culling
+//! (one- and two-pass), the light grid built on the GPU, alpha cut-outs
+//! and textures, the interactive window (`voxkit view`), the ray spray into
+//! a point cloud, and the large procedural scene.
+
+pub mod camera;
+pub mod gpu;
+pub mod lights;
+pub mod partition;
+pub mod scene;
+pub mod scenes;
+
+pub use camera::Camera;
+pub use gpu::{Culling, Frame, FrameOptions, FrameStats, GpuScene, Renderer};
+pub use scene::Scene;
+
+use thiserror::Error;
+
+/// Why a frame could not be rendered.
+#[derive(Debug, Error)]
+pub enum ViewError {
+    /// No adapter (no Vulkan/Metal/DX12 driver).
+    #[error("no GPU adapter found (install a Vulkan driver; on Linux without a GPU, Mesa's lavapipe: apt install mesa-vulkan-drivers)")]
+    NoAdapter,
+    /// The device could not be created, or reported an error.
+    #[error("GPU device: {0}")]
+    Device(String),
+    /// The picture could not be read back.
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
+    /// Nothing to draw.
+    #[error("the scene has no drawable triangles")]
+    EmptyScene,
+    /// A picture larger than the device's textures.
+    #[error("picture {width}x{height}: each side must be 1..={max} on this adapter")]
+    Size {
+        /// Asked width.
+        width: u32,
+        /// Asked height.
+        height: u32,
+        /// The adapter's largest texture side.
+        max: u32,
+    },
+}

@@ -1,0 +1,119 @@
+//! The GPU renderer on lavapipe (CI) or any adapter: culling never changes
+//! the picture, the GPU's surviving clusters equal the CPU reference of
+//! the same test, the Z-prepass changes nothing, and the Cornell box is lit
+//! by its ceiling light.
+//!
+//! Without an adapter the tests say so and pass, unless
+//! `VOXKIT_REQUIRE_GPU=1` (set by `.ci/run`).
+
+use glam::Vec3;
+use voxkit::attributes::Appearance;
+use voxkit_testkit::shared_mesh;
+use voxkit_view::camera::{frustum_box, visible};
+use voxkit_view::{scenes, Camera, Culling, FrameOptions, Renderer, Scene};
+
+fn renderer() -> Option<Renderer> {
+    match Renderer::new() {
+        Ok(r) => Some(r),
+        Err(e) if std::env::var("VOXKIT_REQUIRE_GPU").as_deref() == Ok("1") => panic!("VOXKIT_REQUIRE_GPU=1 but {e}"),
+        Err(e) => {
+            eprintln!("skipping GPU test: {e}");
+            None
+        }
+    }
+}
+
+fn cornell() -> Scene {
+    let (mesh, app) = scenes::cornell();
+    let mut s = Scene::default();
+    assert_eq!(s.add_mesh(mesh.as_ref(), &app), 0);
+    s
+}
+
+fn cameras(scene: &Scene) -> Vec<Camera> {
+    let (lo, hi) = scene.bounds().unwrap();
+    let c = (lo + hi) * 0.5;
+    let e = (hi - lo).max_element();
+    let cam = |eye: Vec3, target: Vec3, fov_deg| Camera { eye, target, up: Vec3::Y, fov_deg };
+    vec![
+        Camera::framing(lo, hi, 1),
+        // Inside, looking at the back wall, and at a corner.
+        cam(c + Vec3::new(0.0, 0.0, 0.2 * e), c - Vec3::new(0.0, 0.0, e), 60.0),
+        cam(c, lo, 40.0),
+        // Close to an occluder, narrow.
+        cam(c + Vec3::new(0.1 * e, -0.2 * e, 0.4 * e), lo + (hi - lo) * Vec3::new(0.3, 0.3, 0.35), 25.0),
+        // Far away, looking past the scene.
+        cam(c + Vec3::new(3.0 * e, 0.0, 0.0), c + Vec3::new(3.0 * e, 0.0, 5.0 * e), 30.0),
+    ]
+}
+
+fn frame(r: &Renderer, g: &voxkit_view::GpuScene, camera: Camera, culling: Culling, prepass: bool) -> voxkit_view::Frame {
+    r.render(g, &FrameOptions { width: 160, height: 120, camera, culling, prepass, gamma: true }).unwrap()
+}
+
+fn check_scene(r: &Renderer, scene: &Scene, what: &str) {
+    let g = r.upload(scene).unwrap();
+    assert!(g.clusters.len() > 1, "{what}: clusters");
+    let mut culled_somewhere = false;
+    for (n, cam) in cameras(scene).into_iter().enumerate() {
+        let none = frame(r, &g, cam, Culling::None, false);
+        let frustum = frame(r, &g, cam, Culling::Frustum, false);
+        assert_eq!(none.stats.clusters_after_frustum, none.stats.clusters, "{what}, camera {n}: nothing culled without culling");
+        assert!(none.rgba == frustum.rgba, "{what}, camera {n}: frustum culling changed the picture");
+        // The GPU's survivors are the CPU reference's.
+        let (lo, hi) = g.bounds;
+        let (near, far) = cam.depth_range(lo, hi);
+        let m = cam.view_proj(160.0 / 120.0, near, far);
+        let (flo, fhi) = frustum_box(m);
+        let want: Vec<bool> = g.clusters.iter().map(|c| visible(c.lo, c.hi, &m, flo, fhi)).collect();
+        assert_eq!(frustum.kept, want, "{what}, camera {n}: GPU and CPU frustum tests differ");
+        let kept = want.iter().filter(|&&k| k).count() as u32;
+        assert_eq!(frustum.stats.clusters_after_frustum, kept);
+        let tris: u64 = g.clusters.iter().zip(&want).filter(|(_, k)| **k).map(|(c, _)| c.index_count as u64 / 3).sum();
+        assert_eq!(frustum.stats.triangles_drawn, tris);
+        culled_somewhere |= kept < g.clusters.len() as u32;
+        // The Z-prepass changes nothing.
+        let pre = frame(r, &g, cam, Culling::Frustum, true);
+        assert!(pre.rgba == frustum.rgba, "{what}, camera {n}: the Z-prepass changed the picture");
+    }
+    assert!(culled_somewhere, "{what}: some camera culls some cluster");
+}
+
+#[test]
+fn culling_and_prepass_never_change_the_picture() {
+    let Some(r) = renderer() else { return };
+    check_scene(&r, &cornell(), "cornell");
+    let mut bunny = Scene::default();
+    bunny.add_mesh(shared_mesh("stanford-bunny.obj").as_ref(), &Appearance::default());
+    check_scene(&r, &bunny, "bunny");
+}
+
+#[test]
+fn the_cornell_box_is_lit_by_its_ceiling() {
+    let Some(r) = renderer() else { return };
+    let scene = cornell();
+    let g = r.upload(&scene).unwrap();
+    assert_eq!(g.lights.emissive_triangles, 2);
+    assert!(g.lights.lights >= 1);
+    let (lo, hi) = g.bounds;
+    // From the open side, looking in.
+    let cam = Camera { eye: Vec3::new(0.5, 0.5, 2.4), target: Vec3::new(0.5, 0.5, 0.0), up: Vec3::Y, fov_deg: 40.0 };
+    assert!(lo.cmple(Vec3::ZERO).all() && hi.cmpge(Vec3::ONE).all());
+    let f = r
+        .render(&g, &FrameOptions { width: 200, height: 200, camera: cam, culling: Culling::Frustum, prepass: false, gamma: true })
+        .unwrap();
+    let px = |x: usize, y: usize| {
+        let i = 4 * (y * 200 + x);
+        [f.rgba[i], f.rgba[i + 1], f.rgba[i + 2]]
+    };
+    // The red wall on the left, the green on the right, the light at the top is the brightest.
+    let left = px(40, 100);
+    let right = px(160, 100);
+    assert!(left[0] > left[1] + 40 && left[0] > left[2] + 40, "left wall {left:?}");
+    assert!(right[1] > right[0] + 20 && right[1] > right[2] + 20, "right wall {right:?}");
+    let light = px(100, 25);
+    assert!(light.iter().all(|&c| c >= 250), "ceiling light {light:?}");
+    // Nearer the light is brighter: the back wall's top against its bottom.
+    let (top, bottom) = (px(100, 50), px(100, 150));
+    assert!(top[0] as u32 + top[1] as u32 > bottom[0] as u32 + bottom[1] as u32, "top {top:?} bottom {bottom:?}");
+}
