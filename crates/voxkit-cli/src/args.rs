@@ -325,8 +325,9 @@ pub struct GpuRenderArgs {
     /// (default: the whole scene from above-front-right, 45°).
     #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
     pub camera: Option<String>,
-    /// --gpu: cluster culling. `occlusion` (Hi-Z) is not built yet.
-    #[arg(long, default_value = "frustum", value_name = "none|frustum|occlusion",
+    /// --gpu: cluster culling: none, frustum, or occlusion (frustum, then
+    /// Hi-Z occlusion against the depth of the frustum survivors).
+    #[arg(long, default_value = "occlusion", value_name = "none|frustum|occlusion",
           value_parser = clap::builder::PossibleValuesParser::new(["none", "frustum", "occlusion"]))]
     pub culling: String,
     /// --gpu: a depth-only pass before shading.

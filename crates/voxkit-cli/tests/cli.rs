@@ -656,7 +656,6 @@ fn gpu_renderer_options_give_one_line_errors() {
     let obj = unit_cube_obj("gpu-opts.obj");
     let png = tmp("gpu-opts.png");
     for (args, says) in [
-        (vec!["--gpu", "--culling", "occlusion"], "not built yet"),
         (vec!["--gpu", "--camera", "1,2,3"], "--camera takes"),
         (vec!["--gpu", "--camera", "1,1,1,1,1,1"], "must differ"),
         (vec!["--gpu", "--camera", "0,0,5,0,0,0,200"], "field of view"),

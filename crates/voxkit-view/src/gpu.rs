@@ -20,6 +20,7 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use crate::camera::{frustum_box, Camera};
+use crate::hiz::{pyramid_size, Pyramid};
 use crate::lights::{lights, LightGrid, LightReport};
 use crate::partition::{Cluster, Partition};
 use crate::scene::{Scene, Vertex};
@@ -32,6 +33,9 @@ pub enum Culling {
     None,
     /// Clusters whose box meets the view frustum (compute pass).
     Frustum,
+    /// Frustum survivors not hidden behind the depth of all frustum
+    /// survivors, tested against a Hi-Z pyramid ([`crate::hiz`]).
+    Occlusion,
 }
 
 /// What one frame is.
@@ -49,6 +53,9 @@ pub struct FrameOptions {
     pub prepass: bool,
     /// Linear to sRGB on output.
     pub gamma: bool,
+    /// With occlusion culling: read the Hi-Z pyramid back into
+    /// [`Frame::hiz`] (for tests and pictures).
+    pub read_hiz: bool,
 }
 
 /// Per-pass GPU time in milliseconds (timestamp queries), where the
@@ -57,8 +64,12 @@ pub struct FrameOptions {
 pub struct PassTimes {
     /// The culling compute pass.
     pub cull_ms: f64,
-    /// The Z-prepass (0 when off).
-    pub prepass_ms: f64,
+    /// The depth pass: the Z-prepass, or occlusion culling's depth pass
+    /// (0 when neither runs).
+    pub depth_ms: f64,
+    /// Building the Hi-Z pyramid and testing the clusters (0 without
+    /// occlusion culling).
+    pub hiz_ms: f64,
     /// The shading pass.
     pub shade_ms: f64,
 }
@@ -70,6 +81,8 @@ pub struct FrameStats {
     pub clusters: u32,
     /// Clusters kept by the frustum test (all of them without culling).
     pub clusters_after_frustum: u32,
+    /// Clusters kept by the occlusion test too (with occlusion culling).
+    pub clusters_after_occlusion: Option<u32>,
     /// Triangles in the scene.
     pub triangles: u64,
     /// Triangles of the kept clusters.
@@ -93,6 +106,8 @@ pub struct Frame {
     pub rgba: Vec<u8>,
     /// Per cluster, whether its command was drawn.
     pub kept: Vec<bool>,
+    /// The Hi-Z pyramid, when asked for.
+    pub hiz: Option<Pyramid>,
     /// Counts and times.
     pub stats: FrameStats,
 }
@@ -146,6 +161,11 @@ pub struct Renderer {
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
     cull: wgpu::ComputePipeline,
+    occlude: wgpu::ComputePipeline,
+    hiz_copy: wgpu::ComputePipeline,
+    hiz_reduce: wgpu::ComputePipeline,
+    hiz_layout: wgpu::BindGroupLayout,
+    hiz_read_layout: wgpu::BindGroupLayout,
     cull_layout: wgpu::BindGroupLayout,
     shade_layout: wgpu::BindGroupLayout,
     prepass: wgpu::RenderPipeline,
@@ -158,6 +178,7 @@ pub struct Renderer {
 
 const COLOUR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+const HIZ: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 /// Background, written as is (not gamma corrected).
 const BACKGROUND: wgpu::Color = wgpu::Color { r: 0.10, g: 0.10, b: 0.12, a: 1.0 };
 
@@ -242,14 +263,55 @@ impl Renderer {
             label: Some("cull"),
             source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/cull.wgsl")]).into()),
         });
-        let cull = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("cull"),
-            layout: Some(&pipeline_layout(&cull_layout)),
-            module: &cull_module,
-            entry_point: Some("cull"),
-            compilation_options: Default::default(),
-            cache: None,
+        let compute = |label, layouts: &[Option<&wgpu::BindGroupLayout>], module, entry| {
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: None,
+                bind_group_layouts: layouts,
+                immediate_size: 0,
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: Some(&layout),
+                module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let cull = compute("cull", &[Some(&cull_layout)], &cull_module, "cull");
+        let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: S::COMPUTE,
+            ty: wgpu::BindingType::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false },
+            count: None,
+        };
+        let float = wgpu::TextureSampleType::Float { filterable: false };
+        let hiz_read_layout =
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("hiz read"), entries: &[texture(0, float)] });
+        let occlude = compute("occlude", &[Some(&cull_layout), Some(&hiz_read_layout)], &cull_module, "occlude");
+        let hiz_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("hiz build"),
+            entries: &[
+                texture(0, wgpu::TextureSampleType::Depth),
+                texture(1, float),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: S::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: HIZ,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
+            ],
         });
+        let hiz_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("hiz"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("shaders/hiz.wgsl").into()),
+        });
+        let hiz_copy = compute("hiz copy", &[Some(&hiz_layout)], &hiz_module, "copy_depth");
+        let hiz_reduce = compute("hiz reduce", &[Some(&hiz_layout)], &hiz_module, "reduce");
         let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shade"),
             source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/shade.wgsl")]).into()),
@@ -297,6 +359,11 @@ impl Renderer {
             queue,
             info,
             cull,
+            occlude,
+            hiz_copy,
+            hiz_reduce,
+            hiz_layout,
+            hiz_read_layout,
             cull_layout,
             shade_layout,
             prepass,
@@ -402,14 +469,14 @@ impl Renderer {
             f_hi: f_hi.extend(0.0).to_array(),
             grid_lo: s.grid.lo.extend(s.grid.unit).to_array(),
             grid_cell: s.grid.cell.extend(0.0).to_array(),
-            params: [n, u32::from(o.culling == Culling::Frustum), flags, 0],
+            params: [n, u32::from(o.culling != Culling::None), flags, o.width | (o.height << 16)],
         };
         self.queue.write_buffer(&s.uniform, 0, bytemuck::bytes_of(&u));
         self.queue.write_buffer(&s.commands, 0, bytemuck::cast_slice(&s.commands_init));
         self.queue.write_buffer(&s.counters, 0, &[0u8; 16]);
 
         let queries = self.timestamps.then(|| {
-            self.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("pass times"), ty: wgpu::QueryType::Timestamp, count: 6 })
+            self.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("pass times"), ty: wgpu::QueryType::Timestamp, count: 8 })
         });
         let stamp = |i: u32| {
             queries.as_ref().map(|q| wgpu::RenderPassTimestampWrites {
@@ -445,7 +512,8 @@ impl Renderer {
             })
         };
         let colour = texture(COLOUR, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
-        let depth = texture(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let occlusion = o.culling == Culling::Occlusion;
+        let depth = texture(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING);
         let (cview, dview) = (colour.create_view(&Default::default()), depth.create_view(&Default::default()));
         let draw_all = |pass: &mut wgpu::RenderPass<'_>| {
             pass.set_bind_group(0, &s.shade_group, &[]);
@@ -455,9 +523,9 @@ impl Renderer {
                 pass.multi_draw_indexed_indirect(&s.commands, 0, n);
             }
         };
-        if o.prepass {
+        if o.prepass || occlusion {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("prepass"),
+                label: Some("depth pass"),
                 color_attachments: &[],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &dview,
@@ -471,6 +539,7 @@ impl Renderer {
             pass.set_pipeline(&self.prepass);
             draw_all(&mut pass);
         }
+        let hiz = occlusion.then(|| self.occlusion_passes(&mut enc, s, &depth, o, queries.as_ref()));
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shade"),
@@ -495,7 +564,7 @@ impl Renderer {
             pass.set_pipeline(if o.prepass { &self.shade_equal } else { &self.shade });
             draw_all(&mut pass);
         }
-        let row = (4 * o.width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let row = aligned_row(o.width);
         let readback = |label, size| {
             self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -513,6 +582,10 @@ impl Renderer {
             },
             wgpu::Extent3d { width: o.width, height: o.height, depth_or_array_layers: 1 },
         );
+        let hiz_read = match (&hiz, o.read_hiz) {
+            (Some(h), true) => Some(self.copy_levels(&mut enc, h)),
+            _ => None,
+        };
         let cmd_bytes = 20 * n.max(1) as u64;
         let cmds = readback("commands", cmd_bytes);
         enc.copy_buffer_to_buffer(&s.commands, 0, &cmds, 0, cmd_bytes);
@@ -521,19 +594,20 @@ impl Renderer {
         let times = queries.as_ref().map(|q| {
             let resolve = self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("timestamps"),
-                size: 48,
+                size: 64,
                 usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
-            let read = readback("timestamps readback", 48);
-            enc.resolve_query_set(q, 0..6, &resolve, 0);
-            enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, 48);
+            let read = readback("timestamps readback", 64);
+            enc.resolve_query_set(q, 0..8, &resolve, 0);
+            enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, 64);
             read
         });
         self.queue.submit([enc.finish()]);
         let mapped: Vec<_> = [Some(&pixels), Some(&cmds), Some(&counts), times.as_ref()]
             .into_iter()
             .flatten()
+            .chain(hiz_read.iter().flat_map(|(bufs, _)| bufs.iter()))
             .map(|b| {
                 let (tx, rx) = std::sync::mpsc::channel();
                 b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
@@ -559,10 +633,26 @@ impl Renderer {
             let words: &[u32] = bytemuck::cast_slice(&data);
             (0..n as usize).map(|c| words[5 * c + 1] != 0).collect()
         };
-        let [after, drawn] = {
+        let [after, drawn, after_occ, drawn_occ] = {
             let data = counts.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
             let w: &[u32] = bytemuck::cast_slice(&data);
-            [w[0], w[1]]
+            [w[0], w[1], w[2], w[3]]
+        };
+        let hiz = match hiz_read {
+            Some((bufs, sizes)) => {
+                let mut levels = Vec::with_capacity(bufs.len());
+                for (b, [w, h]) in bufs.iter().zip(&sizes) {
+                    let data = b.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
+                    let row = aligned_row(*w) as usize;
+                    let mut level = Vec::with_capacity((*w * *h) as usize);
+                    for y in 0..*h as usize {
+                        level.extend_from_slice(bytemuck::cast_slice::<u8, f32>(&data[y * row..y * row + 4 * *w as usize]));
+                    }
+                    levels.push(level);
+                }
+                Some(Pyramid { sizes, levels, picture: [o.width, o.height] })
+            }
+            None => None,
         };
         let gpu = match times {
             Some(t) => {
@@ -570,19 +660,163 @@ impl Renderer {
                 let w: &[u64] = bytemuck::cast_slice(&data);
                 let period = self.queue.get_timestamp_period() as f64 * 1e-6;
                 let span = |i: usize| w[2 * i + 1].saturating_sub(w[2 * i]) as f64 * period;
-                Some(PassTimes { cull_ms: span(0), prepass_ms: if o.prepass { span(1) } else { 0.0 }, shade_ms: span(2) })
+                Some(PassTimes {
+                    cull_ms: span(0),
+                    depth_ms: if o.prepass || occlusion { span(1) } else { 0.0 },
+                    shade_ms: span(2),
+                    hiz_ms: if occlusion { span(3) } else { 0.0 },
+                })
             }
             None => None,
         };
         let stats = FrameStats {
             clusters: n,
             clusters_after_frustum: after,
+            clusters_after_occlusion: occlusion.then_some(after_occ),
             triangles: s.triangles,
-            triangles_drawn: drawn as u64,
+            triangles_drawn: if occlusion { drawn_occ } else { drawn } as u64,
             multi_draw: "multi_draw_indexed_indirect",
             cpu_ms: t0.elapsed().as_secs_f64() * 1e3,
             gpu,
         };
-        Ok(Frame { width: o.width, height: o.height, rgba, kept, stats })
+        Ok(Frame { width: o.width, height: o.height, rgba, kept, hiz, stats })
     }
+
+    /// Builds the Hi-Z pyramid from the depth pass and runs the occlusion
+    /// test over the frustum survivors; returns the pyramid texture and
+    /// its level sizes.
+    fn occlusion_passes(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        s: &GpuScene,
+        depth: &wgpu::Texture,
+        o: &FrameOptions,
+        queries: Option<&wgpu::QuerySet>,
+    ) -> (wgpu::Texture, Vec<[u32; 2]>) {
+        let ([w0, h0], count) = pyramid_size(o.width, o.height);
+        let tex = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("hi-z"),
+            size: wgpu::Extent3d { width: w0, height: h0, depth_or_array_layers: 1 },
+            mip_level_count: count,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: HIZ,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let level =
+            |l: u32| tex.create_view(&wgpu::TextureViewDescriptor { base_mip_level: l, mip_level_count: Some(1), ..Default::default() });
+        let depth_view = depth.create_view(&wgpu::TextureViewDescriptor { aspect: wgpu::TextureAspect::DepthOnly, ..Default::default() });
+        let sizes: Vec<[u32; 2]> = (0..count).map(|l| [(w0 >> l).max(1), (h0 >> l).max(1)]).collect();
+        for l in 0..count {
+            // Level 0 reads the depth; the source binding is then any
+            // level but the one written (level 1 for level 0: unused).
+            let (src, dst) = (level(if l == 0 { 1.min(count - 1) } else { l - 1 }), level(l));
+            let src = if l == 0 && count == 1 { None } else { Some(src) };
+            let dummy;
+            let src_view = match &src {
+                Some(v) => v,
+                None => {
+                    dummy = self.dummy_float();
+                    &dummy
+                }
+            };
+            let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &self.hiz_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_view) },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(src_view) },
+                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&dst) },
+                ],
+            });
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("hi-z level"),
+                timestamp_writes: queries.filter(|_| l == 0).map(|q| wgpu::ComputePassTimestampWrites {
+                    query_set: q,
+                    beginning_of_pass_write_index: Some(6),
+                    end_of_pass_write_index: None,
+                }),
+            });
+            pass.set_pipeline(if l == 0 { &self.hiz_copy } else { &self.hiz_reduce });
+            pass.set_bind_group(0, &group, &[]);
+            let [w, h] = sizes[l as usize];
+            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+        }
+        let all = tex.create_view(&Default::default());
+        let read_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &self.hiz_read_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&all) }],
+        });
+        let n = s.clusters.len() as u32;
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("occlude"),
+            timestamp_writes: queries.map(|q| wgpu::ComputePassTimestampWrites {
+                query_set: q,
+                beginning_of_pass_write_index: None,
+                end_of_pass_write_index: Some(7),
+            }),
+        });
+        pass.set_pipeline(&self.occlude);
+        pass.set_bind_group(0, &s.cull_group, &[]);
+        pass.set_bind_group(1, &read_group, &[]);
+        pass.dispatch_workgroups(n.div_ceil(64).max(1), 1, 1);
+        drop(pass);
+        (tex, sizes)
+    }
+
+    /// A 1×1 float texture view, bound where a pass reads no source level.
+    fn dummy_float(&self) -> wgpu::TextureView {
+        self.device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("unused"),
+                size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: HIZ,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+            .create_view(&Default::default())
+    }
+
+    /// Copies every pyramid level into a readback buffer.
+    fn copy_levels(&self, enc: &mut wgpu::CommandEncoder, hiz: &(wgpu::Texture, Vec<[u32; 2]>)) -> (Vec<wgpu::Buffer>, Vec<[u32; 2]>) {
+        let (tex, sizes) = hiz;
+        let bufs = sizes
+            .iter()
+            .enumerate()
+            .map(|(l, &[w, h])| {
+                let row = aligned_row(w);
+                let buf = self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("hi-z level readback"),
+                    size: row as u64 * h as u64,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                enc.copy_texture_to_buffer(
+                    wgpu::TexelCopyTextureInfo {
+                        texture: tex,
+                        mip_level: l as u32,
+                        origin: wgpu::Origin3d::ZERO,
+                        aspect: wgpu::TextureAspect::All,
+                    },
+                    wgpu::TexelCopyBufferInfo {
+                        buffer: &buf,
+                        layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(h) },
+                    },
+                    wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+                );
+                buf
+            })
+            .collect();
+        (bufs, sizes.clone())
+    }
+}
+
+/// Bytes per row of a 4-byte-texel copy, aligned as copies require.
+fn aligned_row(width: u32) -> u32 {
+    (4 * width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT
 }

@@ -11,18 +11,23 @@
 //!   (`shaders/cull.wgsl`);
 //! - [`lights`]: lights merged from emissive triangles, attenuation
 //!   `i / (d³ + 1)`, the 32³ light grid (CPU build);
-//! - [`gpu`]: the frame — culling pass, optional Z-prepass, Blinn–Phong
+//! - [`hiz`]: Hi-Z occlusion culling — a depth pass of the frustum
+//!   survivors, a max-depth pyramid built on the GPU, each box tested at
+//!   the level where it covers at most 2×2 texels (CPU reference kept);
+//! - [`gpu`]: the frame — culling passes, optional Z-prepass, Blinn–Phong
 //!   shading over the fragment's light-grid cell, gamma — rendered
 //!   headless and read back;
 //! - [`scenes`]: deterministic test scenes (the Cornell box).
 //!
-//! **Not built yet** (the CLI says so when asked): Hi-Z occlusion culling
-//! (one- and two-pass), the light grid built on the GPU, alpha cut-outs
-//! and textures, the interactive window (`voxkit view`), the ray spray into
-//! a point cloud, and the large procedural scene.
+//! **Not built yet** (the CLI says so when asked): the two-pass occlusion
+//! variant (last frame's visible set first), the light grid built on the
+//! GPU, alpha cut-outs and textures, the interactive window (`voxkit
+//! view`), the ray spray into a point cloud, and the large procedural
+//! scene.
 
 pub mod camera;
 pub mod gpu;
+pub mod hiz;
 pub mod lights;
 pub mod partition;
 pub mod scene;

@@ -10,6 +10,7 @@ use glam::Vec3;
 use voxkit::attributes::Appearance;
 use voxkit_testkit::shared_mesh;
 use voxkit_view::camera::{frustum_box, visible};
+use voxkit_view::hiz::Pyramid;
 use voxkit_view::{scenes, Camera, Culling, FrameOptions, Renderer, Scene};
 
 fn renderer() -> Option<Renderer> {
@@ -48,13 +49,13 @@ fn cameras(scene: &Scene) -> Vec<Camera> {
 }
 
 fn frame(r: &Renderer, g: &voxkit_view::GpuScene, camera: Camera, culling: Culling, prepass: bool) -> voxkit_view::Frame {
-    r.render(g, &FrameOptions { width: 160, height: 120, camera, culling, prepass, gamma: true }).unwrap()
+    r.render(g, &FrameOptions { width: 160, height: 120, camera, culling, prepass, gamma: true, read_hiz: true }).unwrap()
 }
 
 fn check_scene(r: &Renderer, scene: &Scene, what: &str) {
     let g = r.upload(scene).unwrap();
     assert!(g.clusters.len() > 1, "{what}: clusters");
-    let mut culled_somewhere = false;
+    let (mut culled_somewhere, mut occluded_somewhere) = (false, false);
     for (n, cam) in cameras(scene).into_iter().enumerate() {
         let none = frame(r, &g, cam, Culling::None, false);
         let frustum = frame(r, &g, cam, Culling::Frustum, false);
@@ -75,8 +76,26 @@ fn check_scene(r: &Renderer, scene: &Scene, what: &str) {
         // The Z-prepass changes nothing.
         let pre = frame(r, &g, cam, Culling::Frustum, true);
         assert!(pre.rgba == frustum.rgba, "{what}, camera {n}: the Z-prepass changed the picture");
+        // Neither does occlusion culling, with or without the prepass.
+        for prepass in [false, true] {
+            let occ = frame(r, &g, cam, Culling::Occlusion, prepass);
+            // The pyramid read back is the CPU's build of its own level 0.
+            let hiz = occ.hiz.expect("asked for the pyramid");
+            let [w0, _] = hiz.sizes[0];
+            let level0: Vec<f32> = (0..120).flat_map(|y| hiz.levels[0][y * w0 as usize..y * w0 as usize + 160].to_vec()).collect();
+            assert!(hiz.levels[0].iter().all(|d| (0.0..=1.0).contains(d)));
+            assert_eq!(Pyramid::build(&level0, 160, 120), hiz, "{what}, camera {n}: GPU and CPU pyramids differ");
+            // The GPU's survivors are the CPU test's on those levels.
+            let want_occ: Vec<bool> = g.clusters.iter().zip(&want).map(|(c, &f)| f && !hiz.occluded(c.lo, c.hi, &m)).collect();
+            assert_eq!(occ.kept, want_occ, "{what}, camera {n}: GPU and CPU occlusion tests differ");
+            let after = want_occ.iter().filter(|&&k| k).count() as u32;
+            assert_eq!(occ.stats.clusters_after_occlusion, Some(after));
+            occluded_somewhere |= after < kept;
+            assert!(occ.rgba == none.rgba, "{what}, camera {n}, prepass {prepass}: occlusion culling changed the picture");
+        }
     }
     assert!(culled_somewhere, "{what}: some camera culls some cluster");
+    assert!(occluded_somewhere, "{what}: some camera culls some cluster by occlusion");
 }
 
 #[test]
@@ -100,7 +119,10 @@ fn the_cornell_box_is_lit_by_its_ceiling() {
     let cam = Camera { eye: Vec3::new(0.5, 0.5, 2.4), target: Vec3::new(0.5, 0.5, 0.0), up: Vec3::Y, fov_deg: 40.0 };
     assert!(lo.cmple(Vec3::ZERO).all() && hi.cmpge(Vec3::ONE).all());
     let f = r
-        .render(&g, &FrameOptions { width: 200, height: 200, camera: cam, culling: Culling::Frustum, prepass: false, gamma: true })
+        .render(
+            &g,
+            &FrameOptions { width: 200, height: 200, camera: cam, culling: Culling::Frustum, prepass: false, gamma: true, read_hiz: false },
+        )
         .unwrap();
     let px = |x: usize, y: usize| {
         let i = 4 * (y * 200 + x);

@@ -91,7 +91,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         bail!("--gpu: this voxkit was built without the gpu feature");
     }
     let g = &a.gpu;
-    if g.camera.is_some() || g.stats_json.is_some() || g.culling != "frustum" || g.prepass != "off" || g.gamma != "on" {
+    if g.camera.is_some() || g.stats_json.is_some() || g.culling != "occlusion" || g.prepass != "off" || g.gamma != "on" {
         bail!("--camera, --culling, --prepass, --gamma and --stats-json belong to the GPU renderer; add --gpu");
     }
     let t0 = Instant::now();

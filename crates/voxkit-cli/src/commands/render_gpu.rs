@@ -34,9 +34,6 @@ fn parse_camera(s: &str, up: Vec3) -> Result<Camera> {
 
 pub fn run(a: &RenderArgs) -> Result<()> {
     let g = &a.gpu;
-    if g.culling == "occlusion" {
-        bail!("--culling occlusion: Hi-Z occlusion culling is not built yet; use --culling frustum or none");
-    }
     if a.picture.outline {
         bail!("--outline belongs to the CPU ray caster; leave out --gpu");
     }
@@ -90,10 +87,22 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let t1 = std::time::Instant::now();
     let uploaded = renderer.upload(&scene)?;
     let upload_s = t1.elapsed().as_secs_f64();
-    let culling = if g.culling == "none" { Culling::None } else { Culling::Frustum };
+    let culling = match g.culling.as_str() {
+        "none" => Culling::None,
+        "frustum" => Culling::Frustum,
+        _ => Culling::Occlusion,
+    };
     let frame = renderer.render(
         &uploaded,
-        &FrameOptions { width: o.width, height: o.height, camera, culling, prepass: g.prepass == "on", gamma: g.gamma == "on" },
+        &FrameOptions {
+            width: o.width,
+            height: o.height,
+            camera,
+            culling,
+            prepass: g.prepass == "on",
+            gamma: g.gamma == "on",
+            read_hiz: false,
+        },
     )?;
     let rgb: Vec<u8> = frame.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
     voxkit_io::write_png(&a.output, frame.width, frame.height, &rgb)?;
@@ -112,7 +121,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         "gamma": g.gamma == "on",
         "clusters": s.clusters,
         "clusters_after_frustum": s.clusters_after_frustum,
-        "clusters_after_occlusion": serde_json::Value::Null,
+        "clusters_after_occlusion": s.clusters_after_occlusion,
         "triangles": s.triangles,
         "triangles_drawn": s.triangles_drawn,
         "lights": uploaded.lights.lights,
@@ -122,7 +131,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         "frame_ms": {
             "cpu": s.cpu_ms,
             "gpu_cull": s.gpu.map(|t| t.cull_ms),
-            "gpu_prepass": s.gpu.map(|t| t.prepass_ms),
+            "gpu_depth_pass": s.gpu.map(|t| t.depth_ms),
+            "gpu_hiz": s.gpu.map(|t| t.hiz_ms),
             "gpu_shade": s.gpu.map(|t| t.shade_ms),
         },
         "load_s": load_s,
@@ -141,7 +151,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         frame.height,
         s.triangles,
         kind,
-        s.clusters_after_frustum,
+        s.clusters_after_occlusion.unwrap_or(s.clusters_after_frustum),
         s.clusters,
         uploaded.lights.lights,
         s.cpu_ms,
