@@ -31,7 +31,8 @@ pub enum Command {
     /// --gpu, the GPU renderer: clusters, one multi-draw-indirect call, GPU
     /// frustum culling, light grid, Blinn–Phong).
     Render(RenderArgs),
-    /// Write a bundled test scene (OBJ + MTL): the Cornell box.
+    /// Write a bundled test scene (OBJ + MTL): the Cornell box, or a city of
+    /// about a million triangles with 169 emissive street lamps.
     Scene(SceneArgs),
     /// Convert a voxel file to another voxel format, or to a mesh of the voxels (.obj, greedy quads).
     Convert(ConvertArgs),
@@ -336,6 +337,15 @@ pub struct GpuRenderArgs {
     /// --gpu: linear to sRGB on output.
     #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
     pub gamma: String,
+    /// --gpu: a camera path, one camera per line as for --camera (`#`
+    /// starts a comment); frame N is written to OUT with `-NNNN` before
+    /// the extension.
+    #[arg(long, value_name = "FILE", conflicts_with = "camera")]
+    pub frames: Option<PathBuf>,
+    /// --gpu: render every frame this many times and report the median
+    /// times (for measuring).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub repeat: u32,
     /// --gpu: write the frame's statistics (clusters kept, triangles
     /// drawn, lights, light grid, the draw call, frame times) as JSON.
     #[arg(long, value_name = "FILE")]
@@ -344,8 +354,8 @@ pub struct GpuRenderArgs {
 
 #[derive(Args, Debug)]
 pub struct SceneArgs {
-    /// Which scene: cornell.
-    #[arg(value_parser = clap::builder::PossibleValuesParser::new(["cornell"]))]
+    /// Which scene: cornell or city.
+    #[arg(value_parser = clap::builder::PossibleValuesParser::new(["cornell", "city"]))]
     pub name: String,
     /// Output OBJ; its MTL is written beside it with the same stem.
     #[arg(short, long, value_name = "OBJ")]

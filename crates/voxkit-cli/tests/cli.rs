@@ -642,6 +642,20 @@ fn the_gpu_renderer_draws_the_cornell_box_and_reports_its_frame() {
     assert!(s["light_grid"]["total"].as_u64().unwrap() > 0);
     assert!(s["clusters_after_frustum"].as_u64().unwrap() <= s["clusters"].as_u64().unwrap());
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    // A camera path: one picture per camera, median times over repeats.
+    let path = tmp("cornell-path.txt");
+    std::fs::write(&path, "# two cameras\n0.5,0.5,2.4,0.5,0.5,0,40\n\n0.5,0.9,0.9, 0.2,0.1,0.2 # inside\n").unwrap();
+    let out = voxkit(&["render", &obj, "--gpu", "-o", &tmp("path.png"), "--size", "40x30", "--frames", &path, "--repeat", "3", "--json"]);
+    let v = json(&out);
+    let frames = v["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 2);
+    assert_eq!(frames[1]["frame_ms"]["repeats"], 3);
+    for n in 0..2 {
+        assert!(std::path::Path::new(&tmp(&format!("path-{n:04}.png"))).exists());
+    }
+    std::fs::write(&path, "0.5,0.5,2.4,0.5,0.5\n").unwrap();
+    let e = error_line(&["render", &obj, "--gpu", "-o", &tmp("path.png"), "--frames", &path]);
+    assert!(e.contains("line 1") && e.contains("--camera takes"), "{e}");
     // A voxel file is drawn as its greedy quads.
     let npy = tmp("cornell-vox.npy");
     assert!(voxkit(&["voxelize", &obj, "-o", &npy, "--resolution", "16"]).status.success());

@@ -3,8 +3,8 @@
 //!
 //! - **Lights.** Emissive triangles are merged by material and proximity:
 //!   those of one material whose centroids fall in the same cube of side
-//!   one attenuation unit (below) become one light, at their area-weighted
-//!   centroid. Its intensity is `sqrt(area)` (area in units², as the report
+//!   [`MERGE`] (an eighth of an attenuation unit, below) become one light,
+//!   at their area-weighted centroid. Its intensity is `sqrt(area)` (area in units², as the report
 //!   sets it) times the largest component of the material's emission; its
 //!   colour is the emission divided by that component.
 //! - **Attenuation** `i / (d³ + 1)`, `d` the distance in *units*: one unit
@@ -26,6 +26,8 @@ use crate::scene::Scene;
 pub const GRID: usize = 32;
 /// Attenuation units along the scene box's largest extent.
 pub const UNITS: usize = 8;
+/// Side of the cubes emissive triangles are merged in, in attenuation units.
+pub const MERGE: f32 = 0.125;
 /// Contributions below this are left out of a cell's list.
 pub const THRESHOLD: f32 = 0.02;
 
@@ -84,7 +86,7 @@ pub fn lights(scene: &Scene) -> (Vec<Light>, LightReport) {
         let p = [0, 1, 2].map(|c| Vec3::from(t[c].position));
         let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length() / (unit * unit);
         let c = (p[0] + p[1] + p[2]) / 3.0;
-        let key = ((c - lo) / unit).floor().as_i64vec3().to_array();
+        let key = ((c - lo) / (unit * MERGE)).floor().as_i64vec3().to_array();
         let g = groups.entry((m, key)).or_insert((0.0, Vec3::ZERO));
         g.0 += area;
         g.1 += c * area;

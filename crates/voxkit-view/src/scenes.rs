@@ -4,6 +4,11 @@
 //! - [`cornell`]: the Cornell box — white floor, ceiling and back wall, red
 //!   left and green right walls, two white blocks, an emissive square just
 //!   below the ceiling (its own material, `Ke` 12).
+//! - [`city`]: a large scene in the spirit of the report's — 144 buildings
+//!   (occluders, facades cut into window panels), 600 trees (trunks and
+//!   finely tessellated crowns), 169 street lamps with emissive heads, a
+//!   ground plane: about a million triangles, from a fixed-seed generator.
+//!   The crowns are opaque: alpha cut-outs are not built yet.
 
 use voxkit::attributes::{Appearance, Material, NO_MATERIAL};
 use voxkit::glam::DVec3;
@@ -29,6 +34,39 @@ impl Builder {
         self.mesh.triangles.push([base, base + 1, base + 2]);
         self.mesh.triangles.push([base, base + 2, base + 3]);
         self.app.triangle_material.extend([material, material]);
+    }
+
+    /// A grid of `nu × nv` quads spanning `o + s·u + t·v`, `s, t ∈ [0, 1]`.
+    fn panel(&mut self, o: DVec3, u: DVec3, v: DVec3, nu: u32, nv: u32, material: u32) {
+        for a in 0..nu {
+            for b in 0..nv {
+                let at = |x: u32, y: u32| o + u * (x as f64 / nu as f64) + v * (y as f64 / nv as f64);
+                self.quad([at(a, b), at(a + 1, b), at(a + 1, b + 1), at(a, b + 1)], material);
+            }
+        }
+    }
+
+    /// A UV sphere of `stacks × slices` quads (triangles at the poles).
+    fn sphere(&mut self, c: DVec3, r: DVec3, stacks: u32, slices: u32, material: u32) {
+        use std::f64::consts::PI;
+        let at = |i: u32, j: u32| {
+            let (th, ph) = (PI * i as f64 / stacks as f64, 2.0 * PI * j as f64 / slices as f64);
+            c + r * DVec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin())
+        };
+        for i in 0..stacks {
+            for j in 0..slices {
+                let base = self.mesh.positions.len() as u32;
+                self.mesh.positions.extend([at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)]);
+                if i > 0 {
+                    self.mesh.triangles.push([base, base + 1, base + 2]);
+                    self.app.triangle_material.push(material);
+                }
+                if i + 1 < stacks {
+                    self.mesh.triangles.push([base, base + 2, base + 3]);
+                    self.app.triangle_material.push(material);
+                }
+            }
+        }
     }
 
     /// An axis-aligned box, faces pointing out.
@@ -59,6 +97,71 @@ pub fn cornell() -> (Mesh, Appearance) {
     b.quad([p(0.38, 0.998, 0.38), p(0.62, 0.998, 0.38), p(0.62, 0.998, 0.62), p(0.38, 0.998, 0.62)], light);
     b.block(p(0.15, 0.0, 0.2), p(0.45, 0.6, 0.5), white); // tall block
     b.block(p(0.55, 0.0, 0.5), p(0.85, 0.3, 0.8), white); // short block
+    (b.mesh, b.app)
+}
+
+/// A city: buildings on a 12 × 12 grid of blocks, trees and street lamps
+/// along the streets, y up, about 1 M triangles; the same every time.
+pub fn city() -> (Mesh, Appearance) {
+    let mut b = Builder::default();
+    let mut state = 0x5eed_c17u64;
+    let mut rnd = move || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let ground = b.material("asphalt", [0.18, 0.18, 0.2], [0.0; 3], 0.9);
+    let facades: Vec<u32> = [[0.62, 0.58, 0.52], [0.45, 0.47, 0.52], [0.7, 0.66, 0.6], [0.5, 0.35, 0.3]]
+        .iter()
+        .enumerate()
+        .map(|(n, c)| b.material(&format!("facade{n}"), *c, [0.0; 3], 0.7))
+        .collect();
+    let roof = b.material("roof", [0.3, 0.3, 0.32], [0.0; 3], 0.8);
+    let trunk = b.material("bark", [0.3, 0.2, 0.12], [0.0; 3], 0.9);
+    let leaves = b.material("leaves", [0.15, 0.4, 0.12], [0.0; 3], 0.8);
+    let pole = b.material("pole", [0.12, 0.12, 0.13], [0.0; 3], 0.4);
+    let lamp = b.material("lamp", [1.0, 0.95, 0.8], [2.5, 2.2, 1.6], 0.5);
+    let (blocks, cell, street) = (12u32, 20.0f64, 6.0f64);
+    let size = blocks as f64 * cell;
+    let p = DVec3::new;
+    b.panel(p(-street, 0.0, -street), p(size + 2.0 * street, 0.0, 0.0), p(0.0, 0.0, size + 2.0 * street), 24, 24, ground);
+    b.mesh.triangles.iter_mut().for_each(|t| t.swap(1, 2)); // the ground faces up
+    for bx in 0..blocks {
+        for bz in 0..blocks {
+            let (x0, z0) = (bx as f64 * cell + street * 0.5, bz as f64 * cell + street * 0.5);
+            let w = cell - street;
+            let (dx, dz) = (w * (0.7 + 0.3 * rnd()), w * (0.7 + 0.3 * rnd()));
+            let h = 8.0 + 52.0 * rnd() * rnd();
+            let m = facades[(rnd() * facades.len() as f64) as usize % facades.len()];
+            let (lo, hi) = (p(x0, 0.0, z0), p(x0 + dx, h, z0 + dz));
+            let floors = (h / 3.0).ceil() as u32;
+            // Facades cut into window panels, each face pointing out.
+            b.panel(lo, p(0.0, 0.0, dz), p(0.0, h, 0.0), 12, floors, m);
+            b.panel(p(hi.x, 0.0, lo.z), p(0.0, h, 0.0), p(0.0, 0.0, dz), floors, 12, m);
+            b.panel(lo, p(0.0, h, 0.0), p(dx, 0.0, 0.0), floors, 12, m);
+            b.panel(p(lo.x, 0.0, hi.z), p(dx, 0.0, 0.0), p(0.0, h, 0.0), 12, floors, m);
+            b.panel(p(lo.x, h, lo.z), p(0.0, 0.0, dz), p(dx, 0.0, 0.0), 4, 4, roof);
+        }
+    }
+    // Trees along the streets between blocks, lamps at every crossing.
+    let mut trees = 0;
+    while trees < 600 {
+        let along = rnd() * size;
+        let line = (rnd() * (blocks + 1) as f64).floor() * cell;
+        let side = if rnd() < 0.5 { -1.8 } else { 1.8 };
+        let (x, z) = if rnd() < 0.5 { (along, line + side) } else { (line + side, along) };
+        let h = 3.0 + 2.0 * rnd();
+        b.block(p(x - 0.2, 0.0, z - 0.2), p(x + 0.2, h, z + 0.2), trunk);
+        let r = 1.4 + 0.8 * rnd();
+        b.sphere(p(x, h + r * 0.6, z), p(r, r * 0.9, r), 24, 32, leaves);
+        trees += 1;
+    }
+    for lx in 0..=blocks {
+        for lz in 0..=blocks {
+            let (x, z) = (lx as f64 * cell - 1.0, lz as f64 * cell - 1.0);
+            b.block(p(x - 0.1, 0.0, z - 0.1), p(x + 0.1, 6.0, z + 0.1), pole);
+            b.block(p(x - 0.5, 6.0, z - 0.5), p(x + 0.5, 6.3, z + 0.5), lamp);
+        }
+    }
     (b.mesh, b.app)
 }
 

@@ -139,3 +139,17 @@ fn the_cornell_box_is_lit_by_its_ceiling() {
     let (top, bottom) = (px(100, 50), px(100, 150));
     assert!(top[0] as u32 + top[1] as u32 > bottom[0] as u32 + bottom[1] as u32, "top {top:?} bottom {bottom:?}");
 }
+
+#[test]
+fn the_city_is_large_lit_and_deterministic() {
+    let (mesh, app) = scenes::city();
+    assert!((900_000..1_200_000).contains(&mesh.triangles.len()), "{} triangles", mesh.triangles.len());
+    let mut scene = Scene::default();
+    assert_eq!(scene.add_mesh(mesh.as_ref(), &app), 0);
+    let (lights, report) = voxkit_view::lights::lights(&scene);
+    assert!(report.lights >= 169 && lights.len() == report.lights, "one light per lamp at least: {report:?}");
+    let partition = voxkit_view::partition::Partition::new(&scene);
+    assert!(partition.clusters.len() > 200);
+    let (again, _) = scenes::city();
+    assert!(again.positions == mesh.positions && again.triangles == mesh.triangles);
+}

@@ -91,8 +91,15 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         bail!("--gpu: this voxkit was built without the gpu feature");
     }
     let g = &a.gpu;
-    if g.camera.is_some() || g.stats_json.is_some() || g.culling != "occlusion" || g.prepass != "off" || g.gamma != "on" {
-        bail!("--camera, --culling, --prepass, --gamma and --stats-json belong to the GPU renderer; add --gpu");
+    if g.camera.is_some()
+        || g.frames.is_some()
+        || g.repeat != 1
+        || g.stats_json.is_some()
+        || g.culling != "occlusion"
+        || g.prepass != "off"
+        || g.gamma != "on"
+    {
+        bail!("--camera, --frames, --repeat, --culling, --prepass, --gamma and --stats-json belong to the GPU renderer; add --gpu");
     }
     let t0 = Instant::now();
     let o = options(&a.picture, a.up.as_deref())?;

@@ -2,12 +2,12 @@
 //! headless, of a mesh with its materials or of a voxel file's greedy
 //! quads; the picture as PNG and the frame's statistics as JSON.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use serde_json::json;
 use voxkit::glam::Vec3;
-use voxkit_view::{Camera, Culling, FrameOptions, Renderer, Scene};
+use voxkit_view::{Camera, Culling, FrameOptions, FrameStats, Renderer, Scene};
 
 use crate::args::RenderArgs;
 use crate::commands::render::{check_png_path, options};
@@ -79,10 +79,19 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     };
     let load_s = t0.elapsed().as_secs_f64();
     let bounds = scene.bounds().with_context(|| format!("{}: nothing to draw (no triangle with area)", a.input.display()))?;
-    let camera = match &g.camera {
-        Some(s) => parse_camera(s, up)?,
-        None => Camera::framing(bounds.0, bounds.1, o.up),
+    let cameras: Vec<Camera> = match (&g.camera, &g.frames) {
+        (Some(s), _) => vec![parse_camera(s, up)?],
+        (None, Some(path)) => read_camera_path(path, up)?,
+        (None, None) => vec![Camera::framing(bounds.0, bounds.1, o.up)],
     };
+    if g.repeat == 0 || g.repeat > 1000 {
+        bail!("--repeat must be 1..=1000, not {}", g.repeat);
+    }
+    let outputs_png: Vec<PathBuf> =
+        if cameras.len() == 1 { vec![a.output.clone()] } else { (0..cameras.len()).map(|n| numbered(&a.output, n)).collect() };
+    for out in &outputs_png[1.min(outputs_png.len())..] {
+        voxkit_io::atomic::refuse_overwriting_inputs(out, std::slice::from_ref(&a.input))?;
+    }
     let renderer = Renderer::new()?;
     let t1 = std::time::Instant::now();
     let uploaded = renderer.upload(&scene)?;
@@ -92,49 +101,70 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         "frustum" => Culling::Frustum,
         _ => Culling::Occlusion,
     };
-    let frame = renderer.render(
-        &uploaded,
-        &FrameOptions {
+    let mut frames = Vec::with_capacity(cameras.len());
+    for (camera, out) in cameras.iter().zip(&outputs_png) {
+        let opts = FrameOptions {
             width: o.width,
             height: o.height,
-            camera,
+            camera: *camera,
             culling,
             prepass: g.prepass == "on",
             gamma: g.gamma == "on",
             read_hiz: false,
-        },
-    )?;
-    let rgb: Vec<u8> = frame.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
-    voxkit_io::write_png(&a.output, frame.width, frame.height, &rgb)?;
-    let s = &frame.stats;
+        };
+        let mut runs = Vec::with_capacity(g.repeat as usize);
+        for _ in 0..g.repeat {
+            runs.push(renderer.render(&uploaded, &opts)?);
+        }
+        let frame = runs.pop().expect("one run at least");
+        let median = |f: &dyn Fn(&FrameStats) -> Option<f64>| -> Option<f64> {
+            let mut v: Vec<f64> = runs.iter().map(|r| &r.stats).chain([&frame.stats]).filter_map(f).collect();
+            v.sort_by(f64::total_cmp);
+            (!v.is_empty()).then(|| v[v.len() / 2])
+        };
+        let rgb: Vec<u8> = frame.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+        voxkit_io::write_png(out, frame.width, frame.height, &rgb)?;
+        let s = &frame.stats;
+        frames.push(json!({
+            "output": out,
+            "camera": {"eye": camera.eye.to_array(), "target": camera.target.to_array(), "up": camera.up.to_array(), "fov_deg": camera.fov_deg},
+            "clusters_after_frustum": s.clusters_after_frustum,
+            "clusters_after_occlusion": s.clusters_after_occlusion,
+            "triangles_drawn": s.triangles_drawn,
+            "frame_ms": {
+                "repeats": g.repeat,
+                "cpu": median(&|s| Some(s.cpu_ms)),
+                "gpu_cull": median(&|s| s.gpu.map(|t| t.cull_ms)),
+                "gpu_depth_pass": median(&|s| s.gpu.map(|t| t.depth_ms)),
+                "gpu_hiz": median(&|s| s.gpu.map(|t| t.hiz_ms)),
+                "gpu_shade": median(&|s| s.gpu.map(|t| t.shade_ms)),
+            },
+        }));
+    }
+    let first = &frames[0];
     let (total, mean, max) = uploaded.grid.stats();
     let stats = json!({
         "input": a.input,
         "kind": kind,
         "output": a.output,
         "adapter": renderer.adapter(),
-        "width": frame.width,
-        "height": frame.height,
-        "camera": {"eye": camera.eye.to_array(), "target": camera.target.to_array(), "up": camera.up.to_array(), "fov_deg": camera.fov_deg},
+        "width": o.width,
+        "height": o.height,
+        "camera": first["camera"],
         "culling": g.culling,
         "prepass": g.prepass == "on",
         "gamma": g.gamma == "on",
-        "clusters": s.clusters,
-        "clusters_after_frustum": s.clusters_after_frustum,
-        "clusters_after_occlusion": s.clusters_after_occlusion,
-        "triangles": s.triangles,
-        "triangles_drawn": s.triangles_drawn,
+        "clusters": uploaded.clusters.len(),
+        "clusters_after_frustum": first["clusters_after_frustum"],
+        "clusters_after_occlusion": first["clusters_after_occlusion"],
+        "triangles": uploaded.triangles,
+        "triangles_drawn": first["triangles_drawn"],
         "lights": uploaded.lights.lights,
         "emissive_triangles": uploaded.lights.emissive_triangles,
         "light_grid": {"cells": uploaded.grid.ranges.len(), "total": total, "mean": mean, "max": max},
-        "multi_draw": s.multi_draw,
-        "frame_ms": {
-            "cpu": s.cpu_ms,
-            "gpu_cull": s.gpu.map(|t| t.cull_ms),
-            "gpu_depth_pass": s.gpu.map(|t| t.depth_ms),
-            "gpu_hiz": s.gpu.map(|t| t.hiz_ms),
-            "gpu_shade": s.gpu.map(|t| t.shade_ms),
-        },
+        "multi_draw": "multi_draw_indexed_indirect",
+        "frame_ms": first["frame_ms"],
+        "frames": frames,
         "load_s": load_s,
         "upload_s": upload_s,
     });
@@ -146,15 +176,48 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         return crate::print_stdout(&stats.to_string());
     }
     crate::print_stdout(&format!(
-        "render --gpu: {}x{} picture of {} triangles ({}), {} of {} clusters drawn, {} lights, {:.1} ms frame -> {}",
-        frame.width,
-        frame.height,
-        s.triangles,
+        "render --gpu: {} frame(s) {}x{} of {} triangles ({}), first: {} of {} clusters drawn, {} lights, {:.1} ms -> {}",
+        stats["frames"].as_array().map_or(0, Vec::len),
+        o.width,
+        o.height,
+        uploaded.triangles,
         kind,
-        s.clusters_after_occlusion.unwrap_or(s.clusters_after_frustum),
-        s.clusters,
+        stats["clusters_after_occlusion"].as_u64().or(stats["clusters_after_frustum"].as_u64()).unwrap_or(0),
+        uploaded.clusters.len(),
         uploaded.lights.lights,
-        s.cpu_ms,
+        stats["frame_ms"]["cpu"].as_f64().unwrap_or(0.0),
         a.output.display()
     ))
+}
+
+/// `out.png` → `out-0003.png` for frame 3.
+fn numbered(out: &Path, n: usize) -> PathBuf {
+    let stem = out.file_stem().and_then(|s| s.to_str()).unwrap_or("frame");
+    let ext = out.extension().and_then(|s| s.to_str()).unwrap_or("png");
+    out.with_file_name(format!("{stem}-{n:04}.{ext}"))
+}
+
+/// Reads a camera path: one `EX,EY,EZ,TX,TY,TZ[,FOV]` per line, `#` comments.
+fn read_camera_path(path: &Path, up: Vec3) -> Result<Vec<Camera>> {
+    let size = std::fs::metadata(path).with_context(|| format!("{}: cannot read the camera path", path.display()))?.len();
+    if size > 1 << 20 {
+        bail!("{}: a camera path of {size} bytes; at most 1 MiB", path.display());
+    }
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read the camera path", path.display()))?;
+    let text = String::from_utf8(bytes).map_err(|_| anyhow::anyhow!("{}: the camera path is not UTF-8 text", path.display()))?;
+    let mut cams = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        cams.push(parse_camera(line, up).with_context(|| format!("{} line {}", path.display(), n + 1))?);
+        if cams.len() > 10_000 {
+            bail!("{}: more than 10000 cameras", path.display());
+        }
+    }
+    if cams.is_empty() {
+        bail!("{}: no camera in the path (one EX,EY,EZ,TX,TY,TZ[,FOV] per line)", path.display());
+    }
+    Ok(cams)
 }

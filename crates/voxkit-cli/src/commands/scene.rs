@@ -7,7 +7,8 @@ use crate::args::SceneArgs;
 pub fn run(a: &SceneArgs) -> Result<()> {
     let (mesh, app) = match a.name.as_str() {
         "cornell" => voxkit_view::scenes::cornell(),
-        other => bail!("unknown scene {other:?} (known: cornell)"),
+        "city" => voxkit_view::scenes::city(),
+        other => bail!("unknown scene {other:?} (known: cornell, city)"),
     };
     if a.output.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("obj")) != Some(true) {
         bail!("{}: scenes are written as OBJ; give a .obj file name", a.output.display());
