@@ -104,7 +104,7 @@ pub fn cornell() -> (Mesh, Appearance) {
 /// along the streets, y up, about 1 M triangles; the same every time.
 pub fn city() -> (Mesh, Appearance) {
     let mut b = Builder::default();
-    let mut state = 0x5eed_c17u64;
+    let mut state = 0x05ee_dc17_u64;
     let mut rnd = move || {
         state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64
