@@ -21,7 +21,7 @@ use wgpu::util::DeviceExt;
 
 use crate::camera::{frustum_box, Camera};
 use crate::hiz::{pyramid_size, Pyramid};
-use crate::lights::{lights, LightGrid, LightReport};
+use crate::lights::{grid_frame, lights, LightGrid, LightReport, GRID};
 use crate::partition::{Cluster, Partition};
 use crate::scene::{Scene, Vertex};
 use crate::ViewError;
@@ -145,8 +145,10 @@ pub struct GpuScene {
     uniform: wgpu::Buffer,
     /// The clusters, in command order.
     pub clusters: Vec<Cluster>,
-    /// The light grid (CPU build).
+    /// The light grid as the GPU built it (read back).
     pub grid: LightGrid,
+    /// Milliseconds the GPU build took (submit to read back).
+    pub grid_ms: f64,
     /// Lights and the emissive triangles they came from.
     pub lights: LightReport,
     /// Scene box.
@@ -166,6 +168,10 @@ pub struct Renderer {
     hiz_reduce: wgpu::ComputePipeline,
     hiz_layout: wgpu::BindGroupLayout,
     hiz_read_layout: wgpu::BindGroupLayout,
+    grid_count: wgpu::ComputePipeline,
+    grid_scan: wgpu::ComputePipeline,
+    grid_fill: wgpu::ComputePipeline,
+    grid_layout: wgpu::BindGroupLayout,
     cull_layout: wgpu::BindGroupLayout,
     shade_layout: wgpu::BindGroupLayout,
     prepass: wgpu::RenderPipeline,
@@ -311,6 +317,23 @@ impl Renderer {
             source: wgpu::ShaderSource::Wgsl(include_str!("shaders/hiz.wgsl").into()),
         });
         let hiz_copy = compute("hiz copy", &[Some(&hiz_layout)], &hiz_module, "copy_depth");
+        let grid_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("light grid"),
+            entries: &[
+                entry(0, S::COMPUTE, Uniform),
+                entry(1, S::COMPUTE, Storage { read_only: true }),
+                entry(2, S::COMPUTE, Storage { read_only: false }),
+                entry(3, S::COMPUTE, Storage { read_only: false }),
+                entry(4, S::COMPUTE, Storage { read_only: false }),
+            ],
+        });
+        let grid_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("light grid"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("shaders/grid.wgsl").into()),
+        });
+        let grid_count = compute("light grid count", &[Some(&grid_layout)], &grid_module, "count");
+        let grid_scan = compute("light grid scan", &[Some(&grid_layout)], &grid_module, "scan");
+        let grid_fill = compute("light grid fill", &[Some(&grid_layout)], &grid_module, "fill");
         let hiz_reduce = compute("hiz reduce", &[Some(&hiz_layout)], &hiz_module, "reduce");
         let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shade"),
@@ -364,6 +387,10 @@ impl Renderer {
             hiz_reduce,
             hiz_layout,
             hiz_read_layout,
+            grid_count,
+            grid_scan,
+            grid_fill,
+            grid_layout,
             cull_layout,
             shade_layout,
             prepass,
@@ -394,18 +421,17 @@ impl Renderer {
         let bounds = scene.bounds().ok_or(ViewError::EmptyScene)?;
         let part = Partition::new(scene);
         let (lights, report) = lights(scene);
-        let grid = LightGrid::build(scene, &lights);
+        let t_grid = Instant::now();
+        let light_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("lights"),
+            contents: bytemuck::cast_slice(&nonempty(&lights)),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let (grid, ranges, light_indices) = self.light_grid(scene, &light_buf, lights.len() as u32)?;
+        let grid_ms = t_grid.elapsed().as_secs_f64() * 1e3;
         let init = |label, contents: &[u8], usage| {
             self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
-        // Bindings may not be empty: one zeroed element stands for none.
-        fn nonempty<T: Pod + Zeroable>(v: &[T]) -> Vec<T> {
-            if v.is_empty() {
-                vec![T::zeroed()]
-            } else {
-                v.to_vec()
-            }
-        }
         use wgpu::BufferUsages as U;
         let vertices = init("vertices", bytemuck::cast_slice(&scene.vertices), U::VERTEX);
         let indices = init("indices", bytemuck::cast_slice(&part.indices), U::INDEX);
@@ -422,9 +448,6 @@ impl Renderer {
             mapped_at_creation: false,
         });
         let materials = init("materials", bytemuck::cast_slice(&nonempty(&scene.materials)), U::STORAGE);
-        let light_buf = init("lights", bytemuck::cast_slice(&nonempty(&lights)), U::STORAGE);
-        let ranges = init("light ranges", bytemuck::cast_slice(&grid.ranges), U::STORAGE);
-        let light_indices = init("light indices", bytemuck::cast_slice(&nonempty(&grid.indices)), U::STORAGE);
         let group = |layout, entries: &[(u32, &wgpu::Buffer)]| {
             let entries: Vec<wgpu::BindGroupEntry> =
                 entries.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
@@ -444,6 +467,7 @@ impl Renderer {
             uniform,
             clusters: part.clusters,
             grid,
+            grid_ms,
             lights: report,
             bounds,
             triangles: scene.triangles() as u64,
@@ -766,6 +790,103 @@ impl Renderer {
         (tex, sizes)
     }
 
+    /// Builds the light grid on the GPU (count, scan, fill) and reads it
+    /// back; returns it with the ranges and indices buffers the shading
+    /// pass binds.
+    fn light_grid(&self, scene: &Scene, lights: &wgpu::Buffer, count: u32) -> Result<(LightGrid, wgpu::Buffer, wgpu::Buffer), ViewError> {
+        use wgpu::BufferUsages as U;
+        let (lo, cell, unit) = grid_frame(scene);
+        let cells = (GRID * GRID * GRID) as u64;
+        let u = GridUniform { lo: lo.extend(0.0).to_array(), cell: cell.extend(0.0).to_array(), counts: [count, 0, 0, 0] };
+        let uniform = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("light grid"),
+            contents: bytemuck::bytes_of(&u),
+            usage: U::UNIFORM,
+        });
+        let buffer = |label, size: u64, usage| {
+            self.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+        };
+        let ranges = buffer("light ranges", 8 * cells, U::STORAGE | U::COPY_SRC);
+        let total = buffer("light total", 4, U::STORAGE | U::COPY_SRC);
+        let placeholder = buffer("no light indices yet", 4, U::STORAGE);
+        let group = |indices: &wgpu::Buffer| {
+            self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &self.grid_layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: lights.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: ranges.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: indices.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: total.as_entire_binding() },
+                ],
+            })
+        };
+        let groups = (cells as u32).div_ceil(64);
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        {
+            let g = group(&placeholder);
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_bind_group(0, &g, &[]);
+            pass.set_pipeline(&self.grid_count);
+            pass.dispatch_workgroups(groups, 1, 1);
+            pass.set_pipeline(&self.grid_scan);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        let total_read = self.read_buffers(enc, &[(&total, 4)])?;
+        let n = u32::from_le_bytes(total_read[0][..4].try_into().expect("4 bytes")) as u64;
+        let indices = buffer("light indices", 4 * n.max(1), U::STORAGE | U::COPY_SRC);
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        {
+            let g = group(&indices);
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_bind_group(0, &g, &[]);
+            pass.set_pipeline(&self.grid_fill);
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+        let read = self.read_buffers(enc, &[(&ranges, 8 * cells), (&indices, 4 * n.max(1))])?;
+        let ranges_v: Vec<[u32; 2]> = bytemuck::cast_slice::<u8, u32>(&read[0]).chunks_exact(2).map(|p| [p[0], p[1]]).collect();
+        let indices_v: Vec<u32> = bytemuck::cast_slice::<u8, u32>(&read[1])[..n as usize].to_vec();
+        Ok((LightGrid { lo, cell, unit, ranges: ranges_v, indices: indices_v }, ranges, indices))
+    }
+
+    /// Submits `enc` after copying each buffer's first bytes to a readback
+    /// buffer, waits, and returns the bytes.
+    fn read_buffers(&self, mut enc: wgpu::CommandEncoder, bufs: &[(&wgpu::Buffer, u64)]) -> Result<Vec<Vec<u8>>, ViewError> {
+        let reads: Vec<wgpu::Buffer> = bufs
+            .iter()
+            .map(|(b, size)| {
+                let r = self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("readback"),
+                    size: *size,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                enc.copy_buffer_to_buffer(b, 0, &r, 0, *size);
+                r
+            })
+            .collect();
+        self.queue.submit([enc.finish()]);
+        let rx: Vec<_> = reads
+            .iter()
+            .map(|b| {
+                let (tx, rx) = std::sync::mpsc::channel();
+                b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+                    let _ = tx.send(r);
+                });
+                rx
+            })
+            .collect();
+        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| ViewError::Device(e.to_string()))?;
+        self.check()?;
+        let mut out = Vec::with_capacity(reads.len());
+        for (b, rx) in reads.iter().zip(rx) {
+            rx.recv().map_err(|e| ViewError::Readback(e.to_string()))?.map_err(|e| ViewError::Readback(e.to_string()))?;
+            out.push(b.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?.to_vec());
+        }
+        Ok(out)
+    }
+
     /// A 1×1 float texture view, bound where a pass reads no source level.
     fn dummy_float(&self) -> wgpu::TextureView {
         self.device
@@ -814,6 +935,24 @@ impl Renderer {
             .collect();
         (bufs, sizes.clone())
     }
+}
+
+/// Bindings may not be empty: one zeroed element stands for none.
+fn nonempty<T: Pod + Zeroable>(v: &[T]) -> Vec<T> {
+    if v.is_empty() {
+        vec![T::zeroed()]
+    } else {
+        v.to_vec()
+    }
+}
+
+/// The light grid pass's uniform block (`grid.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GridUniform {
+    lo: [f32; 4],
+    cell: [f32; 4],
+    counts: [u32; 4],
 }
 
 /// Bytes per row of a 4-byte-texel copy, aligned as copies require.

@@ -10,7 +10,8 @@
 //!   (world-space and clip-space separating axes), run in a compute pass
 //!   (`shaders/cull.wgsl`);
 //! - [`lights`]: lights merged from emissive triangles, attenuation
-//!   `i / (d³ + 1)`, the 32³ light grid (CPU build);
+//!   `i / (d³ + 1)`, the 32³ light grid (built on the GPU by
+//!   `shaders/grid.wgsl`; the CPU build is its reference);
 //! - [`hiz`]: Hi-Z occlusion culling — a depth pass of the frustum
 //!   survivors, a max-depth pyramid built on the GPU, each box tested at
 //!   the level where it covers at most 2×2 texels (CPU reference kept);
@@ -20,8 +21,7 @@
 //! - [`scenes`]: deterministic test scenes (the Cornell box).
 //!
 //! **Not built yet** (the CLI says so when asked): the two-pass occlusion
-//! variant (last frame's visible set first), the light grid built on the
-//! GPU, alpha cut-outs and textures, the interactive window (`voxkit
+//! variant (last frame's visible set first), alpha cut-outs and textures, the interactive window (`voxkit
 //! view`), the ray spray into a point cloud, and the large procedural
 //! scene.
 

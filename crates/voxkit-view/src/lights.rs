@@ -13,9 +13,17 @@
 //! - **Light grid.** 32×32×32 cells over the scene box; a cell lists the
 //!   lights whose largest contribution to any point of the cell,
 //!   `i / (d_min³ + 1)` with `d_min` the distance from the light to the
-//!   cell's box, exceeds [`THRESHOLD`]. The fragment shader loops over its
-//!   cell's list only. This CPU build is the reference; `list_for_point`
-//!   is what the shader does.
+//!   cell's box, exceeds [`THRESHOLD`]. Solved for the distance, that is
+//!   `d_min < cbrt(i / THRESHOLD − 1)`: each light carries the square of
+//!   this reach in world units, and a cell lists it when the squared
+//!   distance from the light to the cell's box is below. The fragment
+//!   shader loops over its cell's list only.
+//! - **Built on the GPU** (`grid.wgsl`: count per cell, one scan, fill in
+//!   light order), as the report proposes; [`LightGrid::build`] is the CPU
+//!   reference. Both evaluate the same `f32` expressions; a GPU may fuse a
+//!   multiply and an add, so the two can differ only for a light whose
+//!   reach meets a cell's box within rounding (the tests bound that
+//!   margin).
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -37,7 +45,8 @@ pub const THRESHOLD: f32 = 0.02;
 pub struct Light {
     /// World position; `w` the intensity.
     pub position_intensity: [f32; 4],
-    /// Linear colour (the emission); `w` unused.
+    /// Linear colour (the emission); `w` the squared reach in world
+    /// units (the distance where the contribution falls to [`THRESHOLD`]).
     pub colour: [f32; 4],
 }
 
@@ -98,11 +107,34 @@ pub fn lights(scene: &Scene) -> (Vec<Light>, LightReport) {
             let p = sum / area;
             let e = scene.materials[m as usize].emission_shininess;
             let peak = e[0].max(e[1]).max(e[2]);
-            Light { position_intensity: [p.x, p.y, p.z, area.sqrt() * peak], colour: [e[0] / peak, e[1] / peak, e[2] / peak, 0.0] }
+            let i = area.sqrt() * peak;
+            let reach = (i / THRESHOLD - 1.0).max(0.0).cbrt() * unit;
+            Light { position_intensity: [p.x, p.y, p.z, i], colour: [e[0] / peak, e[1] / peak, e[2] / peak, reach * reach] }
         })
         .collect();
     report.lights = out.len();
     (out, report)
+}
+
+/// The grid's lower corner, cell size and attenuation unit.
+pub fn grid_frame(scene: &Scene) -> (Vec3, Vec3, f32) {
+    let (lo, hi, unit) = frame(scene);
+    (lo, ((hi - lo) / GRID as f32).max(Vec3::splat(unit * 1e-3)), unit)
+}
+
+/// Whether light `l` reaches the box `clo..chi` above the threshold.
+pub fn reaches(l: &Light, clo: Vec3, chi: Vec3) -> bool {
+    let p = Vec3::from_slice(&l.position_intensity[..3]);
+    let d = p.clamp(clo, chi) - p;
+    d.x * d.x + d.y * d.y + d.z * d.z < l.colour[3]
+}
+
+/// By how much (relative) light `l` misses or makes the box: small values
+/// are decided by rounding.
+pub fn reach_margin(l: &Light, clo: Vec3, chi: Vec3) -> f32 {
+    let p = Vec3::from_slice(&l.position_intensity[..3]);
+    let d = p.clamp(clo, chi) - p;
+    ((d.x * d.x + d.y * d.y + d.z * d.z) - l.colour[3]).abs() / l.colour[3].max(f32::MIN_POSITIVE)
 }
 
 /// A light's contribution at distance `d` units.
@@ -113,8 +145,7 @@ pub fn attenuation(intensity: f32, d: f32) -> f32 {
 impl LightGrid {
     /// Builds the grid over the scene box for `lights`.
     pub fn build(scene: &Scene, lights: &[Light]) -> LightGrid {
-        let (lo, hi, unit) = frame(scene);
-        let cell = ((hi - lo) / GRID as f32).max(Vec3::splat(unit * 1e-3));
+        let (lo, cell, unit) = grid_frame(scene);
         let mut ranges = Vec::with_capacity(GRID * GRID * GRID);
         let mut indices = Vec::new();
         for z in 0..GRID {
@@ -124,9 +155,7 @@ impl LightGrid {
                     let chi = clo + cell;
                     let first = indices.len() as u32;
                     for (n, l) in lights.iter().enumerate() {
-                        let p = Vec3::from_slice(&l.position_intensity[..3]);
-                        let d = (p.clamp(clo, chi) - p).length() / unit;
-                        if attenuation(l.position_intensity[3], d) > THRESHOLD {
+                        if reaches(l, clo, chi) {
                             indices.push(n as u32);
                         }
                     }

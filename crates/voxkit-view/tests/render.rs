@@ -153,3 +153,41 @@ fn the_city_is_large_lit_and_deterministic() {
     let (again, _) = scenes::city();
     assert!(again.positions == mesh.positions && again.triangles == mesh.triangles);
 }
+
+/// The GPU's light grid is the CPU build's, but for lights whose reach
+/// meets a cell's box within rounding (a fused multiply–add on the GPU).
+fn check_light_grid(r: &Renderer, scene: &Scene, what: &str) {
+    use voxkit_view::lights::{lights, reach_margin, LightGrid, GRID};
+    let g = r.upload(scene).unwrap();
+    let (ls, _) = lights(scene);
+    let cpu = LightGrid::build(scene, &ls);
+    assert_eq!((g.grid.lo, g.grid.cell, g.grid.unit), (cpu.lo, cpu.cell, cpu.unit));
+    let mut differ = 0;
+    for c in 0..GRID * GRID * GRID {
+        let list = |grid: &LightGrid| {
+            let [first, n] = grid.ranges[c];
+            grid.indices[first as usize..(first + n) as usize].to_vec()
+        };
+        let (a, b) = (list(&g.grid), list(&cpu));
+        if a != b {
+            let clo = cpu.lo + cpu.cell * glam::Vec3::new((c % GRID) as f32, ((c / GRID) % GRID) as f32, (c / (GRID * GRID)) as f32);
+            for l in a.iter().filter(|l| !b.contains(l)).chain(b.iter().filter(|l| !a.contains(l))) {
+                let m = reach_margin(&ls[*l as usize], clo, clo + cpu.cell);
+                assert!(m < 1e-5, "{what}: cell {c}, light {l}: GPU and CPU lists differ by more than rounding ({m})");
+                differ += 1;
+            }
+        }
+    }
+    assert!(differ <= 8, "{what}: {differ} borderline differences");
+    assert!(!cpu.indices.is_empty());
+}
+
+#[test]
+fn the_light_grid_built_on_the_gpu_is_the_cpu_build() {
+    let Some(r) = renderer() else { return };
+    check_light_grid(&r, &cornell(), "cornell");
+    let (mesh, app) = scenes::city();
+    let mut city = Scene::default();
+    city.add_mesh(mesh.as_ref(), &app);
+    check_light_grid(&r, &city, "city");
+}

@@ -161,7 +161,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         "triangles_drawn": first["triangles_drawn"],
         "lights": uploaded.lights.lights,
         "emissive_triangles": uploaded.lights.emissive_triangles,
-        "light_grid": {"cells": uploaded.grid.ranges.len(), "total": total, "mean": mean, "max": max},
+        "light_grid": {"cells": uploaded.grid.ranges.len(), "total": total, "mean": mean, "max": max, "built_on": "gpu", "build_ms": uploaded.grid_ms},
         "multi_draw": "multi_draw_indexed_indirect",
         "frame_ms": first["frame_ms"],
         "frames": frames,
