@@ -31,6 +31,9 @@ pub enum Command {
     /// --gpu, the GPU renderer: clusters, one multi-draw-indirect call, GPU
     /// frustum culling, light grid, Blinn–Phong).
     Render(RenderArgs),
+    /// Open a window on a mesh (and its voxels) with the GPU renderer:
+    /// orbit and fly camera, keys switching culling, prepass and gamma.
+    View(ViewArgs),
     /// Write a bundled test scene (OBJ + MTL): the Cornell box, or a city of
     /// about a million triangles with 169 emissive street lamps.
     Scene(SceneArgs),
@@ -350,6 +353,55 @@ pub struct GpuRenderArgs {
     /// drawn, lights, light grid, the draw call, frame times) as JSON.
     #[arg(long, value_name = "FILE")]
     pub stats_json: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+pub struct ViewArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
+    /// A mesh (drawn with its materials) or a voxel file (drawn as quads).
+    pub input: PathBuf,
+    /// Also draw this voxel file beside the mesh (or over it: --layout).
+    #[arg(long, value_name = "FILE", conflicts_with = "mode")]
+    pub voxels: Option<PathBuf>,
+    /// Also voxelize the mesh with this surface mode (and the grid
+    /// options) and draw the voxels beside it.
+    #[arg(long, value_enum)]
+    pub mode: Option<Mode>,
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// Voxels beside the mesh (side) or in its place (overlay).
+    #[arg(long, default_value = "side", value_parser = clap::builder::PossibleValuesParser::new(["side", "overlay"]))]
+    pub layout: String,
+    /// Window size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_name = "WxH")]
+    pub size: String,
+    /// The axis pointing up: x, y or z (default y).
+    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
+    pub up: Option<String>,
+    /// Starting camera: eye, target, vertical field of view in degrees.
+    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
+    pub camera: Option<String>,
+    /// Starting culling: none, frustum or occlusion (key C cycles).
+    #[arg(long, default_value = "occlusion", value_parser = clap::builder::PossibleValuesParser::new(["none", "frustum", "occlusion"]))]
+    pub culling: String,
+    /// Starting Z-prepass (key Z toggles).
+    #[arg(long, default_value = "off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub prepass: String,
+    /// Starting gamma correction (key G toggles).
+    #[arg(long, default_value = "on", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub gamma: String,
+    /// Scripted run: close after N frames (with --screenshot, save the last).
+    #[arg(long, value_name = "N")]
+    pub frames: Option<u32>,
+    /// With --frames: the last frame as PNG.
+    #[arg(long, value_name = "PNG", requires = "frames")]
+    pub screenshot: Option<PathBuf>,
+    /// Print one JSON object on stdout when the window closes.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Args, Debug)]

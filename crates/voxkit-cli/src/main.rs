@@ -31,6 +31,10 @@ fn main() -> ExitCode {
         Command::Render(a) => commands::render::run(a),
         #[cfg(feature = "gpu")]
         Command::Scene(a) => commands::scene::run(a),
+        #[cfg(feature = "gpu")]
+        Command::View(a) => commands::view::run(a),
+        #[cfg(not(feature = "gpu"))]
+        Command::View(_) => anyhow::bail!("this voxkit was built without the gpu feature, which holds the viewer"),
         #[cfg(not(feature = "gpu"))]
         Command::Scene(_) => anyhow::bail!("this voxkit was built without the gpu feature, which holds the scene generators"),
         Command::Convert(a) => commands::convert::run(a),

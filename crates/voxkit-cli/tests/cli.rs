@@ -683,3 +683,21 @@ fn gpu_renderer_options_give_one_line_errors() {
     }
     assert!(!std::path::Path::new(&png).exists());
 }
+
+#[test]
+fn view_without_a_display_says_so_in_one_line() {
+    let obj = unit_cube_obj("view-cube.obj");
+    let out = Command::new(env!("CARGO_BIN_EXE_voxkit"))
+        .args(["view", obj.as_str(), "--frames", "1"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("voxkit:")).collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(lines[0].contains("display") || lines[0].contains("no GPU adapter"), "{err}");
+    let e = error_line(&["view", obj.as_str(), "--frames", "0"]);
+    assert!(e.contains("--frames must be at least 1"), "{e}");
+}

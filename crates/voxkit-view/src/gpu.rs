@@ -112,6 +112,12 @@ pub struct Frame {
     pub stats: FrameStats,
 }
 
+/// A pipeline that copies a frame onto a window's texture format.
+pub struct Blit {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
 /// The frame's uniform block (`frame.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -159,7 +165,8 @@ pub struct GpuScene {
 
 /// An open device with the frame's pipelines.
 pub struct Renderer {
-    device: wgpu::Device,
+    pub(crate) adapter: wgpu::Adapter,
+    pub(crate) device: wgpu::Device,
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
     cull: wgpu::ComputePipeline,
@@ -201,8 +208,15 @@ impl Renderer {
     /// Opens the default adapter (high performance preferred).
     pub fn new() -> Result<Renderer, ViewError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Renderer::open(&instance, None)
+    }
+
+    /// Opens an adapter of `instance` (one that can present to `surface`,
+    /// when given).
+    pub fn open(instance: &wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Renderer, ViewError> {
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
+            compatible_surface: surface,
             ..Default::default()
         }))
         .map_err(|_| ViewError::NoAdapter)?;
@@ -378,6 +392,7 @@ impl Renderer {
         let shade = draw("shade", true, true, wgpu::CompareFunction::Less);
         let shade_equal = draw("shade after prepass", true, false, wgpu::CompareFunction::Equal);
         let r = Renderer {
+            adapter,
             device,
             queue,
             info,
@@ -402,6 +417,16 @@ impl Renderer {
         };
         r.check()?;
         Ok(r)
+    }
+
+    /// Shows a window's surface texture.
+    pub fn present_texture(&self, texture: wgpu::SurfaceTexture) {
+        self.queue.present(texture);
+    }
+
+    /// The largest picture side the adapter takes.
+    pub fn max_side(&self) -> u32 {
+        self.max_side
     }
 
     /// The adapter's name and backend.
@@ -476,6 +501,60 @@ impl Renderer {
 
     /// Renders one frame and reads it back.
     pub fn render(&self, s: &GpuScene, o: &FrameOptions) -> Result<Frame, ViewError> {
+        self.frame(s, o, None)
+    }
+
+    /// Renders one frame into `target` through `blit` (a window's surface
+    /// texture) instead of reading the picture back; the statistics are
+    /// read back as for [`Renderer::render`].
+    pub fn present(&self, s: &GpuScene, o: &FrameOptions, blit: &Blit, target: &wgpu::TextureView) -> Result<FrameStats, ViewError> {
+        Ok(self.frame(s, o, Some((blit, target)))?.stats)
+    }
+
+    /// A pipeline copying frames onto textures of `format`.
+    pub fn blit(&self, format: wgpu::TextureFormat) -> Blit {
+        let module = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("blit"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("shaders/blit.wgsl").into()),
+        });
+        let layout = self.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("blit"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            }],
+        });
+        let pl = self.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: None,
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = self.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("blit"),
+            layout: Some(&pl),
+            vertex: wgpu::VertexState { module: &module, entry_point: Some("vs"), compilation_options: Default::default(), buffers: &[] },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Blit { pipeline, layout }
+    }
+
+    fn frame(&self, s: &GpuScene, o: &FrameOptions, present: Option<(&Blit, &wgpu::TextureView)>) -> Result<Frame, ViewError> {
         if o.width == 0 || o.height == 0 || o.width > self.max_side || o.height > self.max_side {
             return Err(ViewError::Size { width: o.width, height: o.height, max: self.max_side });
         }
@@ -535,7 +614,8 @@ impl Renderer {
                 view_formats: &[],
             })
         };
-        let colour = texture(COLOUR, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC);
+        let colour =
+            texture(COLOUR, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING);
         let occlusion = o.culling == Culling::Occlusion;
         let depth = texture(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING);
         let (cview, dview) = (colour.create_view(&Default::default()), depth.create_view(&Default::default()));
@@ -597,15 +677,45 @@ impl Renderer {
                 mapped_at_creation: false,
             })
         };
-        let pixels = readback("picture", row as u64 * o.height as u64);
-        enc.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo { texture: &colour, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &pixels,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(o.height) },
-            },
-            wgpu::Extent3d { width: o.width, height: o.height, depth_or_array_layers: 1 },
-        );
+        let pixels = readback("picture", if present.is_some() { 256 } else { row as u64 * o.height as u64 });
+        match present {
+            Some((blit, target)) => {
+                let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: None,
+                    layout: &blit.layout,
+                    entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&cview) }],
+                });
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("blit"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: target,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(BACKGROUND), store: wgpu::StoreOp::Store },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&blit.pipeline);
+                pass.set_bind_group(0, &group, &[]);
+                pass.draw(0..3, 0..1);
+            }
+            None => enc.copy_texture_to_buffer(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &colour,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &pixels,
+                    layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(o.height) },
+                },
+                wgpu::Extent3d { width: o.width, height: o.height, depth_or_array_layers: 1 },
+            ),
+        }
         let hiz_read = match (&hiz, o.read_hiz) {
             (Some(h), true) => Some(self.copy_levels(&mut enc, h)),
             _ => None,
@@ -646,7 +756,7 @@ impl Renderer {
             rx.recv().map_err(|e| ViewError::Readback(e.to_string()))?.map_err(|e| ViewError::Readback(e.to_string()))?;
         }
         let mut rgba = Vec::with_capacity(4 * o.width as usize * o.height as usize);
-        {
+        if present.is_none() {
             let data = pixels.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
             for y in 0..o.height as usize {
                 rgba.extend_from_slice(&data[y * row as usize..y * row as usize + 4 * o.width as usize]);

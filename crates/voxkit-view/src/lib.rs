@@ -32,6 +32,8 @@ pub mod lights;
 pub mod partition;
 pub mod scene;
 pub mod scenes;
+#[cfg(feature = "window")]
+pub mod window;
 
 pub use camera::Camera;
 pub use gpu::{Culling, Frame, FrameOptions, FrameStats, GpuScene, Renderer};
@@ -54,6 +56,9 @@ pub enum ViewError {
     /// Nothing to draw.
     #[error("the scene has no drawable triangles")]
     EmptyScene,
+    /// The window could not be opened or presented to.
+    #[error("window: {0} (a display is needed: set DISPLAY, or run under xvfb-run)")]
+    Window(String),
     /// A picture larger than the device's textures.
     #[error("picture {width}x{height}: each side must be 1..={max} on this adapter")]
     Size {

@@ -14,4 +14,6 @@ pub mod render;
 pub mod render_gpu;
 #[cfg(feature = "gpu")]
 pub mod scene;
+#[cfg(feature = "gpu")]
+pub mod view;
 pub mod voxelize;

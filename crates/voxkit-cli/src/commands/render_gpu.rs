@@ -15,8 +15,25 @@ use crate::commands::render::{check_png_path, options};
 /// Voxel quads' material: light grey, rough.
 const VOXEL_COLOUR: [f32; 3] = [0.72, 0.72, 0.70];
 
+/// Adds a voxel file's greedy quads, placed where the file says (else
+/// voxel `(i, j, k)` at `(i, j, k)`), moved by `offset`.
+pub(crate) fn add_voxel_file(scene: &mut Scene, path: &Path, up: Option<&str>, offset: Vec3) -> Result<()> {
+    let upname = up.and_then(voxkit_io::orient::Up::from_name).unwrap_or_default();
+    let loaded = voxkit_io::read_voxels_with(path, upname)?;
+    let (origin, size) = loaded.placement.map(|(o, s)| (o.as_vec3(), s as f32)).unwrap_or((Vec3::ZERO, 1.0));
+    add_voxels(scene, &loaded.bits, origin + offset, size);
+    Ok(())
+}
+
+/// Adds voxels as greedy quads of one clay material.
+pub(crate) fn add_voxels(scene: &mut Scene, bits: &voxkit::grid::dense::DenseBits, origin: Vec3, size: f32) {
+    let quads = voxkit::export::greedy::greedy_quads(bits);
+    let m = scene.add_material(voxkit_view::scene::ShadeMaterial::new(VOXEL_COLOUR, [0.0; 3], 0.7));
+    scene.add_quads(&quads, origin, size, m);
+}
+
 /// Parses `EX,EY,EZ,TX,TY,TZ[,FOV]`.
-fn parse_camera(s: &str, up: Vec3) -> Result<Camera> {
+pub(crate) fn parse_camera(s: &str, up: Vec3) -> Result<Camera> {
     let v: Option<Vec<f32>> = s.split(',').map(|x| x.trim().parse::<f32>().ok().filter(|v| v.is_finite())).collect();
     let Some(v) = v.filter(|v| v.len() == 6 || v.len() == 7) else {
         bail!("--camera takes EX,EY,EZ,TX,TY,TZ[,FOV]: an eye, a target and a vertical field of view in degrees, not {s:?}")
@@ -59,12 +76,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let t0 = std::time::Instant::now();
     let mut scene = Scene::default();
     let kind = if voxkit_io::is_voxel_file(&a.input) {
-        let upname = a.up.as_deref().and_then(voxkit_io::orient::Up::from_name).unwrap_or_default();
-        let loaded = voxkit_io::read_voxels_with(&a.input, upname)?;
-        let quads = voxkit::export::greedy::greedy_quads(&loaded.bits);
-        let (origin, size) = loaded.placement.map(|(o, s)| (o.as_vec3(), s as f32)).unwrap_or((Vec3::ZERO, 1.0));
-        let m = scene.add_material(voxkit_view::scene::ShadeMaterial::new(VOXEL_COLOUR, [0.0; 3], 0.7));
-        scene.add_quads(&quads, origin, size, m);
+        add_voxel_file(&mut scene, &a.input, a.up.as_deref(), Vec3::ZERO)?;
         "voxel file"
     } else {
         let loaded = voxkit_io::read_mesh_with(&a.input, &voxkit_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;

@@ -1,0 +1,90 @@
+//! `voxkit view`: the interactive GPU viewer (voxkit-view's window) on a
+//! mesh, a voxel file, or a mesh beside its voxels.
+
+use anyhow::{bail, Context, Result};
+use serde_json::json;
+use voxkit::glam::Vec3;
+use voxkit::voxelize::{self, Options};
+use voxkit_view::window::{run as run_window, ViewOptions};
+use voxkit_view::{Culling, Scene};
+
+use crate::args::ViewArgs;
+use crate::commands::render_gpu::{add_voxel_file, add_voxels, parse_camera};
+use crate::plan;
+
+pub fn run(a: &ViewArgs) -> Result<()> {
+    let size: Option<(u32, u32)> = a.size.split_once(['x', 'X']).and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
+    let Some((width, height)) = size.filter(|&(w, h)| (1..=16_384).contains(&w) && (1..=16_384).contains(&h)) else {
+        bail!("--size takes WIDTHxHEIGHT in pixels (each 1..=16384), not {:?}", a.size)
+    };
+    if let Some(p) = &a.screenshot {
+        crate::commands::render::check_png_path(p)?;
+        voxkit_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.input))?;
+    }
+    if a.frames == Some(0) {
+        bail!("--frames must be at least 1");
+    }
+    let up_axis = match a.up.as_deref() {
+        Some("x") => 0,
+        Some("z") => 2,
+        _ => 1,
+    };
+    let mut up = Vec3::ZERO;
+    up[up_axis] = 1.0;
+    let mut scene = Scene::default();
+    if voxkit_io::is_voxel_file(&a.input) {
+        if a.mode.is_some() || a.voxels.is_some() {
+            bail!("--mode and --voxels draw voxels beside a mesh; {} is already a voxel file", a.input.display());
+        }
+        add_voxel_file(&mut scene, &a.input, a.up.as_deref(), Vec3::ZERO)?;
+    } else {
+        let loaded = voxkit_io::read_mesh_with(&a.input, &voxkit_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
+        if let Some(p) = &a.screenshot {
+            voxkit_io::atomic::refuse_overwriting_inputs(p, &loaded.sources)?;
+        }
+        for w in &loaded.warnings {
+            eprintln!("voxkit: warning: {}: {w}", a.input.display());
+        }
+        scene.add_mesh(loaded.mesh.as_ref(), &loaded.appearance);
+        let (lo, hi) = scene.bounds().with_context(|| format!("{}: nothing to draw (no triangle with area)", a.input.display()))?;
+        // Beside: shifted along the first horizontal axis by the mesh's extent and a gap.
+        let mut offset = Vec3::ZERO;
+        if a.layout == "side" {
+            let h = (up_axis + 1) % 3;
+            offset[h] = (hi[h] - lo[h]) * 1.15;
+        }
+        if let Some(v) = &a.voxels {
+            add_voxel_file(&mut scene, v, a.up.as_deref(), offset)?;
+        } else if let Some(mode) = a.mode {
+            let (mode, _) = voxkit_job::resolve_method(mode.into(), voxkit_job::Method::Fast)
+                .context("view voxelizes with a surface or line mode; voxelize solids to a file and pass --voxels")?;
+            let grid = plan::grid_request(&a.grid)?.fit(&loaded.report.bounds)?;
+            plan::check_memory(&grid)?;
+            let (bits, _) = voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &Options::default());
+            add_voxels(&mut scene, &bits.to_dense(), grid.origin().as_vec3() + offset, grid.voxel_size() as f32);
+        }
+    }
+    let culling = match a.culling.as_str() {
+        "none" => Culling::None,
+        "frustum" => Culling::Frustum,
+        _ => Culling::Occlusion,
+    };
+    let camera = a.camera.as_deref().map(|s| parse_camera(s, up)).transpose()?;
+    let opts =
+        ViewOptions { width, height, camera, up: up_axis, culling, prepass: a.prepass == "on", gamma: a.gamma == "on", frames: a.frames };
+    let report = run_window(scene, opts)?;
+    let mut shot = None;
+    if let (Some(p), Some(f)) = (&a.screenshot, &report.screenshot) {
+        let rgb: Vec<u8> = f.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+        voxkit_io::write_png(p, f.width, f.height, &rgb)?;
+        shot = Some((f.width, f.height));
+    }
+    let c = report.camera;
+    let camera = format!("{},{},{},{},{},{},{}", c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.fov_deg);
+    if a.json {
+        let v = json!({"input": a.input, "frames": report.frames, "adapter": report.adapter, "camera": camera,
+            "screenshot": a.screenshot, "screenshot_size": shot.map(|(w, h)| [w, h])});
+        return crate::print_stdout(&v.to_string());
+    }
+    crate::print_stdout(&format!("view: {} frames on {}; last camera --camera {camera}", report.frames, report.adapter))
+}

@@ -1,0 +1,359 @@
+//! The interactive viewer (`voxkit view`): a resizable window (winit,
+//! X11) showing [`crate::gpu::Renderer`]'s frames, with an orbit and fly
+//! camera and keys that switch each technique. The statistics line is the
+//! window's title.
+//!
+//! Controls: left drag orbits around the target, right drag pans, the
+//! wheel zooms; W/A/S/D/Q/E fly (the target moves along); C cycles culling
+//! none → frustum → occlusion; Z toggles the Z-prepass; G gamma; R resets
+//! the camera; Escape quits.
+//!
+//! Scripted (`frames`): after that many frames the viewer renders one more
+//! frame off screen with the current camera and size, hands it to the
+//! caller (a screenshot) and closes; CI runs this under Xvfb.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::Vec3;
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::window::{Window, WindowId};
+
+use crate::gpu::{Blit, Culling, Frame, FrameOptions, GpuScene, Renderer};
+use crate::{Camera, Scene, ViewError};
+
+/// How the viewer starts.
+#[derive(Clone, Copy, Debug)]
+pub struct ViewOptions {
+    /// Initial window size in pixels.
+    pub width: u32,
+    /// Initial height.
+    pub height: u32,
+    /// Starting camera (`None`: framing the scene).
+    pub camera: Option<Camera>,
+    /// The up axis (0, 1, 2).
+    pub up: usize,
+    /// Culling to start with.
+    pub culling: Culling,
+    /// Z-prepass at start.
+    pub prepass: bool,
+    /// Gamma at start.
+    pub gamma: bool,
+    /// Close after this many frames, with a screenshot.
+    pub frames: Option<u32>,
+}
+
+/// What a viewer session did.
+#[derive(Debug)]
+pub struct ViewReport {
+    /// Frames shown.
+    pub frames: u32,
+    /// The adapter.
+    pub adapter: String,
+    /// The last frame rendered off screen, in scripted runs.
+    pub screenshot: Option<Frame>,
+    /// The camera of that frame.
+    pub camera: Camera,
+}
+
+/// Orbit camera state: a target, a distance and two angles around `up`.
+struct Orbit {
+    target: Vec3,
+    distance: f32,
+    yaw: f32,
+    pitch: f32,
+    up: usize,
+    fov_deg: f32,
+}
+
+impl Orbit {
+    fn from_camera(c: &Camera, up: usize) -> Orbit {
+        let d = c.eye - c.target;
+        let (h0, h1) = ((up + 1) % 3, (up + 2) % 3);
+        let distance = d.length().max(1e-6);
+        Orbit {
+            target: c.target,
+            distance,
+            yaw: d[h1].atan2(d[h0]),
+            pitch: (d[up] / distance).clamp(-1.0, 1.0).asin(),
+            up,
+            fov_deg: c.fov_deg,
+        }
+    }
+
+    fn camera(&self) -> Camera {
+        let (h0, h1) = ((self.up + 1) % 3, (self.up + 2) % 3);
+        let mut d = Vec3::ZERO;
+        d[h0] = self.pitch.cos() * self.yaw.cos();
+        d[h1] = self.pitch.cos() * self.yaw.sin();
+        d[self.up] = self.pitch.sin();
+        let mut up = Vec3::ZERO;
+        up[self.up] = 1.0;
+        Camera { eye: self.target + d * self.distance, target: self.target, up, fov_deg: self.fov_deg }
+    }
+
+    /// Forward and right directions of the current view.
+    fn axes(&self) -> (Vec3, Vec3) {
+        let c = self.camera();
+        let fwd = (c.target - c.eye).normalize_or_zero();
+        (fwd, fwd.cross(c.up).normalize_or_zero())
+    }
+}
+
+struct Active {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    view_format: wgpu::TextureFormat,
+    renderer: Renderer,
+    uploaded: GpuScene,
+    blit: Blit,
+}
+
+struct App {
+    scene: Option<Scene>,
+    opts: ViewOptions,
+    home: Camera,
+    orbit: Orbit,
+    culling: Culling,
+    prepass: bool,
+    gamma: bool,
+    active: Option<Active>,
+    frames: u32,
+    drag: Option<(MouseButton, (f64, f64))>,
+    cursor: (f64, f64),
+    error: Option<ViewError>,
+    screenshot: Option<(Frame, Camera)>,
+    adapter: String,
+}
+
+/// Opens the window and runs until it is closed (or, scripted, until
+/// `frames` frames were shown).
+pub fn run(scene: Scene, opts: ViewOptions) -> Result<ViewReport, ViewError> {
+    let (lo, hi) = scene.bounds().ok_or(ViewError::EmptyScene)?;
+    let home = opts.camera.unwrap_or_else(|| Camera::framing(lo, hi, opts.up));
+    let event_loop = EventLoop::new().map_err(|e| ViewError::Window(e.to_string()))?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut app = App {
+        scene: Some(scene),
+        opts,
+        home,
+        orbit: Orbit::from_camera(&home, opts.up),
+        culling: opts.culling,
+        prepass: opts.prepass,
+        gamma: opts.gamma,
+        active: None,
+        frames: 0,
+        drag: None,
+        cursor: (0.0, 0.0),
+        error: None,
+        screenshot: None,
+        adapter: String::new(),
+    };
+    event_loop.run_app(&mut app).map_err(|e| ViewError::Window(e.to_string()))?;
+    if let Some(e) = app.error {
+        return Err(e);
+    }
+    let (screenshot, camera) = match app.screenshot {
+        Some((f, c)) => (Some(f), c),
+        None => (None, app.orbit.camera()),
+    };
+    Ok(ViewReport { frames: app.frames, adapter: app.adapter, screenshot, camera })
+}
+
+impl App {
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: ViewError) {
+        self.error.get_or_insert(e);
+        event_loop.exit();
+    }
+
+    fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<Active, ViewError> {
+        let attrs = Window::default_attributes()
+            .with_title("voxkit view")
+            .with_inner_size(PhysicalSize::new(self.opts.width.max(1), self.opts.height.max(1)));
+        let window = Arc::new(event_loop.create_window(attrs).map_err(|e| ViewError::Window(e.to_string()))?);
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(event_loop.owned_display_handle())));
+        let surface = instance.create_surface(window.clone()).map_err(|e| ViewError::Window(e.to_string()))?;
+        let renderer = Renderer::open(&instance, Some(&surface))?;
+        let size = window.inner_size();
+        let mut config = surface
+            .get_default_config(&renderer.adapter, size.width.max(1), size.height.max(1))
+            .ok_or_else(|| ViewError::Window("the adapter cannot present to this window".into()))?;
+        // The frame is already gamma-corrected (or not, as asked): present
+        // it through a non-sRGB view so the bytes are shown as they are.
+        let view_format = config.format.remove_srgb_suffix();
+        if view_format != config.format {
+            config.view_formats = vec![view_format];
+        }
+        config.present_mode = wgpu::PresentMode::AutoVsync;
+        surface.configure(&renderer.device, &config);
+        let scene = self.scene.take().ok_or(ViewError::EmptyScene)?;
+        let uploaded = renderer.upload(&scene)?;
+        let blit = renderer.blit(view_format);
+        self.adapter = renderer.adapter();
+        Ok(Active { window, surface, config, view_format, renderer, uploaded, blit })
+    }
+
+    fn options(&self, width: u32, height: u32) -> FrameOptions {
+        FrameOptions {
+            width,
+            height,
+            camera: self.orbit.camera(),
+            culling: self.culling,
+            prepass: self.prepass,
+            gamma: self.gamma,
+            read_hiz: false,
+        }
+    }
+
+    fn draw(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(a) = &self.active else { return };
+        let (w, h) = (a.config.width, a.config.height);
+        let texture = match a.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                a.surface.configure(&a.renderer.device, &a.config);
+                return;
+            }
+            _ => return,
+        };
+        let view = texture.texture.create_view(&wgpu::TextureViewDescriptor { format: Some(a.view_format), ..Default::default() });
+        let t0 = Instant::now();
+        let stats = match a.renderer.present(&a.uploaded, &self.options(w, h), &a.blit, &view) {
+            Ok(s) => s,
+            Err(e) => return self.fail(event_loop, e),
+        };
+        a.renderer.present_texture(texture);
+        self.frames += 1;
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        let culling = match self.culling {
+            Culling::None => "none",
+            Culling::Frustum => "frustum",
+            Culling::Occlusion => "occlusion",
+        };
+        let kept = stats.clusters_after_occlusion.unwrap_or(stats.clusters_after_frustum);
+        a.window.set_title(&format!(
+            "voxkit view | culling {culling} (C), prepass {} (Z), gamma {} (G) | clusters {}/{}/{} | {} of {} triangles | {} lights | {:.1} ms",
+            if self.prepass { "on" } else { "off" },
+            if self.gamma { "on" } else { "off" },
+            kept,
+            stats.clusters_after_frustum,
+            stats.clusters,
+            stats.triangles_drawn,
+            stats.triangles,
+            a.uploaded.lights.lights,
+            ms,
+        ));
+        if self.opts.frames.is_some_and(|n| self.frames >= n) {
+            let o = self.options(w, h);
+            match a.renderer.render(&a.uploaded, &o) {
+                Ok(f) => self.screenshot = Some((f, o.camera)),
+                Err(e) => return self.fail(event_loop, e),
+            }
+            event_loop.exit();
+        }
+    }
+
+    fn key(&mut self, code: KeyCode, event_loop: &ActiveEventLoop) {
+        let (fwd, right) = self.orbit.axes();
+        let step = self.orbit.distance * 0.05;
+        let mut up = Vec3::ZERO;
+        up[self.orbit.up] = 1.0;
+        match code {
+            KeyCode::Escape => event_loop.exit(),
+            KeyCode::KeyC => {
+                self.culling = match self.culling {
+                    Culling::None => Culling::Frustum,
+                    Culling::Frustum => Culling::Occlusion,
+                    Culling::Occlusion => Culling::None,
+                }
+            }
+            KeyCode::KeyZ => self.prepass = !self.prepass,
+            KeyCode::KeyG => self.gamma = !self.gamma,
+            KeyCode::KeyR => self.orbit = Orbit::from_camera(&self.home, self.orbit.up),
+            KeyCode::KeyW => self.orbit.target += fwd * step,
+            KeyCode::KeyS => self.orbit.target -= fwd * step,
+            KeyCode::KeyD => self.orbit.target += right * step,
+            KeyCode::KeyA => self.orbit.target -= right * step,
+            KeyCode::KeyE => self.orbit.target += up * step,
+            KeyCode::KeyQ => self.orbit.target -= up * step,
+            _ => {}
+        }
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.active.is_some() {
+            return;
+        }
+        match self.open(event_loop) {
+            Ok(a) => {
+                a.window.request_redraw();
+                self.active = Some(a);
+            }
+            Err(e) => self.fail(event_loop, e),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                if let Some(a) = &mut self.active {
+                    a.config.width = size.width.clamp(1, a.renderer.max_side());
+                    a.config.height = size.height.clamp(1, a.renderer.max_side());
+                    a.surface.configure(&a.renderer.device, &a.config);
+                }
+            }
+            WindowEvent::RedrawRequested => self.draw(event_loop),
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    self.key(code, event_loop);
+                }
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                self.drag = (state == ElementState::Pressed).then_some((button, self.cursor));
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                let (x, y) = (position.x, position.y);
+                if let Some((button, (px, py))) = self.drag {
+                    let (dx, dy) = ((x - px) as f32, (y - py) as f32);
+                    match button {
+                        MouseButton::Left => {
+                            self.orbit.yaw += dx * 0.01;
+                            self.orbit.pitch = (self.orbit.pitch + dy * 0.01).clamp(-1.55, 1.55);
+                        }
+                        _ => {
+                            let (_, right) = self.orbit.axes();
+                            let up = right.cross((self.orbit.camera().target - self.orbit.camera().eye).normalize_or_zero());
+                            let k = self.orbit.distance * 0.002;
+                            self.orbit.target += (-right * dx + up * dy) * k;
+                        }
+                    }
+                    self.drag = Some((button, (x, y)));
+                }
+                self.cursor = (x, y);
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                self.orbit.distance = (self.orbit.distance * 0.9f32.powf(lines)).max(1e-6);
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        if let Some(a) = &self.active {
+            a.window.request_redraw();
+        }
+    }
+}
