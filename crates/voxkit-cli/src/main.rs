@@ -34,9 +34,9 @@ fn main() -> ExitCode {
         #[cfg(feature = "gpu")]
         Command::View(a) => commands::view::run(a),
         #[cfg(not(feature = "gpu"))]
-        Command::View(_) => anyhow::bail!("this voxkit was built without the gpu feature, which holds the viewer"),
+        Command::View(_) => Err(anyhow::anyhow!("this voxkit was built without the gpu feature, which holds the viewer")),
         #[cfg(not(feature = "gpu"))]
-        Command::Scene(_) => anyhow::bail!("this voxkit was built without the gpu feature, which holds the scene generators"),
+        Command::Scene(_) => Err(anyhow::anyhow!("this voxkit was built without the gpu feature, which holds the scene generators")),
         Command::Convert(a) => commands::convert::run(a),
         Command::Batch(a) => commands::batch::run(a),
         Command::Raster(a) => commands::raster::run(a),
