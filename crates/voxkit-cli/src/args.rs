@@ -337,6 +337,10 @@ pub struct GpuRenderArgs {
     /// --gpu: a depth-only pass before shading.
     #[arg(long, default_value = "off", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
     pub prepass: String,
+    /// --gpu: colour surfaces by their light-grid cell's list length (blue:
+    /// no light, red: the longest list) instead of shading them.
+    #[arg(long, default_value = "off", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub light_grid: String,
     /// --gpu: linear to sRGB on output.
     #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
     pub gamma: String,

@@ -53,6 +53,9 @@ pub struct FrameOptions {
     pub prepass: bool,
     /// Linear to sRGB on output.
     pub gamma: bool,
+    /// Colour surfaces by their light-grid cell's list length (blue: no
+    /// light, red: the longest list) instead of shading them.
+    pub light_grid_view: bool,
     /// With occlusion culling: read the Hi-Z pyramid back into
     /// [`Frame::hiz`] (for tests and pictures).
     pub read_hiz: bool,
@@ -564,14 +567,14 @@ impl Renderer {
         let view_proj = o.camera.view_proj(o.width as f32 / o.height as f32, near, far);
         let (f_lo, f_hi) = frustum_box(view_proj);
         let n = s.clusters.len() as u32;
-        let flags = u32::from(o.gamma) | if s.lights.lights == 0 { 2 } else { 0 };
+        let flags = u32::from(o.gamma) | if s.lights.lights == 0 { 2 } else { 0 } | if o.light_grid_view { 4 } else { 0 };
         let u = FrameUniform {
             view_proj: view_proj.to_cols_array_2d(),
             eye: o.camera.eye.extend(1.0).to_array(),
             f_lo: f_lo.extend(0.0).to_array(),
             f_hi: f_hi.extend(0.0).to_array(),
             grid_lo: s.grid.lo.extend(s.grid.unit).to_array(),
-            grid_cell: s.grid.cell.extend(0.0).to_array(),
+            grid_cell: s.grid.cell.extend(s.grid.stats().2 as f32).to_array(),
             params: [n, u32::from(o.culling != Culling::None), flags, o.width | (o.height << 16)],
         };
         self.queue.write_buffer(&s.uniform, 0, bytemuck::bytes_of(&u));

@@ -18,12 +18,12 @@
 //! - [`gpu`]: the frame — culling passes, optional Z-prepass, Blinn–Phong
 //!   shading over the fragment's light-grid cell, gamma — rendered
 //!   headless and read back;
-//! - [`scenes`]: deterministic test scenes (the Cornell box).
+//! - [`scenes`]: deterministic test scenes (the Cornell box, the city);
+//! - `window` (feature `window`): the interactive viewer.
 //!
-//! **Not built yet** (the CLI says so when asked): the two-pass occlusion
-//! variant (last frame's visible set first), alpha cut-outs and textures, the interactive window (`voxkit
-//! view`), the ray spray into a point cloud, and the large procedural
-//! scene.
+//! **Not built yet**: the two-pass occlusion variant (last frame's visible
+//! set first), alpha cut-outs and textures, the cluster-box wireframe,
+//! and the ray spray into a point cloud.
 
 pub mod camera;
 pub mod gpu;

@@ -5,8 +5,9 @@
 //!
 //! Controls: left drag orbits around the target, right drag pans, the
 //! wheel zooms; W/A/S/D/Q/E fly (the target moves along); C cycles culling
-//! none → frustum → occlusion; Z toggles the Z-prepass; G gamma; R resets
-//! the camera; Escape quits.
+//! none → frustum → occlusion; Z toggles the Z-prepass; G gamma; L the
+//! light-grid view (surfaces coloured by their cell's list length); R
+//! resets the camera; Escape quits.
 //!
 //! Scripted (`frames`): after that many frames the viewer renders one more
 //! frame off screen with the current camera and size, hands it to the
@@ -122,6 +123,7 @@ struct App {
     culling: Culling,
     prepass: bool,
     gamma: bool,
+    light_grid: bool,
     active: Option<Active>,
     frames: u32,
     drag: Option<(MouseButton, (f64, f64))>,
@@ -146,6 +148,7 @@ pub fn run(scene: Scene, opts: ViewOptions) -> Result<ViewReport, ViewError> {
         culling: opts.culling,
         prepass: opts.prepass,
         gamma: opts.gamma,
+        light_grid: false,
         active: None,
         frames: 0,
         drag: None,
@@ -207,6 +210,7 @@ impl App {
             culling: self.culling,
             prepass: self.prepass,
             gamma: self.gamma,
+            light_grid_view: self.light_grid,
             read_hiz: false,
         }
     }
@@ -275,6 +279,7 @@ impl App {
             }
             KeyCode::KeyZ => self.prepass = !self.prepass,
             KeyCode::KeyG => self.gamma = !self.gamma,
+            KeyCode::KeyL => self.light_grid = !self.light_grid,
             KeyCode::KeyR => self.orbit = Orbit::from_camera(&self.home, self.orbit.up),
             KeyCode::KeyW => self.orbit.target += fwd * step,
             KeyCode::KeyS => self.orbit.target -= fwd * step,

@@ -49,7 +49,8 @@ fn cameras(scene: &Scene) -> Vec<Camera> {
 }
 
 fn frame(r: &Renderer, g: &voxkit_view::GpuScene, camera: Camera, culling: Culling, prepass: bool) -> voxkit_view::Frame {
-    r.render(g, &FrameOptions { width: 160, height: 120, camera, culling, prepass, gamma: true, read_hiz: true }).unwrap()
+    r.render(g, &FrameOptions { width: 160, height: 120, camera, culling, prepass, gamma: true, light_grid_view: false, read_hiz: true })
+        .unwrap()
 }
 
 fn check_scene(r: &Renderer, scene: &Scene, what: &str) {
@@ -121,7 +122,16 @@ fn the_cornell_box_is_lit_by_its_ceiling() {
     let f = r
         .render(
             &g,
-            &FrameOptions { width: 200, height: 200, camera: cam, culling: Culling::Frustum, prepass: false, gamma: true, read_hiz: false },
+            &FrameOptions {
+                width: 200,
+                height: 200,
+                camera: cam,
+                culling: Culling::Frustum,
+                prepass: false,
+                gamma: true,
+                light_grid_view: false,
+                read_hiz: false,
+            },
         )
         .unwrap();
     let px = |x: usize, y: usize| {
@@ -135,6 +145,24 @@ fn the_cornell_box_is_lit_by_its_ceiling() {
     assert!(right[1] > right[0] + 20 && right[1] > right[2] + 20, "right wall {right:?}");
     let light = px(100, 25);
     assert!(light.iter().all(|&c| c >= 250), "ceiling light {light:?}");
+    // The light-grid view colours by list length: the cells near the lamp
+    // list it (not blue), and the picture differs from the shaded one.
+    let mut o = FrameOptions {
+        width: 200,
+        height: 200,
+        camera: cam,
+        culling: Culling::Frustum,
+        prepass: false,
+        gamma: true,
+        light_grid_view: true,
+        read_hiz: false,
+    };
+    let grid = r.render(&g, &o).unwrap();
+    assert!(grid.rgba != f.rgba);
+    let i = 4 * (50 * 200 + 100);
+    assert!(grid.rgba[i] > grid.rgba[i + 2], "a cell near the light is warm: {:?}", &grid.rgba[i..i + 3]);
+    o.light_grid_view = false;
+    assert!(r.render(&g, &o).unwrap().rgba == f.rgba);
     // Nearer the light is brighter: the back wall's top against its bottom.
     let (top, bottom) = (px(100, 50), px(100, 150));
     assert!(top[0] as u32 + top[1] as u32 > bottom[0] as u32 + bottom[1] as u32, "top {top:?} bottom {bottom:?}");

@@ -98,8 +98,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         || g.culling != "occlusion"
         || g.prepass != "off"
         || g.gamma != "on"
+        || g.light_grid != "off"
     {
-        bail!("--camera, --frames, --repeat, --culling, --prepass, --gamma and --stats-json belong to the GPU renderer; add --gpu");
+        bail!("--camera, --frames, --repeat, --culling, --prepass, --gamma, --light-grid and --stats-json belong to the GPU renderer; add --gpu");
     }
     let t0 = Instant::now();
     let o = options(&a.picture, a.up.as_deref())?;

@@ -122,6 +122,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             culling,
             prepass: g.prepass == "on",
             gamma: g.gamma == "on",
+            light_grid_view: g.light_grid == "on",
             read_hiz: false,
         };
         let mut runs = Vec::with_capacity(g.repeat as usize);

@@ -5,10 +5,11 @@ struct Frame {
     // The frustum's world-space bounding box.
     f_lo: vec4<f32>,
     f_hi: vec4<f32>,
-    // Light grid: lower corner (w: one attenuation unit in world units), cell size.
+    // Light grid: lower corner (w: one attenuation unit in world units), cell size (w: the longest list).
     grid_lo: vec4<f32>,
     grid_cell: vec4<f32>,
-    // x: clusters, y: culling (0 none, 1 frustum), z: flags (1 gamma, 2 headlight), w: unused.
+    // x: clusters, y: culling (0 none, 1 frustum or more), z: flags (1 gamma, 2 headlight,
+    // 4 light-grid view), w: picture width | height << 16.
     params: vec4<u32>,
 }
 

@@ -57,6 +57,13 @@ fn fs(in: VsOut) -> @location(0) vec4<f32> {
     let cellf = clamp(floor((in.world - frame.grid_lo.xyz) / frame.grid_cell.xyz), vec3<f32>(0.0), vec3<f32>(31.0));
     let cell = u32(cellf.x) + 32u * (u32(cellf.y) + 32u * u32(cellf.z));
     let r = ranges[cell];
+    if (frame.params.z & 4u) != 0u {
+        // The light grid itself: the cell's list length, blue (none) to red (the most).
+        let t = clamp(f32(r.y) / max(frame.grid_cell.w, 1.0), 0.0, 1.0);
+        let heat = clamp(vec3<f32>(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - 1.0)), vec3<f32>(0.0), vec3<f32>(1.0));
+        let shade = 0.55 + 0.45 * max(dot(n, v), 0.0);
+        return vec4<f32>(heat * shade, 1.0);
+    }
     for (var k = 0u; k < r.y; k++) {
         let light = lights[light_indices[r.x + k]];
         let to = light.position_intensity.xyz - in.world;
