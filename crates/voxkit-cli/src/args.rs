@@ -329,10 +329,11 @@ pub struct GpuRenderArgs {
     /// (default: the whole scene from above-front-right, 45°).
     #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
     pub camera: Option<String>,
-    /// --gpu: cluster culling: none, frustum, or occlusion (frustum, then
-    /// Hi-Z occlusion against the depth of the frustum survivors).
-    #[arg(long, default_value = "occlusion", value_name = "none|frustum|occlusion",
-          value_parser = clap::builder::PossibleValuesParser::new(["none", "frustum", "occlusion"]))]
+    /// --gpu: cluster culling: none, frustum, occlusion (frustum, then
+    /// Hi-Z occlusion against the depth of the frustum survivors), or
+    /// occlusion-two-pass (the depth of the previous frame's clusters).
+    #[arg(long, default_value = "occlusion", value_name = "none|frustum|occlusion|occlusion-two-pass",
+          value_parser = clap::builder::PossibleValuesParser::new(["none", "frustum", "occlusion", "occlusion-two-pass"]))]
     pub culling: String,
     /// --gpu: a depth-only pass before shading.
     #[arg(long, default_value = "off", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
@@ -388,8 +389,8 @@ pub struct ViewArgs {
     /// Starting camera: eye, target, vertical field of view in degrees.
     #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
     pub camera: Option<String>,
-    /// Starting culling: none, frustum or occlusion (key C cycles).
-    #[arg(long, default_value = "occlusion", value_parser = clap::builder::PossibleValuesParser::new(["none", "frustum", "occlusion"]))]
+    /// Starting culling: none, frustum, occlusion or occlusion-two-pass (key C cycles).
+    #[arg(long, default_value = "occlusion", value_parser = clap::builder::PossibleValuesParser::new(["none", "frustum", "occlusion", "occlusion-two-pass"]))]
     pub culling: String,
     /// Starting Z-prepass (key Z toggles).
     #[arg(long, default_value = "off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]

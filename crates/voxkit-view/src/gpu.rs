@@ -36,6 +36,31 @@ pub enum Culling {
     /// Frustum survivors not hidden behind the depth of all frustum
     /// survivors, tested against a Hi-Z pyramid ([`crate::hiz`]).
     Occlusion,
+    /// The two-pass variant: the depth pass draws only the clusters the
+    /// previous frame drew (all of them on the first frame), so it is
+    /// cheaper; the pyramid of that partial depth is farther than the
+    /// final one, so the test stays a bound and the picture the same.
+    OcclusionTwoPass,
+}
+
+impl Culling {
+    /// Every setting, in the order the viewer's key cycles them.
+    pub const ALL: [Culling; 4] = [Culling::None, Culling::Frustum, Culling::Occlusion, Culling::OcclusionTwoPass];
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Culling::None => "none",
+            Culling::Frustum => "frustum",
+            Culling::Occlusion => "occlusion",
+            Culling::OcclusionTwoPass => "occlusion-two-pass",
+        }
+    }
+
+    /// The setting of a command-line name.
+    pub fn from_name(name: &str) -> Option<Culling> {
+        Culling::ALL.into_iter().find(|c| c.name() == name)
+    }
 }
 
 /// What one frame is.
@@ -148,6 +173,8 @@ pub struct GpuScene {
     indices: wgpu::Buffer,
     commands: wgpu::Buffer,
     commands_init: Vec<u32>,
+    /// The commands the previous frame drew (the two-pass depth pass).
+    prev_commands: wgpu::Buffer,
     counters: wgpu::Buffer,
     cull_group: wgpu::BindGroup,
     shade_group: wgpu::BindGroup,
@@ -187,6 +214,7 @@ pub struct Renderer {
     prepass: wgpu::RenderPipeline,
     shade: wgpu::RenderPipeline,
     shade_equal: wgpu::RenderPipeline,
+    shade_lequal: wgpu::RenderPipeline,
     timestamps: bool,
     max_side: u32,
     errors: Arc<Mutex<Option<String>>>,
@@ -394,6 +422,7 @@ impl Renderer {
         let prepass = draw("prepass", false, true, wgpu::CompareFunction::Less);
         let shade = draw("shade", true, true, wgpu::CompareFunction::Less);
         let shade_equal = draw("shade after prepass", true, false, wgpu::CompareFunction::Equal);
+        let shade_lequal = draw("shade over a partial prepass", true, true, wgpu::CompareFunction::LessEqual);
         let r = Renderer {
             adapter,
             device,
@@ -414,6 +443,7 @@ impl Renderer {
             prepass,
             shade,
             shade_equal,
+            shade_lequal,
             timestamps,
             max_side: limits.max_texture_dimension_2d,
             errors,
@@ -469,6 +499,7 @@ impl Renderer {
         let boxes = init("cluster boxes", bytemuck::cast_slice(&boxes), U::STORAGE);
         let commands = init("commands", bytemuck::cast_slice(&commands_init), U::STORAGE | U::INDIRECT | U::COPY_DST | U::COPY_SRC);
         let counters = init("counters", &[0u8; 16], U::STORAGE | U::COPY_DST | U::COPY_SRC);
+        let prev_commands = init("previous commands", bytemuck::cast_slice(&commands_init), U::INDIRECT | U::COPY_DST);
         let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame"),
             size: std::mem::size_of::<FrameUniform>() as u64,
@@ -489,6 +520,7 @@ impl Renderer {
             indices,
             commands,
             commands_init,
+            prev_commands,
             counters,
             cull_group,
             shade_group,
@@ -619,15 +651,16 @@ impl Renderer {
         };
         let colour =
             texture(COLOUR, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING);
-        let occlusion = o.culling == Culling::Occlusion;
+        let occlusion = matches!(o.culling, Culling::Occlusion | Culling::OcclusionTwoPass);
+        let two_pass = o.culling == Culling::OcclusionTwoPass;
         let depth = texture(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING);
         let (cview, dview) = (colour.create_view(&Default::default()), depth.create_view(&Default::default()));
-        let draw_all = |pass: &mut wgpu::RenderPass<'_>| {
+        let draw_all = |pass: &mut wgpu::RenderPass<'_>, commands: &wgpu::Buffer| {
             pass.set_bind_group(0, &s.shade_group, &[]);
             pass.set_vertex_buffer(0, s.vertices.slice(..));
             pass.set_index_buffer(s.indices.slice(..), wgpu::IndexFormat::Uint32);
             if n > 0 {
-                pass.multi_draw_indexed_indirect(&s.commands, 0, n);
+                pass.multi_draw_indexed_indirect(commands, 0, n);
             }
         };
         if o.prepass || occlusion {
@@ -644,7 +677,7 @@ impl Renderer {
                 multiview_mask: None,
             });
             pass.set_pipeline(&self.prepass);
-            draw_all(&mut pass);
+            draw_all(&mut pass, if two_pass { &s.prev_commands } else { &s.commands });
         }
         let hiz = occlusion.then(|| self.occlusion_passes(&mut enc, s, &depth, o, queries.as_ref()));
         {
@@ -668,9 +701,16 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(if o.prepass { &self.shade_equal } else { &self.shade });
-            draw_all(&mut pass);
+            // After a two-pass depth pass the depth holds only the previous
+            // frame's clusters: shade over it with a less-or-equal test.
+            pass.set_pipeline(match (o.prepass, two_pass) {
+                (false, _) => &self.shade,
+                (true, false) => &self.shade_equal,
+                (true, true) => &self.shade_lequal,
+            });
+            draw_all(&mut pass, &s.commands);
         }
+        enc.copy_buffer_to_buffer(&s.commands, 0, &s.prev_commands, 0, 20 * n.max(1) as u64);
         let row = aligned_row(o.width);
         let readback = |label, size| {
             self.device.create_buffer(&wgpu::BufferDescriptor {

@@ -14,16 +14,16 @@
 //!   `shaders/grid.wgsl`; the CPU build is its reference);
 //! - [`hiz`]: Hi-Z occlusion culling — a depth pass of the frustum
 //!   survivors, a max-depth pyramid built on the GPU, each box tested at
-//!   the level where it covers at most 2×2 texels (CPU reference kept);
+//!   the level where it covers at most 2×2 texels (CPU reference kept),
+//!   in one pass or two (the previous frame's clusters first);
 //! - [`gpu`]: the frame — culling passes, optional Z-prepass, Blinn–Phong
 //!   shading over the fragment's light-grid cell, gamma — rendered
 //!   headless and read back;
 //! - [`scenes`]: deterministic test scenes (the Cornell box, the city);
 //! - `window` (feature `window`): the interactive viewer.
 //!
-//! **Not built yet**: the two-pass occlusion variant (last frame's visible
-//! set first), alpha cut-outs and textures, the cluster-box wireframe,
-//! and the ray spray into a point cloud.
+//! **Not built yet**: alpha cut-outs and textures, the cluster-box
+//! wireframe, and the ray spray into a point cloud.
 
 pub mod camera;
 pub mod gpu;

@@ -5,7 +5,7 @@
 //!
 //! Controls: left drag orbits around the target, right drag pans, the
 //! wheel zooms; W/A/S/D/Q/E fly (the target moves along); C cycles culling
-//! none → frustum → occlusion; Z toggles the Z-prepass; G gamma; L the
+//! none → frustum → occlusion → two-pass occlusion; Z toggles the Z-prepass; G gamma; L the
 //! light-grid view (surfaces coloured by their cell's list length); R
 //! resets the camera; Escape quits.
 //!
@@ -235,11 +235,7 @@ impl App {
         a.renderer.present_texture(texture);
         self.frames += 1;
         let ms = t0.elapsed().as_secs_f64() * 1e3;
-        let culling = match self.culling {
-            Culling::None => "none",
-            Culling::Frustum => "frustum",
-            Culling::Occlusion => "occlusion",
-        };
+        let culling = self.culling.name();
         let kept = stats.clusters_after_occlusion.unwrap_or(stats.clusters_after_frustum);
         a.window.set_title(&format!(
             "voxkit view | culling {culling} (C), prepass {} (Z), gamma {} (G) | clusters {}/{}/{} | {} of {} triangles | {} lights | {:.1} ms",
@@ -271,11 +267,8 @@ impl App {
         match code {
             KeyCode::Escape => event_loop.exit(),
             KeyCode::KeyC => {
-                self.culling = match self.culling {
-                    Culling::None => Culling::Frustum,
-                    Culling::Frustum => Culling::Occlusion,
-                    Culling::Occlusion => Culling::None,
-                }
+                let at = Culling::ALL.iter().position(|&c| c == self.culling).unwrap_or(0);
+                self.culling = Culling::ALL[(at + 1) % Culling::ALL.len()];
             }
             KeyCode::KeyZ => self.prepass = !self.prepass,
             KeyCode::KeyG => self.gamma = !self.gamma,

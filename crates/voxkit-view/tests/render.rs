@@ -58,6 +58,9 @@ fn check_scene(r: &Renderer, scene: &Scene, what: &str) {
     assert!(g.clusters.len() > 1, "{what}: clusters");
     let (mut culled_somewhere, mut occluded_somewhere) = (false, false);
     for (n, cam) in cameras(scene).into_iter().enumerate() {
+        // First, the two-pass variant, whose depth pass draws what the
+        // previous camera's last frame drew (a stale set).
+        let stale = frame(r, &g, cam, Culling::OcclusionTwoPass, n % 2 == 1);
         let none = frame(r, &g, cam, Culling::None, false);
         let frustum = frame(r, &g, cam, Culling::Frustum, false);
         assert_eq!(none.stats.clusters_after_frustum, none.stats.clusters, "{what}, camera {n}: nothing culled without culling");
@@ -77,9 +80,15 @@ fn check_scene(r: &Renderer, scene: &Scene, what: &str) {
         // The Z-prepass changes nothing.
         let pre = frame(r, &g, cam, Culling::Frustum, true);
         assert!(pre.rgba == frustum.rgba, "{what}, camera {n}: the Z-prepass changed the picture");
-        // Neither does occlusion culling, with or without the prepass.
-        for prepass in [false, true] {
-            let occ = frame(r, &g, cam, Culling::Occlusion, prepass);
+        // Neither does occlusion culling, with or without the prepass, in one or two passes.
+        for (culling, prepass) in
+            [(Culling::Occlusion, false), (Culling::Occlusion, true), (Culling::OcclusionTwoPass, false), (Culling::OcclusionTwoPass, true)]
+        {
+            let occ = if culling == Culling::OcclusionTwoPass && prepass == (n % 2 == 1) {
+                stale.clone()
+            } else {
+                frame(r, &g, cam, culling, prepass)
+            };
             // The pyramid read back is the CPU's build of its own level 0.
             let hiz = occ.hiz.expect("asked for the pyramid");
             let [w0, _] = hiz.sizes[0];
@@ -92,7 +101,7 @@ fn check_scene(r: &Renderer, scene: &Scene, what: &str) {
             let after = want_occ.iter().filter(|&&k| k).count() as u32;
             assert_eq!(occ.stats.clusters_after_occlusion, Some(after));
             occluded_somewhere |= after < kept;
-            assert!(occ.rgba == none.rgba, "{what}, camera {n}, prepass {prepass}: occlusion culling changed the picture");
+            assert!(occ.rgba == none.rgba, "{what}, camera {n}, {culling:?}, prepass {prepass}: occlusion culling changed the picture");
         }
     }
     assert!(culled_somewhere, "{what}: some camera culls some cluster");

@@ -108,11 +108,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let t1 = std::time::Instant::now();
     let uploaded = renderer.upload(&scene)?;
     let upload_s = t1.elapsed().as_secs_f64();
-    let culling = match g.culling.as_str() {
-        "none" => Culling::None,
-        "frustum" => Culling::Frustum,
-        _ => Culling::Occlusion,
-    };
+    let culling = Culling::from_name(&g.culling).expect("clap checked the name");
     let mut frames = Vec::with_capacity(cameras.len());
     for (camera, out) in cameras.iter().zip(&outputs_png) {
         let opts = FrameOptions {

@@ -64,11 +64,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
             add_voxels(&mut scene, &bits.to_dense(), grid.origin().as_vec3() + offset, grid.voxel_size() as f32);
         }
     }
-    let culling = match a.culling.as_str() {
-        "none" => Culling::None,
-        "frustum" => Culling::Frustum,
-        _ => Culling::Occlusion,
-    };
+    let culling = Culling::from_name(&a.culling).expect("clap checked the name");
     let camera = a.camera.as_deref().map(|s| parse_camera(s, up)).transpose()?;
     let opts =
         ViewOptions { width, height, camera, up: up_axis, culling, prepass: a.prepass == "on", gamma: a.gamma == "on", frames: a.frames };
