@@ -781,23 +781,12 @@ impl Renderer {
             read
         });
         self.queue.submit([enc.finish()]);
-        let mapped: Vec<_> = [Some(&pixels), Some(&cmds), Some(&counts), times.as_ref()]
+        let mapped: Vec<&wgpu::Buffer> = [Some(&pixels), Some(&cmds), Some(&counts), times.as_ref()]
             .into_iter()
             .flatten()
             .chain(hiz_read.iter().flat_map(|(bufs, _)| bufs.iter()))
-            .map(|b| {
-                let (tx, rx) = std::sync::mpsc::channel();
-                b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-                    let _ = tx.send(r);
-                });
-                rx
-            })
             .collect();
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| ViewError::Device(e.to_string()))?;
-        self.check()?;
-        for rx in mapped {
-            rx.recv().map_err(|e| ViewError::Readback(e.to_string()))?.map_err(|e| ViewError::Readback(e.to_string()))?;
-        }
+        self.map_all(&mapped)?;
         let mut rgba = Vec::with_capacity(4 * o.width as usize * o.height as usize);
         if present.is_none() {
             let data = pixels.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
@@ -1020,7 +1009,14 @@ impl Renderer {
             })
             .collect();
         self.queue.submit([enc.finish()]);
-        let rx: Vec<_> = reads
+        self.map_all(&reads.iter().collect::<Vec<_>>())?;
+        reads.iter().map(|b| Ok(b.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?.to_vec())).collect()
+    }
+
+    /// Maps every buffer for reading and waits until all are (after the
+    /// submitted work that fills them).
+    fn map_all(&self, bufs: &[&wgpu::Buffer]) -> Result<(), ViewError> {
+        let rx: Vec<_> = bufs
             .iter()
             .map(|b| {
                 let (tx, rx) = std::sync::mpsc::channel();
@@ -1032,12 +1028,10 @@ impl Renderer {
             .collect();
         self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| ViewError::Device(e.to_string()))?;
         self.check()?;
-        let mut out = Vec::with_capacity(reads.len());
-        for (b, rx) in reads.iter().zip(rx) {
+        for rx in rx {
             rx.recv().map_err(|e| ViewError::Readback(e.to_string()))?.map_err(|e| ViewError::Readback(e.to_string()))?;
-            out.push(b.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?.to_vec());
         }
-        Ok(out)
+        Ok(())
     }
 
     /// A 1×1 float texture view, bound where a pass reads no source level.

@@ -128,21 +128,17 @@ fn the_cornell_box_is_lit_by_its_ceiling() {
     // From the open side, looking in.
     let cam = Camera { eye: Vec3::new(0.5, 0.5, 2.4), target: Vec3::new(0.5, 0.5, 0.0), up: Vec3::Y, fov_deg: 40.0 };
     assert!(lo.cmple(Vec3::ZERO).all() && hi.cmpge(Vec3::ONE).all());
-    let f = r
-        .render(
-            &g,
-            &FrameOptions {
-                width: 200,
-                height: 200,
-                camera: cam,
-                culling: Culling::Frustum,
-                prepass: false,
-                gamma: true,
-                light_grid_view: false,
-                read_hiz: false,
-            },
-        )
-        .unwrap();
+    let mut o = FrameOptions {
+        width: 200,
+        height: 200,
+        camera: cam,
+        culling: Culling::Frustum,
+        prepass: false,
+        gamma: true,
+        light_grid_view: false,
+        read_hiz: false,
+    };
+    let f = r.render(&g, &o).unwrap();
     let px = |x: usize, y: usize| {
         let i = 4 * (y * 200 + x);
         [f.rgba[i], f.rgba[i + 1], f.rgba[i + 2]]
@@ -156,16 +152,7 @@ fn the_cornell_box_is_lit_by_its_ceiling() {
     assert!(light.iter().all(|&c| c >= 250), "ceiling light {light:?}");
     // The light-grid view colours by list length: the cells near the lamp
     // list it (not blue), and the picture differs from the shaded one.
-    let mut o = FrameOptions {
-        width: 200,
-        height: 200,
-        camera: cam,
-        culling: Culling::Frustum,
-        prepass: false,
-        gamma: true,
-        light_grid_view: true,
-        read_hiz: false,
-    };
+    o.light_grid_view = true;
     let grid = r.render(&g, &o).unwrap();
     assert!(grid.rgba != f.rgba);
     let i = 4 * (50 * 200 + 100);
