@@ -146,6 +146,13 @@ pub struct Blit {
     layout: wgpu::BindGroupLayout,
 }
 
+impl Frame {
+    /// The picture as RGB rows (alpha dropped), as PNG writers take it.
+    pub fn rgb(&self) -> Vec<u8> {
+        self.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect()
+    }
+}
+
 /// The frame's uniform block (`frame.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -185,6 +192,8 @@ pub struct GpuScene {
     pub grid: LightGrid,
     /// Milliseconds the GPU build took (submit to read back).
     pub grid_ms: f64,
+    /// The longest cell list (the light-grid view's red).
+    grid_max: u32,
     /// Lights and the emissive triangles they came from.
     pub lights: LightReport,
     /// Scene box.
@@ -303,26 +312,17 @@ impl Renderer {
                 entry(7, S::FRAGMENT, Storage { read_only: true }),
             ],
         });
-        let pipeline_layout = |l: &wgpu::BindGroupLayout| {
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: None,
-                bind_group_layouts: &[Some(l)],
-                immediate_size: 0,
-            })
+        let pipeline_layout = |layouts: &[Option<&wgpu::BindGroupLayout>]| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: None, bind_group_layouts: layouts, immediate_size: 0 })
         };
         let cull_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("cull"),
             source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/cull.wgsl")]).into()),
         });
         let compute = |label, layouts: &[Option<&wgpu::BindGroupLayout>], module, entry| {
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: None,
-                bind_group_layouts: layouts,
-                immediate_size: 0,
-            });
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(label),
-                layout: Some(&layout),
+                layout: Some(&pipeline_layout(layouts)),
                 module,
                 entry_point: Some(entry),
                 compilation_options: Default::default(),
@@ -384,7 +384,7 @@ impl Renderer {
             label: Some("shade"),
             source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/shade.wgsl")]).into()),
         });
-        let shade_pl = pipeline_layout(&shade_layout);
+        let shade_pl = pipeline_layout(&[Some(&shade_layout)]);
         let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x3];
         let draw = |label, colour: bool, write: bool, compare| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -526,6 +526,7 @@ impl Renderer {
             shade_group,
             uniform,
             clusters: part.clusters,
+            grid_max: grid.stats().2,
             grid,
             grid_ms,
             lights: report,
@@ -606,7 +607,7 @@ impl Renderer {
             f_lo: f_lo.extend(0.0).to_array(),
             f_hi: f_hi.extend(0.0).to_array(),
             grid_lo: s.grid.lo.extend(s.grid.unit).to_array(),
-            grid_cell: s.grid.cell.extend(s.grid.stats().2 as f32).to_array(),
+            grid_cell: s.grid.cell.extend(s.grid_max as f32).to_array(),
             params: [n, u32::from(o.culling != Culling::None), flags, o.width | (o.height << 16)],
         };
         self.queue.write_buffer(&s.uniform, 0, bytemuck::bytes_of(&u));
@@ -720,9 +721,9 @@ impl Renderer {
                 mapped_at_creation: false,
             })
         };
-        let pixels = readback("picture", if present.is_some() { 256 } else { row as u64 * o.height as u64 });
-        match present {
-            Some((blit, target)) => {
+        let pixels = present.is_none().then(|| readback("picture", row as u64 * o.height as u64));
+        match (present, &pixels) {
+            (Some((blit, target)), _) => {
                 let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: None,
                     layout: &blit.layout,
@@ -745,7 +746,7 @@ impl Renderer {
                 pass.set_bind_group(0, &group, &[]);
                 pass.draw(0..3, 0..1);
             }
-            None => enc.copy_texture_to_buffer(
+            (None, Some(pixels)) => enc.copy_texture_to_buffer(
                 wgpu::TexelCopyTextureInfo {
                     texture: &colour,
                     mip_level: 0,
@@ -753,11 +754,12 @@ impl Renderer {
                     aspect: wgpu::TextureAspect::All,
                 },
                 wgpu::TexelCopyBufferInfo {
-                    buffer: &pixels,
+                    buffer: pixels,
                     layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(o.height) },
                 },
                 wgpu::Extent3d { width: o.width, height: o.height, depth_or_array_layers: 1 },
             ),
+            (None, None) => unreachable!("frames not presented are read back"),
         }
         let hiz_read = match (&hiz, o.read_hiz) {
             (Some(h), true) => Some(self.copy_levels(&mut enc, h)),
@@ -781,14 +783,14 @@ impl Renderer {
             read
         });
         self.queue.submit([enc.finish()]);
-        let mapped: Vec<&wgpu::Buffer> = [Some(&pixels), Some(&cmds), Some(&counts), times.as_ref()]
+        let mapped: Vec<&wgpu::Buffer> = [pixels.as_ref(), Some(&cmds), Some(&counts), times.as_ref()]
             .into_iter()
             .flatten()
             .chain(hiz_read.iter().flat_map(|(bufs, _)| bufs.iter()))
             .collect();
         self.map_all(&mapped)?;
         let mut rgba = Vec::with_capacity(4 * o.width as usize * o.height as usize);
-        if present.is_none() {
+        if let Some(pixels) = &pixels {
             let data = pixels.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
             for y in 0..o.height as usize {
                 rgba.extend_from_slice(&data[y * row as usize..y * row as usize + 4 * o.width as usize]);

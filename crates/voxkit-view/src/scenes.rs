@@ -123,8 +123,8 @@ pub fn city() -> (Mesh, Appearance) {
     let (blocks, cell, street) = (12u32, 20.0f64, 6.0f64);
     let size = blocks as f64 * cell;
     let p = DVec3::new;
-    b.panel(p(-street, 0.0, -street), p(size + 2.0 * street, 0.0, 0.0), p(0.0, 0.0, size + 2.0 * street), 24, 24, ground);
-    b.mesh.triangles.iter_mut().for_each(|t| t.swap(1, 2)); // the ground faces up
+    // z then x: the ground faces up.
+    b.panel(p(-street, 0.0, -street), p(0.0, 0.0, size + 2.0 * street), p(size + 2.0 * street, 0.0, 0.0), 24, 24, ground);
     for bx in 0..blocks {
         for bz in 0..blocks {
             let (x0, z0) = (bx as f64 * cell + street * 0.5, bz as f64 * cell + street * 0.5);

@@ -328,8 +328,8 @@ impl ApplicationHandler for App {
                             self.orbit.pitch = (self.orbit.pitch + dy * 0.01).clamp(-1.55, 1.55);
                         }
                         _ => {
-                            let (_, right) = self.orbit.axes();
-                            let up = right.cross((self.orbit.camera().target - self.orbit.camera().eye).normalize_or_zero());
+                            let (fwd, right) = self.orbit.axes();
+                            let up = right.cross(fwd);
                             let k = self.orbit.distance * 0.002;
                             self.orbit.target += (-right * dx + up * dy) * k;
                         }

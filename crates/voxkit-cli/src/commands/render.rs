@@ -36,17 +36,28 @@ pub fn options(p: &PictureArgs, up: Option<&str>) -> Result<RenderOptions> {
             }
         }
     };
-    let size: Option<(u32, u32)> = p.size.split_once(['x', 'X']).and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
-    let Some((width, height)) = size else { bail!("--size takes WIDTHxHEIGHT in pixels, e.g. 1024x768, not {:?}", p.size) };
+    let (width, height) = parse_size(&p.size)?;
+    let up = up_axis(up);
+    Ok(RenderOptions { width, height, view, up, ..RenderOptions::default() })
+}
+
+/// Parses `--size WIDTHxHEIGHT` within the picture limits.
+pub fn parse_size(text: &str) -> Result<(u32, u32)> {
+    let size: Option<(u32, u32)> = text.split_once(['x', 'X']).and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
+    let Some((width, height)) = size else { bail!("--size takes WIDTHxHEIGHT in pixels, e.g. 1024x768, not {text:?}") };
     if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE || width as u64 * height as u64 > MAX_PIXELS {
         bail!("--size {width}x{height}: each side must be 1..={MAX_SIDE} and the picture at most {MAX_PIXELS} pixels");
     }
-    let up = match up {
+    Ok((width, height))
+}
+
+/// The `--up` axis's index (default y).
+pub fn up_axis(up: Option<&str>) -> usize {
+    match up {
         Some("x") => 0,
         Some("z") => 2,
         _ => 1,
-    };
-    Ok(RenderOptions { width, height, view, up, ..RenderOptions::default() })
+    }
 }
 
 /// A mesh's triangles in grid units, for the silhouette outline.

@@ -58,6 +58,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         bail!("--gpu places its camera with --camera EX,EY,EZ,TX,TY,TZ[,FOV], not --view");
     }
     let o = options(&a.picture, a.up.as_deref())?;
+    if g.repeat == 0 || g.repeat > 1000 {
+        bail!("--repeat must be 1..=1000, not {}", g.repeat);
+    }
     check_png_path(&a.output)?;
     let mut outputs: Vec<PathBuf> = vec![a.output.clone()];
     if let Some(p) = &g.stats_json {
@@ -96,12 +99,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         (None, Some(path)) => read_camera_path(path, up)?,
         (None, None) => vec![Camera::framing(bounds.0, bounds.1, o.up)],
     };
-    if g.repeat == 0 || g.repeat > 1000 {
-        bail!("--repeat must be 1..=1000, not {}", g.repeat);
-    }
     let outputs_png: Vec<PathBuf> =
         if cameras.len() == 1 { vec![a.output.clone()] } else { (0..cameras.len()).map(|n| numbered(&a.output, n)).collect() };
-    for out in &outputs_png[1.min(outputs_png.len())..] {
+    for out in &outputs_png {
         voxkit_io::atomic::refuse_overwriting_inputs(out, std::slice::from_ref(&a.input))?;
     }
     let renderer = Renderer::new()?;
@@ -121,18 +121,19 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             light_grid_view: g.light_grid == "on",
             read_hiz: false,
         };
-        let mut runs = Vec::with_capacity(g.repeat as usize);
-        for _ in 0..g.repeat {
-            runs.push(renderer.render(&uploaded, &opts)?);
+        // Every run's statistics, the last run's picture.
+        let mut frame = renderer.render(&uploaded, &opts)?;
+        let mut runs = vec![frame.stats.clone()];
+        for _ in 1..g.repeat {
+            frame = renderer.render(&uploaded, &opts)?;
+            runs.push(frame.stats.clone());
         }
-        let frame = runs.pop().expect("one run at least");
         let median = |f: &dyn Fn(&FrameStats) -> Option<f64>| -> Option<f64> {
-            let mut v: Vec<f64> = runs.iter().map(|r| &r.stats).chain([&frame.stats]).filter_map(f).collect();
+            let mut v: Vec<f64> = runs.iter().filter_map(f).collect();
             v.sort_by(f64::total_cmp);
             (!v.is_empty()).then(|| v[v.len() / 2])
         };
-        let rgb: Vec<u8> = frame.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
-        voxkit_io::write_png(out, frame.width, frame.height, &rgb)?;
+        voxkit_io::write_png(out, frame.width, frame.height, &frame.rgb())?;
         let s = &frame.stats;
         frames.push(json!({
             "output": out,

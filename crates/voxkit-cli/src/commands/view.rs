@@ -9,26 +9,20 @@ use voxkit_view::window::{run as run_window, ViewOptions};
 use voxkit_view::{Culling, Scene};
 
 use crate::args::ViewArgs;
+use crate::commands::render::{check_png_path, parse_size, up_axis};
 use crate::commands::render_gpu::{add_voxel_file, add_voxels, parse_camera};
 use crate::plan;
 
 pub fn run(a: &ViewArgs) -> Result<()> {
-    let size: Option<(u32, u32)> = a.size.split_once(['x', 'X']).and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
-    let Some((width, height)) = size.filter(|&(w, h)| (1..=16_384).contains(&w) && (1..=16_384).contains(&h)) else {
-        bail!("--size takes WIDTHxHEIGHT in pixels (each 1..=16384), not {:?}", a.size)
-    };
+    let (width, height) = parse_size(&a.size)?;
     if let Some(p) = &a.screenshot {
-        crate::commands::render::check_png_path(p)?;
+        check_png_path(p)?;
         voxkit_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.input))?;
     }
     if a.frames == Some(0) {
         bail!("--frames must be at least 1");
     }
-    let up_axis = match a.up.as_deref() {
-        Some("x") => 0,
-        Some("z") => 2,
-        _ => 1,
-    };
+    let up_axis = up_axis(a.up.as_deref());
     let mut up = Vec3::ZERO;
     up[up_axis] = 1.0;
     let mut scene = Scene::default();
@@ -71,8 +65,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     let report = run_window(scene, opts)?;
     let mut shot = None;
     if let (Some(p), Some(f)) = (&a.screenshot, &report.screenshot) {
-        let rgb: Vec<u8> = f.rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
-        voxkit_io::write_png(p, f.width, f.height, &rgb)?;
+        voxkit_io::write_png(p, f.width, f.height, &f.rgb())?;
         shot = Some((f.width, f.height));
     }
     let c = report.camera;
