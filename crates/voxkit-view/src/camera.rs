@@ -55,17 +55,42 @@ impl Camera {
         (near, far)
     }
 
+    /// The up direction the view uses: `up`, or when looking along it,
+    /// any perpendicular.
+    fn view_up(&self) -> Vec3 {
+        let fwd = (self.target - self.eye).normalize_or_zero();
+        if fwd.cross(self.up).length_squared() < 1e-10 {
+            if fwd.x.abs() < 0.9 {
+                Vec3::X
+            } else {
+                Vec3::Z
+            }
+        } else {
+            self.up
+        }
+    }
+
     /// View–projection matrix (right-handed, depth 0..1) for `aspect`.
     pub fn view_proj(&self, aspect: f32, near: f32, far: f32) -> Mat4 {
-        let mut up = self.up;
-        let fwd = (self.target - self.eye).normalize_or_zero();
-        if fwd.cross(up).length_squared() < 1e-10 {
-            // Looking along the up axis: any perpendicular will do.
-            up = if fwd.x.abs() < 0.9 { Vec3::X } else { Vec3::Z };
-        }
         // wgpu's clip space is Direct3D's: y up, depth 0..1.
         glam::camera::rh::proj::directx::perspective(self.fov_deg.to_radians(), aspect, near, far)
-            * glam::camera::rh::view::look_at_mat4(self.eye, self.target, up)
+            * glam::camera::rh::view::look_at_mat4(self.eye, self.target, self.view_up())
+    }
+
+    /// The picture's right and up directions and the forward direction,
+    /// unit vectors as [`Camera::view_proj`] places them.
+    pub fn basis(&self) -> (Vec3, Vec3, Vec3) {
+        let fwd = (self.target - self.eye).normalize_or_zero();
+        let right = fwd.cross(self.view_up()).normalize_or_zero();
+        (right, right.cross(fwd), fwd)
+    }
+
+    /// The direction of the ray through picture point `(x, y)` in
+    /// normalised coordinates (−1..1, y up) of a picture of `aspect`.
+    pub fn ray(&self, aspect: f32, x: f32, y: f32) -> Vec3 {
+        let (right, up, fwd) = self.basis();
+        let h = (self.fov_deg.to_radians() * 0.5).tan();
+        (fwd + right * (x * h * aspect) + up * (y * h)).normalize_or_zero()
     }
 }
 

@@ -20,10 +20,12 @@
 //!   shading over the fragment's light-grid cell, gamma — rendered
 //!   headless and read back;
 //! - [`scenes`]: deterministic test scenes (the Cornell box, the city);
+//! - [`spray`]: the ray spray into a point cloud (BVH, light samples,
+//!   shadow rays), drawn as points lit towards the viewer each frame;
 //! - `window` (feature `window`): the interactive viewer.
 //!
-//! **Not built yet**: alpha cut-outs and textures, the cluster-box
-//! wireframe, and the ray spray into a point cloud.
+//! **Not built yet**: alpha cut-outs and textures, and the cluster-box
+//! wireframe.
 
 pub mod camera;
 pub mod gpu;
@@ -32,6 +34,7 @@ pub mod lights;
 pub mod partition;
 pub mod scene;
 pub mod scenes;
+pub mod spray;
 #[cfg(feature = "window")]
 pub mod window;
 

@@ -81,6 +81,18 @@ pub fn frame(scene: &Scene) -> (Vec3, Vec3, f32) {
     (lo, hi, unit)
 }
 
+/// The light an emissive triangle joins: its material and the cube of
+/// side [`MERGE`] units its centroid falls in (`lo` and `unit` from [`frame`]).
+pub fn merge_key(lo: Vec3, unit: f32, material: u32, p: [Vec3; 3]) -> (u32, [i64; 3]) {
+    let c = (p[0] + p[1] + p[2]) / 3.0;
+    (material, ((c - lo) / (unit * MERGE)).floor().as_i64vec3().to_array())
+}
+
+/// A triangle's area in units².
+pub fn area_units(p: [Vec3; 3], unit: f32) -> f32 {
+    0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length() / (unit * unit)
+}
+
 /// The lights of the scene's emissive triangles.
 pub fn lights(scene: &Scene) -> (Vec<Light>, LightReport) {
     let (lo, _, unit) = frame(scene);
@@ -93,10 +105,9 @@ pub fn lights(scene: &Scene) -> (Vec<Light>, LightReport) {
         }
         report.emissive_triangles += 1;
         let p = [0, 1, 2].map(|c| Vec3::from(t[c].position));
-        let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length() / (unit * unit);
+        let area = area_units(p, unit);
         let c = (p[0] + p[1] + p[2]) / 3.0;
-        let key = ((c - lo) / (unit * MERGE)).floor().as_i64vec3().to_array();
-        let g = groups.entry((m, key)).or_insert((0.0, Vec3::ZERO));
+        let g = groups.entry(merge_key(lo, unit, m, p)).or_insert((0.0, Vec3::ZERO));
         g.0 += area;
         g.1 += c * area;
     }
