@@ -37,6 +37,11 @@ pub enum Command {
     /// Write a bundled test scene (OBJ + MTL): the Cornell box, or a city of
     /// about a million triangles with 169 emissive street lamps.
     Scene(SceneArgs),
+    /// Spray rays from a camera into a mesh: each hit becomes a point with
+    /// its albedo, emission and light term (Lambert term and attenuation
+    /// towards light samples on the emissive triangles, shadow rays), saved
+    /// as PLY and drawn by render --gpu --points and view --points.
+    Spray(SprayArgs),
     /// Convert a voxel file to another voxel format, or to a mesh of the voxels (.obj, greedy quads).
     Convert(ConvertArgs),
     /// Voxelize whole datasets: one output per input mesh, a manifest of
@@ -358,6 +363,55 @@ pub struct GpuRenderArgs {
     /// drawn, lights, light grid, the draw call, frame times) as JSON.
     #[arg(long, value_name = "FILE")]
     pub stats_json: Option<PathBuf>,
+    /// --gpu: also draw this point cloud of `voxkit spray` (its stored
+    /// light term, lit towards the viewer each frame).
+    #[arg(long, value_name = "PLY")]
+    pub points: Option<PathBuf>,
+    /// --gpu: draw the scene's triangles (off: only the --points cloud).
+    #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub mesh: String,
+}
+
+/// `voxkit spray`: rays from a camera into a scene, hits as a point cloud.
+#[derive(Args, Debug)]
+pub struct SprayArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
+    /// A mesh (with its materials; emissive ones are the lights) or a voxel file (its greedy quads).
+    pub input: PathBuf,
+    /// Output point cloud (.ply).
+    #[arg(short, long, value_name = "PLY")]
+    pub output: PathBuf,
+    /// Rays cast (each hit is a point).
+    #[arg(long, default_value_t = 1_000_000, value_name = "N")]
+    pub rays: usize,
+    /// Light samples per point, drawn uniformly over the emissive triangles.
+    #[arg(long, default_value_t = 16, value_name = "K")]
+    pub light_samples: u32,
+    /// Shadow rays towards the light samples.
+    #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub shadows: String,
+    /// Seed of the random rays and samples (the cloud is the same for a seed, whatever the thread count).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Camera eye, target and vertical field of view in degrees (default:
+    /// the whole scene from above-front-right, 45°, as render --gpu).
+    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
+    pub camera: Option<String>,
+    /// The camera's picture, WIDTHxHEIGHT: rays fill its aspect.
+    #[arg(long, default_value = "1280x720", value_name = "WxH")]
+    pub size: String,
+    /// The axis pointing up: x, y or z (default y).
+    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
+    pub up: Option<String>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Args, Debug)]
@@ -404,6 +458,18 @@ pub struct ViewArgs {
     /// With --frames: the last frame as PNG.
     #[arg(long, value_name = "PNG", requires = "frames")]
     pub screenshot: Option<PathBuf>,
+    /// A point cloud of `voxkit spray` to draw (key P adds to it).
+    #[arg(long, value_name = "PLY")]
+    pub points: Option<PathBuf>,
+    /// On closing, write every point (given and sprayed) to this PLY.
+    #[arg(long, value_name = "PLY")]
+    pub save_points: Option<PathBuf>,
+    /// Rays per spray at the cursor (key P, middle button).
+    #[arg(long, default_value_t = 20_000, value_name = "N")]
+    pub spray_rays: usize,
+    /// Half-angle of the spray's cone in degrees.
+    #[arg(long, default_value_t = 2.0, value_name = "DEG")]
+    pub spray_degrees: f32,
     /// Print one JSON object on stdout when the window closes.
     #[arg(long)]
     pub json: bool,

@@ -33,6 +33,10 @@ fn main() -> ExitCode {
         Command::Scene(a) => commands::scene::run(a),
         #[cfg(feature = "gpu")]
         Command::View(a) => commands::view::run(a),
+        #[cfg(feature = "gpu")]
+        Command::Spray(a) => commands::spray::run(a),
+        #[cfg(not(feature = "gpu"))]
+        Command::Spray(_) => Err(anyhow::anyhow!("this voxkit was built without the gpu feature, which holds the ray spray")),
         #[cfg(not(feature = "gpu"))]
         Command::View(_) => Err(anyhow::anyhow!("this voxkit was built without the gpu feature, which holds the viewer")),
         #[cfg(not(feature = "gpu"))]

@@ -666,6 +666,59 @@ fn the_gpu_renderer_draws_the_cornell_box_and_reports_its_frame() {
 }
 
 #[test]
+fn spray_writes_a_cloud_the_gpu_renderer_draws() {
+    let obj = tmp("spray-cornell.obj");
+    assert!(voxkit(&["scene", "cornell", "-o", &obj]).status.success());
+    let cam = "0.5,0.5,2.2,0.5,0.45,0,45";
+    let (one, two) = (tmp("spray-1.ply"), tmp("spray-2.ply"));
+    let args = |out: &str, threads: &'static str| {
+        let mut a: Vec<String> =
+            ["spray", obj.as_str(), "-o", out, "--rays", "30000", "--camera", cam, "--light-samples", "4", "--size", "500x500", "--json"]
+                .map(String::from)
+                .to_vec();
+        a.extend(["--threads".to_string(), threads.to_string()]);
+        a
+    };
+    let run = |a: Vec<String>| voxkit(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let v = json(&run(args(&one, "1")));
+    let _ = json(&run(args(&two, "2")));
+    assert_eq!(std::fs::read(&one).unwrap(), std::fs::read(&two).unwrap(), "the cloud does not depend on the thread count");
+    assert_eq!(v["rays"], 30000);
+    assert_eq!(v["emissive_triangles"], 2);
+    let points = v["points"].as_u64().unwrap();
+    assert!(points > 15000 && points + v["misses"].as_u64().unwrap() == 30000, "{v}");
+    let bytes = std::fs::read(&one).unwrap();
+    assert!(bytes.starts_with(b"ply\nformat binary_little_endian 1.0\n"));
+    let head = String::from_utf8_lossy(&bytes[..bytes.windows(10).position(|w| w == b"end_header").unwrap()]).into_owned();
+    assert!(head.contains(&format!("element vertex {points}\n")) && head.contains("property float light_r"), "{head}");
+    // Drawn by render --gpu, with and without the mesh.
+    let out = voxkit(&["render", &obj, "--gpu", "--points", &one, "--mesh", "off", "-o", &tmp("spray.png"), "--size", "64x64", "--json"]);
+    if gpu_available(&out) {
+        let r = json(&out);
+        assert_eq!(r["points_drawn"].as_u64(), Some(points));
+        assert_eq!(r["triangles_drawn"], 0);
+    }
+    // Errors: one line each, nothing written.
+    let bad = tmp("spray-bad.ply");
+    for (extra, says) in [
+        (vec!["--rays", "0"], "--rays must be"),
+        (vec!["--light-samples", "100000"], "--light-samples must be"),
+        (vec!["--camera", "1,2,3"], "--camera takes"),
+        (vec!["--size", "0x5"], "--size"),
+    ] {
+        let mut a = vec!["spray", obj.as_str(), "-o", bad.as_str()];
+        a.extend(extra.iter().copied());
+        let e = error_line(&a);
+        assert!(e.contains(says), "{extra:?}: {e}");
+    }
+    let e = error_line(&["spray", &obj, "-o", &tmp("spray.npy")]);
+    assert!(e.contains("PLY"), "{e}");
+    let e = error_line(&["render", &obj, "--gpu", "--points", &obj, "-o", &tmp("spray-bad.png")]);
+    assert!(e.contains("PLY") || e.contains("vertex"), "{e}");
+    assert!(!std::path::Path::new(&bad).exists());
+}
+
+#[test]
 fn gpu_renderer_options_give_one_line_errors() {
     let obj = unit_cube_obj("gpu-opts.obj");
     let png = tmp("gpu-opts.png");

@@ -133,20 +133,22 @@ pub fn panic_is_fenced() -> bool {
 /// crate, triggered by malformed input) becomes an error naming the format
 /// instead of aborting the program.
 fn fence<T>(format: &'static str, f: impl FnOnce() -> Result<T, ErrorKind>) -> Result<T, ErrorKind> {
+    fenced(f).unwrap_or_else(|msg| Err(ErrorKind::malformed(format, format!("the parser crashed on it ({msg})"))))
+}
+
+/// Runs `f` (a parser outside voxkit-io, such as the spray cloud's) inside
+/// the panic fence: a panic becomes `Err` with its message, and the panic
+/// hook stays silent ([`panic_is_fenced`]).
+pub fn fenced<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     FENCED.with(|c| c.set(c.get() + 1));
     let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
     FENCED.with(|c| c.set(c.get() - 1));
-    match r {
-        Ok(r) => r,
-        Err(p) => {
-            let msg = p
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| p.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown cause".into());
-            Err(ErrorKind::malformed(format, format!("the parser crashed on it ({msg})")))
-        }
-    }
+    r.map_err(|p| {
+        p.downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| p.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown cause".into())
+    })
 }
 
 /// Voxel file formats voxkit writes and reads.

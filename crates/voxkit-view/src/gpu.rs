@@ -24,6 +24,7 @@ use crate::hiz::{pyramid_size, Pyramid};
 use crate::lights::{grid_frame, lights, LightGrid, LightReport, GRID};
 use crate::partition::{Cluster, Partition};
 use crate::scene::{Scene, Vertex};
+use crate::spray::SprayPoint;
 use crate::ViewError;
 
 /// Which clusters are drawn.
@@ -84,6 +85,9 @@ pub struct FrameOptions {
     /// With occlusion culling: read the Hi-Z pyramid back into
     /// [`Frame::hiz`] (for tests and pictures).
     pub read_hiz: bool,
+    /// Draw the scene's triangles (off: only the spray's points, when
+    /// there are any; culling still runs and is reported).
+    pub mesh: bool,
 }
 
 /// Per-pass GPU time in milliseconds (timestamp queries), where the
@@ -113,8 +117,10 @@ pub struct FrameStats {
     pub clusters_after_occlusion: Option<u32>,
     /// Triangles in the scene.
     pub triangles: u64,
-    /// Triangles of the kept clusters.
+    /// Triangles of the kept clusters (0 with the mesh hidden).
     pub triangles_drawn: u64,
+    /// Spray points drawn.
+    pub points_drawn: u64,
     /// The draw call that ran.
     pub multi_draw: &'static str,
     /// Wall time from encoding to the picture read back.
@@ -200,6 +206,10 @@ pub struct GpuScene {
     pub bounds: (Vec3, Vec3),
     /// Triangles.
     pub triangles: u64,
+    /// The spray's points ([`Renderer::add_points`]): the buffer (its
+    /// size the capacity) and how many it holds.
+    points: Option<wgpu::Buffer>,
+    point_count: u32,
 }
 
 /// An open device with the frame's pipelines.
@@ -224,6 +234,7 @@ pub struct Renderer {
     shade: wgpu::RenderPipeline,
     shade_equal: wgpu::RenderPipeline,
     shade_lequal: wgpu::RenderPipeline,
+    points: wgpu::RenderPipeline,
     timestamps: bool,
     max_side: u32,
     errors: Arc<Mutex<Option<String>>>,
@@ -382,7 +393,7 @@ impl Renderer {
         let hiz_reduce = compute("hiz reduce", &[Some(&hiz_layout)], &hiz_module, "reduce");
         let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shade"),
-            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/shade.wgsl")]).into()),
+            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/shade.wgsl"), include_str!("shaders/points.wgsl")]).into()),
         });
         let shade_pl = pipeline_layout(&[Some(&shade_layout)]);
         let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x3];
@@ -419,6 +430,38 @@ impl Renderer {
                 cache: None,
             })
         };
+        let point_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x3, 4 => Float32x3];
+        let points = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("spray points"),
+            layout: Some(&shade_pl),
+            vertex: wgpu::VertexState {
+                module: &shade_module,
+                entry_point: Some("vs_point"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<SprayPoint>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &point_attributes,
+                })],
+            },
+            primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::PointList, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &shade_module,
+                entry_point: Some("fs_point"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState { format: COLOUR, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
         let prepass = draw("prepass", false, true, wgpu::CompareFunction::Less);
         let shade = draw("shade", true, true, wgpu::CompareFunction::Less);
         let shade_equal = draw("shade after prepass", true, false, wgpu::CompareFunction::Equal);
@@ -444,6 +487,7 @@ impl Renderer {
             shade,
             shade_equal,
             shade_lequal,
+            points,
             timestamps,
             max_side: limits.max_texture_dimension_2d,
             errors,
@@ -532,7 +576,50 @@ impl Renderer {
             lights: report,
             bounds,
             triangles: scene.triangles() as u64,
+            points: None,
+            point_count: 0,
         })
+    }
+
+    /// Adds spray points to the scene (drawn by every later frame); the
+    /// buffer grows by doubling, so adding a cursor's spray at a time
+    /// stays cheap.
+    pub fn add_points(&self, s: &mut GpuScene, points: &[SprayPoint]) -> Result<(), ViewError> {
+        if points.is_empty() {
+            return Ok(());
+        }
+        let stride = std::mem::size_of::<SprayPoint>() as u64;
+        let count = u64::from(s.point_count) + points.len() as u64;
+        let max = self.device.limits().max_buffer_size / stride;
+        if count > max.min(u64::from(u32::MAX)) {
+            return Err(ViewError::Device(format!("{count} spray points exceed this adapter's largest buffer ({max} points)")));
+        }
+        let capacity = s.points.as_ref().map_or(0, |b| b.size() / stride);
+        if count > capacity {
+            let size = count.max(2 * capacity).max(1024).min(max) * stride;
+            let grown = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("spray points"),
+                size,
+                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            if let Some(old) = &s.points {
+                let mut enc = self.device.create_command_encoder(&Default::default());
+                enc.copy_buffer_to_buffer(old, 0, &grown, 0, u64::from(s.point_count) * stride);
+                self.queue.submit([enc.finish()]);
+            }
+            s.points = Some(grown);
+        }
+        let buffer = s.points.as_ref().expect("grown above");
+        self.queue.write_buffer(buffer, u64::from(s.point_count) * stride, bytemuck::cast_slice(points));
+        s.point_count = count as u32;
+        self.check()
+    }
+
+    /// Drops the scene's spray points.
+    pub fn clear_points(&self, s: &mut GpuScene) {
+        s.points = None;
+        s.point_count = 0;
     }
 
     /// Renders one frame and reads it back.
@@ -603,7 +690,7 @@ impl Renderer {
         let flags = u32::from(o.gamma) | if s.lights.lights == 0 { 2 } else { 0 } | if o.light_grid_view { 4 } else { 0 };
         let u = FrameUniform {
             view_proj: view_proj.to_cols_array_2d(),
-            eye: o.camera.eye.extend(1.0).to_array(),
+            eye: o.camera.eye.extend((o.camera.target - o.camera.eye).length()).to_array(),
             f_lo: f_lo.extend(0.0).to_array(),
             f_hi: f_hi.extend(0.0).to_array(),
             grid_lo: s.grid.lo.extend(s.grid.unit).to_array(),
@@ -709,7 +796,15 @@ impl Renderer {
                 (true, false) => &self.shade_equal,
                 (true, true) => &self.shade_lequal,
             });
-            draw_all(&mut pass, &s.commands);
+            if o.mesh {
+                draw_all(&mut pass, &s.commands);
+            }
+            if let (Some(points), true) = (&s.points, s.point_count > 0) {
+                pass.set_pipeline(&self.points);
+                pass.set_bind_group(0, &s.shade_group, &[]);
+                pass.set_vertex_buffer(0, points.slice(..));
+                pass.draw(0..s.point_count, 0..1);
+            }
         }
         enc.copy_buffer_to_buffer(&s.commands, 0, &s.prev_commands, 0, 20 * n.max(1) as u64);
         let row = aligned_row(o.width);
@@ -842,7 +937,14 @@ impl Renderer {
             clusters_after_frustum: after,
             clusters_after_occlusion: occlusion.then_some(after_occ),
             triangles: s.triangles,
-            triangles_drawn: if occlusion { drawn_occ } else { drawn } as u64,
+            triangles_drawn: if !o.mesh {
+                0
+            } else if occlusion {
+                u64::from(drawn_occ)
+            } else {
+                u64::from(drawn)
+            },
+            points_drawn: u64::from(s.point_count),
             multi_draw: "multi_draw_indexed_indirect",
             cpu_ms: t0.elapsed().as_secs_f64() * 1e3,
             gpu,

@@ -7,7 +7,10 @@
 //! wheel zooms; W/A/S/D/Q/E fly (the target moves along); C cycles culling
 //! none → frustum → occlusion → two-pass occlusion; Z toggles the Z-prepass; G gamma; L the
 //! light-grid view (surfaces coloured by their cell's list length); R
-//! resets the camera; Escape quits.
+//! resets the camera; Escape quits. The ray spray ([`crate::spray`]): P
+//! (or the middle button) sprays rays in a narrow cone through the cursor,
+//! each hit a point lit by its stored light term; M shows or hides the
+//! mesh; X clears the points. The points are handed back on closing.
 //!
 //! Scripted (`frames`): after that many frames the viewer renders one more
 //! frame off screen with the current camera and size, hands it to the
@@ -25,6 +28,7 @@ use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
 
 use crate::gpu::{Blit, Culling, Frame, FrameOptions, GpuScene, Renderer};
+use crate::spray::{SprayOptions, SprayPoint, Tracer};
 use crate::{Camera, Scene, ViewError};
 
 /// How the viewer starts.
@@ -46,6 +50,10 @@ pub struct ViewOptions {
     pub gamma: bool,
     /// Close after this many frames, with a screenshot.
     pub frames: Option<u32>,
+    /// Rays per spray at the cursor.
+    pub spray_rays: usize,
+    /// Half-angle of the spray's cone, in degrees.
+    pub spray_degrees: f32,
 }
 
 /// What a viewer session did.
@@ -59,6 +67,8 @@ pub struct ViewReport {
     pub screenshot: Option<Frame>,
     /// The camera of that frame.
     pub camera: Camera,
+    /// The spray's points: those given at start, then every spray's.
+    pub points: Vec<SprayPoint>,
 }
 
 /// Orbit camera state: a target, a distance and two angles around `up`.
@@ -116,7 +126,12 @@ struct Active {
 }
 
 struct App {
-    scene: Option<Scene>,
+    scene: Scene,
+    /// Built at the first spray.
+    tracer: Option<Tracer>,
+    points: Vec<SprayPoint>,
+    sprays: u64,
+    mesh: bool,
     opts: ViewOptions,
     home: Camera,
     orbit: Orbit,
@@ -135,13 +150,17 @@ struct App {
 
 /// Opens the window and runs until it is closed (or, scripted, until
 /// `frames` frames were shown).
-pub fn run(scene: Scene, opts: ViewOptions) -> Result<ViewReport, ViewError> {
+pub fn run(scene: Scene, points: Vec<SprayPoint>, opts: ViewOptions) -> Result<ViewReport, ViewError> {
     let (lo, hi) = scene.bounds().ok_or(ViewError::EmptyScene)?;
     let home = opts.camera.unwrap_or_else(|| Camera::framing(lo, hi, opts.up));
     let event_loop = EventLoop::new().map_err(|e| ViewError::Window(e.to_string()))?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = App {
-        scene: Some(scene),
+        scene,
+        tracer: None,
+        points,
+        sprays: 0,
+        mesh: true,
         opts,
         home,
         orbit: Orbit::from_camera(&home, opts.up),
@@ -165,7 +184,7 @@ pub fn run(scene: Scene, opts: ViewOptions) -> Result<ViewReport, ViewError> {
         Some((f, c)) => (Some(f), c),
         None => (None, app.orbit.camera()),
     };
-    Ok(ViewReport { frames: app.frames, adapter: app.adapter, screenshot, camera })
+    Ok(ViewReport { frames: app.frames, adapter: app.adapter, screenshot, camera, points: app.points })
 }
 
 impl App {
@@ -195,8 +214,8 @@ impl App {
         }
         config.present_mode = wgpu::PresentMode::AutoVsync;
         surface.configure(&renderer.device, &config);
-        let scene = self.scene.take().ok_or(ViewError::EmptyScene)?;
-        let uploaded = renderer.upload(&scene)?;
+        let mut uploaded = renderer.upload(&self.scene)?;
+        renderer.add_points(&mut uploaded, &self.points)?;
         let blit = renderer.blit(view_format);
         self.adapter = renderer.adapter();
         Ok(Active { window, surface, config, view_format, renderer, uploaded, blit })
@@ -212,6 +231,7 @@ impl App {
             gamma: self.gamma,
             light_grid_view: self.light_grid,
             read_hiz: false,
+            mesh: self.mesh,
         }
     }
 
@@ -238,14 +258,16 @@ impl App {
         let culling = self.culling.name();
         let kept = stats.clusters_after_occlusion.unwrap_or(stats.clusters_after_frustum);
         a.window.set_title(&format!(
-            "voxkit view | culling {culling} (C), prepass {} (Z), gamma {} (G) | clusters {}/{}/{} | {} of {} triangles | {} lights | {:.1} ms",
+            "voxkit view | culling {culling} (C), prepass {} (Z), gamma {} (G), mesh {} (M) | clusters {}/{}/{} | {} of {} triangles | {} points (P sprays) | {} lights | {:.1} ms",
             if self.prepass { "on" } else { "off" },
             if self.gamma { "on" } else { "off" },
+            if self.mesh { "on" } else { "off" },
             kept,
             stats.clusters_after_frustum,
             stats.clusters,
             stats.triangles_drawn,
             stats.triangles,
+            stats.points_drawn,
             a.uploaded.lights.lights,
             ms,
         ));
@@ -257,6 +279,29 @@ impl App {
             }
             event_loop.exit();
         }
+    }
+
+    /// Sprays rays in a cone through the cursor and adds their points.
+    fn spray(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(a) = &mut self.active else { return };
+        if self.tracer.is_none() {
+            match Tracer::new(&self.scene) {
+                Ok(t) => self.tracer = Some(t),
+                Err(e) => return self.fail(event_loop, e),
+            }
+        }
+        let tracer = self.tracer.as_ref().expect("built above");
+        let (w, h) = (a.config.width as f32, a.config.height as f32);
+        let x = (2.0 * self.cursor.0 as f32 / w - 1.0).clamp(-1.0, 1.0);
+        let y = (1.0 - 2.0 * self.cursor.1 as f32 / h).clamp(-1.0, 1.0);
+        let camera = self.orbit.camera();
+        self.sprays += 1;
+        let o = SprayOptions { rays: self.opts.spray_rays, seed: self.sprays, ..SprayOptions::default() };
+        let new = tracer.spray_cone(camera.eye, camera.ray(w / h, x, y), self.opts.spray_degrees.to_radians(), &o);
+        if let Err(e) = a.renderer.add_points(&mut a.uploaded, &new) {
+            return self.fail(event_loop, e);
+        }
+        self.points.extend_from_slice(&new);
     }
 
     fn key(&mut self, code: KeyCode, event_loop: &ActiveEventLoop) {
@@ -273,6 +318,14 @@ impl App {
             KeyCode::KeyZ => self.prepass = !self.prepass,
             KeyCode::KeyG => self.gamma = !self.gamma,
             KeyCode::KeyL => self.light_grid = !self.light_grid,
+            KeyCode::KeyM => self.mesh = !self.mesh,
+            KeyCode::KeyP => self.spray(event_loop),
+            KeyCode::KeyX => {
+                self.points.clear();
+                if let Some(a) = &mut self.active {
+                    a.renderer.clear_points(&mut a.uploaded);
+                }
+            }
             KeyCode::KeyR => self.orbit = Orbit::from_camera(&self.home, self.orbit.up),
             KeyCode::KeyW => self.orbit.target += fwd * step,
             KeyCode::KeyS => self.orbit.target -= fwd * step,
@@ -315,6 +368,7 @@ impl ApplicationHandler for App {
                     self.key(code, event_loop);
                 }
             }
+            WindowEvent::MouseInput { state: ElementState::Pressed, button: MouseButton::Middle, .. } => self.spray(event_loop),
             WindowEvent::MouseInput { state, button, .. } => {
                 self.drag = (state == ElementState::Pressed).then_some((button, self.cursor));
             }

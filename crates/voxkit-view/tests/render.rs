@@ -49,8 +49,21 @@ fn cameras(scene: &Scene) -> Vec<Camera> {
 }
 
 fn frame(r: &Renderer, g: &voxkit_view::GpuScene, camera: Camera, culling: Culling, prepass: bool) -> voxkit_view::Frame {
-    r.render(g, &FrameOptions { width: 160, height: 120, camera, culling, prepass, gamma: true, light_grid_view: false, read_hiz: true })
-        .unwrap()
+    r.render(
+        g,
+        &FrameOptions {
+            width: 160,
+            height: 120,
+            camera,
+            culling,
+            prepass,
+            gamma: true,
+            light_grid_view: false,
+            read_hiz: true,
+            mesh: true,
+        },
+    )
+    .unwrap()
 }
 
 fn check_scene(r: &Renderer, scene: &Scene, what: &str) {
@@ -137,6 +150,7 @@ fn the_cornell_box_is_lit_by_its_ceiling() {
         gamma: true,
         light_grid_view: false,
         read_hiz: false,
+        mesh: true,
     };
     let f = r.render(&g, &o).unwrap();
     let px = |x: usize, y: usize| {
@@ -214,4 +228,109 @@ fn the_light_grid_built_on_the_gpu_is_the_cpu_build() {
     let mut city = Scene::default();
     city.add_mesh(mesh.as_ref(), &app);
     check_light_grid(&r, &city, "city");
+}
+
+fn srgb_byte(x: f32) -> f32 {
+    let x = x.clamp(0.0, 1.0);
+    255.0 * if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 }
+}
+
+#[test]
+fn a_spray_point_is_lit_as_the_shader_documents() {
+    let Some(r) = renderer() else { return };
+    let scene = cornell();
+    let mut g = r.upload(&scene).unwrap();
+    // A point at the target, facing the eye: view Lambert term 1, view
+    // attenuation 2 / (1³ + 1) = 1, so it shows emission + albedo × light.
+    // With an odd picture its projection is the centre pixel's centre.
+    let target = Vec3::new(0.5, 0.5, 0.5);
+    let eye = target + Vec3::new(0.3, 0.4, 1.2);
+    let p = voxkit_view::spray::SprayPoint {
+        position: target.to_array(),
+        normal: (eye - target).normalize().to_array(),
+        albedo: [0.5, 0.25, 0.1],
+        light: [0.8, 0.6, 0.4],
+        emission: [0.05, 0.0, 0.02],
+        _pad: 0.0,
+    };
+    r.add_points(&mut g, &[p]).unwrap();
+    let camera = Camera { eye, target, up: Vec3::Y, fov_deg: 40.0 };
+    let o = FrameOptions {
+        width: 101,
+        height: 81,
+        camera,
+        culling: Culling::None,
+        prepass: false,
+        gamma: true,
+        light_grid_view: false,
+        read_hiz: false,
+        mesh: false,
+    };
+    let f = r.render(&g, &o).unwrap();
+    assert_eq!(f.stats.points_drawn, 1);
+    assert_eq!(f.stats.triangles_drawn, 0, "mesh off");
+    let px = |x: usize, y: usize| &f.rgba[4 * (y * 101 + x)..4 * (y * 101 + x) + 3];
+    for c in 0..3 {
+        let want = srgb_byte(p.emission[c] + p.albedo[c] * p.light[c]);
+        assert!((f32::from(px(50, 40)[c]) - want).abs() <= 1.0, "channel {c}: {:?} vs {want}", px(50, 40));
+    }
+    // Only that pixel is drawn (points are one pixel).
+    let background = px(0, 0).to_vec();
+    let drawn = (0..81).flat_map(|y| (0..101).map(move |x| (x, y))).filter(|&(x, y)| px(x, y) != background.as_slice()).count();
+    assert_eq!(drawn, 1);
+}
+
+#[test]
+fn culling_leaves_a_sprayed_cloud_unchanged() {
+    let Some(r) = renderer() else { return };
+    let scene = cornell();
+    let tracer = voxkit_view::spray::Tracer::new(&scene).unwrap();
+    let (lo, hi) = scene.bounds().unwrap();
+    let from_front = Camera { eye: Vec3::new(0.5, 0.5, 2.2), target: Vec3::new(0.5, 0.45, 0.0), up: Vec3::Y, fov_deg: 45.0 };
+    let o = voxkit_view::spray::SprayOptions { rays: 20_000, light_samples: 4, seed: 2, shadows: true };
+    let points = tracer.spray_camera(&from_front, 1.0, &o);
+    let mut g = r.upload(&scene).unwrap();
+    r.add_points(&mut g, &points[..points.len() / 2]).unwrap();
+    r.add_points(&mut g, &points[points.len() / 2..]).unwrap();
+    for cam in [from_front, Camera::framing(lo, hi, 1)] {
+        for mesh in [true, false] {
+            let pictures: Vec<Vec<u8>> = [Culling::None, Culling::Frustum, Culling::Occlusion]
+                .into_iter()
+                .map(|culling| {
+                    let o = FrameOptions {
+                        width: 96,
+                        height: 96,
+                        camera: cam,
+                        culling,
+                        prepass: false,
+                        gamma: true,
+                        light_grid_view: false,
+                        read_hiz: false,
+                        mesh,
+                    };
+                    let f = r.render(&g, &o).unwrap();
+                    assert_eq!(f.stats.points_drawn, points.len() as u64);
+                    f.rgba
+                })
+                .collect();
+            assert!(pictures.windows(2).all(|w| w[0] == w[1]), "mesh {mesh}: culling changed the picture");
+        }
+    }
+    // Points added in two parts draw as when added at once.
+    let mut once = r.upload(&scene).unwrap();
+    r.add_points(&mut once, &points).unwrap();
+    let o = FrameOptions {
+        width: 96,
+        height: 96,
+        camera: from_front,
+        culling: Culling::None,
+        prepass: false,
+        gamma: true,
+        light_grid_view: false,
+        read_hiz: false,
+        mesh: false,
+    };
+    assert_eq!(r.render(&once, &o).unwrap().rgba, r.render(&g, &o).unwrap().rgba);
+    r.clear_points(&mut once);
+    assert_eq!(r.render(&once, &o).unwrap().stats.points_drawn, 0);
 }

@@ -15,5 +15,7 @@ pub mod render_gpu;
 #[cfg(feature = "gpu")]
 pub mod scene;
 #[cfg(feature = "gpu")]
+pub mod spray;
+#[cfg(feature = "gpu")]
 pub mod view;
 pub mod voxelize;

@@ -32,6 +32,34 @@ pub(crate) fn add_voxels(scene: &mut Scene, bits: &voxkit::grid::dense::DenseBit
     scene.add_quads(&quads, origin, size, m);
 }
 
+/// Loads a mesh with its materials, or a voxel file's greedy quads, as a
+/// scene; the kind loaded ("mesh" or "voxel file"). None of `outputs` may
+/// be a file the mesh reads.
+pub(crate) fn load_scene(input: &Path, up: Option<&str>, allow_external_paths: bool, outputs: &[PathBuf]) -> Result<(Scene, &'static str)> {
+    let mut scene = Scene::default();
+    if voxkit_io::is_voxel_file(input) {
+        add_voxel_file(&mut scene, input, up, Vec3::ZERO)?;
+        return Ok((scene, "voxel file"));
+    }
+    let loaded = voxkit_io::read_mesh_with(input, &voxkit_io::ReadOptions { allow_external_paths })?;
+    for out in outputs {
+        voxkit_io::atomic::refuse_overwriting_inputs(out, &loaded.sources)?;
+    }
+    for w in &loaded.warnings {
+        eprintln!("voxkit: warning: {}: {w}", input.display());
+    }
+    scene.add_mesh(loaded.mesh.as_ref(), &loaded.appearance);
+    Ok((scene, "mesh"))
+}
+
+/// Reads a spray cloud (`voxkit spray`'s PLY).
+pub(crate) fn read_points(path: &Path) -> Result<Vec<voxkit_view::spray::SprayPoint>> {
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    voxkit_io::fenced(|| voxkit_view::spray::read_ply(&bytes))
+        .unwrap_or_else(|msg| Err(format!("the PLY parser crashed on it ({msg})")))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
 /// Parses `EX,EY,EZ,TX,TY,TZ[,FOV]`.
 pub(crate) fn parse_camera(s: &str, up: Vec3) -> Result<Camera> {
     let v: Option<Vec<f32>> = s.split(',').map(|x| x.trim().parse::<f32>().ok().filter(|v| v.is_finite())).collect();
@@ -77,23 +105,13 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     up[o.up] = 1.0;
 
     let t0 = std::time::Instant::now();
-    let mut scene = Scene::default();
-    let kind = if voxkit_io::is_voxel_file(&a.input) {
-        add_voxel_file(&mut scene, &a.input, a.up.as_deref(), Vec3::ZERO)?;
-        "voxel file"
-    } else {
-        let loaded = voxkit_io::read_mesh_with(&a.input, &voxkit_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
-        for out in &outputs {
-            voxkit_io::atomic::refuse_overwriting_inputs(out, &loaded.sources)?;
-        }
-        for w in &loaded.warnings {
-            eprintln!("voxkit: warning: {}: {w}", a.input.display());
-        }
-        scene.add_mesh(loaded.mesh.as_ref(), &loaded.appearance);
-        "mesh"
-    };
+    let (scene, kind) = load_scene(&a.input, a.up.as_deref(), a.allow_external_paths, &outputs)?;
     let load_s = t0.elapsed().as_secs_f64();
     let bounds = scene.bounds().with_context(|| format!("{}: nothing to draw (no triangle with area)", a.input.display()))?;
+    let points = match &g.points {
+        Some(p) => read_points(p)?,
+        None => Vec::new(),
+    };
     let cameras: Vec<Camera> = match (&g.camera, &g.frames) {
         (Some(s), _) => vec![parse_camera(s, up)?],
         (None, Some(path)) => read_camera_path(path, up)?,
@@ -106,7 +124,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     }
     let renderer = Renderer::new()?;
     let t1 = std::time::Instant::now();
-    let uploaded = renderer.upload(&scene)?;
+    let mut uploaded = renderer.upload(&scene)?;
+    renderer.add_points(&mut uploaded, &points)?;
     let upload_s = t1.elapsed().as_secs_f64();
     let culling = Culling::from_name(&g.culling).expect("clap checked the name");
     let mut frames = Vec::with_capacity(cameras.len());
@@ -120,6 +139,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             gamma: g.gamma == "on",
             light_grid_view: g.light_grid == "on",
             read_hiz: false,
+            mesh: g.mesh == "on",
         };
         // Every run's statistics, the last run's picture.
         let mut frame = renderer.render(&uploaded, &opts)?;
@@ -141,6 +161,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             "clusters_after_frustum": s.clusters_after_frustum,
             "clusters_after_occlusion": s.clusters_after_occlusion,
             "triangles_drawn": s.triangles_drawn,
+            "points_drawn": s.points_drawn,
             "frame_ms": {
                 "repeats": g.repeat,
                 "cpu": median(&|s| Some(s.cpu_ms)),
@@ -169,6 +190,8 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         "clusters_after_occlusion": first["clusters_after_occlusion"],
         "triangles": uploaded.triangles,
         "triangles_drawn": first["triangles_drawn"],
+        "points": g.points,
+        "points_drawn": first["points_drawn"],
         "lights": uploaded.lights.lights,
         "emissive_triangles": uploaded.lights.emissive_triangles,
         "light_grid": {"cells": uploaded.grid.ranges.len(), "total": total, "mean": mean, "max": max, "built_on": "gpu", "build_ms": uploaded.grid_ms},

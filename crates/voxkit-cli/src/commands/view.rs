@@ -10,13 +10,20 @@ use voxkit_view::{Culling, Scene};
 
 use crate::args::ViewArgs;
 use crate::commands::render::{check_png_path, parse_size, up_axis};
-use crate::commands::render_gpu::{add_voxel_file, add_voxels, parse_camera};
+use crate::commands::render_gpu::{add_voxel_file, add_voxels, parse_camera, read_points};
 use crate::plan;
 
 pub fn run(a: &ViewArgs) -> Result<()> {
     let (width, height) = parse_size(&a.size)?;
     if let Some(p) = &a.screenshot {
         check_png_path(p)?;
+        voxkit_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.input))?;
+    }
+    if let Some(p) = &a.save_points {
+        if p.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("ply")) != Some(true) {
+            bail!("{}: spray clouds are written as PLY; give a .ply file name", p.display());
+        }
+        voxkit_job::output::check_output_path(p)?;
         voxkit_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.input))?;
     }
     if a.frames == Some(0) {
@@ -60,9 +67,32 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     }
     let culling = Culling::from_name(&a.culling).expect("clap checked the name");
     let camera = a.camera.as_deref().map(|s| parse_camera(s, up)).transpose()?;
-    let opts =
-        ViewOptions { width, height, camera, up: up_axis, culling, prepass: a.prepass == "on", gamma: a.gamma == "on", frames: a.frames };
-    let report = run_window(scene, opts)?;
+    if a.spray_rays == 0 || a.spray_rays > 1 << 24 {
+        bail!("--spray-rays must be 1..={}, not {}", 1 << 24, a.spray_rays);
+    }
+    if !(a.spray_degrees > 0.0 && a.spray_degrees <= 90.0) {
+        bail!("--spray-degrees must be above 0 and at most 90, not {}", a.spray_degrees);
+    }
+    let points = match &a.points {
+        Some(p) => read_points(p)?,
+        None => Vec::new(),
+    };
+    let opts = ViewOptions {
+        width,
+        height,
+        camera,
+        up: up_axis,
+        culling,
+        prepass: a.prepass == "on",
+        gamma: a.gamma == "on",
+        frames: a.frames,
+        spray_rays: a.spray_rays,
+        spray_degrees: a.spray_degrees,
+    };
+    let report = run_window(scene, points, opts)?;
+    if let Some(p) = &a.save_points {
+        voxkit_io::atomic::write_atomically(p, |w| voxkit_view::spray::write_ply(w, &report.points))?;
+    }
     let mut shot = None;
     if let (Some(p), Some(f)) = (&a.screenshot, &report.screenshot) {
         voxkit_io::write_png(p, f.width, f.height, &f.rgb())?;
@@ -72,7 +102,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     let camera = format!("{},{},{},{},{},{},{}", c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.fov_deg);
     if a.json {
         let v = json!({"input": a.input, "frames": report.frames, "adapter": report.adapter, "camera": camera,
-            "screenshot": a.screenshot, "screenshot_size": shot.map(|(w, h)| [w, h])});
+            "screenshot": a.screenshot, "screenshot_size": shot.map(|(w, h)| [w, h]), "points": report.points.len(), "save_points": a.save_points});
         return crate::print_stdout(&v.to_string());
     }
     crate::print_stdout(&format!("view: {} frames on {}; last camera --camera {camera}", report.frames, report.adapter))
