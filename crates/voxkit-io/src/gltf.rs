@@ -100,7 +100,21 @@ impl Builder {
             let name = format!("material {}", m.index().unwrap_or(0));
             let e = m.emissive_factor();
             let roughness = pbr.roughness_factor().clamp(0.0, 1.0);
-            self.app.materials.push(Material { name, factor: [f[0], f[1], f[2]], texture, emission: e.map(|x| x.max(0.0)), roughness });
+            // MASK cuts out below alphaCutoff (glTF's default 0.5); BLEND
+            // would need sorting and is drawn opaque, as OPAQUE is.
+            let alpha_cutoff = match m.alpha_mode() {
+                gltf::material::AlphaMode::Mask => Some(m.alpha_cutoff().unwrap_or(0.5)).filter(|c| c.is_finite()),
+                _ => None,
+            };
+            self.app.materials.push(Material {
+                name,
+                factor: [f[0], f[1], f[2]],
+                texture,
+                emission: e.map(|x| x.max(0.0)),
+                roughness,
+                alpha_cutoff,
+                alpha_texture: None,
+            });
             self.tex_coord.push(set);
         }
         self.app.materials.push(Material {
@@ -109,6 +123,8 @@ impl Builder {
             texture: None,
             emission: [0.0; 3],
             roughness: DEFAULT_ROUGHNESS,
+            alpha_cutoff: None,
+            alpha_texture: None,
         });
         self.tex_coord.push(0);
     }

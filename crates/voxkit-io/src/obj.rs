@@ -153,7 +153,36 @@ pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKin
                 }
             });
             let name = if mat.name.is_empty() { format!("material {index}") } else { mat.name.clone() };
-            app.materials.push(Material { name, factor, texture, emission: obj_emission(mat), roughness: obj_roughness(mat) });
+            // map_d: a cut-out mask (its alpha channel, or for an opaque
+            // image its red channel: masks are usually grey), moved into
+            // the alpha channel of its own texture.
+            let alpha_texture = mat.dissolve_texture.as_deref().filter(|t| !t.trim().is_empty()).and_then(|statement| {
+                let (reference, wrap) = crate::texture::parse_map_statement(statement);
+                match res.resolve(&reference).and_then(|path| crate::texture::load(&path, wrap)) {
+                    Ok(mut t) => {
+                        if t.rgba.chunks_exact(4).all(|p| p[3] == 255) {
+                            t.rgba.chunks_exact_mut(4).for_each(|p| p[3] = p[0]);
+                        }
+                        app.textures.push(t);
+                        Some(app.textures.len() as u32 - 1)
+                    }
+                    Err(e) => {
+                        warnings.push(format!("material {name:?}: map_d {e}; the material is drawn opaque"));
+                        None
+                    }
+                }
+            });
+            let see_through = texture.is_some_and(|t| app.textures[t as usize].rgba.chunks_exact(4).any(|p| p[3] < 255));
+            let alpha_cutoff = (alpha_texture.is_some() || see_through).then_some(0.5);
+            app.materials.push(Material {
+                name,
+                factor,
+                texture,
+                emission: obj_emission(mat),
+                roughness: obj_roughness(mat),
+                alpha_cutoff,
+                alpha_texture,
+            });
         }
     }
     if !app.materials.is_empty() {
@@ -377,6 +406,32 @@ mod tests {
         assert_eq!(m.mesh.triangles.len(), 60_001);
         assert_eq!(m.mesh.triangles[59_999], [179_997, 179_998, 179_999]);
         assert_eq!(m.mesh.triangles[60_000], [0, 1, 2]);
+    }
+
+    #[test]
+    fn map_d_and_transparent_textures_set_an_alpha_cutoff() {
+        let dir = std::env::temp_dir().join(format!("voxkit-obj-alpha-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // A grey mask (opaque PNG: its red channel becomes the alpha), a
+        // colour texture with a transparent texel, and an opaque one.
+        image::GrayImage::from_raw(2, 1, vec![0, 200]).unwrap().save(dir.join("mask.png")).unwrap();
+        image::RgbaImage::from_raw(2, 1, vec![9, 9, 9, 255, 9, 9, 9, 0]).unwrap().save(dir.join("leaf.png")).unwrap();
+        image::RgbaImage::from_raw(1, 1, vec![9, 9, 9, 255]).unwrap().save(dir.join("solid.png")).unwrap();
+        std::fs::write(
+            dir.join("m.mtl"),
+            "newmtl masked\nKd 1 1 1\nmap_Kd solid.png\nmap_d mask.png\nnewmtl leaf\nmap_Kd leaf.png\nnewmtl solid\nmap_Kd solid.png\nnewmtl plain\n",
+        )
+        .unwrap();
+        let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl masked\nf 1/1 2/1 3/1\nusemtl leaf\nf 1/1 2/1 3/1\nusemtl solid\nf 1/1 2/1 3/1\nusemtl plain\nf 1 2 3\n";
+        let m = read(obj.as_bytes(), &Resources::new(Some(&dir), &Default::default())).unwrap();
+        let (mats, tex) = (&m.appearance.materials, &m.appearance.textures);
+        assert_eq!(mats[0].alpha_cutoff, Some(0.5));
+        let mask = &tex[mats[0].alpha_texture.unwrap() as usize];
+        assert_eq!([mask.rgba[3], mask.rgba[7]], [0, 200], "the grey mask's value is its alpha");
+        assert_eq!((mats[1].alpha_cutoff, mats[1].alpha_texture), (Some(0.5), None), "transparent texels in map_Kd");
+        assert_eq!((mats[2].alpha_cutoff, mats[2].alpha_texture), (None, None));
+        assert_eq!((mats[3].alpha_cutoff, mats[3].alpha_texture), (None, None));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

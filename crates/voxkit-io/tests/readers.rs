@@ -206,3 +206,18 @@ fn text_polylines() {
     let m = voxkit_io::read_mesh(&p).unwrap();
     assert_eq!((m.report.triangles, m.report.segments, m.report.vertices), (0, 3, 5));
 }
+
+#[test]
+fn gltf_alpha_modes_become_cutoffs() {
+    // Three materials: MASK with a cutoff, MASK with glTF's default (0.5),
+    // BLEND (drawn opaque); the triangle uses the first.
+    let bin = gltf_bin();
+    write("alpha.bin", &bin);
+    let json = gltf_json(Some("alpha.bin"), bin.len()).replace(r#""indices": 1}"#, r#""indices": 1, "material": 0}"#).replace(
+        r#""buffers":"#,
+        r#""materials": [{"alphaMode": "MASK", "alphaCutoff": 0.3}, {"alphaMode": "MASK"}, {"alphaMode": "BLEND"}], "buffers":"#,
+    );
+    let m = read_mesh(&write("alpha.gltf", json.as_bytes())).unwrap_or_else(|e| panic!("{e}"));
+    let cut: Vec<Option<f32>> = m.appearance.materials.iter().map(|m| m.alpha_cutoff).collect();
+    assert_eq!(cut, [Some(0.3), Some(0.5), None, None], "the last is glTF's default material");
+}

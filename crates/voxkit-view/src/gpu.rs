@@ -243,6 +243,10 @@ pub struct Renderer {
 const COLOUR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const HIZ: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// The largest side of the texture array's layers.
+pub const MAX_TEXTURE_SIDE: u32 = 2048;
+/// The most bytes the texture array takes.
+pub const MAX_TEXTURE_BYTES: u64 = 512 << 20;
 /// Background, written as is (not gamma corrected).
 const BACKGROUND: wgpu::Color = wgpu::Color { r: 0.10, g: 0.10, b: 0.12, a: 1.0 };
 
@@ -281,6 +285,7 @@ impl Renderer {
                 max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
                 max_buffer_size: limits.max_buffer_size,
                 max_texture_dimension_2d: limits.max_texture_dimension_2d,
+                max_texture_array_layers: limits.max_texture_array_layers,
                 ..wgpu::Limits::downlevel_defaults()
             },
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
@@ -321,6 +326,22 @@ impl Renderer {
                 entry(5, S::FRAGMENT, Storage { read_only: true }),
                 entry(6, S::FRAGMENT, Storage { read_only: true }),
                 entry(7, S::FRAGMENT, Storage { read_only: true }),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 8,
+                    visibility: S::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 9,
+                    visibility: S::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
             ],
         });
         let pipeline_layout = |layouts: &[Option<&wgpu::BindGroupLayout>]| {
@@ -396,7 +417,8 @@ impl Renderer {
             source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/shade.wgsl"), include_str!("shaders/points.wgsl")]).into()),
         });
         let shade_pl = pipeline_layout(&[Some(&shade_layout)]);
-        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x3];
+        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x3, 3 => Float32x2];
+        let colour_target = [Some(wgpu::ColorTargetState { format: COLOUR, blend: None, write_mask: wgpu::ColorWrites::ALL })];
         let draw = |label, colour: bool, write: bool, compare| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
@@ -420,11 +442,13 @@ impl Renderer {
                     bias: Default::default(),
                 }),
                 multisample: Default::default(),
-                fragment: colour.then(|| wgpu::FragmentState {
+                // The depth-only passes run the alpha test too (fs_depth),
+                // so cut-out texels neither hide nor occlude anything.
+                fragment: Some(wgpu::FragmentState {
                     module: &shade_module,
-                    entry_point: Some("fs"),
+                    entry_point: Some(if colour { "fs" } else { "fs_depth" }),
                     compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState { format: COLOUR, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+                    targets: if colour { &colour_target } else { &[] },
                 }),
                 multiview_mask: None,
                 cache: None,
@@ -551,13 +575,33 @@ impl Renderer {
             mapped_at_creation: false,
         });
         let materials = init("materials", bytemuck::cast_slice(&nonempty(&scene.materials)), U::STORAGE);
+        let textures = self.texture_array(&scene.textures)?;
+        let texture_view = textures
+            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
+        let sampler = self.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("textures"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
         let group = |layout, entries: &[(u32, &wgpu::Buffer)]| {
             let entries: Vec<wgpu::BindGroupEntry> =
                 entries.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
             self.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout, entries: &entries })
         };
         let cull_group = group(&self.cull_layout, &[(0, &uniform), (1, &boxes), (2, &commands), (3, &counters)]);
-        let shade_group = group(&self.shade_layout, &[(0, &uniform), (4, &materials), (5, &light_buf), (6, &ranges), (7, &light_indices)]);
+        let buffers = [(0, &uniform), (4, &materials), (5, &light_buf), (6, &ranges), (7, &light_indices)];
+        let mut entries: Vec<wgpu::BindGroupEntry> =
+            buffers.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
+        entries.push(wgpu::BindGroupEntry { binding: 8, resource: wgpu::BindingResource::TextureView(&texture_view) });
+        entries.push(wgpu::BindGroupEntry { binding: 9, resource: wgpu::BindingResource::Sampler(&sampler) });
+        let shade_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shade"),
+            layout: &self.shade_layout,
+            entries: &entries,
+        });
         self.check()?;
         Ok(GpuScene {
             vertices,
@@ -579,6 +623,58 @@ impl Renderer {
             points: None,
             point_count: 0,
         })
+    }
+
+    /// The scene's textures as one array of sRGB layers (sampled as
+    /// linear colour; alpha stays linear), every texture resized to the
+    /// array's square side: the largest texture side, at most
+    /// [`MAX_TEXTURE_SIDE`] and halved until the array fits in
+    /// [`MAX_TEXTURE_BYTES`]. One white texel when there is none.
+    fn texture_array(&self, textures: &[voxkit::attributes::Texture]) -> Result<wgpu::Texture, ViewError> {
+        let layers = textures.len().max(1) as u32;
+        let max_layers = self.device.limits().max_texture_array_layers;
+        if layers > max_layers {
+            return Err(ViewError::Device(format!("{layers} textures: this adapter takes at most {max_layers} in one array")));
+        }
+        let mut side = textures.iter().map(|t| t.width.max(t.height)).max().unwrap_or(1).clamp(1, MAX_TEXTURE_SIDE.min(self.max_side));
+        while side > 1 && u64::from(side) * u64::from(side) * 4 * u64::from(layers) > MAX_TEXTURE_BYTES {
+            side /= 2;
+        }
+        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("textures"),
+            size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: layers },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let white = [255u8; 4];
+        for layer in 0..layers {
+            let texels: Vec<u8> = match textures.get(layer as usize) {
+                None => white.repeat((side * side) as usize),
+                Some(t) if t.width == side && t.height == side && t.rgba.len() == (4 * side * side) as usize => t.rgba.clone(),
+                Some(t) => match image::RgbaImage::from_raw(t.width, t.height, t.rgba.clone()) {
+                    Some(img) => image::imageops::resize(&img, side, side, image::imageops::FilterType::Triangle).into_raw(),
+                    None => {
+                        return Err(ViewError::Device(format!("texture {}: {} bytes for {}x{}", t.name, t.rgba.len(), t.width, t.height)))
+                    }
+                },
+            };
+            self.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x: 0, y: 0, z: layer },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &texels,
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * side), rows_per_image: Some(side) },
+                wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 1 },
+            );
+        }
+        Ok(texture)
     }
 
     /// Adds spray points to the scene (drawn by every later frame); the

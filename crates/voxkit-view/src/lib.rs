@@ -24,8 +24,10 @@
 //!   shadow rays), drawn as points lit towards the viewer each frame;
 //! - `window` (feature `window`): the interactive viewer.
 //!
-//! **Not built yet**: alpha cut-outs and textures, and the cluster-box
-//! wireframe.
+//! Base-colour textures come from one texture array; the alpha test (glTF
+//! `MASK`, OBJ `map_d`) runs in the depth passes and the shading pass.
+//!
+//! **Not built yet**: the cluster-box wireframe.
 
 pub mod camera;
 pub mod gpu;

@@ -19,18 +19,22 @@ pub struct Vertex {
     pub material: u32,
     /// Unit face normal.
     pub normal: [f32; 3],
-    /// Padding to 32 bytes.
-    pub _pad: u32,
+    /// Texture coordinate (`v = 0` at the top row; zero without a texture).
+    pub uv: [f32; 2],
 }
 
 /// A material as the shader reads it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct ShadeMaterial {
-    /// Linear base colour (alpha unused for now).
+    /// Linear base colour (multiplies the base texture); `w` the alpha
+    /// cutoff (0: opaque).
     pub colour: [f32; 4],
     /// Linear emitted radiance; `w` is the Blinn–Phong exponent.
     pub emission_shininess: [f32; 4],
+    /// Layers of [`Scene::textures`]: the base colour's and the alpha's
+    /// (−1: none; the alpha is then the base texture's, or 1), and padding.
+    pub layers: [i32; 4],
 }
 
 impl ShadeMaterial {
@@ -40,9 +44,24 @@ impl ShadeMaterial {
     /// 1..=1024.
     pub fn new(colour: [f32; 3], emission: [f32; 3], roughness: f32) -> ShadeMaterial {
         ShadeMaterial {
-            colour: [colour[0], colour[1], colour[2], 1.0],
+            colour: [colour[0], colour[1], colour[2], 0.0],
             emission_shininess: [emission[0], emission[1], emission[2], shininess(roughness)],
+            layers: [-1, -1, 0, 0],
         }
+    }
+
+    /// This material with a base-colour texture layer, an alpha layer and
+    /// an alpha cutoff (fragments whose alpha is below it are cut out).
+    pub fn with_textures(mut self, base: Option<u32>, alpha: Option<u32>, cutoff: Option<f32>) -> ShadeMaterial {
+        let layer = |t: Option<u32>| t.map_or(-1, |t| t as i32);
+        self.layers = [layer(base), layer(alpha), 0, 0];
+        self.colour[3] = cutoff.filter(|c| c.is_finite()).map_or(0.0, |c| c.clamp(0.0, 1.0));
+        self
+    }
+
+    /// True when some of the surface may be cut out.
+    pub fn cut_out(&self) -> bool {
+        self.colour[3] > 0.0
     }
 
     /// True when the material emits light.
@@ -64,6 +83,8 @@ pub struct Scene {
     pub vertices: Vec<Vertex>,
     /// Materials the vertices name.
     pub materials: Vec<ShadeMaterial>,
+    /// Textures the materials name (RGBA8, `v = 0` at the top row).
+    pub textures: Vec<voxkit::attributes::Texture>,
 }
 
 /// The material of triangles that name none: light grey, rough.
@@ -94,8 +115,14 @@ impl Scene {
     /// are skipped; returns how many were.
     pub fn add_mesh(&mut self, mesh: MeshRef<'_>, app: &Appearance) -> usize {
         let base = self.materials.len() as u32;
+        let first_texture = self.textures.len() as u32;
+        self.textures.extend(app.textures.iter().cloned());
+        let layer = |t: Option<u32>| t.filter(|&t| (t as usize) < app.textures.len()).map(|t| first_texture + t);
         for m in &app.materials {
-            self.materials.push(ShadeMaterial::new(m.factor, m.emission, m.roughness));
+            let (texture, alpha) = (layer(m.texture), layer(m.alpha_texture));
+            // A cutoff needs an alpha to test: the alpha texture's or the base texture's.
+            let cutoff = m.alpha_cutoff.filter(|_| texture.is_some() || alpha.is_some());
+            self.materials.push(ShadeMaterial::new(m.factor, m.emission, m.roughness).with_textures(texture, alpha, cutoff));
         }
         let default = self.add_material(ShadeMaterial::new(DEFAULT_COLOUR, [0.0; 3], DEFAULT_ROUGHNESS));
         let mut skipped = 0;
@@ -105,7 +132,8 @@ impl Scene {
                 _ => default,
             };
             let p: Option<Vec<Vec3>> = tri.iter().map(|&v| mesh.positions.get(v as usize).map(|p| p.as_vec3())).collect();
-            if !p.as_ref().is_some_and(|p| self.push_triangle([p[0], p[1], p[2]], material)) {
+            let uv = app.triangle_uv.get(t).copied().filter(|uv| uv.iter().flatten().all(|x| x.is_finite())).unwrap_or([[0.0; 2]; 3]);
+            if !p.as_ref().is_some_and(|p| self.push_triangle_uv([p[0], p[1], p[2]], uv, material)) {
                 skipped += 1;
             }
         }
@@ -115,13 +143,18 @@ impl Scene {
     /// Adds a triangle; false (and nothing added) when it has a
     /// non-finite corner or no area in `f32`.
     pub fn push_triangle(&mut self, p: [Vec3; 3], material: u32) -> bool {
+        self.push_triangle_uv(p, [[0.0; 2]; 3], material)
+    }
+
+    /// Adds a triangle with texture coordinates; as [`Scene::push_triangle`].
+    pub fn push_triangle_uv(&mut self, p: [Vec3; 3], uv: [[f32; 2]; 3], material: u32) -> bool {
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         if !p.iter().all(|c| c.is_finite()) || !n.is_finite() || n.length_squared() <= 0.0 {
             return false;
         }
         let normal = n.normalize().to_array();
-        for c in p {
-            self.vertices.push(Vertex { position: c.to_array(), material, normal, _pad: 0 });
+        for (c, uv) in p.into_iter().zip(uv) {
+            self.vertices.push(Vertex { position: c.to_array(), material, normal, uv });
         }
         true
     }

@@ -8,9 +8,12 @@
 //!   (occluders, facades cut into window panels), 600 trees (trunks and
 //!   finely tessellated crowns), 169 street lamps with emissive heads, a
 //!   ground plane: about a million triangles, from a fixed-seed generator.
-//!   The crowns are opaque: alpha cut-outs are not built yet.
+//!   The crowns are opaque.
+//! - [`cut_outs`]: three quads one behind the other, the front one blue
+//!   with an 8×8 checkerboard of cut-out texels (`alphaMode: MASK`); the
+//!   alpha test's scene.
 
-use voxkit::attributes::{Appearance, Material, NO_MATERIAL};
+use voxkit::attributes::{Appearance, Material, Texture, Wrap, NO_MATERIAL};
 use voxkit::glam::DVec3;
 use voxkit::Mesh;
 
@@ -23,7 +26,15 @@ struct Builder {
 
 impl Builder {
     fn material(&mut self, name: &str, colour: [f32; 3], emission: [f32; 3], roughness: f32) -> u32 {
-        self.app.materials.push(Material { name: name.into(), factor: colour, texture: None, emission, roughness });
+        self.app.materials.push(Material {
+            name: name.into(),
+            factor: colour,
+            texture: None,
+            emission,
+            roughness,
+            alpha_cutoff: None,
+            alpha_texture: None,
+        });
         self.app.materials.len() as u32 - 1
     }
 
@@ -79,6 +90,31 @@ impl Builder {
         self.quad([c(0, 0, 0), c(0, 1, 0), c(1, 1, 0), c(1, 0, 0)], material); // -z
         self.quad([c(0, 0, 1), c(1, 0, 1), c(1, 1, 1), c(0, 1, 1)], material); // +z
     }
+}
+
+/// A red quad at z = 0 (side 3) and a green one at z = 0.25 (side 0.6)
+/// behind a unit quad at z = 0.5 whose base texture is blue with an 8×8
+/// checkerboard alpha (texel `(i, j)`, `i` across and `j` down from the
+/// top, opaque where `i + j` is even), cut out below 0.5; all centred on
+/// `(0.5, 0.5)` and facing +z. The green quad lies wholly behind the front
+/// one, so only an occlusion test that honours the cut-outs keeps it.
+pub fn cut_outs() -> (Mesh, Appearance) {
+    let mut b = Builder::default();
+    let red = b.material("red", [1.0, 0.0, 0.0], [0.0; 3], 0.8);
+    let green = b.material("green", [0.0, 1.0, 0.0], [0.0; 3], 0.8);
+    let leaf = b.material("checker", [1.0; 3], [0.0; 3], 0.8);
+    b.app.materials[leaf as usize].texture = Some(0);
+    b.app.materials[leaf as usize].alpha_cutoff = Some(0.5);
+    let rgba = (0..64).flat_map(|i| [0, 0, 255, if (i % 8 + i / 8) % 2 == 0 { 255 } else { 0 }]).collect();
+    b.app.textures.push(Texture { name: "checker".into(), width: 8, height: 8, rgba, wrap: [Wrap::Repeat; 2] });
+    for (z, side, m) in [(0.0, 3.0, red), (0.25, 0.6, green), (0.5, 1.0, leaf)] {
+        let p = |x: f64, y: f64| DVec3::new(0.5 + (x - 0.5) * side, 0.5 + (y - 0.5) * side, z);
+        b.quad([p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)], m);
+        // v = 0 at the top row.
+        let uv = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]];
+        b.app.triangle_uv.extend([[uv[0], uv[1], uv[2]], [uv[0], uv[2], uv[3]]]);
+    }
+    (b.mesh, b.app)
 }
 
 /// The Cornell box, y up, 0..1 on every axis, open towards +z.

@@ -53,8 +53,10 @@ use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::lights::{area_units, frame, merge_key};
-use crate::scene::Scene;
+use crate::scene::{Scene, ShadeMaterial};
 use crate::ViewError;
+use voxkit::attributes::colour::to_linear;
+use voxkit::attributes::Texture;
 
 /// Rays per random stream.
 pub const BLOCK: usize = 4096;
@@ -121,6 +123,11 @@ struct Emitters {
 pub struct Tracer {
     bvh: CwBvh,
     triangles: Vec<Triangle>,
+    /// Per triangle: its material, and the UV of its corners.
+    material: Vec<u32>,
+    uv: Vec<[[f32; 2]; 3]>,
+    materials: Vec<ShadeMaterial>,
+    textures: Vec<Texture>,
     normals: Vec<Vec3>,
     albedo: Vec<[f32; 3]>,
     emission: Vec<[f32; 3]>,
@@ -171,7 +178,75 @@ impl Tracer {
         emitters.weight = keys.iter().map(|k| (total / f64::from(lights[k]).sqrt()) as f32).collect();
         let bvh = build_cwbvh_from_tris(&triangles, BvhBuildParams::medium_build(), &mut Duration::default());
         let epsilon = (hi - lo).max_element().max(f32::MIN_POSITIVE) * 1e-5;
-        Ok(Tracer { bvh, triangles, normals, albedo, emission, emitters, unit, epsilon })
+        let material = scene.vertices.chunks_exact(3).map(|t| t[0].material).collect();
+        let uv = scene.vertices.chunks_exact(3).map(|t| [t[0].uv, t[1].uv, t[2].uv]).collect();
+        Ok(Tracer {
+            bvh,
+            triangles,
+            material,
+            uv,
+            materials: scene.materials.clone(),
+            textures: scene.textures.clone(),
+            normals,
+            albedo,
+            emission,
+            emitters,
+            unit,
+            epsilon,
+        })
+    }
+
+    /// The texture coordinate of point `p` on triangle `t`.
+    fn uv_at(&self, t: usize, p: Vec3) -> [f64; 2] {
+        let tri = &self.triangles[t];
+        let [a, b, c] = [tri.v0, tri.v1, tri.v2].map(|v| Vec3::from(v).as_dvec3());
+        let (e1, e2, q) = (b - a, c - a, p.as_dvec3() - a);
+        let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        let (d20, d21) = (q.dot(e1), q.dot(e2));
+        let den = d00 * d11 - d01 * d01;
+        let (v, w) = if den > 0.0 { ((d11 * d20 - d01 * d21) / den, (d00 * d21 - d01 * d20) / den) } else { (0.0, 0.0) };
+        let uv = self.uv[t];
+        std::array::from_fn(|k| (1.0 - v - w) * f64::from(uv[0][k]) + v * f64::from(uv[1][k]) + w * f64::from(uv[2][k]))
+    }
+
+    /// The base texture's texel at `p` on triangle `t` (white without one).
+    fn texel(&self, t: usize, p: Vec3) -> [u8; 4] {
+        let m = &self.materials[self.material[t] as usize];
+        match usize::try_from(m.layers[0]).ok().and_then(|l| self.textures.get(l)) {
+            Some(tex) => {
+                let [u, v] = self.uv_at(t, p);
+                tex.texel_rgba(u, v)
+            }
+            None => [255; 4],
+        }
+    }
+
+    /// Whether the alpha test cuts triangle `t` out at `p` (as `shade.wgsl`
+    /// does, with the nearest texel instead of a filtered one).
+    fn cut_out(&self, t: usize, p: Vec3) -> bool {
+        let m = &self.materials[self.material[t] as usize];
+        if !m.cut_out() {
+            return false;
+        }
+        let alpha = match usize::try_from(m.layers[1]).ok().and_then(|l| self.textures.get(l)) {
+            Some(tex) => {
+                let [u, v] = self.uv_at(t, p);
+                tex.texel_rgba(u, v)[3]
+            }
+            None => self.texel(t, p)[3],
+        };
+        f32::from(alpha) / 255.0 < m.colour[3]
+    }
+
+    /// The ray's distance to triangle `t`, infinite on a miss or where the
+    /// surface is cut out (rays and shadow rays pass through cut-outs).
+    fn intersect(&self, r: &Ray, t: usize) -> f32 {
+        let d = self.triangles[t].intersect(r);
+        if d.is_finite() && self.cut_out(t, Vec3::from(r.origin + r.direction * d)) {
+            f32::INFINITY
+        } else {
+            d
+        }
     }
 
     /// Emissive triangles the light samples are drawn from.
@@ -184,7 +259,7 @@ impl Tracer {
         let ray = Ray::new_inf(origin.into(), positive_zeros(dir).into());
         let mut hit = RayHit::none();
         self.bvh
-            .ray_traverse(ray, &mut hit, |r, id| self.triangles[self.bvh.primitive_indices[id] as usize].intersect(r))
+            .ray_traverse(ray, &mut hit, |r, id| self.intersect(r, self.bvh.primitive_indices[id] as usize))
             .then(|| (hit.t, self.bvh.primitive_indices[hit.primitive_id as usize] as usize))
     }
 
@@ -196,7 +271,7 @@ impl Tracer {
             return true;
         }
         let ray = Ray::new(from.into(), positive_zeros(d / len).into(), self.epsilon, len - self.epsilon);
-        self.bvh.ray_traverse_miss(ray, |r, id| self.triangles[self.bvh.primitive_indices[id] as usize].intersect(r))
+        self.bvh.ray_traverse_miss(ray, |r, id| self.intersect(r, self.bvh.primitive_indices[id] as usize))
     }
 
     /// A uniform point on the emissive surface.
@@ -240,7 +315,11 @@ impl Tracer {
         Some(SprayPoint {
             position: p.to_array(),
             normal: n.to_array(),
-            albedo: self.albedo[tri],
+            albedo: {
+                // The base colour times the texture's (sRGB) texel.
+                let texel = self.texel(tri, p);
+                std::array::from_fn(|c| self.albedo[tri][c] * to_linear(texel[c]) as f32)
+            },
             light: light.to_array(),
             emission: self.emission[tri],
             _pad: 0.0,

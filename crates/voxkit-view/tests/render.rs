@@ -334,3 +334,65 @@ fn culling_leaves_a_sprayed_cloud_unchanged() {
     r.clear_points(&mut once);
     assert_eq!(r.render(&once, &o).unwrap().stats.points_drawn, 0);
 }
+
+fn cut_out_scene() -> Scene {
+    let (mesh, app) = scenes::cut_outs();
+    let mut s = Scene::default();
+    assert_eq!(s.add_mesh(mesh.as_ref(), &app), 0);
+    s
+}
+
+#[test]
+fn alpha_cut_outs_show_what_is_behind_with_any_culling_and_prepass() {
+    let Some(r) = renderer() else { return };
+    let scene = cut_out_scene();
+    let g = r.upload(&scene).unwrap();
+    assert_eq!(g.clusters.len(), 6, "each triangle is a cluster: the back ones apart from the front ones");
+    // Straight on, the front quad filling a 128² picture: with a 60° field
+    // of view from z = 0.5 + d, d = 0.5 / tan 30°.
+    let d = 0.5 / 30f32.to_radians().tan();
+    let camera = Camera { eye: Vec3::new(0.5, 0.5, 0.5 + d), target: Vec3::new(0.5, 0.5, 0.0), up: Vec3::Y, fov_deg: 60.0 };
+    let mut pictures = Vec::new();
+    for culling in [Culling::None, Culling::Frustum, Culling::Occlusion, Culling::OcclusionTwoPass] {
+        for prepass in [false, true] {
+            let o = FrameOptions {
+                width: 128,
+                height: 128,
+                camera,
+                culling,
+                prepass,
+                gamma: false,
+                light_grid_view: false,
+                read_hiz: false,
+                mesh: true,
+            };
+            let f = r.render(&g, &o).unwrap();
+            // The back quad lies wholly behind the front one: only a depth
+            // pass that cuts out like the shading keeps it.
+            assert!(f.kept.iter().all(|&k| k), "{culling:?}: a quad behind the cut-outs was culled");
+            pictures.push(f.rgba);
+        }
+    }
+    assert!(pictures.windows(2).all(|w| w[0] == w[1]), "culling or the prepass changed a cut-out picture");
+    // Cell (i, j) of the checker, i across and j down from the top: its
+    // centre pixel is blue where the texel is opaque, red where cut out.
+    let f = &pictures[0];
+    for j in 0..8 {
+        for i in 0..8 {
+            let (x, y) = (16 * i + 8, 16 * j + 8);
+            let p = &f[4 * (y * 128 + x)..4 * (y * 128 + x) + 3];
+            let opaque = (i + j) % 2 == 0;
+            // The green quad (0.2..0.8 at z = 0.25) covers cells 2..=5 of
+            // the front quad's; the head-light's specular term adds white.
+            let dominant = if opaque {
+                2
+            } else if (2..=5).contains(&i) && (2..=5).contains(&j) {
+                1
+            } else {
+                0
+            };
+            let others = (0..3).filter(|&c| c != dominant).map(|c| u32::from(p[c])).max().unwrap();
+            assert!(u32::from(p[dominant]) > 2 * others + 60, "cell ({i}, {j}) should show channel {dominant}: {p:?}");
+        }
+    }
+}

@@ -228,3 +228,42 @@ fn a_cursor_ray_passes_through_what_the_cursor_shows() {
     }
     assert!((cam.ray(aspect, 0.0, 0.0) - (cam.target - cam.eye).normalize()).length() < 1e-6);
 }
+
+#[test]
+fn rays_pass_through_cut_outs_and_take_the_texture_colour() {
+    let (mesh, app) = scenes::cut_outs();
+    let mut scene = Scene::default();
+    assert_eq!(scene.add_mesh(mesh.as_ref(), &app), 0);
+    let tracer = Tracer::new(&scene).unwrap();
+    // Straight on, the front quad just filling the view (24° at 2.5 away).
+    let cam = Camera { eye: Vec3::new(0.5, 0.5, 3.0), target: Vec3::new(0.5, 0.5, 0.0), up: Vec3::Y, fov_deg: 24.0 };
+    let points = tracer.spray_camera(&cam, 1.0, &SprayOptions { rays: 20_000, light_samples: 0, seed: 4, shadows: false });
+    let mut seen = [0usize; 3];
+    for p in &points {
+        let q = Vec3::from(p.position);
+        // Where the ray crosses z = 0.5, the checker texel it meets.
+        let at = cam.eye + (q - cam.eye) * ((0.5 - cam.eye.z) / (q.z - cam.eye.z));
+        let (u, v) = (at.x, 1.0 - at.y);
+        if !(0.0..1.0).contains(&u) || !(0.0..1.0).contains(&v) {
+            continue;
+        }
+        let (i, j) = ((u * 8.0) as usize, (v * 8.0) as usize);
+        // Texels near an edge are left out: f32 rounding may pick either.
+        let frac = |x: f32| (x * 8.0).fract();
+        if [frac(u), frac(v)].iter().any(|f| !(0.01..0.99).contains(f)) {
+            continue;
+        }
+        let opaque = (i + j) % 2 == 0;
+        if opaque {
+            assert!((q.z - 0.5).abs() < 1e-5, "texel ({i}, {j}) is opaque: the ray stops on the front quad, not at {q}");
+            assert_eq!(p.albedo, [0.0, 0.0, 1.0], "the texture's blue");
+            seen[0] += 1;
+        } else {
+            assert!(q.z < 0.5 - 1e-3, "texel ({i}, {j}) is cut out: the ray goes through, not stopping at {q}");
+            let green = q.z > 0.2;
+            assert_eq!(p.albedo, if green { [0.0, 1.0, 0.0] } else { [1.0, 0.0, 0.0] });
+            seen[1 + usize::from(green)] += 1;
+        }
+    }
+    assert!(seen.iter().all(|&n| n > 100), "front, red and green all hit: {seen:?}");
+}

@@ -1,10 +1,15 @@
 // Shading (seed 002): Blinn–Phong per light of the fragment's light-grid
-// cell, attenuation i / (d³ + 1), emission, a small ambient term, gamma.
+// cell, attenuation i / (d³ + 1), emission, a small ambient term, gamma;
+// base-colour textures and the alpha test (cutoff in the prepass and the
+// shading pass alike, seed 002's "transparence").
 
 struct Material {
+    // rgb: base colour (times the texture), w: alpha cutoff (0: opaque).
     colour: vec4<f32>,
     // rgb: emission, w: Blinn–Phong exponent.
     emission_shininess: vec4<f32>,
+    // x: base texture layer, y: alpha texture layer (-1: none).
+    layers: vec4<i32>,
 }
 
 struct Light {
@@ -16,6 +21,8 @@ struct Light {
 @group(0) @binding(5) var<storage, read> lights: array<Light>;
 @group(0) @binding(6) var<storage, read> ranges: array<vec2<u32>>;
 @group(0) @binding(7) var<storage, read> light_indices: array<u32>;
+@group(0) @binding(8) var textures: texture_2d_array<f32>;
+@group(0) @binding(9) var texture_sampler: sampler;
 
 const AMBIENT: f32 = 0.06;
 const SPECULAR: f32 = 0.25;
@@ -26,16 +33,50 @@ struct VsOut {
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) @interpolate(flat) material: u32,
+    @location(3) uv: vec2<f32>,
 }
 
 @vertex
-fn vs(@location(0) position: vec3<f32>, @location(1) material: u32, @location(2) normal: vec3<f32>) -> VsOut {
+fn vs(@location(0) position: vec3<f32>, @location(1) material: u32, @location(2) normal: vec3<f32>, @location(3) uv: vec2<f32>) -> VsOut {
     var out: VsOut;
     out.clip = frame.view_proj * vec4<f32>(position, 1.0);
     out.world = position;
     out.normal = normal;
     out.material = material;
+    out.uv = uv;
     return out;
+}
+
+// The base texture's colour (white without one). Sampled at level 0: the
+// array has no mipmaps, and the explicit level keeps the call legal where
+// control flow is not uniform.
+fn base_texel(m: Material, uv: vec2<f32>) -> vec4<f32> {
+    if m.layers.x < 0 {
+        return vec4<f32>(1.0);
+    }
+    return textureSampleLevel(textures, texture_sampler, uv, m.layers.x, 0.0);
+}
+
+// True where the alpha test cuts the surface out: the alpha texture's
+// alpha, else the base texture's, below the material's cutoff.
+fn cut_out(m: Material, uv: vec2<f32>, base: vec4<f32>) -> bool {
+    if m.colour.w <= 0.0 {
+        return false;
+    }
+    var alpha = base.a;
+    if m.layers.y >= 0 {
+        alpha = textureSampleLevel(textures, texture_sampler, uv, m.layers.y, 0.0).a;
+    }
+    return alpha < m.colour.w;
+}
+
+// The depth-only passes (Z-prepass, occlusion depth): the alpha test alone.
+@fragment
+fn fs_depth(in: VsOut) {
+    let m = materials[in.material];
+    if cut_out(m, in.uv, base_texel(m, in.uv)) {
+        discard;
+    }
 }
 
 fn to_srgb(c: vec3<f32>) -> vec3<f32> {
@@ -46,12 +87,16 @@ fn to_srgb(c: vec3<f32>) -> vec3<f32> {
 @fragment
 fn fs(in: VsOut) -> @location(0) vec4<f32> {
     let m = materials[in.material];
+    let texel = base_texel(m, in.uv);
+    if cut_out(m, in.uv, texel) {
+        discard;
+    }
     let v = normalize(frame.eye.xyz - in.world);
     var n = normalize(in.normal);
     if dot(n, v) < 0.0 {
         n = -n; // two-sided: meshes are not always consistently oriented
     }
-    let albedo = m.colour.rgb;
+    let albedo = m.colour.rgb * texel.rgb;
     let shininess = m.emission_shininess.w;
     var c = m.emission_shininess.rgb + albedo * AMBIENT;
     let cellf = clamp(floor((in.world - frame.grid_lo.xyz) / frame.grid_cell.xyz), vec3<f32>(0.0), vec3<f32>(31.0));

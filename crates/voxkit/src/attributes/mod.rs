@@ -67,10 +67,16 @@ impl Texture {
     /// (glTF's convention; readers flip OBJ's `v` on loading). Nearest-texel
     /// lookup never invents a colour.
     pub fn texel(&self, u: f64, v: f64) -> [u8; 3] {
+        let [r, g, b, _] = self.texel_rgba(u, v);
+        [r, g, b]
+    }
+
+    /// The nearest texel with its alpha (see [`Texture::texel`]).
+    pub fn texel_rgba(&self, u: f64, v: f64) -> [u8; 4] {
         let x = self.wrap[0].texel(u, self.width);
         let y = self.wrap[1].texel(v, self.height);
         let at = 4 * (y as usize * self.width as usize + x as usize);
-        [self.rgba[at], self.rgba[at + 1], self.rgba[at + 2]]
+        [self.rgba[at], self.rgba[at + 1], self.rgba[at + 2], self.rgba[at + 3]]
     }
 }
 
@@ -90,6 +96,14 @@ pub struct Material {
     /// converted by `r = sqrt(2 / (Ns + 2))`, the inverse of the viewer's
     /// Blinn–Phong exponent `2 / r² − 2`). Default 0.6 when unset.
     pub roughness: f32,
+    /// Alpha test of the GPU renderer: where the alpha is below this the
+    /// surface is cut out (glTF `alphaMode: MASK` with its `alphaCutoff`;
+    /// OBJ `map_d`, or a `map_Kd` image with transparent texels: 0.5, as
+    /// seed 002 uses). `None`: opaque. Voxelization ignores it.
+    pub alpha_cutoff: Option<f32>,
+    /// Where the alpha comes from when it is not the base texture's alpha
+    /// channel: a texture whose alpha channel holds it (OBJ `map_d`).
+    pub alpha_texture: Option<u32>,
 }
 
 /// Roughness of a material that does not say.
