@@ -367,6 +367,10 @@ pub struct GpuRenderArgs {
     /// light term, lit towards the viewer each frame).
     #[arg(long, value_name = "PLY")]
     pub points: Option<PathBuf>,
+    /// --gpu: draw every cluster's box over the picture, green where the
+    /// cluster was drawn, red where culling dropped it.
+    #[arg(long, default_value = "off", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub boxes: String,
     /// --gpu: draw the scene's triangles (off: only the --points cloud).
     #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
     pub mesh: String,

@@ -663,6 +663,11 @@ fn the_gpu_renderer_draws_the_cornell_box_and_reports_its_frame() {
     let v = json(&out);
     assert_eq!(v["kind"], "voxel file");
     assert_eq!(v["clusters_after_frustum"], v["clusters"]);
+    // The cluster boxes over the same frame: same counts, another picture.
+    let boxed = tmp("vox-gpu-boxes.png");
+    let out = voxkit(&["render", &npy, "--gpu", "-o", &boxed, "--size", "32x32", "--json", "--culling", "none", "--boxes", "on"]);
+    assert_eq!(json(&out)["clusters_after_frustum"], v["clusters"]);
+    assert_ne!(std::fs::read(&boxed).unwrap(), std::fs::read(tmp("vox-gpu.png")).unwrap());
 }
 
 #[test]

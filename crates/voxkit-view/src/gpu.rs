@@ -88,6 +88,9 @@ pub struct FrameOptions {
     /// Draw the scene's triangles (off: only the spray's points, when
     /// there are any; culling still runs and is reported).
     pub mesh: bool,
+    /// Draw every cluster's box over the picture, green where the cluster
+    /// was drawn and red where culling dropped it.
+    pub boxes: bool,
 }
 
 /// Per-pass GPU time in milliseconds (timestamp queries), where the
@@ -191,6 +194,7 @@ pub struct GpuScene {
     counters: wgpu::Buffer,
     cull_group: wgpu::BindGroup,
     shade_group: wgpu::BindGroup,
+    boxes_group: Option<wgpu::BindGroup>,
     uniform: wgpu::Buffer,
     /// The clusters, in command order.
     pub clusters: Vec<Cluster>,
@@ -235,6 +239,9 @@ pub struct Renderer {
     shade_equal: wgpu::RenderPipeline,
     shade_lequal: wgpu::RenderPipeline,
     points: wgpu::RenderPipeline,
+    /// The cluster-box wireframe, where vertex shaders may read storage
+    /// buffers (a downlevel capability every desktop driver has).
+    boxes: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
     timestamps: bool,
     max_side: u32,
     errors: Arc<Mutex<Option<String>>>,
@@ -486,6 +493,42 @@ impl Renderer {
             multiview_mask: None,
             cache: None,
         });
+        let boxes = adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE).then(|| {
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("cluster boxes"),
+                entries: &[
+                    entry(0, S::VERTEX, Uniform),
+                    entry(1, S::VERTEX, Storage { read_only: true }),
+                    entry(2, S::VERTEX, Storage { read_only: true }),
+                ],
+            });
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("cluster boxes"),
+                source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/boxes.wgsl")]).into()),
+            });
+            let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("cluster boxes"),
+                layout: Some(&pipeline_layout(&[Some(&layout)])),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_box"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::LineList, ..Default::default() },
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_box"),
+                    compilation_options: Default::default(),
+                    targets: &colour_target,
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+            (pipeline, layout)
+        });
         let prepass = draw("prepass", false, true, wgpu::CompareFunction::Less);
         let shade = draw("shade", true, true, wgpu::CompareFunction::Less);
         let shade_equal = draw("shade after prepass", true, false, wgpu::CompareFunction::Equal);
@@ -512,6 +555,7 @@ impl Renderer {
             shade_equal,
             shade_lequal,
             points,
+            boxes,
             timestamps,
             max_side: limits.max_texture_dimension_2d,
             errors,
@@ -592,6 +636,7 @@ impl Renderer {
             self.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout, entries: &entries })
         };
         let cull_group = group(&self.cull_layout, &[(0, &uniform), (1, &boxes), (2, &commands), (3, &counters)]);
+        let boxes_group = self.boxes.as_ref().map(|(_, layout)| group(layout, &[(0, &uniform), (1, &boxes), (2, &commands)]));
         let buffers = [(0, &uniform), (4, &materials), (5, &light_buf), (6, &ranges), (7, &light_indices)];
         let mut entries: Vec<wgpu::BindGroupEntry> =
             buffers.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
@@ -612,6 +657,7 @@ impl Renderer {
             counters,
             cull_group,
             shade_group,
+            boxes_group,
             uniform,
             clusters: part.clusters,
             grid_max: grid.stats().2,
@@ -777,6 +823,11 @@ impl Renderer {
         if o.width == 0 || o.height == 0 || o.width > self.max_side || o.height > self.max_side {
             return Err(ViewError::Size { width: o.width, height: o.height, max: self.max_side });
         }
+        if o.boxes && self.boxes.is_none() {
+            return Err(ViewError::Device(
+                "the cluster-box wireframe needs vertex shaders that read storage buffers, which this adapter lacks".into(),
+            ));
+        }
         let t0 = Instant::now();
         let (lo, hi) = s.bounds;
         let (near, far) = o.camera.depth_range(lo, hi);
@@ -901,6 +952,24 @@ impl Renderer {
                 pass.set_vertex_buffer(0, points.slice(..));
                 pass.draw(0..s.point_count, 0..1);
             }
+        }
+        if let (true, Some((pipeline, _)), Some(group)) = (o.boxes && n > 0, &self.boxes, &s.boxes_group) {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("cluster boxes"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &cview,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, group, &[]);
+            pass.draw(0..24, 0..n);
         }
         enc.copy_buffer_to_buffer(&s.commands, 0, &s.prev_commands, 0, 20 * n.max(1) as u64);
         let row = aligned_row(o.width);

@@ -26,8 +26,8 @@
 //!
 //! Base-colour textures come from one texture array; the alpha test (glTF
 //! `MASK`, OBJ `map_d`) runs in the depth passes and the shading pass.
-//!
-//! **Not built yet**: the cluster-box wireframe.
+//! The cluster boxes can be drawn over the picture (`shaders/boxes.wgsl`),
+//! green where drawn and red where culled.
 
 pub mod camera;
 pub mod gpu;

@@ -7,7 +7,8 @@
 //! wheel zooms; W/A/S/D/Q/E fly (the target moves along); C cycles culling
 //! none → frustum → occlusion → two-pass occlusion; Z toggles the Z-prepass; G gamma; L the
 //! light-grid view (surfaces coloured by their cell's list length); R
-//! resets the camera; Escape quits. The ray spray ([`crate::spray`]): P
+//! resets the camera; B draws the cluster boxes (green drawn, red culled);
+//! Escape quits. The ray spray ([`crate::spray`]): P
 //! (or the middle button) sprays rays in a narrow cone through the cursor,
 //! each hit a point lit by its stored light term; M shows or hides the
 //! mesh; X clears the points. The points are handed back on closing.
@@ -132,6 +133,7 @@ struct App {
     points: Vec<SprayPoint>,
     sprays: u64,
     mesh: bool,
+    boxes: bool,
     opts: ViewOptions,
     home: Camera,
     orbit: Orbit,
@@ -161,6 +163,7 @@ pub fn run(scene: Scene, points: Vec<SprayPoint>, opts: ViewOptions) -> Result<V
         points,
         sprays: 0,
         mesh: true,
+        boxes: false,
         opts,
         home,
         orbit: Orbit::from_camera(&home, opts.up),
@@ -232,6 +235,7 @@ impl App {
             light_grid_view: self.light_grid,
             read_hiz: false,
             mesh: self.mesh,
+            boxes: self.boxes,
         }
     }
 
@@ -319,6 +323,7 @@ impl App {
             KeyCode::KeyG => self.gamma = !self.gamma,
             KeyCode::KeyL => self.light_grid = !self.light_grid,
             KeyCode::KeyM => self.mesh = !self.mesh,
+            KeyCode::KeyB => self.boxes = !self.boxes,
             KeyCode::KeyP => self.spray(event_loop),
             KeyCode::KeyX => {
                 self.points.clear();

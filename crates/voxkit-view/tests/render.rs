@@ -61,6 +61,7 @@ fn frame(r: &Renderer, g: &voxkit_view::GpuScene, camera: Camera, culling: Culli
             light_grid_view: false,
             read_hiz: true,
             mesh: true,
+            boxes: false,
         },
     )
     .unwrap()
@@ -151,6 +152,7 @@ fn the_cornell_box_is_lit_by_its_ceiling() {
         light_grid_view: false,
         read_hiz: false,
         mesh: true,
+        boxes: false,
     };
     let f = r.render(&g, &o).unwrap();
     let px = |x: usize, y: usize| {
@@ -265,6 +267,7 @@ fn a_spray_point_is_lit_as_the_shader_documents() {
         light_grid_view: false,
         read_hiz: false,
         mesh: false,
+        boxes: false,
     };
     let f = r.render(&g, &o).unwrap();
     assert_eq!(f.stats.points_drawn, 1);
@@ -307,6 +310,7 @@ fn culling_leaves_a_sprayed_cloud_unchanged() {
                         light_grid_view: false,
                         read_hiz: false,
                         mesh,
+                        boxes: false,
                     };
                     let f = r.render(&g, &o).unwrap();
                     assert_eq!(f.stats.points_drawn, points.len() as u64);
@@ -329,6 +333,7 @@ fn culling_leaves_a_sprayed_cloud_unchanged() {
         light_grid_view: false,
         read_hiz: false,
         mesh: false,
+        boxes: false,
     };
     assert_eq!(r.render(&once, &o).unwrap().rgba, r.render(&g, &o).unwrap().rgba);
     r.clear_points(&mut once);
@@ -365,6 +370,7 @@ fn alpha_cut_outs_show_what_is_behind_with_any_culling_and_prepass() {
                 light_grid_view: false,
                 read_hiz: false,
                 mesh: true,
+                boxes: false,
             };
             let f = r.render(&g, &o).unwrap();
             // The back quad lies wholly behind the front one: only a depth
@@ -395,4 +401,41 @@ fn alpha_cut_outs_show_what_is_behind_with_any_culling_and_prepass() {
             assert!(u32::from(p[dominant]) > 2 * others + 60, "cell ({i}, {j}) should show channel {dominant}: {p:?}");
         }
     }
+}
+
+#[test]
+fn the_cluster_boxes_show_kept_and_culled_clusters() {
+    let Some(r) = renderer() else { return };
+    let scene = cornell();
+    let g = r.upload(&scene).unwrap();
+    // Close to an occluder and narrow: some clusters culled, some kept.
+    let (lo, hi) = scene.bounds().unwrap();
+    let camera = cameras(&scene)[3];
+    let o = |culling, boxes| FrameOptions {
+        width: 160,
+        height: 120,
+        camera,
+        culling,
+        prepass: false,
+        gamma: true,
+        light_grid_view: false,
+        read_hiz: false,
+        mesh: true,
+        boxes,
+    };
+    let plain = r.render(&g, &o(Culling::Occlusion, false)).unwrap();
+    let boxed = r.render(&g, &o(Culling::Occlusion, true)).unwrap();
+    assert!(plain.kept.iter().any(|&k| k) && plain.kept.iter().any(|&k| !k), "the camera culls some clusters ({lo}..{hi})");
+    assert_eq!(plain.kept, boxed.kept, "drawing boxes changes no culling");
+    let count = |f: &voxkit_view::Frame, rgb: [u8; 3]| f.rgba.chunks_exact(4).filter(|p| p[..3] == rgb).count();
+    // The boxes' colours, written as they are: (0.2, 1, 0.4) and (1, 0.2, 0.2).
+    let (green, red) = ([51, 255, 102], [255, 51, 51]);
+    assert_eq!((count(&plain, green), count(&plain, red)), (0, 0));
+    assert!(count(&boxed, green) > 0 && count(&boxed, red) > 0, "kept and culled boxes drawn");
+    // Without culling every box is green.
+    let all = r.render(&g, &o(Culling::None, true)).unwrap();
+    assert!(count(&all, green) > 0 && count(&all, red) == 0);
+    // Everything that is not a box line is the plain picture.
+    let differ = plain.rgba.chunks_exact(4).zip(boxed.rgba.chunks_exact(4)).filter(|(a, b)| a != b).count();
+    assert_eq!(differ, count(&boxed, green) + count(&boxed, red) - count(&plain, green) - count(&plain, red));
 }

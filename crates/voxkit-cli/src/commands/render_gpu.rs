@@ -140,6 +140,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             light_grid_view: g.light_grid == "on",
             read_hiz: false,
             mesh: g.mesh == "on",
+            boxes: g.boxes == "on",
         };
         // Every run's statistics, the last run's picture.
         let mut frame = renderer.render(&uploaded, &opts)?;
