@@ -439,3 +439,88 @@ fn the_cluster_boxes_show_kept_and_culled_clusters() {
     let differ = plain.rgba.chunks_exact(4).zip(boxed.rgba.chunks_exact(4)).filter(|(a, b)| a != b).count();
     assert_eq!(differ, count(&boxed, green) + count(&boxed, red) - count(&plain, green) - count(&plain, red));
 }
+
+#[test]
+fn a_voxel_grid_drawn_by_the_gpu_covers_the_pixels_the_cpu_ray_caster_does() {
+    // The CPU ray caster (voxkit::render::raycast) is orthographic and
+    // frames the grid's bounding sphere (radius r, 2% margin); the GPU
+    // camera is perspective, so it looks from 1000 r away with the field of
+    // view that shows the same ±1.02 r: the picture scale then varies by at
+    // most 0.1% over the grid's depth, well under a pixel at 128². Both
+    // sample at pixel centres (a voxel face covers a pixel when its centre
+    // is inside, on the GPU by the rasterization rule), so the silhouettes
+    // agree except where a pixel centre lies on a face's edge within
+    // rounding: every disagreement must be a silhouette pixel (a 4-neighbour
+    // classified otherwise by the CPU) and they must be under 2% of those.
+    let Some(r) = renderer() else { return };
+    let mesh = shared_mesh("stanford-bunny.obj");
+    let grid = voxkit::GridSpec::from_resolution(&mesh.as_ref().bounds(), 32).unwrap();
+    let (bits, _) = voxkit::voxelize::fast(voxkit::voxelize::Mode::Cover, mesh.as_ref(), &grid, &Default::default());
+    let mut scene = Scene::default();
+    let m = scene.add_material(voxkit_view::scene::ShadeMaterial::new([0.7; 3], [0.0; 3], 0.7));
+    scene.add_quads(&voxkit::export::greedy::greedy_quads(&bits.to_dense()), Vec3::ZERO, 1.0, m);
+    let g = r.upload(&scene).unwrap();
+    let d = bits.dims();
+    let size = glam::DVec3::new(d[0] as f64, d[1] as f64, d[2] as f64);
+    let radius = 0.5 * size.length();
+    let (w, h) = (128u32, 128u32);
+    use voxkit::render::raycast::{render, RenderOptions, View};
+    for (view, towards) in [
+        (View::Axis(0), glam::DVec3::X),
+        (View::Axis(2), glam::DVec3::Z),
+        (View::Angles(30.0, 20.0), {
+            // Azimuth 30° from the front axis (z, after up y) towards the side axis (x), raised 20°.
+            let (az, el) = (30f64.to_radians(), 20f64.to_radians());
+            (glam::DVec3::Z * az.cos() + glam::DVec3::X * az.sin()) * el.cos() + glam::DVec3::Y * el.sin()
+        }),
+    ] {
+        let cpu = render(&bits, &RenderOptions { width: w, height: h, view, up: 1, ..Default::default() });
+        let dist = 1000.0 * radius;
+        let centre = size * 0.5;
+        let camera = Camera {
+            eye: (centre + towards.normalize() * dist).as_vec3(),
+            target: centre.as_vec3(),
+            up: Vec3::Y,
+            fov_deg: (2.0 * (1.02 * radius / dist).atan()).to_degrees() as f32,
+        };
+        let o = FrameOptions {
+            width: w,
+            height: h,
+            camera,
+            culling: Culling::Occlusion,
+            prepass: false,
+            gamma: true,
+            light_grid_view: false,
+            read_hiz: false,
+            mesh: true,
+            boxes: false,
+        };
+        let gpu = r.render(&g, &o).unwrap();
+        let (cbg, gbg) = (&cpu.rgb[..3], &gpu.rgba[..3]);
+        let on_cpu = |x: i64, y: i64| {
+            let i = 3 * (y as usize * w as usize + x as usize);
+            &cpu.rgb[i..i + 3] != cbg
+        };
+        let (mut differ, mut edges, mut covered) = (0, 0, 0);
+        for y in 0..h as i64 {
+            for x in 0..w as i64 {
+                let i = 4 * (y as usize * w as usize + x as usize);
+                let on_gpu = &gpu.rgba[i..i + 3] != gbg;
+                let c = on_cpu(x, y);
+                covered += usize::from(c);
+                let edge = [(-1, 0), (1, 0), (0, -1), (0, 1)]
+                    .iter()
+                    .any(|&(dx, dy)| (0..w as i64).contains(&(x + dx)) && (0..h as i64).contains(&(y + dy)) && on_cpu(x + dx, y + dy) != c);
+                edges += usize::from(edge);
+                if on_gpu != c {
+                    differ += 1;
+                    assert!(edge, "{view:?}: pixel ({x}, {y}) differs away from the silhouette (cpu {c}, gpu {on_gpu})");
+                }
+            }
+        }
+        assert_eq!(covered as u64, cpu.covered, "{view:?}: the CPU's own count");
+        assert!(covered > 2000, "{view:?}: the bunny fills the picture: {covered}");
+        eprintln!("{view:?}: {differ} of {edges} silhouette pixels differ, {covered} covered");
+        assert!(differ * 50 <= edges, "{view:?}: {differ} of {edges} silhouette pixels differ");
+    }
+}
