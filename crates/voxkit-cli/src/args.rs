@@ -34,8 +34,9 @@ pub enum Command {
     /// Open a window on a mesh (and its voxels) with the GPU renderer:
     /// orbit and fly camera, keys switching culling, prepass and gamma.
     View(ViewArgs),
-    /// Write a bundled test scene (OBJ + MTL): the Cornell box, or a city of
-    /// about a million triangles with 169 emissive street lamps.
+    /// Write a bundled test scene (OBJ + MTL, textures as PNG beside): the
+    /// Cornell box, a city of about a million triangles with 169 emissive
+    /// street lamps and cut-out foliage, or the alpha test's three quads.
     Scene(SceneArgs),
     /// Spray rays from a camera into a mesh: each hit becomes a point with
     /// its albedo, emission and light term (Lambert term and attenuation
@@ -481,8 +482,9 @@ pub struct ViewArgs {
 
 #[derive(Args, Debug)]
 pub struct SceneArgs {
-    /// Which scene: cornell or city.
-    #[arg(value_parser = clap::builder::PossibleValuesParser::new(["cornell", "city"]))]
+    /// Which scene: cornell, city, or cut-outs (three quads, the front one
+    /// cut out in a checkerboard: the alpha test's scene).
+    #[arg(value_parser = clap::builder::PossibleValuesParser::new(["cornell", "city", "cut-outs"]))]
     pub name: String,
     /// Output OBJ; its MTL is written beside it with the same stem.
     #[arg(short, long, value_name = "OBJ")]

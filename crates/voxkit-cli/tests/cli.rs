@@ -724,6 +724,43 @@ fn spray_writes_a_cloud_the_gpu_renderer_draws() {
 }
 
 #[test]
+fn cut_outs_survive_the_obj_round_trip_and_every_culling_setting() {
+    let obj = tmp("cuts.obj");
+    let out = voxkit(&["scene", "cut-outs", "-o", &obj]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mtl = std::fs::read_to_string(tmp("cuts.mtl")).unwrap();
+    assert!(mtl.contains("map_Kd cuts-checker.png") && mtl.contains("map_d cuts-checker.png"), "{mtl}");
+    assert!(std::fs::read(tmp("cuts-checker.png")).unwrap().starts_with(b"\x89PNG"));
+    // Straight on, the checker quad filling the picture.
+    let cam = "0.5,0.5,1.366,0.5,0.5,0,60";
+    let mut pictures = Vec::new();
+    for (n, (culling, prepass)) in
+        [("none", "off"), ("occlusion", "off"), ("occlusion", "on"), ("occlusion-two-pass", "on")].iter().enumerate()
+    {
+        let png = tmp(&format!("cuts-{n}.png"));
+        let out =
+            voxkit(&["render", &obj, "--gpu", "-o", &png, "--size", "64x64", "--camera", cam, "--culling", culling, "--prepass", prepass]);
+        if !gpu_available(&out) {
+            return;
+        }
+        pictures.push(std::fs::read(&png).unwrap());
+    }
+    assert!(pictures.windows(2).all(|w| w[0] == w[1]), "culling or the prepass changed the cut-out picture");
+    // The cut-outs came through the OBJ, MTL and PNG: sprayed rays stop on
+    // the front quad (z = 0.5) and pass through it to the quads behind.
+    let cloud = tmp("cuts.ply");
+    let out = voxkit(&["spray", &obj, "-o", &cloud, "--camera", cam, "--size", "64x64", "--rays", "4000", "--light-samples", "0"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(&cloud).unwrap();
+    let body = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+    // 15 floats and 3 colour bytes per point; z is the third float.
+    let z: Vec<f32> = bytes[body..].chunks_exact(63).map(|p| f32::from_le_bytes(p[8..12].try_into().unwrap())).collect();
+    let front = z.iter().filter(|&&z| (z - 0.5).abs() < 1e-4).count();
+    let behind = z.iter().filter(|&&z| z < 0.3).count();
+    assert!(front > 500 && behind > 500 && front + behind == z.len(), "{front} on the checker, {behind} behind, of {}", z.len());
+}
+
+#[test]
 fn gpu_renderer_options_give_one_line_errors() {
     let obj = unit_cube_obj("gpu-opts.obj");
     let png = tmp("gpu-opts.png");

@@ -39,7 +39,7 @@ use std::path::Path;
 
 pub use error::{ErrorKind, IoError};
 pub use mesh_report::{validate_mesh, LoadedMesh, MeshReport};
-pub use png::write_png;
+pub use png::{write_png, write_png_rgba};
 pub use resources::ReadOptions;
 use voxkit::attributes::VoxelAttributes;
 use voxkit::{DenseBits, GridSpec, VoxelSource};

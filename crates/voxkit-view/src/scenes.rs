@@ -6,9 +6,9 @@
 //!   below the ceiling (its own material, `Ke` 12).
 //! - [`city`]: a large scene in the spirit of the report's — 144 buildings
 //!   (occluders, facades cut into window panels), 600 trees (trunks and
-//!   finely tessellated crowns), 169 street lamps with emissive heads, a
-//!   ground plane: about a million triangles, from a fixed-seed generator.
-//!   The crowns are opaque.
+//!   finely tessellated crowns, each crossed by three cards of alpha
+//!   cut-out foliage), 169 street lamps with emissive heads, a ground
+//!   plane: about a million triangles, from a fixed-seed generator.
 //! - [`cut_outs`]: three quads one behind the other, the front one blue
 //!   with an 8×8 checkerboard of cut-out texels (`alphaMode: MASK`); the
 //!   alpha test's scene.
@@ -17,11 +17,13 @@ use voxkit::attributes::{Appearance, Material, Texture, Wrap, NO_MATERIAL};
 use voxkit::glam::DVec3;
 use voxkit::Mesh;
 
-/// A scene under construction: triangles and their materials.
+/// A scene under construction: triangles and their materials, and the
+/// texture coordinates of the triangles that have some.
 #[derive(Default)]
 struct Builder {
     mesh: Mesh,
     app: Appearance,
+    uv: Vec<(usize, [[f32; 2]; 3])>,
 }
 
 impl Builder {
@@ -45,6 +47,26 @@ impl Builder {
         self.mesh.triangles.push([base, base + 1, base + 2]);
         self.mesh.triangles.push([base, base + 2, base + 3]);
         self.app.triangle_material.extend([material, material]);
+    }
+
+    /// A quad with its texture's corners `(0, 1) (1, 1) (1, 0) (0, 0)`
+    /// (`v = 0` at the top: `a b` is the texture's bottom edge).
+    fn textured_quad(&mut self, p: [DVec3; 4], material: u32) {
+        let t = self.mesh.triangles.len();
+        self.quad(p, material);
+        let uv = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]];
+        self.uv.extend([(t, [uv[0], uv[1], uv[2]]), (t + 1, [uv[0], uv[2], uv[3]])]);
+    }
+
+    /// The mesh and appearance, every triangle without coordinates given NaN ones.
+    fn finish(mut self) -> (Mesh, Appearance) {
+        if !self.uv.is_empty() {
+            self.app.triangle_uv = vec![[[f32::NAN; 2]; 3]; self.mesh.triangles.len()];
+            for (t, uv) in self.uv {
+                self.app.triangle_uv[t] = uv;
+            }
+        }
+        (self.mesh, self.app)
     }
 
     /// A grid of `nu × nv` quads spanning `o + s·u + t·v`, `s, t ∈ [0, 1]`.
@@ -109,12 +131,9 @@ pub fn cut_outs() -> (Mesh, Appearance) {
     b.app.textures.push(Texture { name: "checker".into(), width: 8, height: 8, rgba, wrap: [Wrap::Repeat; 2] });
     for (z, side, m) in [(0.0, 3.0, red), (0.25, 0.6, green), (0.5, 1.0, leaf)] {
         let p = |x: f64, y: f64| DVec3::new(0.5 + (x - 0.5) * side, 0.5 + (y - 0.5) * side, z);
-        b.quad([p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)], m);
-        // v = 0 at the top row.
-        let uv = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]];
-        b.app.triangle_uv.extend([[uv[0], uv[1], uv[2]], [uv[0], uv[2], uv[3]]]);
+        b.textured_quad([p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)], m);
     }
-    (b.mesh, b.app)
+    b.finish()
 }
 
 /// The Cornell box, y up, 0..1 on every axis, open towards +z.
@@ -154,6 +173,10 @@ pub fn city() -> (Mesh, Appearance) {
     let roof = b.material("roof", [0.3, 0.3, 0.32], [0.0; 3], 0.8);
     let trunk = b.material("bark", [0.3, 0.2, 0.12], [0.0; 3], 0.9);
     let leaves = b.material("leaves", [0.15, 0.4, 0.12], [0.0; 3], 0.8);
+    let foliage = b.material("foliage", [1.0; 3], [0.0; 3], 0.8);
+    b.app.materials[foliage as usize].texture = Some(b.app.textures.len() as u32);
+    b.app.materials[foliage as usize].alpha_cutoff = Some(0.5);
+    b.app.textures.push(leaf_texture());
     let pole = b.material("pole", [0.12, 0.12, 0.13], [0.0; 3], 0.4);
     let lamp = b.material("lamp", [1.0, 0.95, 0.8], [2.5, 2.2, 1.6], 0.5);
     let (blocks, cell, street) = (12u32, 20.0f64, 6.0f64);
@@ -188,7 +211,17 @@ pub fn city() -> (Mesh, Appearance) {
         let h = 3.0 + 2.0 * rnd();
         b.block(p(x - 0.2, 0.0, z - 0.2), p(x + 0.2, h, z + 0.2), trunk);
         let r = 1.4 + 0.8 * rnd();
-        b.sphere(p(x, h + r * 0.6, z), p(r, r * 0.9, r), 24, 32, leaves);
+        let c = p(x, h + r * 0.6, z);
+        b.sphere(c, p(r, r * 0.9, r), 24, 32, leaves);
+        // Three vertical cards of cut-out foliage through the crown.
+        let turn = rnd() * std::f64::consts::PI;
+        for k in 0..3 {
+            let a = turn + k as f64 * std::f64::consts::PI / 3.0;
+            let across = p(a.cos(), 0.0, a.sin()) * (1.3 * r);
+            let (lo, hi) = (c.y - 1.2 * r, c.y + 1.1 * r);
+            let at = |s: f64, y: f64| p(c.x + across.x * s, y, c.z + across.z * s);
+            b.textured_quad([at(-1.0, lo), at(1.0, lo), at(1.0, hi), at(-1.0, hi)], foliage);
+        }
         trees += 1;
     }
     for lx in 0..=blocks {
@@ -198,16 +231,61 @@ pub fn city() -> (Mesh, Appearance) {
             b.block(p(x - 0.5, 6.0, z - 0.5), p(x + 0.5, 6.3, z + 0.5), lamp);
         }
     }
-    (b.mesh, b.app)
+    b.finish()
+}
+
+/// A 64×64 foliage card: leaf-green blobs on transparent texels, from a
+/// fixed-seed generator (alpha 255 inside a leaf, 0 outside).
+fn leaf_texture() -> Texture {
+    const N: usize = 64;
+    let mut state = 0x1eaf_u64;
+    let mut rnd = move || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    // Leaves: ellipses at random places inside the card's rounded outline.
+    let leaves: Vec<[f64; 5]> = (0..90).map(|_| [rnd(), rnd(), 0.03 + 0.05 * rnd(), rnd() * std::f64::consts::PI, rnd()]).collect();
+    let mut rgba = vec![0u8; 4 * N * N];
+    for y in 0..N {
+        for x in 0..N {
+            let (u, v) = ((x as f64 + 0.5) / N as f64, (y as f64 + 0.5) / N as f64);
+            let outline = ((u - 0.5) / 0.5).powi(2) + ((v - 0.45) / 0.55).powi(2) < 1.0;
+            let leaf = leaves.iter().find(|l| {
+                let (du, dv) = (u - l[0], v - l[1]);
+                let (s, c) = l[3].sin_cos();
+                let (a, b) = (du * c + dv * s, -du * s + dv * c);
+                (a / l[2]).powi(2) + (b / (0.45 * l[2])).powi(2) < 1.0
+            });
+            if let (true, Some(l)) = (outline, leaf) {
+                let shade = 0.75 + 0.25 * l[4];
+                let at = 4 * (y * N + x);
+                rgba[at..at + 4].copy_from_slice(&[(60.0 * shade) as u8, (140.0 * shade) as u8, (45.0 * shade) as u8, 255]);
+            }
+        }
+    }
+    Texture { name: "leaves".into(), width: N as u32, height: N as u32, rgba, wrap: [Wrap::ClampToEdge; 2] }
 }
 
 /// The scene as OBJ text naming `mtl_name`, and the MTL text (`Kd`, `Ke`,
-/// `Pr`).
-pub fn to_obj(mesh: &Mesh, app: &Appearance, mtl_name: &str) -> (String, String) {
+/// `Pr`, and `map_Kd` and `map_d` naming `texture_files[t]` for a
+/// material of texture `t`: the caller writes those images beside).
+pub fn to_obj(mesh: &Mesh, app: &Appearance, mtl_name: &str, texture_files: &[String]) -> (String, String) {
     use std::fmt::Write;
     let mut obj = format!("# written by voxkit\nmtllib {mtl_name}\n");
     for p in &mesh.positions {
         let _ = writeln!(obj, "v {} {} {}", p.x, p.y, p.z);
+    }
+    // One vt per textured corner (OBJ's v = 0 is the image's bottom row).
+    let mut vt = 0usize;
+    let mut corners = vec![None; mesh.triangles.len()];
+    for (t, uv) in app.triangle_uv.iter().enumerate().take(mesh.triangles.len()) {
+        if uv.iter().flatten().all(|x| x.is_finite()) {
+            for c in uv {
+                let _ = writeln!(obj, "vt {} {}", c[0], 1.0 - c[1]);
+            }
+            corners[t] = Some(vt);
+            vt += 3;
+        }
     }
     let mut current = NO_MATERIAL;
     for (t, tri) in mesh.triangles.iter().enumerate() {
@@ -216,12 +294,26 @@ pub fn to_obj(mesh: &Mesh, app: &Appearance, mtl_name: &str) -> (String, String)
             let _ = writeln!(obj, "usemtl {}", app.materials[m as usize].name);
             current = m;
         }
-        let _ = writeln!(obj, "f {} {} {}", tri[0] + 1, tri[1] + 1, tri[2] + 1);
+        match corners[t] {
+            Some(k) => {
+                let _ = writeln!(obj, "f {}/{} {}/{} {}/{}", tri[0] + 1, k + 1, tri[1] + 1, k + 2, tri[2] + 1, k + 3);
+            }
+            None => {
+                let _ = writeln!(obj, "f {} {} {}", tri[0] + 1, tri[1] + 1, tri[2] + 1);
+            }
+        }
     }
     let mut mtl = String::from("# written by voxkit\n");
     for m in &app.materials {
         let (k, e) = (m.factor, m.emission);
-        let _ = writeln!(mtl, "newmtl {}\nKd {} {} {}\nKe {} {} {}\nPr {}\n", m.name, k[0], k[1], k[2], e[0], e[1], e[2], m.roughness);
+        let _ = writeln!(mtl, "newmtl {}\nKd {} {} {}\nKe {} {} {}\nPr {}", m.name, k[0], k[1], k[2], e[0], e[1], e[2], m.roughness);
+        if let Some(file) = m.texture.and_then(|t| texture_files.get(t as usize)) {
+            let _ = writeln!(mtl, "map_Kd {file}");
+            if m.alpha_cutoff.is_some() {
+                let _ = writeln!(mtl, "map_d {file}");
+            }
+        }
+        mtl.push('\n');
     }
     (obj, mtl)
 }

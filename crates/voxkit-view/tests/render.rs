@@ -190,8 +190,16 @@ fn the_city_is_large_lit_and_deterministic() {
     assert!(report.lights >= 169 && lights.len() == report.lights, "one light per lamp at least: {report:?}");
     let partition = voxkit_view::partition::Partition::new(&scene);
     assert!(partition.clusters.len() > 200);
-    let (again, _) = scenes::city();
+    let (again, again_app) = scenes::city();
     assert!(again.positions == mesh.positions && again.triangles == mesh.triangles);
+    assert_eq!(again_app.textures[0].rgba, app.textures[0].rgba);
+    // Foliage cards: textured, cut out at 0.5, with texels both ways.
+    let foliage = scene.materials.iter().filter(|m| m.cut_out()).count();
+    assert_eq!(foliage, 1);
+    let leaves = &app.textures[0].rgba;
+    assert!(leaves.chunks_exact(4).any(|p| p[3] == 0) && leaves.chunks_exact(4).any(|p| p[3] == 255));
+    assert_eq!(app.triangle_uv.len(), mesh.triangles.len());
+    assert_eq!(app.triangle_uv.iter().filter(|uv| uv[0][0].is_finite()).count(), 600 * 3 * 2);
 }
 
 /// The GPU's light grid is the CPU build's, but for lights whose reach

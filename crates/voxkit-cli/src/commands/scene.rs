@@ -8,7 +8,8 @@ pub fn run(a: &SceneArgs) -> Result<()> {
     let (mesh, app) = match a.name.as_str() {
         "cornell" => voxkit_view::scenes::cornell(),
         "city" => voxkit_view::scenes::city(),
-        other => bail!("unknown scene {other:?} (known: cornell, city)"),
+        "cut-outs" => voxkit_view::scenes::cut_outs(),
+        other => bail!("unknown scene {other:?} (known: cornell, city, cut-outs)"),
     };
     if a.output.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("obj")) != Some(true) {
         bail!("{}: scenes are written as OBJ; give a .obj file name", a.output.display());
@@ -16,14 +17,21 @@ pub fn run(a: &SceneArgs) -> Result<()> {
     voxkit_job::output::check_output_path(&a.output)?;
     let mtl_path = a.output.with_extension("mtl");
     let mtl_name = mtl_path.file_name().and_then(|n| n.to_str()).unwrap_or("scene.mtl").to_string();
-    let (obj, mtl) = voxkit_view::scenes::to_obj(&mesh, &app, &mtl_name);
+    // Textures as PNG beside the OBJ, named after it: STEM-NAME.png.
+    let stem = a.output.file_stem().and_then(|s| s.to_str()).unwrap_or("scene").to_string();
+    let texture_files: Vec<String> = app.textures.iter().map(|t| format!("{stem}-{}.png", t.name)).collect();
+    let (obj, mtl) = voxkit_view::scenes::to_obj(&mesh, &app, &mtl_name, &texture_files);
+    for (t, file) in app.textures.iter().zip(&texture_files) {
+        voxkit_io::write_png_rgba(&a.output.with_file_name(file), t.width, t.height, &t.rgba)?;
+    }
     voxkit_io::atomic::write_atomically(&mtl_path, |w| w.write_all(mtl.as_bytes()))?;
     voxkit_io::atomic::write_atomically(&a.output, |w| w.write_all(obj.as_bytes()))?;
     crate::print_stdout(&format!(
-        "scene {}: {} triangles, {} materials -> {} and {}",
+        "scene {}: {} triangles, {} materials, {} textures -> {} and {}",
         a.name,
         mesh.triangles.len(),
         app.materials.len(),
+        texture_files.len(),
         a.output.display(),
         mtl_path.display()
     ))
