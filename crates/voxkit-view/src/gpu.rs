@@ -175,6 +175,50 @@ struct FrameUniform {
     params: [u32; 4],
 }
 
+/// Pixels between the picture's corner and the overlay text.
+pub const OVERLAY_MARGIN: f32 = 4.0;
+/// Overlay glyphs are 8×8 font texels drawn this many pixels wide.
+pub const GLYPH_SCALE: f32 = 2.0;
+
+/// One overlay glyph (`text.wgsl`): its top-left pixel and ASCII code.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Glyph {
+    at: [f32; 2],
+    code: u32,
+}
+
+/// font8x8's 128 ASCII glyphs side by side in a 1024×8 texture, one byte
+/// per texel (255 where the glyph is drawn; bit 0 of a row is its left).
+fn font_atlas(device: &wgpu::Device, queue: &wgpu::Queue) -> wgpu::TextureView {
+    let mut texels = vec![0u8; 1024 * 8];
+    for (code, rows) in font8x8::legacy::BASIC_LEGACY.iter().enumerate() {
+        for (y, row) in rows.iter().enumerate() {
+            for x in 0..8 {
+                if row & (1 << x) != 0 {
+                    texels[y * 1024 + code * 8 + x] = 255;
+                }
+            }
+        }
+    }
+    let texture = device.create_texture_with_data(
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some("font"),
+            size: wgpu::Extent3d { width: 1024, height: 8, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R8Unorm,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &texels,
+    );
+    texture.create_view(&Default::default())
+}
+
 /// A cluster box as `cull.wgsl` reads it.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -195,6 +239,9 @@ pub struct GpuScene {
     cull_group: wgpu::BindGroup,
     shade_group: wgpu::BindGroup,
     boxes_group: Option<wgpu::BindGroup>,
+    text_group: wgpu::BindGroup,
+    /// The overlay's glyphs ([`Renderer::set_overlay`]) and their count.
+    overlay: Option<(wgpu::Buffer, u32)>,
     uniform: wgpu::Buffer,
     /// The clusters, in command order.
     pub clusters: Vec<Cluster>,
@@ -242,6 +289,9 @@ pub struct Renderer {
     /// The cluster-box wireframe, where vertex shaders may read storage
     /// buffers (a downlevel capability every desktop driver has).
     boxes: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
+    text: wgpu::RenderPipeline,
+    text_layout: wgpu::BindGroupLayout,
+    font: wgpu::TextureView,
     timestamps: bool,
     max_side: u32,
     errors: Arc<Mutex<Option<String>>>,
@@ -529,6 +579,53 @@ impl Renderer {
             });
             (pipeline, layout)
         });
+        let text_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("overlay text"),
+            entries: &[
+                entry(0, S::VERTEX | S::FRAGMENT, Uniform),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: S::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: float,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let text_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("overlay text"),
+            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/text.wgsl")]).into()),
+        });
+        let glyph_attributes = wgpu::vertex_attr_array![0 => Float32x2, 1 => Uint32];
+        let text = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("overlay text"),
+            layout: Some(&pipeline_layout(&[Some(&text_layout)])),
+            vertex: wgpu::VertexState {
+                module: &text_module,
+                entry_point: Some("vs_text"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<Glyph>() as u64,
+                    step_mode: wgpu::VertexStepMode::Instance,
+                    attributes: &glyph_attributes,
+                })],
+            },
+            primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleStrip, ..Default::default() },
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &text_module,
+                entry_point: Some("fs_text"),
+                compilation_options: Default::default(),
+                targets: &colour_target,
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let font = font_atlas(&device, &queue);
         let prepass = draw("prepass", false, true, wgpu::CompareFunction::Less);
         let shade = draw("shade", true, true, wgpu::CompareFunction::Less);
         let shade_equal = draw("shade after prepass", true, false, wgpu::CompareFunction::Equal);
@@ -556,6 +653,9 @@ impl Renderer {
             shade_lequal,
             points,
             boxes,
+            text,
+            text_layout,
+            font,
             timestamps,
             max_side: limits.max_texture_dimension_2d,
             errors,
@@ -637,6 +737,14 @@ impl Renderer {
         };
         let cull_group = group(&self.cull_layout, &[(0, &uniform), (1, &boxes), (2, &commands), (3, &counters)]);
         let boxes_group = self.boxes.as_ref().map(|(_, layout)| group(layout, &[(0, &uniform), (1, &boxes), (2, &commands)]));
+        let text_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("overlay text"),
+            layout: &self.text_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&self.font) },
+            ],
+        });
         let buffers = [(0, &uniform), (4, &materials), (5, &light_buf), (6, &ranges), (7, &light_indices)];
         let mut entries: Vec<wgpu::BindGroupEntry> =
             buffers.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
@@ -658,6 +766,8 @@ impl Renderer {
             cull_group,
             shade_group,
             boxes_group,
+            text_group,
+            overlay: None,
             uniform,
             clusters: part.clusters,
             grid_max: grid.stats().2,
@@ -756,6 +866,31 @@ impl Renderer {
         self.queue.write_buffer(buffer, u64::from(s.point_count) * stride, bytemuck::cast_slice(points));
         s.point_count = count as u32;
         self.check()
+    }
+
+    /// Text drawn over every later frame from the top-left corner, one
+    /// line per string, 16-pixel glyphs (ASCII; other characters show as
+    /// `?`), until set again; an empty list draws none.
+    pub fn set_overlay(&self, s: &mut GpuScene, lines: &[String]) {
+        let step = 8.0 * GLYPH_SCALE;
+        let glyphs: Vec<Glyph> = lines
+            .iter()
+            .enumerate()
+            .flat_map(|(l, line)| {
+                line.chars().enumerate().map(move |(i, c)| Glyph {
+                    at: [OVERLAY_MARGIN + i as f32 * step, OVERLAY_MARGIN + l as f32 * (step + 2.0)],
+                    code: if c.is_ascii() { c as u32 } else { u32::from(b'?') },
+                })
+            })
+            .collect();
+        s.overlay = (!glyphs.is_empty()).then(|| {
+            let buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("overlay glyphs"),
+                contents: bytemuck::cast_slice(&glyphs),
+                usage: wgpu::BufferUsages::VERTEX,
+            });
+            (buffer, glyphs.len() as u32)
+        });
     }
 
     /// Drops the scene's spray points.
@@ -953,9 +1088,13 @@ impl Renderer {
                 pass.draw(0..s.point_count, 0..1);
             }
         }
-        if let (true, Some((pipeline, _)), Some(group)) = (o.boxes && n > 0, &self.boxes, &s.boxes_group) {
+        let boxes = match (o.boxes && n > 0, &self.boxes, &s.boxes_group) {
+            (true, Some((pipeline, _)), Some(group)) => Some((pipeline, group)),
+            _ => None,
+        };
+        if boxes.is_some() || s.overlay.is_some() {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("cluster boxes"),
+                label: Some("cluster boxes and text"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                     view: &cview,
                     depth_slice: None,
@@ -967,9 +1106,17 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, group, &[]);
-            pass.draw(0..24, 0..n);
+            if let Some((pipeline, group)) = boxes {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, group, &[]);
+                pass.draw(0..24, 0..n);
+            }
+            if let Some((glyphs, count)) = &s.overlay {
+                pass.set_pipeline(&self.text);
+                pass.set_bind_group(0, &s.text_group, &[]);
+                pass.set_vertex_buffer(0, glyphs.slice(..));
+                pass.draw(0..4, 0..*count);
+            }
         }
         enc.copy_buffer_to_buffer(&s.commands, 0, &s.prev_commands, 0, 20 * n.max(1) as u64);
         let row = aligned_row(o.width);

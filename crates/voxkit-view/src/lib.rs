@@ -27,7 +27,8 @@
 //! Base-colour textures come from one texture array; the alpha test (glTF
 //! `MASK`, OBJ `map_d`) runs in the depth passes and the shading pass.
 //! The cluster boxes can be drawn over the picture (`shaders/boxes.wgsl`),
-//! green where drawn and red where culled.
+//! green where drawn and red where culled, and lines of text
+//! (`shaders/text.wgsl`, font8x8 glyphs): the viewer's statistics.
 
 pub mod camera;
 pub mod gpu;

@@ -1,14 +1,15 @@
 //! The interactive viewer (`voxkit view`): a resizable window (winit,
 //! X11) showing [`crate::gpu::Renderer`]'s frames, with an orbit and fly
-//! camera and keys that switch each technique. The statistics line is the
-//! window's title.
+//! camera and keys that switch each technique. The statistics (culling,
+//! clusters kept, triangles, lights, light grid, CPU and GPU times) are
+//! drawn over the picture (`text.wgsl`) and repeated in the window title.
 //!
 //! Controls: left drag orbits around the target, right drag pans, the
 //! wheel zooms; W/A/S/D/Q/E fly (the target moves along); C cycles culling
 //! none → frustum → occlusion → two-pass occlusion; Z toggles the Z-prepass; G gamma; L the
 //! light-grid view (surfaces coloured by their cell's list length); R
 //! resets the camera; B draws the cluster boxes (green drawn, red culled);
-//! Escape quits. The ray spray ([`crate::spray`]): P
+//! T hides the statistics overlay; Escape quits. The ray spray ([`crate::spray`]): P
 //! (or the middle button) sprays rays in a narrow cone through the cursor,
 //! each hit a point lit by its stored light term; M shows or hides the
 //! mesh; X clears the points. The points are handed back on closing.
@@ -134,6 +135,7 @@ struct App {
     sprays: u64,
     mesh: bool,
     boxes: bool,
+    text: bool,
     opts: ViewOptions,
     home: Camera,
     orbit: Orbit,
@@ -164,6 +166,7 @@ pub fn run(scene: Scene, points: Vec<SprayPoint>, opts: ViewOptions) -> Result<V
         sprays: 0,
         mesh: true,
         boxes: false,
+        text: true,
         opts,
         home,
         orbit: Orbit::from_camera(&home, opts.up),
@@ -240,8 +243,9 @@ impl App {
     }
 
     fn draw(&mut self, event_loop: &ActiveEventLoop) {
-        let Some(a) = &self.active else { return };
-        let (w, h) = (a.config.width, a.config.height);
+        let Some((w, h)) = self.active.as_ref().map(|a| (a.config.width, a.config.height)) else { return };
+        let opts = self.options(w, h);
+        let Some(a) = &mut self.active else { return };
         let texture = match a.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
@@ -252,7 +256,7 @@ impl App {
         };
         let view = texture.texture.create_view(&wgpu::TextureViewDescriptor { format: Some(a.view_format), ..Default::default() });
         let t0 = Instant::now();
-        let stats = match a.renderer.present(&a.uploaded, &self.options(w, h), &a.blit, &view) {
+        let stats = match a.renderer.present(&a.uploaded, &opts, &a.blit, &view) {
             Ok(s) => s,
             Err(e) => return self.fail(event_loop, e),
         };
@@ -261,24 +265,35 @@ impl App {
         let ms = t0.elapsed().as_secs_f64() * 1e3;
         let culling = self.culling.name();
         let kept = stats.clusters_after_occlusion.unwrap_or(stats.clusters_after_frustum);
-        a.window.set_title(&format!(
-            "voxkit view | culling {culling} (C), prepass {} (Z), gamma {} (G), mesh {} (M) | clusters {}/{}/{} | {} of {} triangles | {} points (P sprays) | {} lights | {:.1} ms",
-            if self.prepass { "on" } else { "off" },
-            if self.gamma { "on" } else { "off" },
-            if self.mesh { "on" } else { "off" },
-            kept,
-            stats.clusters_after_frustum,
-            stats.clusters,
-            stats.triangles_drawn,
-            stats.triangles,
-            stats.points_drawn,
-            a.uploaded.lights.lights,
-            ms,
-        ));
+        let onoff = |b: bool| if b { "on" } else { "off" };
+        let (total, mean, max) = a.uploaded.grid.stats();
+        let gpu = stats.gpu.map_or("GPU times: not offered by this adapter".to_string(), |t| {
+            format!("GPU ms: cull {:.2}  depth {:.2}  Hi-Z {:.2}  shade {:.2}", t.cull_ms, t.depth_ms, t.hiz_ms, t.shade_ms)
+        });
+        // The statistics line of seed 002, shown on the next frame (the
+        // overlay, T hides it) and in the title.
+        let lines = vec![
+            format!(
+                "culling {culling} (C)  prepass {} (Z)  gamma {} (G)  mesh {} (M)  boxes {} (B)",
+                onoff(self.prepass),
+                onoff(self.gamma),
+                onoff(self.mesh),
+                onoff(self.boxes)
+            ),
+            format!(
+                "clusters {}/{}/{}  triangles {}/{}  points {}",
+                kept, stats.clusters_after_frustum, stats.clusters, stats.triangles_drawn, stats.triangles, stats.points_drawn
+            ),
+            format!("lights {}  light grid {total} indices, {mean:.2} per cell, max {max}", a.uploaded.lights.lights),
+            format!("frame {ms:.1} ms  {gpu}"),
+        ];
+        a.window.set_title(&format!("voxkit view | {} | {} | {}", lines[0], lines[1], lines[3]));
+        a.renderer.set_overlay(&mut a.uploaded, if self.text { &lines } else { &[] });
         if self.opts.frames.is_some_and(|n| self.frames >= n) {
-            let o = self.options(w, h);
-            match a.renderer.render(&a.uploaded, &o) {
-                Ok(f) => self.screenshot = Some((f, o.camera)),
+            // The screenshot is the frame as render --gpu draws it: no text.
+            a.renderer.set_overlay(&mut a.uploaded, &[]);
+            match a.renderer.render(&a.uploaded, &opts) {
+                Ok(f) => self.screenshot = Some((f, opts.camera)),
                 Err(e) => return self.fail(event_loop, e),
             }
             event_loop.exit();
@@ -324,6 +339,7 @@ impl App {
             KeyCode::KeyL => self.light_grid = !self.light_grid,
             KeyCode::KeyM => self.mesh = !self.mesh,
             KeyCode::KeyB => self.boxes = !self.boxes,
+            KeyCode::KeyT => self.text = !self.text,
             KeyCode::KeyP => self.spray(event_loop),
             KeyCode::KeyX => {
                 self.points.clear();

@@ -532,3 +532,55 @@ fn a_voxel_grid_drawn_by_the_gpu_covers_the_pixels_the_cpu_ray_caster_does() {
         assert!(differ * 50 <= edges, "{view:?}: {differ} of {edges} silhouette pixels differ");
     }
 }
+
+#[test]
+fn the_overlay_draws_font8x8_glyphs_and_nothing_else() {
+    let Some(r) = renderer() else { return };
+    let scene = cornell();
+    let mut g = r.upload(&scene).unwrap();
+    let (lo, hi) = scene.bounds().unwrap();
+    let o = FrameOptions {
+        width: 96,
+        height: 64,
+        camera: Camera::framing(lo, hi, 1),
+        culling: Culling::Occlusion,
+        prepass: false,
+        gamma: true,
+        light_grid_view: false,
+        read_hiz: false,
+        mesh: true,
+        boxes: false,
+    };
+    let plain = r.render(&g, &o).unwrap();
+    r.set_overlay(&mut g, &["A7".to_string(), "x".to_string()]);
+    let text = r.render(&g, &o).unwrap();
+    let px = |f: &voxkit_view::Frame, x: usize, y: usize| f.rgba[4 * (y * 96 + x)..4 * (y * 96 + x) + 3].to_vec();
+    // Glyph k of line l: its texel (tx, ty) covers pixels 4 + 16 k + 2 tx
+    // (+1) across and 4 + 18 l + 2 ty (+1) down.
+    let mut glyph_pixels = std::collections::HashSet::new();
+    for (l, line) in ["A7", "x"].iter().enumerate() {
+        for (k, c) in line.chars().enumerate() {
+            let rows = font8x8::legacy::BASIC_LEGACY[c as usize];
+            for (ty, row) in rows.iter().enumerate() {
+                for tx in 0..8 {
+                    let on = row & (1 << tx) != 0;
+                    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                        let (x, y) = (4 + 16 * k + 2 * tx + dx, 4 + 18 * l + 2 * ty + dy);
+                        glyph_pixels.insert((x, y));
+                        let want = if on { vec![255, 255, 255] } else { vec![13, 13, 15] };
+                        assert_eq!(px(&text, x, y), want, "{c:?} texel ({tx}, {ty})");
+                    }
+                }
+            }
+        }
+    }
+    for y in 0..64 {
+        for x in 0..96 {
+            if !glyph_pixels.contains(&(x, y)) {
+                assert_eq!(px(&text, x, y), px(&plain, x, y), "({x}, {y}) is not under the text");
+            }
+        }
+    }
+    r.set_overlay(&mut g, &[]);
+    assert_eq!(r.render(&g, &o).unwrap().rgba, plain.rgba);
+}
