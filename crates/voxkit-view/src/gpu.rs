@@ -93,6 +93,26 @@ pub struct FrameOptions {
     pub boxes: bool,
 }
 
+impl FrameOptions {
+    /// A `width × height` frame from `camera` with the defaults of `render
+    /// --gpu`: occlusion culling, no prepass, gamma, the mesh shaded, no
+    /// boxes.
+    pub fn new(width: u32, height: u32, camera: Camera) -> FrameOptions {
+        FrameOptions {
+            width,
+            height,
+            camera,
+            culling: Culling::Occlusion,
+            prepass: false,
+            gamma: true,
+            light_grid_view: false,
+            read_hiz: false,
+            mesh: true,
+            boxes: false,
+        }
+    }
+}
+
 /// Per-pass GPU time in milliseconds (timestamp queries), where the
 /// adapter writes them.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -173,6 +193,51 @@ struct FrameUniform {
     grid_lo: [f32; 4],
     grid_cell: [f32; 4],
     params: [u32; 4],
+}
+
+/// What the frame's render pipelines differ in.
+struct PipelineParts<'a> {
+    label: &'a str,
+    layout: &'a wgpu::PipelineLayout,
+    module: &'a wgpu::ShaderModule,
+    /// Vertex and fragment entry points.
+    entry: (&'a str, &'a str),
+    buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+    topology: wgpu::PrimitiveTopology,
+    /// Depth write and test against [`DEPTH`], or no depth attachment.
+    depth: Option<(bool, wgpu::CompareFunction)>,
+    targets: &'a [Option<wgpu::ColorTargetState>],
+}
+
+/// A render pipeline of the frame: no face culling, no blending.
+fn render_pipeline(device: &wgpu::Device, p: PipelineParts<'_>) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(p.label),
+        layout: Some(p.layout),
+        vertex: wgpu::VertexState {
+            module: p.module,
+            entry_point: Some(p.entry.0),
+            compilation_options: Default::default(),
+            buffers: p.buffers,
+        },
+        primitive: wgpu::PrimitiveState { topology: p.topology, cull_mode: None, ..Default::default() },
+        depth_stencil: p.depth.map(|(write, compare)| wgpu::DepthStencilState {
+            format: DEPTH,
+            depth_write_enabled: Some(write),
+            depth_compare: Some(compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: p.module,
+            entry_point: Some(p.entry.1),
+            compilation_options: Default::default(),
+            targets: p.targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 /// Pixels between the picture's corner and the overlay text.
@@ -476,73 +541,46 @@ impl Renderer {
         let shade_pl = pipeline_layout(&[Some(&shade_layout)]);
         let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x3, 3 => Float32x2];
         let colour_target = [Some(wgpu::ColorTargetState { format: COLOUR, blend: None, write_mask: wgpu::ColorWrites::ALL })];
+        let vertex_layout = [Some(wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<Vertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &attributes,
+        })];
+        // The depth-only passes run the alpha test too (fs_depth), so
+        // cut-out texels neither hide nor occlude anything.
         let draw = |label, colour: bool, write: bool, compare| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&shade_pl),
-                vertex: wgpu::VertexState {
+            render_pipeline(
+                &device,
+                PipelineParts {
+                    label,
+                    layout: &shade_pl,
                     module: &shade_module,
-                    entry_point: Some("vs"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(wgpu::VertexBufferLayout {
-                        array_stride: std::mem::size_of::<Vertex>() as u64,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &attributes,
-                    })],
-                },
-                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH,
-                    depth_write_enabled: Some(write),
-                    depth_compare: Some(compare),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                // The depth-only passes run the alpha test too (fs_depth),
-                // so cut-out texels neither hide nor occlude anything.
-                fragment: Some(wgpu::FragmentState {
-                    module: &shade_module,
-                    entry_point: Some(if colour { "fs" } else { "fs_depth" }),
-                    compilation_options: Default::default(),
+                    entry: ("vs", if colour { "fs" } else { "fs_depth" }),
+                    buffers: &vertex_layout,
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    depth: Some((write, compare)),
                     targets: if colour { &colour_target } else { &[] },
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+                },
+            )
         };
         let point_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x3, 4 => Float32x3];
-        let points = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("spray points"),
-            layout: Some(&shade_pl),
-            vertex: wgpu::VertexState {
+        let points = render_pipeline(
+            &device,
+            PipelineParts {
+                label: "spray points",
+                layout: &shade_pl,
                 module: &shade_module,
-                entry_point: Some("vs_point"),
-                compilation_options: Default::default(),
+                entry: ("vs_point", "fs_point"),
                 buffers: &[Some(wgpu::VertexBufferLayout {
                     array_stride: std::mem::size_of::<SprayPoint>() as u64,
                     step_mode: wgpu::VertexStepMode::Vertex,
                     attributes: &point_attributes,
                 })],
+                topology: wgpu::PrimitiveTopology::PointList,
+                depth: Some((true, wgpu::CompareFunction::LessEqual)),
+                targets: &colour_target,
             },
-            primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::PointList, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &shade_module,
-                entry_point: Some("fs_point"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState { format: COLOUR, blend: None, write_mask: wgpu::ColorWrites::ALL })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        );
         let boxes = adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE).then(|| {
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("cluster boxes"),
@@ -556,27 +594,19 @@ impl Renderer {
                 label: Some("cluster boxes"),
                 source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/boxes.wgsl")]).into()),
             });
-            let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("cluster boxes"),
-                layout: Some(&pipeline_layout(&[Some(&layout)])),
-                vertex: wgpu::VertexState {
+            let pipeline = render_pipeline(
+                &device,
+                PipelineParts {
+                    label: "cluster boxes",
+                    layout: &pipeline_layout(&[Some(&layout)]),
                     module: &module,
-                    entry_point: Some("vs_box"),
-                    compilation_options: Default::default(),
+                    entry: ("vs_box", "fs_box"),
                     buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::LineList, ..Default::default() },
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_box"),
-                    compilation_options: Default::default(),
+                    topology: wgpu::PrimitiveTopology::LineList,
+                    depth: None,
                     targets: &colour_target,
-                }),
-                multiview_mask: None,
-                cache: None,
-            });
+                },
+            );
             (pipeline, layout)
         });
         let text_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -600,31 +630,23 @@ impl Renderer {
             source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/text.wgsl")]).into()),
         });
         let glyph_attributes = wgpu::vertex_attr_array![0 => Float32x2, 1 => Uint32];
-        let text = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("overlay text"),
-            layout: Some(&pipeline_layout(&[Some(&text_layout)])),
-            vertex: wgpu::VertexState {
+        let text = render_pipeline(
+            &device,
+            PipelineParts {
+                label: "overlay text",
+                layout: &pipeline_layout(&[Some(&text_layout)]),
                 module: &text_module,
-                entry_point: Some("vs_text"),
-                compilation_options: Default::default(),
+                entry: ("vs_text", "fs_text"),
                 buffers: &[Some(wgpu::VertexBufferLayout {
                     array_stride: std::mem::size_of::<Glyph>() as u64,
                     step_mode: wgpu::VertexStepMode::Instance,
                     attributes: &glyph_attributes,
                 })],
-            },
-            primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleStrip, ..Default::default() },
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &text_module,
-                entry_point: Some("fs_text"),
-                compilation_options: Default::default(),
+                topology: wgpu::PrimitiveTopology::TriangleStrip,
+                depth: None,
                 targets: &colour_target,
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+            },
+        );
         let font = font_atlas(&device, &queue);
         let prepass = draw("prepass", false, true, wgpu::CompareFunction::Less);
         let shade = draw("shade", true, true, wgpu::CompareFunction::Less);

@@ -49,22 +49,7 @@ fn cameras(scene: &Scene) -> Vec<Camera> {
 }
 
 fn frame(r: &Renderer, g: &voxkit_view::GpuScene, camera: Camera, culling: Culling, prepass: bool) -> voxkit_view::Frame {
-    r.render(
-        g,
-        &FrameOptions {
-            width: 160,
-            height: 120,
-            camera,
-            culling,
-            prepass,
-            gamma: true,
-            light_grid_view: false,
-            read_hiz: true,
-            mesh: true,
-            boxes: false,
-        },
-    )
-    .unwrap()
+    r.render(g, &FrameOptions { culling, prepass, read_hiz: true, ..FrameOptions::new(160, 120, camera) }).unwrap()
 }
 
 fn check_scene(r: &Renderer, scene: &Scene, what: &str) {
@@ -142,18 +127,7 @@ fn the_cornell_box_is_lit_by_its_ceiling() {
     // From the open side, looking in.
     let cam = Camera { eye: Vec3::new(0.5, 0.5, 2.4), target: Vec3::new(0.5, 0.5, 0.0), up: Vec3::Y, fov_deg: 40.0 };
     assert!(lo.cmple(Vec3::ZERO).all() && hi.cmpge(Vec3::ONE).all());
-    let mut o = FrameOptions {
-        width: 200,
-        height: 200,
-        camera: cam,
-        culling: Culling::Frustum,
-        prepass: false,
-        gamma: true,
-        light_grid_view: false,
-        read_hiz: false,
-        mesh: true,
-        boxes: false,
-    };
+    let mut o = FrameOptions { culling: Culling::Frustum, ..FrameOptions::new(200, 200, cam) };
     let f = r.render(&g, &o).unwrap();
     let px = |x: usize, y: usize| {
         let i = 4 * (y * 200 + x);
@@ -265,18 +239,7 @@ fn a_spray_point_is_lit_as_the_shader_documents() {
     };
     r.add_points(&mut g, &[p]).unwrap();
     let camera = Camera { eye, target, up: Vec3::Y, fov_deg: 40.0 };
-    let o = FrameOptions {
-        width: 101,
-        height: 81,
-        camera,
-        culling: Culling::None,
-        prepass: false,
-        gamma: true,
-        light_grid_view: false,
-        read_hiz: false,
-        mesh: false,
-        boxes: false,
-    };
+    let o = FrameOptions { culling: Culling::None, mesh: false, ..FrameOptions::new(101, 81, camera) };
     let f = r.render(&g, &o).unwrap();
     assert_eq!(f.stats.points_drawn, 1);
     assert_eq!(f.stats.triangles_drawn, 0, "mesh off");
@@ -308,18 +271,7 @@ fn culling_leaves_a_sprayed_cloud_unchanged() {
             let pictures: Vec<Vec<u8>> = [Culling::None, Culling::Frustum, Culling::Occlusion]
                 .into_iter()
                 .map(|culling| {
-                    let o = FrameOptions {
-                        width: 96,
-                        height: 96,
-                        camera: cam,
-                        culling,
-                        prepass: false,
-                        gamma: true,
-                        light_grid_view: false,
-                        read_hiz: false,
-                        mesh,
-                        boxes: false,
-                    };
+                    let o = FrameOptions { culling, mesh, ..FrameOptions::new(96, 96, cam) };
                     let f = r.render(&g, &o).unwrap();
                     assert_eq!(f.stats.points_drawn, points.len() as u64);
                     f.rgba
@@ -331,18 +283,7 @@ fn culling_leaves_a_sprayed_cloud_unchanged() {
     // Points added in two parts draw as when added at once.
     let mut once = r.upload(&scene).unwrap();
     r.add_points(&mut once, &points).unwrap();
-    let o = FrameOptions {
-        width: 96,
-        height: 96,
-        camera: from_front,
-        culling: Culling::None,
-        prepass: false,
-        gamma: true,
-        light_grid_view: false,
-        read_hiz: false,
-        mesh: false,
-        boxes: false,
-    };
+    let o = FrameOptions { culling: Culling::None, mesh: false, ..FrameOptions::new(96, 96, from_front) };
     assert_eq!(r.render(&once, &o).unwrap().rgba, r.render(&g, &o).unwrap().rgba);
     r.clear_points(&mut once);
     assert_eq!(r.render(&once, &o).unwrap().stats.points_drawn, 0);
@@ -368,18 +309,7 @@ fn alpha_cut_outs_show_what_is_behind_with_any_culling_and_prepass() {
     let mut pictures = Vec::new();
     for culling in [Culling::None, Culling::Frustum, Culling::Occlusion, Culling::OcclusionTwoPass] {
         for prepass in [false, true] {
-            let o = FrameOptions {
-                width: 128,
-                height: 128,
-                camera,
-                culling,
-                prepass,
-                gamma: false,
-                light_grid_view: false,
-                read_hiz: false,
-                mesh: true,
-                boxes: false,
-            };
+            let o = FrameOptions { culling, prepass, gamma: false, ..FrameOptions::new(128, 128, camera) };
             let f = r.render(&g, &o).unwrap();
             // The back quad lies wholly behind the front one: only a depth
             // pass that cuts out like the shading keeps it.
@@ -419,18 +349,7 @@ fn the_cluster_boxes_show_kept_and_culled_clusters() {
     // Close to an occluder and narrow: some clusters culled, some kept.
     let (lo, hi) = scene.bounds().unwrap();
     let camera = cameras(&scene)[3];
-    let o = |culling, boxes| FrameOptions {
-        width: 160,
-        height: 120,
-        camera,
-        culling,
-        prepass: false,
-        gamma: true,
-        light_grid_view: false,
-        read_hiz: false,
-        mesh: true,
-        boxes,
-    };
+    let o = |culling, boxes| FrameOptions { culling, boxes, ..FrameOptions::new(160, 120, camera) };
     let plain = r.render(&g, &o(Culling::Occlusion, false)).unwrap();
     let boxed = r.render(&g, &o(Culling::Occlusion, true)).unwrap();
     assert!(plain.kept.iter().any(|&k| k) && plain.kept.iter().any(|&k| !k), "the camera culls some clusters ({lo}..{hi})");
@@ -491,18 +410,7 @@ fn a_voxel_grid_drawn_by_the_gpu_covers_the_pixels_the_cpu_ray_caster_does() {
             up: Vec3::Y,
             fov_deg: (2.0 * (1.02 * radius / dist).atan()).to_degrees() as f32,
         };
-        let o = FrameOptions {
-            width: w,
-            height: h,
-            camera,
-            culling: Culling::Occlusion,
-            prepass: false,
-            gamma: true,
-            light_grid_view: false,
-            read_hiz: false,
-            mesh: true,
-            boxes: false,
-        };
+        let o = FrameOptions::new(w, h, camera);
         let gpu = r.render(&g, &o).unwrap();
         let (cbg, gbg) = (&cpu.rgb[..3], &gpu.rgba[..3]);
         let on_cpu = |x: i64, y: i64| {
@@ -539,18 +447,7 @@ fn the_overlay_draws_font8x8_glyphs_and_nothing_else() {
     let scene = cornell();
     let mut g = r.upload(&scene).unwrap();
     let (lo, hi) = scene.bounds().unwrap();
-    let o = FrameOptions {
-        width: 96,
-        height: 64,
-        camera: Camera::framing(lo, hi, 1),
-        culling: Culling::Occlusion,
-        prepass: false,
-        gamma: true,
-        light_grid_view: false,
-        read_hiz: false,
-        mesh: true,
-        boxes: false,
-    };
+    let o = FrameOptions::new(96, 64, Camera::framing(lo, hi, 1));
     let plain = r.render(&g, &o).unwrap();
     r.set_overlay(&mut g, &["A7".to_string(), "x".to_string()]);
     let text = r.render(&g, &o).unwrap();
