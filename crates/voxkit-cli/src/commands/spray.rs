@@ -15,8 +15,9 @@ use crate::args::SprayArgs;
 use crate::commands::render::{parse_size, up_axis};
 use crate::commands::render_gpu::{load_scene, parse_camera};
 
-/// The most rays one run casts (a 64-byte point each).
-const MAX_RAYS: usize = 1 << 30;
+/// The most rays one run casts: every hit is a 64-byte point held until
+/// the PLY is written, so 2^26 rays need at most 4 GiB.
+const MAX_RAYS: usize = 1 << 26;
 /// The most light samples per point.
 const MAX_SAMPLES: u32 = 4096;
 
