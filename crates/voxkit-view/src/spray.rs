@@ -129,8 +129,6 @@ pub struct Tracer {
     materials: Vec<ShadeMaterial>,
     textures: Vec<Texture>,
     normals: Vec<Vec3>,
-    albedo: Vec<[f32; 3]>,
-    emission: Vec<[f32; 3]>,
     emitters: Emitters,
     unit: f32,
     /// Offset of shadow-ray origins off the surface (world units).
@@ -151,9 +149,6 @@ impl Tracer {
             .collect();
         let normals = scene.vertices.chunks_exact(3).map(|t| Vec3::from(t[0].normal)).collect();
         let material = |t: &[crate::scene::Vertex]| scene.materials[t[0].material as usize];
-        let albedo = scene.vertices.chunks_exact(3).map(|t| std::array::from_fn(|c| material(t).colour[c])).collect();
-        let emission: Vec<[f32; 3]> =
-            scene.vertices.chunks_exact(3).map(|t| std::array::from_fn(|c| material(t).emission_shininess[c])).collect();
         // The lights as crate::lights merges them: total area per light.
         let mut emitters = Emitters { triangles: Vec::new(), cumulative: Vec::new(), weight: Vec::new() };
         let mut lights: std::collections::HashMap<(u32, [i64; 3]), f32> = Default::default();
@@ -188,12 +183,16 @@ impl Tracer {
             materials: scene.materials.clone(),
             textures: scene.textures.clone(),
             normals,
-            albedo,
-            emission,
             emitters,
             unit,
             epsilon,
         })
+    }
+
+    /// Triangle `t`'s emitted radiance (its material's).
+    fn emission(&self, t: usize) -> [f32; 3] {
+        let e = self.materials[self.material[t] as usize].emission_shininess;
+        [e[0], e[1], e[2]]
     }
 
     /// The texture coordinate of point `p` on triangle `t`.
@@ -284,7 +283,7 @@ impl Tracer {
         let (u, v) = (rng.random::<f32>(), rng.random::<f32>());
         let s = u.sqrt();
         let p = tri.v0 * (1.0 - s) + tri.v1 * (s * (1.0 - v)) + tri.v2 * (s * v);
-        Some((p.into(), Vec3::from(self.emission[t]) * self.emitters.weight[k]))
+        Some((p.into(), Vec3::from(self.emission(t)) * self.emitters.weight[k]))
     }
 
     /// The point where a ray hits, with its light term, or `None` on a miss.
@@ -318,16 +317,18 @@ impl Tracer {
             albedo: {
                 // The base colour times the texture's (sRGB) texel.
                 let texel = self.texel(tri, p);
-                std::array::from_fn(|c| self.albedo[tri][c] * to_linear(texel[c]) as f32)
+                let base = self.materials[self.material[tri] as usize].colour;
+                std::array::from_fn(|c| base[c] * to_linear(texel[c]) as f32)
             },
             light: light.to_array(),
-            emission: self.emission[tri],
+            emission: self.emission(tri),
             _pad: 0.0,
         })
     }
 
-    /// Casts `rays(i, rng)` for `i` in `0..count`, block by block in
-    /// parallel (see the module documentation); the hits, in ray order.
+    /// Casts `o.rays` rays, each `ray(rng)` (origin and direction), block
+    /// by block in parallel (see the module documentation); the hits, in
+    /// ray order.
     fn cast(&self, o: &SprayOptions, ray: impl Fn(&mut ChaCha8Rng) -> (Vec3, Vec3) + Sync) -> Vec<SprayPoint> {
         let blocks = o.rays.div_ceil(BLOCK);
         let per_block: Vec<Vec<SprayPoint>> = (0..blocks)

@@ -3,6 +3,7 @@
 //! written as PLY for `render --gpu --points`, `view --points` and other
 //! point-cloud tools.
 
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
@@ -21,10 +22,17 @@ const MAX_RAYS: usize = 1 << 26;
 /// The most light samples per point.
 const MAX_SAMPLES: u32 = 4096;
 
-pub fn run(a: &SprayArgs) -> Result<()> {
-    if a.output.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("ply")) != Some(true) {
-        bail!("{}: spray clouds are written as PLY; give a .ply file name", a.output.display());
+/// Checks that a spray cloud may be written to `path`: a `.ply` name in a
+/// folder that exists.
+pub(crate) fn check_cloud_path(path: &Path) -> Result<()> {
+    if path.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("ply")) != Some(true) {
+        bail!("{}: spray clouds are written as PLY; give a .ply file name", path.display());
     }
+    Ok(voxkit_job::output::check_output_path(path)?)
+}
+
+pub fn run(a: &SprayArgs) -> Result<()> {
+    check_cloud_path(&a.output)?;
     if a.rays == 0 || a.rays > MAX_RAYS {
         bail!("--rays must be 1..={MAX_RAYS}, not {}", a.rays);
     }
@@ -32,7 +40,6 @@ pub fn run(a: &SprayArgs) -> Result<()> {
         bail!("--light-samples must be 0..={MAX_SAMPLES}, not {}", a.light_samples);
     }
     let (width, height) = parse_size(&a.size)?;
-    voxkit_job::output::check_output_path(&a.output)?;
     voxkit_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.input))?;
     let pool = crate::thread_pool(a.threads)?;
     let upi = up_axis(a.up.as_deref());

@@ -20,10 +20,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         voxkit_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.input))?;
     }
     if let Some(p) = &a.save_points {
-        if p.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("ply")) != Some(true) {
-            bail!("{}: spray clouds are written as PLY; give a .ply file name", p.display());
-        }
-        voxkit_job::output::check_output_path(p)?;
+        crate::commands::spray::check_cloud_path(p)?;
         voxkit_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.input))?;
     }
     if a.frames == Some(0) {
