@@ -29,8 +29,8 @@ use rayon::prelude::*;
 
 use super::colour::{from_linear, linear_to_rgb, pack, to_linear, unpack};
 use super::{Appearance, ColourRule, Texture, VoxelAttributes, NO_MATERIAL};
-use crate::geom::clip::{clip_triangle_to_box, CLIPPED_MAX};
-use crate::geom::lattice::prepare_triangle;
+use crate::geom::clip::{clip_to_slab, ClipPoly, CLIPPED_MAX};
+use crate::geom::lattice::{prepare_triangle, LatticeTriangle};
 use crate::voxelize::cover::cover_triangle;
 use crate::voxelize::driver::Sink;
 use crate::voxelize::Traversal;
@@ -52,52 +52,50 @@ pub const DEFAULT_COLOUR: [u8; 3] = [200, 200, 200];
 const MAX_SUBDIV: u32 = 24;
 
 struct Contribution {
-    slot: usize,
+    /// The voxel, relative to its slab's first key.
+    slot: u32,
     tri: u32,
     area: f64,
     /// Total weight of the colour samples (the area, or 1 for a touch).
     w: f64,
     /// Blend: weighted linear RGB.
     lin: [f64; 3],
-    /// Dominant: area per `0xRRGGBB`.
-    hist: Hist,
+    /// Dominant: area per `0xRRGGBB`, `hist_len` entries of the slab's
+    /// histogram list from `hist_start`, in the order colours were first seen.
+    hist_start: u32,
+    hist_len: u32,
 }
 
-/// Area per packed colour of one contribution: a few colours inline (a
-/// voxel's piece of one triangle rarely covers more), the rest on the heap.
-#[derive(Clone, Debug, Default)]
-struct Hist {
-    inline: [(u32, f64); HIST_INLINE],
-    len: u8,
-    more: Vec<(u32, f64)>,
-}
-
-const HIST_INLINE: usize = 4;
-
-impl Hist {
+impl Contribution {
+    /// Adds weight `w` to colour `c` in this contribution's histogram, the
+    /// last entries of `hist`.
     #[inline]
-    fn add(&mut self, c: u32, w: f64) {
-        let n = self.len as usize;
-        if let Some(h) = self.inline[..n].iter_mut().find(|h| h.0 == c) {
+    fn add_colour(&mut self, hist: &mut Vec<(u32, f64)>, c: u32, w: f64) {
+        let start = self.hist_start as usize;
+        if let Some(h) = hist[start..].iter_mut().find(|h| h.0 == c) {
             h.1 += w;
-        } else if let Some(h) = self.more.iter_mut().find(|h| h.0 == c) {
-            h.1 += w;
-        } else if n < HIST_INLINE {
-            self.inline[n] = (c, w);
-            self.len += 1;
         } else {
-            self.more.push((c, w));
+            hist.push((c, w));
+            self.hist_len += 1;
         }
     }
 
-    fn iter(&self) -> impl Iterator<Item = &(u32, f64)> {
-        self.inline[..self.len as usize].iter().chain(&self.more)
+    fn hist<'h>(&self, hist: &'h [(u32, f64)]) -> &'h [(u32, f64)] {
+        &hist[self.hist_start as usize..(self.hist_start + self.hist_len) as usize]
     }
 }
 
 /// Attributes of the set voxels of `voxels` (on `grid`) from the triangles of `mesh`.
 /// Colour is present when `appearance` has colour, material ids when it has
 /// materials, normals when asked; coverage always.
+///
+/// The work is cut into z-slabs of about [`SLAB_VOXELS`] set voxels (a
+/// contiguous range of keys each). Triangles are snapped once and binned by
+/// the slabs their voxel box meets; each slab runs `cover` on its triangles
+/// clipped to the slab, in triangle order, and reduces its own
+/// contributions. Every (voxel, triangle) pair is visited exactly once, in
+/// the same order whatever the slabs, so the result does not depend on them
+/// or on the thread count, and memory stays at one slab per thread.
 pub fn carry(
     mesh: MeshRef<'_>,
     appearance: &Appearance,
@@ -108,15 +106,7 @@ pub fn carry(
     let dims = grid.dims();
     let mut keys = Vec::with_capacity(voxels.count() as usize);
     voxels.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
-    let ctx = Ctx { mesh, app: appearance, grid, keys: &keys, rule: opts.rule, colour: appearance.has_colour() };
-    let contribs: Vec<Contribution> =
-        (0..mesh.triangles.len()).into_par_iter().with_min_len(64).flat_map_iter(|t| ctx.triangle(t)).collect();
-    // Reduce in (voxel, triangle) order: contributions come in triangle
-    // order, so sorting `slot << 32 | index` (8 bytes, not the contributions
-    // themselves) orders them by voxel, then triangle.
-    assert!(contribs.len() < 1 << 32, "too many (triangle, voxel) pairs to carry attributes");
-    let mut order: Vec<u64> = contribs.par_iter().enumerate().map(|(i, c)| (c.slot as u64) << 32 | i as u64).collect();
-    order.par_sort_unstable();
+    let ctx = Ctx { mesh, app: appearance, grid, keys: &keys, rule: opts.rule, colour: appearance.has_colour(), normals: opts.normals };
 
     let n = keys.len();
     let materials = appearance.has_materials();
@@ -125,51 +115,43 @@ pub fn carry(
     let mut material = vec![NO_MATERIAL; if materials { n } else { 0 }];
     let mut normal = vec![[0f32; 3]; if opts.normals { n } else { 0 }];
     let mut coverage = vec![0f32; n];
-    let mut hist: Vec<(u32, f64)> = Vec::new();
-    let mut mats: Vec<(u32, f64)> = Vec::new();
-    let mut group: Vec<&Contribution> = Vec::new();
-    for run in order.chunk_by(|a, b| a >> 32 == b >> 32) {
-        group.clear();
-        group.extend(run.iter().map(|o| &contribs[(o & 0xffff_ffff) as usize]));
-        let group = &group[..];
-        let slot = group[0].slot;
-        has[slot] = true;
-        let any_area = group.iter().any(|c| c.area > 0.0);
-        let used = || group.iter().copied().filter(move |c| !any_area || c.area > 0.0);
-        let weight = |c: &Contribution| if any_area { c.area } else { 1.0 };
-        coverage[slot] = group.iter().map(|c| c.area).sum::<f64>() as f32;
-        if ctx.colour {
-            colour[slot] = match opts.rule {
-                ColourRule::Blend => {
-                    let mut sum = [0.0; 3];
-                    let mut w = 0.0;
-                    for c in used() {
-                        (0..3).for_each(|a| sum[a] += c.lin[a]);
-                        w += c.w;
-                    }
-                    linear_to_rgb(sum.map(|s| if w > 0.0 { s / w } else { 0.0 }))
-                }
-                ColourRule::Dominant => {
-                    hist.clear();
-                    for c in used() {
-                        hist.extend(c.hist.iter().copied());
-                    }
-                    unpack(argmax(&mut hist).unwrap_or(pack(DEFAULT_COLOUR)))
-                }
-            };
+    if n > 0 {
+        let slabs = Slab::cut(&keys, dims);
+        // Snap every triangle once, in order; each lattice triangle remembers its source.
+        let prepared: Vec<(u32, LatticeTriangle)> = (0..mesh.triangles.len())
+            .into_par_iter()
+            .with_min_len(256)
+            .flat_map_iter(|t| {
+                let mut out = Vec::new();
+                prepare_triangle(mesh.positions, &mesh.triangles[t], grid, &mut out);
+                out.into_iter().map(move |lt| (t as u32, lt))
+            })
+            .collect();
+        // Bin them (indices into `prepared`, ascending) by the slabs their voxel box meets.
+        // Layers past the last slab hold no set voxel: their triangles go to the last slab, which clips them away.
+        let mut slab_of_k = vec![slabs.len() as u32 - 1; dims[2] as usize];
+        for (s, slab) in slabs.iter().enumerate() {
+            slab_of_k[slab.k0 as usize..slab.k1 as usize].fill(s as u32);
         }
-        if materials {
-            mats.clear();
-            mats.extend(used().map(|c| (ctx.app.triangle_material.get(c.tri as usize).copied().unwrap_or(NO_MATERIAL), weight(c))));
-            material[slot] = argmax(&mut mats).unwrap_or(NO_MATERIAL);
-        }
-        if opts.normals {
-            let mut s = DVec3::ZERO;
-            for c in used() {
-                s += ctx.unit_normal(c.tri as usize) * weight(c);
+        let mut bins: Vec<Vec<u32>> = vec![Vec::new(); slabs.len()];
+        for (e, (_, lt)) in prepared.iter().enumerate() {
+            if let Some((lo, hi)) = lt.voxel_bounds(dims) {
+                for s in slab_of_k[lo[2] as usize]..=slab_of_k[hi[2] as usize] {
+                    bins[s as usize].push(e as u32);
+                }
             }
-            normal[slot] = s.normalize_or_zero().as_vec3().to_array();
         }
+        let mut parts = Vec::with_capacity(slabs.len());
+        let mut rest = Outputs { has: &mut has, colour: &mut colour, material: &mut material, normal: &mut normal, coverage: &mut coverage };
+        for slab in &slabs {
+            let (part, tail) = rest.split(slab.s1 - slab.s0);
+            parts.push(part);
+            rest = tail;
+        }
+        slabs.par_iter().zip(parts).zip(&bins).with_max_len(1).for_each_init(Scratch::default, |scratch, ((slab, mut out), bin)| {
+            ctx.slab(slab, bin, &prepared, scratch);
+            ctx.reduce(scratch, &mut out);
+        });
     }
     let with_colour = ctx.colour;
     fill_from_nearest(&keys, dims, &mut has, &mut colour, &mut material, &mut normal);
@@ -180,6 +162,125 @@ pub fn carry(
         material: materials.then_some(material),
         normal: opts.normals.then_some(normal),
         coverage: Some(coverage),
+    }
+}
+
+/// About how many set voxels one slab of [`carry`] holds.
+const SLAB_VOXELS: usize = 1 << 11;
+
+/// Largest row table of a slab, in rows per set voxel (beyond it, the slab's
+/// keys are binary searched instead).
+const ROWS_PER_VOXEL: usize = 4;
+
+/// A z-slab `k0..k1` of the grid and its keys `s0..s1`.
+struct Slab {
+    k0: u32,
+    k1: u32,
+    s0: usize,
+    s1: usize,
+}
+
+impl Slab {
+    /// Slabs of whole z-layers from 0 to the last key's layer, each holding
+    /// about [`SLAB_VOXELS`] of the sorted `keys` (fewer when there are
+    /// few keys; non-empty).
+    fn cut(keys: &[u64], dims: [u32; 3]) -> Vec<Slab> {
+        let layer = dims[0] as u64 * dims[1] as u64;
+        // Enough slabs for every thread to have several (small grids carry
+        // many texels per voxel, so their work is not in proportion to voxels).
+        let per = keys.len().div_ceil(8 * rayon::current_num_threads()).clamp(1, SLAB_VOXELS);
+        let mut slabs = Vec::new();
+        let (mut k0, mut s0) = (0u32, 0usize);
+        while s0 < keys.len() {
+            // The slab ends after the layer of its `per`-th key.
+            let last = (s0 + per).min(keys.len()) - 1;
+            let k1 = (keys[last] / layer) as u32 + 1;
+            let s1 = s0 + keys[s0..].partition_point(|&key| key < k1 as u64 * layer);
+            slabs.push(Slab { k0, k1, s0, s1 });
+            (k0, s0) = (k1, s1);
+        }
+        slabs
+    }
+}
+
+/// Buffers one thread reuses from slab to slab.
+#[derive(Default)]
+struct Scratch {
+    contribs: Vec<Contribution>,
+    /// The contributions' colour histograms, one after another.
+    hist: Vec<(u32, f64)>,
+    voxels: Vec<[u32; 3]>,
+    order: Vec<u64>,
+}
+
+/// Mutable views of the attribute arrays (empty ones stay empty).
+struct Outputs<'a> {
+    has: &'a mut [bool],
+    colour: &'a mut [[u8; 3]],
+    material: &'a mut [u32],
+    normal: &'a mut [[f32; 3]],
+    coverage: &'a mut [f32],
+}
+
+impl<'a> Outputs<'a> {
+    /// The first `n` slots and the rest.
+    fn split(self, n: usize) -> (Outputs<'a>, Outputs<'a>) {
+        fn cut<T>(v: &mut [T], n: usize) -> (&mut [T], &mut [T]) {
+            if v.is_empty() {
+                (&mut [], &mut [])
+            } else {
+                v.split_at_mut(n)
+            }
+        }
+        let (has, has_r) = cut(self.has, n);
+        let (colour, colour_r) = cut(self.colour, n);
+        let (material, material_r) = cut(self.material, n);
+        let (normal, normal_r) = cut(self.normal, n);
+        let (coverage, coverage_r) = cut(self.coverage, n);
+        (
+            Outputs { has, colour, material, normal, coverage },
+            Outputs { has: has_r, colour: colour_r, material: material_r, normal: normal_r, coverage: coverage_r },
+        )
+    }
+}
+
+/// Finds the slot of a voxel among one slab's keys: through the offsets of
+/// each `(j, k)` row where the table is small, else by binary search.
+struct SlotIndex<'a> {
+    keys: &'a [u64],
+    /// First key of the slab's first layer.
+    base: u64,
+    nx: u64,
+    /// `rows[r]..rows[r + 1]`: the keys of row `r` (counted from `base`), if tabled.
+    rows: Vec<u32>,
+}
+
+impl<'a> SlotIndex<'a> {
+    fn new(keys: &'a [u64], dims: [u32; 3], k0: u32, k1: u32) -> SlotIndex<'a> {
+        let nx = dims[0] as u64;
+        let base = k0 as u64 * nx * dims[1] as u64;
+        let n_rows = (k1 - k0) as usize * dims[1] as usize;
+        let mut rows = Vec::new();
+        if n_rows <= ROWS_PER_VOXEL * keys.len() + 1024 && keys.len() < u32::MAX as usize {
+            rows = vec![0u32; n_rows + 1];
+            for &key in keys {
+                rows[((key - base) / nx) as usize + 1] += 1;
+            }
+            for r in 0..n_rows {
+                rows[r + 1] += rows[r];
+            }
+        }
+        SlotIndex { keys, base, nx, rows }
+    }
+
+    #[inline]
+    fn slot(&self, key: u64) -> Option<usize> {
+        if self.rows.is_empty() {
+            return self.keys.binary_search(&key).ok();
+        }
+        let r = ((key - self.base) / self.nx) as usize;
+        let (a, b) = (self.rows[r] as usize, self.rows[r + 1] as usize);
+        self.keys[a..b].binary_search(&key).ok().map(|s| a + s)
     }
 }
 
@@ -249,11 +350,12 @@ struct Ctx<'a> {
     keys: &'a [u64],
     rule: ColourRule,
     colour: bool,
+    normals: bool,
 }
 
-struct Collect(Vec<[u32; 3]>);
+struct Collect<'a>(&'a mut Vec<[u32; 3]>);
 
-impl Sink for Collect {
+impl Sink for Collect<'_> {
     fn set(&mut self, i: u32, j: u32, k: u32) {
         self.0.push([i, j, k]);
     }
@@ -273,38 +375,81 @@ impl Ctx<'_> {
         self.corners(t).map(|p| (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero()).unwrap_or(DVec3::ZERO)
     }
 
-    fn triangle(&self, t: usize) -> Vec<Contribution> {
-        let Some(p) = self.corners(t) else { return Vec::new() };
+    /// The contributions of one slab: its binned lattice triangles (indices
+    /// into `prepared`, ascending), grouped by source triangle, each
+    /// traversed inside the slab; slots are relative to the slab's first key.
+    fn slab(&self, slab: &Slab, bin: &[u32], prepared: &[(u32, LatticeTriangle)], scratch: &mut Scratch) {
         let dims = self.grid.dims();
-        let mut lattice = Vec::new();
-        prepare_triangle(self.mesh.positions, &self.mesh.triangles[t], self.grid, &mut lattice);
-        let mut voxels = Collect(Vec::new());
-        for lt in &lattice {
-            if let Some((lo, hi)) = lt.voxel_bounds(dims) {
-                cover_triangle(lt, lo, hi, Traversal::Auto, &mut voxels);
+        let index = SlotIndex::new(&self.keys[slab.s0..slab.s1], dims, slab.k0, slab.k1);
+        let out = &mut scratch.contribs;
+        out.clear();
+        scratch.hist.clear();
+        let mut voxels = Collect(&mut scratch.voxels);
+        for group in bin.chunk_by(|&a, &b| prepared[a as usize].0 == prepared[b as usize].0) {
+            let t = prepared[group[0] as usize].0 as usize;
+            voxels.0.clear();
+            for &e in group {
+                let lt = &prepared[e as usize].1;
+                if let Some((mut lo, mut hi)) = lt.voxel_bounds(dims) {
+                    lo[2] = lo[2].max(slab.k0 as i64);
+                    hi[2] = hi[2].min(slab.k1 as i64 - 1);
+                    if lo[2] <= hi[2] {
+                        cover_triangle(lt, lo, hi, Traversal::Auto, &mut voxels);
+                    }
+                }
             }
+            if voxels.0.is_empty() {
+                continue;
+            }
+            voxels.0.sort_unstable();
+            if group.len() > 1 {
+                voxels.0.dedup();
+            }
+            self.triangle(t, voxels.0, &index, out, &mut scratch.hist);
         }
-        let mut voxels = voxels.0;
-        if lattice.len() > 1 {
-            voxels.sort_unstable();
-            voxels.dedup();
-        }
+    }
+
+    /// Appends the contributions of triangle `t` to `voxels` (those it
+    /// touches, sorted).
+    fn triangle(&self, t: usize, voxels: &[[u32; 3]], index: &SlotIndex<'_>, out: &mut Vec<Contribution>, hist: &mut Vec<(u32, f64)>) {
+        let Some(p) = self.corners(t) else { return };
+        let dims = self.grid.dims();
         let shader = Shader::new(self, t, p);
-        let mut out = Vec::new();
+        // Voxels in (i, j, k) order: the triangle clipped to the voxel's x
+        // slab is shared along i, to its x and y slabs along (i, j), so each
+        // voxel clips only along z (the same polygons as clipping to the box).
+        let (mut x_poly, mut xy_poly, mut clipped) = (ClipPoly::default(), ClipPoly::default(), ClipPoly::default());
+        let (mut x_at, mut xy_at) = (None, None);
         for v in voxels {
-            let Ok(slot) = self.keys.binary_search(&VoxelAttributes::key(dims, v[0], v[1], v[2])) else { continue };
+            let Some(slot) = index.slot(VoxelAttributes::key(dims, v[0], v[1], v[2])) else { continue };
             let lo = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
-            let mut clipped = [DVec3::ZERO; CLIPPED_MAX];
-            let n = clip_triangle_to_box(&p, lo, lo + DVec3::ONE, &mut clipped);
-            let poly = &clipped[..n];
-            let mut c = Contribution { slot, tri: t as u32, area: 0.0, w: 0.0, lin: [0.0; 3], hist: Hist::default() };
+            if x_at != Some(v[0]) {
+                clip_to_slab(&p, 0, lo.x, lo.x + 1.0, &mut x_poly);
+                x_at = Some(v[0]);
+                xy_at = None;
+            }
+            if xy_at != Some(v[1]) {
+                clip_to_slab(x_poly.vertices(), 1, lo.y, lo.y + 1.0, &mut xy_poly);
+                xy_at = Some(v[1]);
+            }
+            clip_to_slab(xy_poly.vertices(), 2, lo.z, lo.z + 1.0, &mut clipped);
+            let poly = clipped.vertices();
+            assert!(hist.len() < u32::MAX as usize, "too many colour samples in one slab to carry attributes");
+            let mut c = Contribution { slot: slot as u32, tri: t as u32, area: 0.0, w: 0.0, lin: [0.0; 3], hist_start: hist.len() as u32, hist_len: 0 };
+            // Texture coordinates of the polygon's vertices, each computed once for its fan triangles.
+            let mut uvs = [[0.0; 2]; CLIPPED_MAX];
+            if let (true, Some((_, uv))) = (self.colour, &shader.texture) {
+                for (q, at) in uvs.iter_mut().zip(poly) {
+                    *q = Shader::uv(uv, shader.bary(*at));
+                }
+            }
             for w in 1..poly.len().saturating_sub(1) {
                 let (a, b, d) = (poly[0], poly[w], poly[w + 1]);
                 let area = 0.5 * (b - a).cross(d - a).length();
                 if area > 0.0 {
                     c.area += area;
                     if self.colour {
-                        shader.sample(a, b, d, area, &mut c);
+                        shader.sample([a, b, d], [uvs[0], uvs[w], uvs[w + 1]], area, &mut c, hist);
                     }
                 }
             }
@@ -312,11 +457,71 @@ impl Ctx<'_> {
                 // A touch: one point sample where it touches (or, if the f64
                 // clip lost it, the voxel's nearest point of the triangle's plane).
                 let at = if poly.is_empty() { closest_point(&p, lo + DVec3::splat(0.5)) } else { centroid(poly) };
-                shader.add(at, 1.0, &mut c);
+                shader.add(at, 1.0, &mut c, hist);
             }
             out.push(c);
         }
-        out
+    }
+
+    /// Reduces one slab's contributions into its outputs, per voxel in
+    /// triangle order.
+    fn reduce(&self, scratch: &mut Scratch, out: &mut Outputs<'_>) {
+        let contribs = &scratch.contribs;
+        // Contributions come in triangle order, so sorting `slot << 32 |
+        // index` (8 bytes, not the contributions themselves) orders them by
+        // voxel, then triangle.
+        assert!(contribs.len() < 1 << 32, "too many (triangle, voxel) pairs in one slab to carry attributes");
+        let order = &mut scratch.order;
+        order.clear();
+        order.extend(contribs.iter().enumerate().map(|(i, c)| (c.slot as u64) << 32 | i as u64));
+        order.sort_unstable();
+        let materials = !out.material.is_empty();
+        let mut hist: Vec<(u32, f64)> = Vec::new();
+        let mut mats: Vec<(u32, f64)> = Vec::new();
+        let mut group: Vec<&Contribution> = Vec::new();
+        for run in order.chunk_by(|a, b| a >> 32 == b >> 32) {
+            group.clear();
+            group.extend(run.iter().map(|o| &contribs[(o & 0xffff_ffff) as usize]));
+            let group = &group[..];
+            let slot = group[0].slot as usize;
+            out.has[slot] = true;
+            let any_area = group.iter().any(|c| c.area > 0.0);
+            let used = || group.iter().copied().filter(move |c| !any_area || c.area > 0.0);
+            let weight = |c: &Contribution| if any_area { c.area } else { 1.0 };
+            out.coverage[slot] = group.iter().map(|c| c.area).sum::<f64>() as f32;
+            if self.colour {
+                out.colour[slot] = match self.rule {
+                    ColourRule::Blend => {
+                        let mut sum = [0.0; 3];
+                        let mut w = 0.0;
+                        for c in used() {
+                            (0..3).for_each(|a| sum[a] += c.lin[a]);
+                            w += c.w;
+                        }
+                        linear_to_rgb(sum.map(|s| if w > 0.0 { s / w } else { 0.0 }))
+                    }
+                    ColourRule::Dominant => {
+                        hist.clear();
+                        for c in used() {
+                            hist.extend_from_slice(c.hist(&scratch.hist));
+                        }
+                        unpack(argmax(&mut hist).unwrap_or(pack(DEFAULT_COLOUR)))
+                    }
+                };
+            }
+            if materials {
+                mats.clear();
+                mats.extend(used().map(|c| (self.app.triangle_material.get(c.tri as usize).copied().unwrap_or(NO_MATERIAL), weight(c))));
+                out.material[slot] = argmax(&mut mats).unwrap_or(NO_MATERIAL);
+            }
+            if self.normals {
+                let mut s = DVec3::ZERO;
+                for c in used() {
+                    s += self.unit_normal(c.tri as usize) * weight(c);
+                }
+                out.normal[slot] = s.normalize_or_zero().as_vec3().to_array();
+            }
+        }
     }
 }
 
@@ -413,12 +618,12 @@ impl<'a> Shader<'a> {
         [0, 1].map(|a| b[0] * uv[0][a] + b[1] * uv[1][a] + b[2] * uv[2][a])
     }
 
-    /// Samples the fan triangle `(a, b, c)` of area `area` on an `n × n`
+    /// Samples the fan triangle `(a, b, c)` of area `area` (its corners'
+    /// texture coordinates `uvs`, when there is a texture) on an `n × n`
     /// barycentric subdivision (`n²` cells of equal area, one sample at each centroid).
-    fn sample(&self, a: DVec3, b: DVec3, c: DVec3, area: f64, out: &mut Contribution) {
+    fn sample(&self, [a, b, c]: [DVec3; 3], [ua, ub, uc]: [[f64; 2]; 3], area: f64, out: &mut Contribution, hist: &mut Vec<(u32, f64)>) {
         let n = match &self.texture {
-            Some((tex, uv)) => {
-                let [ua, ub, uc] = [a, b, c].map(|q| Self::uv(uv, self.bary(q)));
+            Some((tex, _)) => {
                 let cross = (ub[0] - ua[0]) * (uc[1] - ua[1]) - (ub[1] - ua[1]) * (uc[0] - ua[0]);
                 let texels = 0.5 * cross.abs() * tex.width as f64 * tex.height as f64;
                 ((2.0 * texels).sqrt().ceil() as u32).clamp(1, MAX_SUBDIV)
@@ -432,21 +637,21 @@ impl<'a> Shader<'a> {
         for i in 0..n {
             for j in 0..n - i {
                 let (fi, fj) = (i as f64, j as f64);
-                self.add(a + e1 * ((fi + 1.0 / 3.0) / nf) + e2 * ((fj + 1.0 / 3.0) / nf), w, out);
+                self.add(a + e1 * ((fi + 1.0 / 3.0) / nf) + e2 * ((fj + 1.0 / 3.0) / nf), w, out, hist);
                 if i + j + 1 < n {
-                    self.add(a + e1 * ((fi + 2.0 / 3.0) / nf) + e2 * ((fj + 2.0 / 3.0) / nf), w, out);
+                    self.add(a + e1 * ((fi + 2.0 / 3.0) / nf) + e2 * ((fj + 2.0 / 3.0) / nf), w, out, hist);
                 }
             }
         }
     }
 
     /// Adds one sample of weight `w` at `q`.
-    fn add(&self, q: DVec3, w: f64, out: &mut Contribution) {
+    fn add(&self, q: DVec3, w: f64, out: &mut Contribution, hist: &mut Vec<(u32, f64)>) {
         let b = self.bary(q);
         out.w += w;
         match self.rule {
             ColourRule::Dominant => {
-                out.hist.add(pack(self.dominant_colour(b)), w);
+                out.add_colour(hist, pack(self.dominant_colour(b)), w);
             }
             ColourRule::Blend => {
                 let l = self.linear_colour(b);

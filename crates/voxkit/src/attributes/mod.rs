@@ -32,6 +32,8 @@ impl Wrap {
         let x = if t.is_finite() { t * n_f } else { 0.0 };
         let i = x.floor();
         let idx = match self {
+            // (`rem_euclid` is a library call; inside the range it is the identity.)
+            Wrap::Repeat if i >= 0.0 && i < n_f => i,
             Wrap::Repeat => i.rem_euclid(n_f),
             Wrap::ClampToEdge => i.clamp(0.0, n_f - 1.0),
             Wrap::MirroredRepeat => {

@@ -41,37 +41,63 @@ const MAX_IN: usize = 8;
 /// Most vertices [`clip_triangle_to_box`] can return (3 + one per plane).
 pub const CLIPPED_MAX: usize = 9;
 
+/// A convex polygon of at most [`CLIPPED_MAX`] vertices, with room to clip it.
+#[derive(Clone, Copy, Debug)]
+pub struct ClipPoly {
+    v: [DVec3; CLIPPED_MAX + 1],
+    n: usize,
+}
+
+impl Default for ClipPoly {
+    fn default() -> ClipPoly {
+        ClipPoly { v: [DVec3::ZERO; CLIPPED_MAX + 1], n: 0 }
+    }
+}
+
+impl ClipPoly {
+    /// The vertices.
+    pub fn vertices(&self) -> &[DVec3] {
+        &self.v[..self.n]
+    }
+}
+
+/// Clips the convex polygon `poly` (at most [`CLIPPED_MAX`] vertices) to the
+/// slab `lo <= p[axis] <= hi`, into `out`: the `lo` plane, then the `hi`
+/// plane, each skipped when the polygon lies entirely on its kept side.
+/// Clipping a triangle to the slabs along x, then y, then z is
+/// [`clip_triangle_to_box`], so a caller visiting many boxes in x, y, z
+/// order may keep the partial results and get the same polygons.
+#[inline]
+pub fn clip_to_slab(poly: &[DVec3], axis: usize, lo: f64, hi: f64, out: &mut ClipPoly) {
+    let poly = &poly[..poly.len().min(CLIPPED_MAX)];
+    // A plane adds at most one vertex to a convex polygon; `clip_plane`
+    // stops at the buffer's end should rounding ever make one non-convex.
+    let mut tmp = [DVec3::ZERO; CLIPPED_MAX + 1];
+    let first: &[DVec3] = if poly.iter().all(|p| p[axis] >= lo) {
+        poly
+    } else {
+        let m = clip_plane(poly, axis, lo, false, &mut tmp).min(CLIPPED_MAX);
+        &tmp[..m]
+    };
+    if first.is_empty() || first.iter().all(|p| p[axis] <= hi) {
+        out.v[..first.len()].copy_from_slice(first);
+        out.n = first.len();
+    } else {
+        out.n = clip_plane(first, axis, hi, true, &mut out.v).min(CLIPPED_MAX);
+    }
+}
+
 /// [`clip_polygon_to_box`] for a triangle, into a fixed array (no
 /// allocation: the attribute carrier clips one triangle per voxel it
 /// touches). Returns the number of vertices in `out`.
 #[inline]
 pub fn clip_triangle_to_box(tri: &[DVec3; 3], lo: DVec3, hi: DVec3, out: &mut [DVec3; CLIPPED_MAX]) -> usize {
-    let mut a = [DVec3::ZERO; CLIPPED_MAX];
-    a[..3].copy_from_slice(tri);
-    let mut n = 3;
-    let mut src = true;
-    for axis in 0..3 {
-        for (bound, keep_below) in [(lo[axis], false), (hi[axis], true)] {
-            if n == 0 {
-                return 0;
-            }
-            // Skip planes the polygon lies entirely on the kept side of.
-            let (from, to) = if src { (&a, &mut *out) } else { (&*out, &mut a) };
-            let inside = from[..n].iter().all(|p| if keep_below { p[axis] <= bound } else { p[axis] >= bound });
-            if inside {
-                continue;
-            }
-            let mut buf = [DVec3::ZERO; CLIPPED_MAX + 1];
-            let m = clip_plane(&from[..n], axis, bound, keep_below, &mut buf);
-            to[..m.min(CLIPPED_MAX)].copy_from_slice(&buf[..m.min(CLIPPED_MAX)]);
-            n = m.min(CLIPPED_MAX);
-            src = !src;
-        }
-    }
-    if src {
-        out[..n].copy_from_slice(&a[..n]);
-    }
-    n
+    let (mut x, mut y, mut z) = (ClipPoly::default(), ClipPoly::default(), ClipPoly::default());
+    clip_to_slab(tri, 0, lo.x, hi.x, &mut x);
+    clip_to_slab(x.vertices(), 1, lo.y, hi.y, &mut y);
+    clip_to_slab(y.vertices(), 2, lo.z, hi.z, &mut z);
+    out[..z.n].copy_from_slice(z.vertices());
+    z.n
 }
 
 fn clip_general(poly: &[DVec3], lo: DVec3, hi: DVec3) -> Vec<DVec3> {
@@ -88,20 +114,21 @@ fn clip_general(poly: &[DVec3], lo: DVec3, hi: DVec3) -> Vec<DVec3> {
 }
 
 /// One Sutherland–Hodgman pass: `cur` clipped to the half-space kept by
-/// the plane `p[axis] = bound` into `out` (room for `cur.len() + 1`); returns the count.
+/// the plane `p[axis] = bound` into `out` (room for `cur.len() + 1`, what a
+/// convex polygon needs; vertices beyond `out` are dropped); returns the count.
 fn clip_plane(cur: &[DVec3], axis: usize, bound: f64, keep_below: bool, out: &mut [DVec3]) -> usize {
     // Signed distance, non-negative on the kept side.
     let dist = |p: DVec3| if keep_below { bound - p[axis] } else { p[axis] - bound };
     let mut n = 0;
     for idx in 0..cur.len() {
         let a = cur[idx];
-        let b = cur[(idx + 1) % cur.len()];
+        let b = if idx + 1 < cur.len() { cur[idx + 1] } else { cur[0] };
         let (da, db) = (dist(a), dist(b));
-        if da >= 0.0 {
+        if da >= 0.0 && n < out.len() {
             out[n] = a;
             n += 1;
         }
-        if (da >= 0.0) != (db >= 0.0) {
+        if (da >= 0.0) != (db >= 0.0) && n < out.len() {
             let t = da / (da - db);
             let mut p = a + (b - a) * t;
             p[axis] = bound; // exact on the plane

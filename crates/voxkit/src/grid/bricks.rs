@@ -230,24 +230,38 @@ impl BrickBits {
     /// The set voxels in order of `k`, then `j`, then `i`.
     pub fn for_each_set(&self, mut f: impl FnMut(u32, u32, u32)) {
         let [bx, by, bz] = self.bdims;
+        // Per layer of bricks, the non-empty bricks of each brick row
+        // (`rows[r]`: brick row `bj` and its `(bi, id)` in `occupied`), so
+        // each of the layer's 64 voxel rows visits only those.
+        let mut occupied: Vec<(u32, u32)> = Vec::new();
+        let mut rows: Vec<(u32, std::ops::Range<usize>)> = Vec::new();
         for bk in 0..bz {
+            occupied.clear();
+            rows.clear();
+            for bj in 0..by {
+                let row = ((bk * by + bj) * bx) as usize;
+                let start = occupied.len();
+                for (bi, &id) in self.index[row..row + bx as usize].iter().enumerate() {
+                    if id != 0 {
+                        occupied.push((bi as u32, id));
+                    }
+                }
+                if occupied.len() > start {
+                    rows.push((bj, start..occupied.len()));
+                }
+            }
             for z in 0..8u32 {
                 let k = bk * 8 + z;
                 if k >= self.dims[2] {
                     break;
                 }
-                for bj in 0..by {
-                    let row = (bk * by + bj) * bx;
+                for (bj, range) in &rows {
                     for y in 0..8u32 {
                         let j = bj * 8 + y;
                         if j >= self.dims[1] {
                             break;
                         }
-                        for bi in 0..bx {
-                            let id = self.index[(row + bi) as usize];
-                            if id == 0 {
-                                continue;
-                            }
+                        for &(bi, id) in &occupied[range.clone()] {
                             let mut byte = (self.bricks[id as usize - 1][z as usize] >> (y * 8)) & 0xff;
                             while byte != 0 {
                                 let x = byte.trailing_zeros();
