@@ -318,3 +318,80 @@ fn gltf_uvs_are_not_flipped_and_samplers_wrap() {
     let tinted = quad_colours(&gltf_quad(&d, 0.0, 10497, [0.0, 1.0, 1.0, 1.0]));
     assert_eq!(tinted, vec![[0, 0, 255], [0, 255, 255], [0, 0, 0], [0, 255, 0]]);
 }
+
+/// Attributes carried slab by slab equal the direct computation
+/// (`carry::reference`: every triangle over the whole grid, each piece
+/// clipped to its box at once, one reduction) bit for bit, for 1 and 2
+/// threads (so for different slab cuts).
+fn assert_matches_reference(mesh: voxkit::MeshRef<'_>, app: &voxkit::attributes::Appearance, grid: &GridSpec, bits: &dyn voxkit::VoxelSource, what: &str) {
+    for rule in [ColourRule::Dominant, ColourRule::Blend] {
+        let opts = CarryOptions { rule, normals: true };
+        let want = voxkit::attributes::carry::reference::carry(mesh, app, grid, bits, &opts);
+        assert_eq!(want.keys.len() as u64, bits.count());
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let got = pool.install(|| carry(mesh, app, grid, bits, &opts));
+            assert!(got == want, "{what}, {rule:?}, {threads} threads: attributes differ from the reference");
+        }
+    }
+}
+
+#[test]
+fn carried_attributes_equal_the_reference_on_rotated_spot() {
+    use rand::{Rng, SeedableRng};
+    let loaded = voxkit_io::read_mesh(&spot_path()).unwrap();
+    let mut rng = rand::rngs::SmallRng::seed_from_u64(14);
+    for (n, res) in [37u64, 61, 90].into_iter().enumerate() {
+        let mut mesh = loaded.mesh.clone();
+        if n > 0 {
+            let axis = DVec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)).normalize();
+            let rot = glam::DQuat::from_axis_angle(axis, rng.random_range(0.0..std::f64::consts::TAU));
+            mesh.transform(|p| rot * p);
+        }
+        let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), res).unwrap();
+        for mode in [Mode::Cover, Mode::Sep26] {
+            let (bits, _) = voxelize::fast(mode, mesh.as_ref(), &grid, &Options::default());
+            assert_matches_reference(mesh.as_ref(), &loaded.appearance, &grid, &bits, &format!("spot {n} at {res}, {mode:?}"));
+        }
+    }
+    // A solid: interior voxels take their colour from the nearest surface voxel.
+    let grid = GridSpec::from_resolution(&loaded.report.bounds, 40).unwrap();
+    let (solid, _) = voxkit::voxelize::solid::parity(loaded.mesh.as_ref(), &grid).unwrap();
+    assert_matches_reference(loaded.mesh.as_ref(), &loaded.appearance, &grid, &solid, "spot solid");
+}
+
+#[test]
+fn carried_attributes_equal_the_reference_on_random_coloured_triangles() {
+    use rand::{Rng, SeedableRng};
+    use voxkit::attributes::{Appearance, Material, NO_MATERIAL};
+    let mut rng = rand::rngs::SmallRng::seed_from_u64(1414);
+    for case in 0..12 {
+        let nt = rng.random_range(1..60);
+        let mut mesh = voxkit::Mesh::default();
+        for _ in 0..nt * 3 {
+            // Coordinates on a coarse lattice now and then, so vertices and edges land on voxel faces.
+            let c = |rng: &mut rand::rngs::SmallRng| if rng.random_bool(0.3) { rng.random_range(0..24) as f64 * 0.25 } else { rng.random_range(0.0..6.0) };
+            mesh.positions.push(DVec3::new(c(&mut rng), c(&mut rng), c(&mut rng)));
+        }
+        mesh.triangles = (0..nt as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+        let material = |name: &str, factor: [f32; 3]| Material {
+            name: name.into(),
+            factor,
+            texture: None,
+            emission: [0.0; 3],
+            roughness: 0.6,
+            alpha_cutoff: None,
+            alpha_texture: None,
+        };
+        let app = Appearance {
+            materials: vec![material("red", [0.8, 0.1, 0.1]), material("blue", [0.1, 0.2, 0.9])],
+            triangle_material: (0..nt).map(|_| [0, 1, NO_MATERIAL][rng.random_range(0..3)]).collect(),
+            vertex_colour: if case % 2 == 0 { (0..nt * 3).map(|_| [rng.random(), rng.random(), rng.random()]).collect() } else { Vec::new() },
+            ..Appearance::default()
+        };
+        let res = rng.random_range(4..40);
+        let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), res).unwrap();
+        let (bits, _) = voxelize::fast(Mode::Cover, mesh.as_ref(), &grid, &Options::default());
+        assert_matches_reference(mesh.as_ref(), &app, &grid, &bits, &format!("case {case}: {nt} triangles at {res}"));
+    }
+}

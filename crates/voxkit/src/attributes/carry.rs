@@ -433,34 +433,41 @@ impl Ctx<'_> {
                 xy_at = Some(v[1]);
             }
             clip_to_slab(xy_poly.vertices(), 2, lo.z, lo.z + 1.0, &mut clipped);
-            let poly = clipped.vertices();
-            assert!(hist.len() < u32::MAX as usize, "too many colour samples in one slab to carry attributes");
-            let mut c = Contribution { slot: slot as u32, tri: t as u32, area: 0.0, w: 0.0, lin: [0.0; 3], hist_start: hist.len() as u32, hist_len: 0 };
-            // Texture coordinates of the polygon's vertices, each computed once for its fan triangles.
-            let mut uvs = [[0.0; 2]; CLIPPED_MAX];
-            if let (true, Some((_, uv))) = (self.colour, &shader.texture) {
-                for (q, at) in uvs.iter_mut().zip(poly) {
-                    *q = Shader::uv(uv, shader.bary(*at));
-                }
-            }
-            for w in 1..poly.len().saturating_sub(1) {
-                let (a, b, d) = (poly[0], poly[w], poly[w + 1]);
-                let area = 0.5 * (b - a).cross(d - a).length();
-                if area > 0.0 {
-                    c.area += area;
-                    if self.colour {
-                        shader.sample([a, b, d], [uvs[0], uvs[w], uvs[w + 1]], area, &mut c, hist);
-                    }
-                }
-            }
-            if c.area <= 0.0 && self.colour {
-                // A touch: one point sample where it touches (or, if the f64
-                // clip lost it, the voxel's nearest point of the triangle's plane).
-                let at = if poly.is_empty() { closest_point(&p, lo + DVec3::splat(0.5)) } else { centroid(poly) };
-                shader.add(at, 1.0, &mut c, hist);
-            }
-            out.push(c);
+            out.push(self.contribution(&shader, t, &p, slot, lo, clipped.vertices(), hist));
         }
+    }
+
+    /// What triangle `t` (corners `p`, grid units) gives voxel `slot`
+    /// (low corner `lo`), whose box clips it to `poly`; colour samples go
+    /// to the end of `hist`.
+    #[allow(clippy::too_many_arguments)]
+    fn contribution(&self, shader: &Shader<'_>, t: usize, p: &[DVec3; 3], slot: usize, lo: DVec3, poly: &[DVec3], hist: &mut Vec<(u32, f64)>) -> Contribution {
+        assert!(hist.len() < u32::MAX as usize && slot < u32::MAX as usize, "too many voxels or colour samples in one slab to carry attributes");
+        let mut c = Contribution { slot: slot as u32, tri: t as u32, area: 0.0, w: 0.0, lin: [0.0; 3], hist_start: hist.len() as u32, hist_len: 0 };
+        // Texture coordinates of the polygon's vertices, each computed once for its fan triangles.
+        let mut uvs = [[0.0; 2]; CLIPPED_MAX];
+        if let (true, Some((_, uv))) = (self.colour, &shader.texture) {
+            for (q, at) in uvs.iter_mut().zip(poly) {
+                *q = Shader::uv(uv, shader.bary(*at));
+            }
+        }
+        for w in 1..poly.len().saturating_sub(1) {
+            let (a, b, d) = (poly[0], poly[w], poly[w + 1]);
+            let area = 0.5 * (b - a).cross(d - a).length();
+            if area > 0.0 {
+                c.area += area;
+                if self.colour {
+                    shader.sample([a, b, d], [uvs[0], uvs[w], uvs[w + 1]], area, &mut c, hist);
+                }
+            }
+        }
+        if c.area <= 0.0 && self.colour {
+            // A touch: one point sample where it touches (or, if the f64
+            // clip lost it, the voxel's nearest point of the triangle's plane).
+            let at = if poly.is_empty() { closest_point(p, lo + DVec3::splat(0.5)) } else { centroid(poly) };
+            shader.add(at, 1.0, &mut c, hist);
+        }
+        c
     }
 
     /// Reduces one slab's contributions into its outputs, per voxel in
@@ -521,6 +528,67 @@ impl Ctx<'_> {
                 }
                 out.normal[slot] = s.normalize_or_zero().as_vec3().to_array();
             }
+        }
+    }
+}
+
+/// The slow, obviously correct way to carry attributes: the same
+/// definition (per voxel, the triangles' pieces inside its box, sampled and
+/// reduced in triangle order) computed directly — every triangle in order
+/// over the whole grid, each voxel's piece clipped to its box at once, each
+/// slot found by a binary search over every key, one reduction. Serial.
+/// [`carry`] must give exactly the same attributes.
+pub mod reference {
+    use super::*;
+    use crate::geom::clip::clip_triangle_to_box;
+
+    /// [`super::carry`], directly.
+    pub fn carry(mesh: MeshRef<'_>, appearance: &Appearance, grid: &GridSpec, voxels: &dyn VoxelSource, opts: &CarryOptions) -> VoxelAttributes {
+        let dims = grid.dims();
+        let mut keys = Vec::new();
+        voxels.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
+        let ctx = Ctx { mesh, app: appearance, grid, keys: &keys, rule: opts.rule, colour: appearance.has_colour(), normals: opts.normals };
+        let n = keys.len();
+        let materials = appearance.has_materials();
+        let mut has = vec![false; n];
+        let mut colour = vec![DEFAULT_COLOUR; if ctx.colour { n } else { 0 }];
+        let mut material = vec![NO_MATERIAL; if materials { n } else { 0 }];
+        let mut normal = vec![[0f32; 3]; if opts.normals { n } else { 0 }];
+        let mut coverage = vec![0f32; n];
+        let mut scratch = Scratch::default();
+        for t in 0..mesh.triangles.len() {
+            let mut lattice = Vec::new();
+            prepare_triangle(mesh.positions, &mesh.triangles[t], grid, &mut lattice);
+            let mut found = Vec::new();
+            for lt in &lattice {
+                if let Some((lo, hi)) = lt.voxel_bounds(dims) {
+                    cover_triangle(lt, lo, hi, Traversal::Auto, &mut Collect(&mut found));
+                }
+            }
+            found.sort_unstable();
+            found.dedup();
+            let Some(p) = ctx.corners(t) else { continue };
+            let shader = Shader::new(&ctx, t, p);
+            for v in found {
+                let Ok(slot) = keys.binary_search(&VoxelAttributes::key(dims, v[0], v[1], v[2])) else { continue };
+                let lo = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
+                let mut clipped = [DVec3::ZERO; CLIPPED_MAX];
+                let m = clip_triangle_to_box(&p, lo, lo + DVec3::ONE, &mut clipped);
+                let c = ctx.contribution(&shader, t, &p, slot, lo, &clipped[..m], &mut scratch.hist);
+                scratch.contribs.push(c);
+            }
+        }
+        let mut out = Outputs { has: &mut has, colour: &mut colour, material: &mut material, normal: &mut normal, coverage: &mut coverage };
+        ctx.reduce(&mut scratch, &mut out);
+        let with_colour = ctx.colour;
+        fill_from_nearest(&keys, dims, &mut has, &mut colour, &mut material, &mut normal);
+        VoxelAttributes {
+            dims,
+            keys,
+            colour: with_colour.then_some(colour),
+            material: materials.then_some(material),
+            normal: opts.normals.then_some(normal),
+            coverage: Some(coverage),
         }
     }
 }
