@@ -323,7 +323,13 @@ fn gltf_uvs_are_not_flipped_and_samplers_wrap() {
 /// (`carry::reference`: every triangle over the whole grid, each piece
 /// clipped to its box at once, one reduction) bit for bit, for 1 and 2
 /// threads (so for different slab cuts).
-fn assert_matches_reference(mesh: voxkit::MeshRef<'_>, app: &voxkit::attributes::Appearance, grid: &GridSpec, bits: &dyn voxkit::VoxelSource, what: &str) {
+fn assert_matches_reference(
+    mesh: voxkit::MeshRef<'_>,
+    app: &voxkit::attributes::Appearance,
+    grid: &GridSpec,
+    bits: &dyn voxkit::VoxelSource,
+    what: &str,
+) {
     for rule in [ColourRule::Dominant, ColourRule::Blend] {
         let opts = CarryOptions { rule, normals: true };
         let want = voxkit::attributes::carry::reference::carry(mesh, app, grid, bits, &opts);
@@ -370,7 +376,13 @@ fn carried_attributes_equal_the_reference_on_random_coloured_triangles() {
         let mut mesh = voxkit::Mesh::default();
         for _ in 0..nt * 3 {
             // Coordinates on a coarse lattice now and then, so vertices and edges land on voxel faces.
-            let c = |rng: &mut rand::rngs::SmallRng| if rng.random_bool(0.3) { rng.random_range(0..24) as f64 * 0.25 } else { rng.random_range(0.0..6.0) };
+            let c = |rng: &mut rand::rngs::SmallRng| {
+                if rng.random_bool(0.3) {
+                    rng.random_range(0..24) as f64 * 0.25
+                } else {
+                    rng.random_range(0.0..6.0)
+                }
+            };
             mesh.positions.push(DVec3::new(c(&mut rng), c(&mut rng), c(&mut rng)));
         }
         mesh.triangles = (0..nt as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
@@ -386,7 +398,11 @@ fn carried_attributes_equal_the_reference_on_random_coloured_triangles() {
         let app = Appearance {
             materials: vec![material("red", [0.8, 0.1, 0.1]), material("blue", [0.1, 0.2, 0.9])],
             triangle_material: (0..nt).map(|_| [0, 1, NO_MATERIAL][rng.random_range(0..3)]).collect(),
-            vertex_colour: if case % 2 == 0 { (0..nt * 3).map(|_| [rng.random(), rng.random(), rng.random()]).collect() } else { Vec::new() },
+            vertex_colour: if case % 2 == 0 {
+                (0..nt * 3).map(|_| [rng.random(), rng.random(), rng.random()]).collect()
+            } else {
+                Vec::new()
+            },
             ..Appearance::default()
         };
         let res = rng.random_range(4..40);

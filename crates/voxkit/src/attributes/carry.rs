@@ -142,7 +142,8 @@ pub fn carry(
             }
         }
         let mut parts = Vec::with_capacity(slabs.len());
-        let mut rest = Outputs { has: &mut has, colour: &mut colour, material: &mut material, normal: &mut normal, coverage: &mut coverage };
+        let mut rest =
+            Outputs { has: &mut has, colour: &mut colour, material: &mut material, normal: &mut normal, coverage: &mut coverage };
         for slab in &slabs {
             let (part, tail) = rest.split(slab.s1 - slab.s0);
             parts.push(part);
@@ -441,9 +442,22 @@ impl Ctx<'_> {
     /// (low corner `lo`), whose box clips it to `poly`; colour samples go
     /// to the end of `hist`.
     #[allow(clippy::too_many_arguments)]
-    fn contribution(&self, shader: &Shader<'_>, t: usize, p: &[DVec3; 3], slot: usize, lo: DVec3, poly: &[DVec3], hist: &mut Vec<(u32, f64)>) -> Contribution {
-        assert!(hist.len() < u32::MAX as usize && slot < u32::MAX as usize, "too many voxels or colour samples in one slab to carry attributes");
-        let mut c = Contribution { slot: slot as u32, tri: t as u32, area: 0.0, w: 0.0, lin: [0.0; 3], hist_start: hist.len() as u32, hist_len: 0 };
+    fn contribution(
+        &self,
+        shader: &Shader<'_>,
+        t: usize,
+        p: &[DVec3; 3],
+        slot: usize,
+        lo: DVec3,
+        poly: &[DVec3],
+        hist: &mut Vec<(u32, f64)>,
+    ) -> Contribution {
+        assert!(
+            hist.len() < u32::MAX as usize && slot < u32::MAX as usize,
+            "too many voxels or colour samples in one slab to carry attributes"
+        );
+        let mut c =
+            Contribution { slot: slot as u32, tri: t as u32, area: 0.0, w: 0.0, lin: [0.0; 3], hist_start: hist.len() as u32, hist_len: 0 };
         // Texture coordinates of the polygon's vertices, each computed once for its fan triangles.
         let mut uvs = [[0.0; 2]; CLIPPED_MAX];
         if let (true, Some((_, uv))) = (self.colour, &shader.texture) {
@@ -543,7 +557,13 @@ pub mod reference {
     use crate::geom::clip::clip_triangle_to_box;
 
     /// [`super::carry`], directly.
-    pub fn carry(mesh: MeshRef<'_>, appearance: &Appearance, grid: &GridSpec, voxels: &dyn VoxelSource, opts: &CarryOptions) -> VoxelAttributes {
+    pub fn carry(
+        mesh: MeshRef<'_>,
+        appearance: &Appearance,
+        grid: &GridSpec,
+        voxels: &dyn VoxelSource,
+        opts: &CarryOptions,
+    ) -> VoxelAttributes {
         let dims = grid.dims();
         let mut keys = Vec::new();
         voxels.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
