@@ -193,6 +193,28 @@ mod tests {
         assert!(clip_segment_to_box(DVec3::new(-1e9, 9.0, 1.0), DVec3::new(1e9, 9.0, 1.0), DVec3::ZERO, DVec3::splat(4.0)).is_none());
     }
 
+    use proptest::prelude::*;
+
+    proptest::proptest! {
+        /// Clipping slab by slab (what the attribute carrier shares between
+        /// neighbouring voxels) gives exactly the polygon of clipping to all
+        /// six planes in turn: vertices on a coarse lattice now and then, so
+        /// they land on the box's planes.
+        #[test]
+        fn slab_by_slab_equals_clipping_to_the_box(
+            v in proptest::array::uniform3(proptest::array::uniform3(proptest::prop_oneof![(-8i32..=24).prop_map(|c| c as f64 * 0.25), -2.0f64..6.0])),
+            lo in proptest::array::uniform3(-1i32..4),
+        ) {
+            let tri = v.map(DVec3::from_array);
+            let lo = DVec3::new(lo[0] as f64, lo[1] as f64, lo[2] as f64);
+            let hi = lo + DVec3::ONE;
+            let mut out = [DVec3::ZERO; CLIPPED_MAX];
+            let n = clip_triangle_to_box(&tri, lo, hi, &mut out);
+            let want = clip_polygon_to_box(&tri, lo, hi);
+            prop_assert_eq!(&out[..n], &want[..]);
+        }
+    }
+
     #[test]
     fn triangle_outside_vanishes() {
         let t = [DVec3::new(10.0, 10.0, 10.0), DVec3::new(11.0, 10.0, 10.0), DVec3::new(10.0, 11.0, 10.0)];
