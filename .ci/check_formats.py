@@ -192,4 +192,21 @@ with tempfile.TemporaryDirectory() as d:
     n = int(da.from_zarr(str(d / "t.zarr")).sum().compute())
     check("zarr: tiled sep6 at 2048 read by Dask has voxkit's count", s["method"] == "tiled" and n == s["voxels"], (n, s["voxels"]))
 
+    # .npz of sparse coordinates: NumPy's own loader reads the (k, 3)
+    # indices and the grid; scattered into a grid they equal the .npy; a
+    # tiled run past --max-memory writes one too, with voxkit's count.
+    s = voxelize(MESHES / "stanford-bunny.obj", d / "b.npz", "--resolution", "300")
+    with np.load(d / "b.npz") as z:
+        idx, dims = z["indices"], z["dims"]
+        check("npz: members, (k, 3) int32 indices", sorted(z.files) == ["dims", "indices", "origin", "voxel_size"] and idx.shape == (s["voxels"], 3) and idx.dtype == np.int32, (z.files, idx.shape, idx.dtype))
+        grid = np.zeros(tuple(dims), bool)
+        grid[tuple(idx.T)] = True
+        check("npz: indices scattered into dims = the .npy", tuple(dims) == tuple(s["dims"]) and np.array_equal(grid, np.load(d / "b.npy") > 0))
+        check("npz: placement", float(z["voxel_size"]) == s["voxel_size"] and list(z["origin"]) == s["origin"], (z["voxel_size"], z["origin"]))
+        order = idx[:, 2].astype(np.int64) * dims[1] * dims[0] + idx[:, 1].astype(np.int64) * dims[0] + idx[:, 0]
+        check("npz: ordered by k, then j, then i", bool((np.diff(order) > 0).all()))
+    s = voxelize(MESHES / "stanford-bunny.obj", d / "t.npz", "--resolution", "3000", "--max-memory", "64M")
+    with np.load(d / "t.npz") as z:
+        check("npz: tiled run past --max-memory has voxkit's count", s["method"] == "tiled" and z["indices"].shape[0] == s["voxels"], (s["method"], z["indices"].shape, s["voxels"]))
+
 ORACLE.finish()

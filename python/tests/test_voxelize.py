@@ -202,7 +202,7 @@ def test_attributes_colours_materials_normals_coverage(meshes, tmp_path, cli):
     assert np.array_equal(back.colours, g.colours)
 
 
-@pytest.mark.parametrize("fmt", ["npy", "npy-bool", "binvox", "vox", "txt", "schem", "vti", "ply", "vdb", "zarr"])
+@pytest.mark.parametrize("fmt", ["npy", "npy-bool", "npz", "binvox", "vox", "txt", "schem", "vti", "ply", "vdb", "zarr"])
 def test_save_and_load_every_voxel_format(tmp_path, meshes, fmt):
     g = voxkit.voxelize(voxkit.load_mesh(meshes / "cow.obj"), resolution=40)
     ext = "npy" if fmt == "npy-bool" else fmt

@@ -198,7 +198,7 @@ pub struct VoxelizeArgs {
     /// voxels; the summary says how many).
     #[arg(long, value_enum, default_value = "compute", value_name = "PATH")]
     pub gpu_path: GpuPathArg,
-    /// Output format: npy, npy-bool, binvox, vox, txt, schem, vti, ply, or obj / glb for a mesh of the voxels (default: from the extension).
+    /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, or obj / glb for a mesh of the voxels (default: from the extension).
     #[arg(long, value_name = "FORMAT")]
     pub format: Option<String>,
     /// Also render the result to this PNG (see `voxkit render` for --view, --size, --up, --outline).
@@ -603,7 +603,7 @@ pub struct ConvertArgs {
     pub input: PathBuf,
     /// Output voxel file, or `.obj` / `.glb` for a mesh of the voxels; the format comes from the extension unless --format is given.
     pub output: PathBuf,
-    /// Output format: npy, npy-bool, binvox, vox, txt, schem, vti, ply, obj or glb (default: from the extension).
+    /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, obj or glb (default: from the extension).
     #[arg(long, value_name = "FORMAT")]
     pub format: Option<String>,
     #[command(flatten)]
@@ -638,7 +638,7 @@ pub struct BatchArgs {
     /// every mesh extension voxkit reads).
     #[arg(long, value_name = "PATTERN")]
     pub glob: Option<String>,
-    /// Output format: npy, npy-bool, binvox, vox, txt, schem, vti, ply, obj or glb.
+    /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, obj or glb.
     #[arg(long, default_value = "npy", value_name = "FORMAT")]
     pub format: String,
     /// Voxelization mode.

@@ -16,6 +16,7 @@ pub mod error;
 pub mod gltf;
 pub mod mesh_report;
 pub mod npy;
+pub mod npz;
 pub mod obj;
 pub mod orient;
 pub mod pixels;
@@ -174,11 +175,13 @@ pub enum VoxelFormat {
     Vdb,
     /// Zarr v3 array, a directory of gzip chunks (see [`zarr`]).
     Zarr,
+    /// NumPy `.npz`: the set voxels' `(k, 3)` indices and the grid (see [`npz`]).
+    Npz,
 }
 
 impl VoxelFormat {
     /// Names accepted by `--format`.
-    pub const NAMES: &'static str = "npy, npy-bool, binvox, vox, txt, schem, vti, ply, vdb, zarr";
+    pub const NAMES: &'static str = "npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr";
 
     /// The format for a `--format` name or a file extension.
     pub fn from_name(name: &str) -> Option<VoxelFormat> {
@@ -193,6 +196,7 @@ impl VoxelFormat {
             "ply" => Some(VoxelFormat::Ply),
             "vdb" => Some(VoxelFormat::Vdb),
             "zarr" => Some(VoxelFormat::Zarr),
+            "npz" => Some(VoxelFormat::Npz),
             _ => None,
         }
     }
@@ -210,6 +214,7 @@ impl VoxelFormat {
             VoxelFormat::Ply => "ply",
             VoxelFormat::Vdb => "vdb",
             VoxelFormat::Zarr => "zarr",
+            VoxelFormat::Npz => "npz",
         }
     }
 
@@ -273,6 +278,7 @@ pub fn write_voxels_with(
         VoxelFormat::Vti => vti::write(w, bits, grid, attrs),
         VoxelFormat::Ply => points::write(w, bits, grid, attrs),
         VoxelFormat::Vdb => vdb::write(w, bits, grid),
+        VoxelFormat::Npz => npz::write(w, bits, grid),
         VoxelFormat::Zarr => unreachable!("Zarr arrays are written above"),
     })
 }
@@ -325,6 +331,12 @@ pub fn read_voxels_with(path: &Path, up: orient::Up) -> Result<LoadedVoxels, IoE
         let mut r = std::io::BufReader::new(file);
         return npy::read_stream(&mut r, total).map_err(|k| IoError::new(path, k));
     }
+    if format == VoxelFormat::Npz {
+        // Streamed from the file: the index array is never held whole.
+        let file = std::fs::File::open(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+        let total = file.metadata().map_err(|e| IoError::new(path, ErrorKind::Read(e)))?.len();
+        return fence("voxel", || npz::read_from(std::io::BufReader::new(file), total)).map_err(|k| IoError::new(path, k));
+    }
     let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
     read_voxels_bytes_with(&bytes, format, up).map_err(|k| IoError::new(path, k))
 }
@@ -346,6 +358,7 @@ pub fn read_voxels_bytes_with(bytes: &[u8], format: VoxelFormat, up: orient::Up)
         VoxelFormat::Vti => vti::read(bytes),
         VoxelFormat::Ply => points::read(bytes),
         VoxelFormat::Vdb => vdb::read(bytes),
+        VoxelFormat::Npz => npz::read(bytes),
         VoxelFormat::Zarr => Err(ErrorKind::malformed("Zarr", "a Zarr array is a directory; read it by path")),
     })
 }

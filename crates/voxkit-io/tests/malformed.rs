@@ -61,6 +61,7 @@ fn random_bytes_never_panic_any_reader() {
                 VoxelFormat::Schem,
                 VoxelFormat::Vti,
                 VoxelFormat::Ply,
+                VoxelFormat::Npz,
             ] {
                 let _ = read_voxels_bytes(&bytes, f);
             }

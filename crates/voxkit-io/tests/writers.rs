@@ -172,3 +172,76 @@ fn an_npy_header_promising_a_huge_grid_is_rejected_before_allocating() {
     let e = read_voxels(&p).unwrap_err().to_string();
     assert!(e.contains("huge.npy") && e.contains("truncated"), "{e}");
 }
+
+/// `.npz` of sparse coordinates: written from the set voxels alone, read
+/// back to the same voxels and placement; archives as NumPy writes them
+/// (deflated, other dtypes, no `dims`) read too; hostile ones are refused
+/// in one line.
+#[test]
+fn npz_round_trips_and_refuses_hostile_archives() {
+    use std::io::Write;
+    let dims = [13, 70, 5];
+    let bits = pattern(dims);
+    let grid = GridSpec::new(DVec3::new(-1.0, 2.0, 0.5), 0.25, [13, 70, 5]).unwrap();
+    let p = tmp("a.npz");
+    write_voxels(&p, VoxelFormat::Npz, &bits, &grid).unwrap();
+    let back = read_voxels(&p).unwrap();
+    assert_eq!(back.bits, bits);
+    assert_eq!(back.placement, Some((DVec3::new(-1.0, 2.0, 0.5), 0.25)));
+    // From memory too, and an empty grid.
+    let bytes = std::fs::read(&p).unwrap();
+    assert_eq!(voxkit_io::read_voxels_bytes(&bytes, VoxelFormat::Npz).unwrap().bits, bits);
+    let empty = DenseBits::new([3, 4, 5]);
+    write_voxels(&p, VoxelFormat::Npz, &empty, &GridSpec::new(DVec3::ZERO, 1.0, [3, 4, 5]).unwrap()).unwrap();
+    assert_eq!(read_voxels(&p).unwrap().bits, empty);
+
+    // An archive built as numpy.savez_compressed would: deflated members,
+    // big-endian int16 indices, no dims (the grid is the smallest holding them).
+    let npy = |descr: &str, shape: &str, data: &[u8]| {
+        let mut h = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+        while (10 + h.len() + 1) % 64 != 0 {
+            h.push(' ');
+        }
+        h.push('\n');
+        let mut v = b"\x93NUMPY\x01\x00".to_vec();
+        v.extend_from_slice(&(h.len() as u16).to_le_bytes());
+        v.extend_from_slice(h.as_bytes());
+        v.extend_from_slice(data);
+        v
+    };
+    let archive = |members: &[(&str, Vec<u8>)]| {
+        let mut z = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+        let o = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+        for (name, data) in members {
+            z.start_file(*name, o).unwrap();
+            z.write_all(data).unwrap();
+        }
+        z.finish().unwrap().into_inner()
+    };
+    let be16: Vec<u8> = [0i16, 0, 0, 4, 1, 2].iter().flat_map(|c| c.to_be_bytes()).collect();
+    let a = archive(&[("indices.npy", npy(">i2", "(2, 3)", &be16))]);
+    let got = voxkit_io::read_voxels_bytes(&a, VoxelFormat::Npz).unwrap();
+    assert_eq!(got.bits.dims(), [5, 2, 3]);
+    assert!(got.bits.get(0, 0, 0) && got.bits.get(4, 1, 2));
+    assert_eq!(got.placement, None);
+
+    // Hostile or wrong archives: one line each, no panic, no huge allocation.
+    let le32 = |v: &[i32]| v.iter().flat_map(|c| c.to_le_bytes()).collect::<Vec<u8>>();
+    let dims_member = ("dims.npy", npy("<i8", "(3,)", &[5i64, 5, 5].iter().flat_map(|c| c.to_le_bytes()).collect::<Vec<u8>>()));
+    let cases: Vec<(Vec<u8>, &str)> = vec![
+        (b"PK\x03\x04 not really".to_vec(), "not a ZIP archive"),
+        (archive(&[("other.npy", npy("<i4", "(1, 3)", &le32(&[0, 0, 0])))]), "no 'indices' array"),
+        (archive(&[("indices.npy", npy("<f8", "(1, 3)", &[0u8; 24]))]), "expected integers"),
+        (archive(&[("indices.npy", npy("<i4", "(1, 2)", &le32(&[0, 0])))]), "expected (k, 3)"),
+        (archive(&[("indices.npy", npy("<i4", "(1000000000, 3)", &le32(&[0, 0, 0])))]), "claims 1000000000 rows"),
+        (archive(&[("indices.npy", npy("<i4", "(1, 3)", &le32(&[0, -1, 0])))]), "is not a voxel"),
+        (archive(&[dims_member.clone(), ("indices.npy", npy("<i4", "(1, 3)", &le32(&[0, 5, 0])))]), "outside the [5, 5, 5] grid"),
+        (archive(&[("dims.npy", npy("<i8", "(3,)", &[0u8; 24])), ("indices.npy", npy("<i4", "(0, 3)", &[]))]), "out of range"),
+        (archive(&[("indices.npy", b"\x93NUMPY\x01\x00\xff\xff{".to_vec())]), "header cut short"),
+    ];
+    for (bytes, want) in cases {
+        let err = voxkit_io::read_voxels_bytes(&bytes, VoxelFormat::Npz).unwrap_err().to_string();
+        assert!(err.contains(want), "expected {want:?} in {err:?}");
+        assert!(!err.contains('\n'), "{err}");
+    }
+}

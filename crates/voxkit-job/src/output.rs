@@ -81,9 +81,9 @@ pub fn output_format(format: Option<&str>, output: &Path) -> Result<Output> {
 
 /// True for the formats written from the set voxels alone (no dense
 /// buffer of the grid): `.vdb`, `.zarr` (only chunks holding voxels),
-/// `.txt`, `.ply`.
+/// `.npz` (the voxels' indices), `.txt`, `.ply`.
 pub fn is_sparse(target: Output) -> bool {
-    matches!(target, Output::Voxels(VoxelFormat::Vdb | VoxelFormat::Zarr | VoxelFormat::Text | VoxelFormat::Ply))
+    matches!(target, Output::Voxels(VoxelFormat::Vdb | VoxelFormat::Zarr | VoxelFormat::Npz | VoxelFormat::Text | VoxelFormat::Ply))
 }
 
 /// Refuses a dense format for a grid that cannot be dense in the memory
@@ -95,7 +95,7 @@ pub fn check_fits(target: Output, grid: &GridSpec, max_memory: Option<u64>) -> R
     }
     let [x, y, z] = grid.dims();
     Err(JobError::invalid(format!(
-        "grid {x}x{y}x{z} cannot be held densely ({} at 1 bit per voxel, more than the {} this run may use) and .{} is a dense format; write .vdb (OpenVDB), .zarr (Zarr v3), .txt or .ply, which hold only the set voxels",
+        "grid {x}x{y}x{z} cannot be held densely ({} at 1 bit per voxel, more than the {} this run may use) and .{} is a dense format; write .vdb (OpenVDB), .zarr (Zarr v3), .npz (NumPy indices), .txt or .ply, which hold only the set voxels",
         crate::memory::bytes(grid.dense_bytes()),
         crate::memory::bytes(budget),
         target.name()
