@@ -109,12 +109,7 @@ pub fn carry(
     let ctx = Ctx { mesh, app: appearance, grid, keys: &keys, rule: opts.rule, colour: appearance.has_colour(), normals: opts.normals };
 
     let n = keys.len();
-    let materials = appearance.has_materials();
-    let mut has = vec![false; n];
-    let mut colour = vec![DEFAULT_COLOUR; if ctx.colour { n } else { 0 }];
-    let mut material = vec![NO_MATERIAL; if materials { n } else { 0 }];
-    let mut normal = vec![[0f32; 3]; if opts.normals { n } else { 0 }];
-    let mut coverage = vec![0f32; n];
+    let mut arrays = Arrays::new(n, ctx.colour, appearance.has_materials(), opts.normals);
     if n > 0 {
         let slabs = Slab::cut(&keys, dims);
         // Snap every triangle once, in order; each lattice triangle remembers its source.
@@ -142,8 +137,7 @@ pub fn carry(
             }
         }
         let mut parts = Vec::with_capacity(slabs.len());
-        let mut rest =
-            Outputs { has: &mut has, colour: &mut colour, material: &mut material, normal: &mut normal, coverage: &mut coverage };
+        let mut rest = arrays.outputs();
         for slab in &slabs {
             let (part, tail) = rest.split(slab.s1 - slab.s0);
             parts.push(part);
@@ -154,15 +148,46 @@ pub fn carry(
             ctx.reduce(scratch, &mut out);
         });
     }
-    let with_colour = ctx.colour;
-    fill_from_nearest(&keys, dims, &mut has, &mut colour, &mut material, &mut normal);
-    VoxelAttributes {
-        dims,
-        keys,
-        colour: with_colour.then_some(colour),
-        material: materials.then_some(material),
-        normal: opts.normals.then_some(normal),
-        coverage: Some(coverage),
+    arrays.finish(keys, dims)
+}
+
+/// The attribute arrays being filled, one entry per set voxel (those not
+/// asked for empty).
+struct Arrays {
+    has: Vec<bool>,
+    colour: Option<Vec<[u8; 3]>>,
+    material: Option<Vec<u32>>,
+    normal: Option<Vec<[f32; 3]>>,
+    coverage: Vec<f32>,
+}
+
+impl Arrays {
+    fn new(n: usize, colour: bool, materials: bool, normals: bool) -> Arrays {
+        Arrays {
+            has: vec![false; n],
+            colour: colour.then(|| vec![DEFAULT_COLOUR; n]),
+            material: materials.then(|| vec![NO_MATERIAL; n]),
+            normal: normals.then(|| vec![[0f32; 3]; n]),
+            coverage: vec![0f32; n],
+        }
+    }
+
+    fn outputs(&mut self) -> Outputs<'_> {
+        Outputs {
+            has: &mut self.has,
+            colour: self.colour.as_deref_mut().unwrap_or_default(),
+            material: self.material.as_deref_mut().unwrap_or_default(),
+            normal: self.normal.as_deref_mut().unwrap_or_default(),
+            coverage: &mut self.coverage,
+        }
+    }
+
+    /// Fills voxels without surface from the nearest that has some, and
+    /// hands the arrays over with their `keys`.
+    fn finish(mut self, keys: Vec<u64>, dims: [u32; 3]) -> VoxelAttributes {
+        let out = self.outputs();
+        fill_from_nearest(&keys, dims, out.has, out.colour, out.material, out.normal);
+        VoxelAttributes { dims, keys, colour: self.colour, material: self.material, normal: self.normal, coverage: Some(self.coverage) }
     }
 }
 
@@ -568,13 +593,7 @@ pub mod reference {
         let mut keys = Vec::new();
         voxels.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
         let ctx = Ctx { mesh, app: appearance, grid, keys: &keys, rule: opts.rule, colour: appearance.has_colour(), normals: opts.normals };
-        let n = keys.len();
-        let materials = appearance.has_materials();
-        let mut has = vec![false; n];
-        let mut colour = vec![DEFAULT_COLOUR; if ctx.colour { n } else { 0 }];
-        let mut material = vec![NO_MATERIAL; if materials { n } else { 0 }];
-        let mut normal = vec![[0f32; 3]; if opts.normals { n } else { 0 }];
-        let mut coverage = vec![0f32; n];
+        let mut arrays = Arrays::new(keys.len(), ctx.colour, appearance.has_materials(), opts.normals);
         let mut scratch = Scratch::default();
         for t in 0..mesh.triangles.len() {
             let mut lattice = Vec::new();
@@ -598,18 +617,8 @@ pub mod reference {
                 scratch.contribs.push(c);
             }
         }
-        let mut out = Outputs { has: &mut has, colour: &mut colour, material: &mut material, normal: &mut normal, coverage: &mut coverage };
-        ctx.reduce(&mut scratch, &mut out);
-        let with_colour = ctx.colour;
-        fill_from_nearest(&keys, dims, &mut has, &mut colour, &mut material, &mut normal);
-        VoxelAttributes {
-            dims,
-            keys,
-            colour: with_colour.then_some(colour),
-            material: materials.then_some(material),
-            normal: opts.normals.then_some(normal),
-            coverage: Some(coverage),
-        }
+        ctx.reduce(&mut scratch, &mut arrays.outputs());
+        arrays.finish(keys, dims)
     }
 }
 
