@@ -172,7 +172,7 @@ fn read_numbers(r: &mut impl Read, descr: &str, n: usize, name: &str) -> Result<
     Ok(out)
 }
 
-/// Reads an `.npz` of sparse coordinates (as [`write`] makes, or any
+/// Reads an `.npz` of sparse coordinates (as [`write()`] makes, or any
 /// `numpy.savez` with an `indices` array of shape `(k, 3)`, integer
 /// dtype); `dims` is read when present, else the smallest grid holding
 /// every voxel; `origin` and `voxel_size`, when present, place the grid.
@@ -180,7 +180,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     read_from(std::io::Cursor::new(bytes), bytes.len() as u64)
 }
 
-/// [`read`] from a seekable reader of `total` bytes (a file: the index
+/// [`read()`] from a seekable reader of `total` bytes (a file: the index
 /// array is streamed into the grid, never held whole).
 pub fn read_from<R: Read + Seek>(r: R, total: u64) -> Result<LoadedVoxels, ErrorKind> {
     let mut zip = zip::ZipArchive::new(r).map_err(|e| ErrorKind::malformed(FORMAT, format!("not a ZIP archive ({e})")))?;

@@ -89,7 +89,7 @@ impl Contribution {
 /// Colour is present when `appearance` has colour, material ids when it has
 /// materials, normals when asked; coverage always.
 ///
-/// The work is cut into z-slabs of about [`SLAB_VOXELS`] set voxels (a
+/// The work is cut into z-slabs of whole layers, about 2 k set voxels each (a
 /// contiguous range of keys each). Triangles are snapped once and binned by
 /// the slabs their voxel box meets; each slab runs `cover` on its triangles
 /// clipped to the slab, in triangle order, and reduces its own
