@@ -128,7 +128,8 @@ impl Kernel<LatticeTriangle> for BubbleKernel {
 }
 
 /// The definition over `cover`'s voxels: each random target first past the
-/// box filter, then the exact segment test of [`TriSetup`] (the same
+/// plane test (its ends on both sides of the displaced plane) and the box
+/// filter, then the exact segment test of [`TriSetup`] (the same
 /// decision as [`segment_meets_triangle`], without its generic 128-bit
 /// determinants).
 #[allow(clippy::too_many_arguments)]
@@ -148,7 +149,12 @@ fn filtered<T: PlaneInt>(
         targets(seed, std::array::from_fn(|a| ijk[a] + offset[a])).iter().any(|seg| {
             let a: P3 = std::array::from_fn(|c| seg[0][c] - shift[c]);
             let d = std::array::from_fn(|c| seg[1][c] - seg[0][c]);
-            segment_may_meet_box(a, d, blo, bhi) && s.segment_hits(&s.dir(tri, d), s.local(a))
+            // Cheapest first: a segment whose ends lie on one side of the
+            // displaced plane misses; most targets are decided here.
+            let pa = s.local(a);
+            let va = s.plane(pa);
+            let vb = s.plane(std::array::from_fn(|c| pa[c] + T::from_i64(d[c])));
+            (va >= s.bn) != (vb >= s.bn) && segment_may_meet_box(a, d, blo, bhi) && s.segment_hits_with(&s.dir(tri, d), pa, va)
         })
     };
     cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });

@@ -358,9 +358,13 @@ pub(crate) fn segment_may_meet_box_inv(a: P3, d: P3, inv: [f64; 3], lo: P3, hi: 
 }
 
 /// One triangle against a fixed set of target segments (start offset from
-/// the voxel's low corner, direction), each direction's exact setup made
-/// on its first use after [`segment_may_meet_box`] lets a segment through:
-/// a small triangle is decided by a few comparisons for most targets.
+/// the voxel's low corner, direction). A target is decided by the cheapest
+/// test first: whether its end points straddle the (displaced) plane, from
+/// the voxel corner's plane value computed once per voxel (and each
+/// target's offset and direction plane values once per triangle); then, for small
+/// triangles, [`segment_may_meet_box`]; then the edge orientations, each
+/// direction's exact setup made on its first use. A small triangle is
+/// decided by a few comparisons for most targets.
 pub(crate) struct LazyTargets<'t, T, const N: usize> {
     tri: &'t LatticeTriangle,
     s: TriSetup<T>,
@@ -371,6 +375,8 @@ pub(crate) struct LazyTargets<'t, T, const N: usize> {
     filter: bool,
     inv: [[f64; 3]; N],
     targets: &'t [(P3, P3)],
+    /// Per target: the plane value of its start offset and of its direction.
+    planes: [(T, T); N],
     setups: [Option<DirSetup<T>>; N],
 }
 
@@ -395,27 +401,50 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
                 *slot = Some(s.dir(tri, *d));
             }
         }
-        LazyTargets { tri, s, lo, hi, filter, inv, targets, setups }
+        let mut planes = [(T::ZERO, T::ZERO); N];
+        for (pl, (o, d)) in planes.iter_mut().zip(targets) {
+            *pl = (dot(s.n, o.map(T::from_i64)), dot(s.n, d.map(T::from_i64)));
+        }
+        LazyTargets { tri, s, lo, hi, filter, inv, targets, planes, setups }
     }
 
     /// Does the displaced target `n` of voxel `ijk` meet the triangle?
     /// The same decision as [`segment_meets_triangle`].
     #[inline]
     pub fn hits(&mut self, n: usize, ijk: [i64; 3]) -> bool {
+        let c = corner(ijk);
+        let pc = self.s.local(c);
+        let vc = self.s.plane(pc);
+        self.hits_from(n, c, pc, vc)
+    }
+
+    /// [`Self::hits`] given the voxel's low corner `c`, it relative to the
+    /// triangle (`pc`) and its plane value `vc`.
+    #[inline(always)]
+    fn hits_from(&mut self, n: usize, c: P3, pc: [T; 3], vc: T) -> bool {
         let (o, d) = self.targets[n];
-        let a = add(corner(ijk), o);
-        if self.filter && !segment_may_meet_box_inv(a, d, self.inv[n], self.lo, self.hi) {
+        let s = &self.s;
+        let (no, nd) = self.planes[n];
+        let vp = vc + no;
+        if (vp >= s.bn) == (vp + nd >= s.bn) {
             return false;
         }
-        let (s, tri) = (&self.s, self.tri);
+        if self.filter && !segment_may_meet_box_inv(add(c, o), d, self.inv[n], self.lo, self.hi) {
+            return false;
+        }
+        let tri = self.tri;
         let ds = self.setups[n].get_or_insert_with(|| s.dir(tri, d));
-        s.segment_hits(ds, s.local(a))
+        let p = std::array::from_fn(|a| pc[a] + T::from_i64(o[a]));
+        s.segment_hits_with(ds, p, vp)
     }
 
     /// Does any of the voxel's targets meet the triangle?
     #[inline]
     pub fn any(&mut self, ijk: [i64; 3]) -> bool {
-        (0..self.targets.len()).any(|n| self.hits(n, ijk))
+        let c = corner(ijk);
+        let pc = self.s.local(c);
+        let vc = self.s.plane(pc);
+        (0..self.targets.len()).any(|n| self.hits_from(n, c, pc, vc))
     }
 }
 
@@ -516,6 +545,31 @@ mod tests {
                             let want = segment_meets_triangle([p, add(p, *d)], t.v, true);
                             assert_eq!(s64.segment_hits(&d64, s64.local(p)), want, "{t:?} {p:?} {d:?}");
                             assert_eq!(s128.segment_hits(&d128, s128.local(p)), want);
+                        }
+                    }
+                }
+            }
+            // The lazy tests (plane first, box filter, setups on first use),
+            // one target at a time and any of a voxel's, in either order.
+            for targets in [&DIAGONALS[..], &CROSSHAIR[..]] {
+                let mut lazy = LazyTargets::<i64, 4>::new(t, targets);
+                let mut wide = LazyTargets::<i128, 4>::new(t, targets);
+                for k in (-1..3).rev() {
+                    for j in -1..3 {
+                        for i in -1..3 {
+                            let ijk = [i, j, k];
+                            let want: Vec<bool> = targets
+                                .iter()
+                                .map(|(o, d)| {
+                                    let p = add(corner(ijk), *o);
+                                    segment_meets_triangle([p, add(p, *d)], t.v, true)
+                                })
+                                .collect();
+                            assert_eq!(lazy.any(ijk), want.contains(&true), "{t:?} {ijk:?}");
+                            for (n, w) in want.iter().enumerate().rev() {
+                                assert_eq!(lazy.hits(n, ijk), *w, "{t:?} {ijk:?} target {n}");
+                                assert_eq!(wide.hits(n, ijk), *w);
+                            }
                         }
                     }
                 }
