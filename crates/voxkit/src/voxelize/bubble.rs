@@ -27,9 +27,12 @@
 //! subset of `cover` (every target lies in the closed voxel). Ties follow
 //! [`crate::geom::perturb`].
 //!
-//! **Fast path.** `cover`'s exact traversal enumerates candidates; each
-//! gets its seven segment tests (the generic `i128` predicate: the targets'
-//! directions differ per voxel).
+//! **Fast path.** `cover`'s exact traversal enumerates candidates not yet
+//! set; each gets its seven segment tests, cheapest first: the ends'
+//! sides of the displaced plane, a box filter, then the three edge
+//! orientations as exact triple products (`i64` relative to the triangle;
+//! the targets' directions differ per voxel, so nothing is set up per
+//! direction).
 //!
 //! **Reference:** [`reference::bubble`], the same targets for every voxel
 //! of each triangle's bounding box.
@@ -129,9 +132,9 @@ impl Kernel<LatticeTriangle> for BubbleKernel {
 
 /// The definition over `cover`'s voxels: each random target first past the
 /// plane test (its ends on both sides of the displaced plane) and the box
-/// filter, then the exact segment test of [`TriSetup`] (the same
-/// decision as [`segment_meets_triangle`], without its generic 128-bit
-/// determinants).
+/// filter, then the exact segment test [`TriSetup::segment_hits_once`]
+/// (the same decision as [`segment_meets_triangle`], without its generic
+/// 128-bit determinants or a per-direction setup).
 #[allow(clippy::too_many_arguments)]
 fn filtered<T: PlaneInt>(
     tri: &LatticeTriangle,
@@ -146,16 +149,29 @@ fn filtered<T: PlaneInt>(
     let s = TriSetup::<T>::new(tri);
     let shift: [i64; 3] = offset.map(|o| o * ONE);
     let keep = |ijk: [i64; 3]| {
-        targets(seed, std::array::from_fn(|a| ijk[a] + offset[a])).iter().any(|seg| {
-            let a: P3 = std::array::from_fn(|c| seg[0][c] - shift[c]);
-            let d = std::array::from_fn(|c| seg[1][c] - seg[0][c]);
-            // Cheapest first: a segment whose ends lie on one side of the
-            // displaced plane misses; most targets are decided here.
-            let pa = s.local(a);
-            let va = s.plane(pa);
-            let vb = s.plane(std::array::from_fn(|c| pa[c] + T::from_i64(d[c])));
-            (va >= s.bn) != (vb >= s.bn) && segment_may_meet_box(a, d, blo, bhi) && s.segment_hits_with(&s.dir(tri, d), pa, va)
-        })
+        let ts = targets(seed, std::array::from_fn(|a| ijk[a] + offset[a]));
+        // Cheapest first: a segment whose ends lie on one side of the
+        // displaced plane misses; most targets are decided here. The
+        // voxel's random point starts six of them and ends the seventh.
+        let local = |p: P3| -> (P3, [T; 3]) {
+            let a: P3 = std::array::from_fn(|c| p[c] - shift[c]);
+            (a, s.local(a))
+        };
+        let (m, pm) = local(ts[0][0]);
+        let vm = s.plane(pm);
+        let inside = vm >= s.bn;
+        let crosses = |(a, pa): (P3, [T; 3]), va: T, b: P3| {
+            let d = std::array::from_fn(|c| b[c] - a[c]);
+            segment_may_meet_box(a, d, blo, bhi) && s.segment_hits_once(tri, pa, d, va)
+        };
+        ts[..6].iter().any(|seg| {
+            let (f, pf) = local(seg[1]);
+            (s.plane(pf) >= s.bn) != inside && crosses((m, pm), vm, f)
+        }) || {
+            let (c, pc) = local(ts[6][0]);
+            let vc = s.plane(pc);
+            (vc >= s.bn) != inside && crosses((c, pc), vc, m)
+        }
     };
     cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
 }

@@ -239,6 +239,32 @@ impl<T: PlaneInt> TriSetup<T> {
         o0 == o(1) && o0 == o(2)
     }
 
+    /// [`Self::segment_hits_with`] for a segment tested once (its direction
+    /// `d` differs from every other's, as `bubble`'s random targets do),
+    /// without [`Self::dir`]'s setup: each edge's orientation is one scalar
+    /// triple product `d·((A − p) × (B − p))` (equal to `c_e − p·m_e`), and
+    /// its tie bias is derived only when that is 0.
+    #[inline(always)]
+    pub fn segment_hits_once(&self, t: &LatticeTriangle, p: [T; 3], d: P3, vp: T) -> bool {
+        let dt = d.map(T::from_i64);
+        if (vp >= self.bn) == (vp + dot(self.n, dt) >= self.bn) {
+            return false;
+        }
+        let side = |i: usize| {
+            let (a, b) = (self.rel[i], self.rel[(i + 1) % 3]);
+            let o = dot(dt, crs(std::array::from_fn(|c| a[c] - p[c]), std::array::from_fn(|c| b[c] - p[c])));
+            if o != T::ZERO {
+                o > T::ZERO
+            } else {
+                // `o >= be` with the tie bias `be` (0 or 1) of −(e × d).
+                let m = crate::geom::lattice::cross(t.edge(i), d);
+                bias([-m[0], -m[1], -m[2]]) == 0
+            }
+        };
+        let s0 = side(0);
+        s0 == side(1) && s0 == side(2)
+    }
+
     /// For a `w`-line that meets the triangle, with plane value
     /// `v0 = n_u·p_u + n_v·p_v` (relative to `a`) along it: the voxel index
     /// `t` whose displaced `w` crosshair segment `[t·ONE, (t+1)·ONE]`
@@ -517,6 +543,9 @@ mod tests {
                 let targets = [(a, d)];
                 let mut lazy = LazyTargets::<i64, 1>::new(&t, &targets);
                 proptest::prop_assert_eq!(lazy.hits(0, [0, 0, 0]), segment_meets_triangle(seg, t.v, true));
+                let s = TriSetup::<i64>::new(&t);
+                let p = s.local(a);
+                proptest::prop_assert_eq!(s.segment_hits_once(&t, p, d, s.plane(p)), segment_meets_triangle(seg, t.v, true));
             }
         }
     }
@@ -545,6 +574,8 @@ mod tests {
                             let want = segment_meets_triangle([p, add(p, *d)], t.v, true);
                             assert_eq!(s64.segment_hits(&d64, s64.local(p)), want, "{t:?} {p:?} {d:?}");
                             assert_eq!(s128.segment_hits(&d128, s128.local(p)), want);
+                            let lp = s64.local(p);
+                            assert_eq!(s64.segment_hits_once(t, lp, *d, s64.plane(lp)), want);
                         }
                     }
                 }
