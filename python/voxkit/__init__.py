@@ -168,7 +168,7 @@ def voxelize(
             ``msaa-approx``.
         seed: ``bubble``: the seed of the random target points (same seed,
             same voxels).
-        tile: run the surface mode tile by tile with tiles of this many
+        tile: run the surface or line mode tile by tile with tiles of this many
             voxels (a multiple of 8); same voxels. By default only grids
             that do not fit in ``max_memory`` run tiled.
         max_memory: memory the run may use, bytes or a string such as

@@ -142,11 +142,11 @@ pub struct GridArgs {
 #[derive(Args, Debug, Default)]
 pub struct MemoryArgs {
     /// Memory the run may use, e.g. 8G or 512M (default: nine tenths of
-    /// what is available). Surface modes on grids that do not fit densely
+    /// what is available). Surface and line modes on grids that do not fit densely
     /// run tile by tile into sparse storage; write those to .vdb, .txt or .ply.
     #[arg(long, value_name = "SIZE")]
     pub max_memory: Option<String>,
-    /// Run the surface mode tile by tile with tiles of N voxels (a multiple
+    /// Run the surface or line mode tile by tile with tiles of N voxels (a multiple
     /// of 8; default: only when the grid does not fit in --max-memory, with
     /// tiles of 512). Same voxels either way.
     #[arg(long, value_name = "N")]

@@ -582,6 +582,24 @@ fn sparse_solids_write_the_same_files() {
     }
 }
 
+/// Line modes run tile by tile too (`--tile`, or on their own past the
+/// memory budget) and write the dense run's file.
+#[test]
+fn line_modes_run_tiled() {
+    let helix = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/meshes/helix.lines");
+    let helix = helix.to_str().unwrap();
+    for mode in ["line26", "line6"] {
+        let (a, b) = (tmp(&format!("dense-{mode}.npy")), tmp(&format!("tiled-{mode}.npy")));
+        let common = ["--resolution", "100", "--mode", mode, "--json"];
+        let d = json(&voxkit(&[&["voxelize", helix, "-o", &a][..], &common[..]].concat()));
+        let t = json(&voxkit(&[&["voxelize", helix, "-o", &b, "--tile", "16"][..], &common[..]].concat()));
+        assert_eq!(t["tile"], 16);
+        assert!(d["voxels"].as_u64().unwrap() > 100);
+        assert_eq!(t["voxels"], d["voxels"]);
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{mode}: tiled .npy differs");
+    }
+}
+
 #[test]
 fn grids_past_memory_errors() {
     let cow = shared("cow.obj");
@@ -591,7 +609,6 @@ fn grids_past_memory_errors() {
         (vec!["--tile", "64", "--mode", "solid", "--fill", "flood"], "flood fills"),
         (vec!["--tile", "64", "--mode", "solid", "--hollow", "6"], "hollow"),
         (vec!["--tile", "64", "--method", "reference"], "fast path"),
-        (vec!["--tile", "64", "--mode", "line26"], "line26"),
         (vec!["--max-memory", "lots"], "unknown unit"),
         (vec!["--max-memory", "1.2.3G"], "not a size"),
         (vec!["--resolution", "16384", "--max-memory", "1G", "--mode", "solid", "--fill", "flood"], "flood fills"),

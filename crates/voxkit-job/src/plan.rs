@@ -333,7 +333,7 @@ pub struct Request {
     pub gpu_path: GpuPath,
     /// `bubble`: the seed of its random points.
     pub seed: u64,
-    /// Run the surface mode tile by tile with tiles of this many voxels (a
+    /// Run the surface or line mode tile by tile with tiles of this many voxels (a
     /// multiple of 8); `None`: only when the grid does not fit densely.
     pub tile: Option<u32>,
     /// Memory the run may use (bytes); `None`: nine tenths of what is available.

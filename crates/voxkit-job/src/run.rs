@@ -111,8 +111,6 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
     if tile.is_none() {
         let why = if plan.solid.is_some() {
             "flood fills, hollow solids, the reference and gpu solids (not tiled yet; parity and winding on closed meshes are)"
-        } else if is_line {
-            "line modes (not tiled yet)"
         } else {
             "--method reference, scanline and gpu (only the fast path is tiled)"
         };
@@ -189,7 +187,8 @@ fn tile_for(plan: &Plan, grid: &GridSpec, budget: u64) -> Option<u32> {
     }
     let fast = matches!(plan.request.method, crate::plan::Method::Auto | crate::plan::Method::Fast);
     let sparse_solid = plan.solid.as_ref().is_some_and(crate::solid::has_sparse_path);
-    if plan.is_line() || !(fast || sparse_solid) || (plan.solid.is_some() && !sparse_solid) {
+    let tileable = if plan.solid.is_some() { sparse_solid } else { fast };
+    if !tileable {
         return None;
     }
     if sparse_solid {

@@ -1,6 +1,7 @@
 //! The tiled driver gives the dense fast path's voxels: every shared mesh at
-//! 256–1024 with tiles of 64, every mode on rotated meshes, and a cropped
-//! window of a large grid equals the same window run alone.
+//! 256–1024 with tiles of 64, every mode on rotated meshes, line modes on a
+//! polyline and a mesh, and a cropped window of a large grid equals the
+//! same window run alone.
 //! (`agree_mode` also runs tiles of 8, 24 and 64 against every reference.)
 
 use glam::DVec3;
@@ -86,13 +87,38 @@ fn a_window_of_a_large_grid_equals_the_window_run_alone() {
 }
 
 #[test]
-fn line_modes_and_bad_tiles_are_refused() {
+fn bad_tiles_are_refused() {
     let mesh = shared_mesh("suzanne.obj");
     let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), 64).unwrap();
-    let e = tiled(Mode::Line26, mesh.as_ref(), &grid, 64, &Options::default()).unwrap_err();
-    assert!(e.to_string().contains("line26"), "{e}");
     let e = tiled(Mode::Cover, mesh.as_ref(), &grid, 12, &Options::default()).unwrap_err();
     assert!(e.to_string().contains("multiple of 8"), "{e}");
+}
+
+/// Line modes tile too: a polyline crossing tile corners, edges and faces
+/// (a helix and straight runs along the tiles' planes) and a triangle mesh
+/// taken as 1D input, against the dense fast path with tiles of 8 to 64.
+#[test]
+fn line_modes_tiled_equal_dense() {
+    let mut pts: Vec<DVec3> = (0..400)
+        .map(|n| {
+            let t = n as f64 * 0.05;
+            DVec3::new(40.0 + 30.0 * t.cos(), 40.0 + 30.0 * t.sin(), 2.0 + 3.5 * t)
+        })
+        .collect();
+    // Along a tile corner's lines and planes (tiles of 8 and 16 meet at 16).
+    pts.extend([DVec3::new(16.0, 16.0, 1.0), DVec3::new(16.0, 16.0, 60.0), DVec3::new(70.0, 16.0, 60.0), DVec3::new(3.0, 64.0, 8.0)]);
+    let polyline =
+        voxkit::Mesh { segments: (0..pts.len() as u32 - 1).map(|i| [i, i + 1]).collect(), positions: pts, triangles: Vec::new() };
+    let grid = GridSpec::new(DVec3::ZERO, 1.0, [80, 80, 76]).unwrap();
+    let suzanne = shared_mesh("suzanne.obj");
+    let sgrid = GridSpec::from_resolution(&suzanne.as_ref().bounds(), 100).unwrap();
+    for mode in [Mode::Line26, Mode::Line6] {
+        assert!(voxelize::fast(mode, polyline.as_ref(), &grid, &Options::default()).1.voxels > 400, "the polyline crosses the grid");
+        for tile in [8, 16, 24, 64] {
+            same(mode, &polyline, &grid, tile, "helix polyline");
+            same(mode, &suzanne, &sgrid, tile, "suzanne as 1D input at 100");
+        }
+    }
 }
 
 /// The sparse solid (brick rows into sparse bricks and full runs) equals

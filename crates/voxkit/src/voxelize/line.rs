@@ -82,6 +82,12 @@ pub fn line(mesh: MeshRef<'_>, grid: &GridSpec, target: LineTarget, opts: &Optio
     (bits, Report { prepare: prepare_stats, voxels })
 }
 
+/// The fast path on already prepared elements of a grid of `dims` (the
+/// tiled driver hands it each tile's elements, translated).
+pub fn line_lattice(elems: &[Element], dims: [u32; 3], target: LineTarget, opts: &Options<'_>) -> BrickBits {
+    run_slabs(&LineKernel { target, traversal: opts.traversal }, elems, dims, opts).0
+}
+
 struct LineKernel {
     target: LineTarget,
     traversal: Traversal,

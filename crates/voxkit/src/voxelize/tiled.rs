@@ -1,5 +1,6 @@
-//! The tiled driver: surface modes on grids too large for a whole-grid
-//! brick index, in memory that follows the surface instead of the grid.
+//! The tiled driver: surface and line modes on grids too large for a
+//! whole-grid brick index, in memory that follows the surface instead of
+//! the grid.
 //!
 //! **Algorithm.** The mesh is snapped once to the whole grid's lattice
 //! (exactly as every other path does). The grid is cut into cubic tiles of
@@ -9,7 +10,9 @@
 //! each one's triangles are translated by the tile's origin — a whole
 //! number of voxels, so an exact integer shift of the lattice — and run
 //! through the mode's own fast kernel on a grid of the tile's size
-//! ([`fast_lattice`]); the kernels only set voxels of the box they are
+//! ([`fast_lattice`]; for the line modes, their segments and triangles
+//! through [`super::line::line_lattice`]); the kernels only set voxels of
+//! the box they are
 //! given, so a triangle spanning tiles contributes to each exactly its
 //! voxels there. The tile's bricks move into a [`SparseBricks`] and the
 //! tile's storage is freed.
@@ -23,13 +26,16 @@
 //! the tile's offset). Tested against the dense fast path with tiles of
 //! 8–64 on the shared meshes, rotated and random triangles.
 //!
-//! **Memory.** The lattice triangles (72 bytes each), one bin entry per
+//! **Memory.** The lattice triangles (72 bytes each; line modes' elements
+//! 80), one bin entry per
 //! (triangle, tile) pair (16 bytes), one tile's brick index (`4 bytes ×
 //! (tile/8)³`, 256 KiB at 512) and the result's non-empty bricks (72
 //! bytes each). Nothing is proportional to the grid's volume.
 
 use rayon::prelude::*;
 
+use super::driver::Primitive;
+use super::line::{line_lattice, prepare_elements, LineTarget};
 use super::{Mode, Options, Report};
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::{prepare, LatticeTriangle};
@@ -63,8 +69,6 @@ pub fn fast_lattice(mode: Mode, tris: &[LatticeTriangle], dims: [u32; 3], offset
 /// Why a tiled run cannot start.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum TiledError {
-    /// The mode has no tiled path.
-    Mode(&'static str),
     /// The tile edge is not a positive multiple of 8.
     Tile(u32),
     /// An axis exceeds [`SparseBricks::MAX_DIM`].
@@ -74,7 +78,6 @@ pub enum TiledError {
 impl std::fmt::Display for TiledError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            TiledError::Mode(m) => write!(f, "mode {m} has no tiled path yet (line modes run on dense grids only)"),
             TiledError::Tile(t) => write!(f, "tile size {t} is not a positive multiple of 8"),
             TiledError::Grid(d) => write!(f, "grid {}x{}x{} exceeds {} voxels per axis", d[0], d[1], d[2], SparseBricks::MAX_DIM),
         }
@@ -86,9 +89,6 @@ impl std::error::Error for TiledError {}
 /// Runs `mode` tile by tile on `grid` (tiles of `tile` voxels). Returns the
 /// voxels as sorted sparse bricks and the usual report.
 pub fn tiled(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, tile: u32, opts: &Options<'_>) -> Result<(SparseBricks, Report), TiledError> {
-    if matches!(mode, Mode::Line26 | Mode::Line6) {
-        return Err(TiledError::Mode(mode.name()));
-    }
     if tile == 0 || tile % BRICK != 0 {
         return Err(TiledError::Tile(tile));
     }
@@ -96,11 +96,46 @@ pub fn tiled(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, tile: u32, opts: &O
     if dims.iter().any(|&d| d > SparseBricks::MAX_DIM) {
         return Err(TiledError::Grid(dims));
     }
-    let (tris, prepare_stats) = prepare(mesh, grid);
+    let line = match mode {
+        Mode::Line26 => Some(LineTarget::Squares26),
+        Mode::Line6 => Some(LineTarget::Surface6),
+        _ => None,
+    };
+    Ok(match line {
+        Some(target) => {
+            let (elems, prepare) = prepare_elements(mesh, grid);
+            let run = |e: &[super::targets::Element], size: [u32; 3], _: [i64; 3], o: &Options<'_>| line_lattice(e, size, target, o);
+            let (out, voxels) = by_tiles(&elems, dims, tile, opts, |e, shift| e.translated(shift), run);
+            (out, Report { prepare, voxels })
+        }
+        None => {
+            let (tris, prepare) = prepare(mesh, grid);
+            let shift = |t: &LatticeTriangle, shift: [i64; 3]| LatticeTriangle { v: t.v.map(|p| std::array::from_fn(|a| p[a] + shift[a])) };
+            let run = |t: &[LatticeTriangle], size: [u32; 3], origin: [i64; 3], o: &Options<'_>| {
+                fast_lattice(mode, t, size, origin, o).expect("line modes take their own path")
+            };
+            let (out, voxels) = by_tiles(&tris, dims, tile, opts, shift, run);
+            (out, Report { prepare, voxels })
+        }
+    })
+}
+
+/// The driver proper: bins `prims` into the tiles of `tile` voxels their
+/// voxel boxes meet, and per tile in order, moves its primitives by the
+/// tile's origin (`shift`) and runs them (`run`, given the tile's size and
+/// origin) on a grid of the tile's size. Returns the voxels and their count.
+fn by_tiles<P: Primitive>(
+    prims: &[P],
+    dims: [u32; 3],
+    tile: u32,
+    opts: &Options<'_>,
+    shift: impl Fn(&P, [i64; 3]) -> P + Sync,
+    run: impl Fn(&[P], [u32; 3], [i64; 3], &Options<'_>) -> BrickBits,
+) -> (SparseBricks, u64) {
     let tdims = dims.map(|d| d.div_ceil(tile) as u64);
     let tile_id = |t: [u64; 3]| (t[2] * tdims[1] + t[1]) * tdims[0] + t[0];
-    // (tile, triangle) pairs, sorted: each tile's triangles in input order.
-    let mut pairs: Vec<(u64, u32)> = tris
+    // (tile, primitive) pairs, sorted: each tile's primitives in input order.
+    let mut pairs: Vec<(u64, u32)> = prims
         .par_iter()
         .enumerate()
         .flat_map_iter(|(n, t)| {
@@ -118,7 +153,7 @@ pub fn tiled(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, tile: u32, opts: &O
     }
     let inner = Options { progress: None, ..*opts };
     let mut out = SparseBricks::new(dims);
-    let mut local: Vec<LatticeTriangle> = Vec::new();
+    let mut local: Vec<P> = Vec::new();
     let mut voxels = 0;
     for (s, &start) in starts.iter().enumerate() {
         let end = starts.get(s + 1).copied().unwrap_or(pairs.len());
@@ -126,13 +161,10 @@ pub fn tiled(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, tile: u32, opts: &O
         let t = [id % tdims[0], (id / tdims[0]) % tdims[1], id / (tdims[0] * tdims[1])];
         let origin: [u32; 3] = t.map(|c| (c * tile as u64) as u32);
         let size: [u32; 3] = std::array::from_fn(|a| tile.min(dims[a] - origin[a]));
-        let shift: [i64; 3] = origin.map(|o| o as i64 * ONE);
+        let back: [i64; 3] = origin.map(|o| -(o as i64) * ONE);
         local.clear();
-        local.extend(pairs[start..end].iter().map(|&(_, n)| {
-            let v = tris[n as usize].v;
-            LatticeTriangle { v: v.map(|p| std::array::from_fn(|a| p[a] - shift[a])) }
-        }));
-        let bits = fast_lattice(mode, &local, size, origin.map(|o| o as i64), &inner).expect("line modes refused above");
+        local.extend(pairs[start..end].iter().map(|&(_, n)| shift(&prims[n as usize], back)));
+        let bits = run(&local, size, origin.map(|o| o as i64), &inner);
         voxels += bits.count();
         out.push_tile(origin, &bits);
         if let Some(p) = opts.progress {
@@ -140,5 +172,5 @@ pub fn tiled(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, tile: u32, opts: &O
         }
     }
     out.finish();
-    Ok((out, Report { prepare: prepare_stats, voxels }))
+    (out, voxels)
 }
