@@ -276,6 +276,13 @@ def test_tiled_runs_give_the_same_voxels(meshes):
         b = voxkit.voxelize(m, mode=mode, resolution=150, tile=64, max_memory="2G")
         assert b.facts["method"] == "tiled" and b.facts["tile"] == 64
         assert np.array_equal(a.indices(), b.indices())
+    lines = pytest.importorskip("pathlib").Path(__file__).resolve().parents[2] / "examples" / "meshes" / "helix.lines"
+    helix = voxkit.load_mesh(lines)
+    for mode in ["line6", "line26"]:
+        a = voxkit.voxelize(helix, mode=mode, resolution=100)
+        b = voxkit.voxelize(helix, mode=mode, resolution=100, tile=16)
+        assert b.facts["method"] == "tiled" and b.facts["tile"] == 16
+        assert a.count > 100 and np.array_equal(a.indices(), b.indices()), mode
     with pytest.raises(ValueError, match="multiple of 8"):
         voxkit.voxelize(m, tile=12)
     with pytest.raises(ValueError, match="not a size|unknown unit"):
