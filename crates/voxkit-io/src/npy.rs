@@ -29,13 +29,7 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, dtype: Dtype) -> std::io
         Dtype::U8 => "|u1",
         Dtype::Bool => "|b1",
     };
-    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': ({nx}, {ny}, {nz}), }}");
-    let total = 10 + header.len() + 1;
-    header.push_str(&" ".repeat(total.div_ceil(64) * 64 - total));
-    header.push('\n');
-    w.write_all(b"\x93NUMPY\x01\x00")?;
-    w.write_all(&(header.len() as u16).to_le_bytes())?;
-    w.write_all(header.as_bytes())?;
+    w.write_all(&header(descr, &format!("({nx}, {ny}, {nz})")))?;
     let plane = ny as usize * nz as usize;
     let block = plane_block(plane);
     let mut buf = vec![0u8; plane * block as usize];
@@ -128,6 +122,25 @@ fn truncated(have: usize, need: usize) -> ErrorKind {
     ErrorKind::malformed("npy", format!("data holds {have} bytes, shape needs {need} (truncated?)"))
 }
 
+/// The version 1.0 `.npy` header of a C-ordered array of dtype `descr` and
+/// `shape` (a Python tuple), padded so the data starts on 64 bytes.
+pub(crate) fn header(descr: &str, shape: &str) -> Vec<u8> {
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+    let total = 10 + header.len() + 1;
+    header.push_str(&" ".repeat(total.div_ceil(64) * 64 - total));
+    header.push('\n');
+    let mut out = b"\x93NUMPY\x01\x00".to_vec();
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    out
+}
+
+/// The value text after `'key':` in a header's dictionary, if present.
+pub(crate) fn header_field<'h>(header: &'h str, key: &str) -> Option<&'h str> {
+    let at = header.find(&format!("'{key}'"))? + key.len() + 2;
+    header[at..].trim_start().strip_prefix(':').map(str::trim_start)
+}
+
 /// Validates the header; returns the shape and where the data starts.
 fn parse_header(bytes: &[u8]) -> Result<([u64; 3], usize), ErrorKind> {
     let bad = |d: &str| ErrorKind::malformed("npy", d);
@@ -141,11 +154,7 @@ fn parse_header(bytes: &[u8]) -> Result<([u64; 3], usize), ErrorKind> {
     };
     let header = bytes.get(hstart..hstart + hlen).ok_or_else(|| bad("truncated header"))?;
     let header = std::str::from_utf8(header).map_err(|_| bad("header is not text"))?;
-    let field = |key: &str| -> Option<&str> {
-        let at = header.find(&format!("'{key}'"))? + key.len() + 2;
-        let rest = header[at..].trim_start().strip_prefix(':')?.trim_start();
-        Some(rest)
-    };
+    let field = |key: &str| header_field(header, key);
     let descr = field("descr").and_then(|r| r.strip_prefix('\'')).and_then(|r| r.split('\'').next()).ok_or_else(|| bad("no descr"))?;
     if !matches!(descr, "|u1" | "|b1" | "|i1" | "<u1" | "<i1") {
         return Err(ErrorKind::Unsupported(format!("npy dtype {descr} (expected uint8 or bool)")));

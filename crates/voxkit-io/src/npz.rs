@@ -16,8 +16,7 @@
 //! of coordinates, never the grid or the whole list, and writes through
 //! the `zip` crate's streaming writer (sizes and checksums in data
 //! descriptors, ZIP64 past 4 GiB), so it needs no seeking and also writes
-//! to standard output. The `.npy` headers are written by hand, as in
-//! [`crate::npy`].
+//! to standard output. The `.npy` headers are [`crate::npy`]'s.
 
 use std::io::{Read, Seek, Write};
 
@@ -25,21 +24,10 @@ use glam::DVec3;
 use voxkit::{GridSpec, VoxelSource};
 
 use crate::error::ErrorKind;
+use crate::npy::{header, header_field};
 use crate::LoadedVoxels;
 
 const FORMAT: &str = "npz";
-
-/// The `.npy` header of an array of dtype `descr` and `shape` (a Python tuple).
-fn npy_header(descr: &str, shape: &str) -> Vec<u8> {
-    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
-    let total = 10 + header.len() + 1;
-    header.push_str(&" ".repeat(total.div_ceil(64) * 64 - total));
-    header.push('\n');
-    let mut out = b"\x93NUMPY\x01\x00".to_vec();
-    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
-    out.extend_from_slice(header.as_bytes());
-    out
-}
 
 /// Writes the set voxels of `bits` on `grid` as an `.npz` archive.
 pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
@@ -57,13 +45,13 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std:
     };
     let o = grid.origin();
     let dims_le: Vec<u8> = dims.iter().flat_map(|&d| (d as i64).to_le_bytes()).collect();
-    member(&mut zip, "dims.npy", npy_header("<i8", "(3,)"), &dims_le)?;
+    member(&mut zip, "dims.npy", header("<i8", "(3,)"), &dims_le)?;
     let origin_le: Vec<u8> = [o.x, o.y, o.z].iter().flat_map(|c| c.to_le_bytes()).collect();
-    member(&mut zip, "origin.npy", npy_header("<f8", "(3,)"), &origin_le)?;
-    member(&mut zip, "voxel_size.npy", npy_header("<f8", "()"), &grid.voxel_size().to_le_bytes())?;
+    member(&mut zip, "origin.npy", header("<f8", "(3,)"), &origin_le)?;
+    member(&mut zip, "voxel_size.npy", header("<f8", "()"), &grid.voxel_size().to_le_bytes())?;
 
     zip.start_file("indices.npy", large).map_err(std::io::Error::other)?;
-    zip.write_all(&npy_header("<i4", &format!("({count}, 3)")))?;
+    zip.write_all(&header("<i4", &format!("({count}, 3)")))?;
     let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
     let mut result = Ok(());
     bits.for_each_set(&mut |i, j, k| {
@@ -117,10 +105,7 @@ fn read_header(r: &mut impl Read, name: &str) -> Result<Header, ErrorKind> {
     let mut text = vec![0u8; len];
     r.read_exact(&mut text).map_err(|_| bad("header cut short".into()))?;
     let text = String::from_utf8(text).map_err(|_| bad("header is not text".into()))?;
-    let field = |key: &str| -> Option<&str> {
-        let at = text.find(&format!("'{key}'"))? + key.len() + 2;
-        Some(text[at..].trim_start().strip_prefix(':')?.trim_start())
-    };
+    let field = |key: &str| header_field(&text, key);
     let descr =
         field("descr").and_then(|v| v.strip_prefix('\'')).and_then(|v| v.split('\'').next()).ok_or_else(|| bad("no dtype".into()))?;
     if !field("fortran_order").is_some_and(|v| v.starts_with("False")) {
