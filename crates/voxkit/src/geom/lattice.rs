@@ -37,6 +37,12 @@ impl LatticeTriangle {
         cross(self.edge(0), self.edge(1))
     }
 
+    /// The triangle moved by `shift` lattice units (the tiled driver moves
+    /// triangles by whole voxels).
+    pub fn translated(&self, shift: [i64; 3]) -> LatticeTriangle {
+        LatticeTriangle { v: self.v.map(|p| add(p, shift)) }
+    }
+
     /// Zero area: the three vertices are collinear (or coincide).
     pub fn is_degenerate(&self) -> bool {
         self.normal() == [0, 0, 0]
@@ -75,6 +81,11 @@ pub struct LatticeSegment {
 }
 
 impl LatticeSegment {
+    /// The segment moved by `shift` lattice units.
+    pub fn translated(&self, shift: [i64; 3]) -> LatticeSegment {
+        LatticeSegment { v: self.v.map(|p| add(p, shift)) }
+    }
+
     /// Per-axis `(min, max)` lattice coordinates.
     #[inline]
     pub fn bounds(&self) -> ([i64; 3], [i64; 3]) {
@@ -100,6 +111,12 @@ fn bounds_to_voxels((lo, hi): ([i64; 3], [i64; 3]), dims: [u32; 3]) -> Option<([
         }
     }
     Some((a, b))
+}
+
+/// `a + b`, per coordinate.
+#[inline]
+fn add(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
 /// Exact cross product of two lattice vectors (inputs below 2^31 in magnitude).

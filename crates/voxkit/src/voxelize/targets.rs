@@ -111,10 +111,9 @@ pub enum Element {
 impl Element {
     /// The element moved by `shift` lattice units.
     pub fn translated(&self, shift: P3) -> Element {
-        let mv = |p: &P3| -> P3 { std::array::from_fn(|a| p[a] + shift[a]) };
         match self {
-            Element::Segment(s) => Element::Segment(LatticeSegment { v: s.v.each_ref().map(mv) }),
-            Element::Triangle(t) => Element::Triangle(LatticeTriangle { v: t.v.each_ref().map(mv) }),
+            Element::Segment(s) => Element::Segment(s.translated(shift)),
+            Element::Triangle(t) => Element::Triangle(t.translated(shift)),
         }
     }
 

@@ -36,6 +36,7 @@ use rayon::prelude::*;
 
 use super::driver::Primitive;
 use super::line::{line_lattice, prepare_elements, LineTarget};
+use super::targets::Element;
 use super::{Mode, Options, Report};
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::{prepare, LatticeTriangle};
@@ -104,17 +105,16 @@ pub fn tiled(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, tile: u32, opts: &O
     Ok(match line {
         Some(target) => {
             let (elems, prepare) = prepare_elements(mesh, grid);
-            let run = |e: &[super::targets::Element], size: [u32; 3], _: [i64; 3], o: &Options<'_>| line_lattice(e, size, target, o);
-            let (out, voxels) = by_tiles(&elems, dims, tile, opts, |e, shift| e.translated(shift), run);
+            let run = |e: &[Element], size: [u32; 3], _: [i64; 3], o: &Options<'_>| line_lattice(e, size, target, o);
+            let (out, voxels) = by_tiles(&elems, dims, tile, opts, Element::translated, run);
             (out, Report { prepare, voxels })
         }
         None => {
             let (tris, prepare) = prepare(mesh, grid);
-            let shift = |t: &LatticeTriangle, shift: [i64; 3]| LatticeTriangle { v: t.v.map(|p| std::array::from_fn(|a| p[a] + shift[a])) };
             let run = |t: &[LatticeTriangle], size: [u32; 3], origin: [i64; 3], o: &Options<'_>| {
                 fast_lattice(mode, t, size, origin, o).expect("line modes take their own path")
             };
-            let (out, voxels) = by_tiles(&tris, dims, tile, opts, shift, run);
+            let (out, voxels) = by_tiles(&tris, dims, tile, opts, LatticeTriangle::translated, run);
             (out, Report { prepare, voxels })
         }
     })
@@ -129,7 +129,7 @@ fn by_tiles<P: Primitive>(
     dims: [u32; 3],
     tile: u32,
     opts: &Options<'_>,
-    shift: impl Fn(&P, [i64; 3]) -> P + Sync,
+    shift: impl Fn(&P, [i64; 3]) -> P,
     run: impl Fn(&[P], [u32; 3], [i64; 3], &Options<'_>) -> BrickBits,
 ) -> (SparseBricks, u64) {
     let tdims = dims.map(|d| d.div_ceil(tile) as u64);
