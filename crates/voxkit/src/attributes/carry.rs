@@ -104,12 +104,10 @@ pub fn carry(
     opts: &CarryOptions,
 ) -> VoxelAttributes {
     let dims = grid.dims();
-    let mut keys = Vec::with_capacity(voxels.count() as usize);
-    voxels.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
-    let ctx = Ctx { mesh, app: appearance, grid, keys: &keys, rule: opts.rule, colour: appearance.has_colour(), normals: opts.normals };
-
+    let keys = keys_of(voxels, dims);
+    let ctx = Ctx::new(mesh, appearance, grid, &keys, opts);
     let n = keys.len();
-    let mut arrays = Arrays::new(n, ctx.colour, appearance.has_materials(), opts.normals);
+    let mut arrays = ctx.arrays();
     if n > 0 {
         let slabs = Slab::cut(&keys, dims);
         // Snap every triangle once, in order; each lattice triangle remembers its source.
@@ -149,6 +147,13 @@ pub fn carry(
         });
     }
     arrays.finish(keys, dims)
+}
+
+/// The sorted keys of the set voxels of `voxels`.
+fn keys_of(voxels: &dyn VoxelSource, dims: [u32; 3]) -> Vec<u64> {
+    let mut keys = Vec::with_capacity(voxels.count() as usize);
+    voxels.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
+    keys
 }
 
 /// The attribute arrays being filled, one entry per set voxel (those not
@@ -387,7 +392,16 @@ impl Sink for Collect<'_> {
     }
 }
 
-impl Ctx<'_> {
+impl<'a> Ctx<'a> {
+    fn new(mesh: MeshRef<'a>, app: &'a Appearance, grid: &'a GridSpec, keys: &'a [u64], opts: &CarryOptions) -> Ctx<'a> {
+        Ctx { mesh, app, grid, keys, rule: opts.rule, colour: app.has_colour(), normals: opts.normals }
+    }
+
+    /// Empty attribute arrays for the keys: those this run fills.
+    fn arrays(&self) -> Arrays {
+        Arrays::new(self.keys.len(), self.colour, self.app.has_materials(), self.normals)
+    }
+
     fn corners(&self, t: usize) -> Option<[DVec3; 3]> {
         let tri = self.mesh.triangles[t];
         let mut p = [DVec3::ZERO; 3];
@@ -590,10 +604,9 @@ pub mod reference {
         opts: &CarryOptions,
     ) -> VoxelAttributes {
         let dims = grid.dims();
-        let mut keys = Vec::new();
-        voxels.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
-        let ctx = Ctx { mesh, app: appearance, grid, keys: &keys, rule: opts.rule, colour: appearance.has_colour(), normals: opts.normals };
-        let mut arrays = Arrays::new(keys.len(), ctx.colour, appearance.has_materials(), opts.normals);
+        let keys = keys_of(voxels, dims);
+        let ctx = Ctx::new(mesh, appearance, grid, &keys, opts);
+        let mut arrays = ctx.arrays();
         let mut scratch = Scratch::default();
         for t in 0..mesh.triangles.len() {
             let mut lattice = Vec::new();
