@@ -6,9 +6,11 @@ reports. Run with the system Python that has pyopenvdb:
     /usr/bin/python3 .ci/check_vdb.py target/release/voxkit ../shared/meshes
 Prints 'N passed, M failed'.
 """
+import re
 import subprocess
 import sys
 import tempfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +34,53 @@ def active(path):
             pts.extend(np.argwhere(np.ones(hi - lo + 1, bool)) + lo)
     pts = np.array(pts, dtype=np.int64).reshape(-1, 3)
     return g, pts[np.lexsort((pts[:, 2], pts[:, 1], pts[:, 0]))]
+
+
+def vti_arrays(path):
+    """The cell arrays of a voxkit .vti (appended raw, zlib blocks, UInt64
+    headers), read with the standard library: {name: array (nx, ny, nz[, c])}."""
+    raw = Path(path).read_bytes()
+    head, data = raw.split(b'<AppendedData encoding="raw">', 1)
+    data = data[data.index(b"_") + 1:]
+    ext = [int(v) for v in re.search(rb'WholeExtent="([^"]+)"', head).group(1).split()]
+    nx, ny, nz = ext[1], ext[3], ext[5]
+    out = {}
+    types = {b"UInt8": np.uint8, b"Int32": np.int32, b"Float32": np.float32}
+    for ty, name, comps, off in re.findall(rb'<DataArray type="(\w+)" Name="(\w+)" NumberOfComponents="(\d+)" format="appended" offset="(\d+)"', head):
+        at = int(off)
+        nb = int.from_bytes(data[at:at + 8], "little")
+        sizes = [int.from_bytes(data[at + 8 * (3 + i):at + 8 * (4 + i)], "little") for i in range(nb)]
+        at += 8 * (3 + nb)
+        buf = b""
+        for s in sizes:
+            buf += zlib.decompress(data[at:at + s])
+            at += s
+        a = np.frombuffer(buf, dtype=types[ty])
+        c = int(comps)
+        # VTK cell order: i fastest.
+        a = a.reshape(nz, ny, nx, c).transpose(2, 1, 0, 3)
+        out[name.decode()] = a[..., 0] if c == 1 else a
+    return out
+
+
+def grid_values(path, name):
+    """Every active voxel of grid `name` and its value, sorted by (i, j, k);
+    active tiles expanded."""
+    g = vdb.read(str(path), name)
+    pts, vals = [], []
+    for it in g.citerOnValues():
+        lo, hi = np.array(it["min"]), np.array(it["max"])
+        box = np.argwhere(np.ones(hi - lo + 1, bool)) + lo
+        pts.extend(box)
+        vals.extend([it["value"]] * len(box))
+    pts = np.array(pts, dtype=np.int64).reshape(-1, 3)
+    order = np.lexsort((pts[:, 2], pts[:, 1], pts[:, 0]))
+    return g, pts[order], np.array(vals, dtype=np.float64)[order]
+
+
+def srgb_to_linear(c):
+    s = c / 255.0
+    return np.where(s <= 0.04045, s / 12.92, ((s + 0.055) / 1.055) ** 2.4)
 
 
 with tempfile.TemporaryDirectory() as d:
@@ -80,6 +129,34 @@ with tempfile.TemporaryDirectory() as d:
         check(f"{name}: the interior is active tiles", tiles > 0, tiles)
         check(f"{name}: every active voxel = the dense run's .npy", got.shape == want.shape and (got == want).all(), (got.shape, want.shape))
         check(f"{name}: activeVoxelCount = voxkit's count", g.activeVoxelCount() == s["voxels"], (g.activeVoxelCount(), s["voxels"]))
+
+    # --attributes: Cd, normal, coverage and material grids over the same
+    # voxels, equal to the .vti arrays of the same run (read here without
+    # voxkit); a solid's interior is tiles in `voxels`, leaves in the others.
+    for mode in ["cover", "solid"]:
+        name = f"spot-textured.obj 64 {mode} --attributes"
+        s = voxelize(MESHES / "spot-textured.obj", d / "a.vdb", "--resolution", "64", "--mode", mode, "--attributes")
+        voxelize(MESHES / "spot-textured.obj", d / "a.vti", "--resolution", "64", "--mode", mode, "--normals")
+        v = vti_arrays(d / "a.vti")
+        want = np.argwhere(v["occupancy"] > 0)
+        names = sorted(m.name for m in vdb.readAllGridMetadata(str(d / "a.vdb")))
+        check(f"{name}: five grids", names == ["Cd", "coverage", "material", "normal", "voxels"], names)
+        _, occ = active(d / "a.vdb")
+        check(f"{name}: voxels = the .vti occupancy", occ.shape == want.shape and (occ == want).all())
+        ix = tuple(want.T)
+        for grid, kind, expect in [
+            ("Cd", vdb.Vec3SGrid, srgb_to_linear(v["colour"][ix].astype(np.float64))),
+            ("normal", vdb.Vec3SGrid, v["normal"][ix].astype(np.float64)),
+            ("coverage", vdb.FloatGrid, v["coverage"][ix].astype(np.float64)),
+            ("material", vdb.FloatGrid, v["material"][ix].astype(np.float64)),
+        ]:
+            g, pts, vals = grid_values(d / "a.vdb", grid)
+            check(f"{name}: {grid} is a {kind.__name__}", isinstance(g, kind), type(g))
+            check(f"{name}: {grid}'s active voxels = the voxels", pts.shape == want.shape and (pts == want).all(), (pts.shape, want.shape))
+            tol = 1e-6 if grid == "Cd" else 0.0
+            check(f"{name}: {grid} values = the .vti's", vals.shape == expect.shape and np.abs(vals - expect).max() <= tol,
+                  np.abs(vals - expect).max() if vals.shape == expect.shape else (vals.shape, expect.shape))
+        check(f"{name}: colours vary (the texture is carried)", len(np.unique(v["colour"][ix], axis=0)) > 10)
 
     # A grid past the memory given: tiled automatically, sparse output.
     s = voxelize(MESHES / "stanford-bunny.obj", d / "big.vdb", "--resolution", "4096", "--max-memory", "1G")

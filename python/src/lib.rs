@@ -714,6 +714,7 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
         "gpu_path",
         "colour_rule",
         "normals",
+        "attributes",
         "dither",
         "threads",
         "jobs",
@@ -736,6 +737,7 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
     let gpu_path = get_str("gpu_path")?.unwrap_or_else(|| "compute".into());
     let rule = get_str("colour_rule")?.unwrap_or_else(|| "dominant".into());
     let normals: bool = options.get_item("normals")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
+    let attributes: bool = options.get_item("attributes")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
     let dither: bool = options.get_item("dither")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
     let watertight: bool = options.get_item("watertight")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(true);
     let triangulate: bool = options.get_item("triangulate")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
@@ -760,6 +762,7 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
         format: target.name(),
         colour_rule: &rule,
         normals,
+        attributes,
         dither,
         up: up_axis.name(),
         watertight,
@@ -769,7 +772,8 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
     let opts = voxkit_job::batch::BatchOptions {
         plan,
         format: target,
-        carry: CarryOptions { rule: self::colour_rule(&rule).map_err(py_err)?, normals },
+        carry: CarryOptions { rule: self::colour_rule(&rule).map_err(py_err)?, normals: normals || attributes },
+        attributes,
         write: voxkit_io::WriteOptions {
             dither,
             blocks: None,

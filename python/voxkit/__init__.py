@@ -249,7 +249,8 @@ def batch(
     interrupted batch resumes; a bad mesh is recorded and the batch goes on.
 
     ``options`` are :func:`voxelize`'s (mode, resolution, method, …) plus
-    ``colour_rule``, ``normals`` and ``dither`` for coloured formats;
+    ``colour_rule``, ``normals`` and ``dither`` for coloured formats and
+    ``attributes=True`` for every attribute grid in ``.vdb`` outputs;
     ``jobs`` meshes run at once (default: all cores).
 
     Returns the summary: ``{"done", "skipped", "failed", "total_s", "manifest"}``.

@@ -561,6 +561,47 @@ fn tiled_runs_write_the_same_files_and_vdb_reads_back() {
     assert!(chk.status.success(), "{}", String::from_utf8_lossy(&chk.stderr));
 }
 
+/// `--attributes` writes the surface's attributes into `.vdb` as grids
+/// beside the voxels: converting that file to `.vti` gives the very bytes
+/// `voxelize` writes to `.vti` (colour, material, coverage, normal), for a
+/// surface and for a solid. Asked for a tiled grid it is refused in one
+/// line, and nothing is written.
+#[test]
+fn vdb_attributes_carry_every_array() {
+    let spot = shared("spot-textured.obj");
+    for mode in ["cover", "solid"] {
+        let (v, direct, back) =
+            (tmp(&format!("attrs-{mode}.vdb")), tmp(&format!("attrs-{mode}.vti")), tmp(&format!("attrs-back-{mode}.vti")));
+        let j = json(&voxkit(&["voxelize", &spot, "-o", &v, "--resolution", "48", "--mode", mode, "--attributes", "--json"]));
+        for a in ["colour", "material", "normal", "coverage"] {
+            assert_eq!(j["attributes"][a], true, "{mode}: {a} not carried: {}", j["attributes"]);
+        }
+        json(&voxkit(&["voxelize", &spot, "-o", &direct, "--resolution", "48", "--mode", mode, "--normals", "--json"]));
+        let c = voxkit(&["convert", &v, &back]);
+        assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+        assert_eq!(std::fs::read(&direct).unwrap(), std::fs::read(&back).unwrap(), "{mode}: .vdb attributes differ from .vti's");
+    }
+    // Without the flag, the bool grid alone (no attributes come back).
+    let (plain, plain_vti) = (tmp("attrs-plain.vdb"), tmp("attrs-plain.vti"));
+    let j = json(&voxkit(&["voxelize", &spot, "-o", &plain, "--resolution", "48", "--json"]));
+    assert!(j["attributes"].is_null(), "{}", j["attributes"]);
+    assert!(std::fs::metadata(&plain).unwrap().len() < std::fs::metadata(tmp("attrs-cover.vdb")).unwrap().len());
+    let c = voxkit(&["convert", &plain, &plain_vti, "--json"]);
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    let tiled = tmp("attrs-tiled.vdb");
+    let e = error_line(&["voxelize", &spot, "-o", &tiled, "--resolution", "48", "--tile", "16", "--attributes"]);
+    assert!(e.contains("--attributes") && e.contains("tiled"), "{e}");
+    assert!(!std::path::Path::new(&tiled).exists());
+    // For a format without attribute grids the flag is named as unused.
+    let out = voxkit(&["voxelize", &spot, "-o", &tmp("attrs.npy"), "--resolution", "16", "--attributes"]);
+    assert!(out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("--attributes (for .vdb) does nothing"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 /// Solids past memory: parity and winding run brick row by brick row into
 /// sparse bricks with full runs, and write the dense run's files.
 #[test]

@@ -277,7 +277,7 @@ pub fn write_voxels_with(
         VoxelFormat::Schem => schem::write(w, bits, attrs, opts.blocks.as_ref().unwrap_or(&schem::BlockPalette::default()), opts.up),
         VoxelFormat::Vti => vti::write(w, bits, grid, attrs),
         VoxelFormat::Ply => points::write(w, bits, grid, attrs),
-        VoxelFormat::Vdb => vdb::write(w, bits, grid),
+        VoxelFormat::Vdb => vdb::write(w, bits, grid, attrs),
         VoxelFormat::Npz => npz::write(w, bits, grid),
         VoxelFormat::Zarr => unreachable!("Zarr arrays are written above"),
     })

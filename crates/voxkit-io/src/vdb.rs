@@ -13,6 +13,17 @@
 //! Full 8³ bricks are active tiles of their 16³ node (value `true`), and
 //! 16³ nodes whose 4096 bricks are all full are active tiles of 128³ in
 //! their 32³ node: a solid's interior costs bits per brick, not voxels.
+//!
+//! **Attributes** (`voxelize --attributes`, or `convert` from a file that
+//! has them) follow as one grid each, over the same active voxels (every
+//! brick a leaf: each voxel holds its own value), background zero: `Cd`
+//! (`Tree_vec3s_5_4_3`, colour in linear RGB, the name Houdini gives
+//! colour), `normal` (`Tree_vec3s_5_4_3`), `coverage` (`Tree_float_5_4_3`)
+//! and `material` (`Tree_float_5_4_3`, the id, -1 for none: pyopenvdb
+//! reads no integer grids; ids below 2^24 are exact). Leaf values use
+//! OpenVDB's active-mask compression with metadata 0 (only the active
+//! values, in index order), the layout of `LeafNode<T>::writeBuffers` and
+//! `io::writeCompressedValues`.
 //! Internal-node values use OpenVDB's active-mask compression (only the
 //! active tiles' values are stored), leaves are uncompressed bit masks, so
 //! the file needs no compression library. The byte layout
@@ -21,10 +32,13 @@
 //! back with OpenVDB's own reader (`pyopenvdb`) and compares every active
 //! voxel.
 //!
-//! **What is read.** Bool grids written uncompressed or with active-mask
-//! compression (voxkit's own files, and OpenVDB files saved without
-//! zip/blosc), active voxels and active tiles; other grid types and
-//! zip/blosc-compressed node values are refused by name.
+//! **What is read.** The first bool grid, written uncompressed or with
+//! active-mask compression (voxkit's own files, and OpenVDB files saved
+//! without zip/blosc), active voxels and active tiles, and beside it the
+//! attribute grids named and typed as above (a set voxel a grid holds no
+//! active value for gets zero, the background). Every node-compression
+//! metadata case of `io::readCompressedValues` is read; zip/blosc and
+//! half-float values are refused by name.
 //!
 //! Sizes are computed before anything is written, so the file streams
 //! through one pass (the grid offsets OpenVDB puts before each grid are
@@ -34,6 +48,8 @@
 use std::io::Write;
 
 use glam::DVec3;
+use voxkit::attributes::colour::{from_linear, to_linear};
+use voxkit::attributes::{VoxelAttributes, NO_MATERIAL};
 use voxkit::grid::bricks::Brick;
 use voxkit::grid::sparse::FULL;
 use voxkit::{GridSpec, VoxelSource};
@@ -50,6 +66,15 @@ const COMPRESS_ZIP: u32 = 1;
 const COMPRESS_ACTIVE_MASK: u32 = 2;
 const COMPRESS_BLOSC: u32 = 4;
 const GRID_TYPE: &str = "Tree_bool_5_4_3";
+const FLOAT_TYPE: &str = "Tree_float_5_4_3";
+const VEC3_TYPE: &str = "Tree_vec3s_5_4_3";
+/// The occupancy grid's name.
+const GRID_NAME: &str = "voxels";
+/// The attribute grids' names (`Cd` as Houdini names colour).
+const ATTR_COLOUR: &str = "Cd";
+const ATTR_NORMAL: &str = "normal";
+const ATTR_COVERAGE: &str = "coverage";
+const ATTR_MATERIAL: &str = "material";
 
 /// Log2 of the node sizes in voxels: leaf 8, lower internal 128, upper 4096.
 const LEAF: u32 = 3;
@@ -93,6 +118,14 @@ fn to_vdb(b: &Brick) -> [u64; 8] {
 /// A byte sink: a writer, or a counter of the bytes a writer would get.
 trait Out {
     fn put(&mut self, b: &[u8]) -> std::io::Result<()>;
+    /// Puts the `len` bytes `fill` appends to a buffer; a counter adds
+    /// `len` without calling it.
+    fn put_with(&mut self, len: usize, fill: &mut dyn FnMut(&mut Vec<u8>) -> std::io::Result<()>) -> std::io::Result<()> {
+        let mut buf = Vec::with_capacity(len);
+        fill(&mut buf)?;
+        debug_assert_eq!(buf.len(), len);
+        self.put(&buf)
+    }
 }
 
 struct Count(u64);
@@ -100,6 +133,10 @@ struct Count(u64);
 impl Out for Count {
     fn put(&mut self, b: &[u8]) -> std::io::Result<()> {
         self.0 += b.len() as u64;
+        Ok(())
+    }
+    fn put_with(&mut self, len: usize, _: &mut dyn FnMut(&mut Vec<u8>) -> std::io::Result<()>) -> std::io::Result<()> {
+        self.0 += len as u64;
         Ok(())
     }
 }
@@ -145,7 +182,7 @@ fn vec3d(v: [f64; 3]) -> Vec<u8> {
 }
 
 /// The grid's metadata and transform.
-fn put_grid_head(o: &mut dyn Out, tree: &Tree, count: u64, grid: &GridSpec) -> std::io::Result<()> {
+fn put_grid_head(o: &mut dyn Out, name: &str, tree: &Tree, count: u64, grid: &GridSpec) -> std::io::Result<()> {
     o.put(&COMPRESS_ACTIVE_MASK.to_le_bytes())?;
     // Bounds of the active voxels: the tiles' boxes, then leaf by leaf: x
     // from the non-zero words, y and z from the bytes and bits of their union.
@@ -175,7 +212,7 @@ fn put_grid_head(o: &mut dyn Out, tree: &Tree, count: u64, grid: &GridSpec) -> s
         entries.push(("file_bbox_min", "vec3i", vec3i(lo)));
     }
     entries.push(("file_voxel_count", "int64", (count as i64).to_le_bytes().to_vec()));
-    entries.push(("name", "string", b"voxels".to_vec()));
+    entries.push(("name", "string", name.as_bytes().to_vec()));
     entries.push(("voxkit_dims", "vec3i", vec3i(dims)));
     entries.push(("voxkit_origin", "vec3d", vec3d(o_.to_array())));
     entries.push(("voxkit_voxel_size", "double", s.to_le_bytes().to_vec()));
@@ -220,8 +257,9 @@ impl Tree {
     /// Gathers the bricks of `bits`: partial ones as leaves, runs of full
     /// ones as tiles (never one by one: a solid's interior is a few runs
     /// per brick row), lower nodes all of whose 4096 bricks are full as
-    /// tiles of 128³.
-    fn of(bits: &dyn VoxelSource) -> Tree {
+    /// tiles of 128³. Without `tiles` (attribute grids, whose voxels each
+    /// hold their own value) every brick is a leaf.
+    fn of(bits: &dyn VoxelSource, tiles: bool) -> Tree {
         use rayon::slice::ParallelSliceMut;
         let mut leaves = Vec::new();
         let mut full: std::collections::HashMap<(u32, u32, u32, u32), Box<[u64; 64]>> = std::collections::HashMap::new();
@@ -229,6 +267,12 @@ impl Tree {
         bits.for_each_brick_run(&mut |b, brick, n| {
             if *brick != FULL {
                 leaves.push(Leaf { origin: b.map(|c| c << LEAF), mask: to_vdb(brick) });
+                return;
+            }
+            if !tiles {
+                for x in b[0]..b[0] + n {
+                    leaves.push(Leaf { origin: [x << LEAF, b[1] << LEAF, b[2] << LEAF], mask: [u64::MAX; 8] });
+                }
                 return;
             }
             let lo = b.map(|c| (c << LEAF) as i32);
@@ -293,11 +337,13 @@ fn put_tile_values(o: &mut dyn Out, tiles: &[u64]) -> std::io::Result<()> {
     Ok(())
 }
 
-/// The tree: topology, then buffers.
-fn put_tree(o: &mut dyn Out, tree: &Tree) -> std::io::Result<()> {
+/// The tree: topology, then buffers. Without `values`, a bool grid
+/// (occupancy); with them, an attribute grid (no tiles, zero background,
+/// each leaf's active values after its mask).
+fn put_tree(o: &mut dyn Out, tree: &Tree, values: Option<&Values<'_>>) -> std::io::Result<()> {
     o.put(&1i32.to_le_bytes())?; // buffer count
-    o.put(&[0])?; // background: false
-                  // Upper nodes: those of lower nodes and of full lower nodes, in order.
+    o.put(&[0; 12][..values.map_or(1, |v| v.size)])?; // background: false, or zero
+                                                      // Upper nodes: those of lower nodes and of full lower nodes, in order.
     let mut uppers: Vec<(u32, u32, u32)> =
         tree.lowers.iter().map(|l| upper_of(&l.key)).chain(tree.full_lowers.iter().map(upper_of)).collect();
     uppers.sort_unstable();
@@ -335,6 +381,32 @@ fn put_tree(o: &mut dyn Out, tree: &Tree) -> std::io::Result<()> {
         }
         (l, f) = (l_end, f_end);
     }
+    if let Some(v) = values {
+        for leaf in &tree.leaves {
+            // Value mask, then OpenVDB's compressed values: metadata 0 (every
+            // inactive value is the background), the active values in
+            // index order (`x·64 + y·8 + z`).
+            put_words(o, &leaf.mask)?;
+            let active: u32 = leaf.mask.iter().map(|w| w.count_ones()).sum();
+            o.put_with(1 + active as usize * v.size, &mut |buf| {
+                buf.push(0);
+                for (x, &w) in leaf.mask.iter().enumerate() {
+                    let mut w = w;
+                    while w != 0 {
+                        let b = w.trailing_zeros();
+                        w &= w - 1;
+                        let p = [leaf.origin[0] + x as u32, leaf.origin[1] + (b >> 3), leaf.origin[2] + (b & 7)];
+                        let slot = v.attrs.slot(p[0], p[1], p[2]).ok_or_else(|| {
+                            std::io::Error::other(format!("voxel {p:?} is set but has no attributes (voxels and attributes differ)"))
+                        })?;
+                        (v.put)(slot, buf);
+                    }
+                }
+                Ok(())
+            })?;
+        }
+        return Ok(());
+    }
     let mut buf = [0u8; 140];
     for leaf in &tree.leaves {
         // Value mask (active), origin, values.
@@ -361,12 +433,59 @@ fn uuid(grid: &GridSpec, count: u64) -> String {
     format!("{}-{}-4{}-8{}-{}", &hex[0..8], &hex[8..12], &hex[13..16], &hex[17..20], &hex[20..32])
 }
 
-/// Writes `bits` on `grid` as a `.vdb` file. Grids larger than 2^31 voxels
-/// per axis cannot be indexed by OpenVDB's 32-bit coordinates and are
-/// refused by the caller's grid limits long before.
-pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
-    let tree = Tree::of(bits);
+/// Appends the value of the voxel in an attribute slot, little-endian.
+type PutValue<'a> = Box<dyn Fn(usize, &mut Vec<u8>) + 'a>;
+
+/// An attribute grid's values: bytes per value, and each voxel's value
+/// (by its attribute slot).
+struct Values<'a> {
+    attrs: &'a VoxelAttributes,
+    size: usize,
+    put: PutValue<'a>,
+}
+
+fn f32s(buf: &mut Vec<u8>, v: &[f32]) {
+    for x in v {
+        buf.extend_from_slice(&x.to_le_bytes());
+    }
+}
+
+/// The attribute grids of `attrs`, as `(name, tree type, values)`: `Cd`
+/// (colour, linear RGB), `normal`, `coverage` and `material` (the id as a
+/// float, -1 for none; pyopenvdb reads no integer grids).
+fn attribute_grids(attrs: &VoxelAttributes) -> Vec<(&'static str, &'static str, Values<'_>)> {
+    let mut out: Vec<(&'static str, &'static str, Values<'_>)> = Vec::new();
+    if let Some(c) = &attrs.colour {
+        let put = move |s: usize, b: &mut Vec<u8>| f32s(b, &c[s].map(|v| to_linear(v) as f32));
+        out.push((ATTR_COLOUR, VEC3_TYPE, Values { attrs, size: 12, put: Box::new(put) }));
+    }
+    if let Some(n) = &attrs.normal {
+        out.push((ATTR_NORMAL, VEC3_TYPE, Values { attrs, size: 12, put: Box::new(move |s, b| f32s(b, &n[s])) }));
+    }
+    if let Some(c) = &attrs.coverage {
+        out.push((ATTR_COVERAGE, FLOAT_TYPE, Values { attrs, size: 4, put: Box::new(move |s, b| f32s(b, &[c[s]])) }));
+    }
+    if let Some(m) = &attrs.material {
+        let put = move |s: usize, b: &mut Vec<u8>| f32s(b, &[if m[s] == NO_MATERIAL { -1.0 } else { m[s] as f32 }]);
+        out.push((ATTR_MATERIAL, FLOAT_TYPE, Values { attrs, size: 4, put: Box::new(put) }));
+    }
+    out
+}
+
+/// Writes `bits` on `grid` as a `.vdb` file: the `voxels` bool grid, then,
+/// with `attrs`, one grid per attribute over the same voxels (see the
+/// module doc). Grids larger than 2^31 voxels per axis cannot be indexed
+/// by OpenVDB's 32-bit coordinates and are refused by the caller's grid
+/// limits long before.
+pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: Option<&VoxelAttributes>) -> std::io::Result<()> {
+    let tree = Tree::of(bits, true);
     let count = bits.count();
+    let extra = attrs.map(attribute_grids).unwrap_or_default();
+    let value_tree = (!extra.is_empty()).then(|| Tree::of(bits, false));
+    let mut grids: Vec<(&str, &str, &Tree, Option<&Values<'_>>)> = vec![(GRID_NAME, GRID_TYPE, &tree, None)];
+    for (name, ty, v) in &extra {
+        grids.push((name, ty, value_tree.as_ref().expect("built when there are attributes"), Some(v)));
+    }
     let mut header = Vec::new();
     let mut o = Stream(&mut header);
     let o: &mut dyn Out = &mut o;
@@ -378,31 +497,38 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std:
     o.put(uuid(grid, count).as_bytes())?;
     o.put(&1u32.to_le_bytes())?; // file metadata: one entry
     put_meta(o, "creator", "string", format!("voxkit {}", env!("CARGO_PKG_VERSION")).as_bytes())?;
-    o.put(&1i32.to_le_bytes())?; // grids
-    let mut desc = Count(0);
-    put_str(&mut desc, "voxels")?;
-    put_str(&mut desc, GRID_TYPE)?;
-    put_str(&mut desc, "")?;
-    // The grid head (metadata, transform) is small: built once, in memory.
-    // The tree is streamed, after a first pass that only counts its bytes.
-    let mut head = Vec::new();
-    put_grid_head(&mut Stream(&mut head), &tree, count, grid)?;
-    let mut tree_len = Count(0);
-    put_tree(&mut tree_len, &tree)?;
-    let grid_pos = header.len() as u64 + desc.0 + 24;
+    o.put(&(grids.len() as i32).to_le_bytes())?;
     w.write_all(&header)?;
+    // Each grid: its descriptor with the offsets of its head, its tree and
+    // its end (where the next descriptor starts), the head (metadata and
+    // transform, small: built in memory), then the tree, streamed after a
+    // first pass that only counts its bytes.
+    let mut at = header.len() as u64;
     let mut o = Stream(w);
     let o: &mut dyn Out = &mut o;
-    let block_pos = grid_pos + head.len() as u64;
-    let end_pos = block_pos + tree_len.0;
-    put_str(o, "voxels")?;
-    put_str(o, GRID_TYPE)?;
-    put_str(o, "")?;
-    for p in [grid_pos, block_pos, end_pos] {
-        o.put(&(p as i64).to_le_bytes())?;
+    for (name, ty, tree, values) in grids {
+        let mut desc = Count(0);
+        put_str(&mut desc, name)?;
+        put_str(&mut desc, ty)?;
+        put_str(&mut desc, "")?;
+        let mut head = Vec::new();
+        put_grid_head(&mut Stream(&mut head), name, tree, count, grid)?;
+        let mut tree_len = Count(0);
+        put_tree(&mut tree_len, tree, values)?;
+        let grid_pos = at + desc.0 + 24;
+        let block_pos = grid_pos + head.len() as u64;
+        let end_pos = block_pos + tree_len.0;
+        put_str(o, name)?;
+        put_str(o, ty)?;
+        put_str(o, "")?;
+        for p in [grid_pos, block_pos, end_pos] {
+            o.put(&(p as i64).to_le_bytes())?;
+        }
+        o.put(&head)?;
+        put_tree(o, tree, values)?;
+        at = end_pos;
     }
-    o.put(&head)?;
-    put_tree(o, &tree)
+    Ok(())
 }
 
 /// A cursor over untrusted bytes: every read is bounds-checked.
@@ -478,73 +604,80 @@ fn bit(words: &[u64], n: usize) -> bool {
     words[n / 64] >> (n % 64) & 1 == 1
 }
 
-/// Active boxes and leaves found while reading the tree.
+/// A tree as read: active tiles (origin, edge length, value bytes) and
+/// leaves (origin, active mask in OpenVDB's layout, active values in index
+/// order; none for a bool grid, whose leaves' activity is the occupancy).
 #[derive(Default)]
 struct Found {
-    /// Active tiles: (origin, edge length).
-    tiles: Vec<([i64; 3], i64)>,
-    /// Leaf origins, in file order (their buffers follow the topology).
+    tiles: Vec<([i64; 3], i64, [u8; 12])>,
     leaves: Vec<[i64; 3]>,
+}
+
+/// One node's values as OpenVDB's `readCompressedValues` stores them: the
+/// metadata byte, the inactive values and selection mask it announces,
+/// then every value or, with active-mask compression, only the active
+/// ones. Returns the active values' bytes in index order.
+fn read_values(c: &mut Cur<'_>, active: &[u64], n: usize, mask_compressed: bool, vs: usize) -> Result<Vec<u8>, ErrorKind> {
+    let meta = c.u8()?;
+    match meta {
+        // 0: inactive values are the background, 1: its negative, 3: a
+        // mask selects between the two, 6: every value stored.
+        0 | 1 | 3 | 6 => {}
+        2 | 4 => {
+            c.take(vs)?; // one inactive value
+        }
+        5 => {
+            c.take(2 * vs)?; // two inactive values
+        }
+        m => return Err(bad(format!("unknown node compression metadata {m}"))),
+    }
+    if matches!(meta, 3..=5) {
+        c.take(n / 8)?; // selection mask
+    }
+    let on: usize = active.iter().map(|w| w.count_ones() as usize).sum();
+    if mask_compressed && meta != 6 {
+        return Ok(c.take(on * vs)?.to_vec());
+    }
+    let all = c.take(n * vs)?;
+    let mut out = Vec::with_capacity(on * vs);
+    for idx in (0..n).filter(|&i| bit(active, i)) {
+        out.extend_from_slice(&all[idx * vs..(idx + 1) * vs]);
+    }
+    Ok(out)
 }
 
 /// An internal node's topology: masks, compressed tile values, children.
 fn read_internal(
     c: &mut Cur<'_>,
     origin: [i64; 3],
-    log2: u32,
-    child_log2: u32,
+    (log2, child_log2): (u32, u32),
     mask_compressed: bool,
+    vs: usize,
     found: &mut Found,
 ) -> Result<(), ErrorKind> {
     let dim = log2 - child_log2;
     let n = 1usize << (3 * dim);
     let child = c.words(n / 64)?;
     let value = c.words(n / 64)?;
-    let meta = c.u8()?;
-    // OpenVDB's per-node metadata: which inactive values and selection mask follow.
-    match meta {
-        0 | 6 => {}
-        1 | 3 => {
-            c.u8()?;
-        }
-        2 => {}
-        4 => {
-            c.u8()?;
-        }
-        5 => {
-            c.u8()?;
-            c.u8()?;
-        }
-        m => return Err(bad(format!("unknown node compression metadata {m}"))),
-    }
-    if matches!(meta, 2 | 4 | 5) {
-        c.words(n / 64)?; // selection mask
-    }
-    let stored = if mask_compressed && meta != 6 { value.iter().map(|w| w.count_ones() as usize).sum() } else { n };
-    let vals = c.take(stored)?;
-    let mut v = 0;
-    for idx in 0..n {
-        let on = bit(&value, idx);
-        let val = if !mask_compressed || meta == 6 || on {
-            let b = vals[v];
-            v += 1;
-            b != 0
-        } else {
-            false
-        };
-        if on && !bit(&child, idx) && val {
-            let off = [(idx >> (2 * dim)) as i64, ((idx >> dim) & ((1 << dim) - 1)) as i64, (idx & ((1 << dim) - 1)) as i64];
-            found.tiles.push((std::array::from_fn(|a| origin[a] + (off[a] << child_log2)), 1 << child_log2));
+    let vals = read_values(c, &value, n, mask_compressed, vs)?;
+    let offset = |idx: usize| -> [i64; 3] {
+        let off = [(idx >> (2 * dim)) as i64, ((idx >> dim) & ((1 << dim) - 1)) as i64, (idx & ((1 << dim) - 1)) as i64];
+        std::array::from_fn(|a| origin[a] + (off[a] << child_log2))
+    };
+    for (v, idx) in (0..n).filter(|&i| bit(&value, i)).enumerate() {
+        if !bit(&child, idx) {
+            let mut val = [0u8; 12];
+            val[..vs].copy_from_slice(&vals[v * vs..(v + 1) * vs]);
+            found.tiles.push((offset(idx), 1 << child_log2, val));
         }
     }
     for idx in (0..n).filter(|&i| bit(&child, i)) {
-        let off = [(idx >> (2 * dim)) as i64, ((idx >> dim) & ((1 << dim) - 1)) as i64, (idx & ((1 << dim) - 1)) as i64];
-        let o: [i64; 3] = std::array::from_fn(|a| origin[a] + (off[a] << child_log2));
+        let o = offset(idx);
         if child_log2 == LEAF {
             c.take(64)?; // the leaf's value mask, read again with its buffer
             found.leaves.push(o);
         } else {
-            read_internal(c, o, child_log2, LEAF, mask_compressed, found)?;
+            read_internal(c, o, (child_log2, LEAF), mask_compressed, vs, found)?;
         }
     }
     Ok(())
@@ -555,7 +688,16 @@ fn read_internal(
 /// of words at a time; files with more tile voxels are refused.
 const MAX_TILE_VOXELS: i64 = 1 << 30;
 
-/// Parses a `.vdb` file: its first bool grid's active voxels.
+/// A grid's descriptor: name, tree type, where its head starts.
+struct Descriptor {
+    name: String,
+    ty: String,
+    pos: i64,
+}
+
+/// Parses a `.vdb` file: its first bool grid's active voxels and, when
+/// grids named as voxkit writes them are present (`Cd`, `normal`,
+/// `coverage`, `material`), those attributes of each voxel.
 pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     let mut c = Cur { b: bytes, at: 0 };
     if c.i64().ok() != Some(MAGIC) {
@@ -574,44 +716,84 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if !has_offsets {
         return Err(bad("streamed VDB files (without grid offsets) are not supported"));
     }
-    let mut types = Vec::new();
+    let mut found = Vec::new();
     for _ in 0..grids.max(0) {
         let name = c.string()?;
         let ty = c.string()?;
         if version >= 223 {
             c.string()?;
         }
-        let (grid_pos, _block, end) = (c.i64()?, c.i64()?, c.i64()?);
-        if ty == GRID_TYPE {
-            c.seek(grid_pos)?;
-            return read_grid(&mut c).map_err(|e| match e {
-                ErrorKind::Malformed { format, detail } => ErrorKind::Malformed { format, detail: format!("grid '{name}': {detail}") },
-                e => e,
-            });
-        }
-        types.push(format!("{name} ({ty})"));
+        let (pos, _block, end) = (c.i64()?, c.i64()?, c.i64()?);
         // Grids follow one another: an end before this descriptor would
         // read the same grids again, billions of times.
         if end <= c.at as i64 {
             return Err(bad(format!("grid '{name}' ends at byte {end}, before its own descriptor")));
         }
+        found.push(Descriptor { name, ty, pos });
         c.seek(end)?;
     }
-    Err(bad(if types.is_empty() {
-        "no grids".to_string()
-    } else {
-        format!("no bool grid (voxkit reads {GRID_TYPE}); grids: {}", types.join(", "))
-    }))
+    let in_grid = |name: &str, e: ErrorKind| match e {
+        ErrorKind::Malformed { format, detail } => ErrorKind::Malformed { format, detail: format!("grid '{name}': {detail}") },
+        e => e,
+    };
+    let Some(occupancy) = found.iter().find(|d| d.ty == GRID_TYPE) else {
+        let types: Vec<String> = found.iter().map(|d| format!("{} ({})", d.name, d.ty)).collect();
+        return Err(bad(if types.is_empty() {
+            "no grids".to_string()
+        } else {
+            format!("no bool grid (voxkit reads {GRID_TYPE}); grids: {}", types.join(", "))
+        }));
+    };
+    c.seek(occupancy.pos)?;
+    let (mut loaded, offset) = read_grid(&mut c).map_err(|e| in_grid(&occupancy.name, e))?;
+    let wanted = [(ATTR_COLOUR, VEC3_TYPE), (ATTR_NORMAL, VEC3_TYPE), (ATTR_COVERAGE, FLOAT_TYPE), (ATTR_MATERIAL, FLOAT_TYPE)];
+    if found.iter().any(|d| wanted.contains(&(d.name.as_str(), d.ty.as_str()))) {
+        let mut keys = Vec::with_capacity(loaded.bits.count() as usize);
+        let dims = loaded.bits.dims();
+        loaded.bits.for_each_set(|i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
+        keys.sort_unstable();
+        let mut attrs = VoxelAttributes { dims, keys, ..Default::default() };
+        for (name, ty) in wanted {
+            let Some(d) = found.iter().find(|d| d.name == name && d.ty == ty) else { continue };
+            c.seek(d.pos)?;
+            let values = read_values_grid(&mut c, if ty == VEC3_TYPE { 12 } else { 4 }).map_err(|e| in_grid(name, e))?;
+            let at = |key: u64| {
+                let v = attrs.voxel(key);
+                values.at(std::array::from_fn(|a| v[a] as i64 + offset[a]))
+            };
+            let f = |b: &[u8], n: usize| f32::from_le_bytes(b[4 * n..4 * n + 4].try_into().expect("4 bytes"));
+            match name {
+                ATTR_COLOUR => {
+                    attrs.colour = Some(attrs.keys.iter().map(|&k| std::array::from_fn(|n| from_linear(f(&at(k), n) as f64))).collect())
+                }
+                ATTR_NORMAL => attrs.normal = Some(attrs.keys.iter().map(|&k| std::array::from_fn(|n| f(&at(k), n))).collect()),
+                ATTR_COVERAGE => attrs.coverage = Some(attrs.keys.iter().map(|&k| f(&at(k), 0)).collect()),
+                _ => {
+                    let id = |v: f32| if v >= 0.0 && v.fract() == 0.0 && v < NO_MATERIAL as f32 { v as u32 } else { NO_MATERIAL };
+                    attrs.material = Some(attrs.keys.iter().map(|&k| id(f(&at(k), 0))).collect());
+                }
+            }
+        }
+        loaded.attributes = Some(attrs);
+    }
+    Ok(loaded)
 }
 
-fn read_grid(c: &mut Cur<'_>) -> Result<LoadedVoxels, ErrorKind> {
+/// The grid head up to its tree: compression flags, metadata, transform.
+struct Head {
+    mask_compressed: bool,
+    meta: Vec<(String, String, Vec<u8>)>,
+    translation: [f64; 3],
+    scale: [f64; 3],
+}
+
+fn read_head(c: &mut Cur<'_>) -> Result<Head, ErrorKind> {
     let compression = c.u32()?;
     if compression & (COMPRESS_ZIP | COMPRESS_BLOSC) != 0 {
         return Err(bad("zip/blosc-compressed grids are not supported (voxkit writes uncompressed VDB; re-save without compression)"));
     }
     let mask_compressed = compression & COMPRESS_ACTIVE_MASK != 0;
     let meta = read_meta(c)?;
-    let get = |n: &str| meta.iter().find(|m| m.0 == n).map(|m| m.2.clone());
     let map = c.string()?;
     let (translation, scale) = match map.as_str() {
         "UniformScaleTranslateMap" | "ScaleTranslateMap" => {
@@ -632,27 +814,90 @@ fn read_grid(c: &mut Cur<'_>) -> Result<LoadedVoxels, ErrorKind> {
         "TranslationMap" => (c.vec3d()?, [1.0; 3]),
         m => return Err(bad(format!("transform {m} is not supported (voxkit reads scale and translation maps)"))),
     };
+    Ok(Head { mask_compressed, meta, translation, scale })
+}
+
+/// A tree's root and internal nodes, values `vs` bytes each.
+fn read_topology(c: &mut Cur<'_>, mask_compressed: bool, vs: usize) -> Result<Found, ErrorKind> {
     if c.i32()? != 1 {
         return Err(bad("multi-buffer trees are not supported"));
     }
-    c.u8()?; // background
+    c.take(vs)?; // background
     let (ntiles, nchildren) = (c.u32()? as usize, c.u32()? as usize);
-    // Each tile takes 14 bytes, each child at least 12 + 2·4096 + 1.
-    if ntiles.saturating_mul(14).saturating_add(nchildren.saturating_mul(8205)) > c.b.len() - c.at {
+    // Each tile takes 13 + vs bytes, each child at least 12 + 2·4096 + 1.
+    if ntiles.saturating_mul(13 + vs).saturating_add(nchildren.saturating_mul(8205)) > c.b.len() - c.at {
         return Err(bad(format!("root claims {ntiles} tiles and {nchildren} children, more than the file holds")));
     }
     let mut found = Found::default();
     for _ in 0..ntiles {
         let o = c.coord()?;
-        let (value, active) = (c.u8()?, c.u8()?);
-        if value != 0 && active != 0 {
-            found.tiles.push((o.map(|v| v as i64), 1 << UPPER));
+        let mut val = [0u8; 12];
+        val[..vs].copy_from_slice(c.take(vs)?);
+        if c.u8()? != 0 {
+            found.tiles.push((o.map(|v| v as i64), 1 << UPPER, val));
         }
     }
     for _ in 0..nchildren {
         let o = c.coord()?;
-        read_internal(c, o.map(|v| v as i64), UPPER, LOWER, mask_compressed, &mut found)?;
+        read_internal(c, o.map(|v| v as i64), (UPPER, LOWER), mask_compressed, vs, &mut found)?;
     }
+    Ok(found)
+}
+
+/// An attribute grid's active values, looked up by index coordinate.
+struct GridValues {
+    vs: usize,
+    /// Leaf origin → (active mask, active values).
+    leaves: std::collections::HashMap<[i64; 3], (Vec<u64>, Vec<u8>)>,
+    /// (Tile origin, edge) → value.
+    tiles: std::collections::HashMap<([i64; 3], i64), [u8; 12]>,
+}
+
+impl GridValues {
+    /// The value at `p`: its leaf's if it is active there, else an active
+    /// tile's, else zero (the background voxkit writes).
+    fn at(&self, p: [i64; 3]) -> [u8; 12] {
+        let mut out = [0u8; 12];
+        if let Some((mask, vals)) = self.leaves.get(&p.map(|c| c & !7)) {
+            let n = ((p[0] & 7) * 64 + (p[1] & 7) * 8 + (p[2] & 7)) as usize;
+            if bit(mask, n) {
+                let below = mask[..n / 64].iter().map(|w| w.count_ones() as usize).sum::<usize>()
+                    + (mask[n / 64] & ((1u64 << (n % 64)) - 1)).count_ones() as usize;
+                out[..self.vs].copy_from_slice(&vals[below * self.vs..(below + 1) * self.vs]);
+            }
+            return out;
+        }
+        for edge in [1i64 << LEAF, 1 << LOWER, 1 << UPPER] {
+            if let Some(v) = self.tiles.get(&(p.map(|c| c & !(edge - 1)), edge)) {
+                return *v;
+            }
+        }
+        out
+    }
+}
+
+fn read_values_grid(c: &mut Cur<'_>, vs: usize) -> Result<GridValues, ErrorKind> {
+    let head = read_head(c)?;
+    if head.meta.iter().any(|m| m.0 == "is_saved_as_half_float" && m.2.first().is_some_and(|&b| b != 0)) {
+        return Err(bad("half-float grids are not supported (voxkit writes 32-bit floats)"));
+    }
+    let found = read_topology(c, head.mask_compressed, vs)?;
+    let mut leaves = std::collections::HashMap::with_capacity(found.leaves.len());
+    for o in &found.leaves {
+        let active = c.words(8)?;
+        let vals = read_values(c, &active, 512, head.mask_compressed, vs)?;
+        leaves.insert(*o, (active, vals));
+    }
+    let tiles = found.tiles.iter().map(|(o, e, v)| ((*o, *e), *v)).collect();
+    Ok(GridValues { vs, leaves, tiles })
+}
+
+/// The bool grid at the cursor, and the index coordinate of voxel (0, 0, 0).
+fn read_grid(c: &mut Cur<'_>) -> Result<(LoadedVoxels, [i64; 3]), ErrorKind> {
+    let Head { mask_compressed, meta, translation, scale } = read_head(c)?;
+    let get = |n: &str| meta.iter().find(|m| m.0 == n).map(|m| m.2.clone());
+    let mut found = read_topology(c, mask_compressed, 1)?;
+    found.tiles.retain(|t| t.2[0] != 0);
     let mut leaves: Vec<([i64; 3], Vec<u64>)> = Vec::with_capacity(found.leaves.len());
     for expect in &found.leaves {
         let active = c.words(8)?;
@@ -676,7 +921,7 @@ fn read_grid(c: &mut Cur<'_>) -> Result<LoadedVoxels, ErrorKind> {
             hi[a] = hi[a].max(q[a]);
         }
     };
-    for (o, e) in &found.tiles {
+    for (o, e, _) in &found.tiles {
         grow(*o, o.map(|c| c + e - 1));
     }
     for (o, m) in &leaves {
@@ -702,7 +947,7 @@ fn read_grid(c: &mut Cur<'_>) -> Result<LoadedVoxels, ErrorKind> {
         Ok(q.map(|c| c as u32))
     };
     let mut tiles = Vec::with_capacity(found.tiles.len());
-    for (o, e) in &found.tiles {
+    for (o, e, _) in &found.tiles {
         // A tile is inside the grid when its two corners are.
         tiles.push((inside(*o)?, inside(o.map(|c| c + e - 1))?));
     }
@@ -741,7 +986,7 @@ fn read_grid(c: &mut Cur<'_>) -> Result<LoadedVoxels, ErrorKind> {
         }
         _ => None,
     };
-    Ok(LoadedVoxels { bits, placement, attributes: None })
+    Ok((LoadedVoxels { bits, placement, attributes: None }, offset))
 }
 
 #[cfg(test)]
@@ -758,7 +1003,7 @@ mod tests {
         }
         let grid = GridSpec::new(DVec3::new(-1.0, 2.0, 0.5), 0.25, dims.map(|x| x as u64)).unwrap();
         let mut buf = Vec::new();
-        write(&mut buf, &d, &grid).unwrap();
+        write(&mut buf, &d, &grid, None).unwrap();
         let back = read(&buf).unwrap();
         assert_eq!(back.bits, d);
         let (o, s) = back.placement.unwrap();
@@ -798,7 +1043,7 @@ mod tests {
         );
         let grid = GridSpec::new(DVec3::ZERO, 0.5, dims.map(|x| x as u64)).unwrap();
         let mut buf = Vec::new();
-        write(&mut buf, &sparse, &grid).unwrap();
+        write(&mut buf, &sparse, &grid, None).unwrap();
         assert!(buf.len() < 20_000, "{} bytes", buf.len());
         let back = read(&buf).unwrap();
         assert_eq!(back.bits, sparse.to_dense());
@@ -823,7 +1068,7 @@ mod tests {
         d.set(1, 2, 3);
         let grid = GridSpec::new(DVec3::ZERO, 1.0, [4, 4, 4]).unwrap();
         let mut buf = Vec::new();
-        write(&mut buf, &d, &grid).unwrap();
+        write(&mut buf, &d, &grid, None).unwrap();
         let ty = buf.windows(GRID_TYPE.len()).position(|w| w == GRID_TYPE.as_bytes()).unwrap();
         let desc = ty - 4 - 4 - "voxels".len();
         buf[desc - 4..desc].copy_from_slice(&i32::MAX.to_le_bytes());
@@ -833,5 +1078,102 @@ mod tests {
         buf[end..end + 8].copy_from_slice(&(desc as i64).to_le_bytes());
         let e = read(&buf).unwrap_err().to_string();
         assert!(e.contains("before its own descriptor"), "{e}");
+    }
+
+    /// Attributes are written as `Cd`, `normal`, `coverage` and `material`
+    /// grids over the voxels (full bricks as leaves, not tiles) and read
+    /// back exactly: colours byte for byte through linear light, the
+    /// other values bit for bit, "no material" as -1.
+    #[test]
+    fn attributes_round_trip() {
+        let dims = [140, 20, 17];
+        let mut d = DenseBits::new(dims);
+        d.fill_box([8, 8, 8], [15, 15, 15]); // one full brick
+        for (i, j, k) in [(0, 0, 0), (139, 19, 16), (128, 3, 9), (16, 8, 8), (7, 7, 7)] {
+            d.set(i, j, k);
+        }
+        let mut keys = Vec::new();
+        d.for_each_set(|i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
+        keys.sort_unstable();
+        let n = keys.len();
+        let attrs = VoxelAttributes {
+            dims,
+            colour: Some((0..n).map(|s| [(s * 37 % 256) as u8, (s * 101 % 256) as u8, 255 - (s % 256) as u8]).collect()),
+            material: Some((0..n).map(|s| if s % 3 == 0 { NO_MATERIAL } else { s as u32 }).collect()),
+            normal: Some((0..n).map(|s| [s as f32 * 0.25, -0.5, 1.0 / (s as f32 + 1.0)]).collect()),
+            coverage: Some((0..n).map(|s| s as f32 / 7.0).collect()),
+            keys,
+        };
+        let grid = GridSpec::new(DVec3::new(1.0, -2.0, 3.0), 0.5, dims.map(|x| x as u64)).unwrap();
+        let mut buf = Vec::new();
+        write(&mut buf, &d, &grid, Some(&attrs)).unwrap();
+        let back = read(&buf).unwrap();
+        assert_eq!(back.bits, d);
+        assert_eq!(back.attributes.as_ref(), Some(&attrs));
+        // Without attributes: the bool grid alone, as before.
+        let mut plain = Vec::new();
+        write(&mut plain, &d, &grid, None).unwrap();
+        assert!(read(&plain).unwrap().attributes.is_none());
+        for n in (0..buf.len()).step_by(61) {
+            assert!(read(&buf[..n]).is_err());
+        }
+        // Every sRGB byte survives linear f32 storage.
+        for c in 0..=255u8 {
+            assert_eq!(from_linear(to_linear(c) as f32 as f64), c);
+        }
+    }
+
+    /// Attributes that do not cover a set voxel are an error, not a
+    /// silently zero value.
+    #[test]
+    fn attributes_must_cover_the_voxels() {
+        let mut d = DenseBits::new([4, 4, 4]);
+        d.set(1, 2, 3);
+        d.set(2, 2, 3);
+        let attrs = VoxelAttributes {
+            dims: [4, 4, 4],
+            keys: vec![VoxelAttributes::key([4, 4, 4], 1, 2, 3)],
+            coverage: Some(vec![1.0]),
+            ..Default::default()
+        };
+        let grid = GridSpec::new(DVec3::ZERO, 1.0, [4, 4, 4]).unwrap();
+        let e = write(&mut Vec::new(), &d, &grid, Some(&attrs)).unwrap_err().to_string();
+        assert!(e.contains("no attributes"), "{e}");
+    }
+
+    /// Node values in each of OpenVDB's seven compression-metadata layouts
+    /// (`io::writeCompressedValues`): inactive values after the byte for 2
+    /// and 4 (one) and 5 (two), a selection mask for 3, 4 and 5, then the
+    /// active values only — or all of them for 6 or without mask
+    /// compression. Each is read to its last byte and gives the active values.
+    #[test]
+    fn node_values_in_every_metadata_layout() {
+        let mut active = [0u64; 8];
+        active[0] = 0b1011;
+        active[7] = 1 << 63;
+        let on: Vec<usize> = (0..512).filter(|&i| bit(&active, i)).collect();
+        let value = |i: usize| (i as f32 * 1.5).to_le_bytes();
+        let want: Vec<u8> = on.iter().flat_map(|&i| value(i)).collect();
+        let actives: Vec<u8> = want.clone();
+        let all: Vec<u8> = (0..512).flat_map(value).collect();
+        let mask = vec![0xa5u8; 64];
+        for (meta, extra, body, compressed) in [
+            (0u8, vec![], &actives, true),
+            (1, vec![], &actives, true),
+            (2, vec![9u8; 4], &actives, true),
+            (3, mask.clone(), &actives, true),
+            (4, [vec![9u8; 4], mask.clone()].concat(), &actives, true),
+            (5, [vec![9u8; 8], mask.clone()].concat(), &actives, true),
+            (6, vec![], &all, true),
+            (0, vec![], &all, false),
+        ] {
+            let bytes = [vec![meta], extra, body.clone(), vec![0xee]].concat();
+            let mut c = Cur { b: &bytes, at: 0 };
+            let got = read_values(&mut c, &active, 512, compressed, 4).unwrap();
+            assert_eq!(got, want, "metadata {meta}");
+            assert_eq!(c.at, bytes.len() - 1, "metadata {meta}: read to the wrong byte");
+        }
+        let mut c = Cur { b: &[7], at: 0 };
+        assert!(read_values(&mut c, &active, 512, true, 4).is_err());
     }
 }

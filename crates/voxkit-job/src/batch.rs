@@ -50,6 +50,8 @@ pub struct BatchOptions {
     pub format: Output,
     /// Colour rule and normals, when the format stores attributes.
     pub carry: CarryOptions,
+    /// `--attributes`: every attribute array into `.vdb` outputs.
+    pub attributes: bool,
     /// Writer options.
     pub write: WriteOptions,
     /// Worker threads per mesh (`None`: share the batch's pool).
@@ -241,7 +243,7 @@ pub fn process_one(item: &Item, opts: &BatchOptions) -> Value {
         let run = || -> Result<Value> {
             let v = crate::voxelize(&opts.plan, loaded.mesh.as_ref(), &name, None)?;
             let t = Instant::now();
-            let attrs = crate::run::attributes_for(&opts.plan, &loaded, &v, opts.format, false, &opts.carry);
+            let attrs = crate::run::attributes_for(&opts.plan, &loaded, &v, opts.format, (false, opts.attributes), &opts.carry)?;
             let attributes_s = t.elapsed().as_secs_f64();
             let t = Instant::now();
             crate::output::write(&item.output, opts.format, &v.voxels, &v.grid, attrs.as_ref(), &opts.write)?;
@@ -376,6 +378,8 @@ pub struct FingerprintParts<'a> {
     pub colour_rule: &'a str,
     /// Normals carried.
     pub normals: bool,
+    /// Every attribute array into `.vdb` (`--attributes`).
+    pub attributes: bool,
     /// `.vox` dithering.
     pub dither: bool,
     /// `.vox`/`.schem` up axis.
@@ -393,7 +397,7 @@ pub struct FingerprintParts<'a> {
 /// resumed run compares.
 pub fn fingerprint(p: &FingerprintParts<'_>) -> Value {
     let g = p.grid;
-    json!({
+    let mut v = json!({
         "mode": p.mode,
         "method": p.method,
         "resolution": g.resolution.or((!g.any()).then_some(128)),
@@ -413,5 +417,10 @@ pub fn fingerprint(p: &FingerprintParts<'_>) -> Value {
         "watertight": p.watertight,
         "triangulate": p.triangulate,
         "seed": p.seed,
-    })
+    });
+    // Only when set, so manifests written before the option existed still resume.
+    if p.attributes {
+        v["attributes"] = json!(true);
+    }
+    v
 }

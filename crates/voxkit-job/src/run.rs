@@ -207,24 +207,43 @@ pub fn attributes(plan: &Plan, mesh: MeshRef<'_>, appearance: &Appearance, v: &V
     (!plan.is_line() && !matches!(v.voxels, Voxels::Sparse(_))).then(|| carry(mesh, appearance, &v.grid, v.voxels.source(), opts))
 }
 
+/// True when `format` gets every attribute array: `.vti` always, `.vdb`
+/// when `asked` (`--attributes`).
+pub fn every_attribute(format: crate::output::Output, asked: bool) -> bool {
+    use voxkit_io::VoxelFormat as F;
+    format == crate::output::Output::Voxels(F::Vti) || (asked && format == crate::output::Output::Voxels(F::Vdb))
+}
+
+/// `--attributes` (`asked`) for `.vdb` on a grid that ran tiled: refused,
+/// not dropped, since carrying needs a whole-grid brick index.
+pub fn check_attributes_carried(format: crate::output::Output, asked: bool, v: &Voxelized) -> Result<()> {
+    if asked && every_attribute(format, true) && matches!(v.voxels, Voxels::Sparse(_)) {
+        return Err(JobError::invalid(
+            "--attributes: attributes are not carried on tiled grids yet (this grid ran tiled: past --max-memory, or --tile); drop --attributes for the voxels alone",
+        ));
+    }
+    Ok(())
+}
+
 /// The attributes an output needs: colours where the format stores them
 /// (or a `preview` picture shows them) and the mesh has them, every array
-/// for `.vti`; `None` otherwise.
+/// for `.vti` and, when `asked`, for `.vdb`; `None` otherwise. Errors
+/// when `.vdb` attributes were asked for a tiled grid.
 pub fn attributes_for(
     plan: &Plan,
     loaded: &voxkit_io::LoadedMesh,
     v: &Voxelized,
     format: crate::output::Output,
-    preview: bool,
+    (preview, asked): (bool, bool),
     opts: &CarryOptions,
-) -> Option<VoxelAttributes> {
-    let is_vti = format == crate::output::Output::Voxels(voxkit_io::VoxelFormat::Vti);
+) -> Result<Option<VoxelAttributes>> {
+    check_attributes_carried(format, asked, v)?;
     let want_colour = loaded.appearance.has_colour() && (format.has_colour() || preview);
-    if want_colour || is_vti {
+    Ok(if want_colour || every_attribute(format, asked) {
         attributes(plan, loaded.mesh.as_ref(), &loaded.appearance, v, opts)
     } else {
         None
-    }
+    })
 }
 
 impl Voxelized {

@@ -47,6 +47,7 @@ pub fn run(a: &BatchArgs) -> Result<()> {
         format: format.name(),
         colour_rule: &colour_rule,
         normals: a.export.normals,
+        attributes: a.export.attributes,
         dither: a.export.dither,
         up: crate::commands::export::up(&a.export).name(),
         watertight: a.export.watertight.as_deref() != Some("off"),
@@ -56,7 +57,11 @@ pub fn run(a: &BatchArgs) -> Result<()> {
     let opts = BatchOptions {
         plan,
         format,
-        carry: CarryOptions { rule: crate::commands::export::colour_rule(a.export.colour_rule), normals: a.export.normals },
+        carry: CarryOptions {
+            rule: crate::commands::export::colour_rule(a.export.colour_rule),
+            normals: a.export.normals || a.export.attributes,
+        },
+        attributes: a.export.attributes,
         write,
         threads: None,
         read: voxkit_io::ReadOptions { allow_external_paths: a.allow_external_paths },

@@ -61,6 +61,13 @@ pub fn warn_unused(e: &ExportArgs, format: Output, output: &Path, from_mesh: boo
     if e.normals && (!from_mesh || format != Output::Voxels(F::Vti)) {
         unused.push(if from_mesh { "--normals (for .vti)" } else { "--normals (normals come from a mesh)" });
     }
+    if e.attributes && (!from_mesh || format != Output::Voxels(F::Vdb)) {
+        unused.push(if from_mesh {
+            "--attributes (for .vdb)"
+        } else {
+            "--attributes (attributes come from a mesh; convert writes those the input has)"
+        });
+    }
     if e.colour_rule != ColourRule::Dominant && (!from_mesh || !format.has_colour()) {
         unused.push(if from_mesh { "--colour-rule (for coloured formats)" } else { "--colour-rule (colours come from a mesh)" });
     }

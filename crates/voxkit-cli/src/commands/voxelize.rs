@@ -5,7 +5,7 @@ use std::time::Instant;
 use anyhow::Result;
 use serde_json::json;
 use voxkit::attributes::carry::CarryOptions;
-use voxkit_job::output::{check_output_path, output_format, Output};
+use voxkit_job::output::{check_output_path, output_format};
 
 use crate::args::VoxelizeArgs;
 use crate::plan;
@@ -61,19 +61,24 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let grid = v.grid;
 
     // Attributes: colours for the formats that store them (and the preview),
-    // every array (coverage, material, normal) for .vti.
-    let is_vti = format == Output::Voxels(voxkit_io::VoxelFormat::Vti);
+    // every array (coverage, material, normal) for .vti, and for .vdb with
+    // --attributes (refused, not dropped, on a tiled grid).
+    voxkit_job::check_attributes_carried(format, a.export.attributes, &v)?;
+    let every = voxkit_job::every_attribute(format, a.export.attributes);
     let app = &loaded.appearance;
     let want_colour = app.has_colour() && (format.has_colour() || preview.is_some());
     let t_attr = Instant::now();
     let tiled = matches!(v.voxels, voxkit_job::Voxels::Sparse(_));
-    if tiled && (want_colour || is_vti || preview.is_some()) && !a.quiet && !a.json {
+    if tiled && (want_colour || every || preview.is_some()) && !a.quiet && !a.json {
         eprintln!("voxkit: warning: colours, .vti arrays and --preview are not made for tiled grids yet; writing the voxels alone");
     }
     let preview = preview.filter(|_| !tiled);
-    let attrs = (!tiled && (want_colour || is_vti)).then(|| {
+    let attrs = (!tiled && (want_colour || every)).then(|| {
         bar.phase("carrying colours into voxels");
-        let opts = CarryOptions { rule: crate::commands::export::colour_rule(a.export.colour_rule), normals: a.export.normals };
+        let opts = CarryOptions {
+            rule: crate::commands::export::colour_rule(a.export.colour_rule),
+            normals: a.export.normals || a.export.attributes,
+        };
         pool.install(|| voxkit_job::attributes(&plan, loaded.mesh.as_ref(), app, &v, &opts))
     });
     let attrs = attrs.flatten();
