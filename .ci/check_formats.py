@@ -192,6 +192,27 @@ with tempfile.TemporaryDirectory() as d:
     n = int(da.from_zarr(str(d / "t.zarr")).sum().compute())
     check("zarr: tiled sep6 at 2048 read by Dask has voxkit's count", s["method"] == "tiled" and n == s["voxels"], (n, s["voxels"]))
 
+    # --attributes: a Zarr group of `voxels` and attribute arrays with the
+    # same chunking, equal to the .vti arrays VTK read above (same run);
+    # Dask opens each array by component.
+    s = voxelize(spot, d / "s.zarr", "--resolution", "64", "--attributes")
+    voxelize(spot, d / "sn.vti", "--resolution", "64", "--normals")
+    rn = vtk.vtkXMLImageDataReader()  # a reader of its own: the arrays above are views into r's output
+    rn.SetFileName(str(d / "sn.vti"))
+    rn.Update()
+    vnorm = vtk_to_numpy(rn.GetOutput().GetCellData().GetArray("normal")).reshape(nz, ny, nx, 3).transpose(2, 1, 0, 3).copy()
+    g = zarr.open_group(str(d / "s.zarr"), mode="r")
+    check("zarr attributes: a group with voxels, colour, normal, coverage, material",
+          sorted(g.array_keys()) == ["colour", "coverage", "material", "normal", "voxels"], sorted(g.array_keys()))
+    check("zarr attributes: voxels = npy", np.array_equal(g["voxels"][:], occ))
+    check("zarr attributes: colour (uint8, last axis 3) = vti", g["colour"].dtype == np.uint8 and np.array_equal(g["colour"][:], vcol), g["colour"].shape)
+    check("zarr attributes: coverage = vti", np.array_equal(g["coverage"][:], cov))
+    check("zarr attributes: material (int32, -1 elsewhere) = vti", g["material"].dtype == np.int32 and np.array_equal(g["material"][:], mat))
+    check("zarr attributes: normal = vti --normals", np.array_equal(g["normal"][:], vnorm))
+    check("zarr attributes: same chunking as voxels", g["coverage"].chunks == g["voxels"].chunks and g["colour"].chunks == g["voxels"].chunks + (3,), g["colour"].chunks)
+    dc = da.from_zarr(str(d / "s.zarr"), component="colour")
+    check("zarr attributes: Dask reads the colour array", np.array_equal(dc.compute(), vcol))
+
     # .npz of sparse coordinates: NumPy's own loader reads the (k, 3)
     # indices and the grid; scattered into a grid they equal the .npy; a
     # tiled run past --max-memory writes one too, with voxkit's count.

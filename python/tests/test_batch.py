@@ -146,3 +146,27 @@ def test_ray_tasks_write_what_batch_writes(tmp_path, dataset):
         assert np.array_equal(a[k], b[k]), k
     s = voxkit.batch(dataset, out, resolution=24, glob="**/*.obj")
     assert s["skipped"] == 6
+
+
+def test_batch_attributes_into_vdb(tmp_path, meshes, cli):
+    """``attributes=True`` (``--attributes``) writes the attribute grids
+    into each .vdb, the same bytes from Python and the CLI, and is part of
+    the options a resumed batch compares."""
+    src = tmp_path / "in"
+    src.mkdir()
+    shutil.copy(meshes / "spot-textured.obj", src)
+    shutil.copy(meshes / "spot.mtl", src)
+    shutil.copy(meshes / "spot_texture.png", src)
+    plain, py_out, cli_out = tmp_path / "plain", tmp_path / "py", tmp_path / "cli"
+    assert voxkit.batch(src, plain, format="vdb", resolution=24)["done"] == 1
+    assert voxkit.batch(src, py_out, format="vdb", resolution=24, attributes=True)["done"] == 1
+    run_cli(cli, "batch", src, "-o", cli_out, "--format", "vdb", "--resolution", 24, "--attributes", "--json")
+    a, b = (py_out / "spot-textured.vdb").read_bytes(), (cli_out / "spot-textured.vdb").read_bytes()
+    assert a == b
+    assert len(a) > len((plain / "spot-textured.vdb").read_bytes())
+    for name in (b"Cd", b"normal", b"coverage", b"material"):
+        assert name in a
+    assert manifest(py_out)[0]["options"]["attributes"] is True
+    assert "attributes" not in manifest(plain)[0]["options"]
+    # Other options redo the mesh: attributes asked for after a plain run.
+    assert voxkit.batch(src, plain, format="vdb", resolution=24, attributes=True)["done"] == 1

@@ -228,11 +228,13 @@ pub struct ExportArgs {
     /// .vti: also store each voxel's average surface normal.
     #[arg(long)]
     pub normals: bool,
-    /// .vdb: also write what the surface carries into each voxel, as grids
-    /// over the same voxels beside the `voxels` bool grid: `Cd` (colour,
-    /// linear RGB; when the mesh has colours), `normal`, `coverage`
+    /// .vdb and .zarr: also write what the surface carries into each voxel.
+    /// .vdb: grids over the same voxels beside the `voxels` bool grid: `Cd`
+    /// (colour, linear RGB; when the mesh has colours), `normal`, `coverage`
     /// (surface area inside the voxel over a voxel face's) and `material`
-    /// (the id as a float, -1 for none; when the mesh has materials).
+    /// (the id as a float, -1 for none). .zarr: a group of arrays `voxels`,
+    /// `colour` (uint8 sRGB, last axis of 3), `normal` (float32, 3),
+    /// `coverage` (float32) and `material` (int32, -1 for none).
     #[arg(long)]
     pub attributes: bool,
     /// .vox: dither colours onto the 255-colour palette (error diffusion; off by default).

@@ -562,9 +562,9 @@ fn tiled_runs_write_the_same_files_and_vdb_reads_back() {
 }
 
 /// `--attributes` writes the surface's attributes into `.vdb` as grids
-/// beside the voxels: converting that file to `.vti` gives the very bytes
-/// `voxelize` writes to `.vti` (colour, material, coverage, normal), for a
-/// surface and for a solid. Asked for a tiled grid it is refused in one
+/// beside the voxels (and into `.zarr` as a group of arrays): converting
+/// that file to `.vti` gives the very bytes `voxelize` writes to `.vti`
+/// (colour, material, coverage, normal), for a surface and for a solid. Asked for a tiled grid it is refused in one
 /// line, and nothing is written.
 #[test]
 fn vdb_attributes_carry_every_array() {
@@ -596,10 +596,16 @@ fn vdb_attributes_carry_every_array() {
     let out = voxkit(&["voxelize", &spot, "-o", &tmp("attrs.npy"), "--resolution", "16", "--attributes"]);
     assert!(out.status.success());
     assert!(
-        String::from_utf8_lossy(&out.stderr).contains("--attributes (for .vdb) does nothing"),
+        String::from_utf8_lossy(&out.stderr).contains("--attributes (for .vdb and .zarr) does nothing"),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // .zarr: a group of arrays, converted back to the same .vti.
+    let (z, back) = (tmp("attrs.zarr"), tmp("attrs-back-zarr.vti"));
+    json(&voxkit(&["voxelize", &spot, "-o", &z, "--resolution", "48", "--attributes", "--json"]));
+    let c = voxkit(&["convert", &z, &back]);
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    assert_eq!(std::fs::read(tmp("attrs-cover.vti")).unwrap(), std::fs::read(&back).unwrap(), ".zarr attributes differ from .vti's");
 }
 
 /// Solids past memory: parity and winding run brick row by brick row into

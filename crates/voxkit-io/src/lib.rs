@@ -266,7 +266,7 @@ pub fn write_voxels_with(
                 ErrorKind::Write(std::io::Error::other("a Zarr array is a directory; give a path ending in .zarr")),
             ));
         }
-        return zarr::write(path, bits, grid);
+        return zarr::write(path, bits, grid, attrs);
     }
     atomic::write_atomically(path, |w| match format {
         VoxelFormat::Npy => npy::write(w, bits, npy::Dtype::U8),

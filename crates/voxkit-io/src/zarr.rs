@@ -23,7 +23,16 @@
 //! chunks, padded with `false`. The Python `zarr` package (and Dask,
 //! `dask.array.from_zarr`) opens it as one array; CI checks every voxel.
 //!
-//! The reader takes voxkit's arrays and plain (unsharded) ones with the
+//! **Attributes** (`--attributes`): the directory is a Zarr group
+//! (`node_type` `group`, `attributes.voxkit` with the grid and the array
+//! names) holding the array above as `voxels/` and, with the same shards
+//! and chunks, `colour/` (`uint8`, sRGB, shape `[nx, ny, nz, 3]`, chunks
+//! `[64, 64, 64, 3]`, keys `c/a/b/c/0`), `normal/` (`float32`, 3
+//! components likewise), `coverage/` (`float32`) and `material/`
+//! (`int32`, fill -1: none), little-endian; elements off the voxels hold
+//! the fill value.
+//!
+//! The reader takes voxkit's arrays and groups, and plain (unsharded) ones with the
 //! `bytes` and `gzip` codecs, as the `zarr` package writes them; a shard
 //! index's `crc32c` checksum, where present, is skipped, not verified
 //! (every offset is still bounds-checked).
@@ -39,6 +48,7 @@ use flate2::read::GzDecoder;
 use flate2::write::GzEncoder;
 use rayon::prelude::*;
 use serde_json::{json, Value};
+use voxkit::attributes::{VoxelAttributes, NO_MATERIAL};
 use voxkit::grid::bricks::Brick;
 use voxkit::{GridSpec, VoxelSource};
 
@@ -60,32 +70,127 @@ fn shard_shape(dims: [u32; 3]) -> [u32; 3] {
 /// An empty inner chunk's index entry (offset and size both all ones).
 const EMPTY: u64 = u64::MAX;
 
-/// The array's metadata document.
-fn metadata(grid: &GridSpec) -> Value {
+/// The grid placement voxkit records in `attributes.voxkit`.
+fn placement(grid: &GridSpec) -> Value {
     let o = grid.origin();
+    json!({"voxkit": {"origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size()}})
+}
+
+/// An array's metadata document: occupancy (`bool`), or an attribute with
+/// `comps` components per voxel as a trailing axis `c` of that length.
+fn metadata(grid: &GridSpec, kind: &Kind<'_>) -> Value {
+    // Multi-byte values say their byte order; one-byte ones need none.
+    let bytes = if kind.bytes as u32 > kind.comps {
+        json!({"name": "bytes", "configuration": {"endian": "little"}})
+    } else {
+        json!({"name": "bytes"})
+    };
+    let (mut shape, mut shard, mut inner, mut names) =
+        (grid.dims().to_vec(), shard_shape(grid.dims()).to_vec(), vec![CHUNK; 3], vec!["i", "j", "k"]);
+    if kind.comps > 1 {
+        shape.push(kind.comps);
+        shard.push(kind.comps);
+        inner.push(kind.comps);
+        names.push("c");
+    }
     json!({
         "zarr_format": 3,
         "node_type": "array",
-        "shape": grid.dims(),
-        "data_type": "bool",
-        "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": shard_shape(grid.dims())}},
+        "shape": shape,
+        "data_type": kind.data_type,
+        "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": shard}},
         "chunk_key_encoding": {"name": "default", "configuration": {"separator": "/"}},
-        "fill_value": false,
+        "fill_value": kind.fill_value,
         "codecs": [{"name": "sharding_indexed", "configuration": {
-            "chunk_shape": [CHUNK, CHUNK, CHUNK],
-            "codecs": [{"name": "bytes"}, {"name": "gzip", "configuration": {"level": 1}}],
+            "chunk_shape": inner,
+            "codecs": [bytes, {"name": "gzip", "configuration": {"level": 1}}],
             "index_codecs": [{"name": "bytes", "configuration": {"endian": "little"}}],
             "index_location": "end",
         }}],
-        "dimension_names": ["i", "j", "k"],
-        "attributes": {"voxkit": {"origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size()}},
+        "dimension_names": names,
+        "attributes": placement(grid),
     })
 }
 
-/// One chunk's bytes (C order, `k` fastest) from its bricks.
-fn chunk_bytes(bricks: &[([u32; 3], Brick)]) -> Vec<u8> {
+/// Appends the value of the voxel in an attribute slot, little-endian.
+type PutValue<'a> = Box<dyn Fn(usize, &mut Vec<u8>) + Sync + 'a>;
+
+/// What one array holds: the occupancy (`put` is `None`: one byte, 1 where
+/// set) or an attribute, `comps` values of `data_type` per voxel.
+struct Kind<'a> {
+    name: &'static str,
+    data_type: &'static str,
+    comps: u32,
+    /// Bytes per voxel (all components).
+    bytes: usize,
+    fill_value: Value,
+    /// One voxel's fill bytes.
+    fill: Vec<u8>,
+    put: Option<(&'a VoxelAttributes, PutValue<'a>)>,
+}
+
+/// The occupancy array.
+fn occupancy<'a>() -> Kind<'a> {
+    Kind { name: "voxels", data_type: "bool", comps: 1, bytes: 1, fill_value: json!(false), fill: vec![0], put: None }
+}
+
+/// The attribute arrays of `attrs`: `colour` (uint8 × 3, sRGB), `normal`
+/// (float32 × 3), `coverage` (float32), `material` (int32, -1 for none).
+fn attribute_arrays(attrs: &VoxelAttributes) -> Vec<Kind<'_>> {
+    let mut out = Vec::new();
+    let f32s = |b: &mut Vec<u8>, v: &[f32]| v.iter().for_each(|x| b.extend_from_slice(&x.to_le_bytes()));
+    if let Some(c) = &attrs.colour {
+        let put: PutValue<'_> = Box::new(move |s, b| b.extend_from_slice(&c[s]));
+        out.push(Kind {
+            name: "colour",
+            data_type: "uint8",
+            comps: 3,
+            bytes: 3,
+            fill_value: json!(0),
+            fill: vec![0; 3],
+            put: Some((attrs, put)),
+        });
+    }
+    if let Some(n) = &attrs.normal {
+        let put: PutValue<'_> = Box::new(move |s, b| f32s(b, &n[s]));
+        out.push(Kind {
+            name: "normal",
+            data_type: "float32",
+            comps: 3,
+            bytes: 12,
+            fill_value: json!(0.0),
+            fill: vec![0; 12],
+            put: Some((attrs, put)),
+        });
+    }
+    if let Some(c) = &attrs.coverage {
+        let put: PutValue<'_> = Box::new(move |s, b| f32s(b, &[c[s]]));
+        out.push(Kind {
+            name: "coverage",
+            data_type: "float32",
+            comps: 1,
+            bytes: 4,
+            fill_value: json!(0.0),
+            fill: vec![0; 4],
+            put: Some((attrs, put)),
+        });
+    }
+    if let Some(m) = &attrs.material {
+        let put: PutValue<'_> =
+            Box::new(move |s, b| b.extend_from_slice(&(if m[s] == NO_MATERIAL { -1 } else { m[s] as i32 }).to_le_bytes()));
+        let fill = (-1i32).to_le_bytes().to_vec();
+        out.push(Kind { name: "material", data_type: "int32", comps: 1, bytes: 4, fill_value: json!(-1), fill, put: Some((attrs, put)) });
+    }
+    out
+}
+
+/// One chunk's bytes (C order, `k` fastest, then the components) from its
+/// bricks: 1 per set voxel for the occupancy, else each set voxel's value
+/// and the fill value elsewhere.
+fn chunk_bytes(bricks: &[([u32; 3], Brick)], kind: &Kind<'_>) -> std::io::Result<Vec<u8>> {
     let c = CHUNK as usize;
-    let mut out = vec![0u8; c * c * c];
+    let mut out = kind.fill.repeat(c * c * c);
+    let mut value = Vec::with_capacity(kind.bytes);
     for (b, bits) in bricks {
         let base = b.map(|v| (v % (CHUNK / 8)) as usize * 8);
         for (z, &w) in bits.iter().enumerate() {
@@ -94,34 +199,72 @@ fn chunk_bytes(bricks: &[([u32; 3], Brick)]) -> Vec<u8> {
                 let bit = w.trailing_zeros() as usize;
                 w &= w - 1;
                 let (i, j, k) = (base[0] + (bit & 7), base[1] + (bit >> 3), base[2] + z);
-                out[(i * c + j) * c + k] = 1;
+                let at = ((i * c + j) * c + k) * kind.bytes;
+                match &kind.put {
+                    None => out[at] = 1,
+                    Some((attrs, put)) => {
+                        let v = [b[0] * 8 + (bit & 7) as u32, b[1] * 8 + (bit >> 3) as u32, b[2] * 8 + z as u32];
+                        let slot = attrs.slot(v[0], v[1], v[2]).ok_or_else(|| {
+                            std::io::Error::other(format!("voxel {v:?} is set but has no attributes (voxels and attributes differ)"))
+                        })?;
+                        value.clear();
+                        put(slot, &mut value);
+                        out[at..at + kind.bytes].copy_from_slice(&value);
+                    }
+                }
             }
         }
     }
-    out
+    Ok(out)
 }
 
 fn io(path: &Path, e: std::io::Error) -> IoError {
     IoError::new(path, ErrorKind::Write(e))
 }
 
-/// Writes `bits` on `grid` as a Zarr v3 array directory at `path`.
-pub fn write(path: &Path, bits: &dyn VoxelSource, grid: &GridSpec) -> Result<(), IoError> {
+/// Writes `bits` on `grid` as a Zarr v3 array directory at `path`; with
+/// `attrs` that have any array, a group holding the `voxels` array and one
+/// array per attribute.
+pub fn write(path: &Path, bits: &dyn VoxelSource, grid: &GridSpec, attrs: Option<&VoxelAttributes>) -> Result<(), IoError> {
     if path.exists() && !path.join("zarr.json").is_file() {
         return Err(io(path, std::io::Error::other("exists and is not a Zarr array; voxkit replaces only Zarr arrays")));
     }
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let tmp = path.with_file_name(format!(".{name}.voxkit-tmp-{}", std::process::id()));
-    let result = fill(&tmp, bits, grid).and_then(|_| replace(&tmp, path));
+    let extra = attrs.map(attribute_arrays).unwrap_or_default();
+    let result = fill_all(&tmp, bits, grid, extra).and_then(|_| replace(&tmp, path));
     if result.is_err() {
         let _ = std::fs::remove_dir_all(&tmp);
     }
     result.map_err(|e| io(path, e))
 }
 
-fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
+/// The occupancy array at `dir`, or with `extra` arrays a group there
+/// holding `voxels` and them.
+fn fill_all(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec, extra: Vec<Kind<'_>>) -> std::io::Result<()> {
+    if extra.is_empty() {
+        return fill(dir, bits, grid, &[occupancy()]);
+    }
     std::fs::create_dir_all(dir)?;
-    std::fs::write(dir.join("zarr.json"), serde_json::to_vec_pretty(&metadata(grid)).map_err(std::io::Error::other)?)?;
+    let names: Vec<&str> = std::iter::once("voxels").chain(extra.iter().map(|k| k.name)).collect();
+    let mut attributes = placement(grid);
+    attributes["voxkit"]["arrays"] = json!(names);
+    let group = json!({"zarr_format": 3, "node_type": "group", "attributes": attributes});
+    std::fs::write(dir.join("zarr.json"), serde_json::to_vec_pretty(&group).map_err(std::io::Error::other)?)?;
+    let mut kinds = vec![occupancy()];
+    kinds.extend(extra);
+    fill(dir, bits, grid, &kinds)
+}
+
+/// Writes each of `kinds` as an array: at `dir` itself for the occupancy
+/// alone, else at `dir/NAME`. The bricks are gathered and sorted once.
+fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec, kinds: &[Kind<'_>]) -> std::io::Result<()> {
+    let alone = kinds.len() == 1;
+    let dir_of = |k: &Kind<'_>| if alone { dir.to_path_buf() } else { dir.join(k.name) };
+    for k in kinds {
+        std::fs::create_dir_all(dir_of(k))?;
+        std::fs::write(dir_of(k).join("zarr.json"), serde_json::to_vec_pretty(&metadata(grid, k)).map_err(std::io::Error::other)?)?;
+    }
     // Bricks grouped by shard, then by chunk within it (C order of chunks).
     let shard = shard_shape(grid.dims());
     let inner = shard.map(|s| s / CHUNK);
@@ -135,7 +278,8 @@ fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<
         (shard_of(c), c)
     });
     let shards = crate::runs(&bricks, |(b, _)| shard_of(chunk_of(b)));
-    shards.par_iter().try_for_each(|r| -> std::io::Result<()> {
+    let work: Vec<(&Kind<'_>, &std::ops::Range<usize>)> = kinds.iter().flat_map(|k| shards.iter().map(move |r| (k, r))).collect();
+    work.par_iter().try_for_each(|&(kind, r)| -> std::io::Result<()> {
         let s = shard_of(chunk_of(&bricks[r.start].0));
         let mut body = Vec::new();
         let mut index = vec![EMPTY; 2 * (inner[0] * inner[1] * inner[2]) as usize];
@@ -144,16 +288,23 @@ fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<
             let c = chunk_of(&bricks[g.start].0);
             let n = (((c[0] % inner[0]) * inner[1] + c[1] % inner[1]) * inner[2] + c[2] % inner[2]) as usize;
             let mut enc = GzEncoder::new(Vec::new(), flate2::Compression::new(1));
-            enc.write_all(&chunk_bytes(&bricks[g]))?;
+            enc.write_all(&chunk_bytes(&bricks[g], kind)?)?;
             let z = enc.finish()?;
             index[2 * n] = body.len() as u64;
             index[2 * n + 1] = z.len() as u64;
             body.extend_from_slice(&z);
         }
         body.extend(index.iter().flat_map(|v| v.to_le_bytes()));
-        let d = dir.join("c").join(s[0].to_string()).join(s[1].to_string());
+        // Shard (a, b, c) at `c/a/b/c`; with a component axis (one chunk
+        // along it) at `c/a/b/c/0`.
+        let mut d = dir_of(kind).join("c").join(s[0].to_string()).join(s[1].to_string());
+        let mut file = s[2].to_string();
+        if kind.comps > 1 {
+            d = d.join(file);
+            file = "0".to_string();
+        }
         std::fs::create_dir_all(&d)?;
-        std::fs::write(d.join(s[2].to_string()), body)
+        std::fs::write(d.join(file), body)
     })
 }
 
@@ -208,9 +359,8 @@ fn chunk_codecs(codecs: &[Value]) -> Result<bool, ErrorKind> {
     Ok(gzip)
 }
 
-/// Decodes one chunk of `shape` into `buf` (one byte per element).
-fn decode(raw: &[u8], gzip: bool, shape: [u64; 3], buf: &mut Vec<u8>) -> Result<(), ErrorKind> {
-    let len = shape.iter().product::<u64>();
+/// Decodes one chunk of `len` bytes into `buf`.
+fn decode(raw: &[u8], gzip: bool, len: u64, buf: &mut Vec<u8>) -> Result<(), ErrorKind> {
     buf.clear();
     if gzip {
         GzDecoder::new(raw).take(len + 1).read_to_end(buf).map_err(|x| bad(x.to_string()))?;
@@ -239,20 +389,46 @@ fn place(bits: &mut voxkit::DenseBits, buf: &[u8], origin: [u64; 3], shape: [u64
     }
 }
 
-/// Reads a Zarr v3 array of `bool` or `uint8` (non-zero = set) with
-/// regular chunks, the `bytes` codec and optionally `gzip`, sharded
-/// (`sharding_indexed`) or not: voxkit's own arrays and those written the
-/// same way by the `zarr` package.
-pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
+/// A Zarr v3 array's metadata, as voxkit reads it.
+struct ArrayMeta {
+    /// Voxels per axis.
+    shape: [u64; 3],
+    /// The chunk (or shard) shape over the voxel axes.
+    chunk: [u64; 3],
+    /// Components per voxel: the length of a fourth axis, or 1 without one.
+    comps: u64,
+    /// The array has that fourth axis (its chunk keys have four indices).
+    four_axes: bool,
+    data_type: String,
+    sep: String,
+    layout: Layout,
+    attributes: Value,
+}
+
+/// Reads `path/zarr.json`, which must be a Zarr v3 node.
+fn node(path: &Path) -> Result<Value, IoError> {
     let e = |k| IoError::new(path, k);
-    let meta_path = path.join("zarr.json");
-    let text = std::fs::read(&meta_path).map_err(|x| e(ErrorKind::Read(x)))?;
+    let text = std::fs::read(path.join("zarr.json")).map_err(|x| e(ErrorKind::Read(x)))?;
     let m: Value = serde_json::from_slice(&text).map_err(|x| e(bad(format!("zarr.json: {x}"))))?;
-    if m["zarr_format"] != 3 || m["node_type"] != "array" {
+    if m["zarr_format"] != 3 || !matches!(m["node_type"].as_str(), Some("array" | "group")) {
+        return Err(e(bad("zarr.json is not a Zarr v3 array or group")));
+    }
+    Ok(m)
+}
+
+/// The metadata of the array `m` at `path`: three voxel axes, and with
+/// `max_comps` above 1 optionally a fourth of at most that many components
+/// (whole in every chunk).
+fn array_meta(path: &Path, m: &Value, max_comps: u64) -> Result<ArrayMeta, IoError> {
+    let e = |k| IoError::new(path, k);
+    if m["node_type"] != "array" {
         return Err(e(bad("zarr.json is not a Zarr v3 array")));
     }
-    let dims3 = |v: &Value, what: &str| -> Result<[u64; 3], IoError> {
-        let a = v.as_array().filter(|a| a.len() == 3).ok_or_else(|| e(bad(format!("{what} must have three axes"))))?;
+    // The voxel axes, and the component axis (1 when absent).
+    let axes = |v: &Value, what: &str| -> Result<([u64; 3], u64), IoError> {
+        let a = v.as_array().filter(|a| a.len() == 3 || (max_comps > 1 && a.len() == 4)).ok_or_else(|| {
+            e(bad(if max_comps > 1 { format!("{what} must have three or four axes") } else { format!("{what} must have three axes") }))
+        })?;
         let mut out = [0u64; 3];
         for (o, x) in out.iter_mut().zip(a) {
             *o = x
@@ -260,19 +436,26 @@ pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
                 .filter(|&x| x > 0 && x <= voxkit::grid::spec::MAX_DIM as u64)
                 .ok_or_else(|| e(bad(format!("{what}: {x} is not a size from 1 to {}", voxkit::grid::spec::MAX_DIM))))?;
         }
-        Ok(out)
+        let comps = match a.get(3) {
+            None => 1,
+            Some(x) => x
+                .as_u64()
+                .filter(|&c| (1..=max_comps).contains(&c))
+                .ok_or_else(|| e(bad(format!("{what}: {x} components (voxkit reads 1 to {max_comps})"))))?,
+        };
+        Ok((out, comps))
     };
-    let shape = dims3(&m["shape"], "shape")?;
+    let (shape, comps) = axes(&m["shape"], "shape")?;
+    let four_axes = m["shape"].as_array().is_some_and(|a| a.len() == 4);
     if m["chunk_grid"]["name"] != "regular" {
         return Err(e(bad("only regular chunk grids are read")));
     }
-    let chunk = dims3(&m["chunk_grid"]["configuration"]["chunk_shape"], "chunk_shape")?;
-    if chunk.iter().product::<u64>() > MAX_CHUNK_ELEMENTS {
+    let whole =
+        |c: u64, what: &str| if c == comps { Ok(()) } else { Err(e(bad(format!("{what} splits the {comps} components of a voxel")))) };
+    let (chunk, c) = axes(&m["chunk_grid"]["configuration"]["chunk_shape"], "chunk_shape")?;
+    whole(c, "chunk_shape")?;
+    if chunk.iter().product::<u64>() * comps > MAX_CHUNK_ELEMENTS {
         return Err(e(bad(format!("chunk shape {chunk:?} is larger than voxkit reads"))));
-    }
-    let dtype = m["data_type"].as_str().unwrap_or("");
-    if !matches!(dtype, "bool" | "uint8") {
-        return Err(e(bad(format!("data_type {dtype:?} (voxkit reads bool and uint8)"))));
     }
     let sep = match m["chunk_key_encoding"]["name"].as_str() {
         Some("default") => m["chunk_key_encoding"]["configuration"]["separator"].as_str().unwrap_or("/").to_string(),
@@ -282,7 +465,8 @@ pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
     let layout = match &codecs[..] {
         [c] if c["name"] == "sharding_indexed" => {
             let conf = &c["configuration"];
-            let inner = dims3(&conf["chunk_shape"], "sharding chunk_shape")?;
+            let (inner, c) = axes(&conf["chunk_shape"], "sharding chunk_shape")?;
+            whole(c, "sharding chunk_shape")?;
             if (0..3).any(|a| chunk[a] % inner[a] != 0) {
                 return Err(e(bad(format!("shard shape {chunk:?} is not a multiple of its chunk shape {inner:?}"))));
             }
@@ -308,26 +492,38 @@ pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
     if n.iter().product::<u64>() > MAX_CHUNKS {
         return Err(e(bad(format!("{n:?} chunks, more than voxkit looks for ({MAX_CHUNKS})"))));
     }
-    let dims = shape.map(|d| d as u32);
-    let mut bits = crate::dense_grid(dims).map_err(e)?;
+    let data_type = m["data_type"].as_str().unwrap_or("").to_string();
+    Ok(ArrayMeta { shape, chunk, comps, four_axes, data_type, sep, layout, attributes: m["attributes"].clone() })
+}
+
+/// Calls `f(origin, shape, bytes)` for every chunk the array at `path`
+/// stores, decoded (C order, components last; `elem` bytes per component).
+fn for_each_chunk(path: &Path, a: &ArrayMeta, elem: u64, mut f: impl FnMut([u64; 3], [u64; 3], &[u8])) -> Result<(), IoError> {
+    let e = |k| IoError::new(path, k);
+    let n = [0, 1, 2].map(|x| a.shape[x].div_ceil(a.chunk[x]));
+    let bytes = |shape: [u64; 3]| shape.iter().product::<u64>() * a.comps * elem;
+    let sep = &a.sep;
     let mut buf = Vec::new();
-    for a in 0..n[0] {
-        for b in 0..n[1] {
-            for c in 0..n[2] {
-                let key = format!("c{sep}{a}{sep}{b}{sep}{c}");
+    for i in 0..n[0] {
+        for j in 0..n[1] {
+            for k in 0..n[2] {
+                let mut key = format!("c{sep}{i}{sep}{j}{sep}{k}");
+                if a.four_axes {
+                    key += &format!("{sep}0"); // the one chunk along the component axis
+                }
                 let Ok(raw) = std::fs::read(path.join(&key)) else { continue };
-                let o = [a * chunk[0], b * chunk[1], c * chunk[2]];
+                let o = [i * a.chunk[0], j * a.chunk[1], k * a.chunk[2]];
                 let at = |x: ErrorKind| match x {
                     ErrorKind::Malformed { format, detail } => e(ErrorKind::Malformed { format, detail: format!("{key}: {detail}") }),
                     x => e(x),
                 };
-                match layout {
+                match a.layout {
                     Layout::Plain { gzip } => {
-                        decode(&raw, gzip, chunk, &mut buf).map_err(at)?;
-                        place(&mut bits, &buf, o, chunk, shape);
+                        decode(&raw, gzip, bytes(a.chunk), &mut buf).map_err(at)?;
+                        f(o, a.chunk, &buf);
                     }
                     Layout::Sharded { inner, gzip, checksum, at_end } => {
-                        let per = [0, 1, 2].map(|x| chunk[x] / inner[x]);
+                        let per = [0, 1, 2].map(|x| a.chunk[x] / inner[x]);
                         let count = per.iter().product::<u64>() as usize;
                         let index_len = 16 * count + if checksum { 4 } else { 0 };
                         if index_len > raw.len() {
@@ -340,28 +536,126 @@ pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
                             if off == EMPTY && len == EMPTY {
                                 continue;
                             }
-                            let Some(bytes) =
+                            let Some(bytes_at) =
                                 off.checked_add(len).filter(|&end| end <= raw.len() as u64).map(|end| &raw[off as usize..end as usize])
                             else {
                                 return Err(at(bad(format!("inner chunk {q} at bytes {off}+{len}, outside the shard"))));
                             };
-                            decode(bytes, gzip, inner, &mut buf).map_err(at)?;
+                            decode(bytes_at, gzip, bytes(inner), &mut buf).map_err(at)?;
                             let qi = [q as u64 / (per[1] * per[2]), (q as u64 / per[2]) % per[1], q as u64 % per[2]];
-                            place(&mut bits, &buf, std::array::from_fn(|x| o[x] + qi[x] * inner[x]), inner, shape);
+                            f(std::array::from_fn(|x| o[x] + qi[x] * inner[x]), inner, &buf);
                         }
                     }
                 }
             }
         }
     }
-    let vk = &m["attributes"]["voxkit"];
-    let placement = match (vk["origin"].as_array(), vk["voxel_size"].as_f64()) {
+    Ok(())
+}
+
+/// The grid placement in `attributes.voxkit`, when recorded.
+fn read_placement(attributes: &Value) -> Option<(glam::DVec3, f64)> {
+    let vk = &attributes["voxkit"];
+    match (vk["origin"].as_array(), vk["voxel_size"].as_f64()) {
         (Some(o), Some(s)) if o.len() == 3 && o.iter().all(|x| x.is_f64() || x.is_i64()) => {
             Some((glam::DVec3::new(o[0].as_f64().unwrap_or(0.0), o[1].as_f64().unwrap_or(0.0), o[2].as_f64().unwrap_or(0.0)), s))
         }
         _ => None,
-    };
-    Ok(LoadedVoxels { bits, placement, attributes: None })
+    }
+}
+
+/// Reads a Zarr v3 array of `bool` or `uint8` (non-zero = set) with
+/// regular chunks, the `bytes` codec and optionally `gzip`, sharded
+/// (`sharding_indexed`) or not: voxkit's own arrays and those written the
+/// same way by the `zarr` package. A group (voxkit's layout with
+/// attributes) is read as its `voxels` array and the attribute arrays
+/// beside it (`colour`, `normal`, `coverage`, `material`).
+pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
+    let m = node(path)?;
+    if m["node_type"] == "array" {
+        return read_occupancy(path, &m);
+    }
+    let voxels = path.join("voxels");
+    if !voxels.join("zarr.json").is_file() {
+        return Err(IoError::new(path, bad("a Zarr group without a `voxels` array (voxkit reads its own groups, or an array)")));
+    }
+    let mut loaded = read_occupancy(&voxels, &node(&voxels)?)?;
+    if loaded.placement.is_none() {
+        loaded.placement = read_placement(&m["attributes"]);
+    }
+    let dims = loaded.bits.dims();
+    let mut keys = Vec::with_capacity(loaded.bits.count() as usize);
+    loaded.bits.for_each_set(|i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
+    keys.sort_unstable();
+    let mut attrs = VoxelAttributes { dims, keys, ..Default::default() };
+    let mut any = false;
+    for (name, data_type, comps) in [("colour", "uint8", 3), ("normal", "float32", 3), ("coverage", "float32", 1), ("material", "int32", 1)]
+    {
+        let dir = path.join(name);
+        if !dir.join("zarr.json").is_file() {
+            continue;
+        }
+        let a = array_meta(&dir, &node(&dir)?, 3)?;
+        if a.data_type != data_type || a.comps != comps || a.shape != dims.map(u64::from) {
+            return Err(IoError::new(
+                &dir,
+                bad(format!(
+                    "{} × {} over {:?}; voxkit reads {name} as {data_type} × {comps} over the voxels' {dims:?}",
+                    a.data_type, a.comps, a.shape
+                )),
+            ));
+        }
+        // Each set voxel's value bytes, by slot (the fill value where no chunk is stored).
+        let elem = if data_type == "uint8" { 1 } else { 4 };
+        let size = elem * comps as usize;
+        let fill: Vec<u8> = if name == "material" { (-1i32).to_le_bytes().to_vec() } else { vec![0; size] };
+        let mut vals = fill.repeat(attrs.keys.len());
+        let bits = &loaded.bits;
+        let keys = &attrs.keys;
+        for_each_chunk(&dir, &a, elem as u64, |o, shape, buf| {
+            for (n, v) in buf.chunks_exact(size).enumerate() {
+                let n = n as u64;
+                let q = [o[0] + n / (shape[1] * shape[2]), o[1] + (n / shape[2]) % shape[1], o[2] + n % shape[2]];
+                if q[0] < dims[0] as u64
+                    && q[1] < dims[1] as u64
+                    && q[2] < dims[2] as u64
+                    && bits.get(q[0] as u32, q[1] as u32, q[2] as u32)
+                {
+                    let key = VoxelAttributes::key(dims, q[0] as u32, q[1] as u32, q[2] as u32);
+                    let s = keys.binary_search(&key).expect("a set voxel has a key");
+                    vals[s * size..(s + 1) * size].copy_from_slice(v);
+                }
+            }
+        })?;
+        let f = |b: &[u8]| f32::from_le_bytes(b.try_into().expect("4 bytes"));
+        match name {
+            "colour" => attrs.colour = Some(vals.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()),
+            "normal" => attrs.normal = Some(vals.chunks_exact(12).map(|c| [f(&c[0..4]), f(&c[4..8]), f(&c[8..12])]).collect()),
+            "coverage" => attrs.coverage = Some(vals.chunks_exact(4).map(f).collect()),
+            _ => {
+                let id = |c: &[u8]| u32::try_from(i32::from_le_bytes(c.try_into().expect("4 bytes"))).unwrap_or(NO_MATERIAL);
+                attrs.material = Some(vals.chunks_exact(4).map(id).collect());
+            }
+        }
+        any = true;
+    }
+    if any {
+        loaded.attributes = Some(attrs);
+    }
+    Ok(loaded)
+}
+
+/// The occupancy array `m` at `path`.
+fn read_occupancy(path: &Path, m: &Value) -> Result<LoadedVoxels, IoError> {
+    let e = |k| IoError::new(path, k);
+    let a = array_meta(path, m, 1)?;
+    if !matches!(a.data_type.as_str(), "bool" | "uint8") {
+        return Err(e(bad(format!("data_type {:?} (voxkit reads bool and uint8)", a.data_type))));
+    }
+    let dims = a.shape.map(|d| d as u32);
+    let mut bits = crate::dense_grid(dims).map_err(e)?;
+    for_each_chunk(path, &a, 1, |o, shape, buf| place(&mut bits, buf, o, shape, a.shape))?;
+    Ok(LoadedVoxels { bits, placement: read_placement(&a.attributes), attributes: None })
 }
 
 #[cfg(test)]
@@ -381,7 +675,7 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         let out = dir.join("v.zarr");
-        write(&out, &d, &grid).unwrap();
+        write(&out, &d, &grid, None).unwrap();
         let back = read(&out).unwrap();
         assert_eq!(back.bits, d);
         assert_eq!(back.placement, Some((grid.origin(), 0.25)));
@@ -390,12 +684,12 @@ mod tests {
         // Writing again replaces the array; a non-Zarr directory is refused.
         let mut e = DenseBits::new(dims);
         e.set(5, 5, 5);
-        write(&out, &e, &grid).unwrap();
+        write(&out, &e, &grid, None).unwrap();
         assert_eq!(read(&out).unwrap().bits, e);
         let other = dir.join("other.zarr");
         std::fs::create_dir_all(&other).unwrap();
         std::fs::write(other.join("keep.txt"), "mine").unwrap();
-        assert!(write(&other, &e, &grid).is_err());
+        assert!(write(&other, &e, &grid, None).is_err());
         assert_eq!(std::fs::read_to_string(other.join("keep.txt")).unwrap(), "mine");
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -419,7 +713,7 @@ mod tests {
         let grid = GridSpec::new(glam::DVec3::ZERO, 1.0, dims.map(|x| x as u64)).unwrap();
         let dir = scratch("shards");
         let out = dir.join("v.zarr");
-        write(&out, &d, &grid).unwrap();
+        write(&out, &d, &grid, None).unwrap();
         assert_eq!(read(&out).unwrap().bits, d);
         assert!(out.join("c/0/0/0").is_file() && !out.join("c/1/0/0").exists() && out.join("c/2/0/0").is_file());
         // Shard (0, 0, 0): 8 × 2 × 1 chunks, of which (0, 0, 0) and (7, 1, 0) hold voxels.
@@ -454,7 +748,7 @@ mod tests {
         d.set(1, 1, 1);
         let grid = GridSpec::new(glam::DVec3::ZERO, 1.0, [8, 8, 8]).unwrap();
         let sharded = dir.join("s.zarr");
-        write(&sharded, &d, &grid).unwrap();
+        write(&sharded, &d, &grid, None).unwrap();
         let f = sharded.join("c/0/0/0");
         let mut shard = std::fs::read(&f).unwrap();
         let n = shard.len();
@@ -462,6 +756,51 @@ mod tests {
         std::fs::write(&f, &shard).unwrap();
         let e = read(&sharded).unwrap_err().to_string();
         assert!(e.contains("c/0/0/0") && e.contains("outside the shard"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// With attributes, a group: `voxels` and one array per attribute over
+    /// the same grid (components as a last axis), read back exactly; the
+    /// `zarr.json` of a plain array is unchanged without them.
+    #[test]
+    fn attributes_make_a_group_read_back_exactly() {
+        let dims = [70, 9, 66];
+        let mut d = DenseBits::new(dims);
+        d.fill_box([8, 0, 56], [15, 7, 65]);
+        for (i, j, k) in [(0, 0, 0), (69, 8, 65), (64, 3, 1)] {
+            d.set(i, j, k);
+        }
+        let mut keys = Vec::new();
+        d.for_each_set(|i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
+        keys.sort_unstable();
+        let n = keys.len();
+        let attrs = VoxelAttributes {
+            dims,
+            colour: Some((0..n).map(|s| [(s % 256) as u8, 7, (s * 3 % 256) as u8]).collect()),
+            material: Some((0..n).map(|s| if s % 4 == 0 { NO_MATERIAL } else { s as u32 }).collect()),
+            normal: Some((0..n).map(|s| [s as f32, -1.5, 0.25]).collect()),
+            coverage: Some((0..n).map(|s| s as f32 / 3.0).collect()),
+            keys,
+        };
+        let grid = GridSpec::new(glam::DVec3::new(0.5, 1.0, -2.0), 0.125, dims.map(|x| x as u64)).unwrap();
+        let dir = scratch("attrs");
+        let out = dir.join("a.zarr");
+        write(&out, &d, &grid, Some(&attrs)).unwrap();
+        let m: Value = serde_json::from_slice(&std::fs::read(out.join("zarr.json")).unwrap()).unwrap();
+        assert_eq!(m["node_type"], "group");
+        let c: Value = serde_json::from_slice(&std::fs::read(out.join("colour/zarr.json")).unwrap()).unwrap();
+        assert_eq!(c["shape"], json!([70, 9, 66, 3]));
+        assert!(out.join("colour/c/0/0/0/0").is_file() && out.join("coverage/c/0/0/0").is_file());
+        let back = read(&out).unwrap();
+        assert_eq!(back.bits, d);
+        assert_eq!(back.placement, Some((grid.origin(), 0.125)));
+        assert_eq!(back.attributes.as_ref(), Some(&attrs));
+        // Without attributes: the plain array, as before.
+        write(&out, &d, &grid, None).unwrap();
+        let m: Value = serde_json::from_slice(&std::fs::read(out.join("zarr.json")).unwrap()).unwrap();
+        assert_eq!(m["node_type"], "array");
+        assert_eq!(m["codecs"][0]["configuration"]["codecs"][0], json!({"name": "bytes"}));
+        assert!(read(&out).unwrap().attributes.is_none() && !out.join("colour").exists());
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -50,7 +50,7 @@ pub struct BatchOptions {
     pub format: Output,
     /// Colour rule and normals, when the format stores attributes.
     pub carry: CarryOptions,
-    /// `--attributes`: every attribute array into `.vdb` outputs.
+    /// `--attributes`: every attribute array into `.vdb` and `.zarr` outputs.
     pub attributes: bool,
     /// Writer options.
     pub write: WriteOptions,
@@ -378,7 +378,7 @@ pub struct FingerprintParts<'a> {
     pub colour_rule: &'a str,
     /// Normals carried.
     pub normals: bool,
-    /// Every attribute array into `.vdb` (`--attributes`).
+    /// Every attribute array into `.vdb` and `.zarr` (`--attributes`).
     pub attributes: bool,
     /// `.vox` dithering.
     pub dither: bool,

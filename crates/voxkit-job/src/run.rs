@@ -208,13 +208,14 @@ pub fn attributes(plan: &Plan, mesh: MeshRef<'_>, appearance: &Appearance, v: &V
 }
 
 /// True when `format` gets every attribute array: `.vti` always, `.vdb`
-/// when `asked` (`--attributes`).
+/// and `.zarr` when `asked` (`--attributes`).
 pub fn every_attribute(format: crate::output::Output, asked: bool) -> bool {
+    use crate::output::Output::Voxels;
     use voxkit_io::VoxelFormat as F;
-    format == crate::output::Output::Voxels(F::Vti) || (asked && format == crate::output::Output::Voxels(F::Vdb))
+    format == Voxels(F::Vti) || (asked && matches!(format, Voxels(F::Vdb | F::Zarr)))
 }
 
-/// `--attributes` (`asked`) for `.vdb` on a grid that ran tiled: refused,
+/// `--attributes` (`asked`) for `.vdb` or `.zarr` on a grid that ran tiled: refused,
 /// not dropped, since carrying needs a whole-grid brick index.
 pub fn check_attributes_carried(format: crate::output::Output, asked: bool, v: &Voxelized) -> Result<()> {
     if asked && every_attribute(format, true) && matches!(v.voxels, Voxels::Sparse(_)) {
@@ -227,8 +228,8 @@ pub fn check_attributes_carried(format: crate::output::Output, asked: bool, v: &
 
 /// The attributes an output needs: colours where the format stores them
 /// (or a `preview` picture shows them) and the mesh has them, every array
-/// for `.vti` and, when `asked`, for `.vdb`; `None` otherwise. Errors
-/// when `.vdb` attributes were asked for a tiled grid.
+/// for `.vti` and, when `asked`, for `.vdb` and `.zarr`; `None` otherwise.
+/// Errors when attributes were asked for a tiled grid.
 pub fn attributes_for(
     plan: &Plan,
     loaded: &voxkit_io::LoadedMesh,

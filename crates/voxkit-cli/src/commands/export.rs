@@ -61,9 +61,9 @@ pub fn warn_unused(e: &ExportArgs, format: Output, output: &Path, from_mesh: boo
     if e.normals && (!from_mesh || format != Output::Voxels(F::Vti)) {
         unused.push(if from_mesh { "--normals (for .vti)" } else { "--normals (normals come from a mesh)" });
     }
-    if e.attributes && (!from_mesh || format != Output::Voxels(F::Vdb)) {
+    if e.attributes && (!from_mesh || !matches!(format, Output::Voxels(F::Vdb | F::Zarr))) {
         unused.push(if from_mesh {
-            "--attributes (for .vdb)"
+            "--attributes (for .vdb and .zarr)"
         } else {
             "--attributes (attributes come from a mesh; convert writes those the input has)"
         });
