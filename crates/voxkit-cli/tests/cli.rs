@@ -543,7 +543,43 @@ fn tiled_runs_write_the_same_files_and_vdb_reads_back() {
         assert_eq!(t["tile"], 64);
         assert!(t["peak_memory_bytes"].as_u64().unwrap() > 0);
         assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{mode}: tiled .npy differs");
+        if mode != "diagonal" {
+            // The scanline kernel in the tiles: the same file.
+            let c = tmp(&format!("tiled-scan-{mode}.npy"));
+            let t = json(&voxkit(&[
+                "voxelize",
+                &bunny,
+                "-o",
+                &c,
+                "--resolution",
+                "200",
+                "--mode",
+                mode,
+                "--tile",
+                "64",
+                "--method",
+                "scanline",
+                "--json",
+            ]));
+            assert_eq!((&t["method"], &t["tile_kernel"]), (&serde_json::json!("tiled"), &serde_json::json!("scanline")));
+            assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&c).unwrap(), "{mode}: tiled scanline .npy differs");
+        }
     }
+    let e = error_line(&[
+        "voxelize",
+        &bunny,
+        "-o",
+        &tmp("x.npy"),
+        "--resolution",
+        "64",
+        "--mode",
+        "ss6",
+        "--tile",
+        "64",
+        "--method",
+        "scanline",
+    ]);
+    assert!(e.contains("scanline exists for cover, sep26 and sep6"), "{e}");
     // .vdb: what voxkit writes it reads back (convert to .npy: the same file).
     let (v, n) = (tmp("tiled.vdb"), tmp("from-vdb.npy"));
     json(&voxkit(&["voxelize", &bunny, "-o", &v, "--resolution", "200", "--tile", "64", "--json"]));

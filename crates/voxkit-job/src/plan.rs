@@ -385,8 +385,8 @@ impl Plan {
                         "--tile: flood fills, hollow solids and the reference and gpu solids do not run tiled yet (parity and winding do)",
                     ));
                 }
-            } else if !matches!(request.method, Method::Auto | Method::Fast) {
-                return Err(JobError::invalid("--tile runs the fast path: use --method auto or fast"));
+            } else if !matches!(request.method, Method::Auto | Method::Fast | Method::Scanline) {
+                return Err(JobError::invalid("--tile runs the fast or scanline path: use --method auto, fast or scanline"));
             }
         }
         let (core, surface_method) = match solid {

@@ -124,8 +124,10 @@ pub fn agree(mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits, String> {
 
 /// [`agree`] for any surface or line mode: the mode's reference against its
 /// fast path on 1, 2 and 8 threads, several slab heights and every
-/// traversal, and against its scanline path where it has one; names the
-/// first differing voxel. Returns the reference grid.
+/// traversal, against its tiled runs (tiles of 8, 24 and 64; the scanline
+/// kernel in tiles of 8 and 24 where the mode has one), and against its
+/// scanline path where it has one; names the first differing voxel.
+/// Returns the reference grid.
 pub fn agree_mode(mode: Mode, mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits, String> {
     let (reference, rep) = voxelize::reference(mode, mesh.as_ref(), grid);
     if reference.count() != rep.voxels {
@@ -160,14 +162,25 @@ pub fn agree_mode(mode: Mode, mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits,
             }
         }
         if threads != 2 {
-            for tile in [8, 24, 64] {
-                let Ok((tiled, trep)) = pool.install(|| voxelize::tiled::tiled(mode, mesh.as_ref(), grid, tile, &Options::default()))
+            use voxelize::tiled::TileKernel;
+            for (tile, kernel) in [
+                (8, TileKernel::Fast),
+                (24, TileKernel::Fast),
+                (64, TileKernel::Fast),
+                (8, TileKernel::Scanline),
+                (24, TileKernel::Scanline),
+            ] {
+                if kernel == TileKernel::Scanline && !voxelize::scanline::supports(mode) {
+                    continue;
+                }
+                let Ok((tiled, trep)) =
+                    pool.install(|| voxelize::tiled::tiled_with(mode, kernel, mesh.as_ref(), grid, tile, &Options::default()))
                 else {
                     break;
                 };
                 if let Some(v) = reference.first_difference(&tiled.to_dense()) {
                     return Err(format!(
-                        "{} tiled (threads {threads}, tile {tile}) differs from reference at voxel {v:?}: reference {}, tiled {}",
+                        "{} tiled (threads {threads}, tile {tile}, {kernel:?} kernel) differs from reference at voxel {v:?}: reference {}, tiled {}",
                         mode.name(),
                         reference.get(v[0], v[1], v[2]),
                         tiled.get(v[0], v[1], v[2])

@@ -42,6 +42,30 @@ fn bunny_at_1024_with_tiles_of_64() {
     }
 }
 
+/// The scanline kernel in tiles gives the dense fast path's voxels too.
+#[test]
+fn scanline_tiles_equal_dense_on_rotated_meshes() {
+    use voxkit::voxelize::tiled::{tiled_with, TileKernel};
+    let mut r = rng(0x5ca7);
+    for name in ["stanford-bunny.obj", "fandisk.obj", "cheburashka.obj"] {
+        let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
+        for res in [200, 512] {
+            let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), res).unwrap();
+            for mode in [Mode::Cover, Mode::Sep26, Mode::Sep6] {
+                let (dense, drep) = voxelize::fast(mode, mesh.as_ref(), &grid, &Options::default());
+                let (sparse, trep) = tiled_with(mode, TileKernel::Scanline, mesh.as_ref(), &grid, 64, &Options::default()).unwrap();
+                assert_eq!(trep, drep, "{name} {} at {res}: reports differ", mode.name());
+                let d = dense.to_dense();
+                assert!(d.first_difference(&sparse.to_dense()).is_none(), "{name} {} at {res}: scanline tiles differ", mode.name());
+            }
+        }
+    }
+    let mesh = shared_mesh("cow.obj");
+    let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), 64).unwrap();
+    let e = tiled_with(Mode::Ss6, TileKernel::Scanline, mesh.as_ref(), &grid, 64, &Options::default()).unwrap_err();
+    assert!(e.to_string().contains("scanline exists for cover, sep26 and sep6"), "{e}");
+}
+
 #[test]
 fn every_mode_on_rotated_meshes_at_256() {
     let mut r = rng(0x711e);

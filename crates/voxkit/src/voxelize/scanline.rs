@@ -48,7 +48,7 @@
 //! tests compare voxel for voxel.
 
 use super::cover::{cover_triangle_runs, div_floor, edges_2d, run, set};
-use super::driver::{run_mesh, Filter, Kernel, Sink};
+use super::driver::{run_mesh, run_slabs, Filter, Kernel, Sink};
 use super::targets::{fits_i64, DirSetup, TriSetup, CROSSHAIR, DIAGONALS};
 use super::{Mode, Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
@@ -70,6 +70,13 @@ pub fn scanline(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'
         return None;
     }
     Some(run_mesh(&ScanKernel { mode }, mesh, grid, opts))
+}
+
+/// The scanline path on prepared triangles of a grid of `dims` (one tile
+/// of the tiled driver, or a whole grid). `None` for modes it does not
+/// implement.
+pub fn scanline_lattice(mode: Mode, tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>) -> Option<BrickBits> {
+    supports(mode).then(|| run_slabs(&ScanKernel { mode }, tris, dims, opts).0)
 }
 
 /// Whether the scanline path is expected to beat the triangle-box fast path

@@ -11,7 +11,9 @@
 //! number of voxels, so an exact integer shift of the lattice — and run
 //! through the mode's own fast kernel on a grid of the tile's size
 //! ([`fast_lattice`]; for the line modes, their segments and triangles
-//! through [`super::line::line_lattice`]); the kernels only set voxels of
+//! through [`super::line::line_lattice`]; for `cover`, `sep26` and
+//! `sep6`, on request, the scanline path's kernel,
+//! [`super::scanline::scanline_lattice`]); the kernels only set voxels of
 //! the box they are
 //! given, so a triangle spanning tiles contributes to each exactly its
 //! voxels there. The tile's bricks move into a [`SparseBricks`] and the
@@ -67,6 +69,17 @@ pub fn fast_lattice(mode: Mode, tris: &[LatticeTriangle], dims: [u32; 3], offset
     })
 }
 
+/// The kernel each tile runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TileKernel {
+    /// The mode's fast path ([`fast_lattice`]).
+    #[default]
+    Fast,
+    /// The scanline path ([`super::scanline::scanline_lattice`]; `cover`,
+    /// `sep26` and `sep6` only).
+    Scanline,
+}
+
 /// Why a tiled run cannot start.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum TiledError {
@@ -74,6 +87,8 @@ pub enum TiledError {
     Tile(u32),
     /// An axis exceeds [`SparseBricks::MAX_DIM`].
     Grid([u32; 3]),
+    /// The kernel does not implement the mode.
+    Kernel(Mode),
 }
 
 impl std::fmt::Display for TiledError {
@@ -81,15 +96,34 @@ impl std::fmt::Display for TiledError {
         match self {
             TiledError::Tile(t) => write!(f, "tile size {t} is not a positive multiple of 8"),
             TiledError::Grid(d) => write!(f, "grid {}x{}x{} exceeds {} voxels per axis", d[0], d[1], d[2], SparseBricks::MAX_DIM),
+            TiledError::Kernel(m) => write!(f, "--method scanline exists for cover, sep26 and sep6, not {}", m.name()),
         }
     }
 }
 
 impl std::error::Error for TiledError {}
 
-/// Runs `mode` tile by tile on `grid` (tiles of `tile` voxels). Returns the
-/// voxels as sorted sparse bricks and the usual report.
+/// Runs `mode` tile by tile on `grid` (tiles of `tile` voxels) with the
+/// fast path's kernels. Returns the voxels as sorted sparse bricks and the
+/// usual report.
 pub fn tiled(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, tile: u32, opts: &Options<'_>) -> Result<(SparseBricks, Report), TiledError> {
+    tiled_with(mode, TileKernel::Fast, mesh, grid, tile, opts)
+}
+
+/// [`tiled`] with the kernel each tile runs: the fast path's, or the
+/// scanline path's (the same voxels; faster where triangles span many
+/// voxels, as they do on very large grids).
+pub fn tiled_with(
+    mode: Mode,
+    kernel: TileKernel,
+    mesh: MeshRef<'_>,
+    grid: &GridSpec,
+    tile: u32,
+    opts: &Options<'_>,
+) -> Result<(SparseBricks, Report), TiledError> {
+    if kernel == TileKernel::Scanline && !super::scanline::supports(mode) {
+        return Err(TiledError::Kernel(mode));
+    }
     if tile == 0 || tile % BRICK != 0 {
         return Err(TiledError::Tile(tile));
     }
@@ -111,8 +145,9 @@ pub fn tiled(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec, tile: u32, opts: &O
         }
         None => {
             let (tris, prepare) = prepare(mesh, grid);
-            let run = |t: &[LatticeTriangle], size: [u32; 3], origin: [i64; 3], o: &Options<'_>| {
-                fast_lattice(mode, t, size, origin, o).expect("line modes take their own path")
+            let run = |t: &[LatticeTriangle], size: [u32; 3], origin: [i64; 3], o: &Options<'_>| match kernel {
+                TileKernel::Fast => fast_lattice(mode, t, size, origin, o).expect("line modes take their own path"),
+                TileKernel::Scanline => super::scanline::scanline_lattice(mode, t, size, o).expect("checked above"),
             };
             let (out, voxels) = by_tiles(&tris, dims, tile, opts, LatticeTriangle::translated, run);
             (out, Report { prepare, voxels })
