@@ -691,7 +691,7 @@ fn grids_past_memory_errors() {
         (vec!["--tile", "12"], "multiple of 8"),
         (vec!["--tile", "64", "--mode", "solid", "--fill", "flood"], "flood fills"),
         (vec!["--tile", "64", "--mode", "solid", "--hollow", "6"], "hollow"),
-        (vec!["--tile", "64", "--method", "reference"], "fast path"),
+        (vec!["--tile", "64", "--method", "reference"], "fast or scanline path"),
         (vec!["--max-memory", "lots"], "unknown unit"),
         (vec!["--max-memory", "1.2.3G"], "not a size"),
         (vec!["--resolution", "16384", "--max-memory", "1G", "--mode", "solid", "--fill", "flood"], "flood fills"),
