@@ -644,6 +644,30 @@ fn vdb_attributes_carry_every_array() {
     assert_eq!(std::fs::read(tmp("attrs-cover.vti")).unwrap(), std::fs::read(&back).unwrap(), ".zarr attributes differ from .vti's");
 }
 
+/// `convert` of a `.vdb` or `.zarr` grid that cannot be dense (20000³ here,
+/// 932 GiB of bits) into a format holding only the set voxels reads and
+/// writes it without a dense grid: `.vdb` → `.zarr` → `.vdb` gives the
+/// same bytes, `.txt` the voxels `voxelize` lists; a dense format is one
+/// line naming the sparse ones.
+#[test]
+fn convert_sparse_grids_past_memory() {
+    let cube = unit_cube_obj("sparse-cube.obj");
+    let (v, z, v2, t, direct) =
+        (tmp("sparse.vdb"), tmp("sparse.zarr"), tmp("sparse2.vdb"), tmp("sparse-from-zarr.txt"), tmp("sparse-direct.txt"));
+    let grid = ["--voxel-size", "0.01", "--origin", "-0.5,-0.5,-0.5", "--dims", "20000,20000,20000", "--mode", "solid"];
+    let s = json(&voxkit(&[&["voxelize", cube.as_str(), "-o", &v, "--json"][..], &grid[..]].concat()));
+    assert_eq!(s["tile"], 512);
+    json(&voxkit(&[&["voxelize", cube.as_str(), "-o", &direct, "--json"][..], &grid[..]].concat()));
+    let c = json(&voxkit(&["convert", &v, &z, "--json"]));
+    assert_eq!((c["sparse"].as_bool(), &c["voxels"]), (Some(true), &s["voxels"]));
+    json(&voxkit(&["convert", &z, &v2, "--json"]));
+    assert_eq!(std::fs::read(&v).unwrap(), std::fs::read(&v2).unwrap(), ".vdb -> .zarr -> .vdb changed the file");
+    json(&voxkit(&["convert", &z, &t, "--json"]));
+    assert_eq!(std::fs::read(&direct).unwrap(), std::fs::read(&t).unwrap());
+    let e = error_line(&["convert", &v, &tmp("sparse.npy")]);
+    assert!(e.contains("932") && e.contains(".zarr"), "{e}");
+}
+
 /// Solids past memory: parity and winding run brick row by brick row into
 /// sparse bricks with full runs, and write the dense run's files.
 #[test]

@@ -341,6 +341,32 @@ pub fn read_voxels_with(path: &Path, up: orient::Up) -> Result<LoadedVoxels, IoE
     read_voxels_bytes_with(&bytes, format, up).map_err(|k| IoError::new(path, k))
 }
 
+/// Voxels read without a dense grid.
+#[derive(Clone, Debug)]
+pub struct SparseVoxels {
+    /// The voxels, as sparse bricks (full regions as runs of full bricks).
+    pub bits: voxkit::grid::sparse::SparseBricks,
+    /// Origin and voxel size, when the file records them.
+    pub placement: Option<(glam::DVec3, f64)>,
+    /// The file holds attributes, which only the dense readers take.
+    pub attributes_left: bool,
+}
+
+/// Reads a `.vdb` file or a `.zarr` array without a dense grid, for grids
+/// that do not fit in memory densely ([`read_voxels`] refuses those with
+/// [`ErrorKind::TooLarge`]): memory follows the set voxels. Other formats
+/// are refused by name.
+pub fn read_voxels_sparse(path: &Path) -> Result<SparseVoxels, IoError> {
+    match VoxelFormat::from_path(path) {
+        Some(VoxelFormat::Vdb) => {
+            let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+            fence("VDB", || vdb::read_sparse(&bytes)).map_err(|k| IoError::new(path, k))
+        }
+        Some(VoxelFormat::Zarr) => zarr::read_sparse(path),
+        _ => Err(IoError::new(path, ErrorKind::Unsupported("only .vdb and .zarr are read without a dense grid".into()))),
+    }
+}
+
 /// Parses a voxel file from memory.
 pub fn read_voxels_bytes(bytes: &[u8], format: VoxelFormat) -> Result<LoadedVoxels, ErrorKind> {
     read_voxels_bytes_with(bytes, format, orient::Up::default())

@@ -51,11 +51,11 @@ use glam::DVec3;
 use voxkit::attributes::colour::{from_linear, to_linear};
 use voxkit::attributes::{VoxelAttributes, NO_MATERIAL};
 use voxkit::grid::bricks::Brick;
-use voxkit::grid::sparse::FULL;
+use voxkit::grid::sparse::{SparseBricks, FULL};
 use voxkit::{GridSpec, VoxelSource};
 
 use crate::error::ErrorKind;
-use crate::LoadedVoxels;
+use crate::{LoadedVoxels, SparseVoxels};
 
 const MAGIC: i64 = 0x5644_4220;
 const FILE_VERSION: u32 = 224;
@@ -695,10 +695,8 @@ struct Descriptor {
     pos: i64,
 }
 
-/// Parses a `.vdb` file: its first bool grid's active voxels and, when
-/// grids named as voxkit writes them are present (`Cd`, `normal`,
-/// `coverage`, `material`), those attributes of each voxel.
-pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
+/// A file's grid descriptors, after its header.
+fn descriptors(bytes: &[u8]) -> Result<Vec<Descriptor>, ErrorKind> {
     let mut c = Cur { b: bytes, at: 0 };
     if c.i64().ok() != Some(MAGIC) {
         return Err(bad("not an OpenVDB file (bad magic number)"));
@@ -732,11 +730,19 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         found.push(Descriptor { name, ty, pos });
         c.seek(end)?;
     }
-    let in_grid = |name: &str, e: ErrorKind| match e {
+    Ok(found)
+}
+
+fn in_grid(name: &str, e: ErrorKind) -> ErrorKind {
+    match e {
         ErrorKind::Malformed { format, detail } => ErrorKind::Malformed { format, detail: format!("grid '{name}': {detail}") },
         e => e,
-    };
-    let Some(occupancy) = found.iter().find(|d| d.ty == GRID_TYPE) else {
+    }
+}
+
+/// The first bool grid of a file.
+fn occupancy(bytes: &[u8], found: &[Descriptor]) -> Result<Occupancy, ErrorKind> {
+    let Some(d) = found.iter().find(|d| d.ty == GRID_TYPE) else {
         let types: Vec<String> = found.iter().map(|d| format!("{} ({})", d.name, d.ty)).collect();
         return Err(bad(if types.is_empty() {
             "no grids".to_string()
@@ -744,9 +750,36 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
             format!("no bool grid (voxkit reads {GRID_TYPE}); grids: {}", types.join(", "))
         }));
     };
-    c.seek(occupancy.pos)?;
-    let (mut loaded, offset) = read_grid(&mut c).map_err(|e| in_grid(&occupancy.name, e))?;
-    let wanted = [(ATTR_COLOUR, VEC3_TYPE), (ATTR_NORMAL, VEC3_TYPE), (ATTR_COVERAGE, FLOAT_TYPE), (ATTR_MATERIAL, FLOAT_TYPE)];
+    let mut c = Cur { b: bytes, at: 0 };
+    c.seek(d.pos)?;
+    read_grid(&mut c).map_err(|e| in_grid(&d.name, e))
+}
+
+/// The attribute grids voxkit reads: name and tree type.
+const ATTRIBUTE_GRIDS: [(&str, &str); 4] =
+    [(ATTR_COLOUR, VEC3_TYPE), (ATTR_NORMAL, VEC3_TYPE), (ATTR_COVERAGE, FLOAT_TYPE), (ATTR_MATERIAL, FLOAT_TYPE)];
+
+/// A `.vdb` file's voxels without a dense grid: its first bool grid as
+/// sparse bricks (active tiles as runs of full bricks), the placement, and
+/// whether attribute grids were left unread (they need the dense path).
+pub fn read_sparse(bytes: &[u8]) -> Result<SparseVoxels, ErrorKind> {
+    let found = descriptors(bytes)?;
+    let occ = occupancy(bytes, &found)?;
+    let attributes_left = found.iter().any(|d| ATTRIBUTE_GRIDS.contains(&(d.name.as_str(), d.ty.as_str())));
+    Ok(SparseVoxels { bits: occ.sparse()?, placement: occ.placement, attributes_left })
+}
+
+/// Parses a `.vdb` file: its first bool grid's active voxels and, when
+/// grids named as voxkit writes them are present (`Cd`, `normal`,
+/// `coverage`, `material`), those attributes of each voxel.
+pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
+    let found = descriptors(bytes)?;
+    let occ = occupancy(bytes, &found)?;
+    let mut loaded = LoadedVoxels { bits: occ.dense()?, placement: occ.placement, attributes: None };
+    let offset = occ.offset;
+    drop(occ);
+    let mut c = Cur { b: bytes, at: 0 };
+    let wanted = ATTRIBUTE_GRIDS;
     if found.iter().any(|d| wanted.contains(&(d.name.as_str(), d.ty.as_str()))) {
         let mut keys = Vec::with_capacity(loaded.bits.count() as usize);
         let dims = loaded.bits.dims();
@@ -892,12 +925,124 @@ fn read_values_grid(c: &mut Cur<'_>, vs: usize) -> Result<GridValues, ErrorKind>
     Ok(GridValues { vs, leaves, tiles })
 }
 
-/// The bool grid at the cursor, and the index coordinate of voxel (0, 0, 0).
-fn read_grid(c: &mut Cur<'_>) -> Result<(LoadedVoxels, [i64; 3]), ErrorKind> {
+/// The bool grid as read, before it becomes voxels: leaves (origin,
+/// active mask in OpenVDB's layout), active `true` tiles (origin, edge),
+/// the index coordinate of voxel (0, 0, 0), the grid's dims and placement.
+struct Occupancy {
+    leaves: Vec<([i64; 3], Vec<u64>)>,
+    tiles: Vec<([i64; 3], i64)>,
+    offset: [i64; 3],
+    dims: [u32; 3],
+    placement: Option<(DVec3, f64)>,
+}
+
+impl Occupancy {
+    /// Voxel coordinates of index coordinate `p`, which must be in the grid.
+    fn inside(&self, p: [i64; 3]) -> Result<[u32; 3], ErrorKind> {
+        let q: [i64; 3] = std::array::from_fn(|a| p[a] - self.offset[a]);
+        if (0..3).any(|a| q[a] < 0 || q[a] >= self.dims[a] as i64) {
+            return Err(bad(format!("active voxel {p:?} outside the recorded grid {:?}", self.dims)));
+        }
+        Ok(q.map(|c| c as u32))
+    }
+
+    /// Calls `f` with every active voxel of the leaves (voxel coordinates).
+    fn leaf_voxels(&self, mut f: impl FnMut([u32; 3])) -> Result<(), ErrorKind> {
+        for (o, m) in &self.leaves {
+            for (x, &w) in m.iter().enumerate() {
+                let mut w = w;
+                while w != 0 {
+                    let b = w.trailing_zeros() as i64;
+                    w &= w - 1;
+                    f(self.inside([o[0] + x as i64, o[1] + (b >> 3), o[2] + (b & 7)])?);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The voxels in a dense grid (active tiles filled a row of words at a time).
+    fn dense(&self) -> Result<voxkit::DenseBits, ErrorKind> {
+        // First: a grid that cannot be dense says so (`TooLarge`; the sparse
+        // reader takes such files).
+        let mut bits = crate::dense_grid(self.dims)?;
+        let tile_voxels: i64 = self.tiles.iter().fold(0i64, |n, t| n.saturating_add(t.1 * t.1 * t.1));
+        if tile_voxels > MAX_TILE_VOXELS {
+            return Err(bad(format!(
+                "active tiles cover {tile_voxels} voxels, more than voxkit reads into a dense grid ({MAX_TILE_VOXELS})"
+            )));
+        }
+        let mut tiles = Vec::with_capacity(self.tiles.len());
+        for (o, e) in &self.tiles {
+            // A tile is inside the grid when its two corners are.
+            tiles.push((self.inside(*o)?, self.inside(o.map(|c| c + e - 1))?));
+        }
+        self.leaf_voxels(|q| bits.set(q[0], q[1], q[2]))?;
+        for (lo, hi) in tiles {
+            bits.fill_box(lo, hi);
+        }
+        Ok(bits)
+    }
+
+    /// The voxels as sparse bricks: leaves become bricks, active tiles runs
+    /// of full bricks (never voxels), so memory follows the file, not the
+    /// grid. Needs the grid to start on a brick (voxkit's files do).
+    fn sparse(&self) -> Result<SparseBricks, ErrorKind> {
+        if self.offset.iter().any(|o| o % 8 != 0) {
+            return Err(ErrorKind::Unsupported(format!(
+                "this grid's voxels start at index {:?}, not on an 8-voxel brick, so it is read only into a dense grid",
+                self.offset
+            )));
+        }
+        if self.dims.iter().any(|&d| d > SparseBricks::MAX_DIM) {
+            return Err(bad(format!("grid {:?} beyond {} voxels per axis", self.dims, SparseBricks::MAX_DIM)));
+        }
+        let mut bricks: Vec<([u32; 3], Brick)> = Vec::with_capacity(self.leaves.len());
+        for (o, m) in &self.leaves {
+            let mut brick = [0u64; 8];
+            let base: [i64; 3] = std::array::from_fn(|a| o[a] - self.offset[a]);
+            for (x, &w) in m.iter().enumerate() {
+                let mut w = w;
+                while w != 0 {
+                    let b = w.trailing_zeros();
+                    w &= w - 1;
+                    let (y, z) = (b >> 3, b & 7);
+                    self.inside([o[0] + x as i64, o[1] + y as i64, o[2] + z as i64])?;
+                    brick[z as usize] |= 1 << (y * 8 + x as u32);
+                }
+            }
+            if brick != [0; 8] {
+                bricks.push((base.map(|c| (c / 8) as u32), brick));
+            }
+        }
+        let mut runs: Vec<([u32; 3], u32)> = Vec::new();
+        for (o, e) in &self.tiles {
+            let (lo, _) = (self.inside(*o)?, self.inside(o.map(|c| c + e - 1))?);
+            let n = (*e / 8) as u32;
+            if runs.len() as u64 + (n as u64) * (n as u64) > MAX_SPARSE_RUNS {
+                return Err(bad(format!("active tiles make more than {MAX_SPARSE_RUNS} brick rows")));
+            }
+            let b = lo.map(|c| c / 8);
+            for bk in b[2]..b[2] + n {
+                for bj in b[1]..b[1] + n {
+                    runs.push(([b[0], bj, bk], n));
+                }
+            }
+        }
+        Ok(SparseBricks::from_parts(self.dims, bricks, runs))
+    }
+}
+
+/// Most rows of full bricks the sparse reader makes from active tiles (16
+/// bytes each: 1 GiB; a 4096³ tile is 262 144 rows).
+const MAX_SPARSE_RUNS: u64 = 1 << 26;
+
+/// The bool grid at the cursor.
+fn read_grid(c: &mut Cur<'_>) -> Result<Occupancy, ErrorKind> {
     let Head { mask_compressed, meta, translation, scale } = read_head(c)?;
     let get = |n: &str| meta.iter().find(|m| m.0 == n).map(|m| m.2.clone());
-    let mut found = read_topology(c, mask_compressed, 1)?;
-    found.tiles.retain(|t| t.2[0] != 0);
+    let found = read_topology(c, mask_compressed, 1)?;
+    let tiles: Vec<([i64; 3], i64)> = found.tiles.iter().filter(|t| t.2[0] != 0).map(|t| (t.0, t.1)).collect();
     let mut leaves: Vec<([i64; 3], Vec<u64>)> = Vec::with_capacity(found.leaves.len());
     for expect in &found.leaves {
         let active = c.words(8)?;
@@ -908,10 +1053,6 @@ fn read_grid(c: &mut Cur<'_>) -> Result<(LoadedVoxels, [i64; 3]), ErrorKind> {
         c.words(8)?; // values: occupancy is activity
         leaves.push((o, active));
     }
-    let tile_voxels: i64 = found.tiles.iter().fold(0i64, |n, t| n.saturating_add(t.1 * t.1 * t.1));
-    if tile_voxels > MAX_TILE_VOXELS {
-        return Err(bad(format!("active tiles cover {tile_voxels} voxels, more than voxkit reads into a dense grid ({MAX_TILE_VOXELS})")));
-    }
     // The index box of the active voxels.
     let mut lo = [i64::MAX; 3];
     let mut hi = [i64::MIN; 3];
@@ -921,7 +1062,7 @@ fn read_grid(c: &mut Cur<'_>) -> Result<(LoadedVoxels, [i64; 3]), ErrorKind> {
             hi[a] = hi[a].max(q[a]);
         }
     };
-    for (o, e, _) in &found.tiles {
+    for (o, e) in &tiles {
         grow(*o, o.map(|c| c + e - 1));
     }
     for (o, m) in &leaves {
@@ -938,37 +1079,6 @@ fn read_grid(c: &mut Cur<'_>) -> Result<(LoadedVoxels, [i64; 3]), ErrorKind> {
         _ if lo[0] == i64::MAX => ([0; 3], [1, 1, 1]),
         _ => (lo, std::array::from_fn(|a| u32::try_from(hi[a] - lo[a] + 1).unwrap_or(u32::MAX))),
     };
-    let mut bits = crate::dense_grid(dims)?;
-    let inside = |p: [i64; 3]| -> Result<[u32; 3], ErrorKind> {
-        let q: [i64; 3] = std::array::from_fn(|a| p[a] - offset[a]);
-        if (0..3).any(|a| q[a] < 0 || q[a] >= dims[a] as i64) {
-            return Err(bad(format!("active voxel {p:?} outside the recorded grid {dims:?}")));
-        }
-        Ok(q.map(|c| c as u32))
-    };
-    let mut tiles = Vec::with_capacity(found.tiles.len());
-    for (o, e, _) in &found.tiles {
-        // A tile is inside the grid when its two corners are.
-        tiles.push((inside(*o)?, inside(o.map(|c| c + e - 1))?));
-    }
-    let mut set = |p: [i64; 3]| -> Result<(), ErrorKind> {
-        let q = inside(p)?;
-        bits.set(q[0], q[1], q[2]);
-        Ok(())
-    };
-    for (o, m) in &leaves {
-        for (x, &w) in m.iter().enumerate() {
-            let mut w = w;
-            while w != 0 {
-                let b = w.trailing_zeros() as i64;
-                w &= w - 1;
-                set([o[0] + x as i64, o[1] + (b >> 3), o[2] + (b & 7)])?;
-            }
-        }
-    }
-    for (lo, hi) in tiles {
-        bits.fill_box(lo, hi);
-    }
     let origin_meta = get("voxkit_origin").filter(|v| v.len() == 24).map(|v| {
         let d: [f64; 3] = std::array::from_fn(|a| f64::from_le_bytes(v[8 * a..8 * a + 8].try_into().expect("8 bytes")));
         DVec3::from(d)
@@ -986,7 +1096,7 @@ fn read_grid(c: &mut Cur<'_>) -> Result<(LoadedVoxels, [i64; 3]), ErrorKind> {
         }
         _ => None,
     };
-    Ok((LoadedVoxels { bits, placement, attributes: None }, offset))
+    Ok(Occupancy { leaves, tiles, offset, dims, placement })
 }
 
 #[cfg(test)]
@@ -1010,8 +1120,9 @@ mod tests {
         assert_eq!((o, s), (grid.origin(), 0.25));
         // Every truncation is an error, never a panic.
         for n in (0..buf.len()).step_by(97) {
-            assert!(read(&buf[..n]).is_err());
+            assert!(read(&buf[..n]).is_err() && read_sparse(&buf[..n]).is_err());
         }
+        assert_eq!(read_sparse(&buf).unwrap().bits.to_dense(), d);
     }
 
     /// Full runs become tiles (of 8³, and of 128³ where a whole 16³ node is
@@ -1048,6 +1159,12 @@ mod tests {
         let back = read(&buf).unwrap();
         assert_eq!(back.bits, sparse.to_dense());
         assert_eq!(back.bits.count(), 128 * 128 * 128 + 4 * 512 + 4);
+        // Read without a dense grid: the same bricks, the tiles as full runs.
+        let again = read_sparse(&buf).unwrap();
+        assert_eq!(again.bits.to_dense(), back.bits);
+        assert_eq!(again.bits.full_bricks(), 16 * 16 * 16 + 4);
+        assert_eq!(again.bits.brick_count(), 2);
+        assert_eq!((again.placement, again.attributes_left), (back.placement, false));
     }
 
     /// Active tiles are filled whole, quickly (the file fuzzing found
@@ -1110,6 +1227,8 @@ mod tests {
         let back = read(&buf).unwrap();
         assert_eq!(back.bits, d);
         assert_eq!(back.attributes.as_ref(), Some(&attrs));
+        let sparse = read_sparse(&buf).unwrap();
+        assert_eq!((sparse.bits.to_dense(), sparse.attributes_left), (d.clone(), true), "the sparse reader says it left the attributes");
         // Without attributes: the bool grid alone, as before.
         let mut plain = Vec::new();
         write(&mut plain, &d, &grid, None).unwrap();

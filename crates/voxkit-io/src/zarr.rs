@@ -50,10 +50,11 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 use voxkit::attributes::{VoxelAttributes, NO_MATERIAL};
 use voxkit::grid::bricks::Brick;
+use voxkit::grid::sparse::SparseBricks;
 use voxkit::{GridSpec, VoxelSource};
 
 use crate::error::{ErrorKind, IoError};
-use crate::LoadedVoxels;
+use crate::{LoadedVoxels, SparseVoxels};
 
 /// Chunk edge in voxels (8 bricks).
 pub const CHUNK: u32 = 64;
@@ -645,6 +646,71 @@ pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
     Ok(loaded)
 }
 
+/// A Zarr array's voxels (or those of a voxkit group's `voxels` array)
+/// as sparse bricks, without a dense grid: memory follows the set voxels.
+/// Also the placement, and whether attribute arrays were left unread
+/// (they need the dense path).
+pub fn read_sparse(path: &Path) -> Result<SparseVoxels, IoError> {
+    let m = node(path)?;
+    let (dir, m, placement, attributes_left) = if m["node_type"] == "group" {
+        let voxels = path.join("voxels");
+        if !voxels.join("zarr.json").is_file() {
+            return Err(IoError::new(path, bad("a Zarr group without a `voxels` array (voxkit reads its own groups, or an array)")));
+        }
+        let attributes = ["colour", "normal", "coverage", "material"].iter().any(|n| path.join(n).join("zarr.json").is_file());
+        (voxels.clone(), node(&voxels)?, read_placement(&m["attributes"]), attributes)
+    } else {
+        (path.to_path_buf(), m, None, false)
+    };
+    let a = array_meta(&dir, &m, 1)?;
+    if !matches!(a.data_type.as_str(), "bool" | "uint8") {
+        return Err(IoError::new(&dir, bad(format!("data_type {:?} (voxkit reads bool and uint8)", a.data_type))));
+    }
+    if a.shape.iter().any(|&d| d > SparseBricks::MAX_DIM as u64) {
+        return Err(IoError::new(&dir, bad(format!("shape {:?} beyond {} voxels per axis", a.shape, SparseBricks::MAX_DIM))));
+    }
+    let mut bricks = Vec::new();
+    for_each_chunk(&dir, &a, 1, |o, shape, buf| place_bricks(&mut bricks, buf, o, shape, a.shape))?;
+    let placement = read_placement(&a.attributes).or(placement);
+    Ok(SparseVoxels { bits: SparseBricks::from_parts(a.shape.map(|d| d as u32), bricks, Vec::new()), placement, attributes_left })
+}
+
+/// Appends the non-empty bricks of a decoded chunk of `shape` at `origin`
+/// (any alignment; elements past `dims` are padding).
+fn place_bricks(out: &mut Vec<([u32; 3], Brick)>, buf: &[u8], origin: [u64; 3], shape: [u64; 3], dims: [u64; 3]) {
+    if (0..3).any(|x| origin[x] >= dims[x]) {
+        return;
+    }
+    let lo = origin.map(|c| c / 8);
+    let hi: [u64; 3] = std::array::from_fn(|x| ((origin[x] + shape[x]).min(dims[x]) - 1) / 8);
+    let n: [usize; 3] = std::array::from_fn(|x| (hi[x] - lo[x] + 1) as usize);
+    let mut local = vec![[0u64; 8]; n[0] * n[1] * n[2]];
+    for (g, group) in buf.chunks(8).enumerate() {
+        if group.iter().all(|&v| v == 0) {
+            continue;
+        }
+        for (e, &v) in group.iter().enumerate() {
+            if v == 0 {
+                continue;
+            }
+            let idx = (8 * g + e) as u64;
+            let q = [idx / (shape[1] * shape[2]), (idx / shape[2]) % shape[1], idx % shape[2]];
+            let p: [u64; 3] = std::array::from_fn(|x| origin[x] + q[x]);
+            if (0..3).any(|x| p[x] >= dims[x]) {
+                continue;
+            }
+            let b: [usize; 3] = std::array::from_fn(|x| (p[x] / 8 - lo[x]) as usize);
+            local[(b[2] * n[1] + b[1]) * n[0] + b[0]][(p[2] % 8) as usize] |= 1 << ((p[1] % 8) * 8 + p[0] % 8);
+        }
+    }
+    for (at, brick) in local.into_iter().enumerate() {
+        if brick != [0; 8] {
+            let b = [at % n[0], at / n[0] % n[1], at / (n[0] * n[1])];
+            out.push((std::array::from_fn(|x| (lo[x] + b[x] as u64) as u32), brick));
+        }
+    }
+}
+
 /// The occupancy array `m` at `path`.
 fn read_occupancy(path: &Path, m: &Value) -> Result<LoadedVoxels, IoError> {
     let e = |k| IoError::new(path, k);
@@ -715,6 +781,7 @@ mod tests {
         let out = dir.join("v.zarr");
         write(&out, &d, &grid, None).unwrap();
         assert_eq!(read(&out).unwrap().bits, d);
+        assert_eq!(read_sparse(&out).unwrap().bits.to_dense(), d);
         assert!(out.join("c/0/0/0").is_file() && !out.join("c/1/0/0").exists() && out.join("c/2/0/0").is_file());
         // Shard (0, 0, 0): 8 × 2 × 1 chunks, of which (0, 0, 0) and (7, 1, 0) hold voxels.
         let shard = std::fs::read(out.join("c/0/0/0")).unwrap();
@@ -743,6 +810,7 @@ mod tests {
         let mut set = Vec::new();
         back.for_each_set(|i, j, k| set.push([i, j, k]));
         assert_eq!(set, [[4, 0, 0], [3, 1, 1]]);
+        assert_eq!(read_sparse(&out).unwrap().bits.to_dense(), back, "chunks off the bricks (3 × 2 × 2)");
 
         let mut d = DenseBits::new([8, 8, 8]);
         d.set(1, 1, 1);
@@ -795,6 +863,9 @@ mod tests {
         assert_eq!(back.bits, d);
         assert_eq!(back.placement, Some((grid.origin(), 0.125)));
         assert_eq!(back.attributes.as_ref(), Some(&attrs));
+        let sparse = read_sparse(&out).unwrap();
+        assert_eq!((sparse.bits.to_dense(), sparse.placement, sparse.attributes_left), (d.clone(), back.placement, true));
+        assert_eq!(sparse.bits.full_bricks(), 1, "the full brick is read as a run");
         // Without attributes: the plain array, as before.
         write(&out, &d, &grid, None).unwrap();
         let m: Value = serde_json::from_slice(&std::fs::read(out.join("zarr.json")).unwrap()).unwrap();

@@ -12,19 +12,58 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
     voxkit_job::output::check_output_path(&a.output)?;
     voxkit_job::output::refuse_overwriting(&a.output, format, std::slice::from_ref(&a.input))?;
     let write_opts = crate::commands::export::writer_options(&a.export)?;
-    let input_has_up =
-        matches!(voxkit_io::VoxelFormat::from_path(&a.input), Some(voxkit_io::VoxelFormat::Vox | voxkit_io::VoxelFormat::Schem));
+    use voxkit_io::VoxelFormat as F;
+    let input_format = F::from_path(&a.input);
+    let input_has_up = matches!(input_format, Some(F::Vox | F::Schem));
     crate::commands::export::warn_unused(&a.export, format, &a.output, false, input_has_up);
     // The up axis is the data's: .vox and .schem files are read back with it too.
-    let loaded = voxkit_io::read_voxels_with(&a.input, crate::commands::export::up(&a.export))?;
-    let dims = loaded.bits.dims();
-    let (grid, source) = placement(a, &loaded)?;
-    let facts = voxkit_job::output::write(&a.output, format, &loaded.bits, &grid, loaded.attributes.as_ref(), &write_opts)?;
-    let voxels = loaded.bits.count();
+    let loaded = match voxkit_io::read_voxels_with(&a.input, crate::commands::export::up(&a.export)) {
+        Ok(l) => l,
+        // A .vdb or .zarr grid past memory, to a format that holds only the
+        // set voxels: read and written without a dense grid.
+        Err(e) if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. }) && voxkit_job::output::is_sparse(format) => {
+            let sparse = match voxkit_io::read_voxels_sparse(&a.input) {
+                Ok(s) => s,
+                // Formats read only densely: the grid's size is the error.
+                Err(s) if matches!(s.kind, voxkit_io::ErrorKind::Unsupported(_)) && !matches!(input_format, Some(F::Vdb | F::Zarr)) => {
+                    return Err(e.into())
+                }
+                Err(s) => return Err(s.into()),
+            };
+            if sparse.attributes_left {
+                eprintln!(
+                    "voxkit: warning: {}: its attributes are not carried: the grid does not fit densely, and only the voxels are read sparsely",
+                    a.input.display()
+                );
+            }
+            return finish(a, format, &sparse.bits, sparse.placement, None, &write_opts, true);
+        }
+        Err(e) if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. }) && matches!(input_format, Some(F::Vdb | F::Zarr)) => {
+            bail!("{e}; {} is a dense format: convert it to .vdb, .zarr, .npz, .txt or .ply, which need no dense grid", format.name())
+        }
+        Err(e) => return Err(e.into()),
+    };
+    finish(a, format, &loaded.bits, loaded.placement, loaded.attributes.as_ref(), &write_opts, false)
+}
+
+/// Writes the voxels read (`sparse`: without a dense grid) and prints the summary.
+fn finish(
+    a: &ConvertArgs,
+    format: voxkit_job::output::Output,
+    bits: &dyn voxkit::VoxelSource,
+    recorded: Option<(DVec3, f64)>,
+    attributes: Option<&voxkit::attributes::VoxelAttributes>,
+    write_opts: &voxkit_io::WriteOptions,
+    sparse: bool,
+) -> Result<()> {
+    let dims = bits.dims();
+    let (grid, source) = placement(a, dims, recorded)?;
+    let facts = voxkit_job::output::write(&a.output, format, bits, &grid, attributes, write_opts)?;
+    let voxels = bits.count();
     if a.json {
         let o = grid.origin();
         let v = json!({"input": a.input, "output": a.output, "format": format.name(), "dims": dims, "voxels": voxels,
-            "origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size(), "grid_from": source, "export": facts});
+            "origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size(), "grid_from": source, "export": facts, "sparse": sparse});
         return crate::print_stdout(&v.to_string());
     }
     let what = match (facts.get("quads"), facts.get("vertices")) {
@@ -41,9 +80,8 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
 }
 
 /// The grid: what the input records, else the options, else unit voxels at the origin.
-fn placement(a: &ConvertArgs, loaded: &voxkit_io::LoadedVoxels) -> Result<(GridSpec, &'static str)> {
-    let dims = loaded.bits.dims();
-    let (origin, size, source) = match (loaded.placement, &a.origin, a.voxel_size) {
+fn placement(a: &ConvertArgs, dims: [u32; 3], recorded: Option<(DVec3, f64)>) -> Result<(GridSpec, &'static str)> {
+    let (origin, size, source) = match (recorded, &a.origin, a.voxel_size) {
         (Some((o, s)), None, None) => (o, s, "input"),
         (placement, o, s) => {
             let origin = match o {

@@ -138,6 +138,41 @@ impl SparseBricks {
         out
     }
 
+    /// Builds a grid from bricks and runs of full bricks in any order, as a
+    /// reader finds them (a file's leaves and active tiles): bricks given
+    /// twice are merged, empty ones dropped, full ones and overlapping or
+    /// touching runs of a row joined into runs, bricks inside a run
+    /// dropped. Brick coordinates must lie in the grid, bits outside
+    /// `dims` must be clear and runs must lie wholly inside it.
+    pub fn from_parts(dims: [u32; 3], bricks: Vec<([u32; 3], Brick)>, runs: Vec<([u32; 3], u32)>) -> SparseBricks {
+        let mut out = SparseBricks::from_bricks(dims, bricks);
+        let mut full: Vec<(u64, u32)> = runs.iter().filter(|r| r.1 > 0).map(|&(b, n)| (key(b), n)).collect();
+        // Full bricks become runs of one (a brick full of bits is wholly inside the grid).
+        full.extend(out.keys.iter().zip(&out.bricks).filter(|(_, b)| **b == FULL).map(|(k, _)| (*k, 1)));
+        full.sort_unstable();
+        // A run never leaves its row (bi + n <= the row's bricks), so two
+        // runs of a row overlap or touch iff the next starts by the end of
+        // the last; runs of different rows are 2^21 keys apart.
+        let mut joined: Vec<(u64, u32)> = Vec::with_capacity(full.len());
+        for (k, n) in full {
+            match joined.last_mut() {
+                Some(last) if k <= last.0 + last.1 as u64 => last.1 = last.1.max((k + n as u64 - last.0) as u32),
+                _ => joined.push((k, n)),
+            }
+        }
+        out.full = joined;
+        for &(k, n) in &out.full {
+            let b = unkey(k);
+            assert!((0..3).all(|a| (b[a] + if a == 0 { n } else { 1 }) * BRICK <= dims[a]), "full run outside the grid");
+        }
+        let keep: Vec<bool> = out.keys.iter().map(|&k| out.full_at(k).is_none()).collect();
+        let mut n = 0;
+        out.keys.retain(|_| (keep[n], n += 1).0);
+        let mut n = 0;
+        out.bricks.retain(|_| (keep[n], n += 1).0);
+        out
+    }
+
     /// Appends the bricks of `tile`, a grid whose voxel `(0,0,0)` is this
     /// grid's voxel `origin` (a multiple of 8 on every axis). Call
     /// [`SparseBricks::finish`] after the last tile.
@@ -396,5 +431,46 @@ mod tests {
         assert_eq!(got.count(), expect.count());
         assert_eq!(got.full_bricks(), 3);
         assert!(got.keys.windows(2).all(|w| w[0] < w[1]));
+    }
+
+    /// Parts as a reader finds them — repeated and full bricks, bricks
+    /// inside runs, runs overlapping and touching — give the grid of their
+    /// union, normalised (`from_sorted` accepts its parts again).
+    #[test]
+    fn parts_in_any_order_are_normalised() {
+        let dims = [64, 24, 16];
+        let mut partial = [0u64; 8];
+        partial[2] = 0x8001;
+        let bricks = vec![
+            ([7, 2, 1], partial),
+            ([1, 0, 0], partial),
+            ([7, 2, 1], [0, 1, 0, 0, 0, 0, 0, 0]),
+            ([3, 1, 1], partial),
+            ([5, 1, 1], FULL),
+            ([0, 0, 0], [0; 8]),
+        ];
+        let runs = vec![([2, 1, 1], 2), ([0, 2, 0], 3), ([3, 1, 1], 2), ([6, 1, 1], 1), ([1, 2, 0], 1)];
+        let got = SparseBricks::from_parts(dims, bricks.clone(), runs.clone());
+        let mut want = DenseBits::new(dims);
+        for (b, bits) in &bricks {
+            for (z, &w) in bits.iter().enumerate() {
+                for bit in 0..64 {
+                    if w >> bit & 1 == 1 {
+                        want.set(b[0] * 8 + bit % 8, b[1] * 8 + bit / 8, b[2] * 8 + z as u32);
+                    }
+                }
+            }
+        }
+        for (b, n) in &runs {
+            want.fill_box([b[0] * 8, b[1] * 8, b[2] * 8], [(b[0] + n) * 8 - 1, b[1] * 8 + 7, b[2] * 8 + 7]);
+        }
+        assert_eq!(got.to_dense(), want);
+        assert_eq!(got.count(), want.count());
+        // Runs (2..7, 1, 1) joined with the full brick 5, and (0..3, 2, 0).
+        assert_eq!(got.full_runs().collect::<Vec<_>>(), [([0, 2, 0], 3), ([2, 1, 1], 5)]);
+        assert_eq!(got.brick_count(), 2, "brick (3, 1, 1) lies in a run, (0, 0, 0) is empty");
+        let parts: Vec<([u32; 3], Brick)> = got.keys.iter().zip(&got.bricks).map(|(k, b)| (unkey(*k), *b)).collect();
+        let again = SparseBricks::from_sorted(dims, parts, got.full_runs().collect());
+        assert_eq!(again.to_dense(), want);
     }
 }
