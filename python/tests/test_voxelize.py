@@ -202,6 +202,23 @@ def test_attributes_colours_materials_normals_coverage(meshes, tmp_path, cli):
     assert np.array_equal(back.colours, g.colours)
 
 
+@pytest.mark.parametrize("fmt", ["vdb", "zarr", "vti"])
+def test_attributes_saved_to_vdb_and_zarr_load_back(tmp_path, meshes, fmt):
+    """Attributes carried in Python go into .vdb grids and Zarr arrays
+    (as into .vti) and come back with load_voxels, value for value."""
+    g = voxkit.voxelize(voxkit.load_mesh(meshes / "spot-textured.obj"), resolution=40, attributes=True, normals=True)
+    p = tmp_path / f"spot.{fmt}"
+    g.save(p)
+    back = voxkit.load_voxels(p)
+    assert np.array_equal(back.indices(), g.indices())
+    for name in ("colours", "materials", "normals", "coverage"):
+        assert np.array_equal(getattr(back, name), getattr(g, name)), name
+    plain = tmp_path / f"plain.{fmt}"
+    voxkit.voxelize(voxkit.load_mesh(meshes / "spot-textured.obj"), resolution=40).save(plain)
+    if fmt != "vti":
+        assert voxkit.load_voxels(plain).colours is None
+
+
 @pytest.mark.parametrize("fmt", ["npy", "npy-bool", "npz", "binvox", "vox", "txt", "schem", "vti", "ply", "vdb", "zarr"])
 def test_save_and_load_every_voxel_format(tmp_path, meshes, fmt):
     g = voxkit.voxelize(voxkit.load_mesh(meshes / "cow.obj"), resolution=40)

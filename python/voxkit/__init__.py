@@ -69,7 +69,7 @@ MODES = ("cover", "sep26", "sep6", "ss6", "tunnel18", "tunnel26", "bubble", "dia
 #: Every method, as ``voxelize(method=...)`` takes it.
 METHODS = ("auto", "reference", "fast", "scanline", "gpu", "parity", "winding")
 #: Every output format ``VoxelGrid.save`` and ``batch`` write.
-FORMATS = ("npy", "npy-bool", "binvox", "vox", "txt", "schem", "vti", "ply", "obj", "glb")
+FORMATS = ("npy", "npy-bool", "npz", "binvox", "vox", "txt", "schem", "vti", "ply", "vdb", "zarr", "obj", "glb")
 
 MeshLike = Union[Mesh, Any]
 

@@ -781,11 +781,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     let mut c = Cur { b: bytes, at: 0 };
     let wanted = ATTRIBUTE_GRIDS;
     if found.iter().any(|d| wanted.contains(&(d.name.as_str(), d.ty.as_str()))) {
-        let mut keys = Vec::with_capacity(loaded.bits.count() as usize);
-        let dims = loaded.bits.dims();
-        loaded.bits.for_each_set(|i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
-        keys.sort_unstable();
-        let mut attrs = VoxelAttributes { dims, keys, ..Default::default() };
+        let mut attrs = VoxelAttributes { dims: loaded.bits.dims(), keys: VoxelAttributes::keys_of(&loaded.bits), ..Default::default() };
         for (name, ty) in wanted {
             let Some(d) = found.iter().find(|d| d.name == name && d.ty == ty) else { continue };
             c.seek(d.pos)?;
@@ -1209,9 +1205,7 @@ mod tests {
         for (i, j, k) in [(0, 0, 0), (139, 19, 16), (128, 3, 9), (16, 8, 8), (7, 7, 7)] {
             d.set(i, j, k);
         }
-        let mut keys = Vec::new();
-        d.for_each_set(|i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
-        keys.sort_unstable();
+        let keys = VoxelAttributes::keys_of(&d);
         let n = keys.len();
         let attrs = VoxelAttributes {
             dims,

@@ -151,8 +151,7 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: 
         }
     }
     // The set voxels' keys, ascending; `aligned` when they are the attributes' slots.
-    let mut keys = Vec::with_capacity(bits.count() as usize);
-    bits.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
+    let keys = VoxelAttributes::keys_of(bits);
     let aligned = attrs.is_some_and(|a| a.keys == keys);
     // One array per task: each is an independent block stream.
     let encode = |(name, _, _, width, value): &(&str, &str, usize, usize, Option<Value<'_>>)| -> std::io::Result<Vec<u8>> {

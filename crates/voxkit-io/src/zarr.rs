@@ -137,52 +137,45 @@ fn occupancy<'a>() -> Kind<'a> {
 
 /// The attribute arrays of `attrs`: `colour` (uint8 × 3, sRGB), `normal`
 /// (float32 × 3), `coverage` (float32), `material` (int32, -1 for none).
+/// An attribute array of `comps` values per voxel (`bytes` in all) and
+/// `fill` elsewhere, when the attribute is present (`put`).
+fn attribute_kind<'a>(
+    attrs: &'a VoxelAttributes,
+    (name, data_type, comps, bytes, fill): (&'static str, &'static str, u32, usize, i32),
+    put: Option<PutValue<'a>>,
+) -> Option<Kind<'a>> {
+    let fill_value = if data_type == "float32" { json!(fill as f64) } else { json!(fill) };
+    let fill = if data_type == "int32" { fill.to_le_bytes().to_vec() } else { vec![0; bytes] };
+    put.map(|put| Kind { name, data_type, comps, bytes, fill_value, fill, put: Some((attrs, put)) })
+}
+
 fn attribute_arrays(attrs: &VoxelAttributes) -> Vec<Kind<'_>> {
-    let mut out = Vec::new();
     let f32s = |b: &mut Vec<u8>, v: &[f32]| v.iter().for_each(|x| b.extend_from_slice(&x.to_le_bytes()));
-    if let Some(c) = &attrs.colour {
-        let put: PutValue<'_> = Box::new(move |s, b| b.extend_from_slice(&c[s]));
-        out.push(Kind {
-            name: "colour",
-            data_type: "uint8",
-            comps: 3,
-            bytes: 3,
-            fill_value: json!(0),
-            fill: vec![0; 3],
-            put: Some((attrs, put)),
-        });
-    }
-    if let Some(n) = &attrs.normal {
-        let put: PutValue<'_> = Box::new(move |s, b| f32s(b, &n[s]));
-        out.push(Kind {
-            name: "normal",
-            data_type: "float32",
-            comps: 3,
-            bytes: 12,
-            fill_value: json!(0.0),
-            fill: vec![0; 12],
-            put: Some((attrs, put)),
-        });
-    }
-    if let Some(c) = &attrs.coverage {
-        let put: PutValue<'_> = Box::new(move |s, b| f32s(b, &[c[s]]));
-        out.push(Kind {
-            name: "coverage",
-            data_type: "float32",
-            comps: 1,
-            bytes: 4,
-            fill_value: json!(0.0),
-            fill: vec![0; 4],
-            put: Some((attrs, put)),
-        });
-    }
-    if let Some(m) = &attrs.material {
-        let put: PutValue<'_> =
-            Box::new(move |s, b| b.extend_from_slice(&(if m[s] == NO_MATERIAL { -1 } else { m[s] as i32 }).to_le_bytes()));
-        let fill = (-1i32).to_le_bytes().to_vec();
-        out.push(Kind { name: "material", data_type: "int32", comps: 1, bytes: 4, fill_value: json!(-1), fill, put: Some((attrs, put)) });
-    }
-    out
+    let kind = |name, data_type, comps, bytes, fill, put| attribute_kind(attrs, (name, data_type, comps, bytes, fill), put);
+    let material = |m: u32| if m == NO_MATERIAL { -1 } else { m as i32 };
+    [
+        kind(
+            "colour",
+            "uint8",
+            3,
+            3,
+            0,
+            attrs.colour.as_ref().map(|c| -> PutValue<'_> { Box::new(move |s, b| b.extend_from_slice(&c[s])) }),
+        ),
+        kind("normal", "float32", 3, 12, 0, attrs.normal.as_ref().map(|n| -> PutValue<'_> { Box::new(move |s, b| f32s(b, &n[s])) })),
+        kind("coverage", "float32", 1, 4, 0, attrs.coverage.as_ref().map(|c| -> PutValue<'_> { Box::new(move |s, b| f32s(b, &[c[s]])) })),
+        kind(
+            "material",
+            "int32",
+            1,
+            4,
+            -1,
+            attrs.material.as_ref().map(|m| -> PutValue<'_> { Box::new(move |s, b| b.extend_from_slice(&material(m[s]).to_le_bytes())) }),
+        ),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
 }
 
 /// One chunk's bytes (C order, `k` fastest, then the components) from its
@@ -585,10 +578,7 @@ pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
         loaded.placement = read_placement(&m["attributes"]);
     }
     let dims = loaded.bits.dims();
-    let mut keys = Vec::with_capacity(loaded.bits.count() as usize);
-    loaded.bits.for_each_set(|i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
-    keys.sort_unstable();
-    let mut attrs = VoxelAttributes { dims, keys, ..Default::default() };
+    let mut attrs = VoxelAttributes { dims, keys: VoxelAttributes::keys_of(&loaded.bits), ..Default::default() };
     let mut any = false;
     for (name, data_type, comps) in [("colour", "uint8", 3), ("normal", "float32", 3), ("coverage", "float32", 1), ("material", "int32", 1)]
     {
@@ -838,9 +828,7 @@ mod tests {
         for (i, j, k) in [(0, 0, 0), (69, 8, 65), (64, 3, 1)] {
             d.set(i, j, k);
         }
-        let mut keys = Vec::new();
-        d.for_each_set(|i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
-        keys.sort_unstable();
+        let keys = VoxelAttributes::keys_of(&d);
         let n = keys.len();
         let attrs = VoxelAttributes {
             dims,

@@ -104,7 +104,7 @@ pub fn carry(
     opts: &CarryOptions,
 ) -> VoxelAttributes {
     let dims = grid.dims();
-    let keys = keys_of(voxels, dims);
+    let keys = VoxelAttributes::keys_of(voxels);
     let ctx = Ctx::new(mesh, appearance, grid, &keys, opts);
     let n = keys.len();
     let mut arrays = ctx.arrays();
@@ -147,13 +147,6 @@ pub fn carry(
         });
     }
     arrays.finish(keys, dims)
-}
-
-/// The sorted keys of the set voxels of `voxels`.
-fn keys_of(voxels: &dyn VoxelSource, dims: [u32; 3]) -> Vec<u64> {
-    let mut keys = Vec::with_capacity(voxels.count() as usize);
-    voxels.for_each_set(&mut |i, j, k| keys.push(VoxelAttributes::key(dims, i, j, k)));
-    keys
 }
 
 /// The attribute arrays being filled, one entry per set voxel (those not
@@ -604,7 +597,7 @@ pub mod reference {
         opts: &CarryOptions,
     ) -> VoxelAttributes {
         let dims = grid.dims();
-        let keys = keys_of(voxels, dims);
+        let keys = VoxelAttributes::keys_of(voxels);
         let ctx = Ctx::new(mesh, appearance, grid, &keys, opts);
         let mut arrays = ctx.arrays();
         let mut scratch = Scratch::default();

@@ -179,6 +179,16 @@ impl VoxelAttributes {
         i as u64 + dims[0] as u64 * (j as u64 + dims[1] as u64 * k as u64)
     }
 
+    /// The keys of the set voxels of `voxels`, ascending: the slots
+    /// attributes of exactly those voxels take.
+    pub fn keys_of(voxels: &dyn crate::VoxelSource) -> Vec<u64> {
+        let dims = voxels.dims();
+        let mut keys = Vec::with_capacity(voxels.count() as usize);
+        // `for_each_set` goes by k, then j, then i: ascending keys.
+        voxels.for_each_set(&mut |i, j, k| keys.push(Self::key(dims, i, j, k)));
+        keys
+    }
+
     /// The voxel of a key.
     pub fn voxel(&self, key: u64) -> [u32; 3] {
         let (nx, ny) = (self.dims[0] as u64, self.dims[1] as u64);
