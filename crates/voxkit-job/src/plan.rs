@@ -382,7 +382,7 @@ impl Plan {
             if let Some(sp) = &solid {
                 if !crate::solid::has_sparse_path(sp) {
                     return Err(JobError::invalid(
-                        "--tile: flood fills, hollow solids and the reference and gpu solids do not run tiled yet (parity and winding do)",
+                        "--tile: flood fills and the reference and gpu solids do not run tiled yet (parity and winding do, hollowed or not)",
                     ));
                 }
             } else if !matches!(request.method, Method::Auto | Method::Fast | Method::Scanline) {

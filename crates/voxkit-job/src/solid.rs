@@ -120,10 +120,10 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
 }
 
 /// Whether `plan` has a sparse path (for grids past memory): parity or the
-/// closed winding number, alone or with a surface; not flood fills,
-/// `hollow`, the brute-force reference or the GPU.
+/// closed winding number, alone or with a surface, hollowed or not; not
+/// flood fills, the brute-force reference or the GPU.
 pub fn has_sparse_path(plan: &SolidPlan) -> bool {
-    matches!(plan.method, SolidMethod::Auto | SolidMethod::Parity | SolidMethod::Winding) && plan.hollow.is_none()
+    matches!(plan.method, SolidMethod::Auto | SolidMethod::Parity | SolidMethod::Winding)
 }
 
 /// A sparse solid and what was done to get it (see [`run_sparse`]).
@@ -153,7 +153,7 @@ pub fn run_sparse(
 ) -> Result<SparseOutcome> {
     if !has_sparse_path(plan) {
         return Err(JobError::invalid(format!(
-            "{name}: this solid (flood fill, hollow, reference or gpu) has no sparse path yet; parity and winding on closed meshes do"
+            "{name}: this solid (flood fill, reference or gpu) has no sparse path yet; parity and winding on closed meshes do"
         )));
     }
     let snapped = voxkit::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
@@ -195,6 +195,13 @@ pub fn run_sparse(
             let (shell, _) = voxelize::tiled::tiled(surface, mesh, grid, tile, opts).map_err(|e| JobError::invalid(e.to_string()))?;
             facts["surface"] = json!(surface.name());
             bits.union(&shell)
+        }
+        None => bits,
+    };
+    let bits = match plan.hollow {
+        Some(conn) => {
+            facts["hollow"] = json!(if conn == voxkit::topology::runs::Connectivity::Six { 6 } else { 26 });
+            fill::hollow_sparse(&bits, conn)
         }
         None => bits,
     };

@@ -247,6 +247,21 @@ impl SparseBricks {
         }
     }
 
+    /// The bits of brick `b`: stored, full (in a run), or empty.
+    pub fn brick_bits(&self, b: [u32; 3]) -> Brick {
+        let k = key(b);
+        match self.keys.binary_search(&k) {
+            Ok(n) => self.bricks[n],
+            Err(_) if self.full_at(k).is_some() => FULL,
+            Err(_) => [0; 8],
+        }
+    }
+
+    /// The coordinates of the stored (not full-run) bricks, in key order.
+    pub fn stored_bricks(&self) -> impl Iterator<Item = [u32; 3]> + '_ {
+        self.keys.iter().map(|&k| unkey(k))
+    }
+
     /// Calls `f(brick coordinates, bits)` for every non-empty brick, full
     /// runs brick by brick, in order of `bk`, then `bj`, then `bi`.
     pub fn for_each_brick(&self, mut f: impl FnMut([u32; 3], &Brick)) {
