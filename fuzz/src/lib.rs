@@ -24,20 +24,23 @@ const MAX_VISITED_WORDS: u64 = 1 << 20;
 /// panic; the voxels read are inside their grid, counted right, and carry at
 /// most one attribute per voxel.
 pub fn check_voxels(data: &[u8], format: VoxelFormat) {
-    // The sparse .vdb reader never panics either, and where both readers
-    // succeed they give the same voxels.
-    let sparse = if format == VoxelFormat::Vdb { voxkit_io::vdb::read_sparse(data).ok() } else { None };
+    // The sparse .vdb and .npz readers never panic either, and where both
+    // readers succeed they give the same voxels.
+    let sparse = match format {
+        VoxelFormat::Vdb => voxkit_io::vdb::read_sparse(data).ok(),
+        VoxelFormat::Npz => voxkit_io::npz::read_sparse_from(std::io::Cursor::new(data), data.len() as u64).ok(),
+        _ => None,
+    };
     let Ok(v) = voxkit_io::read_voxels_bytes(data, format) else { return };
-    if let Some(s) = &sparse {
-        if s.bits.dims() == v.bits.dims() && s.bits.count() <= MAX_VISITED_WORDS {
-            assert_eq!(s.bits.count(), v.bits.count());
-            assert_eq!(format!("{:?}", s.placement), format!("{:?}", v.placement)); // NaN-proof
-            voxkit::VoxelSource::for_each_set(&s.bits, &mut |i, j, k| assert!(v.bits.get(i, j, k)));
-        }
-    }
     let [nx, ny, nz] = v.bits.dims();
     if (nx as u64).div_ceil(64) * ny as u64 * nz as u64 > MAX_VISITED_WORDS {
         return;
+    }
+    if let Some(s) = &sparse {
+        assert_eq!(s.bits.dims(), v.bits.dims());
+        assert_eq!(s.bits.count(), v.bits.count());
+        assert_eq!(format!("{:?}", s.placement), format!("{:?}", v.placement)); // NaN-proof
+        voxkit::VoxelSource::for_each_set(&s.bits, &mut |i, j, k| assert!(v.bits.get(i, j, k)));
     }
     let mut n = 0u64;
     v.bits.for_each_set(|i, j, k| {

@@ -644,11 +644,12 @@ fn vdb_attributes_carry_every_array() {
     assert_eq!(std::fs::read(tmp("attrs-cover.vti")).unwrap(), std::fs::read(&back).unwrap(), ".zarr attributes differ from .vti's");
 }
 
-/// `convert` of a `.vdb` or `.zarr` grid that cannot be dense (20000³ here,
-/// 932 GiB of bits) into a format holding only the set voxels reads and
-/// writes it without a dense grid: `.vdb` → `.zarr` → `.vdb` gives the
-/// same bytes, `.txt` the voxels `voxelize` lists; a dense format is one
-/// line naming the sparse ones.
+/// `convert` of a `.vdb`, `.zarr` or `.npz` grid that cannot be dense
+/// (20000³ here, 932 GiB of bits) into a format holding only the set
+/// voxels reads and writes it without a dense grid: `.vdb` → `.zarr` →
+/// `.vdb` and `.vdb` → `.npz` → `.vdb` give the same bytes, `.txt` the
+/// voxels `voxelize` lists; a dense format is one line naming the sparse
+/// ones.
 #[test]
 fn convert_sparse_grids_past_memory() {
     let cube = unit_cube_obj("sparse-cube.obj");
@@ -664,6 +665,12 @@ fn convert_sparse_grids_past_memory() {
     assert_eq!(std::fs::read(&v).unwrap(), std::fs::read(&v2).unwrap(), ".vdb -> .zarr -> .vdb changed the file");
     json(&voxkit(&["convert", &z, &t, "--json"]));
     assert_eq!(std::fs::read(&direct).unwrap(), std::fs::read(&t).unwrap());
+    // .npz of indices too: .vdb -> .npz -> .vdb.
+    let (n, v3) = (tmp("sparse.npz"), tmp("sparse3.vdb"));
+    json(&voxkit(&["convert", &v, &n, "--json"]));
+    let c = json(&voxkit(&["convert", &n, &v3, "--json"]));
+    assert_eq!(c["sparse"].as_bool(), Some(true));
+    assert_eq!(std::fs::read(&v).unwrap(), std::fs::read(&v3).unwrap(), ".vdb -> .npz -> .vdb changed the file");
     let e = error_line(&["convert", &v, &tmp("sparse.npy")]);
     assert!(e.contains("932") && e.contains(".zarr"), "{e}");
 }

@@ -352,7 +352,7 @@ pub struct SparseVoxels {
     pub attributes_left: bool,
 }
 
-/// Reads a `.vdb` file or a `.zarr` array without a dense grid, for grids
+/// Reads a `.vdb` file, a `.zarr` array or a `.npz` of indices without a dense grid, for grids
 /// that do not fit in memory densely ([`read_voxels`] refuses those with
 /// [`ErrorKind::TooLarge`]): memory follows the set voxels. Other formats
 /// are refused by name.
@@ -363,7 +363,12 @@ pub fn read_voxels_sparse(path: &Path) -> Result<SparseVoxels, IoError> {
             fence("VDB", || vdb::read_sparse(&bytes)).map_err(|k| IoError::new(path, k))
         }
         Some(VoxelFormat::Zarr) => zarr::read_sparse(path),
-        _ => Err(IoError::new(path, ErrorKind::Unsupported("only .vdb and .zarr are read without a dense grid".into()))),
+        Some(VoxelFormat::Npz) => {
+            let file = std::fs::File::open(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+            let total = file.metadata().map_err(|e| IoError::new(path, ErrorKind::Read(e)))?.len();
+            fence("NumPy .npz", || npz::read_sparse_from(std::io::BufReader::new(file), total)).map_err(|k| IoError::new(path, k))
+        }
+        _ => Err(IoError::new(path, ErrorKind::Unsupported("only .vdb, .zarr and .npz are read without a dense grid".into()))),
     }
 }
 

@@ -21,11 +21,15 @@
 use std::io::{Read, Seek, Write};
 
 use glam::DVec3;
+use std::collections::HashMap;
+
+use voxkit::grid::bricks::Brick;
+use voxkit::grid::sparse::SparseBricks;
 use voxkit::{GridSpec, VoxelSource};
 
 use crate::error::ErrorKind;
 use crate::npy::{header, header_field};
-use crate::LoadedVoxels;
+use crate::{LoadedVoxels, SparseVoxels};
 
 const FORMAT: &str = "npz";
 
@@ -127,6 +131,9 @@ fn read_header(r: &mut impl Read, name: &str) -> Result<Header, ErrorKind> {
 /// or 8 bytes, or 8-byte floats) as `f64`.
 fn read_numbers(r: &mut impl Read, descr: &str, n: usize, name: &str) -> Result<Vec<f64>, ErrorKind> {
     let bad = |d: String| ErrorKind::malformed("npz", format!("member {name}: {d}"));
+    if !descr.is_ascii() {
+        return Err(bad(format!("dtype {descr:?} (expected integers or float64)")));
+    }
     let (order, kind) = descr.split_at(1.min(descr.len()));
     let big = order == ">";
     let size: usize = kind.get(1..).and_then(|s| s.parse().ok()).ok_or_else(|| bad(format!("dtype {descr:?}")))?;
@@ -168,6 +175,42 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
 /// [`read()`] from a seekable reader of `total` bytes (a file: the index
 /// array is streamed into the grid, never held whole).
 pub fn read_from<R: Read + Seek>(r: R, total: u64) -> Result<LoadedVoxels, ErrorKind> {
+    let (grid, placement) = read_into(r, total, false)?;
+    match grid {
+        Read3::Dense(bits) => Ok(LoadedVoxels { bits, placement, attributes: None }),
+        Read3::Sparse(_) => unreachable!("asked for a dense grid"),
+    }
+}
+
+/// [`read_from`] without a dense grid: the indices gathered into bricks,
+/// for grids past memory.
+pub fn read_sparse_from<R: Read + Seek>(r: R, total: u64) -> Result<SparseVoxels, ErrorKind> {
+    let (grid, placement) = read_into(r, total, true)?;
+    match grid {
+        Read3::Sparse(bits) => Ok(SparseVoxels { bits, placement, attributes_left: false }),
+        Read3::Dense(_) => unreachable!("asked for sparse bricks"),
+    }
+}
+
+/// The voxels read: a dense grid, or sparse bricks.
+enum Read3 {
+    Dense(voxkit::DenseBits),
+    Sparse(SparseBricks),
+}
+
+/// Where indices go while they are read.
+enum Sink {
+    Dense(voxkit::DenseBits),
+    Bricks(HashMap<[u32; 3], Brick>),
+    /// Without recorded dims, the grid is sized after reading them all.
+    List(Vec<[u32; 3]>),
+}
+
+fn set_in(bricks: &mut HashMap<[u32; 3], Brick>, q: [u32; 3]) {
+    bricks.entry(q.map(|c| c / 8)).or_insert([0; 8])[(q[2] % 8) as usize] |= 1 << ((q[1] % 8) * 8 + q[0] % 8);
+}
+
+fn read_into<R: Read + Seek>(r: R, total: u64, sparse: bool) -> Result<(Read3, Option<(DVec3, f64)>), ErrorKind> {
     let mut zip = zip::ZipArchive::new(r).map_err(|e| ErrorKind::malformed(FORMAT, format!("not a ZIP archive ({e})")))?;
     let small = |zip: &mut zip::ZipArchive<R>, name: &str, n: usize| -> Result<Option<Vec<f64>>, ErrorKind> {
         let Ok(mut f) = zip.by_name(name) else { return Ok(None) };
@@ -206,8 +249,16 @@ pub fn read_from<R: Read + Seek>(r: R, total: u64) -> Result<LoadedVoxels, Error
         None => None,
     };
     // Indices come in chunks; without dims the grid is sized after reading them all.
-    let mut voxels: Vec<[u32; 3]> = Vec::new();
-    let mut bits = dims.map(crate::dense_grid).transpose()?;
+    let mut sink = match dims {
+        Some(d) if sparse => {
+            if d.iter().any(|&x| x > SparseBricks::MAX_DIM) {
+                return Err(ErrorKind::malformed(FORMAT, format!("grid dims {d:?} beyond {} voxels per axis", SparseBricks::MAX_DIM)));
+            }
+            Sink::Bricks(HashMap::new())
+        }
+        Some(d) => Sink::Dense(crate::dense_grid(d)?),
+        None => Sink::List(Vec::new()),
+    };
     let mut left = k as usize;
     while left > 0 {
         let n = left.min(1 << 16);
@@ -217,32 +268,42 @@ pub fn read_from<R: Read + Seek>(r: R, total: u64) -> Result<LoadedVoxels, Error
                 return Err(ErrorKind::malformed(FORMAT, format!("index {p:?} is not a voxel of a grid")));
             }
             let q = [p[0] as u32, p[1] as u32, p[2] as u32];
-            match (&mut bits, dims) {
-                (Some(b), Some(d)) => {
-                    if (0..3).any(|a| q[a] >= d[a]) {
-                        return Err(ErrorKind::malformed(FORMAT, format!("index {q:?} lies outside the {d:?} grid")));
-                    }
-                    b.set(q[0], q[1], q[2]);
+            if let Some(d) = dims {
+                if (0..3).any(|a| q[a] >= d[a]) {
+                    return Err(ErrorKind::malformed(FORMAT, format!("index {q:?} lies outside the {d:?} grid")));
                 }
-                _ => voxels.push(q),
+            }
+            match &mut sink {
+                Sink::Dense(b) => b.set(q[0], q[1], q[2]),
+                Sink::Bricks(b) => set_in(b, q),
+                Sink::List(v) => v.push(q),
             }
         }
         left -= n;
     }
-    let bits = match bits {
-        Some(b) => b,
-        None => {
+    let grid = match sink {
+        Sink::Dense(b) => Read3::Dense(b),
+        Sink::Bricks(b) => Read3::Sparse(SparseBricks::from_parts(dims.expect("bricks need dims"), b.into_iter().collect(), Vec::new())),
+        Sink::List(voxels) => {
             let mut d = [1u32; 3];
             for v in &voxels {
                 for a in 0..3 {
                     d[a] = d[a].max(v[a] + 1);
                 }
             }
-            let mut b = crate::dense_grid(d)?;
-            for v in voxels {
-                b.set(v[0], v[1], v[2]);
+            if sparse {
+                let mut b = HashMap::new();
+                for v in voxels {
+                    set_in(&mut b, v);
+                }
+                Read3::Sparse(SparseBricks::from_parts(d, b.into_iter().collect(), Vec::new()))
+            } else {
+                let mut b = crate::dense_grid(d)?;
+                for v in voxels {
+                    b.set(v[0], v[1], v[2]);
+                }
+                Read3::Dense(b)
             }
-            b
         }
     };
     let placement = match (origin, size) {
@@ -252,5 +313,5 @@ pub fn read_from<R: Read + Seek>(r: R, total: u64) -> Result<LoadedVoxels, Error
         (None, None) => None,
         _ => return Err(ErrorKind::malformed(FORMAT, "origin and voxel_size must both be finite, the size positive")),
     };
-    Ok(LoadedVoxels { bits, placement, attributes: None })
+    Ok((grid, placement))
 }

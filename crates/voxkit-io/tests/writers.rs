@@ -188,6 +188,9 @@ fn npz_round_trips_and_refuses_hostile_archives() {
     let back = read_voxels(&p).unwrap();
     assert_eq!(back.bits, bits);
     assert_eq!(back.placement, Some((DVec3::new(-1.0, 2.0, 0.5), 0.25)));
+    // Without a dense grid (grids past memory): the same voxels and placement.
+    let sparse = voxkit_io::read_voxels_sparse(std::path::Path::new(&p)).unwrap();
+    assert_eq!((sparse.bits.to_dense(), sparse.placement), (bits.clone(), back.placement));
     // From memory too, and an empty grid.
     let bytes = std::fs::read(&p).unwrap();
     assert_eq!(voxkit_io::read_voxels_bytes(&bytes, VoxelFormat::Npz).unwrap().bits, bits);
@@ -224,6 +227,8 @@ fn npz_round_trips_and_refuses_hostile_archives() {
     assert_eq!(got.bits.dims(), [5, 2, 3]);
     assert!(got.bits.get(0, 0, 0) && got.bits.get(4, 1, 2));
     assert_eq!(got.placement, None);
+    let sparse = voxkit_io::npz::read_sparse_from(std::io::Cursor::new(&a), a.len() as u64).unwrap();
+    assert_eq!(sparse.bits.to_dense(), got.bits, "no dims: sized after the indices, sparse too");
 
     // Hostile or wrong archives: one line each, no panic, no huge allocation.
     let le32 = |v: &[i32]| v.iter().flat_map(|c| c.to_le_bytes()).collect::<Vec<u8>>();
