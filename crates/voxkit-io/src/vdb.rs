@@ -925,7 +925,7 @@ fn read_values_grid(c: &mut Cur<'_>, vs: usize) -> Result<GridValues, ErrorKind>
 /// active mask in OpenVDB's layout), active `true` tiles (origin, edge),
 /// the index coordinate of voxel (0, 0, 0), the grid's dims and placement.
 struct Occupancy {
-    leaves: Vec<([i64; 3], Vec<u64>)>,
+    leaves: Vec<([i64; 3], [u64; 8])>,
     tiles: Vec<([i64; 3], i64)>,
     offset: [i64; 3],
     dims: [u32; 3],
@@ -1039,7 +1039,9 @@ fn read_grid(c: &mut Cur<'_>) -> Result<Occupancy, ErrorKind> {
     let get = |n: &str| meta.iter().find(|m| m.0 == n).map(|m| m.2.clone());
     let found = read_topology(c, mask_compressed, 1)?;
     let tiles: Vec<([i64; 3], i64)> = found.tiles.iter().filter(|t| t.2[0] != 0).map(|t| (t.0, t.1)).collect();
-    let mut leaves: Vec<([i64; 3], Vec<u64>)> = Vec::with_capacity(found.leaves.len());
+    // Masks inline: a heap vector per leaf would more than double the
+    // memory of a large file's tree.
+    let mut leaves: Vec<([i64; 3], [u64; 8])> = Vec::with_capacity(found.leaves.len());
     for expect in &found.leaves {
         let active = c.words(8)?;
         let o = c.coord()?.map(|v| v as i64);
@@ -1047,7 +1049,7 @@ fn read_grid(c: &mut Cur<'_>) -> Result<Occupancy, ErrorKind> {
             return Err(bad(format!("leaf at {o:?} where the topology has {expect:?}")));
         }
         c.words(8)?; // values: occupancy is activity
-        leaves.push((o, active));
+        leaves.push((o, active.try_into().expect("8 words")));
     }
     // The index box of the active voxels.
     let mut lo = [i64::MAX; 3];
