@@ -104,29 +104,13 @@ pub fn hollow(solid: &DenseBits, conn: Connectivity) -> DenseBits {
     out
 }
 
-/// Intervals `[start, end)` of bricks along `bi`, sorted and disjoint.
+/// Inclusive intervals `[first, last]` of bricks along `bi`, sorted and
+/// disjoint (intersected with [`super::solid::intersect`]).
 type Intervals = Vec<(u32, u32)>;
-
-/// Bricks in both lists.
-fn intersect(a: &[(u32, u32)], b: &[(u32, u32)]) -> Intervals {
-    let (mut i, mut j, mut out) = (0, 0, Vec::new());
-    while i < a.len() && j < b.len() {
-        let (s, e) = (a[i].0.max(b[j].0), a[i].1.min(b[j].1));
-        if s < e {
-            out.push((s, e));
-        }
-        if a[i].1 < b[j].1 {
-            i += 1;
-        } else {
-            j += 1;
-        }
-    }
-    out
-}
 
 /// Bricks whose neighbours on both sides along `bi` are in the list too.
 fn erode(a: &[(u32, u32)]) -> Intervals {
-    a.iter().filter(|r| r.1 >= r.0 + 3).map(|r| (r.0 + 1, r.1 - 1)).collect()
+    a.iter().filter(|r| r.1 >= r.0 + 2).map(|r| (r.0 + 1, r.1 - 1)).collect()
 }
 
 /// [`hollow`] on sparse bricks: the set voxels of `solid` with a 6- (or
@@ -139,8 +123,8 @@ pub fn hollow_sparse(solid: &SparseBricks, conn: Connectivity) -> SparseBricks {
     for (b, n) in solid.full_runs() {
         let row = rows.entry((b[1], b[2])).or_default();
         match row.last_mut() {
-            Some(last) if last.1 == b[0] => last.1 += n,
-            _ => row.push((b[0], b[0] + n)),
+            Some(last) if last.1 + 1 == b[0] => last.1 += n,
+            _ => row.push((b[0], b[0] + n - 1)),
         }
     }
     let row = |bj: i64, bk: i64| -> &[(u32, u32)] {
@@ -156,20 +140,20 @@ pub fn hollow_sparse(solid: &SparseBricks, conn: Connectivity) -> SparseBricks {
         let (j, k) = (bj as i64, bk as i64);
         let deep = match conn {
             Connectivity::Six => {
-                [row(j - 1, k), row(j + 1, k), row(j, k - 1), row(j, k + 1)].iter().fold(erode(full), |d, r| intersect(&d, r))
+                [row(j - 1, k), row(j + 1, k), row(j, k - 1), row(j, k + 1)].iter().fold(erode(full), |d, r| super::solid::intersect(&d, r))
             }
             Connectivity::TwentySix => {
                 let mut d = erode(full);
                 for (dj, dk) in [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)] {
-                    d = intersect(&d, &erode(row(j + dj, k + dk)));
+                    d = super::solid::intersect(&d, &erode(row(j + dj, k + dk)));
                 }
                 d
             }
         };
         let mut d = deep.iter().peekable();
         for &(s, e) in full {
-            for bi in s..e {
-                while d.peek().is_some_and(|r| r.1 <= bi) {
+            for bi in s..=e {
+                while d.peek().is_some_and(|r| r.1 < bi) {
                     d.next();
                 }
                 if d.peek().is_none_or(|r| r.0 > bi) {

@@ -188,7 +188,7 @@ fn coalesce(mut v: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
 }
 
 /// The intersection of two sorted, disjoint lists of inclusive intervals.
-fn intersect(a: &[(u32, u32)], b: &[(u32, u32)]) -> Vec<(u32, u32)> {
+pub(crate) fn intersect(a: &[(u32, u32)], b: &[(u32, u32)]) -> Vec<(u32, u32)> {
     let (mut x, mut y, mut out) = (0, 0, Vec::new());
     while x < a.len() && y < b.len() {
         let (lo, hi) = (a[x].0.max(b[y].0), a[x].1.min(b[y].1));
