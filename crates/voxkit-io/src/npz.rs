@@ -23,7 +23,7 @@ use std::io::{Read, Seek, Write};
 use glam::DVec3;
 use std::collections::HashMap;
 
-use voxkit::grid::bricks::Brick;
+use voxkit::grid::bricks::{set_in_brick, Brick};
 use voxkit::grid::sparse::SparseBricks;
 use voxkit::{GridSpec, VoxelSource};
 
@@ -207,7 +207,7 @@ enum Sink {
 }
 
 fn set_in(bricks: &mut HashMap<[u32; 3], Brick>, q: [u32; 3]) {
-    bricks.entry(q.map(|c| c / 8)).or_insert([0; 8])[(q[2] % 8) as usize] |= 1 << ((q[1] % 8) * 8 + q[0] % 8);
+    set_in_brick(bricks.entry(q.map(|c| c / 8)).or_insert([0; 8]), q[0], q[1], q[2]);
 }
 
 fn read_into<R: Read + Seek>(r: R, total: u64, sparse: bool) -> Result<(Read3, Option<(DVec3, f64)>), ErrorKind> {

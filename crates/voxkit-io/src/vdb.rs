@@ -50,7 +50,7 @@ use std::io::Write;
 use glam::DVec3;
 use voxkit::attributes::colour::{from_linear, to_linear};
 use voxkit::attributes::{VoxelAttributes, NO_MATERIAL};
-use voxkit::grid::bricks::Brick;
+use voxkit::grid::bricks::{set_in_brick, Brick};
 use voxkit::grid::sparse::{SparseBricks, FULL};
 use voxkit::{GridSpec, VoxelSource};
 
@@ -993,24 +993,16 @@ impl Occupancy {
         if self.dims.iter().any(|&d| d > SparseBricks::MAX_DIM) {
             return Err(bad(format!("grid {:?} beyond {} voxels per axis", self.dims, SparseBricks::MAX_DIM)));
         }
+        // The offset is a multiple of 8, so a leaf's voxels, visited
+        // together, all fall in one brick.
         let mut bricks: Vec<([u32; 3], Brick)> = Vec::with_capacity(self.leaves.len());
-        for (o, m) in &self.leaves {
-            let mut brick = [0u64; 8];
-            let base: [i64; 3] = std::array::from_fn(|a| o[a] - self.offset[a]);
-            for (x, &w) in m.iter().enumerate() {
-                let mut w = w;
-                while w != 0 {
-                    let b = w.trailing_zeros();
-                    w &= w - 1;
-                    let (y, z) = (b >> 3, b & 7);
-                    self.inside([o[0] + x as i64, o[1] + y as i64, o[2] + z as i64])?;
-                    brick[z as usize] |= 1 << (y * 8 + x as u32);
-                }
+        self.leaf_voxels(|q| {
+            let b = q.map(|c| c / 8);
+            if bricks.last().is_none_or(|l| l.0 != b) {
+                bricks.push((b, [0; 8]));
             }
-            if brick != [0; 8] {
-                bricks.push((base.map(|c| (c / 8) as u32), brick));
-            }
-        }
+            set_in_brick(&mut bricks.last_mut().expect("pushed above").1, q[0], q[1], q[2]);
+        })?;
         let mut runs: Vec<([u32; 3], u32)> = Vec::new();
         for (o, e) in &self.tiles {
             let (lo, _) = (self.inside(*o)?, self.inside(o.map(|c| c + e - 1))?);

@@ -49,7 +49,7 @@ use flate2::write::GzEncoder;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use voxkit::attributes::{VoxelAttributes, NO_MATERIAL};
-use voxkit::grid::bricks::Brick;
+use voxkit::grid::bricks::{set_in_brick, Brick};
 use voxkit::grid::sparse::SparseBricks;
 use voxkit::{GridSpec, VoxelSource};
 
@@ -690,7 +690,7 @@ fn place_bricks(out: &mut Vec<([u32; 3], Brick)>, buf: &[u8], origin: [u64; 3], 
                 continue;
             }
             let b: [usize; 3] = std::array::from_fn(|x| (p[x] / 8 - lo[x]) as usize);
-            local[(b[2] * n[1] + b[1]) * n[0] + b[0]][(p[2] % 8) as usize] |= 1 << ((p[1] % 8) * 8 + p[0] % 8);
+            set_in_brick(&mut local[(b[2] * n[1] + b[1]) * n[0] + b[0]], p[0] as u32, p[1] as u32, p[2] as u32);
         }
     }
     for (at, brick) in local.into_iter().enumerate() {

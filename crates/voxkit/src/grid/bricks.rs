@@ -18,6 +18,13 @@ const SHIFT: u32 = 3;
 /// One brick: word `z & 7`, bit `(y & 7) * 8 + (x & 7)`.
 pub type Brick = [u64; 8];
 
+/// Sets voxel `(i, j, k)` in its brick `b` (only the coordinates' low
+/// three bits count: whole-grid and brick-local coordinates alike).
+#[inline(always)]
+pub fn set_in_brick(b: &mut Brick, i: u32, j: u32, k: u32) {
+    b[(k & 7) as usize] |= 1u64 << (((j & 7) << 3) | (i & 7));
+}
+
 /// A sparse grid of bits in 8×8×8 bricks.
 ///
 /// # Guarantees
@@ -86,7 +93,7 @@ impl BrickBits {
             self.index[b] = self.bricks.len() as u32;
         }
         let id = self.index[b] as usize - 1;
-        self.bricks[id][(k & 7) as usize] |= 1u64 << (((j & 7) << 3) | (i & 7));
+        set_in_brick(&mut self.bricks[id], i, j, k);
     }
 
     /// Bricks along x, y, z.
@@ -373,7 +380,7 @@ impl SlabView<'_> {
     pub fn set(&mut self, i: u32, j: u32, k: u32) {
         debug_assert!(k >= self.k0 && k < self.k1);
         let slot = self.slot(i, j, k);
-        self.pool[slot][(k & 7) as usize] |= 1u64 << (((j & 7) << 3) | (i & 7));
+        set_in_brick(&mut self.pool[slot], i, j, k);
     }
 
     /// Sets the `len` voxels from `(i, j, k)` along `axis` (0, 1 or 2), all

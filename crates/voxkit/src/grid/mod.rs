@@ -32,8 +32,7 @@ pub trait VoxelSource: Sync {
     fn for_each_brick(&self, f: &mut dyn FnMut([u32; 3], &bricks::Brick)) {
         let mut map: std::collections::BTreeMap<[u32; 3], bricks::Brick> = std::collections::BTreeMap::new();
         self.for_each_set(&mut |i, j, k| {
-            let b = map.entry([k / 8, j / 8, i / 8]).or_insert([0; 8]);
-            b[(k % 8) as usize] |= 1 << ((j % 8) * 8 + i % 8);
+            bricks::set_in_brick(map.entry([k / 8, j / 8, i / 8]).or_insert([0; 8]), i, j, k);
         });
         for (kji, b) in &map {
             f([kji[2], kji[1], kji[0]], b);
