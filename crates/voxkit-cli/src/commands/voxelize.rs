@@ -61,8 +61,8 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let grid = v.grid;
 
     // Attributes: colours for the formats that store them (and the preview),
-    // every array (coverage, material, normal) for .vti, and for .vdb with
-    // --attributes (refused, not dropped, on a tiled grid).
+    // every array (coverage, material, normal) for .vti, and for .vdb and
+    // .zarr with --attributes (refused, not dropped, on a tiled grid).
     voxkit_job::check_attributes_carried(format, a.export.attributes, &v)?;
     let every = voxkit_job::every_attribute(format, a.export.attributes);
     let app = &loaded.appearance;

@@ -193,21 +193,18 @@ fn skin_of(solid: &SparseBricks, b: [u32; 3], bdims: [u32; 3], conn: Connectivit
                 if bits == [0; 8] {
                     continue;
                 }
-                // The neighbour's voxels that fall in the halo.
-                let zs: Vec<(usize, usize)> = match dz {
-                    -1 => vec![(7, 0)],
-                    1 => vec![(0, 9)],
-                    _ => (0..8).map(|z| (z, z + 1)).collect(),
+                // The neighbour's voxels that fall in the halo: its layers
+                // (rows) `s` go to halo layers (rows) `s + d * 8 + 1`.
+                let span = |d: i64| match d {
+                    -1 => 7..8,
+                    1 => 0..1,
+                    _ => 0..8,
                 };
-                let ys: Vec<(usize, usize)> = match dy {
-                    -1 => vec![(7, 0)],
-                    1 => vec![(0, 9)],
-                    _ => (0..8).map(|y| (y, y + 1)).collect(),
-                };
-                for &(z, hz) in &zs {
-                    for &(y, hy) in &ys {
+                let at = |v: usize, d: i64| (v as i64 + d * 8 + 1) as usize;
+                for z in span(dz) {
+                    for y in span(dy) {
                         let r = ((bits[z] >> (y * 8)) & 0xff) as u16;
-                        h[hz][hy] |= match dx {
+                        h[at(z, dz)][at(y, dy)] |= match dx {
                             -1 => r >> 7,
                             1 => (r & 1) << 9,
                             _ => r << 1,
