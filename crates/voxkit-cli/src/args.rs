@@ -507,7 +507,8 @@ pub struct CheckArgs {
     /// `../`, links leading out. Off by default.
     #[arg(long)]
     pub allow_external_paths: bool,
-    /// Voxel file written by voxkit (.npy, .binvox, .vox, .txt).
+    /// Voxel file (any format voxkit reads: .npy, .binvox, .vox, .vti,
+    /// .vdb, .zarr, .npz, ...).
     pub voxels: PathBuf,
     /// The source mesh (a closed surface for the separation checks).
     #[arg(long)]
@@ -521,6 +522,11 @@ pub struct CheckArgs {
     /// voxelize; default y), when the file does not record it.
     #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
     pub up: Option<String>,
+    /// Check without a dense grid, window by window (.vdb, .zarr and .npz
+    /// only; chosen by itself when the grid does not fit in memory densely).
+    /// Same report.
+    #[arg(long)]
+    pub sparse: bool,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,

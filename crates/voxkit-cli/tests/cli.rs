@@ -938,3 +938,56 @@ fn view_without_a_display_says_so_in_one_line() {
     let e = error_line(&["view", obj.as_str(), "--frames", "0"]);
     assert!(e.contains("--frames must be at least 1"), "{e}");
 }
+
+/// `check` of a grid that cannot be dense (20000³, 932 GiB of bits) reads
+/// the `.vdb` sparsely and checks it window by window: its report equals
+/// the same cube's on a small grid (voxels shifted by whole voxels,
+/// witnesses too); `--sparse` gives the dense report on a small `.vdb`;
+/// `--sparse` of a dense format is one line.
+#[test]
+fn check_past_memory_window_by_window() {
+    let cube = unit_cube_obj("check-sparse-cube.obj");
+    for mode in ["sep6", "cover"] {
+        let (big, small, small_npy) =
+            (tmp(&format!("check-big-{mode}.vdb")), tmp(&format!("check-small-{mode}.vdb")), tmp(&format!("check-small-{mode}.npy")));
+        let at = |o: &str, d: &str| ["--voxel-size", "0.125", "--origin", o, "--dims", d, "--mode", mode].map(String::from);
+        let (big_grid, small_grid) = (at("-1248.5,-1248.5,-1248.5", "20000,20000,20000"), at("-0.5,-0.5,-0.5", "16,16,16"));
+        for (out, grid) in [(&big, &big_grid), (&small, &small_grid), (&small_npy, &small_grid)] {
+            let args: Vec<&str> =
+                ["voxelize", cube.as_str(), "-o", out.as_str(), "--json"].into_iter().chain(grid.iter().map(String::as_str)).collect();
+            json(&voxkit(&args));
+        }
+        let b = json(&voxkit(&["check", &big, "--mesh", &cube, "--json"]));
+        let s = json(&voxkit(&["check", &small, "--mesh", &cube, "--json"]));
+        assert_eq!((b["sparse"].as_bool(), s["sparse"].as_bool()), (Some(true), Some(false)));
+        assert!(b["windows"].as_u64().unwrap() >= 1);
+        assert!(s["voxels"].as_u64().unwrap() > 0 && s["separating_6"].as_bool() == Some(true));
+        for (key, want) in s.as_object().unwrap() {
+            if matches!(key.as_str(), "check_s" | "sparse" | "windows" | "dims" | "grid") {
+                continue;
+            }
+            let got = &b[key];
+            if key.starts_with("witness_") && !want.is_null() {
+                for end in ["inside", "outside"] {
+                    let shifted: Vec<u64> = want[end].as_array().unwrap().iter().map(|c| c.as_u64().unwrap() + 9984).collect();
+                    assert_eq!(got[end], serde_json::json!(shifted), "{mode} {key}");
+                }
+                continue;
+            }
+            assert_eq!(got, want, "{mode}: {key} differs past memory");
+        }
+        // --sparse on a grid that fits: the same report.
+        let mut sp = json(&voxkit(&["check", &small, "--mesh", &cube, "--json", "--sparse"]));
+        assert_eq!(sp["sparse"].as_bool(), Some(true));
+        let mut dense = s.clone();
+        for v in [&mut sp, &mut dense] {
+            let o = v.as_object_mut().unwrap();
+            for key in ["check_s", "sparse", "windows"] {
+                o.remove(key);
+            }
+        }
+        assert_eq!(sp, dense, "{mode}: --sparse differs");
+    }
+    let e = error_line(&["check", &tmp("check-small-cover.npy"), "--sparse"]);
+    assert!(e.contains("--sparse") && e.contains(".vdb"), "{e}");
+}

@@ -2,7 +2,8 @@
 //! are on, and the report as one JSON object.
 
 use serde_json::{json, Value};
-use voxkit::topology::certify;
+use voxkit::grid::sparse::SparseBricks;
+use voxkit::topology::{certify, certify_sparse, CheckReport};
 use voxkit::{DenseBits, GridSpec, MeshRef};
 
 use crate::error::{JobError, Result};
@@ -49,12 +50,39 @@ pub fn check_grid(
 /// without the timing.
 pub fn report(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec, &str)>) -> Result<Value> {
     let report = certify(bits, mesh.map(|(m, g, _)| (m, g))).map_err(|e| JobError::invalid(e.to_string()))?;
+    let mut v = to_json(&report, bits.dims(), mesh.map(|(_, g, s)| (g, s)));
+    v["sparse"] = json!(false);
+    Ok(v)
+}
+
+/// Brick layers (8 planes each) per window of [`report_sparse`] for a grid
+/// of `dims` within `budget` bytes: a window's brick index, parity and
+/// run rows take about `bx·by·4 + 80·ny` bytes per layer; a quarter of the
+/// budget goes to them (the rest to the grid's bricks and the mesh).
+pub fn window_layers(dims: [u32; 3], budget: u64) -> u32 {
+    let per_layer = dims[0].div_ceil(8) as u64 * dims[1].div_ceil(8) as u64 * 4 + 80 * dims[1] as u64;
+    (budget / 4 / per_layer.max(1)).clamp(1, dims[2].div_ceil(8).max(1) as u64) as u32
+}
+
+/// [`report`] for a grid held as sparse bricks, checked window by window
+/// ([`voxkit::topology::certify_sparse`]) in windows of `layers` brick
+/// layers; the report is the same, with `sparse` true and the number of
+/// windows.
+pub fn report_sparse(bits: &SparseBricks, mesh: Option<(MeshRef<'_>, &GridSpec, &str)>, layers: u32) -> Result<Value> {
+    let report = certify_sparse(bits, mesh.map(|(m, g, _)| (m, g)), layers).map_err(|e| JobError::invalid(e.to_string()))?;
+    let mut v = to_json(&report, bits.dims(), mesh.map(|(_, g, s)| (g, s)));
+    v["sparse"] = json!(true);
+    v["windows"] = json!(bits.dims()[2].div_ceil(8).div_ceil(layers.max(1)).max(1));
+    Ok(v)
+}
+
+fn to_json(report: &CheckReport, dims: [u32; 3], grid: Option<(&GridSpec, &str)>) -> Value {
     let facts = report.mesh.as_ref();
     let sep = facts.and_then(|f| f.separation.as_ref());
     let witness = |w: Option<[[u32; 3]; 2]>| w.map(|p| json!({"inside": p[0], "outside": p[1]}));
-    Ok(json!({
+    json!({
         "voxels": report.voxels,
-        "dims": bits.dims(),
+        "dims": dims,
         "components_6": report.components_6,
         "components_26": report.components_26,
         "thick_voxels": report.thick_voxels,
@@ -76,9 +104,9 @@ pub fn report(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec, &str)>) ->
             let c = f.columns;
             json!({"samples": c.samples, "empty": c.empty, "one": c.one, "two": c.two, "three_or_more": c.more, "max": c.max})
         }),
-        "grid": mesh.map(|(_, g, source)| {
+        "grid": grid.map(|(g, source)| {
             let o = g.origin();
             json!({"origin": [o.x, o.y, o.z], "voxel_size": g.voxel_size(), "dims": g.dims(), "source": source})
         }),
-    }))
+    })
 }

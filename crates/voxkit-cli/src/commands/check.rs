@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 use serde_json::{json, Value};
 
 use crate::args::CheckArgs;
@@ -11,8 +11,30 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     let t0 = Instant::now();
     let pool = crate::thread_pool(a.threads)?;
     let up = a.up.as_deref().and_then(voxkit_io::orient::Up::from_name).unwrap_or_default();
-    let loaded = voxkit_io::read_voxels_with(&a.voxels, up)?;
-    let dims = loaded.bits.dims();
+    use voxkit_io::VoxelFormat as F;
+    let sparse_format = matches!(F::from_path(&a.voxels), Some(F::Vdb | F::Zarr | F::Npz));
+    if a.sparse && !sparse_format {
+        bail!("{}: --sparse reads only .vdb, .zarr and .npz files", a.voxels.display());
+    }
+    let voxels = if a.sparse {
+        Voxels::Sparse(voxkit_io::read_voxels_sparse(&a.voxels)?)
+    } else {
+        match voxkit_io::read_voxels_with(&a.voxels, up) {
+            Ok(l) => Voxels::Dense(l),
+            // Past memory: checked window by window.
+            Err(e) if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. }) && sparse_format => {
+                Voxels::Sparse(voxkit_io::read_voxels_sparse(&a.voxels)?)
+            }
+            Err(e) if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. }) => {
+                bail!("{e}; grids past memory are checked from .vdb, .zarr or .npz files (window by window)")
+            }
+            Err(e) => return Err(e.into()),
+        }
+    };
+    let (dims, placement) = match &voxels {
+        Voxels::Dense(l) => (l.bits.dims(), l.placement),
+        Voxels::Sparse(s) => (s.bits.dims(), s.placement),
+    };
     let mesh = match &a.mesh {
         Some(path) => {
             let m = voxkit_io::read_mesh_with(path, &voxkit_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
@@ -21,7 +43,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
             }
             let (grid, source) = voxkit_job::check::check_grid(
                 dims,
-                loaded.placement,
+                placement,
                 &crate::plan::grid_options(&a.grid),
                 &m.report.bounds,
                 &a.voxels.display().to_string(),
@@ -31,12 +53,25 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         }
         None => None,
     };
-    let mut v = pool.install(|| voxkit_job::check::report(&loaded.bits, mesh.as_ref().map(|(m, g, s)| (m.mesh.as_ref(), g, *s))))?;
+    let mesh = mesh.as_ref().map(|(m, g, s)| (m.mesh.as_ref(), g, *s));
+    let mut v = pool.install(|| match &voxels {
+        Voxels::Dense(l) => voxkit_job::check::report(&l.bits, mesh),
+        Voxels::Sparse(s) => {
+            let layers = voxkit_job::check::window_layers(dims, voxkit_job::budget(None));
+            voxkit_job::check::report_sparse(&s.bits, mesh, layers)
+        }
+    })?;
     v["check_s"] = json!(t0.elapsed().as_secs_f64());
     if a.json {
         return crate::print_stdout(&v.to_string());
     }
     crate::print_stdout(&text(&v, a))
+}
+
+/// The voxels, read densely or (past memory, or with `--sparse`) as bricks.
+enum Voxels {
+    Dense(voxkit_io::LoadedVoxels),
+    Sparse(voxkit_io::SparseVoxels),
 }
 
 fn text(v: &Value, a: &CheckArgs) -> String {
@@ -87,5 +122,9 @@ fn text(v: &Value, a: &CheckArgs) -> String {
             v["tunnels_26"]
         );
     }
-    s + &format!("\nchecked in {:.2} s", v["check_s"].as_f64().unwrap_or(0.0))
+    let how = match v["windows"].as_u64() {
+        Some(n) => format!(" without a dense grid, in {n} window{}", if n == 1 { "" } else { "s" }),
+        None => String::new(),
+    };
+    s + &format!("\nchecked{how} in {:.2} s", v["check_s"].as_f64().unwrap_or(0.0))
 }

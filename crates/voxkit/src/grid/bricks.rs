@@ -96,6 +96,21 @@ impl BrickBits {
         set_in_brick(&mut self.bricks[id], i, j, k);
     }
 
+    /// ORs `bits` into brick `(bi, bj, bk)`. Panics if the brick is out of
+    /// range; bits outside the grid must be clear.
+    pub fn insert_brick(&mut self, b: [u32; 3], bits: Brick) {
+        assert!((0..3).all(|a| b[a] < self.bdims[a]), "brick out of range");
+        let n = (b[2] as usize * self.bdims[1] as usize + b[1] as usize) * self.bdims[0] as usize + b[0] as usize;
+        if self.index[n] == 0 {
+            self.bricks.push([0; 8]);
+            self.index[n] = self.bricks.len() as u32;
+        }
+        let slot = &mut self.bricks[self.index[n] as usize - 1];
+        for (w, x) in slot.iter_mut().zip(bits) {
+            *w |= x;
+        }
+    }
+
     /// Bricks along x, y, z.
     pub fn brick_dims(&self) -> [u32; 3] {
         self.bdims

@@ -284,6 +284,27 @@ impl SparseBricks {
         }
     }
 
+    /// [`SparseBricks::for_each_brick`] for the bricks of the brick
+    /// layers `layers` (`bk` in that range) only, found by binary search.
+    pub fn for_each_brick_in_layers(&self, layers: std::ops::Range<u32>, mut f: impl FnMut([u32; 3], &Brick)) {
+        let (lo, hi) = (key([0, 0, layers.start]), key([0, 0, layers.end]));
+        let (k0, k1) = (self.keys.partition_point(|&k| k < lo), self.keys.partition_point(|&k| k < hi));
+        let (r0, r1) = (self.full.partition_point(|r| r.0 < lo), self.full.partition_point(|r| r.0 < hi));
+        let mut runs = self.full[r0..r1].iter().peekable();
+        for (k, b) in self.keys[k0..k1].iter().zip(&self.bricks[k0..k1]) {
+            while let Some(&&(r, n)) = runs.peek().filter(|r| r.0 < *k) {
+                let first = unkey(r);
+                (0..n).for_each(|x| f([first[0] + x, first[1], first[2]], &FULL));
+                runs.next();
+            }
+            f(unkey(*k), b);
+        }
+        for &(r, n) in runs {
+            let first = unkey(r);
+            (0..n).for_each(|x| f([first[0] + x, first[1], first[2]], &FULL));
+        }
+    }
+
     /// The same voxels, dense.
     pub fn to_dense(&self) -> DenseBits {
         let mut d = DenseBits::new(self.dims);

@@ -24,13 +24,17 @@
 //!
 //! Inside/outside comes from [`super::inside`]; all tests are exact.
 
+use std::ops::Range;
+
 use rayon::prelude::*;
 
 use super::inside::{snap_all, ClassifyError, Parity};
-use super::runs::{components, Connectivity, Runs};
+use super::runs::{Connectivity, Runs, UnionFind};
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::LatticeTriangle;
+use crate::grid::bricks::{Brick, BrickBits, BRICK};
 use crate::grid::dense::DenseBits;
+use crate::grid::sparse::SparseBricks;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
 use crate::voxelize::targets::{fits_i64, TriSetup};
@@ -115,35 +119,330 @@ pub struct Separation {
 
 /// Checks `bits`; with `mesh` (on `grid`), also separation and tunnels.
 pub fn certify(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec)>) -> Result<CheckReport, ClassifyError> {
-    let set_runs = Runs::of(bits, true);
-    let (_, components_6) = components(&set_runs, Connectivity::Six);
-    let (_, components_26) = components(&set_runs, Connectivity::TwentySix);
-    let mut report = CheckReport { voxels: bits.count(), components_6, components_26, thick_voxels: thick_voxels(bits), mesh: None };
-    if let Some((mesh, grid)) = mesh {
-        let snapped = snap_all(mesh, grid)?;
-        let tris = snapped.crossing_triangles();
-        let closed = snapped.boundary_edges == 0 && !tris.is_empty();
-        let separation = closed.then(|| {
-            let parity = Parity::classify(&tris, bits.dims());
-            Separation {
-                inside_voxels: inside_count(&parity, bits.dims()),
-                witness_6: witness(bits, &parity, Connectivity::Six),
-                witness_26: witness(bits, &parity, Connectivity::TwentySix),
-                thin_removable: thin_removable(bits, &parity),
+    let dims = bits.dims();
+    let mut pass = Pass::new(dims, mesh)?;
+    let tris = pass.mesh.as_ref().map(|m| m.tris.clone()).unwrap_or_default();
+    pass.window(bits, 0, 0..dims[2], &tris, &|_, _, _| false);
+    Ok(pass.finish())
+}
+
+/// [`certify`] of a grid held as sparse bricks, without a dense grid: the
+/// grid is checked window by window, each `layers` brick layers (8
+/// planes each) thick plus one brick layer of halo on either side, and
+/// what crosses a window's border is carried to the next (components by
+/// a union–find over the labels of each window's last plane, the first
+/// separation witness in `k` order). Memory follows one window and the
+/// set voxels; the report equals [`certify`]'s for any `layers`.
+pub fn certify_sparse(bits: &SparseBricks, mesh: Option<(MeshRef<'_>, &GridSpec)>, layers: u32) -> Result<CheckReport, ClassifyError> {
+    let dims = bits.dims();
+    let layers = layers.max(1);
+    let mut pass = Pass::new(dims, mesh)?;
+    let bz = dims[2].div_ceil(BRICK);
+    let windows = bz.div_ceil(layers).max(1) as usize;
+    let span = layers * BRICK;
+    // Each window's triangles: those within two voxels of its planes, halo
+    // included (what the parity rows, tunnels and columns of the window need).
+    let mut binned: Vec<Vec<u32>> = vec![Vec::new(); windows];
+    if let Some(m) = &pass.mesh {
+        for (n, t) in m.tris.iter().enumerate() {
+            let (lo, hi) = t.bounds();
+            let (klo, khi) = (lo[2].div_euclid(ONE) - 2 - BRICK as i64, hi[2].div_euclid(ONE) + 2 + BRICK as i64);
+            if khi < 0 || klo >= dims[2] as i64 {
+                continue;
             }
-        });
-        let tunnels = tunnels(bits, &tris);
-        report.mesh = Some(MeshFacts {
-            boundary_edges: snapped.boundary_edges,
-            closed,
-            tunnels_6: tunnels[0],
-            tunnels_18: tunnels[1],
-            tunnels_26: tunnels[2],
-            columns: columns(bits, &tris),
-            separation,
-        });
+            let (w0, w1) = ((klo.max(0) as u64 / span as u64) as usize, ((khi.min(dims[2] as i64 - 1)) as u64 / span as u64) as usize);
+            for bin in &mut binned[w0..=w1.min(windows - 1)] {
+                bin.push(n as u32);
+            }
+        }
     }
-    Ok(report)
+    let beyond = |i: u32, j: u32, k: u32| bits.get(i, j, k);
+    for (w, bin) in binned.into_iter().enumerate() {
+        let owned_layers = w as u32 * layers..((w as u32 + 1) * layers).min(bz);
+        let layers_held = owned_layers.start.saturating_sub(1)..(owned_layers.end + 1).min(bz);
+        let base = layers_held.start * BRICK;
+        let planes = (layers_held.end * BRICK).min(dims[2]) - base;
+        let owned = owned_layers.start * BRICK..(owned_layers.end * BRICK).min(dims[2]);
+        let window = BrickWindow::new(bits, layers_held, [dims[0], dims[1], planes]);
+        let tris: Vec<LatticeTriangle> = pass.mesh.as_ref().map(|m| bin.iter().map(|&n| m.tris[n as usize]).collect()).unwrap_or_default();
+        pass.window(&window, base, owned, &tris, &beyond);
+    }
+    Ok(pass.finish())
+}
+
+/// What the checks read of one window of planes: a dense grid or the
+/// bricks of a sparse one. Coordinates are the window's (`k` from its
+/// first plane).
+trait WindowBits: Sync {
+    /// Voxels along x, y and the window's planes.
+    fn dims(&self) -> [u32; 3];
+    fn get(&self, i: u32, j: u32, k: u32) -> bool;
+    /// [`WindowBits::get`], false outside the window.
+    fn get_signed(&self, i: i64, j: i64, k: i64) -> bool {
+        let d = self.dims();
+        i >= 0 && j >= 0 && k >= 0 && i < d[0] as i64 && j < d[1] as i64 && k < d[2] as i64 && self.get(i as u32, j as u32, k as u32)
+    }
+    /// The runs of set voxels of the planes `planes`.
+    fn runs(&self, planes: Range<u32>) -> Runs;
+    /// Sums `f` over the set voxels of the planes `planes`, in parallel.
+    fn sum_over_set<F: Fn(u32, u32, u32) -> bool + Sync>(&self, planes: Range<u32>, f: F) -> u64;
+}
+
+impl WindowBits for DenseBits {
+    fn dims(&self) -> [u32; 3] {
+        DenseBits::dims(self)
+    }
+
+    #[inline]
+    fn get(&self, i: u32, j: u32, k: u32) -> bool {
+        DenseBits::get(self, i, j, k)
+    }
+
+    fn runs(&self, planes: Range<u32>) -> Runs {
+        Runs::of_planes(self, true, planes)
+    }
+
+    fn sum_over_set<F: Fn(u32, u32, u32) -> bool + Sync>(&self, planes: Range<u32>, f: F) -> u64 {
+        let ny = self.dims()[1];
+        planes
+            .into_par_iter()
+            .map(|k| {
+                let mut n = 0u64;
+                for j in 0..ny {
+                    for_each_set_in_row(self, j, k, |i| n += f(i, j, k) as u64);
+                }
+                n
+            })
+            .sum()
+    }
+}
+
+/// Brick layers of a sparse grid, indexed for random access
+/// ([`BrickBits`]) and listed in key order (for runs and sums).
+struct BrickWindow {
+    bits: BrickBits,
+    /// The window's bricks (window brick coordinates), sorted by `(bk, bj, bi)`.
+    list: Vec<([u32; 3], Brick)>,
+}
+
+impl BrickWindow {
+    fn new(src: &SparseBricks, layers: Range<u32>, dims: [u32; 3]) -> BrickWindow {
+        let mut list = Vec::new();
+        src.for_each_brick_in_layers(layers.clone(), |b, bits| list.push(([b[0], b[1], b[2] - layers.start], *bits)));
+        let mut bits = BrickBits::new(dims);
+        for (b, brick) in &list {
+            bits.insert_brick(*b, *brick);
+        }
+        BrickWindow { bits, list }
+    }
+}
+
+impl WindowBits for BrickWindow {
+    fn dims(&self) -> [u32; 3] {
+        self.bits.dims()
+    }
+
+    #[inline]
+    fn get(&self, i: u32, j: u32, k: u32) -> bool {
+        self.bits.get(i, j, k)
+    }
+
+    fn runs(&self, planes: Range<u32>) -> Runs {
+        let d = self.dims();
+        Runs::of_bricks(d[0], d[1], planes, &self.list)
+    }
+
+    fn sum_over_set<F: Fn(u32, u32, u32) -> bool + Sync>(&self, planes: Range<u32>, f: F) -> u64 {
+        let (lo, hi) = (
+            self.list.partition_point(|(b, _)| b[2] < planes.start / BRICK),
+            self.list.partition_point(|(b, _)| b[2] * BRICK < planes.end),
+        );
+        self.list[lo..hi]
+            .par_chunks(1024)
+            .map(|chunk| {
+                let mut n = 0u64;
+                for (b, bits) in chunk {
+                    for (z, &word) in bits.iter().enumerate() {
+                        let k = b[2] * BRICK + z as u32;
+                        if !planes.contains(&k) {
+                            continue;
+                        }
+                        let mut w = word;
+                        while w != 0 {
+                            let bit = w.trailing_zeros();
+                            n += f(b[0] * BRICK + (bit & 7), b[1] * BRICK + (bit >> 3), k) as u64;
+                            w &= w - 1;
+                        }
+                    }
+                }
+                n
+            })
+            .sum()
+    }
+}
+
+/// Components counted window by window: each window's runs (its own
+/// planes and the last plane of the window before) are joined locally,
+/// every local component gets a global label, and the runs of the shared
+/// plane join the labels they had in the window before.
+struct StreamedComponents {
+    conn: Connectivity,
+    labels: UnionFind,
+    merged: usize,
+    /// Global label of each run of the last plane seen.
+    carry: Vec<u32>,
+}
+
+impl StreamedComponents {
+    fn new(conn: Connectivity) -> StreamedComponents {
+        StreamedComponents { conn, labels: UnionFind::new(0), merged: 0, carry: Vec::new() }
+    }
+
+    /// Adds the runs of a window; with `shared`, their first plane is the
+    /// last plane of the previous window.
+    fn add(&mut self, runs: &Runs, shared: bool) {
+        let mut local = UnionFind::new(runs.len());
+        runs.for_each_adjacent(self.conn, |a, b| {
+            local.union(a, b);
+        });
+        // Union by index: a run's representative comes no later than it.
+        let mut ids = vec![0u32; runs.len()];
+        for x in 0..runs.len() {
+            let r = local.find(x);
+            ids[x] = if r == x { self.labels.push() as u32 } else { ids[r] };
+        }
+        let ny = runs.dims()[1] as usize;
+        if shared {
+            let first = runs.row_start[ny] as usize;
+            debug_assert_eq!(first, self.carry.len());
+            for (t, &c) in self.carry.iter().enumerate().take(first) {
+                if self.labels.union(ids[t] as usize, c as usize) {
+                    self.merged += 1;
+                }
+            }
+        }
+        let last = runs.row_start[runs.row_start.len() - 1 - ny] as usize;
+        self.carry = ids[last..].to_vec();
+    }
+
+    fn count(&self) -> usize {
+        self.labels.len() - self.merged
+    }
+}
+
+/// What the checks gather over the windows of a grid.
+struct Pass {
+    dims: [u32; 3],
+    voxels: u64,
+    thick_voxels: u64,
+    components: [StreamedComponents; 2],
+    mesh: Option<MeshPass>,
+}
+
+struct MeshPass {
+    tris: Vec<LatticeTriangle>,
+    boundary_edges: usize,
+    closed: bool,
+    inside_voxels: u64,
+    witness: [Option<[[u32; 3]; 2]>; 2],
+    thin_removable: u64,
+    tunnels: [u64; 3],
+    columns: ColumnStats,
+}
+
+impl Pass {
+    fn new(dims: [u32; 3], mesh: Option<(MeshRef<'_>, &GridSpec)>) -> Result<Pass, ClassifyError> {
+        let mesh = match mesh {
+            Some((mesh, grid)) => {
+                let snapped = snap_all(mesh, grid)?;
+                let tris = snapped.crossing_triangles();
+                let closed = snapped.boundary_edges == 0 && !tris.is_empty();
+                Some(MeshPass {
+                    tris,
+                    boundary_edges: snapped.boundary_edges,
+                    closed,
+                    inside_voxels: 0,
+                    witness: [None; 2],
+                    thin_removable: 0,
+                    tunnels: [0; 3],
+                    columns: ColumnStats::default(),
+                })
+            }
+            None => None,
+        };
+        Ok(Pass {
+            dims,
+            voxels: 0,
+            thick_voxels: 0,
+            components: [StreamedComponents::new(Connectivity::Six), StreamedComponents::new(Connectivity::TwentySix)],
+            mesh,
+        })
+    }
+
+    /// Checks the planes `owned` (grid coordinates) of window `o`, whose
+    /// first plane is the grid's `base`; `o` holds the planes next to
+    /// `owned` wherever the grid has them. `tris` holds the triangles near
+    /// the window; `beyond` reads voxels outside it.
+    fn window<O: WindowBits>(
+        &mut self,
+        o: &O,
+        base: u32,
+        owned: Range<u32>,
+        tris: &[LatticeTriangle],
+        beyond: &(dyn Fn(u32, u32, u32) -> bool + Sync),
+    ) {
+        if owned.is_empty() {
+            return;
+        }
+        let local = owned.start - base..owned.end - base;
+        self.voxels += o.sum_over_set(local.clone(), |_, _, _| true);
+        self.thick_voxels += thick_voxels(o, local.clone());
+        let shared = local.start > 0;
+        let runs = o.runs(local.start - shared as u32..local.end);
+        for c in &mut self.components {
+            c.add(&runs, shared);
+        }
+        drop(runs);
+        let Some(m) = &mut self.mesh else { return };
+        if m.closed {
+            let parity = Parity::classify_planes(tris, self.dims, base..base + o.dims()[2]);
+            m.inside_voxels += inside_count(&parity, o.dims(), local.clone());
+            for (w, conn) in m.witness.iter_mut().zip([Connectivity::Six, Connectivity::TwentySix]) {
+                if w.is_none() {
+                    *w = witness(o, &parity, local.clone(), conn).map(|p| p.map(|v| [v[0], v[1], v[2] + base]));
+                }
+            }
+            m.thin_removable += thin_removable(o, &parity, local.clone());
+        }
+        let t = tunnels(o, tris, self.dims, base, owned.clone());
+        for (a, b) in m.tunnels.iter_mut().zip(t) {
+            *a += b;
+        }
+        m.columns = m.columns.add(columns(o, tris, self.dims, base, owned, beyond));
+    }
+
+    fn finish(self) -> CheckReport {
+        CheckReport {
+            voxels: self.voxels,
+            components_6: self.components[0].count(),
+            components_26: self.components[1].count(),
+            thick_voxels: self.thick_voxels,
+            mesh: self.mesh.map(|m| MeshFacts {
+                boundary_edges: m.boundary_edges,
+                closed: m.closed,
+                tunnels_6: m.tunnels[0],
+                tunnels_18: m.tunnels[1],
+                tunnels_26: m.tunnels[2],
+                columns: m.columns,
+                separation: m.closed.then_some(Separation {
+                    inside_voxels: m.inside_voxels,
+                    witness_6: m.witness[0],
+                    witness_26: m.witness[1],
+                    thin_removable: m.thin_removable,
+                }),
+            }),
+        }
+    }
 }
 
 /// Neighbour offsets `(di, dj, dk)`, each unordered pair once.
@@ -179,8 +478,9 @@ fn forward_offsets_upto(order: i64) -> Vec<[i64; 3]> {
     out
 }
 
-fn inside_count(p: &Parity, dims: [u32; 3]) -> u64 {
-    (0..dims[2])
+/// Voxel centres inside in the planes `planes` of a window.
+fn inside_count(p: &Parity, dims: [u32; 3], planes: Range<u32>) -> u64 {
+    planes
         .into_par_iter()
         .map(|k| {
             (0..dims[1])
@@ -198,12 +498,28 @@ fn inside_count(p: &Parity, dims: [u32; 3]) -> u64 {
 }
 
 /// The first (in `k`, `j`, `i` order) pair of adjacent unset voxels of
-/// different class, as `[inside, outside]`.
-fn witness(bits: &DenseBits, p: &Parity, conn: Connectivity) -> Option<[[u32; 3]; 2]> {
-    let [nx, ny, nz] = bits.dims();
+/// different class with the first in the planes `planes`, as `[inside,
+/// outside]`. Only row pairs where either row has a toggle can differ in
+/// class (a row without toggles is wholly outside).
+fn witness<O: WindowBits>(o: &O, p: &Parity, planes: Range<u32>, conn: Connectivity) -> Option<[[u32; 3]; 2]> {
+    let [nx, ny, nz] = o.dims();
     let offsets = forward_offsets(conn);
-    (0..nz).into_par_iter().find_map_first(|k| {
+    planes.into_par_iter().find_map_first(|k| {
+        // Rows j of plane k paired with a row holding toggles: (j, k)
+        // itself, (j + 1, k), and (j + dj, k + 1) for dj in −1..=1.
+        let mut rows: Vec<u32> = Vec::new();
         for j in 0..ny {
+            if !p.row(j, k).is_empty() {
+                rows.extend([j.saturating_sub(1), j]);
+            }
+            if k + 1 < nz && !p.row(j, k + 1).is_empty() {
+                rows.extend([j.saturating_sub(1), j, (j + 1).min(ny - 1)]);
+            }
+        }
+        rows.sort_unstable();
+        rows.dedup();
+        let mut cuts: Vec<i64> = Vec::new();
+        for &j in &rows {
             for d in &offsets {
                 let (jj, kk) = (j as i64 + d[1], k as i64 + d[2]);
                 if jj < 0 || jj >= ny as i64 || kk >= nz as i64 {
@@ -213,7 +529,11 @@ fn witness(bits: &DenseBits, p: &Parity, conn: Connectivity) -> Option<[[u32; 3]
                 // The class differs only on intervals bounded by toggles of
                 // either row (the second shifted by −di).
                 let (tr, tq) = (p.row(j, k), p.row(jj, kk));
-                let mut cuts: Vec<i64> = tr.iter().map(|&t| t as i64).chain(tq.iter().map(|&t| t as i64 - d[0])).collect();
+                if tr.is_empty() && tq.is_empty() {
+                    continue;
+                }
+                cuts.clear();
+                cuts.extend(tr.iter().map(|&t| t as i64).chain(tq.iter().map(|&t| t as i64 - d[0])));
                 cuts.push(0);
                 cuts.push(nx as i64);
                 cuts.sort_unstable();
@@ -230,7 +550,7 @@ fn witness(bits: &DenseBits, p: &Parity, conn: Connectivity) -> Option<[[u32; 3]
                     }
                     for i in a..b {
                         let (ir, iq) = (i as u32, (i + d[0]) as u32);
-                        if !bits.get(ir, j, k) && !bits.get(iq, jj, kk) {
+                        if !o.get(ir, j, k) && !o.get(iq, jj, kk) {
                             let (u, v) = ([ir, j, k], [iq, jj, kk]);
                             return Some(if cr { [u, v] } else { [v, u] });
                         }
@@ -257,25 +577,10 @@ fn for_each_set_in_row(bits: &DenseBits, j: u32, k: u32, mut f: impl FnMut(u32))
     }
 }
 
-/// Sums `f` over every set voxel, in parallel over `k`.
-fn sum_over_set(bits: &DenseBits, f: impl Fn(u32, u32, u32) -> bool + Sync) -> u64 {
-    let [_, ny, nz] = bits.dims();
-    (0..nz)
-        .into_par_iter()
-        .map(|k| {
-            let mut n = 0u64;
-            for j in 0..ny {
-                for_each_set_in_row(bits, j, k, |i| n += f(i, j, k) as u64);
-            }
-            n
-        })
-        .sum()
-}
-
-fn thin_removable(bits: &DenseBits, p: &Parity) -> u64 {
-    let [nx, ny, nz] = bits.dims();
+fn thin_removable<O: WindowBits>(o: &O, p: &Parity, planes: Range<u32>) -> u64 {
+    let [nx, ny, nz] = o.dims();
     let six: Vec<[i64; 3]> = forward_offsets(Connectivity::Six).iter().flat_map(|d| [*d, d.map(|x| -x)]).collect();
-    sum_over_set(bits, |i, j, k| {
+    o.sum_over_set(planes, |i, j, k| {
         let c = p.inside(i, j, k);
         six.iter().all(|d| {
             let q = [i as i64 + d[0], j as i64 + d[1], k as i64 + d[2]];
@@ -283,28 +588,47 @@ fn thin_removable(bits: &DenseBits, p: &Parity) -> u64 {
                 return true;
             }
             let q = q.map(|x| x as u32);
-            bits.get(q[0], q[1], q[2]) || p.inside(q[0], q[1], q[2]) == c
+            o.get(q[0], q[1], q[2]) || p.inside(q[0], q[1], q[2]) == c
         })
     })
 }
 
-fn thick_voxels(bits: &DenseBits) -> u64 {
-    let get = |i, j, k| bits.get_signed(i, j, k);
-    sum_over_set(bits, |i, j, k| {
+fn thick_voxels<O: WindowBits>(o: &O, planes: Range<u32>) -> u64 {
+    let get = |i, j, k| o.get_signed(i, j, k);
+    o.sum_over_set(planes, |i, j, k| {
         let (i, j, k) = (i as i64, j as i64, k as i64);
         (get(i - 1, j, k) || get(i + 1, j, k)) && (get(i, j - 1, k) || get(i, j + 1, k)) && (get(i, j, k - 1) || get(i, j, k + 1))
     })
 }
 
-fn columns(bits: &DenseBits, tris: &[LatticeTriangle]) -> ColumnStats {
+/// The column statistics of the crossings in the planes `owned` of a grid
+/// of `dims`, read from window `o` (first plane `base`) and, for runs
+/// leaving it, from `beyond`.
+fn columns<O: WindowBits>(
+    o: &O,
+    tris: &[LatticeTriangle],
+    dims: [u32; 3],
+    base: u32,
+    owned: Range<u32>,
+    beyond: &(dyn Fn(u32, u32, u32) -> bool + Sync),
+) -> ColumnStats {
+    let held = base as i64..(base + o.dims()[2]) as i64;
+    let at = |q: [i64; 3]| {
+        if held.contains(&q[2]) {
+            o.get(q[0] as u32, q[1] as u32, (q[2] - base as i64) as u32)
+        } else {
+            beyond(q[0] as u32, q[1] as u32, q[2] as u32)
+        }
+    };
+    let owned = owned.start as i64..owned.end as i64;
     tris.par_chunks(256)
         .map(|chunk| {
             let mut st = ColumnStats::default();
             for t in chunk {
                 if fits_i64(t) {
-                    columns_of::<i64>(bits, t, &mut st);
+                    columns_of::<i64>(&at, dims, &owned, t, &mut st);
                 } else {
-                    columns_of::<i128>(bits, t, &mut st);
+                    columns_of::<i128>(&at, dims, &owned, t, &mut st);
                 }
             }
             st
@@ -312,17 +636,28 @@ fn columns(bits: &DenseBits, tris: &[LatticeTriangle]) -> ColumnStats {
         .reduce(ColumnStats::default, ColumnStats::add)
 }
 
-fn columns_of<T: crate::geom::fixed::PlaneInt>(bits: &DenseBits, t: &LatticeTriangle, st: &mut ColumnStats) {
-    let dims = bits.dims();
-    let Some((lo, hi)) = t.voxel_bounds(dims) else { return };
+fn columns_of<T: crate::geom::fixed::PlaneInt>(
+    at: &impl Fn([i64; 3]) -> bool,
+    dims: [u32; 3],
+    owned: &Range<i64>,
+    t: &LatticeTriangle,
+    st: &mut ColumnStats,
+) {
+    let Some((mut lo, mut hi)) = t.voxel_bounds(dims) else { return };
     let (u, v, w) = crate::voxelize::targets::dominant_axes(t);
+    if w != 2 {
+        lo[2] = lo[2].max(owned.start);
+        hi[2] = hi[2].min(owned.end - 1);
+        if lo[2] > hi[2] {
+            return;
+        }
+    }
     let s = TriSetup::<T>::new(t);
     let mut d = [0i64; 3];
     d[w] = ONE;
     let dw = s.dir(t, d);
     let n = t.normal();
     let h = ONE / 2;
-    let at = |ijk: [i64; 3]| bits.get(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
     for iv in lo[v]..=hi[v] {
         for iu in lo[u]..=hi[u] {
             let mut c = s.a;
@@ -340,6 +675,9 @@ fn columns_of<T: crate::geom::fixed::PlaneInt>(bits: &DenseBits, t: &LatticeTria
             }
             let mut ijk = [0i64; 3];
             (ijk[u], ijk[v], ijk[w]) = (iu, iv, tw as i64);
+            if !owned.contains(&ijk[2]) {
+                continue;
+            }
             st.samples += 1;
             if !at(ijk) {
                 st.empty += 1;
@@ -371,8 +709,9 @@ fn columns_of<T: crate::geom::fixed::PlaneInt>(bits: &DenseBits, t: &LatticeTria
 /// 6-, 18- and 26-adjacency (neighbours with `|di| + |dj| + |dk|` at most
 /// 1, 2 and 3): one pass over the 26-neighbour segments, each found
 /// segment counted for every adjacency that contains it.
-fn tunnels(bits: &DenseBits, tris: &[LatticeTriangle]) -> [u64; 3] {
-    let dims = bits.dims();
+/// Counted for the segments starting in the planes `owned` of a grid of
+/// `dims`, read from window `o` whose first plane is `base`.
+fn tunnels<O: WindowBits>(o: &O, tris: &[LatticeTriangle], dims: [u32; 3], base: u32, owned: Range<u32>) -> [u64; 3] {
     let offsets = forward_offsets_upto(3);
     let mut found: Vec<(u64, u8)> = tris
         .par_chunks(256)
@@ -380,9 +719,9 @@ fn tunnels(bits: &DenseBits, tris: &[LatticeTriangle]) -> [u64; 3] {
             let mut out = Vec::new();
             for t in chunk {
                 if fits_i64(t) {
-                    tunnels_of::<i64>(bits, t, &offsets, dims, &mut out);
+                    tunnels_of::<i64, O>(o, base, &owned, t, &offsets, dims, &mut out);
                 } else {
-                    tunnels_of::<i128>(bits, t, &offsets, dims, &mut out);
+                    tunnels_of::<i128, O>(o, base, &owned, t, &offsets, dims, &mut out);
                 }
             }
             out
@@ -400,8 +739,10 @@ fn tunnels(bits: &DenseBits, tris: &[LatticeTriangle]) -> [u64; 3] {
     counts
 }
 
-fn tunnels_of<T: crate::geom::fixed::PlaneInt>(
-    bits: &DenseBits,
+fn tunnels_of<T: crate::geom::fixed::PlaneInt, O: WindowBits>(
+    o: &O,
+    base: u32,
+    owned: &Range<u32>,
     t: &LatticeTriangle,
     offsets: &[[i64; 3]],
     dims: [u32; 3],
@@ -449,12 +790,13 @@ fn tunnels_of<T: crate::geom::fixed::PlaneInt>(
         }
     }
     let (vp_lo, vp_hi) = (s.bn - nd_hi, s.bn - nd_lo);
-    for k in all_lo[2]..=all_hi[2] {
+    let get = |i: i64, j: i64, k: i64| o.get(i as u32, j as u32, (k - base as i64) as u32);
+    for k in all_lo[2].max(owned.start as i64)..=all_hi[2].min(owned.end as i64 - 1) {
         for j in all_lo[1]..=all_hi[1] {
             for i in all_lo[0]..=all_hi[0] {
                 let pc = s.local([i * ONE + h, j * ONE + h, k * ONE + h]);
                 let vp = s.plane(pc);
-                if vp < vp_lo || vp >= vp_hi || bits.get(i as u32, j as u32, k as u32) {
+                if vp < vp_lo || vp >= vp_hi || get(i, j, k) {
                     continue;
                 }
                 for (di, (d, b)) in offsets.iter().zip(&boxes).enumerate() {
@@ -462,7 +804,7 @@ fn tunnels_of<T: crate::geom::fixed::PlaneInt>(
                     if i < r[0].0 || i > r[0].1 || j < r[1].0 || j > r[1].1 || k < r[2].0 || k > r[2].1 {
                         continue;
                     }
-                    if bits.get((i + d[0]) as u32, (j + d[1]) as u32, (k + d[2]) as u32) {
+                    if get(i + d[0], j + d[1], k + d[2]) {
                         continue;
                     }
                     if s.segment_hits_with(ds, pc, vp) {

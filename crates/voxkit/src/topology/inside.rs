@@ -128,10 +128,17 @@ pub struct Parity {
 impl Parity {
     /// Classifies every voxel centre of `grid` against `tris`.
     pub fn classify(tris: &[LatticeTriangle], dims: [u32; 3]) -> Parity {
-        let [nx, ny, nz] = dims;
-        let hits: Vec<(u32, u32)> = row_crossings(tris, dims).into_iter().map(|(r, i, _)| (r, i)).collect();
+        Parity::classify_planes(tris, dims, 0..dims[2])
+    }
+
+    /// Classifies the voxel centres of the planes `planes` of a grid of
+    /// `dims`; row `(j, k)` of the result is the grid's `(j, planes.start + k)`.
+    /// `tris` must hold every triangle crossing those planes' rows.
+    pub fn classify_planes(tris: &[LatticeTriangle], dims: [u32; 3], planes: std::ops::Range<u32>) -> Parity {
+        let [nx, ny, _] = dims;
+        let hits: Vec<(u32, u32)> = row_crossings_in(tris, dims, planes.clone()).into_iter().map(|(r, i, _)| (r, i)).collect();
         // Toggles at the same voxel cancel in pairs.
-        let rows = ny as usize * nz as usize;
+        let rows = ny as usize * planes.len();
         let mut row_start = Vec::with_capacity(rows + 1);
         let mut toggles = Vec::new();
         let mut h = 0;
@@ -170,12 +177,18 @@ impl Parity {
 /// the winding number (`+1` where the ray leaves through an outward face,
 /// i.e. `−sign(n_x)`).
 pub fn row_crossings(tris: &[LatticeTriangle], dims: [u32; 3]) -> Vec<(u32, u32, i8)> {
+    row_crossings_in(tris, dims, 0..dims[2])
+}
+
+/// [`row_crossings`] of the rows in the planes `planes` only, numbered
+/// from the first of them (`row = (k − planes.start)·ny + j`).
+pub fn row_crossings_in(tris: &[LatticeTriangle], dims: [u32; 3], planes: std::ops::Range<u32>) -> Vec<(u32, u32, i8)> {
     let mut hits: Vec<(u32, u32, i8)> = tris
         .par_chunks(1024)
         .flat_map_iter(|chunk| {
             let mut out = Vec::new();
             for t in chunk {
-                crossings(t, dims, &mut out);
+                crossings(t, dims, &planes, &mut out);
             }
             out
         })
@@ -187,24 +200,25 @@ pub fn row_crossings(tris: &[LatticeTriangle], dims: [u32; 3]) -> Vec<(u32, u32,
 /// Appends `(row, i0, sign)` for every row whose centre line crosses `t`,
 /// where `i0` is the first voxel whose displaced centre lies beyond the
 /// crossing (clamped to `[0, nx]`; voxels `>= i0` see one more crossing).
-fn crossings(t: &LatticeTriangle, dims: [u32; 3], out: &mut Vec<(u32, u32, i8)>) {
+fn crossings(t: &LatticeTriangle, dims: [u32; 3], planes: &std::ops::Range<u32>, out: &mut Vec<(u32, u32, i8)>) {
     let n = t.normal();
     if n[0] == 0 {
         // Parallel to the rays: a displaced ray misses it.
         return;
     }
     let (lo, hi) = t.bounds();
-    let rows = |a: usize| {
+    let rows = |a: usize, range: (i64, i64)| {
         // Rows whose centre coordinate lies in [lo, hi] (with one of margin
         // for the displacement; the exact test decides).
-        let first = ((lo[a] - H - 1).div_euclid(ONE)).max(0);
-        let last = ((hi[a] - H + 1).div_euclid(ONE)).min(dims[a] as i64 - 1);
+        let first = ((lo[a] - H - 1).div_euclid(ONE)).max(range.0);
+        let last = ((hi[a] - H + 1).div_euclid(ONE)).min(range.1 - 1);
         first..=last
     };
+    let (rj, rk) = (rows(1, (0, dims[1] as i64)), rows(2, (planes.start as i64, planes.end as i64)));
     if crate::voxelize::targets::fits_i64(t) {
-        crossings_in::<i64>(t, n, dims, rows(1), rows(2), out);
+        crossings_in::<i64>(t, n, dims, planes.start, rj, rk, out);
     } else {
-        crossings_in::<i128>(t, n, dims, rows(1), rows(2), out);
+        crossings_in::<i128>(t, n, dims, planes.start, rj, rk, out);
     }
 }
 
@@ -212,6 +226,7 @@ fn crossings_in<T: PlaneInt>(
     t: &LatticeTriangle,
     n: [i64; 3],
     dims: [u32; 3],
+    k0: u32,
     rows_j: std::ops::RangeInclusive<i64>,
     rows_k: std::ops::RangeInclusive<i64>,
     out: &mut Vec<(u32, u32, i8)>,
@@ -236,7 +251,7 @@ fn crossings_in<T: PlaneInt>(
             let x_star = if nx > 0 { ax - (v0 - bn).div_euclid(nx) } else { ax + (v0 - bn).div_euclid(-nx) + 1 };
             // First i with i·ONE + H >= x_star.
             let i0 = (x_star - H as i128 + ONE as i128 - 1).div_euclid(ONE as i128).clamp(0, dims[0] as i128);
-            out.push(((k as u64 * dims[1] as u64 + j as u64) as u32, i0 as u32, if nx > 0 { -1 } else { 1 }));
+            out.push((((k - k0 as i64) as u64 * dims[1] as u64 + j as u64) as u32, i0 as u32, if nx > 0 { -1 } else { 1 }));
         }
     }
 }

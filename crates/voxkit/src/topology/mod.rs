@@ -5,4 +5,4 @@ pub mod certify;
 pub mod inside;
 pub mod runs;
 
-pub use certify::{certify, CheckReport, ColumnStats, MeshFacts, Separation};
+pub use certify::{certify, certify_sparse, CheckReport, ColumnStats, MeshFacts, Separation};

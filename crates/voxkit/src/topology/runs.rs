@@ -9,6 +9,7 @@
 
 use rayon::prelude::*;
 
+use crate::grid::bricks::{Brick, BRICK};
 use crate::grid::dense::DenseBits;
 
 /// Connectivity of a path of voxels.
@@ -35,11 +36,18 @@ pub struct Runs {
 impl Runs {
     /// The runs of voxels equal to `value` in `bits`.
     pub fn of(bits: &DenseBits, value: bool) -> Runs {
-        let dims = bits.dims();
+        Runs::of_planes(bits, value, 0..bits.dims()[2])
+    }
+
+    /// The runs of voxels equal to `value` in the planes `planes` of
+    /// `bits`, as a grid of those planes (row `r` is `(k − planes.start)·ny + j`).
+    pub fn of_planes(bits: &DenseBits, value: bool, planes: std::ops::Range<u32>) -> Runs {
+        let [nx, ny, _] = bits.dims();
+        let dims = [nx, ny, planes.len() as u32];
         let wpr = bits.words_per_row();
-        let nx = dims[0];
-        let per_row: Vec<Vec<(u32, u32)>> = bits
-            .words()
+        let plane_words = wpr * ny as usize;
+        let words = &bits.words()[planes.start as usize * plane_words..planes.end as usize * plane_words];
+        let per_row: Vec<Vec<(u32, u32)>> = words
             .par_chunks(wpr.max(1))
             .map(|row| {
                 let mut out = Vec::new();
@@ -72,6 +80,8 @@ impl Runs {
                 out
             })
             .collect();
+        // Rows of zero words: no chunks at all when nx is 0.
+        let per_row = if wpr == 0 { vec![Vec::new(); ny as usize * planes.len()] } else { per_row };
         let total: usize = per_row.iter().map(Vec::len).sum();
         let mut row_start = Vec::with_capacity(per_row.len() + 1);
         let mut start = Vec::with_capacity(total);
@@ -85,6 +95,71 @@ impl Runs {
             row_start.push(start.len() as u32);
         }
         Runs { dims, row_start, start, end }
+    }
+
+    /// The runs of the set voxels of sparse bricks: `bricks` (whole-grid
+    /// brick coordinates, sorted by `(bk, bj, bi)`, full bricks included)
+    /// hold every set voxel of the planes `planes` of an `nx × ny` grid;
+    /// bricks outside those planes are skipped. Rows as in [`Runs::of_planes`].
+    pub fn of_bricks(nx: u32, ny: u32, planes: std::ops::Range<u32>, bricks: &[([u32; 3], Brick)]) -> Runs {
+        let mut row_start = Vec::with_capacity(ny as usize * planes.len() + 1);
+        let (mut start, mut end) = (Vec::new(), Vec::new());
+        row_start.push(0u32);
+        for k in planes.clone() {
+            let (bk, z) = (k / BRICK, (k % BRICK) as usize);
+            let (mut g, layer_end) = (bricks.partition_point(|(b, _)| b[2] < bk), bricks.partition_point(|(b, _)| b[2] <= bk));
+            let mut j = 0;
+            while g < layer_end {
+                // The bricks of brick row bj, sorted by bi.
+                let bj = bricks[g].0[1];
+                let row_end = g + bricks[g..layer_end].partition_point(|(b, _)| b[1] == bj);
+                while j < bj * BRICK {
+                    row_start.push(start.len() as u32);
+                    j += 1;
+                }
+                while j < ((bj + 1) * BRICK).min(ny) {
+                    let y = (j % BRICK) * 8;
+                    let mut open: Option<(u32, u32)> = None;
+                    for (b, bits) in &bricks[g..row_end] {
+                        let mut byte = (bits[z] >> y) as u8 as u32;
+                        let i0 = b[0] * BRICK;
+                        while byte != 0 {
+                            let s = byte.trailing_zeros();
+                            let len = (byte >> s).trailing_ones();
+                            let (first, last) = (i0 + s, i0 + s + len - 1);
+                            match open {
+                                Some((os, oe)) if oe + 1 == first => open = Some((os, last)),
+                                _ => {
+                                    if let Some((os, oe)) = open {
+                                        start.push(os);
+                                        end.push(oe);
+                                    }
+                                    open = Some((first, last));
+                                }
+                            }
+                            byte &= !((1u32 << (s + len)) - 1);
+                        }
+                    }
+                    if let Some((os, oe)) = open {
+                        start.push(os);
+                        end.push(oe);
+                    }
+                    row_start.push(start.len() as u32);
+                    j += 1;
+                }
+                g = row_end;
+            }
+            while j < ny {
+                row_start.push(start.len() as u32);
+                j += 1;
+            }
+        }
+        Runs { dims: [nx, ny, planes.len() as u32], row_start, start, end }
+    }
+
+    /// Voxels along x, y and the planes the runs cover.
+    pub fn dims(&self) -> [u32; 3] {
+        self.dims
     }
 
     /// Number of runs.
@@ -220,12 +295,30 @@ impl UnionFind {
     }
 
     /// Merges the sets of `a` and `b`; the smaller representative wins.
-    pub fn union(&mut self, a: usize, b: usize) {
+    /// Returns whether they were two sets.
+    pub fn union(&mut self, a: usize, b: usize) -> bool {
         let (ra, rb) = (self.find(a), self.find(b));
         if ra != rb {
             let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
             self.parent[hi] = lo as u32;
         }
+        ra != rb
+    }
+
+    /// Adds a singleton; returns it.
+    pub fn push(&mut self) -> usize {
+        self.parent.push(self.parent.len() as u32);
+        self.parent.len() - 1
+    }
+
+    /// Number of elements.
+    pub fn len(&self) -> usize {
+        self.parent.len()
+    }
+
+    /// No elements.
+    pub fn is_empty(&self) -> bool {
+        self.parent.is_empty()
     }
 }
 
@@ -233,7 +326,9 @@ impl UnionFind {
 /// number of components.
 pub fn components(runs: &Runs, conn: Connectivity) -> (Vec<u32>, usize) {
     let mut uf = UnionFind::new(runs.len());
-    runs.for_each_adjacent(conn, |a, b| uf.union(a, b));
+    runs.for_each_adjacent(conn, |a, b| {
+        uf.union(a, b);
+    });
     let mut count = 0;
     let labels = (0..runs.len())
         .map(|x| {
