@@ -6,7 +6,7 @@
 
 use proptest::prelude::*;
 use voxkit::grid::sparse::SparseBricks;
-use voxkit::topology::inside::snap_all;
+use voxkit::topology::inside::{snap_all, Parity};
 use voxkit::topology::{certify, certify_sparse};
 use voxkit::voxelize::{self, Mode, Options};
 use voxkit::{DenseBits, GridSpec, Mesh, VoxelSource};
@@ -42,6 +42,40 @@ fn thinned(d: &DenseBits, n: usize) -> DenseBits {
     out
 }
 
+/// The first pair of adjacent unset voxels of different class, by brute
+/// force over every voxel and forward offset, in (k, j, offset, i) order.
+fn brute_witness(bits: &DenseBits, p: &Parity, all26: bool) -> Option<[[u32; 3]; 2]> {
+    let [nx, ny, nz] = bits.dims();
+    let mut offsets = Vec::new();
+    for dk in -1..=1i64 {
+        for dj in -1..=1i64 {
+            for di in -1..=1i64 {
+                if (dk, dj, di) > (0, 0, 0) && (all26 || di.abs() + dj.abs() + dk.abs() == 1) {
+                    offsets.push([di, dj, dk]);
+                }
+            }
+        }
+    }
+    for k in 0..nz as i64 {
+        for j in 0..ny as i64 {
+            for d in &offsets {
+                for i in 0..nx as i64 {
+                    let q = [i + d[0], j + d[1], k + d[2]];
+                    if q.iter().zip([nx, ny, nz]).any(|(&x, n)| x < 0 || x >= n as i64) {
+                        continue;
+                    }
+                    let (u, v) = ([i as u32, j as u32, k as u32], q.map(|x| x as u32));
+                    let (cu, cv) = (p.inside(u[0], u[1], u[2]), p.inside(v[0], v[1], v[2]));
+                    if cu != cv && !bits.get(u[0], u[1], u[2]) && !bits.get(v[0], v[1], v[2]) {
+                        return Some(if cu { [u, v] } else { [v, u] });
+                    }
+                }
+            }
+        }
+    }
+    None
+}
+
 #[test]
 fn shared_meshes_every_window_size() {
     let mut r = rng(0xc4ec);
@@ -58,6 +92,12 @@ fn shared_meshes_every_window_size() {
                 for bits in [d.clone(), thinned(&d, 7)] {
                     let f = same(&bits, &sparse_of(&bits), Some((&mesh, &grid)), &what).mesh.unwrap();
                     let s = f.separation.as_ref();
+                    if let Some(s) = s {
+                        let snapped = snap_all(mesh.as_ref(), &grid).unwrap();
+                        let parity = Parity::classify(&snapped.crossing_triangles(), grid.dims());
+                        assert_eq!(s.witness_6, brute_witness(&bits, &parity, false), "{what}: 6-witness");
+                        assert_eq!(s.witness_26, brute_witness(&bits, &parity, true), "{what}: 26-witness");
+                    }
                     witnesses += s.map_or(0, |s| s.witness_6.is_some() as u32 + s.witness_26.is_some() as u32);
                     tunnels += (f.tunnels_6 > 0) as u32;
                     holes += (f.columns.empty > 0) as u32;

@@ -518,7 +518,6 @@ fn witness<O: WindowBits>(o: &O, p: &Parity, planes: Range<u32>, conn: Connectiv
         }
         rows.sort_unstable();
         rows.dedup();
-        let mut cuts: Vec<i64> = Vec::new();
         for &j in &rows {
             for d in &offsets {
                 let (jj, kk) = (j as i64 + d[1], k as i64 + d[2]);
@@ -526,40 +525,54 @@ fn witness<O: WindowBits>(o: &O, p: &Parity, planes: Range<u32>, conn: Connectiv
                     continue;
                 }
                 let (jj, kk) = (jj as u32, kk as u32);
-                // The class differs only on intervals bounded by toggles of
-                // either row (the second shifted by −di).
                 let (tr, tq) = (p.row(j, k), p.row(jj, kk));
                 if tr.is_empty() && tq.is_empty() {
                     continue;
                 }
-                cuts.clear();
-                cuts.extend(tr.iter().map(|&t| t as i64).chain(tq.iter().map(|&t| t as i64 - d[0])));
-                cuts.push(0);
-                cuts.push(nx as i64);
-                cuts.sort_unstable();
-                cuts.dedup();
-                for w in cuts.windows(2) {
-                    let (a, b) = (w[0].max(0).max(-d[0]), w[1].min(nx as i64).min(nx as i64 - d[0]));
-                    if a >= b {
-                        continue;
-                    }
-                    let (ir, iq) = (a as u32, (a + d[0]) as u32);
-                    let (cr, cq) = (p.inside(ir, j, k), p.inside(iq, jj, kk));
-                    if cr == cq {
-                        continue;
-                    }
-                    for i in a..b {
-                        let (ir, iq) = (i as u32, (i + d[0]) as u32);
-                        if !o.get(ir, j, k) && !o.get(iq, jj, kk) {
-                            let (u, v) = ([ir, j, k], [iq, jj, kk]);
-                            return Some(if cr { [u, v] } else { [v, u] });
-                        }
-                    }
+                if let Some(w) = row_pair_witness(o, [tr, tq], [j, k], [jj, kk], d[0], nx) {
+                    return Some(w);
                 }
             }
         }
         None
     })
+}
+
+/// The first `i` where voxel `(i, r)` and `(i + di, q)` are both unset and
+/// of different class, as `[inside, outside]`. The classes change only at
+/// toggles (`toggles[0]` of row `r`, `toggles[1]` of row `q`, the latter
+/// seen shifted by `−di`): one merged walk over both lists.
+fn row_pair_witness<O: WindowBits>(o: &O, toggles: [&[u32]; 2], r: [u32; 2], q: [u32; 2], di: i64, nx: u32) -> Option<[[u32; 3]; 2]> {
+    let (lo, hi) = (0i64.max(-di), (nx as i64).min(nx as i64 - di));
+    let (tr, tq) = (toggles[0], toggles[1]);
+    let (mut a, mut b) = (0usize, 0usize);
+    let (mut cr, mut cq) = (false, false);
+    let mut pos = lo;
+    loop {
+        // Classes at `pos`: every toggle at or before it passed.
+        while a < tr.len() && tr[a] as i64 <= pos {
+            cr = !cr;
+            a += 1;
+        }
+        while b < tq.len() && tq[b] as i64 - di <= pos {
+            cq = !cq;
+            b += 1;
+        }
+        let next = tr.get(a).map_or(hi, |&t| t as i64).min(tq.get(b).map_or(hi, |&t| t as i64 - di)).min(hi);
+        if cr != cq {
+            for i in pos..next {
+                let (ir, iq) = (i as u32, (i + di) as u32);
+                if !o.get(ir, r[0], r[1]) && !o.get(iq, q[0], q[1]) {
+                    let (u, v) = ([ir, r[0], r[1]], [iq, q[0], q[1]]);
+                    return Some(if cr { [u, v] } else { [v, u] });
+                }
+            }
+        }
+        if next >= hi {
+            return None;
+        }
+        pos = next;
+    }
 }
 
 /// Calls `f(i)` for every set voxel of row `(j, k)`.
@@ -791,9 +804,26 @@ fn tunnels_of<T: crate::geom::fixed::PlaneInt, O: WindowBits>(
     }
     let (vp_lo, vp_hi) = (s.bn - nd_hi, s.bn - nd_lo);
     let get = |i: i64, j: i64, k: i64| o.get(i as u32, j as u32, (k - base as i64) as u32);
+    // The plane value grows by n_x·ONE per voxel along a row: only the
+    // voxels of each row whose value lies in [vp_lo, vp_hi) are visited
+    // (work along the plane, not through the box).
+    let (lo_v, hi_v, step) = (vp_lo.to_i128(), vp_hi.to_i128(), s.n[0].to_i128() * ONE as i128);
+    let ceil_div = |a: i128, b: i128| -((-a).div_euclid(b));
     for k in all_lo[2].max(owned.start as i64)..=all_hi[2].min(owned.end as i64 - 1) {
         for j in all_lo[1]..=all_hi[1] {
-            for i in all_lo[0]..=all_hi[0] {
+            let i0 = all_lo[0];
+            let v0 = s.plane(s.local([i0 * ONE + h, j * ONE + h, k * ONE + h])).to_i128();
+            let (first, last) = match step.signum() {
+                0 if v0 >= lo_v && v0 < hi_v => (0, i128::MAX),
+                0 => continue,
+                1 => (ceil_div(lo_v - v0, step), (hi_v - 1 - v0).div_euclid(step)),
+                _ => (ceil_div(v0 - hi_v + 1, -step), (v0 - lo_v).div_euclid(-step)),
+            };
+            let (first, last) = (i0 as i128 + first.max(0), (i0 as i128).saturating_add(last).min(all_hi[0] as i128));
+            if first > last {
+                continue;
+            }
+            for i in first as i64..=last as i64 {
                 let pc = s.local([i * ONE + h, j * ONE + h, k * ONE + h]);
                 let vp = s.plane(pc);
                 if vp < vp_lo || vp >= vp_hi || get(i, j, k) {
