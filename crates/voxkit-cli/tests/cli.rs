@@ -991,3 +991,29 @@ fn check_past_memory_window_by_window() {
     let e = error_line(&["check", &tmp("check-small-cover.npy"), "--sparse"]);
     assert!(e.contains("--sparse") && e.contains(".vdb"), "{e}");
 }
+
+/// Pictures of grids past memory: `render` draws a `.vdb` that cannot be
+/// dense from its bricks, and `voxelize --preview` of a tiled run draws
+/// the same picture, byte for byte, as the dense run's.
+#[test]
+fn pictures_of_sparse_grids() {
+    let bunny = shared("stanford-bunny.obj");
+    let (dense_png, tiled_png) = (tmp("preview-dense.png"), tmp("preview-tiled.png"));
+    for (png, extra) in [(&dense_png, None), (&tiled_png, Some("64"))] {
+        let out = tmp("preview-run.vdb");
+        let mut args = vec!["voxelize", bunny.as_str(), "-o", out.as_str(), "--resolution", "200", "--preview", png.as_str(), "--json"];
+        if let Some(t) = extra {
+            args.extend(["--tile", t]);
+        }
+        let v = json(&voxkit(&args));
+        assert_eq!(v["tile"].is_null(), extra.is_none(), "{v}");
+    }
+    assert_eq!(std::fs::read(&dense_png).unwrap(), std::fs::read(&tiled_png).unwrap(), "tiled preview differs");
+    let cube = unit_cube_obj("render-sparse-cube.obj");
+    let big = tmp("render-big.vdb");
+    let grid = ["--voxel-size", "0.004", "--origin", "-40,-40,-40", "--dims", "20000,20000,20000"];
+    json(&voxkit(&[&["voxelize", cube.as_str(), "-o", &big, "--json"][..], &grid[..]].concat()));
+    let r = json(&voxkit(&["render", &big, "-o", &tmp("render-big.png"), "--json"]));
+    assert_eq!(r["dims"], serde_json::json!([20000, 20000, 20000]));
+    assert!(r["covered_pixels"].as_u64().unwrap() > 0, "{r}");
+}

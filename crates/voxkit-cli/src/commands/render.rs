@@ -9,7 +9,8 @@ use serde_json::json;
 use voxkit::attributes::carry::{carry, CarryOptions};
 use voxkit::attributes::VoxelAttributes;
 use voxkit::glam::DVec3;
-use voxkit::render::raycast::{render_with, Image, RenderOptions, View};
+use voxkit::grid::sparse::SparseBricks;
+use voxkit::render::raycast::{render_grid, render_with, Image, RenderGrid, RenderOptions, View};
 use voxkit::voxelize::{self, Options};
 use voxkit::{BrickBits, VoxelSource};
 
@@ -86,6 +87,18 @@ pub fn picture(
     Ok(img)
 }
 
+/// [`picture`] of a grid held as sparse bricks (past memory), without a
+/// dense grid or brick index: the ray caster indexes 64³-voxel blocks.
+pub fn picture_sparse(bits: &SparseBricks, path: &Path, o: &RenderOptions, outline: Option<&[[DVec3; 3]]>) -> Result<Image> {
+    let Some(grid) = RenderGrid::from_sparse(bits) else {
+        let [x, y, z] = bits.dims();
+        bail!("grid {x}x{y}x{z} is too large to render: its index of 64^3-voxel blocks would pass 1 GiB");
+    };
+    let img = render_grid(&grid, o, None, outline);
+    voxkit_io::write_png(path, img.width, img.height, &img.rgb)?;
+    Ok(img)
+}
+
 /// Refuses an output that is not a `.png` or whose folder does not exist.
 pub fn check_png_path(path: &Path) -> Result<()> {
     if path.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("png")) != Some(true) {
@@ -124,8 +137,23 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         }
         // .vox and .schem are rotated back so the --up axis is up again.
         let up = a.up.as_deref().and_then(voxkit_io::orient::Up::from_name).unwrap_or_default();
-        let loaded = voxkit_io::read_voxels_with(&a.input, up)?;
-        (Box::new(loaded.bits), "voxel file", loaded.attributes, None)
+        use voxkit_io::VoxelFormat as F;
+        match voxkit_io::read_voxels_with(&a.input, up) {
+            Ok(loaded) => (Box::new(loaded.bits), "voxel file", loaded.attributes, None),
+            // A .vdb, .zarr or .npz grid past memory: drawn from its bricks.
+            Err(e)
+                if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. })
+                    && matches!(F::from_path(&a.input), Some(F::Vdb | F::Zarr | F::Npz)) =>
+            {
+                let sparse = voxkit_io::read_voxels_sparse(&a.input)?;
+                if sparse.attributes_left {
+                    eprintln!("voxkit: warning: {}: drawn without its colours: the grid does not fit densely", a.input.display());
+                }
+                let img = pool.install(|| picture_sparse(&sparse.bits, &a.output, &o, None))?;
+                return summary(a, &img, "voxel file", &sparse.bits, t0);
+            }
+            Err(e) => return Err(e.into()),
+        }
     } else {
         let (mode, _) = voxkit_job::resolve_method(a.mode.into(), voxkit_job::Method::Fast)
             .context("render voxelizes meshes with a surface or line mode; voxelize solids to a file first")?;
@@ -145,6 +173,11 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         (Box::new(b), "mesh", colours, outline)
     };
     let img = pool.install(|| picture(bits.as_ref(), &a.output, &o, colours.as_ref(), outline.as_deref()))?;
+    summary(a, &img, what, bits.as_ref(), t0)
+}
+
+/// Prints what `render` drew.
+fn summary(a: &RenderArgs, img: &Image, what: &str, bits: &dyn VoxelSource, t0: Instant) -> Result<()> {
     let total_s = t0.elapsed().as_secs_f64();
     if a.json {
         let v = json!({"input": a.input, "kind": what, "output": a.output, "width": img.width, "height": img.height,

@@ -69,10 +69,9 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let want_colour = app.has_colour() && (format.has_colour() || preview.is_some());
     let t_attr = Instant::now();
     let tiled = matches!(v.voxels, voxkit_job::Voxels::Sparse(_));
-    if tiled && (want_colour || every || preview.is_some()) && !a.quiet && !a.json {
-        eprintln!("voxkit: warning: colours, .vti arrays and --preview are not made for tiled grids yet; writing the voxels alone");
+    if tiled && (want_colour || every) && !a.quiet && !a.json {
+        eprintln!("voxkit: warning: colours and .vti arrays are not made for tiled grids yet; writing the voxels alone (a --preview in clay colour)");
     }
-    let preview = preview.filter(|_| !tiled);
     let attrs = (!tiled && (want_colour || every)).then(|| {
         bar.phase("carrying colours into voxels");
         let opts = CarryOptions {
@@ -94,7 +93,12 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     if let Some((path, o)) = &preview {
         bar.phase("rendering the preview");
         let outline = a.picture.outline.then(|| crate::commands::render::outline_triangles(loaded.mesh.as_ref(), &grid));
-        pool.install(|| crate::commands::render::picture(&v.voxels, path, o, attrs.as_ref(), outline.as_deref()))?;
+        match &v.voxels {
+            voxkit_job::Voxels::Sparse(sparse) => {
+                pool.install(|| crate::commands::render::picture_sparse(sparse, path, o, outline.as_deref()))?
+            }
+            voxels => pool.install(|| crate::commands::render::picture(voxels, path, o, attrs.as_ref(), outline.as_deref()))?,
+        };
     }
     bar.finish();
     let total_s = t_total.elapsed().as_secs_f64();

@@ -111,6 +111,12 @@ impl BrickBits {
         }
     }
 
+    /// The brick index (`0` empty, else `1 +` position in the second
+    /// slice; layout `(bk * by + bj) * bx + bi`) and the bricks.
+    pub fn raw(&self) -> (&[u32], &[Brick]) {
+        (&self.index, &self.bricks)
+    }
+
     /// Bricks along x, y, z.
     pub fn brick_dims(&self) -> [u32; 3] {
         self.bdims

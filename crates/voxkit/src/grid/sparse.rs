@@ -257,6 +257,12 @@ impl SparseBricks {
         }
     }
 
+    /// The stored (not full-run) bricks' bits, in key order (beside
+    /// [`SparseBricks::stored_bricks`]).
+    pub fn stored_bits(&self) -> &[Brick] {
+        &self.bricks
+    }
+
     /// The coordinates of the stored (not full-run) bricks, in key order.
     pub fn stored_bricks(&self) -> impl Iterator<Item = [u32; 3]> + '_ {
         self.keys.iter().map(|&k| unkey(k))

@@ -14,8 +14,10 @@
 //!
 //! **Guarantee.** Each pixel shows the first set voxel its ray enters (the
 //! voxel, not an approximation: the DDA visits every cell the ray passes
-//! through, in order), shaded by the face it enters through. Empty 8×8×8
-//! bricks are crossed in one step. The result depends only on the voxels,
+//! through, in order), shaded by the face it enters through. Empty blocks
+//! of 64³ voxels and empty 8×8×8 bricks are crossed in one step each (a
+//! three-level DDA over [`RenderGrid`], which indexes dense bricks and,
+//! for grids past memory, sparse ones alike). The result depends only on the voxels,
 //! the options and the image size, not on the thread count.
 //!
 //! **Reference:** [`reference::first_hit`], the entry parameter of every set
@@ -27,7 +29,94 @@ use rayon::prelude::*;
 
 use crate::attributes::colour::to_linear;
 use crate::attributes::VoxelAttributes;
-use crate::grid::bricks::{BrickBits, BRICK};
+use crate::grid::bricks::{Brick, BrickBits, BRICK};
+use crate::grid::sparse::{SparseBricks, FULL};
+
+/// Bricks per block edge (a block is 64³ voxels).
+const BLOCK: u32 = 8;
+/// Brick id of a full brick (a sparse solid's interior).
+const FULL_ID: u32 = u32::MAX;
+/// Largest block index: 2^28 entries (1 GiB), a 2^22-voxel cube.
+const MAX_BLOCKS: u64 = 1 << 28;
+
+/// The voxels as the ray caster reads them: an index of 64³-voxel blocks,
+/// each non-empty block an index of its 8³ bricks, borrowing the bricks
+/// of a [`BrickBits`] or a [`SparseBricks`]. Memory follows the occupied
+/// blocks, so grids past a dense brick index (16384³ and beyond) render.
+pub struct RenderGrid<'a> {
+    dims: [u32; 3],
+    /// Blocks along each axis.
+    kdims: [u32; 3],
+    /// `0` empty, else `1 +` position in `blocks`.
+    top: Vec<u32>,
+    /// Per block, its 512 bricks (`bi` fastest): `0` empty, [`FULL_ID`],
+    /// or `1 +` position in `bricks`.
+    blocks: Vec<[u32; 512]>,
+    bricks: &'a [Brick],
+}
+
+impl<'a> RenderGrid<'a> {
+    fn new(dims: [u32; 3], bricks: &'a [Brick]) -> Option<RenderGrid<'a>> {
+        let kdims = dims.map(|d| d.div_ceil(BRICK * BLOCK).max(1));
+        let n = kdims.iter().map(|&k| k as u64).product::<u64>();
+        (n <= MAX_BLOCKS).then(|| RenderGrid { dims, kdims, top: vec![0; n as usize], blocks: Vec::new(), bricks })
+    }
+
+    fn insert(&mut self, b: [u32; 3], id: u32) {
+        let k = b.map(|c| c / BLOCK);
+        let t = (k[2] as usize * self.kdims[1] as usize + k[1] as usize) * self.kdims[0] as usize + k[0] as usize;
+        if self.top[t] == 0 {
+            self.blocks.push([0; 512]);
+            self.top[t] = self.blocks.len() as u32;
+        }
+        let l = b.map(|c| (c % BLOCK) as usize);
+        self.blocks[self.top[t] as usize - 1][(l[2] * 8 + l[1]) * 8 + l[0]] = id;
+    }
+
+    /// The bricks of a [`BrickBits`].
+    pub fn from_bricks(bits: &'a BrickBits) -> RenderGrid<'a> {
+        let (index, bricks) = bits.raw();
+        let mut g = RenderGrid::new(bits.dims(), bricks).expect("a brick index's grid has a block index");
+        let [bx, by, _] = bits.brick_dims();
+        for (n, &id) in index.iter().enumerate() {
+            if id != 0 {
+                let n = n as u32;
+                g.insert([n % bx, n / bx % by, n / bx / by], id);
+            }
+        }
+        g
+    }
+
+    /// The bricks of a [`SparseBricks`] (full runs as full bricks), or
+    /// `None` for a grid whose block index would pass 1 GiB.
+    pub fn from_sparse(bits: &'a SparseBricks) -> Option<RenderGrid<'a>> {
+        let mut g = RenderGrid::new(bits.dims(), bits.stored_bits())?;
+        for (n, b) in bits.stored_bricks().enumerate() {
+            g.insert(b, n as u32 + 1);
+        }
+        for (b, n) in bits.full_runs() {
+            for x in 0..n {
+                g.insert([b[0] + x, b[1], b[2]], FULL_ID);
+            }
+        }
+        Some(g)
+    }
+
+    /// Voxels along x, y, z.
+    pub fn dims(&self) -> [u32; 3] {
+        self.dims
+    }
+
+    /// The 512 brick ids of block `k`, if it holds any.
+    #[inline]
+    fn block(&self, k: [i64; 3]) -> Option<&[u32; 512]> {
+        let t = (k[2] as usize * self.kdims[1] as usize + k[1] as usize) * self.kdims[0] as usize + k[0] as usize;
+        match self.top[t] {
+            0 => None,
+            id => Some(&self.blocks[id as usize - 1]),
+        }
+    }
+}
 
 /// Where the camera looks from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -147,10 +236,15 @@ pub fn render(bits: &BrickBits, o: &RenderOptions) -> Image {
 /// outline of a mesh's silhouette (`outline`: triangles in grid units,
 /// `grid.to_grid_units(p)`), drawn dark over the picture.
 pub fn render_with(bits: &BrickBits, o: &RenderOptions, colours: Option<&VoxelAttributes>, outline: Option<&[[DVec3; 3]]>) -> Image {
+    render_grid(&RenderGrid::from_bricks(bits), o, colours, outline)
+}
+
+/// [`render_with`] of any [`RenderGrid`] (sparse grids past memory too).
+pub fn render_grid(grid: &RenderGrid<'_>, o: &RenderOptions, colours: Option<&VoxelAttributes>, outline: Option<&[[DVec3; 3]]>) -> Image {
     let colours = colours.filter(|c| c.colour.is_some());
-    let mut img = shade(bits, o, colours);
+    let mut img = shade(grid, o, colours);
     if let Some(tris) = outline {
-        let cam = Camera::new(bits.dims(), o);
+        let cam = Camera::new(grid.dims(), o);
         let mask = silhouette(&cam, tris, img.width, img.height);
         let (w, h) = (img.width as usize, img.height as usize);
         let inside = |x: i64, y: i64| x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h && mask[y as usize * w + x as usize];
@@ -206,7 +300,7 @@ fn silhouette(cam: &Camera, tris: &[[DVec3; 3]], w: u32, h: u32) -> Vec<bool> {
     mask
 }
 
-fn shade(bits: &BrickBits, o: &RenderOptions, colours: Option<&VoxelAttributes>) -> Image {
+fn shade(bits: &RenderGrid<'_>, o: &RenderOptions, colours: Option<&VoxelAttributes>) -> Image {
     let (w, h) = (o.width.max(1), o.height.max(1));
     let cam = Camera::new(bits.dims(), o);
     // Key light from the upper left, in front of the surface; view vector
@@ -332,20 +426,32 @@ fn walk<T>(
 }
 
 /// The first set voxel along `origin + t·dir` (`t >= 0`), in voxel units
-/// (voxel `(i, j, k)` is the box `[i, i+1] × [j, j+1] × [k, k+1]`).
-pub fn first_hit(bits: &BrickBits, origin: DVec3, dir: DVec3) -> Option<Hit> {
-    let dims = bits.dims();
+/// (voxel `(i, j, k)` is the box `[i, i+1] × [j, j+1] × [k, k+1]`):
+/// blocks, then their bricks, then the bricks' voxels.
+pub fn first_hit(grid: &RenderGrid<'_>, origin: DVec3, dir: DVec3) -> Option<Hit> {
+    let dims = grid.dims;
     let span = clip_to_box(dims, origin, dir)?;
     let b = BRICK as i64;
-    let bd = bits.brick_dims().map(|c| c as i64 - 1);
+    let kd = grid.kdims.map(|c| c as i64 - 1);
+    let bd = dims.map(|c| c.div_ceil(BRICK) as i64 - 1);
     let vd = dims.map(|c| c as i64 - 1);
-    walk(origin, dir, span, BRICK as f64, ([0; 3], bd), |bc, (t0, t1, axis)| {
-        let brick = bits.brick(bc[0] as u32, bc[1] as u32, bc[2] as u32)?;
-        let lo = bc.map(|c| c * b);
-        let hi: [i64; 3] = std::array::from_fn(|a| (lo[a] + b - 1).min(vd[a]));
-        walk(origin, dir, (t0, t1, axis), 1.0, (lo, hi), |v, (t, _, axis)| {
-            let (x, y, z) = (v[0] as u32 & 7, v[1] as u32 & 7, v[2] as u32 & 7);
-            ((brick[z as usize] >> (y * 8 + x)) & 1 == 1).then_some(Hit { t, voxel: v.map(|c| c as u32), axis })
+    walk(origin, dir, span, (BRICK * BLOCK) as f64, ([0; 3], kd), |kc, inner| {
+        let block = grid.block(kc)?;
+        let blo = kc.map(|c| c * BLOCK as i64);
+        let bhi: [i64; 3] = std::array::from_fn(|a| (blo[a] + BLOCK as i64 - 1).min(bd[a]));
+        walk(origin, dir, inner, BRICK as f64, (blo, bhi), |bc, (t0, t1, axis)| {
+            let l = [0, 1, 2].map(|a| (bc[a] - blo[a]) as usize);
+            let brick = match block[(l[2] * 8 + l[1]) * 8 + l[0]] {
+                0 => return None,
+                FULL_ID => &FULL,
+                id => &grid.bricks[id as usize - 1],
+            };
+            let lo = bc.map(|c| c * b);
+            let hi: [i64; 3] = std::array::from_fn(|a| (lo[a] + b - 1).min(vd[a]));
+            walk(origin, dir, (t0, t1, axis), 1.0, (lo, hi), |v, (t, _, axis)| {
+                let (x, y, z) = (v[0] as u32 & 7, v[1] as u32 & 7, v[2] as u32 & 7);
+                ((brick[z as usize] >> (y * 8 + x)) & 1 == 1).then_some(Hit { t, voxel: v.map(|c| c as u32), axis })
+            })
         })
     })
 }
@@ -411,7 +517,7 @@ mod tests {
                 let origin = DVec3::new(f(&mut r) * 3.0, f(&mut r) * 3.0, f(&mut r) * 3.0);
                 let target = DVec3::new(f(&mut r).abs() * 2.0, f(&mut r).abs() * 2.0, f(&mut r).abs() * 2.0);
                 let dir = (target - origin).normalize();
-                let fast = first_hit(&bits, origin, dir);
+                let fast = first_hit(&RenderGrid::from_bricks(&bits), origin, dir);
                 let slow = reference::first_hit(&bits, origin, dir);
                 match (fast, slow) {
                     (None, None) => {}
@@ -423,6 +529,56 @@ mod tests {
                     (a, b) => panic!("round {round}: {a:?} vs {b:?} ({origin} {dir})"),
                 }
             }
+        }
+    }
+
+    /// Sparse bricks with runs of full bricks, over several 64³ blocks,
+    /// give the same hits as the same voxels in a [`BrickBits`] and as the
+    /// slab test, and the same pictures.
+    #[test]
+    fn sparse_grids_over_many_blocks_render_like_dense_ones() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut r = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for round in 0..6 {
+            let dims = [70 + (r() % 120) as u32, 65 + (r() % 100) as u32, 66 + (r() % 90) as u32];
+            let mut dense = BrickBits::new(dims);
+            for _ in 0..300 {
+                let v: [u32; 3] = std::array::from_fn(|a| (r() % dims[a] as u64) as u32);
+                dense.set(v[0], v[1], v[2]);
+            }
+            // A run of full bricks along bi, away from the random voxels' bricks.
+            let b = [1 + (r() % 3) as u32, (r() % (dims[1] as u64 / 8)) as u32, (r() % (dims[2] as u64 / 8)) as u32];
+            let run = 1 + (r() % 4) as u32;
+            let mut stored = Vec::new();
+            let d = dense.to_dense();
+            crate::grid::VoxelSource::for_each_brick(&d, &mut |c, bits| {
+                if !(c[1] == b[1] && c[2] == b[2] && c[0] >= b[0] && c[0] < b[0] + run) {
+                    stored.push((c, *bits));
+                }
+            });
+            let sparse = SparseBricks::from_parts(dims, stored, vec![(b, run)]);
+            let full = BrickBits::from_source(&sparse);
+            let (gs, gd) = (RenderGrid::from_sparse(&sparse).unwrap(), RenderGrid::from_bricks(&full));
+            for _ in 0..150 {
+                let f = |r: &mut dyn FnMut() -> u64, n: u32| (r() % (n as u64 * 3000)) as f64 / 1000.0 - n as f64;
+                let origin = DVec3::new(f(&mut r, dims[0]), f(&mut r, dims[1]), f(&mut r, dims[2]));
+                let target = DVec3::new(f(&mut r, dims[0]).abs(), f(&mut r, dims[1]).abs(), f(&mut r, dims[2]).abs());
+                let dir = (target - origin).normalize();
+                let (a, b) = (first_hit(&gs, origin, dir), first_hit(&gd, origin, dir));
+                assert_eq!(a, b, "round {round}");
+                let slow = reference::first_hit(&full, origin, dir);
+                assert_eq!(a.is_some(), slow.is_some(), "round {round}");
+                if let (Some(h), Some((_, t))) = (a, slow) {
+                    assert!((h.t - t).abs() < 1e-9, "round {round}: t {} vs {t}", h.t);
+                }
+            }
+            let o = RenderOptions { width: 96, height: 72, ..RenderOptions::default() };
+            assert_eq!(render_grid(&gs, &o, None, None), render(&full, &o), "round {round}");
         }
     }
 
