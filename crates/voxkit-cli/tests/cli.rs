@@ -681,9 +681,13 @@ fn convert_sparse_grids_past_memory() {
 fn sparse_solids_write_the_same_files() {
     let bunny = shared("stanford-bunny.obj");
     let cow = shared("cow.obj");
-    for (mesh, mode, method) in
-        [(&bunny, "solid", "parity"), (&bunny, "solid+surface", "parity"), (&cow, "solid", "winding"), (&cow, "solid", "auto")]
-    {
+    for (mesh, mode, method) in [
+        (&bunny, "solid", "parity"),
+        (&bunny, "solid+surface", "parity"),
+        (&cow, "solid", "winding"),
+        (&cow, "solid", "auto"),
+        (&bunny, "solid", "auto"),
+    ] {
         let (a, b) = (tmp(&format!("dense-{mode}-{method}.npy")), tmp(&format!("sparse-{mode}-{method}.npy")));
         let common = ["--resolution", "150", "--mode", mode, "--method", method, "--json"];
         let d = json(&voxkit(&[&["voxelize", mesh.as_str(), "-o", &a][..], &common[..]].concat()));
@@ -691,6 +695,8 @@ fn sparse_solids_write_the_same_files() {
         assert_eq!(t["tile"], 64);
         assert_eq!(t["method"], d["method"]);
         assert_eq!(t["voxels"], d["voxels"]);
+        // The open bunny by the generalized winding number: the same caps.
+        assert_eq!(t["solid"]["generalized_winding"], d["solid"]["generalized_winding"]);
         assert!(t["solid"]["full_bricks"].as_u64().unwrap() > 0, "{mode}: no full bricks");
         assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{mode} {method}: sparse .npy differs");
     }

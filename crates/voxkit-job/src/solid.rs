@@ -120,7 +120,7 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
 }
 
 /// Whether `plan` has a sparse path (for grids past memory): parity or the
-/// closed winding number, alone or with a surface, hollowed or not; not
+/// winding numbers (closed and generalized), alone or with a surface, hollowed or not; not
 /// flood fills, the brute-force reference or the GPU.
 pub fn has_sparse_path(plan: &SolidPlan) -> bool {
     matches!(plan.method, SolidMethod::Auto | SolidMethod::Parity | SolidMethod::Winding)
@@ -140,9 +140,8 @@ pub struct SparseOutcome {
 
 /// Makes the solid `plan` asks for without a dense grid: rows of crossings
 /// turned brick row by brick row into sparse bricks and full runs, united
-/// with the tiled surface (tiles of `tile`) for `solid+surface`. Parity and
-/// the closed winding number only: an open mesh, which needs the
-/// generalized winding number over the whole grid, is an error.
+/// with the tiled surface (tiles of `tile`) for `solid+surface`. Parity,
+/// the closed winding number and, for open meshes, the generalized one.
 pub fn run_sparse(
     plan: &SolidPlan,
     mesh: MeshRef<'_>,
@@ -153,7 +152,7 @@ pub fn run_sparse(
 ) -> Result<SparseOutcome> {
     if !has_sparse_path(plan) {
         return Err(JobError::invalid(format!(
-            "{name}: this solid (flood fill, reference or gpu) has no sparse path yet; parity and winding on closed meshes do"
+            "{name}: this solid (flood fill, reference or gpu) has no sparse path yet; parity and the winding numbers do"
         )));
     }
     let snapped = voxkit::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
@@ -164,6 +163,7 @@ pub fn run_sparse(
         inspect.boundary_edges, inspect.unbalanced_edges
     );
     let dims = grid.dims();
+    let mut gwn = None;
     let (bits, rep, method) = match plan.method {
         SolidMethod::Parity => {
             if !inspect.watertight() {
@@ -173,9 +173,9 @@ pub fn run_sparse(
             (b, r, "parity")
         }
         _ if !inspect.watertight() => {
-            return Err(JobError::invalid(format!(
-            "{open}: the generalized winding number has no sparse path yet (grids past memory); use --method parity, or a grid that fits"
-        )))
+            let (b, r) = winding::winding_sparse(&snapped, dims);
+            gwn = Some(json!({"boundary_cycles": r.cycles, "cap_triangles": r.cap_triangles, "evaluated_voxels": r.evaluated}));
+            (b, r.solid, "winding")
         }
         SolidMethod::Winding => {
             let (b, r) = solid::winding_closed_sparse(&snapped, dims);
@@ -188,7 +188,7 @@ pub fn run_sparse(
     };
     drop(snapped);
     let mut facts = mesh_facts(&rep);
-    facts["generalized_winding"] = Value::Null;
+    facts["generalized_winding"] = gwn.unwrap_or(Value::Null);
     facts["full_bricks"] = json!(bits.full_bricks());
     let bits = match plan.surface {
         Some(surface) => {

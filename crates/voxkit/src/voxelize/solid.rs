@@ -229,7 +229,7 @@ fn subtract(a: &[(u32, u32)], b: &[(u32, u32)]) -> Vec<(u32, u32)> {
 }
 
 /// Bricks and full runs of one brick row `(bj, bk)`, in order of `bi`.
-type BrickRow = (Vec<([u32; 3], Brick)>, Vec<([u32; 3], u32)>);
+pub(crate) type BrickRow = (Vec<([u32; 3], Brick)>, Vec<([u32; 3], u32)>);
 
 /// One brick row of the solid: the spans of its 64 voxel rows; bricks
 /// every row covers wholly form full runs; the other bricks any span
@@ -239,8 +239,6 @@ fn brick_row(hits: &[(u32, u32, i8)], dims: [u32; 3], bj: u32, bk: u32, rule: Ru
     let b = BRICK;
     // spans[dk · 8 + dj]: the inside spans of voxel row (bj·8 + dj, bk·8 + dk).
     let mut spans: [Vec<(u32, u32)>; 64] = std::array::from_fn(|_| Vec::new());
-    // A row of this brick row outside the grid: no brick of it is full.
-    let mut edge = bj * b + b > ny || bk * b + b > nz;
     let j0 = bj * b;
     let j1 = (j0 + b).min(ny);
     for dk in 0..b.min(nz - bk * b) {
@@ -257,6 +255,18 @@ fn brick_row(hits: &[(u32, u32, i8)], dims: [u32; 3], bj: u32, bk: u32, rule: Ru
             h = e;
         }
     }
+    bricks_of_spans(&spans, dims, bj, bk)
+}
+
+/// The bricks of brick row `(bj, bk)` from the inside spans of its 64
+/// voxel rows (`spans[dk · 8 + dj]`: sorted, disjoint, inclusive, not
+/// adjacent): bricks every row covers wholly form full runs; the other
+/// bricks any span touches are built bit by bit.
+pub(crate) fn bricks_of_spans(spans: &[Vec<(u32, u32)>; 64], dims: [u32; 3], bj: u32, bk: u32) -> BrickRow {
+    let [_, ny, nz] = dims;
+    let b = BRICK;
+    // A row of this brick row outside the grid: no brick of it is full.
+    let mut edge = bj * b + b > ny || bk * b + b > nz;
     if spans.iter().all(Vec::is_empty) {
         return (Vec::new(), Vec::new());
     }

@@ -19,7 +19,8 @@
 //! crossings of each voxel's `−x` ray, computed with the exact,
 //! perturbation-decided row crossings of [`super::solid`]. Then
 //! `w = J − w_caps`. Far from every cap, `|w_caps| < 1/2` is guaranteed by
-//! a bound (`area / 4π d²` per cap cycle, over 8³-voxel blocks), so the
+//! a bound (`area / 4π d²` per cap cycle, over blocks of 64³ voxels halved
+//! as needed), so the
 //! voxel is inside iff `J ≠ 0`: no solid angles at all. Only voxels of
 //! blocks near a cap sum the caps' solid angles (cycles whose bound is
 //! below 10⁻³ are neglected; the error is below 10⁻² in `w`). Blocks are
@@ -40,11 +41,13 @@ use std::collections::HashMap;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::solid::SolidReport;
+use super::solid::{bricks_of_spans, BrickRow, SolidReport};
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::{orient, P3};
+use crate::grid::bricks::BRICK;
 use crate::grid::dense::DenseBits;
+use crate::grid::sparse::SparseBricks;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
 use crate::topology::inside::{row_crossings, row_starts, snap_all, ClassifyError, Snapped};
@@ -62,8 +65,9 @@ pub struct WindingReport {
     pub evaluated: u64,
 }
 
-/// Block edge (voxels) of the far-field test.
-const BLOCK: u32 = 8;
+/// Edge (voxels) of the blocks the far-field refinement starts from (a
+/// power of two: blocks halve down to single voxels).
+const TOP: u32 = 64;
 /// Cycles whose bound at a voxel is below this are neglected there.
 const NEGLECT: f64 = 1e-3;
 
@@ -489,41 +493,110 @@ pub fn winding(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, Winding
 
 /// [`winding`] on an already snapped mesh.
 pub fn winding_snapped(snapped: &Snapped, dims: [u32; 3]) -> (DenseBits, WindingReport) {
-    let cycles = boundary_cycles(&snapped.triangles);
-    let caps = caps(&cycles);
-    let mut closed = snapped.crossing_triangles();
-    for c in &caps {
-        closed.extend(c.tris.iter().map(|&v| LatticeTriangle { v }).filter(|t| !t.is_degenerate()));
-    }
-    let hits = row_crossings(&closed, dims);
-    let rows = dims[1] as usize * dims[2] as usize;
-    let start = row_starts(rows, hits.iter().map(|h| h.0 as usize));
-    // Voxels whose decision needs w_cap: octree refinement from 8³ blocks.
-    // A block is settled (inside iff J ≠ 0) when |w_cap| stays below 1/2
-    // over it, by each cap's sphere bound or by w_cap at its centre plus a
-    // Lipschitz bound; otherwise its eight children are refined, down to
-    // single voxels, where w_cap at the centre is the value used.
-    let nb = dims.map(|d| d.div_ceil(BLOCK));
-    let blocks: Vec<[u32; 3]> = (0..nb[2]).flat_map(|k| (0..nb[1]).flat_map(move |j| (0..nb[0]).map(move |i| [i, j, k]))).collect();
-    let mut needed: Vec<Span> = if caps.is_empty() {
-        Vec::new()
-    } else {
-        blocks
-            .par_iter()
-            .flat_map_iter(|&b| {
-                let mut out = Vec::new();
-                refine(&caps, b.map(|x| x * BLOCK), BLOCK, dims, &mut out);
-                out
-            })
-            .collect()
-    };
-    needed.par_sort_unstable_by_key(|s| (s.row, s.i0));
-    let nstart = row_starts(rows, needed.iter().map(|n| n.row as usize));
+    let plan = Plan::new(snapped, dims);
     let mut bits = DenseBits::new(dims);
-    let nx = dims[0];
-    bits.par_rows_mut().enumerate().for_each(|(r, row)| {
-        let row_hits = &hits[start[r]..start[r + 1]];
-        let spans = &needed[nstart[r]..nstart[r + 1]];
+    bits.par_rows_mut().enumerate().for_each(|(r, row)| plan.row(r, |f, t| DenseBits::fill_row(row, f, t)));
+    let voxels = bits.count();
+    (bits, plan.report(snapped, voxels))
+}
+
+/// [`winding_snapped`] without a dense grid, for grids past memory: the
+/// same rows' inside spans, turned brick row by brick row into sparse
+/// bricks with the interior as runs of full bricks. The same voxels.
+pub fn winding_sparse(snapped: &Snapped, dims: [u32; 3]) -> (SparseBricks, WindingReport) {
+    let plan = Plan::new(snapped, dims);
+    let (by, bz) = (dims[1].div_ceil(BRICK) as u64, dims[2].div_ceil(BRICK) as u64);
+    let rows: Vec<BrickRow> = (0..(by * bz) as usize)
+        .into_par_iter()
+        .with_min_len(16)
+        .map(|n| {
+            let (bj, bk) = ((n as u64 % by) as u32, (n as u64 / by) as u32);
+            let mut spans: [Vec<(u32, u32)>; 64] = std::array::from_fn(|_| Vec::new());
+            for dk in 0..BRICK.min(dims[2] - bk * BRICK) {
+                for dj in 0..BRICK.min(dims[1] - bj * BRICK) {
+                    let r = (bk * BRICK + dk) as usize * dims[1] as usize + (bj * BRICK + dj) as usize;
+                    let out = &mut spans[(dk * BRICK + dj) as usize];
+                    plan.row(r, |f, t| out.push((f, t)));
+                }
+            }
+            bricks_of_spans(&spans, dims, bj, bk)
+        })
+        .collect();
+    let (mut bricks, mut full) = (Vec::new(), Vec::new());
+    for (b, f) in rows {
+        bricks.extend(b);
+        full.extend(f);
+    }
+    let out = SparseBricks::from_sorted(dims, bricks, full);
+    let voxels = out.count();
+    (out, plan.report(snapped, voxels))
+}
+
+/// What both storages need: the crossings of mesh + caps per row and the
+/// spans whose decision needs the caps.
+struct Plan {
+    dims: [u32; 3],
+    cycles: u64,
+    cap_triangles: u64,
+    hits: Vec<(u32, u32, i8)>,
+    start: Vec<usize>,
+    needed: Vec<Span>,
+    nstart: Vec<usize>,
+}
+
+impl Plan {
+    fn new(snapped: &Snapped, dims: [u32; 3]) -> Plan {
+        let cycles = boundary_cycles(&snapped.triangles);
+        let caps = caps(&cycles);
+        let mut closed = snapped.crossing_triangles();
+        for c in &caps {
+            closed.extend(c.tris.iter().map(|&v| LatticeTriangle { v }).filter(|t| !t.is_degenerate()));
+        }
+        let hits = row_crossings(&closed, dims);
+        let rows = dims[1] as usize * dims[2] as usize;
+        let start = row_starts(rows, hits.iter().map(|h| h.0 as usize));
+        // Voxels whose decision needs w_cap: octree refinement from blocks
+        // of TOP³ voxels. A block is settled (inside iff J ≠ 0) when
+        // |w_cap| stays below 1/2 over it, by each cap's sphere bound or by
+        // w_cap at its centre plus a Lipschitz bound; otherwise its eight
+        // children are refined, down to single voxels, where w_cap at the
+        // centre is the value used.
+        let nb = dims.map(|d| d.div_ceil(TOP));
+        let blocks: Vec<[u32; 3]> = (0..nb[2]).flat_map(|k| (0..nb[1]).flat_map(move |j| (0..nb[0]).map(move |i| [i, j, k]))).collect();
+        let mut needed: Vec<Span> = if caps.is_empty() {
+            Vec::new()
+        } else {
+            blocks
+                .par_iter()
+                .flat_map_iter(|&b| {
+                    let mut out = Vec::new();
+                    refine(&caps, b.map(|x| x * TOP), TOP, dims, &mut out);
+                    out
+                })
+                .collect()
+        };
+        needed.par_sort_unstable_by_key(|s| (s.row, s.i0));
+        let nstart = row_starts(rows, needed.iter().map(|n| n.row as usize));
+        let cap_triangles = caps.iter().map(|c| c.tris.len() as u64).sum();
+        Plan { dims, cycles: cycles.len() as u64, cap_triangles, hits, start, needed, nstart }
+    }
+
+    /// Calls `emit(first, last)` for the inside spans of row `r` (`k·ny + j`),
+    /// in order, maximal (adjacent spans joined).
+    fn row(&self, r: usize, mut emit: impl FnMut(u32, u32)) {
+        let nx = self.dims[0];
+        let row_hits = &self.hits[self.start[r]..self.start[r + 1]];
+        let spans = &self.needed[self.nstart[r]..self.nstart[r + 1]];
+        let mut open: Option<(u32, u32)> = None;
+        let mut add = |f: u32, t: u32| match open {
+            Some((of, ot)) if ot + 1 == f => open = Some((of, t)),
+            _ => {
+                if let Some((of, ot)) = open {
+                    emit(of, ot);
+                }
+                open = Some((f, t));
+            }
+        };
         let (mut ptr, mut sp) = (0, 0);
         let mut w = 0i64;
         let mut i = 0u32;
@@ -538,7 +611,7 @@ pub fn winding_snapped(snapped: &Snapped, dims: [u32; 3]) -> (DenseBits, Winding
                     Rule::Exact(v) => (w as f64 - v).abs() >= 0.5,
                 };
                 if inside {
-                    DenseBits::fill_row(row, i, i);
+                    add(i, i);
                 }
                 i += 1;
                 if i >= s.i0 + s.len {
@@ -550,17 +623,21 @@ pub fn winding_snapped(snapped: &Snapped, dims: [u32; 3]) -> (DenseBits, Winding
             let next_span = spans.get(sp).map_or(nx, |s| s.i0);
             let next = next_hit.min(next_span).min(nx).max(i + 1);
             if w != 0 {
-                DenseBits::fill_row(row, i, next - 1);
+                add(i, next - 1);
             }
             i = next;
         }
-    });
-    let evaluated = needed.iter().filter(|s| matches!(s.rule, Rule::Exact(_))).count() as u64;
+        if let Some((of, ot)) = open {
+            emit(of, ot);
+        }
+    }
 
-    let mut solid = super::solid::inspect(snapped);
-    solid.voxels = bits.count();
-    let cap_triangles = caps.iter().map(|c| c.tris.len() as u64).sum();
-    (bits, WindingReport { solid, cycles: cycles.len() as u64, cap_triangles, evaluated })
+    fn report(&self, snapped: &Snapped, voxels: u64) -> WindingReport {
+        let evaluated = self.needed.iter().filter(|s| matches!(s.rule, Rule::Exact(_))).count() as u64;
+        let mut solid = super::solid::inspect(snapped);
+        solid.voxels = voxels;
+        WindingReport { solid, cycles: self.cycles, cap_triangles: self.cap_triangles, evaluated }
+    }
 }
 
 /// The slow, obviously correct definition.
