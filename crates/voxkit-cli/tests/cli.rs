@@ -700,6 +700,16 @@ fn sparse_solids_write_the_same_files() {
         assert!(t["solid"]["full_bricks"].as_u64().unwrap() > 0, "{mode}: no full bricks");
         assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{mode} {method}: sparse .npy differs");
     }
+    // Flood fills of a tiled shell, plane by plane: the dense fill's file.
+    for (mesh, shell) in [(&cow, "cover"), (&bunny, "sep26")] {
+        let (a, b) = (tmp(&format!("dense-flood-{shell}.npy")), tmp(&format!("sparse-flood-{shell}.npy")));
+        let common = ["--resolution", "150", "--mode", "solid", "--fill", "flood", "--surface", shell, "--json"];
+        let d = json(&voxkit(&[&["voxelize", mesh.as_str(), "-o", &a][..], &common[..]].concat()));
+        let t = json(&voxkit(&[&["voxelize", mesh.as_str(), "-o", &b, "--tile", "64"][..], &common[..]].concat()));
+        assert_eq!((&t["tile"], &t["method"]), (&serde_json::json!(64), &d["method"]));
+        assert_eq!(t["solid"]["enclosed_voxels"], d["solid"]["enclosed_voxels"]);
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "flood {shell}: sparse .npy differs");
+    }
     // Hollowed: skinned brick by brick on the sparse solid, the dense skin.
     for (mesh, hollow, extra) in [(&bunny, "6", ["--method", "parity"]), (&cow, "26", ["--surface", "sep26"])] {
         let (a, b) = (tmp(&format!("dense-hollow-{hollow}.npy")), tmp(&format!("sparse-hollow-{hollow}.npy")));
@@ -738,11 +748,11 @@ fn grids_past_memory_errors() {
     for (args, says) in [
         (vec!["--resolution", "16384", "--max-memory", "1G"], ".vdb"),
         (vec!["--tile", "12"], "multiple of 8"),
-        (vec!["--tile", "64", "--mode", "solid", "--fill", "flood"], "flood fills"),
+        (vec!["--tile", "64", "--mode", "solid", "--method", "reference"], "reference and gpu solids"),
         (vec!["--tile", "64", "--method", "reference"], "fast or scanline path"),
         (vec!["--max-memory", "lots"], "unknown unit"),
         (vec!["--max-memory", "1.2.3G"], "not a size"),
-        (vec!["--resolution", "16384", "--max-memory", "1G", "--mode", "solid", "--fill", "flood"], "flood fills"),
+        (vec!["--resolution", "16384", "--max-memory", "1G", "--mode", "solid", "--method", "reference"], "reference and gpu solids"),
     ] {
         let mut a = vec!["voxelize", &cow, "-o"];
         let out = tmp(if args.contains(&"solid") { "past.vdb" } else { "past.npy" });

@@ -382,7 +382,7 @@ impl Plan {
             if let Some(sp) = &solid {
                 if !crate::solid::has_sparse_path(sp) {
                     return Err(JobError::invalid(
-                        "--tile: flood fills and the reference and gpu solids do not run tiled yet (parity and winding do, hollowed or not)",
+                        "--tile: the reference and gpu solids do not run tiled yet (parity, winding and flood fills do, hollowed or not)",
                     ));
                 }
             } else if !matches!(request.method, Method::Auto | Method::Fast | Method::Scanline) {

@@ -112,7 +112,7 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
     let tile = tile_for(plan, &grid, budget);
     if tile.is_none() {
         let why = if plan.solid.is_some() {
-            "flood fills, the reference and gpu solids (not tiled yet; parity and winding are, hollowed or not)"
+            "the reference and gpu solids (not tiled yet; parity, winding and flood fills are, hollowed or not)"
         } else {
             "--method reference and gpu (the fast and scanline paths are tiled)"
         };

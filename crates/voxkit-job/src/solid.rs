@@ -43,10 +43,7 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         let shell = voxelize::fast(surface, mesh, grid, opts).0.to_dense();
         let (bits, rep) = fill::flood_fill(&shell);
         if rep.enclosed == 0 {
-            warnings.push(format!(
-                "the {} shell encloses no voxel: it leaks through a hole wider than the shell, or the mesh is too thin for this grid",
-                surface.name()
-            ));
+            warnings.push(flood_leak_warning(surface));
         }
         (bits, "flood", json!({"shell": surface.name(), "shell_voxels": rep.shell, "enclosed_voxels": rep.enclosed}))
     } else {
@@ -119,11 +116,11 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
     Ok(Outcome { bits, method, facts, warnings })
 }
 
-/// Whether `plan` has a sparse path (for grids past memory): parity or the
-/// winding numbers (closed and generalized), alone or with a surface, hollowed or not; not
-/// flood fills, the brute-force reference or the GPU.
+/// Whether `plan` has a sparse path (for grids past memory): parity, the
+/// winding numbers (closed and generalized) and flood fills, alone or with
+/// a surface, hollowed or not; not the brute-force reference or the GPU.
 pub fn has_sparse_path(plan: &SolidPlan) -> bool {
-    matches!(plan.method, SolidMethod::Auto | SolidMethod::Parity | SolidMethod::Winding)
+    matches!(plan.method, SolidMethod::Auto | SolidMethod::Parity | SolidMethod::Winding | SolidMethod::Flood)
 }
 
 /// A sparse solid and what was done to get it (see [`run_sparse`]).
@@ -141,7 +138,8 @@ pub struct SparseOutcome {
 /// Makes the solid `plan` asks for without a dense grid: rows of crossings
 /// turned brick row by brick row into sparse bricks and full runs, united
 /// with the tiled surface (tiles of `tile`) for `solid+surface`. Parity,
-/// the closed winding number and, for open meshes, the generalized one.
+/// the closed winding number and, for open meshes, the generalized one;
+/// flood fills fill a tiled shell plane by plane.
 pub fn run_sparse(
     plan: &SolidPlan,
     mesh: MeshRef<'_>,
@@ -152,8 +150,22 @@ pub fn run_sparse(
 ) -> Result<SparseOutcome> {
     if !has_sparse_path(plan) {
         return Err(JobError::invalid(format!(
-            "{name}: this solid (flood fill, reference or gpu) has no sparse path yet; parity and the winding numbers do"
+            "{name}: this solid (reference or gpu) has no sparse path yet; parity, the winding numbers and flood fills do"
         )));
+    }
+    if plan.method == SolidMethod::Flood {
+        let surface = plan.surface.unwrap_or(voxelize::Mode::Cover);
+        let (shell, _) = voxelize::tiled::tiled(surface, mesh, grid, tile, opts).map_err(|e| JobError::invalid(e.to_string()))?;
+        let (bits, rep) = fill::flood_fill_sparse(&shell);
+        drop(shell);
+        let mut warnings = Vec::new();
+        if rep.enclosed == 0 {
+            warnings.push(flood_leak_warning(surface));
+        }
+        let mut facts =
+            json!({"shell": surface.name(), "shell_voxels": rep.shell, "enclosed_voxels": rep.enclosed, "full_bricks": bits.full_bricks()});
+        let bits = hollow_sparse(plan, bits, &mut facts);
+        return Ok(SparseOutcome { bits, method: "flood", facts, warnings });
     }
     let snapped = voxkit::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
     let inspect = solid::inspect(&snapped);
@@ -198,14 +210,27 @@ pub fn run_sparse(
         }
         None => bits,
     };
-    let bits = match plan.hollow {
+    let bits = hollow_sparse(plan, bits, &mut facts);
+    Ok(SparseOutcome { bits, method, facts, warnings })
+}
+
+/// `--hollow` on a sparse solid, if the plan asks.
+fn hollow_sparse(plan: &SolidPlan, bits: SparseBricks, facts: &mut Value) -> SparseBricks {
+    match plan.hollow {
         Some(conn) => {
             facts["hollow"] = json!(if conn == voxkit::topology::runs::Connectivity::Six { 6 } else { 26 });
             fill::hollow_sparse(&bits, conn)
         }
         None => bits,
-    };
-    Ok(SparseOutcome { bits, method, facts, warnings })
+    }
+}
+
+/// The warning of a flood fill that enclosed nothing.
+fn flood_leak_warning(surface: voxelize::Mode) -> String {
+    format!(
+        "the {} shell encloses no voxel: it leaks through a hole wider than the shell, or the mesh is too thin for this grid",
+        surface.name()
+    )
 }
 
 /// What the solid learned about the mesh's closedness, as the JSON summary

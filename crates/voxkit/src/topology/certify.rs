@@ -29,7 +29,7 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 use super::inside::{snap_all, ClassifyError, Parity};
-use super::runs::{Connectivity, Runs, UnionFind};
+use super::runs::{Connectivity, Runs, StreamedComponents};
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::LatticeTriangle;
 use crate::grid::bricks::{Brick, BrickBits, BRICK};
@@ -278,55 +278,6 @@ impl WindowBits for BrickWindow {
                 n
             })
             .sum()
-    }
-}
-
-/// Components counted window by window: each window's runs (its own
-/// planes and the last plane of the window before) are joined locally,
-/// every local component gets a global label, and the runs of the shared
-/// plane join the labels they had in the window before.
-struct StreamedComponents {
-    conn: Connectivity,
-    labels: UnionFind,
-    merged: usize,
-    /// Global label of each run of the last plane seen.
-    carry: Vec<u32>,
-}
-
-impl StreamedComponents {
-    fn new(conn: Connectivity) -> StreamedComponents {
-        StreamedComponents { conn, labels: UnionFind::new(0), merged: 0, carry: Vec::new() }
-    }
-
-    /// Adds the runs of a window; with `shared`, their first plane is the
-    /// last plane of the previous window.
-    fn add(&mut self, runs: &Runs, shared: bool) {
-        let mut local = UnionFind::new(runs.len());
-        runs.for_each_adjacent(self.conn, |a, b| {
-            local.union(a, b);
-        });
-        // Union by index: a run's representative comes no later than it.
-        let mut ids = vec![0u32; runs.len()];
-        for x in 0..runs.len() {
-            let r = local.find(x);
-            ids[x] = if r == x { self.labels.push() as u32 } else { ids[r] };
-        }
-        let ny = runs.dims()[1] as usize;
-        if shared {
-            let first = runs.row_start[ny] as usize;
-            debug_assert_eq!(first, self.carry.len());
-            for (t, &c) in self.carry.iter().enumerate().take(first) {
-                if self.labels.union(ids[t] as usize, c as usize) {
-                    self.merged += 1;
-                }
-            }
-        }
-        let last = runs.row_start[runs.row_start.len() - 1 - ny] as usize;
-        self.carry = ids[last..].to_vec();
-    }
-
-    fn count(&self) -> usize {
-        self.labels.len() - self.merged
     }
 }
 

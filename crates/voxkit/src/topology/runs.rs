@@ -157,6 +157,31 @@ impl Runs {
         Runs { dims: [nx, ny, planes.len() as u32], row_start, start, end }
     }
 
+    /// The runs of the other voxels: each row's complement within `0..nx`.
+    pub fn complement(&self) -> Runs {
+        let nx = self.dims[0];
+        let rows = self.row_start.len() - 1;
+        let mut row_start = Vec::with_capacity(rows + 1);
+        let (mut start, mut end) = (Vec::with_capacity(self.len() + rows), Vec::with_capacity(self.len() + rows));
+        row_start.push(0u32);
+        for r in 0..rows {
+            let mut next = 0u32;
+            for a in self.row_runs(r) {
+                if self.start[a] > next {
+                    start.push(next);
+                    end.push(self.start[a] - 1);
+                }
+                next = self.end[a] + 1;
+            }
+            if next < nx {
+                start.push(next);
+                end.push(nx - 1);
+            }
+            row_start.push(start.len() as u32);
+        }
+        Runs { dims: self.dims, row_start, start, end }
+    }
+
     /// Voxels along x, y and the planes the runs cover.
     pub fn dims(&self) -> [u32; 3] {
         self.dims
@@ -319,6 +344,91 @@ impl UnionFind {
     /// No elements.
     pub fn is_empty(&self) -> bool {
         self.parent.is_empty()
+    }
+}
+
+/// Components counted window by window (grids past memory): each
+/// window's runs (its own planes and the last plane of the window before)
+/// are joined locally, every local component gets a global label, and the
+/// runs of the shared plane join the labels they had in the window before.
+#[derive(Clone, Debug)]
+pub struct StreamedComponents {
+    conn: Connectivity,
+    labels: UnionFind,
+    merged: usize,
+    /// Global label of each run of the last plane seen.
+    carry: Vec<u32>,
+}
+
+impl StreamedComponents {
+    /// No windows yet.
+    pub fn new(conn: Connectivity) -> StreamedComponents {
+        StreamedComponents { conn, labels: UnionFind::new(0), merged: 0, carry: Vec::new() }
+    }
+
+    /// Adds the runs of a window; with `shared`, their first plane is the
+    /// last plane of the previous window. Returns every run's global label
+    /// (the labels [`StreamedComponents::relabel`] gives again from the
+    /// same runs and the number of labels before this window).
+    pub fn add(&mut self, runs: &Runs, shared: bool) -> Vec<u32> {
+        let (ids, new) = Self::relabel(runs, self.conn, self.labels.len() as u32);
+        for _ in 0..new {
+            self.labels.push();
+        }
+        let ny = runs.dims()[1] as usize;
+        if runs.dims()[2] == 0 {
+            return ids;
+        }
+        if shared {
+            let first = runs.row_start[ny] as usize;
+            debug_assert_eq!(first, self.carry.len());
+            for (t, &c) in self.carry.iter().enumerate().take(first) {
+                if self.labels.union(ids[t] as usize, c as usize) {
+                    self.merged += 1;
+                }
+            }
+        }
+        let last = runs.row_start[runs.row_start.len() - 1 - ny] as usize;
+        self.carry = ids[last..].to_vec();
+        ids
+    }
+
+    /// The global labels [`StreamedComponents::add`] gave `runs` when
+    /// `base` labels existed before them, and how many it added: local
+    /// components numbered from `base` in order of their first run.
+    pub fn relabel(runs: &Runs, conn: Connectivity, base: u32) -> (Vec<u32>, usize) {
+        let mut local = UnionFind::new(runs.len());
+        runs.for_each_adjacent(conn, |a, b| {
+            local.union(a, b);
+        });
+        // Union by index: a run's representative comes no later than it.
+        let mut ids = vec![0u32; runs.len()];
+        let mut new = 0;
+        for x in 0..runs.len() {
+            let r = local.find(x);
+            ids[x] = if r == x {
+                new += 1;
+                base + new as u32 - 1
+            } else {
+                ids[r]
+            };
+        }
+        (ids, new)
+    }
+
+    /// Labels given so far.
+    pub fn labels(&self) -> usize {
+        self.labels.len()
+    }
+
+    /// The representative of global label `id`.
+    pub fn root(&mut self, id: u32) -> usize {
+        self.labels.find(id as usize)
+    }
+
+    /// Components of all windows added.
+    pub fn count(&self) -> usize {
+        self.labels.len() - self.merged
     }
 }
 

@@ -24,10 +24,11 @@ use rayon::prelude::*;
 
 use std::collections::HashMap;
 
+use super::solid::{bricks_of_spans, BrickRow};
 use crate::grid::bricks::{Brick, BRICK};
 use crate::grid::dense::DenseBits;
 use crate::grid::sparse::SparseBricks;
-use crate::topology::runs::{components, Connectivity, Runs};
+use crate::topology::runs::{components, Connectivity, Runs, StreamedComponents};
 
 /// What a flood fill found.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -69,6 +70,108 @@ pub fn flood_fill(shell: &DenseBits) -> (DenseBits, FloodReport) {
         })
         .sum();
     (out, FloodReport { shell: shell.count(), enclosed })
+}
+
+/// [`flood_fill`] without a dense grid, for shells past memory: plane by
+/// plane, the unset runs of each plane are joined with those of the plane
+/// before ([`StreamedComponents`]: labels only for each plane's 2D
+/// components), components touching the grid's boundary are marked
+/// outside, and a second pass emits the shell plus the enclosed runs
+/// brick row by brick row, enclosed interiors as runs of full bricks. The
+/// same voxels and report as [`flood_fill`].
+pub fn flood_fill_sparse(shell: &SparseBricks) -> (SparseBricks, FloodReport) {
+    let dims = shell.dims();
+    let [nx, ny, nz] = dims;
+    let bz = nz.div_ceil(BRICK);
+    // Bricks of the layers `layers`, in key order (whole-grid coordinates).
+    let bricks_of = |layers: std::ops::Range<u32>| {
+        let mut v = Vec::new();
+        shell.for_each_brick_in_layers(layers, |b, bits| v.push((b, *bits)));
+        v
+    };
+    // The set runs of plane k and the unset runs of planes (k − 1, k) or (k).
+    let window = |bricks: &[([u32; 3], Brick)], k: u32| {
+        let planes = k.saturating_sub(1)..k + 1;
+        (Runs::of_bricks(nx, ny, k..k + 1, bricks), Runs::of_bricks(nx, ny, planes, bricks).complement())
+    };
+    let plane_rows = |k: u32| if k > 0 { ny as usize..2 * ny as usize } else { 0..ny as usize };
+    // Pass 1: components and which touch the boundary.
+    let mut comps = StreamedComponents::new(Connectivity::Six);
+    let mut outside: Vec<bool> = Vec::new();
+    let mut bases = Vec::with_capacity(nz as usize);
+    for layer in 0..bz {
+        let bricks = bricks_of(layer.saturating_sub(1)..layer + 1);
+        for k in layer * BRICK..((layer + 1) * BRICK).min(nz) {
+            let (_, unset) = window(&bricks, k);
+            bases.push(comps.labels() as u32);
+            let ids = comps.add(&unset, k > 0);
+            outside.resize(comps.labels(), false);
+            for r in plane_rows(k) {
+                let j = (r % ny as usize) as u32;
+                let edge_row = j == 0 || k == 0 || j == ny - 1 || k == nz - 1;
+                for a in unset.row_runs(r) {
+                    if edge_row || unset.start[a] == 0 || unset.end[a] == nx - 1 {
+                        outside[ids[a] as usize] = true;
+                    }
+                }
+            }
+        }
+    }
+    let mut root_outside = vec![false; comps.labels()];
+    let roots: Vec<u32> = (0..comps.labels() as u32).map(|id| comps.root(id) as u32).collect();
+    for (id, &o) in outside.iter().enumerate() {
+        if o {
+            root_outside[roots[id] as usize] = true;
+        }
+    }
+    drop(outside);
+    // Pass 2, brick layers in parallel: the same labels again, the shell's
+    // runs and the enclosed unset runs of each row, as brick rows.
+    let by = ny.div_ceil(BRICK);
+    let layers: Vec<(BrickRow, u64)> = (0..bz)
+        .into_par_iter()
+        .map(|layer| {
+            let bricks = bricks_of(layer.saturating_sub(1)..layer + 1);
+            let mut spans: Vec<[Vec<(u32, u32)>; 64]> = (0..by).map(|_| std::array::from_fn(|_| Vec::new())).collect();
+            let mut enclosed = 0u64;
+            for k in layer * BRICK..((layer + 1) * BRICK).min(nz) {
+                let (set, unset) = window(&bricks, k);
+                let (ids, _) = StreamedComponents::relabel(&unset, Connectivity::Six, bases[k as usize]);
+                for (n, r) in plane_rows(k).enumerate() {
+                    let j = n as u32;
+                    let mut row: Vec<(u32, u32)> = set.row_runs(n).map(|a| (set.start[a], set.end[a])).collect();
+                    for a in unset.row_runs(r) {
+                        if !root_outside[roots[ids[a] as usize] as usize] {
+                            row.push((unset.start[a], unset.end[a]));
+                            enclosed += (unset.end[a] - unset.start[a] + 1) as u64;
+                        }
+                    }
+                    row.sort_unstable();
+                    let out = &mut spans[(j / BRICK) as usize][((k % BRICK) * BRICK + j % BRICK) as usize];
+                    for (f, t) in row {
+                        match out.last_mut() {
+                            Some(last) if last.1 + 1 == f => last.1 = t,
+                            _ => out.push((f, t)),
+                        }
+                    }
+                }
+            }
+            let mut parts: BrickRow = (Vec::new(), Vec::new());
+            for (bj, s) in spans.iter().enumerate() {
+                let (b, f) = bricks_of_spans(s, dims, bj as u32, layer);
+                parts.0.extend(b);
+                parts.1.extend(f);
+            }
+            (parts, enclosed)
+        })
+        .collect();
+    let (mut bricks, mut full, mut enclosed) = (Vec::new(), Vec::new(), 0);
+    for ((b, f), e) in layers {
+        bricks.extend(b);
+        full.extend(f);
+        enclosed += e;
+    }
+    (SparseBricks::from_sorted(dims, bricks, full), FloodReport { shell: shell.count(), enclosed })
 }
 
 /// The voxels of `solid` with a neighbour (6- or 26-connected) outside it
