@@ -656,8 +656,12 @@ fn voxelize(
         .detach(move || {
             let run = || -> Result<GridData, JobError> {
                 let v = voxkit_job::voxelize(&plan, inner.mesh.as_ref(), &name, None)?;
-                let attrs =
-                    if attributes { voxkit_job::attributes(&plan, inner.mesh.as_ref(), &inner.appearance, &v, &carry) } else { None };
+                let attrs = if attributes && !plan.is_line() {
+                    voxkit_job::check_attributes_carried(&plan, &v)?;
+                    voxkit_job::attributes(&plan, inner.mesh.as_ref(), &inner.appearance, &v, &carry)
+                } else {
+                    None
+                };
                 let mut facts = v.facts(&plan);
                 facts["warnings"] = serde_json::json!(v.warnings);
                 Ok(GridData { voxels: v.voxels, grid: v.grid, attrs, facts })

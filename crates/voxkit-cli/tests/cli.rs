@@ -600,8 +600,9 @@ fn tiled_runs_write_the_same_files_and_vdb_reads_back() {
 /// `--attributes` writes the surface's attributes into `.vdb` as grids
 /// beside the voxels (and into `.zarr` as a group of arrays): converting
 /// that file to `.vti` gives the very bytes `voxelize` writes to `.vti`
-/// (colour, material, coverage, normal), for a surface and for a solid. Asked for a tiled grid it is refused in one
-/// line, and nothing is written.
+/// (colour, material, coverage, normal), for a surface and for a solid; a
+/// tiled run writes the same file. Attributes past the memory limit are
+/// refused in one line, and nothing is written.
 #[test]
 fn vdb_attributes_carry_every_array() {
     let spot = shared("spot-textured.obj");
@@ -624,10 +625,35 @@ fn vdb_attributes_carry_every_array() {
     assert!(std::fs::metadata(&plain).unwrap().len() < std::fs::metadata(tmp("attrs-cover.vdb")).unwrap().len());
     let c = voxkit(&["convert", &plain, &plain_vti, "--json"]);
     assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
-    let tiled = tmp("attrs-tiled.vdb");
-    let e = error_line(&["voxelize", &spot, "-o", &tiled, "--resolution", "48", "--tile", "16", "--attributes"]);
-    assert!(e.contains("--attributes") && e.contains("tiled"), "{e}");
-    assert!(!std::path::Path::new(&tiled).exists());
+    // A tiled run carries the same attributes: the same file, byte for byte.
+    for mode in ["cover", "solid"] {
+        let tiled = tmp(&format!("attrs-tiled-{mode}.vdb"));
+        let j = json(&voxkit(&[
+            "voxelize",
+            &spot,
+            "-o",
+            &tiled,
+            "--resolution",
+            "48",
+            "--mode",
+            mode,
+            "--tile",
+            "16",
+            "--attributes",
+            "--json",
+        ]));
+        assert_eq!(j["tile"], 16);
+        assert_eq!(
+            std::fs::read(&tiled).unwrap(),
+            std::fs::read(tmp(&format!("attrs-{mode}.vdb"))).unwrap(),
+            "{mode}: tiled attributes differ"
+        );
+    }
+    // Attributes that would not fit in --max-memory: one line, nothing written.
+    let big = tmp("attrs-too-big.vdb");
+    let e = error_line(&["voxelize", &spot, "-o", &big, "--resolution", "300", "--max-memory", "1M", "--attributes"]);
+    assert!(e.contains("attributes of") && e.contains("1.0 MiB"), "{e}");
+    assert!(!std::path::Path::new(&big).exists());
     // For a format without attribute grids the flag is named as unused.
     let out = voxkit(&["voxelize", &spot, "-o", &tmp("attrs.npy"), "--resolution", "16", "--attributes"]);
     assert!(out.status.success());

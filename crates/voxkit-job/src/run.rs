@@ -214,10 +214,15 @@ fn tile_for(plan: &Plan, grid: &GridSpec, budget: u64) -> Option<u32> {
 
 /// Carries the mesh's colours, materials, normals and coverage into the
 /// voxels (see [`voxkit::attributes::carry`]); `None` for line modes.
+/// Dense, brick and tiled grids alike (carrying works from the set
+/// voxels' keys); see [`check_attributes_carried`] for its memory.
 pub fn attributes(plan: &Plan, mesh: MeshRef<'_>, appearance: &Appearance, v: &Voxelized, opts: &CarryOptions) -> Option<VoxelAttributes> {
-    // Not on tiled grids yet: carrying needs a whole-grid brick index.
-    (!plan.is_line() && !matches!(v.voxels, Voxels::Sparse(_))).then(|| carry(mesh, appearance, &v.grid, v.voxels.source(), opts))
+    (!plan.is_line()).then(|| carry(mesh, appearance, &v.grid, v.voxels.source(), opts))
 }
+
+/// Bytes per set voxel that carried attributes take (key, flag, coverage,
+/// colour, material, normal).
+pub const ATTRIBUTE_BYTES_PER_VOXEL: u64 = 32;
 
 /// True when `format` gets every attribute array: `.vti` always, `.vdb`
 /// and `.zarr` when `asked` (`--attributes`).
@@ -227,13 +232,20 @@ pub fn every_attribute(format: crate::output::Output, asked: bool) -> bool {
     format == Voxels(F::Vti) || (asked && matches!(format, Voxels(F::Vdb | F::Zarr)))
 }
 
-/// `--attributes` (`asked`) for `.vdb` or `.zarr` on a grid that ran tiled: refused,
-/// not dropped, since carrying needs a whole-grid brick index.
-pub fn check_attributes_carried(format: crate::output::Output, asked: bool, v: &Voxelized) -> Result<()> {
-    if asked && every_attribute(format, true) && matches!(v.voxels, Voxels::Sparse(_)) {
-        return Err(JobError::invalid(
-            "--attributes: attributes are not carried on tiled grids yet (this grid ran tiled: past --max-memory, or --tile); drop --attributes for the voxels alone",
-        ));
+/// Refuses carrying attributes that would not fit in the run's memory
+/// (`--max-memory`, else most of the available memory): about
+/// [`ATTRIBUTE_BYTES_PER_VOXEL`] per set voxel, all held at once (a tiled
+/// grid's voxels past memory, or a sparse solid's interior, can pass it).
+pub fn check_attributes_carried(plan: &Plan, v: &Voxelized) -> Result<()> {
+    let voxels = v.voxels.source().count();
+    let need = voxels.saturating_mul(ATTRIBUTE_BYTES_PER_VOXEL);
+    let budget = crate::memory::budget(plan.request.max_memory);
+    if need > budget {
+        return Err(JobError::failed(format!(
+            "attributes of {voxels} voxels need about {} ({ATTRIBUTE_BYTES_PER_VOXEL} bytes each, held at once), more than the {} this run may use; drop the colours and attributes (an output without them), or use a coarser grid",
+            crate::memory::bytes(need),
+            crate::memory::bytes(budget)
+        )));
     }
     Ok(())
 }
@@ -241,7 +253,7 @@ pub fn check_attributes_carried(format: crate::output::Output, asked: bool, v: &
 /// The attributes an output needs: colours where the format stores them
 /// (or a `preview` picture shows them) and the mesh has them, every array
 /// for `.vti` and, when `asked`, for `.vdb` and `.zarr`; `None` otherwise.
-/// Errors when attributes were asked for a tiled grid.
+/// Errors when they would not fit in memory.
 pub fn attributes_for(
     plan: &Plan,
     loaded: &voxkit_io::LoadedMesh,
@@ -250,9 +262,9 @@ pub fn attributes_for(
     (preview, asked): (bool, bool),
     opts: &CarryOptions,
 ) -> Result<Option<VoxelAttributes>> {
-    check_attributes_carried(format, asked, v)?;
     let want_colour = loaded.appearance.has_colour() && (format.has_colour() || preview);
-    Ok(if want_colour || every_attribute(format, asked) {
+    Ok(if (want_colour || every_attribute(format, asked)) && !plan.is_line() {
+        check_attributes_carried(plan, v)?;
         attributes(plan, loaded.mesh.as_ref(), &loaded.appearance, v, opts)
     } else {
         None

@@ -89,12 +89,18 @@ pub fn picture(
 
 /// [`picture`] of a grid held as sparse bricks (past memory), without a
 /// dense grid or brick index: the ray caster indexes 64³-voxel blocks.
-pub fn picture_sparse(bits: &SparseBricks, path: &Path, o: &RenderOptions, outline: Option<&[[DVec3; 3]]>) -> Result<Image> {
+pub fn picture_sparse(
+    bits: &SparseBricks,
+    path: &Path,
+    o: &RenderOptions,
+    colours: Option<&VoxelAttributes>,
+    outline: Option<&[[DVec3; 3]]>,
+) -> Result<Image> {
     let Some(grid) = RenderGrid::from_sparse(bits) else {
         let [x, y, z] = bits.dims();
         bail!("grid {x}x{y}x{z} is too large to render: its index of 64^3-voxel blocks would pass 1 GiB");
     };
-    let img = render_grid(&grid, o, None, outline);
+    let img = render_grid(&grid, o, colours, outline);
     voxkit_io::write_png(path, img.width, img.height, &img.rgb)?;
     Ok(img)
 }
@@ -149,7 +155,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 if sparse.attributes_left {
                     eprintln!("voxkit: warning: {}: drawn without its colours: the grid does not fit densely", a.input.display());
                 }
-                let img = pool.install(|| picture_sparse(&sparse.bits, &a.output, &o, None))?;
+                let img = pool.install(|| picture_sparse(&sparse.bits, &a.output, &o, None, None))?;
                 return summary(a, &img, "voxel file", &sparse.bits, t0);
             }
             Err(e) => return Err(e.into()),

@@ -62,17 +62,15 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
 
     // Attributes: colours for the formats that store them (and the preview),
     // every array (coverage, material, normal) for .vti, and for .vdb and
-    // .zarr with --attributes (refused, not dropped, on a tiled grid).
-    voxkit_job::check_attributes_carried(format, a.export.attributes, &v)?;
+    // .zarr with --attributes; tiled grids too, while they fit in memory.
     let every = voxkit_job::every_attribute(format, a.export.attributes);
     let app = &loaded.appearance;
     let want_colour = app.has_colour() && (format.has_colour() || preview.is_some());
     let t_attr = Instant::now();
-    let tiled = matches!(v.voxels, voxkit_job::Voxels::Sparse(_));
-    if tiled && (want_colour || every) && !a.quiet && !a.json {
-        eprintln!("voxkit: warning: colours and .vti arrays are not made for tiled grids yet; writing the voxels alone (a --preview in clay colour)");
+    if (want_colour || every) && !plan.is_line() {
+        voxkit_job::check_attributes_carried(&plan, &v)?;
     }
-    let attrs = (!tiled && (want_colour || every)).then(|| {
+    let attrs = (want_colour || every).then(|| {
         bar.phase("carrying colours into voxels");
         let opts = CarryOptions {
             rule: crate::commands::export::colour_rule(a.export.colour_rule),
@@ -95,7 +93,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
         let outline = a.picture.outline.then(|| crate::commands::render::outline_triangles(loaded.mesh.as_ref(), &grid));
         match &v.voxels {
             voxkit_job::Voxels::Sparse(sparse) => {
-                pool.install(|| crate::commands::render::picture_sparse(sparse, path, o, outline.as_deref()))?
+                pool.install(|| crate::commands::render::picture_sparse(sparse, path, o, attrs.as_ref(), outline.as_deref()))?
             }
             voxels => pool.install(|| crate::commands::render::picture(voxels, path, o, attrs.as_ref(), outline.as_deref()))?,
         };
