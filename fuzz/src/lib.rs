@@ -25,9 +25,9 @@ const MAX_VISITED_WORDS: u64 = 1 << 20;
 /// most one attribute per voxel.
 pub fn check_voxels(data: &[u8], format: VoxelFormat) {
     // The sparse .vdb and .npz readers never panic either, and where both
-    // readers succeed they give the same voxels.
+    // readers succeed they give the same voxels and attributes.
     let sparse = match format {
-        VoxelFormat::Vdb => voxkit_io::vdb::read_sparse(data).ok(),
+        VoxelFormat::Vdb => voxkit_io::vdb::read_sparse(data, true).ok(),
         VoxelFormat::Npz => voxkit_io::npz::read_sparse_from(std::io::Cursor::new(data), data.len() as u64).ok(),
         _ => None,
     };
@@ -41,6 +41,7 @@ pub fn check_voxels(data: &[u8], format: VoxelFormat) {
         assert_eq!(s.bits.count(), v.bits.count());
         assert_eq!(format!("{:?}", s.placement), format!("{:?}", v.placement)); // NaN-proof
         voxkit::VoxelSource::for_each_set(&s.bits, &mut |i, j, k| assert!(v.bits.get(i, j, k)));
+        assert_eq!(s.attributes, v.attributes);
     }
     let mut n = 0u64;
     v.bits.for_each_set(|i, j, k| {

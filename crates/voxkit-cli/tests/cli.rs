@@ -1059,3 +1059,22 @@ fn pictures_of_sparse_grids() {
     assert_eq!(r["dims"], serde_json::json!([20000, 20000, 20000]));
     assert!(r["covered_pixels"].as_u64().unwrap() > 0, "{r}");
 }
+
+/// Attributes past memory: a textured mesh in a 20000³ grid runs tiled and
+/// carries `--attributes` into `.vdb`; `convert` reads them back without a
+/// dense grid into `.zarr` (a group with the attribute arrays) and back
+/// into the very same `.vdb`.
+#[test]
+fn attributes_past_memory_round_trip() {
+    let spot = shared("spot-textured.obj");
+    let (v, z, v2) = (tmp("attrs-big.vdb"), tmp("attrs-big.zarr"), tmp("attrs-big2.vdb"));
+    let grid = ["--voxel-size", "0.02", "--origin", "-200,-200,-200", "--dims", "20000,20000,20000"];
+    let j = json(&voxkit(&[&["voxelize", spot.as_str(), "-o", &v, "--attributes", "--json"][..], &grid[..]].concat()));
+    assert!(j["tile"].as_u64().is_some() && j["attributes"]["colour"] == true, "{j}");
+    let c = voxkit(&["convert", &v, &z, "--json"]);
+    assert!(c.status.success() && c.stderr.is_empty(), "{}", String::from_utf8_lossy(&c.stderr));
+    assert!(std::path::Path::new(&z).join("colour/zarr.json").is_file(), "no colour array");
+    let c = voxkit(&["convert", &z, &v2, "--json"]);
+    assert!(c.status.success() && c.stderr.is_empty(), "{}", String::from_utf8_lossy(&c.stderr));
+    assert_eq!(std::fs::read(&v).unwrap(), std::fs::read(&v2).unwrap(), ".vdb -> .zarr -> .vdb lost attributes");
+}

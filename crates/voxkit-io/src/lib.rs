@@ -348,21 +348,26 @@ pub struct SparseVoxels {
     pub bits: voxkit::grid::sparse::SparseBricks,
     /// Origin and voxel size, when the file records them.
     pub placement: Option<(glam::DVec3, f64)>,
-    /// The file holds attributes, which only the dense readers take.
+    /// The file holds attributes that were not read (not asked for).
     pub attributes_left: bool,
+    /// The attributes of the set voxels, when asked for and present.
+    pub attributes: Option<VoxelAttributes>,
 }
 
 /// Reads a `.vdb` file, a `.zarr` array or a `.npz` of indices without a dense grid, for grids
 /// that do not fit in memory densely ([`read_voxels`] refuses those with
 /// [`ErrorKind::TooLarge`]): memory follows the set voxels. Other formats
 /// are refused by name.
-pub fn read_voxels_sparse(path: &Path) -> Result<SparseVoxels, IoError> {
+///
+/// With `attributes`, the attribute grids or arrays of a `.vdb` or `.zarr`
+/// written with `--attributes` are read too (about 32 bytes per set voxel).
+pub fn read_voxels_sparse(path: &Path, attributes: bool) -> Result<SparseVoxels, IoError> {
     match VoxelFormat::from_path(path) {
         Some(VoxelFormat::Vdb) => {
             let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
-            fence("VDB", || vdb::read_sparse(&bytes)).map_err(|k| IoError::new(path, k))
+            fence("VDB", || vdb::read_sparse(&bytes, attributes)).map_err(|k| IoError::new(path, k))
         }
-        Some(VoxelFormat::Zarr) => zarr::read_sparse(path),
+        Some(VoxelFormat::Zarr) => zarr::read_sparse(path, attributes),
         Some(VoxelFormat::Npz) => {
             let file = std::fs::File::open(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
             let total = file.metadata().map_err(|e| IoError::new(path, ErrorKind::Read(e)))?.len();

@@ -187,7 +187,7 @@ pub fn read_from<R: Read + Seek>(r: R, total: u64) -> Result<LoadedVoxels, Error
 pub fn read_sparse_from<R: Read + Seek>(r: R, total: u64) -> Result<SparseVoxels, ErrorKind> {
     let (grid, placement) = read_into(r, total, true)?;
     match grid {
-        Read3::Sparse(bits) => Ok(SparseVoxels { bits, placement, attributes_left: false }),
+        Read3::Sparse(bits) => Ok(SparseVoxels { bits, placement, attributes_left: false, attributes: None }),
         Read3::Dense(_) => unreachable!("asked for sparse bricks"),
     }
 }

@@ -760,13 +760,17 @@ const ATTRIBUTE_GRIDS: [(&str, &str); 4] =
     [(ATTR_COLOUR, VEC3_TYPE), (ATTR_NORMAL, VEC3_TYPE), (ATTR_COVERAGE, FLOAT_TYPE), (ATTR_MATERIAL, FLOAT_TYPE)];
 
 /// A `.vdb` file's voxels without a dense grid: its first bool grid as
-/// sparse bricks (active tiles as runs of full bricks), the placement, and
-/// whether attribute grids were left unread (they need the dense path).
-pub fn read_sparse(bytes: &[u8]) -> Result<SparseVoxels, ErrorKind> {
+/// sparse bricks (active tiles as runs of full bricks), the placement,
+/// and with `attributes` the attribute grids of its set voxels (memory:
+/// about 32 bytes per voxel); otherwise whether any were left unread.
+pub fn read_sparse(bytes: &[u8], attributes: bool) -> Result<SparseVoxels, ErrorKind> {
     let found = descriptors(bytes)?;
     let occ = occupancy(bytes, &found)?;
-    let attributes_left = found.iter().any(|d| ATTRIBUTE_GRIDS.contains(&(d.name.as_str(), d.ty.as_str())));
-    Ok(SparseVoxels { bits: occ.sparse()?, placement: occ.placement, attributes_left })
+    let has = found.iter().any(|d| ATTRIBUTE_GRIDS.contains(&(d.name.as_str(), d.ty.as_str())));
+    let (bits, placement, offset) = (occ.sparse()?, occ.placement, occ.offset);
+    drop(occ);
+    let attrs = if attributes && has { read_attributes(bytes, &found, offset, &bits)? } else { None };
+    Ok(SparseVoxels { bits, placement, attributes_left: has && attrs.is_none(), attributes: attrs })
 }
 
 /// Parses a `.vdb` file: its first bool grid's active voxels and, when
@@ -778,34 +782,47 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     let mut loaded = LoadedVoxels { bits: occ.dense()?, placement: occ.placement, attributes: None };
     let offset = occ.offset;
     drop(occ);
-    let mut c = Cur { b: bytes, at: 0 };
+    loaded.attributes = read_attributes(bytes, &found, offset, &loaded.bits)?;
+    Ok(loaded)
+}
+
+/// The attribute grids voxkit writes (`Cd`, `normal`, `coverage`,
+/// `material`) at the set voxels of `voxels` (any storage; index
+/// coordinates shifted by `offset`), or `None` when the file has none.
+fn read_attributes(
+    bytes: &[u8],
+    found: &[Descriptor],
+    offset: [i64; 3],
+    voxels: &dyn VoxelSource,
+) -> Result<Option<VoxelAttributes>, ErrorKind> {
     let wanted = ATTRIBUTE_GRIDS;
-    if found.iter().any(|d| wanted.contains(&(d.name.as_str(), d.ty.as_str()))) {
-        let mut attrs = VoxelAttributes { dims: loaded.bits.dims(), keys: VoxelAttributes::keys_of(&loaded.bits), ..Default::default() };
-        for (name, ty) in wanted {
-            let Some(d) = found.iter().find(|d| d.name == name && d.ty == ty) else { continue };
-            c.seek(d.pos)?;
-            let values = read_values_grid(&mut c, if ty == VEC3_TYPE { 12 } else { 4 }).map_err(|e| in_grid(name, e))?;
-            let at = |key: u64| {
-                let v = attrs.voxel(key);
-                values.at(std::array::from_fn(|a| v[a] as i64 + offset[a]))
-            };
-            let f = |b: &[u8], n: usize| f32::from_le_bytes(b[4 * n..4 * n + 4].try_into().expect("4 bytes"));
-            match name {
-                ATTR_COLOUR => {
-                    attrs.colour = Some(attrs.keys.iter().map(|&k| std::array::from_fn(|n| from_linear(f(&at(k), n) as f64))).collect())
-                }
-                ATTR_NORMAL => attrs.normal = Some(attrs.keys.iter().map(|&k| std::array::from_fn(|n| f(&at(k), n))).collect()),
-                ATTR_COVERAGE => attrs.coverage = Some(attrs.keys.iter().map(|&k| f(&at(k), 0)).collect()),
-                _ => {
-                    let id = |v: f32| if v >= 0.0 && v.fract() == 0.0 && v < NO_MATERIAL as f32 { v as u32 } else { NO_MATERIAL };
-                    attrs.material = Some(attrs.keys.iter().map(|&k| id(f(&at(k), 0))).collect());
-                }
+    if !found.iter().any(|d| wanted.contains(&(d.name.as_str(), d.ty.as_str()))) {
+        return Ok(None);
+    }
+    let mut c = Cur { b: bytes, at: 0 };
+    let mut attrs = VoxelAttributes { dims: voxels.dims(), keys: VoxelAttributes::keys_of(voxels), ..Default::default() };
+    for (name, ty) in wanted {
+        let Some(d) = found.iter().find(|d| d.name == name && d.ty == ty) else { continue };
+        c.seek(d.pos)?;
+        let values = read_values_grid(&mut c, if ty == VEC3_TYPE { 12 } else { 4 }).map_err(|e| in_grid(name, e))?;
+        let at = |key: u64| {
+            let v = attrs.voxel(key);
+            values.at(std::array::from_fn(|a| v[a] as i64 + offset[a]))
+        };
+        let f = |b: &[u8], n: usize| f32::from_le_bytes(b[4 * n..4 * n + 4].try_into().expect("4 bytes"));
+        match name {
+            ATTR_COLOUR => {
+                attrs.colour = Some(attrs.keys.iter().map(|&k| std::array::from_fn(|n| from_linear(f(&at(k), n) as f64))).collect())
+            }
+            ATTR_NORMAL => attrs.normal = Some(attrs.keys.iter().map(|&k| std::array::from_fn(|n| f(&at(k), n))).collect()),
+            ATTR_COVERAGE => attrs.coverage = Some(attrs.keys.iter().map(|&k| f(&at(k), 0)).collect()),
+            _ => {
+                let id = |v: f32| if v >= 0.0 && v.fract() == 0.0 && v < NO_MATERIAL as f32 { v as u32 } else { NO_MATERIAL };
+                attrs.material = Some(attrs.keys.iter().map(|&k| id(f(&at(k), 0))).collect());
             }
         }
-        loaded.attributes = Some(attrs);
     }
-    Ok(loaded)
+    Ok(Some(attrs))
 }
 
 /// The grid head up to its tree: compression flags, metadata, transform.
@@ -1110,9 +1127,9 @@ mod tests {
         assert_eq!((o, s), (grid.origin(), 0.25));
         // Every truncation is an error, never a panic.
         for n in (0..buf.len()).step_by(97) {
-            assert!(read(&buf[..n]).is_err() && read_sparse(&buf[..n]).is_err());
+            assert!(read(&buf[..n]).is_err() && read_sparse(&buf[..n], true).is_err());
         }
-        assert_eq!(read_sparse(&buf).unwrap().bits.to_dense(), d);
+        assert_eq!(read_sparse(&buf, false).unwrap().bits.to_dense(), d);
     }
 
     /// Full runs become tiles (of 8³, and of 128³ where a whole 16³ node is
@@ -1150,7 +1167,7 @@ mod tests {
         assert_eq!(back.bits, sparse.to_dense());
         assert_eq!(back.bits.count(), 128 * 128 * 128 + 4 * 512 + 4);
         // Read without a dense grid: the same bricks, the tiles as full runs.
-        let again = read_sparse(&buf).unwrap();
+        let again = read_sparse(&buf, false).unwrap();
         assert_eq!(again.bits.to_dense(), back.bits);
         assert_eq!(again.bits.full_bricks(), 16 * 16 * 16 + 4);
         assert_eq!(again.bits.brick_count(), 2);
@@ -1215,8 +1232,11 @@ mod tests {
         let back = read(&buf).unwrap();
         assert_eq!(back.bits, d);
         assert_eq!(back.attributes.as_ref(), Some(&attrs));
-        let sparse = read_sparse(&buf).unwrap();
+        let sparse = read_sparse(&buf, false).unwrap();
         assert_eq!((sparse.bits.to_dense(), sparse.attributes_left), (d.clone(), true), "the sparse reader says it left the attributes");
+        let sparse = read_sparse(&buf, true).unwrap();
+        assert_eq!((sparse.bits.to_dense(), sparse.attributes_left), (d.clone(), false));
+        assert_eq!(sparse.attributes.as_ref(), Some(&attrs), "the sparse reader reads the same attributes");
         // Without attributes: the bool grid alone, as before.
         let mut plain = Vec::new();
         write(&mut plain, &d, &grid, None).unwrap();

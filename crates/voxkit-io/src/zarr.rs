@@ -577,14 +577,27 @@ pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
     if loaded.placement.is_none() {
         loaded.placement = read_placement(&m["attributes"]);
     }
-    let dims = loaded.bits.dims();
-    let mut attrs = VoxelAttributes { dims, keys: VoxelAttributes::keys_of(&loaded.bits), ..Default::default() };
+    loaded.attributes = read_attributes(path, &loaded.bits)?;
+    Ok(loaded)
+}
+
+/// The attribute arrays of a voxkit group (`colour`, `normal`, `coverage`,
+/// `material`) at the set voxels of `voxels` (any storage), or `None`
+/// when the group has none. Each stored chunk is visited row by row
+/// through the voxels' sorted keys, so the work follows the set voxels
+/// and the chunks' rows, not the chunks' volume.
+fn read_attributes(path: &Path, voxels: &dyn VoxelSource) -> Result<Option<VoxelAttributes>, IoError> {
+    let dims = voxels.dims();
+    let mut attrs = VoxelAttributes { dims, keys: Vec::new(), ..Default::default() };
     let mut any = false;
     for (name, data_type, comps) in [("colour", "uint8", 3), ("normal", "float32", 3), ("coverage", "float32", 1), ("material", "int32", 1)]
     {
         let dir = path.join(name);
         if !dir.join("zarr.json").is_file() {
             continue;
+        }
+        if !any {
+            attrs.keys = VoxelAttributes::keys_of(voxels);
         }
         let a = array_meta(&dir, &node(&dir)?, 3)?;
         if a.data_type != data_type || a.comps != comps || a.shape != dims.map(u64::from) {
@@ -601,20 +614,33 @@ pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
         let size = elem * comps as usize;
         let fill: Vec<u8> = if name == "material" { (-1i32).to_le_bytes().to_vec() } else { vec![0; size] };
         let mut vals = fill.repeat(attrs.keys.len());
-        let bits = &loaded.bits;
         let keys = &attrs.keys;
         for_each_chunk(&dir, &a, elem as u64, |o, shape, buf| {
-            for (n, v) in buf.chunks_exact(size).enumerate() {
-                let n = n as u64;
-                let q = [o[0] + n / (shape[1] * shape[2]), o[1] + (n / shape[2]) % shape[1], o[2] + n % shape[2]];
-                if q[0] < dims[0] as u64
-                    && q[1] < dims[1] as u64
-                    && q[2] < dims[2] as u64
-                    && bits.get(q[0] as u32, q[1] as u32, q[2] as u32)
-                {
-                    let key = VoxelAttributes::key(dims, q[0] as u32, q[1] as u32, q[2] as u32);
-                    let s = keys.binary_search(&key).expect("a set voxel has a key");
-                    vals[s * size..(s + 1) * size].copy_from_slice(v);
+            // The chunk's rows along i (its elements are laid out i, j, k
+            // with k fastest); each row's set voxels are a range of keys.
+            let end = [0, 1, 2].map(|x| (o[x] + shape[x]).min(dims[x] as u64));
+            if (0..3).any(|x| o[x] >= end[x]) {
+                return;
+            }
+            let key = |i: u64, j: u64, k: u64| VoxelAttributes::key(dims, i as u32, j as u32, k as u32);
+            for k in o[2]..end[2] {
+                // The keys of this plane's part of the chunk, then row by row
+                // within them (rows ascend with j).
+                let (mut lo, ph) =
+                    (keys.partition_point(|&x| x < key(o[0], o[1], k)), keys.partition_point(|&x| x <= key(end[0] - 1, end[1] - 1, k)));
+                if lo >= ph {
+                    continue;
+                }
+                for j in o[1]..end[1] {
+                    lo += keys[lo..ph].partition_point(|&x| x < key(o[0], j, k));
+                    let hi = lo + keys[lo..ph].partition_point(|&x| x <= key(end[0] - 1, j, k));
+                    let row0 = key(0, j, k);
+                    for (s, &kk) in keys[lo..hi].iter().enumerate() {
+                        let i = kk - row0;
+                        let n = (((i - o[0]) * shape[1] + (j - o[1])) * shape[2] + (k - o[2])) as usize;
+                        let slot = lo + s;
+                        vals[slot * size..(slot + 1) * size].copy_from_slice(&buf[n * size..(n + 1) * size]);
+                    }
                 }
             }
         })?;
@@ -630,17 +656,15 @@ pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
         }
         any = true;
     }
-    if any {
-        loaded.attributes = Some(attrs);
-    }
-    Ok(loaded)
+    Ok(any.then_some(attrs))
 }
 
 /// A Zarr array's voxels (or those of a voxkit group's `voxels` array)
 /// as sparse bricks, without a dense grid: memory follows the set voxels.
-/// Also the placement, and whether attribute arrays were left unread
-/// (they need the dense path).
-pub fn read_sparse(path: &Path) -> Result<SparseVoxels, IoError> {
+/// Also the placement and, with `attributes`, a group's attribute arrays
+/// at the set voxels (about 32 bytes per voxel); otherwise whether any
+/// were left unread.
+pub fn read_sparse(path: &Path, attributes: bool) -> Result<SparseVoxels, IoError> {
     let m = node(path)?;
     let (dir, m, placement, attributes_left) = if m["node_type"] == "group" {
         let voxels = path.join("voxels");
@@ -662,7 +686,9 @@ pub fn read_sparse(path: &Path) -> Result<SparseVoxels, IoError> {
     let mut bricks = Vec::new();
     for_each_chunk(&dir, &a, 1, |o, shape, buf| place_bricks(&mut bricks, buf, o, shape, a.shape))?;
     let placement = read_placement(&a.attributes).or(placement);
-    Ok(SparseVoxels { bits: SparseBricks::from_parts(a.shape.map(|d| d as u32), bricks, Vec::new()), placement, attributes_left })
+    let bits = SparseBricks::from_parts(a.shape.map(|d| d as u32), bricks, Vec::new());
+    let attrs = if attributes && attributes_left { read_attributes(path, &bits)? } else { None };
+    Ok(SparseVoxels { bits, placement, attributes_left: attributes_left && attrs.is_none(), attributes: attrs })
 }
 
 /// Appends the non-empty bricks of a decoded chunk of `shape` at `origin`
@@ -771,7 +797,7 @@ mod tests {
         let out = dir.join("v.zarr");
         write(&out, &d, &grid, None).unwrap();
         assert_eq!(read(&out).unwrap().bits, d);
-        assert_eq!(read_sparse(&out).unwrap().bits.to_dense(), d);
+        assert_eq!(read_sparse(&out, false).unwrap().bits.to_dense(), d);
         assert!(out.join("c/0/0/0").is_file() && !out.join("c/1/0/0").exists() && out.join("c/2/0/0").is_file());
         // Shard (0, 0, 0): 8 × 2 × 1 chunks, of which (0, 0, 0) and (7, 1, 0) hold voxels.
         let shard = std::fs::read(out.join("c/0/0/0")).unwrap();
@@ -800,7 +826,7 @@ mod tests {
         let mut set = Vec::new();
         back.for_each_set(|i, j, k| set.push([i, j, k]));
         assert_eq!(set, [[4, 0, 0], [3, 1, 1]]);
-        assert_eq!(read_sparse(&out).unwrap().bits.to_dense(), back, "chunks off the bricks (3 × 2 × 2)");
+        assert_eq!(read_sparse(&out, false).unwrap().bits.to_dense(), back, "chunks off the bricks (3 × 2 × 2)");
 
         let mut d = DenseBits::new([8, 8, 8]);
         d.set(1, 1, 1);
@@ -851,8 +877,10 @@ mod tests {
         assert_eq!(back.bits, d);
         assert_eq!(back.placement, Some((grid.origin(), 0.125)));
         assert_eq!(back.attributes.as_ref(), Some(&attrs));
-        let sparse = read_sparse(&out).unwrap();
+        let sparse = read_sparse(&out, false).unwrap();
         assert_eq!((sparse.bits.to_dense(), sparse.placement, sparse.attributes_left), (d.clone(), back.placement, true));
+        let with = read_sparse(&out, true).unwrap();
+        assert_eq!((with.attributes.as_ref(), with.attributes_left), (Some(&attrs), false), "the sparse reader reads the same attributes");
         assert_eq!(sparse.bits.full_bricks(), 1, "the full brick is read as a run");
         // Without attributes: the plain array, as before.
         write(&out, &d, &grid, None).unwrap();

@@ -189,7 +189,7 @@ fn npz_round_trips_and_refuses_hostile_archives() {
     assert_eq!(back.bits, bits);
     assert_eq!(back.placement, Some((DVec3::new(-1.0, 2.0, 0.5), 0.25)));
     // Without a dense grid (grids past memory): the same voxels and placement.
-    let sparse = voxkit_io::read_voxels_sparse(std::path::Path::new(&p)).unwrap();
+    let sparse = voxkit_io::read_voxels_sparse(std::path::Path::new(&p), false).unwrap();
     assert_eq!((sparse.bits.to_dense(), sparse.placement), (bits.clone(), back.placement));
     // From memory too, and an empty grid.
     let bytes = std::fs::read(&p).unwrap();

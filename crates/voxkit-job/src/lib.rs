@@ -33,7 +33,9 @@ pub use plan::{
     auto_method, gpu_has, resolve_method, Fill, GpuPath, Method, Mode, Plan, Request, SolidMethod, SolidPlan, SurfaceMethod,
     GPU_AUTO_MIN_SIDE,
 };
-pub use run::{attributes, attributes_for, check_attributes_carried, every_attribute, voxelize, Voxelized, Voxels};
+pub use run::{
+    attributes, attributes_for, check_attributes_carried, every_attribute, voxelize, Voxelized, Voxels, ATTRIBUTE_BYTES_PER_VOXEL,
+};
 pub use solid::Outcome as SolidOutcome;
 
 /// A rayon pool of `threads` workers, made once per count and kept (jobs

@@ -17,13 +17,13 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         bail!("{}: --sparse reads only .vdb, .zarr and .npz files", a.voxels.display());
     }
     let voxels = if a.sparse {
-        Voxels::Sparse(voxkit_io::read_voxels_sparse(&a.voxels)?)
+        Voxels::Sparse(voxkit_io::read_voxels_sparse(&a.voxels, false)?)
     } else {
         match voxkit_io::read_voxels_with(&a.voxels, up) {
             Ok(l) => Voxels::Dense(l),
             // Past memory: checked window by window.
             Err(e) if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. }) && sparse_format => {
-                Voxels::Sparse(voxkit_io::read_voxels_sparse(&a.voxels)?)
+                Voxels::Sparse(voxkit_io::read_voxels_sparse(&a.voxels, false)?)
             }
             Err(e) if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. }) => {
                 bail!("{e}; grids past memory are checked from .vdb, .zarr or .npz files (window by window)")

@@ -22,7 +22,7 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
         // A .vdb or .zarr grid past memory, to a format that holds only the
         // set voxels: read and written without a dense grid.
         Err(e) if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. }) && voxkit_job::output::is_sparse(format) => {
-            let sparse = match voxkit_io::read_voxels_sparse(&a.input) {
+            let sparse = match voxkit_io::read_voxels_sparse(&a.input, false) {
                 Ok(s) => s,
                 // Formats read only densely: the grid's size is the error.
                 Err(s)
@@ -33,13 +33,25 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
                 }
                 Err(s) => return Err(s.into()),
             };
-            if sparse.attributes_left {
-                eprintln!(
-                    "voxkit: warning: {}: its attributes are not carried: the grid does not fit densely, and only the voxels are read sparsely",
-                    a.input.display()
-                );
-            }
-            return finish(a, format, &sparse.bits, sparse.placement, None, &write_opts, true);
+            // Attributes the output stores are read too (a second pass over
+            // the file, at the set voxels only) while they fit in memory.
+            let wanted = format.has_colour() || voxkit_job::every_attribute(format, true);
+            let need = sparse.bits.count().saturating_mul(voxkit_job::ATTRIBUTE_BYTES_PER_VOXEL);
+            let attributes = if sparse.attributes_left && wanted {
+                if need <= voxkit_job::budget(None) {
+                    voxkit_io::read_voxels_sparse(&a.input, true)?.attributes
+                } else {
+                    eprintln!(
+                        "voxkit: warning: {}: its attributes are not carried: they would need {} of memory",
+                        a.input.display(),
+                        voxkit_job::bytes(need)
+                    );
+                    None
+                }
+            } else {
+                None
+            };
+            return finish(a, format, &sparse.bits, sparse.placement, attributes.as_ref(), &write_opts, true);
         }
         Err(e) if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. }) && matches!(input_format, Some(F::Vdb | F::Zarr | F::Npz)) => {
             bail!("{e}; {} is a dense format: convert it to .vdb, .zarr, .npz, .txt or .ply, which need no dense grid", format.name())

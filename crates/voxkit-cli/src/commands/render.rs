@@ -151,7 +151,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. })
                     && matches!(F::from_path(&a.input), Some(F::Vdb | F::Zarr | F::Npz)) =>
             {
-                let sparse = voxkit_io::read_voxels_sparse(&a.input)?;
+                let sparse = voxkit_io::read_voxels_sparse(&a.input, false)?;
                 if sparse.attributes_left {
                     eprintln!("voxkit: warning: {}: drawn without its colours: the grid does not fit densely", a.input.display());
                 }
