@@ -276,9 +276,17 @@ impl SparseBricks {
 
     /// Calls `f(first brick, bits, n)` for every stored brick (`n = 1`) and
     /// every run of `n` full bricks, in key order.
-    pub fn for_each_brick_run(&self, mut f: impl FnMut([u32; 3], &Brick, u32)) {
-        let mut runs = self.full.iter().peekable();
-        for (k, b) in self.keys.iter().zip(&self.bricks) {
+    pub fn for_each_brick_run(&self, f: impl FnMut([u32; 3], &Brick, u32)) {
+        self.for_each_brick_run_in(0..u64::MAX, f)
+    }
+
+    /// [`SparseBricks::for_each_brick_run`] for the bricks and runs whose
+    /// (first) key lies in `keys`.
+    fn for_each_brick_run_in(&self, keys: std::ops::Range<u64>, mut f: impl FnMut([u32; 3], &Brick, u32)) {
+        let (k0, k1) = (self.keys.partition_point(|&k| k < keys.start), self.keys.partition_point(|&k| k < keys.end));
+        let (r0, r1) = (self.full.partition_point(|r| r.0 < keys.start), self.full.partition_point(|r| r.0 < keys.end));
+        let mut runs = self.full[r0..r1].iter().peekable();
+        for (k, b) in self.keys[k0..k1].iter().zip(&self.bricks[k0..k1]) {
             while let Some(&&(r, n)) = runs.peek().filter(|r| r.0 < *k) {
                 f(unkey(r), &FULL, n);
                 runs.next();
@@ -293,22 +301,8 @@ impl SparseBricks {
     /// [`SparseBricks::for_each_brick`] for the bricks of the brick
     /// layers `layers` (`bk` in that range) only, found by binary search.
     pub fn for_each_brick_in_layers(&self, layers: std::ops::Range<u32>, mut f: impl FnMut([u32; 3], &Brick)) {
-        let (lo, hi) = (key([0, 0, layers.start]), key([0, 0, layers.end]));
-        let (k0, k1) = (self.keys.partition_point(|&k| k < lo), self.keys.partition_point(|&k| k < hi));
-        let (r0, r1) = (self.full.partition_point(|r| r.0 < lo), self.full.partition_point(|r| r.0 < hi));
-        let mut runs = self.full[r0..r1].iter().peekable();
-        for (k, b) in self.keys[k0..k1].iter().zip(&self.bricks[k0..k1]) {
-            while let Some(&&(r, n)) = runs.peek().filter(|r| r.0 < *k) {
-                let first = unkey(r);
-                (0..n).for_each(|x| f([first[0] + x, first[1], first[2]], &FULL));
-                runs.next();
-            }
-            f(unkey(*k), b);
-        }
-        for &(r, n) in runs {
-            let first = unkey(r);
-            (0..n).for_each(|x| f([first[0] + x, first[1], first[2]], &FULL));
-        }
+        let keys = key([0, 0, layers.start])..key([0, 0, layers.end]);
+        self.for_each_brick_run_in(keys, |b, bits, n| (0..n).for_each(|x| f([b[0] + x, b[1], b[2]], bits)));
     }
 
     /// The same voxels, dense.
