@@ -439,15 +439,22 @@ impl VoxelGrid {
 
     /// check(mesh=None) -> dict: the `voxkit check` report (components,
     /// thick voxels; with the mesh: closedness, separation with witnesses,
-    /// thinness, tunnels).
+    /// thinness, tunnels). A tiled grid (past memory) is checked window by
+    /// window without a dense copy (`sparse` is true in the report).
     #[pyo3(signature = (mesh=None))]
     fn check<'py>(&self, py: Python<'py>, mesh: Option<&Mesh>) -> PyResult<Bound<'py, PyAny>> {
         let inner = self.inner.clone();
         let m = mesh.map(|m| m.inner.clone());
         let v = py
             .detach(move || {
-                let dense = inner.voxels.to_dense();
-                voxkit_job::check::report(&dense, m.as_ref().map(|m| (m.mesh.as_ref(), &inner.grid, "grid")))
+                let mesh = m.as_ref().map(|m| (m.mesh.as_ref(), &inner.grid, "grid"));
+                match &inner.voxels {
+                    voxkit_job::Voxels::Sparse(s) => {
+                        let layers = voxkit_job::check::window_layers(s.dims(), voxkit_job::budget(None));
+                        voxkit_job::check::report_sparse(s, mesh, layers)
+                    }
+                    voxels => voxkit_job::check::report(&voxels.to_dense(), mesh),
+                }
             })
             .map_err(py_err)?;
         to_py(py, &v)

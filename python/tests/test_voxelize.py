@@ -263,6 +263,16 @@ def test_check_matches_the_cli_report(tmp_path, meshes, cli):
     assert g.check()["components_26"] == cli_report["components_26"]
 
 
+def test_check_of_a_tiled_grid_runs_window_by_window(meshes):
+    m = voxkit.load_mesh(meshes / "cow.obj")
+    dense = voxkit.voxelize(m, mode="sep6", resolution=64).check(m)
+    tiled = voxkit.voxelize(m, mode="sep6", resolution=64, tile=16).check(m)
+    assert (dense["sparse"], tiled["sparse"]) == (False, True) and tiled["windows"] >= 1
+    for k, v in dense.items():
+        if k not in ("sparse", "windows"):
+            assert tiled[k] == v, k
+
+
 def test_trimesh_in_and_out(meshes):
     trimesh = pytest.importorskip("trimesh")
     tm = trimesh.load(meshes / "cow.obj", process=False, force="mesh")
