@@ -775,7 +775,7 @@ fn grids_past_memory_errors() {
         (vec!["--resolution", "16384", "--max-memory", "1G"], ".vdb"),
         (vec!["--tile", "12"], "multiple of 8"),
         (vec!["--tile", "64", "--mode", "solid", "--method", "reference"], "reference and gpu solids"),
-        (vec!["--tile", "64", "--method", "reference"], "fast or scanline path"),
+        (vec!["--tile", "64", "--method", "reference"], "scanline or gpu path"),
         (vec!["--max-memory", "lots"], "unknown unit"),
         (vec!["--max-memory", "1.2.3G"], "not a size"),
         (vec!["--resolution", "16384", "--max-memory", "1G", "--mode", "solid", "--method", "reference"], "reference and gpu solids"),
@@ -1077,4 +1077,30 @@ fn attributes_past_memory_round_trip() {
     let c = voxkit(&["convert", &z, &v2, "--json"]);
     assert!(c.status.success() && c.stderr.is_empty(), "{}", String::from_utf8_lossy(&c.stderr));
     assert_eq!(std::fs::read(&v).unwrap(), std::fs::read(&v2).unwrap(), ".vdb -> .zarr -> .vdb lost attributes");
+}
+
+/// `--method gpu` runs tile by tile (`--tile`, or past memory): each tile's
+/// triangles, snapped once to the whole grid, on the GPU — the fast path's
+/// voxels, byte for byte, for every GPU mode and both exact paths.
+#[test]
+fn gpu_tiles_give_the_fast_paths_voxels() {
+    let bunny = shared("stanford-bunny.obj");
+    for (mode, path) in [("cover", "compute"), ("sep26", "raster"), ("sep6", "compute")] {
+        let (a, b) = (tmp(&format!("gpu-tiled-fast-{mode}.npy")), tmp(&format!("gpu-tiled-{mode}.npy")));
+        let common = ["--resolution", "120", "--mode", mode, "--json"];
+        json(&voxkit(&[&["voxelize", bunny.as_str(), "-o", &a, "--method", "fast"][..], &common[..]].concat()));
+        let out = voxkit(
+            &[&["voxelize", bunny.as_str(), "-o", &b, "--method", "gpu", "--gpu-path", path, "--tile", "48"][..], &common[..]].concat(),
+        );
+        if !gpu_available(&out) {
+            return;
+        }
+        let t = json(&out);
+        assert_eq!(
+            (&t["tile"], &t["tile_kernel"], &t["method"]),
+            (&serde_json::json!(48), &serde_json::json!("gpu"), &serde_json::json!("tiled"))
+        );
+        assert!(t["gpu"]["tiles"].as_u64().unwrap() > 8, "{}", t["gpu"]);
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap(), "{mode} {path}: GPU tiles differ from the fast path");
+    }
 }

@@ -139,10 +139,28 @@ impl Gpu {
     ) -> Result<(BrickBits, CoverReport), GpuError> {
         let t0 = Instant::now();
         let (tris, prepare_stats) = prepare(mesh, grid);
-        let dims = grid.dims();
+        let snapping_s = t0.elapsed().as_secs_f64();
+        let (bits, mut report) = self.voxelize_lattice(mode, path, &tris, grid.dims())?;
+        report.report.prepare = prepare_stats;
+        report.timings.upload_s += snapping_s;
+        Ok((bits, report))
+    }
+
+    /// `mode` by `path` on triangles already snapped to a grid of `dims`
+    /// (a whole grid, or one tile of a tiled run with its triangles moved
+    /// by whole voxels): the voxels of [`Gpu::voxelize_with`]. The
+    /// report's preparation counts are zero.
+    pub fn voxelize_lattice(
+        &self,
+        mode: GpuMode,
+        path: GpuPath,
+        tris: &[LatticeTriangle],
+        dims: [u32; 3],
+    ) -> Result<(BrickBits, CoverReport), GpuError> {
+        let t0 = Instant::now();
         let mut on_gpu: Vec<(GpuTri, [i64; 2])> = Vec::with_capacity(tris.len());
         let mut on_cpu: Vec<LatticeTriangle> = Vec::new();
-        for t in &tris {
+        for t in tris {
             let Some((lo, hi)) = t.voxel_bounds(dims) else { continue };
             let base = lo.map(|c| c * ONE);
             let rel = t.v.map(|p| [p[0] - base[0], p[1] - base[1], p[2] - base[2]]);
@@ -255,7 +273,7 @@ impl Gpu {
         timings.cpu_s = t_cpu.elapsed().as_secs_f64();
         let voxels = bits.count();
         let report = CoverReport {
-            report: Report { prepare: prepare_stats, voxels },
+            report: Report { prepare: Default::default(), voxels },
             gpu_triangles: on_gpu.len() as u64,
             cpu_triangles: on_cpu.len() as u64,
             timings,

@@ -385,8 +385,8 @@ impl Plan {
                         "--tile: the reference and gpu solids do not run tiled yet (parity, winding and flood fills do, hollowed or not)",
                     ));
                 }
-            } else if !matches!(request.method, Method::Auto | Method::Fast | Method::Scanline) {
-                return Err(JobError::invalid("--tile runs the fast or scanline path: use --method auto, fast or scanline"));
+            } else if !matches!(request.method, Method::Auto | Method::Fast | Method::Scanline | Method::Gpu) {
+                return Err(JobError::invalid("--tile runs the fast, scanline or gpu path: use --method auto, fast, scanline or gpu"));
             }
         }
         let (core, surface_method) = match solid {

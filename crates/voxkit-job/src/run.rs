@@ -86,7 +86,7 @@ pub struct Voxelized {
     /// The tile edge when the tiled path ran.
     pub tile: Option<u32>,
     /// The kernel each tile ran (surface modes on the tiled path).
-    pub tile_kernel: Option<voxelize::tiled::TileKernel>,
+    pub tile_kernel: Option<&'static str>,
 }
 
 /// Runs `plan` on `mesh` (named `name` in messages) on the grid its request
@@ -114,7 +114,7 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
         let why = if plan.solid.is_some() {
             "the reference and gpu solids (not tiled yet; parity, winding and flood fills are, hollowed or not)"
         } else {
-            "--method reference and gpu (the fast and scanline paths are tiled)"
+            "--method reference (the fast, scanline and gpu paths are tiled)"
         };
         crate::memory::check_memory(&grid, budget, why)?;
     }
@@ -131,17 +131,23 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
         warnings.extend(out.warnings);
         let voxels = out.bits.count();
         (Voxels::Sparse(out.bits), Report { voxels, prepare: Default::default() }, out.method, out.facts)
+    } else if let (Some(t), SurfaceMethod::Gpu) = (tile, surface_method) {
+        // Each tile on the GPU: the same voxels as the GPU on the whole grid.
+        let (s, r, facts) = gpu_tiled(plan.core, plan.request.gpu_path, mesh, &grid, t, &opts)?;
+        gpu = facts;
+        tile_kernel = Some("gpu");
+        (Voxels::Sparse(s), r, "tiled", Value::Null)
     } else if let Some(t) = tile {
         // Each tile runs the fast path's kernel, or the scanline path's when
         // asked for (`auto` keeps the fast one: on the bunny at 4096–16384
         // the two are within 5–12 %, the kernels being a small part of a
         // tiled run; BENCHMARKS.md).
-        let kernel = match plan.request.method {
-            crate::plan::Method::Scanline => voxelize::tiled::TileKernel::Scanline,
-            _ => voxelize::tiled::TileKernel::Fast,
+        let (kernel, name) = match plan.request.method {
+            crate::plan::Method::Scanline => (voxelize::tiled::TileKernel::Scanline, "scanline"),
+            _ => (voxelize::tiled::TileKernel::Fast, "fast"),
         };
         let (s, r) = voxelize::tiled::tiled_with(plan.core, kernel, mesh, &grid, t, &opts).map_err(|e| JobError::invalid(e.to_string()))?;
-        tile_kernel = Some(kernel);
+        tile_kernel = Some(name);
         (Voxels::Sparse(s), r, "tiled", Value::Null)
     } else if let Some(sp) = &plan.solid {
         let out = crate::solid::run(sp, mesh, name, &grid, &opts)?;
@@ -197,7 +203,10 @@ fn tile_for(plan: &Plan, grid: &GridSpec, budget: u64) -> Option<u32> {
     if plan.request.tile.is_some() {
         return plan.request.tile;
     }
-    let fast = matches!(plan.request.method, crate::plan::Method::Auto | crate::plan::Method::Fast | crate::plan::Method::Scanline);
+    let fast = matches!(
+        plan.request.method,
+        crate::plan::Method::Auto | crate::plan::Method::Fast | crate::plan::Method::Scanline | crate::plan::Method::Gpu
+    );
     let sparse_solid = plan.solid.as_ref().is_some_and(crate::solid::has_sparse_path);
     let tileable = if plan.solid.is_some() { sparse_solid } else { fast };
     if !tileable {
@@ -286,10 +295,7 @@ impl Voxelized {
             "voxels": self.report.voxels,
             "voxelize_s": self.voxelize_s,
             "tile": self.tile,
-            "tile_kernel": self.tile_kernel.map(|k| match k {
-                voxelize::tiled::TileKernel::Fast => "fast",
-                voxelize::tiled::TileKernel::Scanline => "scanline",
-            }),
+            "tile_kernel": self.tile_kernel,
             "peak_memory_bytes": crate::memory::peak_memory(),
             "triangles": if plan.solid.is_some() { Value::Null } else { json!({
                 "input": p.input,
@@ -353,6 +359,68 @@ fn gpu_voxelize(
         "slabs": t.slabs,
     });
     Ok((bits, r.report, facts, warnings))
+}
+
+/// The GPU path tile by tile (grids past memory, or `--tile`): each tile's
+/// triangles, snapped once to the whole grid and moved by whole voxels,
+/// go through [`voxkit_gpu::Gpu::voxelize_lattice`].
+#[cfg(feature = "gpu")]
+fn gpu_tiled(
+    mode: voxelize::Mode,
+    path: GpuPath,
+    mesh: MeshRef<'_>,
+    grid: &GridSpec,
+    tile: u32,
+    opts: &Options<'_>,
+) -> Result<(SparseBricks, Report, Value)> {
+    use voxkit_gpu::GpuPath as P;
+    let fail = |e: voxkit_gpu::GpuError| JobError::failed(format!("--method gpu: {e}"));
+    let gm = voxkit_gpu::GpuMode::of(mode)
+        .ok_or_else(|| JobError::invalid(format!("--method gpu: {} on the GPU is not built yet", mode.name())))?;
+    let gp = match path {
+        GpuPath::Compute => P::Compute,
+        GpuPath::Raster => P::Raster,
+        GpuPath::MsaaApprox => {
+            return Err(JobError::invalid(
+                "--gpu-path msaa-approx does not run tiled (it is checked against a whole-grid run); use compute or raster",
+            ))
+        }
+    };
+    let gpu = voxkit_gpu::Gpu::new().map_err(fail)?;
+    let counts = std::sync::Mutex::new([0u64; 3]);
+    let (s, r) = voxelize::tiled::tiled_by(mesh, grid, tile, opts, |tris, size| {
+        let (bits, r) = gpu.voxelize_lattice(gm, gp, tris, size)?;
+        let mut c = counts.lock().unwrap_or_else(|e| e.into_inner());
+        c[0] += r.gpu_triangles;
+        c[1] += r.cpu_triangles;
+        c[2] += 1;
+        Ok(bits)
+    })
+    .map_err(|e| JobError::invalid(e.to_string()))?
+    .map_err(fail)?;
+    let c = counts.into_inner().unwrap_or_else(|e| e.into_inner());
+    let facts = json!({
+        "path": match gp { P::Compute => "compute", _ => "raster" },
+        "hardware_conservative": gpu.hardware_conservative(),
+        "adapter": gpu.adapter(),
+        "software": gpu.is_software(),
+        "gpu_triangles": c[0],
+        "cpu_triangles": c[1],
+        "tiles": c[2],
+    });
+    Ok((s, r, facts))
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_tiled(
+    _mode: voxelize::Mode,
+    _path: GpuPath,
+    _mesh: MeshRef<'_>,
+    _grid: &GridSpec,
+    _tile: u32,
+    _opts: &Options<'_>,
+) -> Result<(SparseBricks, Report, Value)> {
+    Err(JobError::invalid("--method gpu: this voxkit was built without the `gpu` feature"))
 }
 
 #[cfg(not(feature = "gpu"))]

@@ -34,6 +34,8 @@
 //! (tile/8)³`, 256 KiB at 512) and the result's non-empty bricks (72
 //! bytes each). Nothing is proportional to the grid's volume.
 
+use std::convert::Infallible;
+
 use rayon::prelude::*;
 
 use super::driver::Primitive;
@@ -139,34 +141,62 @@ pub fn tiled_with(
     Ok(match line {
         Some(target) => {
             let (elems, prepare) = prepare_elements(mesh, grid);
-            let run = |e: &[Element], size: [u32; 3], _: [i64; 3], o: &Options<'_>| line_lattice(e, size, target, o);
-            let (out, voxels) = by_tiles(&elems, dims, tile, opts, Element::translated, run);
+            let run = |e: &[Element], size: [u32; 3], _: [i64; 3], o: &Options<'_>| Ok::<_, Infallible>(line_lattice(e, size, target, o));
+            let Ok((out, voxels)) = by_tiles(&elems, dims, tile, opts, Element::translated, run);
             (out, Report { prepare, voxels })
         }
         None => {
             let (tris, prepare) = prepare(mesh, grid);
-            let run = |t: &[LatticeTriangle], size: [u32; 3], origin: [i64; 3], o: &Options<'_>| match kernel {
-                TileKernel::Fast => fast_lattice(mode, t, size, origin, o).expect("line modes take their own path"),
-                TileKernel::Scanline => super::scanline::scanline_lattice(mode, t, size, o).expect("checked above"),
+            let run = |t: &[LatticeTriangle], size: [u32; 3], origin: [i64; 3], o: &Options<'_>| {
+                Ok::<_, Infallible>(match kernel {
+                    TileKernel::Fast => fast_lattice(mode, t, size, origin, o).expect("line modes take their own path"),
+                    TileKernel::Scanline => super::scanline::scanline_lattice(mode, t, size, o).expect("checked above"),
+                })
             };
-            let (out, voxels) = by_tiles(&tris, dims, tile, opts, LatticeTriangle::translated, run);
+            let Ok((out, voxels)) = by_tiles(&tris, dims, tile, opts, LatticeTriangle::translated, run);
             (out, Report { prepare, voxels })
         }
     })
+}
+
+/// [`tiled`] with the caller's kernel for a triangle mode (the GPU's, which
+/// the core crate does not know): `run(triangles, size)` voxelizes one
+/// tile's triangles, moved by whole voxels to the tile's origin, on a grid
+/// of the tile's size, and must give the mode's voxels there. The outer
+/// error is the run's set-up, the inner one the first error of `run`
+/// (which stops the run).
+#[allow(clippy::type_complexity)]
+pub fn tiled_by<E>(
+    mesh: MeshRef<'_>,
+    grid: &GridSpec,
+    tile: u32,
+    opts: &Options<'_>,
+    run: impl Fn(&[LatticeTriangle], [u32; 3]) -> Result<BrickBits, E>,
+) -> Result<Result<(SparseBricks, Report), E>, TiledError> {
+    if tile == 0 || tile % BRICK != 0 {
+        return Err(TiledError::Tile(tile));
+    }
+    let dims = grid.dims();
+    if dims.iter().any(|&d| d > SparseBricks::MAX_DIM) {
+        return Err(TiledError::Grid(dims));
+    }
+    let (tris, prepare) = prepare(mesh, grid);
+    Ok(by_tiles(&tris, dims, tile, opts, LatticeTriangle::translated, |t, size, _, _| run(t, size))
+        .map(|(out, voxels)| (out, Report { prepare, voxels })))
 }
 
 /// The driver proper: bins `prims` into the tiles of `tile` voxels their
 /// voxel boxes meet, and per tile in order, moves its primitives by the
 /// tile's origin (`shift`) and runs them (`run`, given the tile's size and
 /// origin) on a grid of the tile's size. Returns the voxels and their count.
-fn by_tiles<P: Primitive>(
+fn by_tiles<P: Primitive, E>(
     prims: &[P],
     dims: [u32; 3],
     tile: u32,
     opts: &Options<'_>,
     shift: impl Fn(&P, [i64; 3]) -> P,
-    run: impl Fn(&[P], [u32; 3], [i64; 3], &Options<'_>) -> BrickBits,
-) -> (SparseBricks, u64) {
+    run: impl Fn(&[P], [u32; 3], [i64; 3], &Options<'_>) -> Result<BrickBits, E>,
+) -> Result<(SparseBricks, u64), E> {
     let tdims = dims.map(|d| d.div_ceil(tile) as u64);
     let tile_id = |t: [u64; 3]| (t[2] * tdims[1] + t[1]) * tdims[0] + t[0];
     // (tile, primitive) pairs, sorted: each tile's primitives in input order.
@@ -199,7 +229,7 @@ fn by_tiles<P: Primitive>(
         let back: [i64; 3] = origin.map(|o| -(o as i64) * ONE);
         local.clear();
         local.extend(pairs[start..end].iter().map(|&(_, n)| shift(&prims[n as usize], back)));
-        let bits = run(&local, size, origin.map(|o| o as i64), &inner);
+        let bits = run(&local, size, origin.map(|o| o as i64), &inner)?;
         voxels += bits.count();
         out.push_tile(origin, &bits);
         if let Some(p) = opts.progress {
@@ -207,5 +237,5 @@ fn by_tiles<P: Primitive>(
         }
     }
     out.finish();
-    (out, voxels)
+    Ok((out, voxels))
 }
