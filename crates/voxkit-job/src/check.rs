@@ -58,11 +58,16 @@ pub fn report(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec, &str)>) ->
 /// Brick layers (8 planes each) per window of [`report_sparse`] for a grid
 /// of `dims` within `budget` bytes: a window's brick index, parity and
 /// run rows take about `bx·by·4 + 80·ny` bytes per layer; a quarter of the
-/// budget goes to them (the rest to the grid's bricks and the mesh).
+/// budget goes to them (the rest to the grid's bricks and the mesh), and
+/// at most [`WINDOW_BYTES`]: larger windows save nothing but memory (the
+/// work follows the voxels and rows, not the windows).
 pub fn window_layers(dims: [u32; 3], budget: u64) -> u32 {
     let per_layer = dims[0].div_ceil(8) as u64 * dims[1].div_ceil(8) as u64 * 4 + 80 * dims[1] as u64;
-    (budget / 4 / per_layer.max(1)).clamp(1, dims[2].div_ceil(8).max(1) as u64) as u32
+    ((budget / 4).min(WINDOW_BYTES) / per_layer.max(1)).clamp(1, dims[2].div_ceil(8).max(1) as u64) as u32
 }
+
+/// Most bytes a window's index and rows take (see [`window_layers`]).
+pub const WINDOW_BYTES: u64 = 512 << 20;
 
 /// [`report`] for a grid held as sparse bricks, checked window by window
 /// ([`voxkit::topology::certify_sparse`]) in windows of `layers` brick
