@@ -24,7 +24,7 @@ use rayon::prelude::*;
 
 use std::collections::HashMap;
 
-use super::solid::{bricks_of_spans, BrickRow};
+use super::solid::{bricks_of_spans, from_brick_rows, push_span, BrickRow};
 use crate::grid::bricks::{Brick, BRICK};
 use crate::grid::dense::DenseBits;
 use crate::grid::sparse::SparseBricks;
@@ -128,7 +128,7 @@ pub fn flood_fill_sparse(shell: &SparseBricks) -> (SparseBricks, FloodReport) {
     // Pass 2, brick layers in parallel: the same labels again, the shell's
     // runs and the enclosed unset runs of each row, as brick rows.
     let by = ny.div_ceil(BRICK);
-    let layers: Vec<(BrickRow, u64)> = (0..bz)
+    let layers: Vec<(Vec<BrickRow>, u64)> = (0..bz)
         .into_par_iter()
         .map(|layer| {
             let bricks = bricks_of(layer.saturating_sub(1)..layer + 1);
@@ -149,29 +149,17 @@ pub fn flood_fill_sparse(shell: &SparseBricks) -> (SparseBricks, FloodReport) {
                     row.sort_unstable();
                     let out = &mut spans[(j / BRICK) as usize][((k % BRICK) * BRICK + j % BRICK) as usize];
                     for (f, t) in row {
-                        match out.last_mut() {
-                            Some(last) if last.1 + 1 == f => last.1 = t,
-                            _ => out.push((f, t)),
-                        }
+                        push_span(out, f, t);
                     }
                 }
             }
-            let mut parts: BrickRow = (Vec::new(), Vec::new());
-            for (bj, s) in spans.iter().enumerate() {
-                let (b, f) = bricks_of_spans(s, dims, bj as u32, layer);
-                parts.0.extend(b);
-                parts.1.extend(f);
-            }
-            (parts, enclosed)
+            let rows: Vec<BrickRow> = spans.iter().enumerate().map(|(bj, s)| bricks_of_spans(s, dims, bj as u32, layer)).collect();
+            (rows, enclosed)
         })
         .collect();
-    let (mut bricks, mut full, mut enclosed) = (Vec::new(), Vec::new(), 0);
-    for ((b, f), e) in layers {
-        bricks.extend(b);
-        full.extend(f);
-        enclosed += e;
-    }
-    (SparseBricks::from_sorted(dims, bricks, full), FloodReport { shell: shell.count(), enclosed })
+    let enclosed = layers.iter().map(|l| l.1).sum();
+    let out = from_brick_rows(dims, layers.into_iter().flat_map(|l| l.0));
+    (out, FloodReport { shell: shell.count(), enclosed })
 }
 
 /// The voxels of `solid` with a neighbour (6- or 26-connected) outside it

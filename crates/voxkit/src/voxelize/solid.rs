@@ -258,6 +258,34 @@ fn brick_row(hits: &[(u32, u32, i8)], dims: [u32; 3], bj: u32, bk: u32, rule: Ru
     bricks_of_spans(&spans, dims, bj, bk)
 }
 
+/// Appends the inclusive span `[first, last]` to `out`, joined with the
+/// last span when adjacent (spans come in order, disjoint).
+pub(crate) fn push_span(out: &mut Vec<(u32, u32)>, first: u32, last: u32) {
+    match out.last_mut() {
+        Some(prev) if prev.1 + 1 == first => prev.1 = last,
+        _ => out.push((first, last)),
+    }
+}
+
+/// A sparse grid from its brick rows, given in `(bk, bj)` order.
+pub(crate) fn from_brick_rows(dims: [u32; 3], rows: impl IntoIterator<Item = BrickRow>) -> SparseBricks {
+    let (mut bricks, mut full) = (Vec::new(), Vec::new());
+    for (b, f) in rows {
+        bricks.extend(b);
+        full.extend(f);
+    }
+    SparseBricks::from_sorted(dims, bricks, full)
+}
+
+/// A sparse grid built brick row by brick row in parallel: `row(bj, bk)`
+/// gives each row's bricks and full runs.
+pub(crate) fn by_brick_rows(dims: [u32; 3], row: impl Fn(u32, u32) -> BrickRow + Sync) -> SparseBricks {
+    let (by, bz) = (dims[1].div_ceil(BRICK) as u64, dims[2].div_ceil(BRICK) as u64);
+    let rows: Vec<BrickRow> =
+        (0..(by * bz) as usize).into_par_iter().with_min_len(16).map(|n| row((n as u64 % by) as u32, (n as u64 / by) as u32)).collect();
+    from_brick_rows(dims, rows)
+}
+
 /// The bricks of brick row `(bj, bk)` from the inside spans of its 64
 /// voxel rows (`spans[dk · 8 + dj]`: sorted, disjoint, inclusive, not
 /// adjacent): bricks every row covers wholly form full runs; the other
@@ -316,19 +344,8 @@ pub(crate) fn bricks_of_spans(spans: &[Vec<(u32, u32)>; 64], dims: [u32; 3], bj:
 /// rows' crossings (found by binary search in the sorted crossings).
 fn fill_sparse(snapped: &Snapped, dims: [u32; 3], rule: Rule) -> (SparseBricks, SolidReport) {
     let hits = row_crossings(&snapped.crossing_triangles(), dims);
-    let (by, bz) = (dims[1].div_ceil(BRICK) as u64, dims[2].div_ceil(BRICK) as u64);
-    let rows: Vec<BrickRow> = (0..(by * bz) as usize)
-        .into_par_iter()
-        .with_min_len(16)
-        .map(|r| brick_row(&hits, dims, (r as u64 % by) as u32, (r as u64 / by) as u32, rule))
-        .collect();
+    let out = by_brick_rows(dims, |bj, bk| brick_row(&hits, dims, bj, bk, rule));
     drop(hits);
-    let (mut bricks, mut full) = (Vec::new(), Vec::new());
-    for (b, f) in rows {
-        bricks.extend(b);
-        full.extend(f);
-    }
-    let out = SparseBricks::from_sorted(dims, bricks, full);
     let mut rep = inspect(snapped);
     rep.voxels = out.count();
     (out, rep)

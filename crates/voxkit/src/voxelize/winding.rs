@@ -41,7 +41,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::solid::{bricks_of_spans, BrickRow, SolidReport};
+use super::solid::{bricks_of_spans, by_brick_rows, push_span, SolidReport};
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::{orient, P3};
@@ -495,7 +495,13 @@ pub fn winding(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, Winding
 pub fn winding_snapped(snapped: &Snapped, dims: [u32; 3]) -> (DenseBits, WindingReport) {
     let plan = Plan::new(snapped, dims);
     let mut bits = DenseBits::new(dims);
-    bits.par_rows_mut().enumerate().for_each(|(r, row)| plan.row(r, |f, t| DenseBits::fill_row(row, f, t)));
+    bits.par_rows_mut().enumerate().for_each_init(Vec::new, |spans, (r, row)| {
+        spans.clear();
+        plan.row(r, spans);
+        for &(f, t) in spans.iter() {
+            DenseBits::fill_row(row, f, t);
+        }
+    });
     let voxels = bits.count();
     (bits, plan.report(snapped, voxels))
 }
@@ -505,29 +511,16 @@ pub fn winding_snapped(snapped: &Snapped, dims: [u32; 3]) -> (DenseBits, Winding
 /// bricks with the interior as runs of full bricks. The same voxels.
 pub fn winding_sparse(snapped: &Snapped, dims: [u32; 3]) -> (SparseBricks, WindingReport) {
     let plan = Plan::new(snapped, dims);
-    let (by, bz) = (dims[1].div_ceil(BRICK) as u64, dims[2].div_ceil(BRICK) as u64);
-    let rows: Vec<BrickRow> = (0..(by * bz) as usize)
-        .into_par_iter()
-        .with_min_len(16)
-        .map(|n| {
-            let (bj, bk) = ((n as u64 % by) as u32, (n as u64 / by) as u32);
-            let mut spans: [Vec<(u32, u32)>; 64] = std::array::from_fn(|_| Vec::new());
-            for dk in 0..BRICK.min(dims[2] - bk * BRICK) {
-                for dj in 0..BRICK.min(dims[1] - bj * BRICK) {
-                    let r = (bk * BRICK + dk) as usize * dims[1] as usize + (bj * BRICK + dj) as usize;
-                    let out = &mut spans[(dk * BRICK + dj) as usize];
-                    plan.row(r, |f, t| out.push((f, t)));
-                }
+    let out = by_brick_rows(dims, |bj, bk| {
+        let mut spans: [Vec<(u32, u32)>; 64] = std::array::from_fn(|_| Vec::new());
+        for dk in 0..BRICK.min(dims[2] - bk * BRICK) {
+            for dj in 0..BRICK.min(dims[1] - bj * BRICK) {
+                let r = (bk * BRICK + dk) as usize * dims[1] as usize + (bj * BRICK + dj) as usize;
+                plan.row(r, &mut spans[(dk * BRICK + dj) as usize]);
             }
-            bricks_of_spans(&spans, dims, bj, bk)
-        })
-        .collect();
-    let (mut bricks, mut full) = (Vec::new(), Vec::new());
-    for (b, f) in rows {
-        bricks.extend(b);
-        full.extend(f);
-    }
-    let out = SparseBricks::from_sorted(dims, bricks, full);
+        }
+        bricks_of_spans(&spans, dims, bj, bk)
+    });
     let voxels = out.count();
     (out, plan.report(snapped, voxels))
 }
@@ -581,22 +574,12 @@ impl Plan {
         Plan { dims, cycles: cycles.len() as u64, cap_triangles, hits, start, needed, nstart }
     }
 
-    /// Calls `emit(first, last)` for the inside spans of row `r` (`k·ny + j`),
-    /// in order, maximal (adjacent spans joined).
-    fn row(&self, r: usize, mut emit: impl FnMut(u32, u32)) {
+    /// Appends the inside spans of row `r` (`k·ny + j`) to `out`, in
+    /// order, maximal (adjacent spans joined).
+    fn row(&self, r: usize, out: &mut Vec<(u32, u32)>) {
         let nx = self.dims[0];
         let row_hits = &self.hits[self.start[r]..self.start[r + 1]];
         let spans = &self.needed[self.nstart[r]..self.nstart[r + 1]];
-        let mut open: Option<(u32, u32)> = None;
-        let mut add = |f: u32, t: u32| match open {
-            Some((of, ot)) if ot + 1 == f => open = Some((of, t)),
-            _ => {
-                if let Some((of, ot)) = open {
-                    emit(of, ot);
-                }
-                open = Some((f, t));
-            }
-        };
         let (mut ptr, mut sp) = (0, 0);
         let mut w = 0i64;
         let mut i = 0u32;
@@ -611,7 +594,7 @@ impl Plan {
                     Rule::Exact(v) => (w as f64 - v).abs() >= 0.5,
                 };
                 if inside {
-                    add(i, i);
+                    push_span(out, i, i);
                 }
                 i += 1;
                 if i >= s.i0 + s.len {
@@ -623,12 +606,9 @@ impl Plan {
             let next_span = spans.get(sp).map_or(nx, |s| s.i0);
             let next = next_hit.min(next_span).min(nx).max(i + 1);
             if w != 0 {
-                add(i, next - 1);
+                push_span(out, i, next - 1);
             }
             i = next;
-        }
-        if let Some((of, ot)) = open {
-            emit(of, ot);
         }
     }
 
