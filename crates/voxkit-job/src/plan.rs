@@ -173,6 +173,17 @@ pub enum GpuPath {
     MsaaApprox,
 }
 
+impl GpuPath {
+    /// The name `--gpu-path` takes and the summary reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            GpuPath::Compute => "compute",
+            GpuPath::Raster => "raster",
+            GpuPath::MsaaApprox => "msaa-approx",
+        }
+    }
+}
+
 /// The surface/line paths a method can name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SurfaceMethod {

@@ -312,6 +312,26 @@ impl Voxelized {
     }
 }
 
+/// A GPU error as the job reports it.
+#[cfg(feature = "gpu")]
+fn gpu_failed(e: voxkit_gpu::GpuError) -> JobError {
+    JobError::failed(format!("--method gpu: {e}"))
+}
+
+/// The GPU, and the mode and path a `--method gpu` run asks of it.
+#[cfg(feature = "gpu")]
+fn gpu_setup(mode: voxelize::Mode, path: GpuPath) -> Result<(voxkit_gpu::Gpu, voxkit_gpu::GpuMode, voxkit_gpu::GpuPath)> {
+    use voxkit_gpu::GpuPath as P;
+    let gm = voxkit_gpu::GpuMode::of(mode)
+        .ok_or_else(|| JobError::invalid(format!("--method gpu: {} on the GPU is not built yet", mode.name())))?;
+    let gp = match path {
+        GpuPath::Compute => P::Compute,
+        GpuPath::Raster => P::Raster,
+        GpuPath::MsaaApprox => P::RasterMsaa,
+    };
+    Ok((voxkit_gpu::Gpu::new().map_err(gpu_failed)?, gm, gp))
+}
+
 /// A surface mode on the GPU: the voxels, the report, facts, warnings.
 #[cfg(feature = "gpu")]
 fn gpu_voxelize(
@@ -321,15 +341,8 @@ fn gpu_voxelize(
     grid: &GridSpec,
 ) -> Result<(BrickBits, Report, Value, Vec<String>)> {
     use voxkit_gpu::GpuPath as P;
-    let fail = |e: voxkit_gpu::GpuError| JobError::failed(format!("--method gpu: {e}"));
-    let gm = voxkit_gpu::GpuMode::of(mode)
-        .ok_or_else(|| JobError::invalid(format!("--method gpu: {} on the GPU is not built yet", mode.name())))?;
-    let gpu = voxkit_gpu::Gpu::new().map_err(fail)?;
-    let gp = match path {
-        GpuPath::Compute => P::Compute,
-        GpuPath::Raster => P::Raster,
-        GpuPath::MsaaApprox => P::RasterMsaa,
-    };
+    let (gpu, gm, gp) = gpu_setup(mode, path)?;
+    let fail = gpu_failed;
     let (bits, r) = gpu.voxelize_with(gm, gp, mesh, grid).map_err(fail)?;
     let mut warnings = Vec::new();
     // The approximation says what it misses: the exact voxels by the compute path.
@@ -344,7 +357,7 @@ fn gpu_voxelize(
     };
     let t = r.timings;
     let facts = json!({
-        "path": match gp { P::Compute => "compute", P::Raster => "raster", P::RasterMsaa => "msaa-approx" },
+        "path": path.name(),
         "hardware_conservative": gpu.hardware_conservative(),
         "missed_voxels": missed,
         "adapter": gpu.adapter(),
@@ -373,34 +386,24 @@ fn gpu_tiled(
     tile: u32,
     opts: &Options<'_>,
 ) -> Result<(SparseBricks, Report, Value)> {
-    use voxkit_gpu::GpuPath as P;
-    let fail = |e: voxkit_gpu::GpuError| JobError::failed(format!("--method gpu: {e}"));
-    let gm = voxkit_gpu::GpuMode::of(mode)
-        .ok_or_else(|| JobError::invalid(format!("--method gpu: {} on the GPU is not built yet", mode.name())))?;
-    let gp = match path {
-        GpuPath::Compute => P::Compute,
-        GpuPath::Raster => P::Raster,
-        GpuPath::MsaaApprox => {
-            return Err(JobError::invalid(
-                "--gpu-path msaa-approx does not run tiled (it is checked against a whole-grid run); use compute or raster",
-            ))
-        }
-    };
-    let gpu = voxkit_gpu::Gpu::new().map_err(fail)?;
-    let counts = std::sync::Mutex::new([0u64; 3]);
+    if path == GpuPath::MsaaApprox {
+        return Err(JobError::invalid(
+            "--gpu-path msaa-approx does not run tiled (it is checked against a whole-grid run); use compute or raster",
+        ));
+    }
+    let (gpu, gm, gp) = gpu_setup(mode, path)?;
+    let mut c = [0u64; 3];
     let (s, r) = voxelize::tiled::tiled_by(mesh, grid, tile, opts, |tris, size| {
         let (bits, r) = gpu.voxelize_lattice(gm, gp, tris, size)?;
-        let mut c = counts.lock().unwrap_or_else(|e| e.into_inner());
         c[0] += r.gpu_triangles;
         c[1] += r.cpu_triangles;
         c[2] += 1;
         Ok(bits)
     })
     .map_err(|e| JobError::invalid(e.to_string()))?
-    .map_err(fail)?;
-    let c = counts.into_inner().unwrap_or_else(|e| e.into_inner());
+    .map_err(gpu_failed)?;
     let facts = json!({
-        "path": match gp { P::Compute => "compute", _ => "raster" },
+        "path": path.name(),
         "hardware_conservative": gpu.hardware_conservative(),
         "adapter": gpu.adapter(),
         "software": gpu.is_software(),
@@ -420,7 +423,13 @@ fn gpu_tiled(
     _tile: u32,
     _opts: &Options<'_>,
 ) -> Result<(SparseBricks, Report, Value)> {
-    Err(JobError::invalid("--method gpu: this voxkit was built without the `gpu` feature"))
+    Err(no_gpu())
+}
+
+/// What `--method gpu` says in a build without the `gpu` feature.
+#[cfg(not(feature = "gpu"))]
+fn no_gpu() -> JobError {
+    JobError::invalid("--method gpu: this voxkit was built without the `gpu` feature")
 }
 
 #[cfg(not(feature = "gpu"))]
@@ -430,5 +439,5 @@ fn gpu_voxelize(
     _mesh: MeshRef<'_>,
     _grid: &GridSpec,
 ) -> Result<(BrickBits, Report, Value, Vec<String>)> {
-    Err(JobError::invalid("--method gpu: this voxkit was built without the `gpu` feature"))
+    Err(no_gpu())
 }

@@ -171,7 +171,7 @@ pub fn tiled_by<E>(
     grid: &GridSpec,
     tile: u32,
     opts: &Options<'_>,
-    run: impl Fn(&[LatticeTriangle], [u32; 3]) -> Result<BrickBits, E>,
+    mut run: impl FnMut(&[LatticeTriangle], [u32; 3]) -> Result<BrickBits, E>,
 ) -> Result<Result<(SparseBricks, Report), E>, TiledError> {
     if tile == 0 || tile % BRICK != 0 {
         return Err(TiledError::Tile(tile));
@@ -188,14 +188,14 @@ pub fn tiled_by<E>(
 /// The driver proper: bins `prims` into the tiles of `tile` voxels their
 /// voxel boxes meet, and per tile in order, moves its primitives by the
 /// tile's origin (`shift`) and runs them (`run`, given the tile's size and
-/// origin) on a grid of the tile's size. Returns the voxels and their count.
+/// origin; tiles one after another) on a grid of the tile's size. Returns the voxels and their count.
 fn by_tiles<P: Primitive, E>(
     prims: &[P],
     dims: [u32; 3],
     tile: u32,
     opts: &Options<'_>,
     shift: impl Fn(&P, [i64; 3]) -> P,
-    run: impl Fn(&[P], [u32; 3], [i64; 3], &Options<'_>) -> Result<BrickBits, E>,
+    mut run: impl FnMut(&[P], [u32; 3], [i64; 3], &Options<'_>) -> Result<BrickBits, E>,
 ) -> Result<(SparseBricks, u64), E> {
     let tdims = dims.map(|d| d.div_ceil(tile) as u64);
     let tile_id = |t: [u64; 3]| (t[2] * tdims[1] + t[1]) * tdims[0] + t[0];
