@@ -77,7 +77,7 @@ pub fn report_sparse(bits: &SparseBricks, mesh: Option<(MeshRef<'_>, &GridSpec, 
     let report = certify_sparse(bits, mesh.map(|(m, g, _)| (m, g)), layers).map_err(|e| JobError::invalid(e.to_string()))?;
     let mut v = to_json(&report, bits.dims(), mesh.map(|(_, g, s)| (g, s)));
     v["sparse"] = json!(true);
-    v["windows"] = json!(bits.dims()[2].div_ceil(8).div_ceil(layers.max(1)).max(1));
+    v["windows"] = json!(voxkit::topology::certify::sparse_windows(bits.dims(), layers));
     Ok(v)
 }
 

@@ -121,7 +121,9 @@ pub struct Separation {
 pub fn certify(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec)>) -> Result<CheckReport, ClassifyError> {
     let dims = bits.dims();
     let mut pass = Pass::new(dims, mesh)?;
-    let tris = pass.mesh.as_ref().map(|m| m.tris.clone()).unwrap_or_default();
+    // One window, all triangles: moved out for the call (the window reads
+    // only its argument), not copied.
+    let tris = pass.mesh.as_mut().map(|m| std::mem::take(&mut m.tris)).unwrap_or_default();
     pass.window(bits, 0, 0..dims[2], &tris, &|_, _, _| false);
     Ok(pass.finish())
 }
@@ -138,7 +140,7 @@ pub fn certify_sparse(bits: &SparseBricks, mesh: Option<(MeshRef<'_>, &GridSpec)
     let layers = layers.max(1);
     let mut pass = Pass::new(dims, mesh)?;
     let bz = dims[2].div_ceil(BRICK);
-    let windows = bz.div_ceil(layers).max(1) as usize;
+    let windows = sparse_windows(dims, layers) as usize;
     let span = layers * BRICK;
     // Each window's triangles: those within two voxels of its planes, halo
     // included (what the parity rows, tunnels and columns of the window need).
@@ -168,6 +170,12 @@ pub fn certify_sparse(bits: &SparseBricks, mesh: Option<(MeshRef<'_>, &GridSpec)
         pass.window(&window, base, owned, &tris, &beyond);
     }
     Ok(pass.finish())
+}
+
+/// How many windows [`certify_sparse`] cuts a grid of `dims` into, with
+/// windows of `layers` brick layers.
+pub fn sparse_windows(dims: [u32; 3], layers: u32) -> u32 {
+    dims[2].div_ceil(BRICK).div_ceil(layers.max(1)).max(1)
 }
 
 /// What the checks read of one window of planes: a dense grid or the
