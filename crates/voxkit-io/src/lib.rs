@@ -180,6 +180,12 @@ pub enum VoxelFormat {
 }
 
 impl VoxelFormat {
+    /// Whether [`read_voxels_sparse`] reads this format without a dense
+    /// grid (`.vdb`, `.zarr`, `.npz`).
+    pub fn reads_sparsely(self) -> bool {
+        matches!(self, VoxelFormat::Vdb | VoxelFormat::Zarr | VoxelFormat::Npz)
+    }
+
     /// Names accepted by `--format`.
     pub const NAMES: &'static str = "npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr";
 

@@ -11,8 +11,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     let t0 = Instant::now();
     let pool = crate::thread_pool(a.threads)?;
     let up = a.up.as_deref().and_then(voxkit_io::orient::Up::from_name).unwrap_or_default();
-    use voxkit_io::VoxelFormat as F;
-    let sparse_format = matches!(F::from_path(&a.voxels), Some(F::Vdb | F::Zarr | F::Npz));
+    let sparse_format = voxkit_io::VoxelFormat::from_path(&a.voxels).is_some_and(voxkit_io::VoxelFormat::reads_sparsely);
     if a.sparse && !sparse_format {
         bail!("{}: --sparse reads only .vdb, .zarr and .npz files", a.voxels.display());
     }

@@ -25,10 +25,7 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
             let sparse = match voxkit_io::read_voxels_sparse(&a.input, false) {
                 Ok(s) => s,
                 // Formats read only densely: the grid's size is the error.
-                Err(s)
-                    if matches!(s.kind, voxkit_io::ErrorKind::Unsupported(_))
-                        && !matches!(input_format, Some(F::Vdb | F::Zarr | F::Npz)) =>
-                {
+                Err(s) if matches!(s.kind, voxkit_io::ErrorKind::Unsupported(_)) && !input_format.is_some_and(F::reads_sparsely) => {
                     return Err(e.into())
                 }
                 Err(s) => return Err(s.into()),
@@ -53,7 +50,7 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
             };
             return finish(a, format, &sparse.bits, sparse.placement, attributes.as_ref(), &write_opts, true);
         }
-        Err(e) if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. }) && matches!(input_format, Some(F::Vdb | F::Zarr | F::Npz)) => {
+        Err(e) if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. }) && input_format.is_some_and(F::reads_sparsely) => {
             bail!("{e}; {} is a dense format: convert it to .vdb, .zarr, .npz, .txt or .ply, which need no dense grid", format.name())
         }
         Err(e) => return Err(e.into()),

@@ -147,10 +147,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         match voxkit_io::read_voxels_with(&a.input, up) {
             Ok(loaded) => (Box::new(loaded.bits), "voxel file", loaded.attributes, None),
             // A .vdb, .zarr or .npz grid past memory: drawn from its bricks.
-            Err(e)
-                if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. })
-                    && matches!(F::from_path(&a.input), Some(F::Vdb | F::Zarr | F::Npz)) =>
-            {
+            Err(e) if matches!(e.kind, voxkit_io::ErrorKind::TooLarge { .. }) && F::from_path(&a.input).is_some_and(F::reads_sparsely) => {
                 let sparse = voxkit_io::read_voxels_sparse(&a.input, false)?;
                 if sparse.attributes_left {
                     eprintln!("voxkit: warning: {}: drawn without its colours: the grid does not fit densely", a.input.display());

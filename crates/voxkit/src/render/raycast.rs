@@ -498,36 +498,41 @@ mod tests {
         b
     }
 
-    #[test]
-    fn dda_finds_the_same_first_voxel_as_the_slab_test() {
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        let mut r = move || {
+    /// A xorshift generator.
+    fn xorshift(mut x: u64) -> impl FnMut() -> u64 {
+        move || {
             x ^= x << 13;
             x ^= x >> 7;
             x ^= x << 17;
             x
-        };
+        }
+    }
+
+    /// The DDA's hit and the slab test's agree (rays through a shared edge
+    /// or corner may report a different voxel at the same parameter).
+    fn assert_same_hit(fast: Option<Hit>, slow: Option<([u32; 3], f64)>, round: usize) {
+        match (fast, slow) {
+            (None, None) => {}
+            (Some(h), Some((v, t))) => assert!((h.t - t).abs() < 1e-9, "round {round}: t {} vs {t} ({:?} vs {v:?})", h.t, h.voxel),
+            (a, b) => panic!("round {round}: {a:?} vs {b:?}"),
+        }
+    }
+
+    #[test]
+    fn dda_finds_the_same_first_voxel_as_the_slab_test() {
+        let mut r = xorshift(0x9e37_79b9_7f4a_7c15);
         for round in 0..60 {
             let dims = [5 + (r() % 20) as u32, 5 + (r() % 20) as u32, 5 + (r() % 20) as u32];
             let n = 1 + r() % 40;
             let voxels: Vec<[u32; 3]> = (0..n).map(|_| std::array::from_fn(|a| (r() % dims[a] as u64) as u32)).collect();
             let bits = grid(dims, &voxels);
+            let g = RenderGrid::from_bricks(&bits);
             for _ in 0..200 {
                 let f = |r: &mut dyn FnMut() -> u64| (r() % 20_000) as f64 / 1000.0 - 10.0;
                 let origin = DVec3::new(f(&mut r) * 3.0, f(&mut r) * 3.0, f(&mut r) * 3.0);
                 let target = DVec3::new(f(&mut r).abs() * 2.0, f(&mut r).abs() * 2.0, f(&mut r).abs() * 2.0);
                 let dir = (target - origin).normalize();
-                let fast = first_hit(&RenderGrid::from_bricks(&bits), origin, dir);
-                let slow = reference::first_hit(&bits, origin, dir);
-                match (fast, slow) {
-                    (None, None) => {}
-                    (Some(h), Some((v, t))) => {
-                        // Rays through a shared edge or corner may report a
-                        // different voxel at the same parameter.
-                        assert!((h.t - t).abs() < 1e-9, "round {round}: t {} vs {t} ({:?} vs {v:?})", h.t, h.voxel);
-                    }
-                    (a, b) => panic!("round {round}: {a:?} vs {b:?} ({origin} {dir})"),
-                }
+                assert_same_hit(first_hit(&g, origin, dir), reference::first_hit(&bits, origin, dir), round);
             }
         }
     }
@@ -537,13 +542,7 @@ mod tests {
     /// slab test, and the same pictures.
     #[test]
     fn sparse_grids_over_many_blocks_render_like_dense_ones() {
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut r = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut r = xorshift(0x2545_f491_4f6c_dd1d);
         for round in 0..6 {
             let dims = [70 + (r() % 120) as u32, 65 + (r() % 100) as u32, 66 + (r() % 90) as u32];
             let mut dense = BrickBits::new(dims);
@@ -571,11 +570,7 @@ mod tests {
                 let dir = (target - origin).normalize();
                 let (a, b) = (first_hit(&gs, origin, dir), first_hit(&gd, origin, dir));
                 assert_eq!(a, b, "round {round}");
-                let slow = reference::first_hit(&full, origin, dir);
-                assert_eq!(a.is_some(), slow.is_some(), "round {round}");
-                if let (Some(h), Some((_, t))) = (a, slow) {
-                    assert!((h.t - t).abs() < 1e-9, "round {round}: t {} vs {t}", h.t);
-                }
+                assert_same_hit(a, reference::first_hit(&full, origin, dir), round);
             }
             let o = RenderOptions { width: 96, height: 72, ..RenderOptions::default() };
             assert_eq!(render_grid(&gs, &o, None, None), render(&full, &o), "round {round}");
