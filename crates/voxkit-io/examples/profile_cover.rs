@@ -1,6 +1,7 @@
 //! Times one mode's fast path on one mesh, by driver (and the phases of the
 //! slab driver: prepare, kernel), for profiling: `cargo run --release -p
 //! voxkit-io --example profile_cover -- MESH RESOLUTION THREADS [REPEATS] [MODE]`.
+//! With `PROFILE_AUTO_ONLY=1` only the default driver runs (for `perf`).
 
 use std::time::Instant;
 
@@ -38,14 +39,16 @@ fn main() {
             )
         };
         let mut line = format!("{} threads {threads} res {res}:", mode.name());
-        for driver in [Driver::Auto, Driver::Slabs, Driver::Triangles] {
+        let auto_only = std::env::var_os("PROFILE_AUTO_ONLY").is_some();
+        let drivers: &[Driver] = if auto_only { &[Driver::Auto] } else { &[Driver::Auto, Driver::Slabs, Driver::Triangles] };
+        for &driver in drivers {
             let opts = Options { driver, ..Options::default() };
             let t = time(&mut || {
                 std::hint::black_box(voxelize::fast(mode, mesh, &grid, &opts));
             });
             line += &format!(" {driver:?} {t:.2} ms;");
         }
-        if mode == Mode::Cover {
+        if mode == Mode::Cover && !auto_only {
             let prep = time(&mut || {
                 std::hint::black_box(prepare(mesh, &grid));
             });

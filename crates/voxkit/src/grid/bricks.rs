@@ -452,7 +452,39 @@ impl SlabView<'_> {
     }
 
     /// Are all voxels of the inclusive box `[lo, hi]` set (by this slab)?
+    /// A box inside one brick (a small triangle's, mostly) is one brick
+    /// lookup and a masked compare per brick word.
+    #[inline(always)]
     pub fn all_set(&self, lo: [i64; 3], hi: [i64; 3]) -> bool {
+        let (l0, l1, l2) = (lo[0] as u32, lo[1] as u32, lo[2] as u32);
+        let (h0, h1, h2) = (hi[0] as u32, hi[1] as u32, hi[2] as u32);
+        if (l0 ^ h0) | (l1 ^ h1) | (l2 ^ h2) >= BRICK {
+            return self.all_set_across(lo, hi);
+        }
+        let key = brick_key(l0, l1, l2);
+        let slot = if self.last.0 == key {
+            self.last.1
+        } else {
+            match self.index[self.entry(l0, l1, l2)] {
+                0 => return false,
+                id => id as usize - 1,
+            }
+        };
+        // The box's x range in one row of the brick, repeated over its y rows.
+        let row = ((2u64 << (h0 - l0)) - 1) << (l0 & 7);
+        let rows = (0x0101_0101_0101_0101u64 >> ((7 - (h1 - l1)) << 3)) << ((l1 & 7) << 3);
+        let mask = row * rows;
+        let brick = &self.pool[slot];
+        let mut all = true;
+        for k in l2 & 7..=h2 & 7 {
+            all &= brick[k as usize] & mask == mask;
+        }
+        all
+    }
+
+    /// [`Self::all_set`] for a box across brick borders, voxel by voxel.
+    #[inline(never)]
+    fn all_set_across(&self, lo: [i64; 3], hi: [i64; 3]) -> bool {
         (lo[2]..=hi[2]).all(|k| (lo[1]..=hi[1]).all(|j| (lo[0]..=hi[0]).all(|i| self.get(i as u32, j as u32, k as u32))))
     }
 
@@ -533,6 +565,41 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn all_set_agrees_with_single_voxels() {
+        // Boxes inside one brick and across brick borders, over a slab
+        // whose voxels are set densely but not completely.
+        let dims = [19u32, 18, 21];
+        let mut grid = BrickBits::new(dims);
+        let mut slabs = grid.slabs_mut(8);
+        let slab = &mut slabs[0];
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    x ^= x << 13;
+                    x ^= x >> 7;
+                    x ^= x << 17;
+                    if x % 16 != 0 {
+                        slab.set(i, j, k);
+                    }
+                }
+            }
+        }
+        let (mut full, mut checked) = (0, 0);
+        for lo in [[0i64, 0, 0], [3, 5, 6], [6, 7, 7], [7, 1, 4], [9, 9, 15]] {
+            for ext in [[0i64, 0, 0], [1, 0, 0], [0, 1, 1], [1, 1, 1], [0, 2, 1], [2, 0, 0], [3, 3, 3]] {
+                let hi = [lo[0] + ext[0], lo[1] + ext[1], lo[2] + ext[2]];
+                let want =
+                    (lo[2]..=hi[2]).all(|k| (lo[1]..=hi[1]).all(|j| (lo[0]..=hi[0]).all(|i| slab.get(i as u32, j as u32, k as u32))));
+                assert_eq!(slab.all_set(lo, hi), want, "{lo:?} {hi:?}");
+                full += want as u32;
+                checked += 1;
+            }
+        }
+        assert!(full > 0 && full < checked, "{full} of {checked} boxes full");
     }
 
     fn random_pair(dims: [u32; 3], n: usize, seed: u64) -> (BrickBits, DenseBits) {
