@@ -59,6 +59,25 @@ fn huge_triangles_take_the_wide_arithmetic_path() {
 }
 
 #[test]
+fn single_large_triangles_on_half_voxels() {
+    // One triangle per mesh (no neighbour hides a wrong voxel), a few to a
+    // dozen voxels wide so the column paths run, vertices on grid planes
+    // and voxel-centre planes so ties are common.
+    use rand::Rng;
+    let mut r = rng(0x5516);
+    let grid = GridSpec::new(DVec3::ZERO, 1.0, [16, 15, 17]).unwrap();
+    for n in 0..30 {
+        let p = |r: &mut rand::rngs::SmallRng| {
+            DVec3::new(r.gen_range(2..28) as f64, r.gen_range(2..26) as f64, r.gen_range(2..30) as f64) * 0.5
+        };
+        let m = soup(&[[p(&mut r), p(&mut r), p(&mut r)]]);
+        for mode in [Mode::Sep26, Mode::Sep6, Mode::Ss6] {
+            agree_mode(mode, &m, &grid).unwrap_or_else(|e| panic!("triangle {n}: {e}"));
+        }
+    }
+}
+
+#[test]
 fn explicit_grid_clipping_the_mesh() {
     let mesh = shared_mesh("cow.obj");
     let b = mesh.as_ref().bounds();

@@ -75,10 +75,16 @@ fn project<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab:
 #[inline(always)]
 fn project_w<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     let s = TriSetup::<T>::new(tri);
-    let dirs = DIAGONALS.map(|(o, d)| {
+    let mut dirs = DIAGONALS.map(|(o, d)| {
         let o = o.map(T::from_i64);
         (o, s.plane(o), s.dir(tri, d))
     });
+    // The diagonal along which the plane value changes most (its signs
+    // are the normal's) joins the voxel's lowest and highest corners, so
+    // it crosses the plane wherever any diagonal does: tested first, it
+    // ends most hits' tests.
+    let steepest = (1..4).fold(0, |b, i| if dirs[i].2.nd.to_f64().abs() > dirs[b].2.nd.to_f64().abs() { i } else { b });
+    dirs.swap(0, steepest);
     let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
     debug_assert_eq!(dominant_axes(tri), (u, v, w));
     let pix = PixelTest::new(&s, tri, (u, v, w));
@@ -92,40 +98,42 @@ fn project_w<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, lo: [i64; 3], h
     debug_assert_eq!(range.w(), w);
     range.shift_plane(shift_hi, shift_lo);
     let (nu, nw) = range.steps();
-    // Edge values of the w-line are affine in the pixel centre: step them along u.
+    // Pixel bounds are affine in the pixel centre: step them along u.
     let mut c0 = s.a;
     (c0[u], c0[v]) = (lo[u] * ONE + H, lo[v] * ONE + H);
     let mut c1 = c0;
     c1[u] += ONE;
-    let (o0, o1) = (s.line_values(&pix.dw, s.local(c0)), s.line_values(&pix.dw, s.local(c1)));
-    let step: [T; 3] = std::array::from_fn(|i| o1[i] - o0[i]);
+    let delta = pix.bounds(&s, s.local(c0)).delta(&pix.bounds(&s, s.local(c1)));
     for iv in lo[v]..=hi[v] {
         let mut c = s.a;
         (c[u], c[v]) = (lo[u] * ONE + H, iv * ONE + H);
-        let mut o = s.line_values(&pix.dw, s.local(c));
+        let mut b = pix.bounds(&s, s.local(c));
         let mut plane = PlaneRange::at::<W>(&range, lo[u], iv);
         let mut iu = lo[u];
         loop {
             let (ta, tb) = (plane.t0.max(lo[w]), plane.t1.min(hi[w]));
-            if ta <= tb && !pix.misses(&o) {
+            if ta <= tb && !b.misses() {
                 // Edges the pixel lies strictly inside of: a diagonal's
                 // crossing with the plane lies in the voxel, so projects into
                 // the pixel, and those edges' tests are known to pass.
-                let safe = pix.strictly_inside_edges(&o);
+                let safe = b.strictly_inside_edges();
+                let all_safe = safe == [true; 3];
                 for t in ta..=tb {
+                    let mut ijk = [0u32; 3];
+                    (ijk[u], ijk[v], ijk[w]) = (iu as u32, iv as u32, t as u32);
                     // The corners straddle the plane, so some opposite pair does
-                    // (opposite corners average to the centre's value).
-                    let hit = safe == [true; 3] || {
-                        let mut corner = [0i64; 3];
-                        (corner[u], corner[v], corner[w]) = (iu * ONE, iv * ONE, t * ONE);
-                        let p = s.local(corner);
-                        let vc = s.plane(p);
-                        dirs.iter()
-                            .any(|(o, vo, ds)| s.segment_hits_unsafe_edges(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]], vc + *vo, safe))
-                    };
+                    // (opposite corners average to the centre's value). A voxel
+                    // a neighbouring triangle has set needs no diagonal tests.
+                    let hit = all_safe
+                        || (!slab.get(ijk[0], ijk[1], ijk[2]) && {
+                            let mut corner = [0i64; 3];
+                            (corner[u], corner[v], corner[w]) = (iu * ONE, iv * ONE, t * ONE);
+                            let p = s.local(corner);
+                            let vc = s.plane(p);
+                            dirs.iter()
+                                .any(|(o, vo, ds)| s.segment_hits_unsafe_edges(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]], vc + *vo, safe))
+                        });
                     if hit {
-                        let mut ijk = [0u32; 3];
-                        (ijk[u], ijk[v], ijk[w]) = (iu as u32, iv as u32, t as u32);
                         slab.set(ijk[0], ijk[1], ijk[2]);
                     }
                 }
@@ -135,9 +143,7 @@ fn project_w<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, lo: [i64; 3], h
             }
             iu += 1;
             plane.next_column(nu, nw);
-            for i in 0..3 {
-                o[i] = o[i] + step[i];
-            }
+            b.step(&delta);
         }
     }
 }

@@ -23,8 +23,12 @@
 //! octahedron test contains the crosshair target), so `sep6 ⊆ ss6`, and not
 //! minimal; a subset of `cover`.
 //!
-//! **Fast path.** `cover`'s exact traversal enumerates candidates; each gets
-//! the test above in `i64` (relative to the voxel box) or `i128`.
+//! **Fast path.** The plane test passes one voxel per column of the
+//! dominant-axis projection; where the pixel lies strictly inside the
+//! projected triangle that voxel is set untested, elsewhere it gets the
+//! test above ([`columns`]). Triangles in a box of at most 27 voxels take
+//! `cover`'s exact traversal with the test on each candidate. All in `i64`
+//! (relative to the first vertex) or `i128`.
 //!
 //! **Reference:** [`reference::ss6`], the formulas above in `i128` with
 //! the perturbation evaluated symbolically, for every voxel of each
@@ -32,7 +36,7 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, Filter, Kernel};
-use super::targets::fits_i64;
+use super::targets::{dominant_axes, fits_i64, is_tiny, PixelTest, TriSetup};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -104,7 +108,96 @@ fn filtered<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], trav
         let d: [T; 3] = std::array::from_fn(|x| t(ijk[x] * ONE + H - a[x]));
         tests.iter().all(|l| l.g[0] * d[0] + l.g[1] * d[1] + l.g[2] * d[2] + l.c >= T::ZERO)
     };
-    cover_triangle(tri, lo, hi, traversal, &mut Filter { slab, keep });
+    if traversal == Traversal::Auto && !is_tiny(lo, hi) {
+        // `columns` asks only about voxels that pass the plane test: the
+        // nine edge tests, those of the dominant projection (whose pixel
+        // straddles an edge) first, as they fail most.
+        let w = dominant_axes(tri).2;
+        let mut edges = [tests[2]; 9];
+        for (i, e) in edges.iter_mut().enumerate() {
+            *e = tests[2 + (3 * w + i) % 9];
+        }
+        let edge_tests = |ijk: [i64; 3]| {
+            let d: [T; 3] = std::array::from_fn(|x| t(ijk[x] * ONE + H - a[x]));
+            edges.iter().all(|l| l.g[0] * d[0] + l.g[1] * d[1] + l.g[2] * d[2] + l.c >= T::ZERO)
+        };
+        columns::<T>(tri, lo, hi, edge_tests, slab);
+    } else {
+        cover_triangle(tri, lo, hi, traversal, &mut Filter { slab, keep });
+    }
+}
+
+/// One triangle by the columns of its dominant-axis (`w`) projection. The
+/// plane test alone passes exactly one voxel per column: with `n_w > 0`
+/// and `d = m − a`, it asks `n·d ∈ [b − r, r − 1 + b]` (`b = bias(n)`,
+/// `bias(−n) = 1 − b`, `r = H·n_w`), `2r = ONE·n_w` consecutive values,
+/// and `n·d` steps by `ONE·n_w` along the column. That voxel `t*` is
+/// tracked along each row by a remainder (it moves by at most one per
+/// column as `|n_u| <= n_w`). Where the pixel square lies strictly inside
+/// the projected triangle, the voxel is set with no further test: a point
+/// `X` of the plane in the (displaced) octahedron projects strictly inside
+/// the projection, so lies in the triangle, and its projections along the
+/// other two axes lie in the projected triangle and in that projection's
+/// (displaced) diamond, so every edge test passes. Where the square
+/// misses the projection a `w` diamond test fails; the other columns run
+/// the edge tests (`edge_tests`) on `t*`.
+fn columns<T: PlaneInt>(
+    tri: &LatticeTriangle,
+    lo: [i64; 3],
+    hi: [i64; 3],
+    edge_tests: impl Fn([i64; 3]) -> bool,
+    slab: &mut BrickSlab<'_>,
+) {
+    let s = TriSetup::<T>::new(tri);
+    let (u, v, w) = dominant_axes(tri);
+    let pix = PixelTest::new(&s, tri, (u, v, w));
+    let n = tri.normal();
+    let flip = if n[w] < 0 { -1 } else { 1 };
+    let nf = n.map(|c| c * flip);
+    let t = T::from_i64;
+    let (nu, nv, d) = (t(nf[u]), t(nf[v]), t(nf[w] * ONE));
+    // K = n·d − b + r at the voxel t = lo_w: t* = lo_w − floor(K / D).
+    let kw = t(nf[w]) * t(lo[w] * ONE + H - s.a[w]) - t(bias(nf)) + t(H * nf[w]);
+    let mut c0 = s.a;
+    (c0[u], c0[v]) = (lo[u] * ONE + H, lo[v] * ONE + H);
+    let mut c1 = c0;
+    c1[u] += ONE;
+    let b0 = pix.bounds(&s, s.local(c0));
+    let delta = b0.delta(&pix.bounds(&s, s.local(c1)));
+    let du = nu * t(ONE);
+    for iv in lo[v]..=hi[v] {
+        let mut c = c0;
+        c[v] = iv * ONE + H;
+        let pc = s.local(c);
+        let mut b = pix.bounds(&s, pc);
+        let k = nu * pc[u] + nv * pc[v] + kw;
+        let mut q = k.div_floor(d);
+        let mut rem = k - q * d;
+        let mut iu = lo[u];
+        loop {
+            let tw = lo[w] - q.to_i128() as i64;
+            if tw >= lo[w] && tw <= hi[w] && !b.misses() {
+                let mut ijk = [0i64; 3];
+                (ijk[u], ijk[v], ijk[w]) = (iu, iv, tw);
+                if b.strictly_inside_edges() == [true; 3] || edge_tests(ijk) {
+                    slab.set(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
+                }
+            }
+            if iu == hi[u] {
+                break;
+            }
+            iu += 1;
+            b.step(&delta);
+            rem = rem + du;
+            if rem >= d {
+                rem = rem - d;
+                q = q + t(1);
+            } else if rem < T::ZERO {
+                rem = rem + d;
+                q = q - t(1);
+            }
+        }
+    }
 }
 
 /// The slow, obviously correct definition of `ss6`.

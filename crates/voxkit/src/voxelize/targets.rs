@@ -341,10 +341,52 @@ impl<T: PlaneInt> PixelTest<T> {
         (0..3).any(|i| self.sign * o[i] + self.reach[i] < T::ZERO)
     }
 
-    /// Per edge: does the closed pixel square lie strictly on the inner side?
+    /// The [`PixelBounds`] of the pixel centred at `p` (relative, any `w`).
     #[inline(always)]
-    pub fn strictly_inside_edges(&self, o: &[T; 3]) -> [bool; 3] {
-        std::array::from_fn(|i| self.sign * o[i] - self.reach[i] > T::ZERO)
+    pub fn bounds(&self, s: &TriSetup<T>, p: [T; 3]) -> PixelBounds<T> {
+        let o = s.line_values(&self.dw, p);
+        PixelBounds(std::array::from_fn(|i| {
+            let (e, r) = (i % 3, self.reach[i % 3]);
+            self.sign * o[e] + if i < 3 { -r } else { r }
+        }))
+    }
+}
+
+/// A pixel's three edge values signed so that the projection's inside is
+/// positive, less (`[0..3]`) and plus (`[3..6]`) each edge's reach: the
+/// decision of [`PixelTest::misses`] and whether the square lies strictly
+/// inside each edge, without multiplications, stepped along a row by
+/// additions ([`Self::step`]).
+#[derive(Clone, Copy)]
+pub(crate) struct PixelBounds<T>(pub [T; 6]);
+
+impl<T: PlaneInt> PixelBounds<T> {
+    /// Does the closed pixel square miss the projected triangle?
+    #[inline(always)]
+    pub fn misses(&self) -> bool {
+        let b = &self.0;
+        b[3] < T::ZERO || b[4] < T::ZERO || b[5] < T::ZERO
+    }
+
+    /// Per edge: does the closed square lie strictly on the inner side?
+    #[inline(always)]
+    pub fn strictly_inside_edges(&self) -> [bool; 3] {
+        let b = &self.0;
+        [b[0] > T::ZERO, b[1] > T::ZERO, b[2] > T::ZERO]
+    }
+
+    /// The difference `next − self` (both of one row), for [`Self::step`].
+    #[inline(always)]
+    pub fn delta(&self, next: &PixelBounds<T>) -> [T; 6] {
+        std::array::from_fn(|i| next.0[i] - self.0[i])
+    }
+
+    /// Moves to the next pixel of the row.
+    #[inline(always)]
+    pub fn step(&mut self, delta: &[T; 6]) {
+        for i in 0..6 {
+            self.0[i] = self.0[i] + delta[i];
+        }
     }
 }
 
