@@ -243,20 +243,71 @@ fn count(chunk: &[u8]) -> Counts {
     c
 }
 
-fn words(rest: &[u8]) -> impl Iterator<Item = &[u8]> {
-    let rest = match rest.iter().position(|&b| b == b'#') {
-        Some(p) => &rest[..p],
-        None => rest,
-    };
-    rest.split(|b| b.is_ascii_whitespace()).filter(|w| !w.is_empty())
+/// The whitespace-separated words of a line's rest, up to a `#` comment.
+fn words(rest: &[u8]) -> Words<'_> {
+    Words { rest }
+}
+
+/// Iterator of [`words`]: one pass over the bytes, no closure per byte.
+struct Words<'a> {
+    rest: &'a [u8],
+}
+
+impl<'a> Iterator for Words<'a> {
+    type Item = &'a [u8];
+
+    #[inline]
+    fn next(&mut self) -> Option<&'a [u8]> {
+        let s = self.rest;
+        let mut i = 0;
+        while i < s.len() && s[i].is_ascii_whitespace() {
+            i += 1;
+        }
+        if i == s.len() || s[i] == b'#' {
+            self.rest = &[];
+            return None;
+        }
+        let mut j = i;
+        while j < s.len() && !s[j].is_ascii_whitespace() && s[j] != b'#' {
+            j += 1;
+        }
+        self.rest = &s[j..];
+        Some(&s[i..j])
+    }
 }
 
 fn number(w: &[u8]) -> Option<f64> {
+    // A number is ASCII; checking that is cheaper than UTF-8 validation.
+    if !w.is_ascii() {
+        return None;
+    }
     std::str::from_utf8(w).ok()?.parse().ok()
 }
 
+/// A decimal integer with an optional sign (as `i64::from_str` reads it),
+/// parsed straight from the bytes: face indices are most of an OBJ file.
 fn index(w: &[u8]) -> Option<i64> {
-    std::str::from_utf8(w).ok()?.parse().ok()
+    let (neg, digits) = match w.first()? {
+        b'-' => (true, &w[1..]),
+        b'+' => (false, &w[1..]),
+        _ => (false, w),
+    };
+    if digits.is_empty() {
+        return None;
+    }
+    let mut x: u64 = 0;
+    for &b in digits {
+        let d = b.wrapping_sub(b'0');
+        if d > 9 {
+            return None;
+        }
+        x = x.checked_mul(10)?.checked_add(d as u64)?;
+    }
+    match neg {
+        true if x <= 1 << 63 => Some((x as i64).wrapping_neg()),
+        true => None,
+        false => i64::try_from(x).ok(),
+    }
 }
 
 fn parse_chunk(chunk: &[u8], before: Counts) -> Result<Chunk, ErrorKind> {
@@ -451,6 +502,21 @@ mod tests {
         assert_eq!(mats[2].emission, [0.0; 3]);
         assert_eq!(mats[2].roughness, DEFAULT_ROUGHNESS);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn words_and_numbers_read_as_the_standard_parsers_do() {
+        let w: Vec<&[u8]> = words(b"  1/2/3\t-4 +5#comment 6").collect();
+        assert_eq!(w, [&b"1/2/3"[..], b"-4", b"+5"]);
+        assert_eq!(words(b"# only a comment").count(), 0);
+        assert_eq!(words(b"a#b c").collect::<Vec<_>>(), [&b"a"[..]]);
+        assert_eq!(words(b"").count(), 0);
+        for t in ["0", "7", "-12", "+3", "007", "", "-", "+", "1x", "x1", "--1", "1.5", "9223372036854775807", "9223372036854775808", "-9223372036854775808", "-9223372036854775809", " 1", "١"] {
+            assert_eq!(index(t.as_bytes()), t.parse::<i64>().ok(), "{t:?}");
+        }
+        for t in ["1", "-0.5", "1e3", "inf", "NaN", "1.5.2", "", "é"] {
+            assert_eq!(number(t.as_bytes()).map(f64::to_bits), t.parse::<f64>().ok().map(f64::to_bits), "{t:?}");
+        }
     }
 
     #[test]
