@@ -65,6 +65,8 @@ struct Chunk {
 struct Counts {
     v: i64,
     vt: i64,
+    /// `f` records (a lower bound on the triangles: one each).
+    f: usize,
     lines: usize,
 }
 
@@ -80,7 +82,8 @@ pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKin
         total.vt += c.vt;
         total.lines += c.lines;
     }
-    let parsed: Vec<Chunk> = chunks.par_iter().zip(&before).map(|(c, b)| parse_chunk(c, *b)).collect::<Result<_, _>>()?;
+    let parsed: Vec<Chunk> =
+        chunks.par_iter().zip(&before).zip(&counts).map(|((c, b), own)| parse_chunk(c, *b, own)).collect::<Result<_, _>>()?;
 
     let mut warnings = Vec::new();
     // Material libraries, in order of first mention.
@@ -228,11 +231,12 @@ fn keyword(line: &[u8]) -> (&[u8], &[u8]) {
 
 fn count(chunk: &[u8]) -> Counts {
     let mut c = Counts::default();
-    for line in chunk.split(|&b| b == b'\n') {
+    for line in lines(chunk) {
         c.lines += 1;
         match keyword(line).0 {
             b"v" => c.v += 1,
             b"vt" => c.vt += 1,
+            b"f" => c.f += 1,
             _ => {}
         }
     }
@@ -241,6 +245,37 @@ fn count(chunk: &[u8]) -> Counts {
         c.lines -= 1;
     }
     c
+}
+
+/// The pieces of `chunk` between line ends, as `split(|&b| b == b'\n')`
+/// gives them (an empty last piece after a final line end), found by
+/// `memchr`.
+fn lines(chunk: &[u8]) -> Lines<'_> {
+    Lines { rest: Some(chunk) }
+}
+
+/// Iterator of [`lines`].
+struct Lines<'a> {
+    rest: Option<&'a [u8]>,
+}
+
+impl<'a> Iterator for Lines<'a> {
+    type Item = &'a [u8];
+
+    #[inline]
+    fn next(&mut self) -> Option<&'a [u8]> {
+        let r = self.rest?;
+        match memchr::memchr(b'\n', r) {
+            Some(i) => {
+                self.rest = Some(&r[i + 1..]);
+                Some(&r[..i])
+            }
+            None => {
+                self.rest = None;
+                Some(r)
+            }
+        }
+    }
 }
 
 /// The whitespace-separated words of a line's rest, up to a `#` comment.
@@ -310,12 +345,22 @@ fn index(w: &[u8]) -> Option<i64> {
     }
 }
 
-fn parse_chunk(chunk: &[u8], before: Counts) -> Result<Chunk, ErrorKind> {
-    let mut out = Chunk::default();
+/// Parses one chunk; `before` counts the records of the chunks before it,
+/// `own` this chunk's (its vectors are allocated once at their size).
+fn parse_chunk(chunk: &[u8], before: Counts, own: &Counts) -> Result<Chunk, ErrorKind> {
+    let mut out = Chunk {
+        positions: Vec::with_capacity(own.v as usize),
+        colours: Vec::with_capacity(own.v as usize),
+        texcoords: Vec::with_capacity(own.vt as usize),
+        triangles: Vec::with_capacity(own.f),
+        triangle_vt: Vec::with_capacity(own.f),
+        triangle_material: Vec::with_capacity(own.f),
+        ..Chunk::default()
+    };
     let mut material = INHERIT;
     let mut poly: Vec<(i64, i64)> = Vec::new();
     let bad = |line: usize, what: String| ErrorKind::malformed("OBJ", format!("line {}: {what}", before.lines + line + 1));
-    for (n, line) in chunk.split(|&b| b == b'\n').enumerate() {
+    for (n, line) in lines(chunk).enumerate() {
         let (key, rest) = keyword(line);
         match key {
             b"v" => {
@@ -502,6 +547,14 @@ mod tests {
         assert_eq!(mats[2].emission, [0.0; 3]);
         assert_eq!(mats[2].roughness, DEFAULT_ROUGHNESS);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn lines_split_as_slice_split_does() {
+        for t in ["", "\n", "a", "a\n", "a\nb", "\n\na\r\n\nb\n"] {
+            let want: Vec<&[u8]> = t.as_bytes().split(|&b| b == b'\n').collect();
+            assert_eq!(lines(t.as_bytes()).collect::<Vec<_>>(), want, "{t:?}");
+        }
     }
 
     #[test]
