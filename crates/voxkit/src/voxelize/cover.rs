@@ -257,15 +257,81 @@ const TINY: i64 = 4;
 #[inline(never)]
 fn tiny_box<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], n: [usize; 3], lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     // Most tiny triangles span 2×2×2 voxels (about two thirds at 128³ on
-    // the bunny): that case runs with its sizes known, fully unrolled.
+    // the bunny): those take the octant test.
     if n == [2; 3] {
-        tiny_box_n(tri, base, [2; 3], lo, hi, out)
+        octants(tri, base, lo, hi, out)
     } else {
         tiny_box_n(tri, base, n, lo, hi, out)
     }
 }
 
-/// The body of [`tiny_box`], inlined into it once per size case.
+/// Octants whose coordinate along axis `c` is the upper one (bit
+/// `i + 2j + 4k` of a mask is the voxel `base + (i, j, k)`), and the lower.
+const UPPER: [u8; 3] = [0b1010_1010, 0b1100_1100, 0b1111_0000];
+const LOWER: [u8; 3] = [0b0101_0101, 0b0011_0011, 0b0000_1111];
+
+/// The octants reaching out along axis `c` in the direction a value with
+/// slope `slope` along `c` increases (none if it is flat).
+#[inline(always)]
+fn rising(c: usize, slope: i64) -> u8 {
+    if slope > 0 {
+        UPPER[c]
+    } else if slope < 0 {
+        LOWER[c]
+    } else {
+        0
+    }
+}
+
+/// [`tiny_box`] for a span of 2×2×2 voxels: the triangle lies in the
+/// closed block of the eight voxels, so it meets a voxel iff it meets the
+/// voxel's octant around the block's centre lattice point `P` (the
+/// octant's other sides hold the whole block). The separating axis test
+/// against an octant needs one value per axis at `P`: an octant meets the
+/// closed half-space `f >= 0` of an affine `f` iff `f(P) >= 0` or `f`
+/// rises along one of its directions. That decides the plane (both sides
+/// of it, with `f = ±(n·(x − v₀))`) and, in each axis projection, the
+/// three edges' inner half-planes; the box axes hold, as the triangle
+/// reaches both sides of `P` on every axis. Nine edge values and one
+/// plane value, against the 3 × 4 squares and 8 plane tests of the
+/// general case.
+#[inline(always)]
+fn octants<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], lo: [i64; 3], hi: [i64; 3], out: &mut O) {
+    // Vertices relative to P.
+    let v: [[i64; 3]; 3] = tri.v.map(|p| std::array::from_fn(|a| p[a] - (base[a] + 1) * ONE));
+    let rel = LatticeTriangle { v };
+    let n = rel.normal();
+    // The plane's value n·(x − v₀) at P; the octant meets the plane iff it
+    // reaches a value of the other sign (or P is on it).
+    let h = -(n[0] * v[0][0] + n[1] * v[0][1] + n[2] * v[0][2]);
+    let mut mask = match h {
+        0 => 0xff,
+        h if h > 0 => rising(0, -n[0]) | rising(1, -n[1]) | rising(2, -n[2]),
+        _ => rising(0, n[0]) | rising(1, n[1]) | rising(2, n[2]),
+    };
+    for r in 0..3 {
+        let (p, q) = ((r + 1) % 3, (r + 2) % 3);
+        let sigma = if n[r] >= 0 { 1 } else { -1 };
+        for i in 0..3 {
+            let e = rel.edge(i);
+            let (a, b) = (-e[q] * sigma, e[p] * sigma);
+            // The edge function a·(x_p − v_p) + b·(x_q − v_q) at P.
+            if a * v[i][p] + b * v[i][q] > 0 {
+                mask &= rising(p, a) | rising(q, b);
+            }
+        }
+    }
+    while mask != 0 {
+        let o = mask.trailing_zeros() as i64;
+        mask &= mask - 1;
+        let ijk = [base[0] + (o & 1), base[1] + (o >> 1 & 1), base[2] + (o >> 2)];
+        if (0..3).all(|a| ijk[a] >= lo[a] && ijk[a] <= hi[a]) {
+            out.set(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
+        }
+    }
+}
+
+/// The body of [`tiny_box`] for spans other than 2×2×2.
 #[inline(always)]
 fn tiny_box_n<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], n: [usize; 3], lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     let rel = LatticeTriangle { v: tri.v.map(|p| std::array::from_fn(|a| p[a] - base[a] * ONE)) };
