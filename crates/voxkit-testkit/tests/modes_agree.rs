@@ -68,7 +68,7 @@ fn single_large_triangles_on_half_voxels() {
     let grid = GridSpec::new(DVec3::ZERO, 1.0, [16, 15, 17]).unwrap();
     for n in 0..30 {
         let p = |r: &mut rand::rngs::SmallRng| {
-            DVec3::new(r.gen_range(2..28) as f64, r.gen_range(2..26) as f64, r.gen_range(2..30) as f64) * 0.5
+            DVec3::new(r.random_range(2..28) as f64, r.random_range(2..26) as f64, r.random_range(2..30) as f64) * 0.5
         };
         let m = soup(&[[p(&mut r), p(&mut r), p(&mut r)]]);
         for mode in [Mode::Sep26, Mode::Sep6, Mode::Ss6] {

@@ -26,7 +26,7 @@
 //! **Fast path.** The plane test passes one voxel per column of the
 //! dominant-axis projection; where the pixel lies strictly inside the
 //! projected triangle that voxel is set untested, elsewhere it gets the
-//! test above ([`columns`]). Triangles in a box of at most 27 voxels take
+//! test above (`columns`). Triangles in a box of at most 27 voxels take
 //! `cover`'s exact traversal with the test on each candidate. All in `i64`
 //! (relative to the first vertex) or `i128`.
 //!
