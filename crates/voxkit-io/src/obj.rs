@@ -67,6 +67,9 @@ struct Counts {
     vt: i64,
     /// `f` records (a lower bound on the triangles: one each).
     f: usize,
+    /// `mtllib` records: without any, no triangle's texture coordinates or
+    /// material is kept, so none is recorded.
+    mtllib: usize,
     lines: usize,
 }
 
@@ -81,9 +84,13 @@ pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKin
         total.v += c.v;
         total.vt += c.vt;
         total.lines += c.lines;
+        total.mtllib += c.mtllib;
     }
+    // Per-triangle texture coordinates and materials serve only materials,
+    // which come from material libraries resolved next to the file.
+    let appearance = total.mtllib > 0 && res.base().is_some();
     let parsed: Vec<Chunk> =
-        chunks.par_iter().zip(&before).zip(&counts).map(|((c, b), own)| parse_chunk(c, *b, own)).collect::<Result<_, _>>()?;
+        chunks.par_iter().zip(&before).zip(&counts).map(|((c, b), own)| parse_chunk(c, *b, own, appearance)).collect::<Result<_, _>>()?;
 
     let mut warnings = Vec::new();
     // Material libraries, in order of first mention.
@@ -113,8 +120,9 @@ pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKin
     let mut colours = Vec::new();
     let mut texcoords = Vec::with_capacity(total.vt as usize);
     let mut triangles = Vec::with_capacity(nt);
-    let mut tri_vt = Vec::with_capacity(nt);
-    let mut tri_material = Vec::with_capacity(nt);
+    let per_triangle = if appearance { nt } else { 0 };
+    let mut tri_vt = Vec::with_capacity(per_triangle);
+    let mut tri_material = Vec::with_capacity(per_triangle);
     let mut segments = Vec::new();
     let any_colour = parsed.iter().any(|c| c.colours.iter().any(Option::is_some));
     let mut current = NO_MATERIAL;
@@ -237,6 +245,7 @@ fn count(chunk: &[u8]) -> Counts {
             b"v" => c.v += 1,
             b"vt" => c.vt += 1,
             b"f" => c.f += 1,
+            b"mtllib" => c.mtllib += 1,
             _ => {}
         }
     }
@@ -347,14 +356,17 @@ fn index(w: &[u8]) -> Option<i64> {
 
 /// Parses one chunk; `before` counts the records of the chunks before it,
 /// `own` this chunk's (its vectors are allocated once at their size).
-fn parse_chunk(chunk: &[u8], before: Counts, own: &Counts) -> Result<Chunk, ErrorKind> {
+/// Triangles' texture coordinates and materials are recorded only with
+/// `appearance`.
+fn parse_chunk(chunk: &[u8], before: Counts, own: &Counts, appearance: bool) -> Result<Chunk, ErrorKind> {
+    let per_triangle = if appearance { own.f } else { 0 };
     let mut out = Chunk {
         positions: Vec::with_capacity(own.v as usize),
         colours: Vec::with_capacity(own.v as usize),
         texcoords: Vec::with_capacity(own.vt as usize),
         triangles: Vec::with_capacity(own.f),
-        triangle_vt: Vec::with_capacity(own.f),
-        triangle_material: Vec::with_capacity(own.f),
+        triangle_vt: Vec::with_capacity(per_triangle),
+        triangle_material: Vec::with_capacity(per_triangle),
         ..Chunk::default()
     };
     let mut material = INHERIT;
@@ -415,8 +427,10 @@ fn parse_chunk(chunk: &[u8], before: Counts, own: &Counts) -> Result<Chunk, Erro
                     for w in 1..poly.len() - 1 {
                         let c = [poly[0], poly[w], poly[w + 1]];
                         out.triangles.push(c.map(|p| p.0));
-                        out.triangle_vt.push(c.map(|p| p.1));
-                        out.triangle_material.push(material);
+                        if appearance {
+                            out.triangle_vt.push(c.map(|p| p.1));
+                            out.triangle_material.push(material);
+                        }
                     }
                 } else {
                     if poly.len() < 2 {
