@@ -309,14 +309,17 @@ fn octants<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], lo: [i64; 3], hi: [i6
         h if h > 0 => rising(0, -n[0]) | rising(1, -n[1]) | rising(2, -n[2]),
         _ => rising(0, n[0]) | rising(1, n[1]) | rising(2, n[2]),
     };
-    for (r, &nr) in n.iter().enumerate() {
+    // Indexed loops: with them the compiler unrolls both (iterating over
+    // `n` and `v` instead cost this test its whole gain).
+    #[allow(clippy::needless_range_loop)]
+    for r in 0..3 {
         let (p, q) = ((r + 1) % 3, (r + 2) % 3);
-        let sigma = if nr >= 0 { 1 } else { -1 };
-        for (i, vi) in v.iter().enumerate() {
+        let sigma = if n[r] >= 0 { 1 } else { -1 };
+        for i in 0..3 {
             let e = rel.edge(i);
             let (a, b) = (-e[q] * sigma, e[p] * sigma);
             // The edge function a·(x_p − v_p) + b·(x_q − v_q) at P.
-            if a * vi[p] + b * vi[q] > 0 {
+            if a * v[i][p] + b * v[i][q] > 0 {
                 mask &= rising(p, a) | rising(q, b);
             }
         }
