@@ -439,23 +439,16 @@ impl SlabView<'_> {
     #[inline(always)]
     pub fn get(&self, i: u32, j: u32, k: u32) -> bool {
         debug_assert!(k >= self.k0 && k < self.k1);
-        match self.existing_slot(i, j, k) {
-            Some(slot) => self.pool[slot][(k & 7) as usize] >> (((j & 7) << 3) | (i & 7)) & 1 == 1,
-            None => false,
-        }
-    }
-
-    /// The pool slot of the brick holding voxel `(i, j, k)`, if this slab
-    /// has allocated it.
-    #[inline(always)]
-    fn existing_slot(&self, i: u32, j: u32, k: u32) -> Option<usize> {
-        if self.last.0 == brick_key(i, j, k) {
-            return Some(self.last.1);
-        }
-        match self.index[self.entry(i, j, k)] {
-            0 => None,
-            id => Some(id as usize - 1),
-        }
+        let key = brick_key(i, j, k);
+        let slot = if self.last.0 == key {
+            self.last.1
+        } else {
+            match self.index[self.entry(i, j, k)] {
+                0 => return false,
+                id => id as usize - 1,
+            }
+        };
+        self.pool[slot][(k & 7) as usize] >> (((j & 7) << 3) | (i & 7)) & 1 == 1
     }
 
     /// Are all voxels of the inclusive box `[lo, hi]` set (by this slab)?
@@ -468,7 +461,15 @@ impl SlabView<'_> {
         if (l0 ^ h0) | (l1 ^ h1) | (l2 ^ h2) >= BRICK {
             return self.all_set_across(lo, hi);
         }
-        let Some(slot) = self.existing_slot(l0, l1, l2) else { return false };
+        let key = brick_key(l0, l1, l2);
+        let slot = if self.last.0 == key {
+            self.last.1
+        } else {
+            match self.index[self.entry(l0, l1, l2)] {
+                0 => return false,
+                id => id as usize - 1,
+            }
+        };
         // The box's x range in one row of the brick, repeated over its y rows.
         let row = ((2u64 << (h0 - l0)) - 1) << (l0 & 7);
         let rows = (0x0101_0101_0101_0101u64 >> ((7 - (h1 - l1)) << 3)) << ((l1 & 7) << 3);

@@ -384,8 +384,9 @@ impl<T: PlaneInt> PixelBounds<T> {
     /// Moves to the next pixel of the row.
     #[inline(always)]
     pub fn step(&mut self, delta: &[T; 6]) {
-        for (b, &d) in self.0.iter_mut().zip(delta) {
-            *b = *b + d;
+        #[allow(clippy::needless_range_loop)]
+        for i in 0..6 {
+            self.0[i] = self.0[i] + delta[i];
         }
     }
 }
