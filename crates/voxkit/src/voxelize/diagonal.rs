@@ -26,7 +26,7 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, Filter, Kernel};
-use super::targets::{fits_i64, LazyTargets, DIAGONALS};
+use super::targets::{fits_i64, LazyTargets, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -90,7 +90,8 @@ impl Kernel<LatticeTriangle> for DiagonalKernel {
 }
 
 fn filtered<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], traversal: Traversal, slab: &mut BrickSlab<'_>) {
-    let mut targets = LazyTargets::<T, 4>::new(tri, &DIAGONALS);
+    let mut setups = [None; 4];
+    let mut targets = LazyTargets::<T, 4>::new(tri, &DIAGONAL_SET, &mut setups);
     let keep = |ijk: [i64; 3]| targets.hits(which(ijk), ijk);
     cover_triangle(tri, lo, hi, traversal, &mut Filter { slab, keep });
 }

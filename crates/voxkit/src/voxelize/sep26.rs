@@ -23,7 +23,7 @@
 
 use super::cover::{PlaneRange, Setup as CoverSetup};
 use super::driver::{run_mesh, run_slabs, Kernel};
-use super::targets::{dominant_axes, fits_i64, is_tiny, targets_in_box, PixelTest, TriSetup, DIAGONALS};
+use super::targets::{dominant_axes, fits_i64, is_tiny, targets_in_box, PixelTest, TriSetup, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -51,7 +51,7 @@ impl Kernel<LatticeTriangle> for Sep26Kernel {
         if !fits_i64(tri) {
             project::<i128>(tri, lo, hi, slab);
         } else if is_tiny(lo, hi) {
-            targets_in_box(tri, &DIAGONALS, lo, hi, slab);
+            targets_in_box(tri, &DIAGONAL_SET, lo, hi, slab);
         } else {
             project::<i64>(tri, lo, hi, slab);
         }

@@ -27,7 +27,7 @@
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
 use super::driver::{run_mesh, run_slabs, Kernel};
-use super::targets::{dominant_axes, fits_i64, is_tiny, targets_in_box, PixelTest, TriSetup, CROSSHAIR};
+use super::targets::{dominant_axes, fits_i64, is_tiny, targets_in_box, PixelTest, TriSetup, CROSSHAIR_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -55,7 +55,7 @@ impl Kernel<LatticeTriangle> for Sep6Kernel {
         if !fits_i64(tri) {
             project::<i128>(tri, lo, hi, slab);
         } else if is_tiny(lo, hi) {
-            targets_in_box(tri, &CROSSHAIR, lo, hi, slab);
+            targets_in_box(tri, &CROSSHAIR_SET, lo, hi, slab);
         } else {
             project::<i64>(tri, lo, hi, slab);
         }

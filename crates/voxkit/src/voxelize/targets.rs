@@ -434,46 +434,92 @@ pub(crate) fn segment_may_meet_box_inv(a: P3, d: P3, inv: [f64; 3], lo: P3, hi: 
     t0 <= t1 + 1e-9 * (1.0 + t0.abs().max(t1.abs()))
 }
 
-/// One triangle against a fixed set of target segments (start offset from
-/// the voxel's low corner, direction). A target is decided by the cheapest
-/// test first: whether its end points straddle the (displaced) plane, from
-/// the voxel corner's plane value computed once per voxel (and each
-/// target's offset and direction plane values once per triangle); then, for small
-/// triangles, [`segment_may_meet_box`]; then the edge orientations, each
-/// direction's exact setup made on its first use. A small triangle is
-/// decided by a few comparisons for most targets.
+/// A fixed list of target segments (start offset from the voxel's low
+/// corner, direction) with each direction's [`reciprocals`], computed once
+/// per kernel rather than per triangle (tunnels have 26 directions).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TargetSet<const N: usize> {
+    seg: [(P3, P3); N],
+    inv: [[f64; 3]; N],
+    len: usize,
+}
+
+impl<const N: usize> TargetSet<N> {
+    /// The set of `list` (at most `N` targets).
+    pub const fn new(list: &[(P3, P3)]) -> Self {
+        assert!(list.len() <= N, "too many targets for the set");
+        let mut seg = [([0; 3], [0; 3]); N];
+        let mut inv = [[0.0; 3]; N];
+        let mut n = 0;
+        while n < list.len() {
+            seg[n] = list[n];
+            let mut c = 0;
+            while c < 3 {
+                let d = list[n].1[c];
+                inv[n][c] = if d == 0 { 0.0 } else { 1.0 / d as f64 };
+                c += 1;
+            }
+            n += 1;
+        }
+        TargetSet { seg, inv, len: list.len() }
+    }
+
+    /// The targets, in order.
+    pub fn segments(&self) -> &[(P3, P3)] {
+        &self.seg[..self.len]
+    }
+}
+
+/// [`DIAGONALS`] as a [`TargetSet`].
+pub(crate) const DIAGONAL_SET: TargetSet<4> = TargetSet::new(&DIAGONALS);
+
+/// [`CROSSHAIR`] as a [`TargetSet`].
+pub(crate) const CROSSHAIR_SET: TargetSet<3> = TargetSet::new(&CROSSHAIR);
+
+/// One triangle against a fixed set of target segments. A target is
+/// decided by the cheapest test first: whether its end points straddle the
+/// (displaced) plane, from the voxel corner's plane value computed once
+/// per voxel (and each target's offset and direction plane values once per
+/// triangle); then, for small triangles, [`segment_may_meet_box`]; then
+/// the edge orientations, each direction's exact setup made on its first
+/// use. A small triangle is decided by a few comparisons for most targets.
 pub(crate) struct LazyTargets<'t, T, const N: usize> {
     tri: &'t LatticeTriangle,
     s: TriSetup<T>,
     lo: P3,
     hi: P3,
-    /// Box-filter targets first (small triangles), with each direction's
-    /// reciprocals.
+    /// Box-filter targets first (small triangles).
     filter: bool,
-    inv: [[f64; 3]; N],
-    targets: &'t [(P3, P3)],
+    set: &'t TargetSet<N>,
     /// Per target: the plane value of its start offset and of its direction.
     planes: [(T, T); N],
-    setups: [Option<DirSetup<T>>; N],
+    /// Each direction's exact setup once made: kept by the caller, as
+    /// moving a kilobyte or more per triangle showed in profiles.
+    setups: &'t mut DirCache<T, N>,
 }
 
+/// Sets of more targets than this decide a small triangle's targets by
+/// [`TriSetup::segment_hits_once`] instead of cached direction setups: the
+/// tunnels' 18 or 26 directions (−10 % at 128 on the bunny), not the four
+/// diagonals, whose setups a small triangle's voxels share (+10–20 % there).
+const ONCE_ABOVE: usize = 4;
+
+/// The direction setups of [`LazyTargets`], on the caller's stack.
+pub(crate) type DirCache<T, const N: usize> = [Option<DirSetup<T>>; N];
+
 impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
-    /// Setup for `tri` against `targets` (at most `N`: the cache is sized
-    /// by the caller, as a few bytes per triangle matter at small grids).
+    /// Setup for `tri` against the targets of `set` (`N` is sized by the
+    /// caller, as a few bytes per triangle matter at small grids), with
+    /// `setups` a fresh `[None; N]`.
     /// Triangles wider than two voxels meet most targets' boxes, so theirs
     /// are set up at once and the filter is skipped.
-    pub fn new(tri: &'t LatticeTriangle, targets: &'t [(P3, P3)]) -> Self {
-        assert!(targets.len() <= N, "at most {N} targets");
+    #[inline(always)]
+    pub fn new(tri: &'t LatticeTriangle, set: &'t TargetSet<N>, setups: &'t mut DirCache<T, N>) -> Self {
         let (lo, hi) = tri.bounds();
         let s = TriSetup::new(tri);
-        let mut setups = [None; N];
         let filter = (0..3).all(|c| hi[c] - lo[c] <= 2 * ONE);
-        let mut inv = [[0.0; 3]; N];
-        if filter {
-            for (r, (_, d)) in inv.iter_mut().zip(targets) {
-                *r = reciprocals(*d);
-            }
-        } else {
+        let targets = set.segments();
+        if !filter {
             for (slot, (_, d)) in setups.iter_mut().zip(targets) {
                 *slot = Some(s.dir(tri, *d));
             }
@@ -482,7 +528,7 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
         for (pl, (o, d)) in planes.iter_mut().zip(targets) {
             *pl = (dot(s.n, o.map(T::from_i64)), dot(s.n, d.map(T::from_i64)));
         }
-        LazyTargets { tri, s, lo, hi, filter, inv, targets, planes, setups }
+        LazyTargets { tri, s, lo, hi, filter, set, planes, setups }
     }
 
     /// Does the displaced target `n` of voxel `ijk` meet the triangle?
@@ -499,19 +545,24 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
     /// triangle (`pc`) and its plane value `vc`.
     #[inline(always)]
     fn hits_from(&mut self, n: usize, c: P3, pc: [T; 3], vc: T) -> bool {
-        let (o, d) = self.targets[n];
+        let (o, d) = self.set.seg[n];
         let s = &self.s;
         let (no, nd) = self.planes[n];
         let vp = vc + no;
         if (vp >= s.bn) == (vp + nd >= s.bn) {
             return false;
         }
-        if self.filter && !segment_may_meet_box_inv(add(c, o), d, self.inv[n], self.lo, self.hi) {
+        if self.filter && !segment_may_meet_box_inv(add(c, o), d, self.set.inv[n], self.lo, self.hi) {
             return false;
         }
         let tri = self.tri;
-        let ds = self.setups[n].get_or_insert_with(|| s.dir(tri, d));
         let p = std::array::from_fn(|a| pc[a] + T::from_i64(o[a]));
+        if self.filter && N > ONCE_ABOVE {
+            // Many directions, each met by few voxels of a small triangle:
+            // a direction's setup would rarely be used twice.
+            return s.segment_hits_once(tri, p, d, vp);
+        }
+        let ds = self.setups[n].get_or_insert_with(|| s.dir(tri, d));
         s.segment_hits_with(ds, p, vp)
     }
 
@@ -521,7 +572,7 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
         let c = corner(ijk);
         let pc = self.s.local(c);
         let vc = self.s.plane(pc);
-        (0..self.targets.len()).any(|n| self.hits_from(n, c, pc, vc))
+        (0..self.set.len).any(|n| self.hits_from(n, c, pc, vc))
     }
 }
 
@@ -542,14 +593,15 @@ pub(crate) fn is_tiny(lo: [i64; 3], hi: [i64; 3]) -> bool {
 /// already set are skipped.
 pub(crate) fn targets_in_box<const N: usize>(
     tri: &LatticeTriangle,
-    targets: &[(P3, P3); N],
+    targets: &TargetSet<N>,
     lo: [i64; 3],
     hi: [i64; 3],
     slab: &mut BrickSlab<'_>,
 ) {
     debug_assert!(fits_i64(tri));
     // Every target lies in its closed voxel: only `cover`'s voxels can hit.
-    let mut lazy = LazyTargets::<i64, N>::new(tri, targets);
+    let mut setups = [None; N];
+    let mut lazy = LazyTargets::<i64, N>::new(tri, targets, &mut setups);
     let keep = |ijk: [i64; 3]| lazy.any(ijk);
     cover_triangle(tri, lo, hi, Traversal::Auto, &mut FilterUnset { slab, keep });
 }
@@ -591,8 +643,9 @@ mod tests {
                 proptest::prop_assert!(segment_may_meet_box(a, d, lo, hi));
             }
             if t.normal() != [0, 0, 0] && fits_i64(&t) {
-                let targets = [(a, d)];
-                let mut lazy = LazyTargets::<i64, 1>::new(&t, &targets);
+                let targets = TargetSet::<1>::new(&[(a, d)]);
+                let mut setups = [None; 1];
+                let mut lazy = LazyTargets::<i64, 1>::new(&t, &targets, &mut setups);
                 proptest::prop_assert_eq!(lazy.hits(0, [0, 0, 0]), segment_meets_triangle(seg, t.v, true));
                 let s = TriSetup::<i64>::new(&t);
                 let p = s.local(a);
@@ -634,8 +687,10 @@ mod tests {
             // The lazy tests (plane first, box filter, setups on first use),
             // one target at a time and any of a voxel's, in either order.
             for targets in [&DIAGONALS[..], &CROSSHAIR[..]] {
-                let mut lazy = LazyTargets::<i64, 4>::new(t, targets);
-                let mut wide = LazyTargets::<i128, 4>::new(t, targets);
+                let set = TargetSet::<4>::new(targets);
+                let (mut narrow_setups, mut wide_setups) = ([None; 4], [None; 4]);
+                let mut lazy = LazyTargets::<i64, 4>::new(t, &set, &mut narrow_setups);
+                let mut wide = LazyTargets::<i128, 4>::new(t, &set, &mut wide_setups);
                 for k in (-1..3).rev() {
                     for j in -1..3 {
                         for i in -1..3 {

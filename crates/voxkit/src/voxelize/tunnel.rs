@@ -31,7 +31,7 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, FilterUnset, Kernel};
-use super::targets::{fits_i64, LazyTargets};
+use super::targets::{fits_i64, LazyTargets, TargetSet};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -74,17 +74,23 @@ pub fn targets(target: TunnelTarget) -> Vec<(P3, P3)> {
 
 /// Tunnel-free voxelization, fast path, into sparse bricks.
 pub fn tunnel(mesh: MeshRef<'_>, grid: &GridSpec, target: TunnelTarget, opts: &Options<'_>) -> (BrickBits, Report) {
-    run_mesh(&TunnelKernel { dirs: targets(target), traversal: opts.traversal }, mesh, grid, opts)
+    run_mesh(&TunnelKernel::new(target, opts), mesh, grid, opts)
 }
 
 /// The fast path on already prepared triangles.
 pub fn tunnel_lattice(tris: &[LatticeTriangle], dims: [u32; 3], target: TunnelTarget, opts: &Options<'_>) -> BrickBits {
-    super::driver::run_slabs(&TunnelKernel { dirs: targets(target), traversal: opts.traversal }, tris, dims, opts).0
+    super::driver::run_slabs(&TunnelKernel::new(target, opts), tris, dims, opts).0
 }
 
 struct TunnelKernel {
-    dirs: Vec<(P3, P3)>,
+    dirs: TargetSet<26>,
     traversal: Traversal,
+}
+
+impl TunnelKernel {
+    fn new(target: TunnelTarget, opts: &Options<'_>) -> TunnelKernel {
+        TunnelKernel { dirs: TargetSet::new(&targets(target)), traversal: opts.traversal }
+    }
 }
 
 impl Kernel<LatticeTriangle> for TunnelKernel {
@@ -99,13 +105,14 @@ impl Kernel<LatticeTriangle> for TunnelKernel {
 
 fn filtered<T: PlaneInt>(
     tri: &LatticeTriangle,
-    dirs: &[(P3, P3)],
+    dirs: &TargetSet<26>,
     lo: [i64; 3],
     hi: [i64; 3],
     traversal: Traversal,
     slab: &mut BrickSlab<'_>,
 ) {
-    let mut targets = LazyTargets::<T, 26>::new(tri, dirs);
+    let mut setups = [None; 26];
+    let mut targets = LazyTargets::<T, 26>::new(tri, dirs, &mut setups);
     let keep = |ijk: [i64; 3]| targets.any(ijk);
     cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
 }
