@@ -27,7 +27,7 @@
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
 use super::driver::{run_mesh, run_slabs, Kernel};
-use super::targets::{dominant_axes, fits_i64, is_tiny, targets_in_box, PixelTest, TriSetup, CROSSHAIR_SET};
+use super::targets::{dominant_axes, fits_i64, is_tiny, mid_planes, targets_in_box, PixelTest, TriSetup, CROSSHAIR_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -50,12 +50,23 @@ pub fn sep6_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>
 
 struct Sep6Kernel;
 
+/// A triangle whose box [`is_tiny`]: its crosshair targets one by one,
+/// unless its box holds mid-planes on fewer than two axes (then it meets
+/// no crosshair segment).
+#[inline(never)]
+fn tiny(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+    let (blo, bhi) = tri.bounds();
+    if mid_planes(blo, bhi).iter().filter(|&&m| m).count() >= 2 {
+        targets_in_box(tri, &CROSSHAIR_SET, lo, hi, slab);
+    }
+}
+
 impl Kernel<LatticeTriangle> for Sep6Kernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
         if !fits_i64(tri) {
             project::<i128>(tri, lo, hi, slab);
         } else if is_tiny(lo, hi) {
-            targets_in_box(tri, &CROSSHAIR_SET, lo, hi, slab);
+            tiny(tri, lo, hi, slab);
         } else {
             project::<i64>(tri, lo, hi, slab);
         }
@@ -70,6 +81,7 @@ fn unit(a: usize) -> [i64; 3] {
 
 /// Laine's single-projection algorithm for one triangle, restricted to the
 /// voxel box `[lo, hi]`.
+#[inline(never)]
 fn project<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     let s = TriSetup::<T>::new(tri);
     let n = tri.normal();

@@ -391,6 +391,43 @@ impl<T: PlaneInt> PixelBounds<T> {
     }
 }
 
+/// Per axis `a`: does the closed lattice box `[lo, hi]`, grown by one
+/// lattice unit (the tie rule's displacement is infinitesimal), hold one
+/// of the voxels' mid-planes `x_a = m·ONE + H`? Every target of `sep6`
+/// (the crosshair) lies on two mid-planes and every target of `tunnel18`
+/// on at least one, so a triangle whose box holds fewer meets none of
+/// them: at 32³ most triangles are an eighth of a voxel wide and are
+/// decided here by a few integer comparisons, before any setup.
+#[inline(always)]
+pub(crate) fn mid_planes(lo: P3, hi: P3) -> [bool; 3] {
+    std::array::from_fn(|a| (lo[a] - 1 - H + ONE - 1).div_euclid(ONE) <= (hi[a] + 1 - H).div_euclid(ONE))
+}
+
+/// Can a space diagonal of some voxel meet a triangle in the closed
+/// lattice box `[lo, hi]` (grown by one lattice unit for the tie rule)?
+/// Along a diagonal of direction `(s₀, s₁, s₂)` (signs) the values
+/// `s₁x − s₀y` and `s₂y − s₁z` are constant, and multiples of `ONE`, as
+/// the diagonal joins voxel corners; a box over which either misses every
+/// multiple of `ONE`, for each of the four directions, meets no diagonal.
+/// Decides most triangles much smaller than a voxel (at 32³) by integer
+/// comparisons, before any setup.
+#[inline(always)]
+pub(crate) fn diagonals_may_meet(lo: P3, hi: P3) -> bool {
+    let (l, h) = (lo.map(|c| c - 1), hi.map(|c| c + 1));
+    // Does `a·x_p + b·x_q` (a, b = ±1) reach a multiple of ONE over the box?
+    let reaches = |a: i64, p: usize, b: i64, q: usize| {
+        let (min, max) = (
+            if a > 0 { l[p] } else { -h[p] } + if b > 0 { l[q] } else { -h[q] },
+            if a > 0 { h[p] } else { -l[p] } + if b > 0 { h[q] } else { -l[q] },
+        );
+        (min + ONE - 1).div_euclid(ONE) <= max.div_euclid(ONE)
+    };
+    DIAGONALS.iter().any(|(_, d)| {
+        let s = d.map(i64::signum);
+        reaches(s[1], 0, -s[0], 1) && reaches(s[2], 1, -s[1], 2)
+    })
+}
+
 /// Is a triangle with these lattice bounds small enough for `i64` setups?
 pub(crate) fn fits_i64(t: &LatticeTriangle) -> bool {
     let (lo, hi) = t.bounds();
@@ -650,6 +687,55 @@ mod tests {
                 let s = TriSetup::<i64>::new(&t);
                 let p = s.local(a);
                 proptest::prop_assert_eq!(s.segment_hits_once(&t, p, d, s.plane(p)), segment_meets_triangle(seg, t.v, true));
+            }
+        }
+    }
+
+    proptest::proptest! {
+        /// A triangle that meets a crosshair segment of some voxel has mid-planes
+        /// in its box on two axes; one that meets a `tunnel18` target, on
+        /// one; one that meets a space diagonal passes `diagonals_may_meet`.
+        #[test]
+        fn integer_box_tests_hold_every_hit(
+            cell in proptest::array::uniform3(-1i64..=1),
+            target in 0usize..25,
+            along in 0i64..=16,
+            off in proptest::array::uniform2(proptest::array::uniform3(-ONE / 4..=ONE / 4)),
+            shrink in proptest::sample::select(vec![1i64, 4, 16]),
+            coarse in proptest::bool::ANY,
+        ) {
+            // Small and tiny triangles (the ones the tests reject), some
+            // with coordinates on an eighth of a voxel: on mid-planes,
+            // faces and corners.
+            // Around a point of some voxel's diagonal, crosshair segment or
+            // tunnel18 target, so that hits are common.
+            let tunnel = crate::voxelize::tunnel::targets(crate::voxelize::tunnel::TunnelTarget::Eighteen);
+            let all: Vec<(P3, P3)> = DIAGONALS.iter().chain(CROSSHAIR.iter()).chain(tunnel.iter()).copied().collect();
+            let (o, d) = all[target];
+            let base: P3 = std::array::from_fn(|c| cell[c] * ONE + o[c] + d[c] * along / 16);
+            // Centroid on it (the third offset is minus the other two).
+            let off: [[i64; 3]; 3] = [off[0], off[1], std::array::from_fn(|c| -off[0][c] - off[1][c])];
+            let v = off.map(|o| std::array::from_fn(|c| base[c] + o[c] / shrink));
+            let v = if coarse { v.map(|p: [i64; 3]| p.map(|c| c.div_euclid(ONE / 8) * (ONE / 8))) } else { v };
+            let t = lt(v);
+            let (lo, hi) = t.bounds();
+            let mids = mid_planes(lo, hi).iter().filter(|&&m| m).count();
+            for k in -2..3 {
+                for j in -2..3 {
+                    for i in -2..3 {
+                        let ijk = [i, j, k];
+                        if sep6_hit(&t, ijk) {
+                            proptest::prop_assert!(mids >= 2, "{t:?} {ijk:?}");
+                        }
+                        if sep26_hit(&t, ijk) {
+                            proptest::prop_assert!(diagonals_may_meet(lo, hi), "{t:?} {ijk:?}");
+                        }
+                        let c = corner(ijk);
+                        if tunnel.iter().any(|(o, d)| segment_meets_triangle([add(c, *o), add(add(c, *o), *d)], t.v, true)) {
+                            proptest::prop_assert!(mids >= 1, "{t:?} {ijk:?}");
+                        }
+                    }
+                }
             }
         }
     }
