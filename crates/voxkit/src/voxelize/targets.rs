@@ -405,27 +405,38 @@ pub(crate) fn mid_planes(lo: P3, hi: P3) -> [bool; 3] {
 
 /// Can a space diagonal of some voxel meet a triangle in the closed
 /// lattice box `[lo, hi]` (grown by one lattice unit for the tie rule)?
-/// Along a diagonal of direction `(s₀, s₁, s₂)` (signs) the values
-/// `s₁x − s₀y` and `s₂y − s₁z` are constant, and multiples of `ONE`, as
-/// the diagonal joins voxel corners; a box over which either misses every
-/// multiple of `ONE`, for each of the four directions, meets no diagonal.
-/// Decides most triangles much smaller than a voxel (at 32³) by integer
-/// comparisons, before any setup.
+/// Along a diagonal the values `x ± y` and `y ± z` of its direction are
+/// constant multiples of `ONE` (it joins voxel corners), so a box that
+/// misses either form of each of the four directions ([`forms_reached`])
+/// meets no diagonal. Decides most triangles much smaller than a voxel
+/// (at 32³) by integer comparisons, before any setup.
 #[inline(always)]
 pub(crate) fn diagonals_may_meet(lo: P3, hi: P3) -> bool {
+    let reached = forms_reached(lo, hi);
+    DIAGONAL_SET.needs.iter().any(|n| n & !reached == 0)
+}
+
+/// The invariant forms whose values the closed lattice box `[lo, hi]`
+/// (grown by one lattice unit for the tie rule) reaches, as bits: bit `a`
+/// (`a` < 3) if `x_a ≡ H (mod ONE)` somewhere (a voxel mid-plane, as in
+/// [`mid_planes`]); bit `3 + 2i` (`3 + 2i + 1`) if `x_p + x_q` (`x_p −
+/// x_q`) reaches a multiple of `ONE`, for the `i`-th axis pair `(p, q)`.
+/// A target that needs a form the box misses cannot meet the triangle
+/// ([`TargetSet`]).
+#[inline(always)]
+pub(crate) fn forms_reached(lo: P3, hi: P3) -> u16 {
     let (l, h) = (lo.map(|c| c - 1), hi.map(|c| c + 1));
-    // Does `a·x_p + b·x_q` (a, b = ±1) reach a multiple of ONE over the box?
-    let reaches = |a: i64, p: usize, b: i64, q: usize| {
-        let (min, max) = (
-            if a > 0 { l[p] } else { -h[p] } + if b > 0 { l[q] } else { -h[q] },
-            if a > 0 { h[p] } else { -l[p] } + if b > 0 { h[q] } else { -l[q] },
-        );
-        (min + ONE - 1).div_euclid(ONE) <= max.div_euclid(ONE)
-    };
-    DIAGONALS.iter().any(|(_, d)| {
-        let s = d.map(i64::signum);
-        reaches(s[1], 0, -s[0], 1) && reaches(s[2], 1, -s[1], 2)
-    })
+    let mut bits = 0u16;
+    for (a, m) in mid_planes(lo, hi).into_iter().enumerate() {
+        bits |= (m as u16) << a;
+    }
+    for (i, &(p, q)) in PAIRS.iter().enumerate() {
+        // x_p + x_q over [l_p + l_q, h_p + h_q]; x_p − x_q over [l_p − h_q, h_p − l_q].
+        let plus = (l[p] + l[q] + ONE - 1).div_euclid(ONE) <= (h[p] + h[q]).div_euclid(ONE);
+        let minus = (l[p] - h[q] + ONE - 1).div_euclid(ONE) <= (h[p] - l[q]).div_euclid(ONE);
+        bits |= (plus as u16) << (3 + 2 * i) | (minus as u16) << (4 + 2 * i);
+    }
+    bits
 }
 
 /// Is a triangle with these lattice bounds small enough for `i64` setups?
@@ -478,27 +489,77 @@ pub(crate) fn segment_may_meet_box_inv(a: P3, d: P3, inv: [f64; 3], lo: P3, hi: 
 pub(crate) struct TargetSet<const N: usize> {
     seg: [(P3, P3); N],
     inv: [[f64; 3]; N],
+    /// Per target: the [`forms_reached`] bits every triangle that meets
+    /// one of its translates by whole voxels must have.
+    needs: [u16; N],
     len: usize,
 }
 
+/// The axis pairs of the [`forms_reached`] pair forms.
+const PAIRS: [(usize, usize); 3] = [(0, 1), (1, 2), (0, 2)];
+
 impl<const N: usize> TargetSet<N> {
-    /// The set of `list` (at most `N` targets).
+    /// The set of `list` (at most `N`, and at most 32, targets).
     pub const fn new(list: &[(P3, P3)]) -> Self {
-        assert!(list.len() <= N, "too many targets for the set");
+        assert!(list.len() <= N && N <= 32, "too many targets for the set");
         let mut seg = [([0; 3], [0; 3]); N];
         let mut inv = [[0.0; 3]; N];
+        let mut needs = [0u16; N];
         let mut n = 0;
         while n < list.len() {
             seg[n] = list[n];
+            let (o, d) = list[n];
             let mut c = 0;
             while c < 3 {
-                let d = list[n].1[c];
-                inv[n][c] = if d == 0 { 0.0 } else { 1.0 / d as f64 };
+                inv[n][c] = if d[c] == 0 { 0.0 } else { 1.0 / d[c] as f64 };
                 c += 1;
             }
+            needs[n] = Self::needs(o, d);
             n += 1;
         }
-        TargetSet { seg, inv, len: list.len() }
+        TargetSet { seg, inv, needs, len: list.len() }
+    }
+
+    /// The [`forms_reached`] bits a triangle meeting a whole-voxel
+    /// translate of the segment from `o` along `d` must have. Along the
+    /// segment a coordinate `x_q` with `d_q = 0` stays `o_q`, and where
+    /// `|d_p| = |d_q| ≠ 0`, `x_p + σ·x_q` with `σ = −sign(d_p·d_q)` stays
+    /// `o_p + σ·o_q`; translates add multiples of `ONE`. Only the forms
+    /// the bits stand for (`x_q ≡ H`, `x_p ± x_q ≡ 0`) are required; a
+    /// segment of unequal non-zero steps requires none.
+    const fn needs(o: P3, d: P3) -> u16 {
+        let mut mag = 0;
+        let mut c = 0;
+        while c < 3 {
+            let a = d[c].abs();
+            if a != 0 {
+                if mag != 0 && a != mag {
+                    return 0;
+                }
+                mag = a;
+            }
+            c += 1;
+        }
+        let mut bits = 0u16;
+        c = 0;
+        while c < 3 {
+            if d[c] == 0 && o[c].rem_euclid(ONE) == H {
+                bits |= 1 << c;
+            }
+            c += 1;
+        }
+        let mut i = 0;
+        while i < 3 {
+            let (p, q) = PAIRS[i];
+            if d[p] != 0 && d[q] != 0 {
+                let sigma = -d[p].signum() * d[q].signum();
+                if (o[p] + sigma * o[q]).rem_euclid(ONE) == 0 {
+                    bits |= 1 << (3 + 2 * i + (sigma < 0) as usize);
+                }
+            }
+            i += 1;
+        }
+        bits
     }
 
     /// The targets, in order.
@@ -530,6 +591,9 @@ pub(crate) struct LazyTargets<'t, T, const N: usize> {
     set: &'t TargetSet<N>,
     /// Per target: the plane value of its start offset and of its direction.
     planes: [(T, T); N],
+    /// The targets that may meet the triangle (bit `n`): for small
+    /// triangles, those whose [`TargetSet`] forms the box reaches.
+    live: u32,
     /// Each direction's exact setup once made: kept by the caller, as
     /// moving a kilobyte or more per triangle showed in profiles.
     setups: &'t mut DirCache<T, N>,
@@ -565,13 +629,27 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
         for (pl, (o, d)) in planes.iter_mut().zip(targets) {
             *pl = (dot(s.n, o.map(T::from_i64)), dot(s.n, d.map(T::from_i64)));
         }
-        LazyTargets { tri, s, lo, hi, filter, set, planes, setups }
+        let mut live = u32::MAX.checked_shr(32 - set.len as u32).unwrap_or(0);
+        // Triangles under half a voxel (most at 32³) miss most forms; at
+        // about a voxel (128³) they reach nearly all, and the test cost 3 %.
+        if (0..3).all(|c| hi[c] - lo[c] <= H) {
+            let reached = forms_reached(lo, hi);
+            for (n, needs) in set.needs[..set.len].iter().enumerate() {
+                if needs & !reached != 0 {
+                    live &= !(1 << n);
+                }
+            }
+        }
+        LazyTargets { tri, s, lo, hi, filter, set, planes, live, setups }
     }
 
     /// Does the displaced target `n` of voxel `ijk` meet the triangle?
     /// The same decision as [`segment_meets_triangle`].
     #[inline]
     pub fn hits(&mut self, n: usize, ijk: [i64; 3]) -> bool {
+        if self.live >> n & 1 == 0 {
+            return false;
+        }
         let c = corner(ijk);
         let pc = self.s.local(c);
         let vc = self.s.plane(pc);
@@ -609,7 +687,7 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
         let c = corner(ijk);
         let pc = self.s.local(c);
         let vc = self.s.plane(pc);
-        (0..self.set.len).any(|n| self.hits_from(n, c, pc, vc))
+        (0..self.set.len).any(|n| self.live >> n & 1 != 0 && self.hits_from(n, c, pc, vc))
     }
 }
 
@@ -720,6 +798,14 @@ mod tests {
             let t = lt(v);
             let (lo, hi) = t.bounds();
             let mids = mid_planes(lo, hi).iter().filter(|&&m| m).count();
+            let reached = forms_reached(lo, hi);
+            // Every target of the sets the kernels use, with the forms it needs.
+            let every: Vec<((P3, P3), u16)> = crate::voxelize::tunnel::targets(crate::voxelize::tunnel::TunnelTarget::TwentySix)
+                .into_iter()
+                .chain(DIAGONALS)
+                .chain(CROSSHAIR)
+                .map(|t| (t, TargetSet::<1>::new(&[t]).needs[0]))
+                .collect();
             for k in -2..3 {
                 for j in -2..3 {
                     for i in -2..3 {
@@ -734,10 +820,26 @@ mod tests {
                         if tunnel.iter().any(|(o, d)| segment_meets_triangle([add(c, *o), add(add(c, *o), *d)], t.v, true)) {
                             proptest::prop_assert!(mids >= 1, "{t:?} {ijk:?}");
                         }
+                        for ((o, d), needs) in &every {
+                            if segment_meets_triangle([add(c, *o), add(add(c, *o), *d)], t.v, true) {
+                                proptest::prop_assert_eq!(needs & !reached, 0, "{:?} {:?} target {:?}", t, ijk, (o, d));
+                            }
+                        }
                     }
                 }
             }
         }
+    }
+
+    #[test]
+    fn target_sets_need_their_forms() {
+        // The diagonals need two pair forms, the crosshair two mid-planes,
+        // a tunnel target to an edge midpoint one of each.
+        assert!(DIAGONAL_SET.needs.iter().all(|n| n.count_ones() == 3));
+        assert!(CROSSHAIR_SET.needs.iter().all(|n| *n & 0b111 != 0 && n.count_ones() == 2));
+        assert_eq!(TargetSet::<1>::new(&[([H, H, H], [H, H, 0])]).needs[0], 1 << 2 | 1 << 4);
+        // Unequal steps need nothing.
+        assert_eq!(TargetSet::<1>::new(&[([0, 0, 0], [ONE, H, 0])]).needs[0], 0);
     }
 
     #[test]
