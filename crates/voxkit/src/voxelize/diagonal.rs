@@ -26,7 +26,7 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, Filter, Kernel};
-use super::targets::{diagonals_may_meet, fits_i64, is_tiny, LazyTargets, DIAGONALS, DIAGONAL_SET};
+use super::targets::{fits_i64, is_tiny, LazyTargets, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -84,7 +84,7 @@ impl Kernel<LatticeTriangle> for DiagonalKernel {
         // Integer test first: most triangles at 32³ pass no space diagonal.
         if is_tiny(lo, hi) {
             let (blo, bhi) = tri.bounds();
-            if !diagonals_may_meet(blo, bhi) {
+            if !DIAGONAL_SET.may_meet(blo, bhi) {
                 return;
             }
         }

@@ -23,7 +23,7 @@
 
 use super::cover::{PlaneRange, Setup as CoverSetup};
 use super::driver::{run_mesh, run_slabs, Kernel};
-use super::targets::{diagonals_may_meet, dominant_axes, fits_i64, is_tiny, targets_in_box, PixelTest, TriSetup, DIAGONALS, DIAGONAL_SET};
+use super::targets::{dominant_axes, fits_i64, is_tiny, targets_in_box, PixelTest, TriSetup, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -52,7 +52,7 @@ struct Sep26Kernel;
 #[inline(never)]
 fn tiny(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     let (blo, bhi) = tri.bounds();
-    if diagonals_may_meet(blo, bhi) {
+    if DIAGONAL_SET.may_meet(blo, bhi) {
         targets_in_box(tri, &DIAGONAL_SET, lo, hi, slab);
     }
 }

@@ -27,7 +27,7 @@
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
 use super::driver::{run_mesh, run_slabs, Kernel};
-use super::targets::{dominant_axes, fits_i64, is_tiny, mid_planes, targets_in_box, PixelTest, TriSetup, CROSSHAIR_SET};
+use super::targets::{dominant_axes, fits_i64, is_tiny, targets_in_box, PixelTest, TriSetup, CROSSHAIR_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -52,11 +52,11 @@ struct Sep6Kernel;
 
 /// A triangle whose box [`is_tiny`]: its crosshair targets one by one,
 /// unless its box holds mid-planes on fewer than two axes (then it meets
-/// no crosshair segment).
+/// no crosshair segment, `TargetSet::may_meet`).
 #[inline(never)]
 fn tiny(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     let (blo, bhi) = tri.bounds();
-    if mid_planes(blo, bhi).iter().filter(|&&m| m).count() >= 2 {
+    if CROSSHAIR_SET.may_meet(blo, bhi) {
         targets_in_box(tri, &CROSSHAIR_SET, lo, hi, slab);
     }
 }

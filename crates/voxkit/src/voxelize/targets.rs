@@ -403,19 +403,6 @@ pub(crate) fn mid_planes(lo: P3, hi: P3) -> [bool; 3] {
     std::array::from_fn(|a| (lo[a] - 1 - H + ONE - 1).div_euclid(ONE) <= (hi[a] + 1 - H).div_euclid(ONE))
 }
 
-/// Can a space diagonal of some voxel meet a triangle in the closed
-/// lattice box `[lo, hi]` (grown by one lattice unit for the tie rule)?
-/// Along a diagonal the values `x ± y` and `y ± z` of its direction are
-/// constant multiples of `ONE` (it joins voxel corners), so a box that
-/// misses either form of each of the four directions ([`forms_reached`])
-/// meets no diagonal. Decides most triangles much smaller than a voxel
-/// (at 32³) by integer comparisons, before any setup.
-#[inline(always)]
-pub(crate) fn diagonals_may_meet(lo: P3, hi: P3) -> bool {
-    let reached = forms_reached(lo, hi);
-    DIAGONAL_SET.needs.iter().any(|n| n & !reached == 0)
-}
-
 /// The invariant forms whose values the closed lattice box `[lo, hi]`
 /// (grown by one lattice unit for the tie rule) reaches, as bits: bit `a`
 /// (`a` < 3) if `x_a ≡ H (mod ONE)` somewhere (a voxel mid-plane, as in
@@ -459,8 +446,16 @@ pub(crate) fn segment_may_meet_box(a: P3, d: P3, lo: P3, hi: P3) -> bool {
 
 /// `1 / d` per axis (0 where `d` is 0), for [`segment_may_meet_box_inv`].
 #[inline]
-pub(crate) fn reciprocals(d: P3) -> [f64; 3] {
-    d.map(|c| if c == 0 { 0.0 } else { 1.0 / c as f64 })
+pub(crate) const fn reciprocals(d: P3) -> [f64; 3] {
+    let mut r = [0.0; 3];
+    let mut c = 0;
+    while c < 3 {
+        if d[c] != 0 {
+            r[c] = 1.0 / d[c] as f64;
+        }
+        c += 1;
+    }
+    r
 }
 
 /// [`segment_may_meet_box`] given `inv = reciprocals(d)`.
@@ -509,11 +504,7 @@ impl<const N: usize> TargetSet<N> {
         while n < list.len() {
             seg[n] = list[n];
             let (o, d) = list[n];
-            let mut c = 0;
-            while c < 3 {
-                inv[n][c] = if d[c] == 0 { 0.0 } else { 1.0 / d[c] as f64 };
-                c += 1;
-            }
+            inv[n] = reciprocals(d);
             needs[n] = Self::needs(o, d);
             n += 1;
         }
@@ -565,6 +556,17 @@ impl<const N: usize> TargetSet<N> {
     /// The targets, in order.
     pub fn segments(&self) -> &[(P3, P3)] {
         &self.seg[..self.len]
+    }
+
+    /// Can one of the targets, in some voxel, meet a triangle whose
+    /// vertices lie in the closed lattice box `[lo, hi]`? Only if the box
+    /// reaches every form one target [`Self::needs`] ([`forms_reached`]).
+    /// Decides most triangles much smaller than a voxel (at 32³) by a few
+    /// integer comparisons, before any setup.
+    #[inline(always)]
+    pub fn may_meet(&self, lo: P3, hi: P3) -> bool {
+        let reached = forms_reached(lo, hi);
+        self.needs[..self.len].iter().any(|n| n & !reached == 0)
     }
 }
 
@@ -772,7 +774,7 @@ mod tests {
     proptest::proptest! {
         /// A triangle that meets a crosshair segment of some voxel has mid-planes
         /// in its box on two axes; one that meets a `tunnel18` target, on
-        /// one; one that meets a space diagonal passes `diagonals_may_meet`.
+        /// one; one that meets a target of a set passes its `may_meet`.
         #[test]
         fn integer_box_tests_hold_every_hit(
             cell in proptest::array::uniform3(-1i64..=1),
@@ -814,7 +816,10 @@ mod tests {
                             proptest::prop_assert!(mids >= 2, "{t:?} {ijk:?}");
                         }
                         if sep26_hit(&t, ijk) {
-                            proptest::prop_assert!(diagonals_may_meet(lo, hi), "{t:?} {ijk:?}");
+                            proptest::prop_assert!(DIAGONAL_SET.may_meet(lo, hi), "{t:?} {ijk:?}");
+                        }
+                        if sep6_hit(&t, ijk) {
+                            proptest::prop_assert!(CROSSHAIR_SET.may_meet(lo, hi), "{t:?} {ijk:?}");
                         }
                         let c = corner(ijk);
                         if tunnel.iter().any(|(o, d)| segment_meets_triangle([add(c, *o), add(add(c, *o), *d)], t.v, true)) {

@@ -31,7 +31,7 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, FilterUnset, Kernel};
-use super::targets::{diagonals_may_meet, fits_i64, mid_planes, LazyTargets, TargetSet};
+use super::targets::{fits_i64, LazyTargets, TargetSet};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -84,15 +84,12 @@ pub fn tunnel_lattice(tris: &[LatticeTriangle], dims: [u32; 3], target: TunnelTa
 
 struct TunnelKernel {
     dirs: TargetSet<26>,
-    /// The targets to the corners too (`tunnel26`: halves of the space
-    /// diagonals; the others lie on voxel mid-planes).
-    corners: bool,
     traversal: Traversal,
 }
 
 impl TunnelKernel {
     fn new(target: TunnelTarget, opts: &Options<'_>) -> TunnelKernel {
-        TunnelKernel { dirs: TargetSet::new(&targets(target)), corners: target == TunnelTarget::TwentySix, traversal: opts.traversal }
+        TunnelKernel { dirs: TargetSet::new(&targets(target)), traversal: opts.traversal }
     }
 }
 
@@ -100,7 +97,7 @@ impl Kernel<LatticeTriangle> for TunnelKernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
         // Integer tests first: most triangles at 32³ pass no target line.
         let (blo, bhi) = tri.bounds();
-        if mid_planes(blo, bhi) == [false; 3] && !(self.corners && diagonals_may_meet(blo, bhi)) {
+        if !self.dirs.may_meet(blo, bhi) {
             return;
         }
         if fits_i64(tri) {
