@@ -97,8 +97,7 @@ impl Kernel<LatticeTriangle> for DiagonalKernel {
 }
 
 fn filtered<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], traversal: Traversal, slab: &mut BrickSlab<'_>) {
-    let mut setups = [None; 4];
-    let mut targets = LazyTargets::<T, 4>::new(tri, &DIAGONAL_SET, &mut setups);
+    let targets = LazyTargets::<T, 4>::new(tri, &DIAGONAL_SET);
     let keep = |ijk: [i64; 3]| targets.hits(which(ijk), ijk);
     cover_triangle(tri, lo, hi, traversal, &mut Filter { slab, keep });
 }

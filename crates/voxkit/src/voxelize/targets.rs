@@ -19,7 +19,9 @@
 //!
 //! The `*_hit` functions here are the definitions, in `i128` via the generic
 //! orientation predicate; `TriSetup` is the same test specialised for one
-//! triangle and a fixed segment direction, for the fast paths.
+//! triangle and a fixed segment direction, for the fast paths, and
+//! `LazyTargets` decides the targets of a voxel that lie on lines through
+//! its centre from one cross product per triangle edge.
 
 use super::cover::cover_triangle;
 use super::driver::{box_volume, FilterUnset};
@@ -529,6 +531,11 @@ pub(crate) struct TargetSet<const N: usize> {
     inv: [[f64; 3]; N],
     /// Per target: its [`even_step`] (0 if none: the `f64` box filter).
     step: [i64; N],
+    /// Per target: its direction over its [`even_step`] (components −1, 0, 1).
+    unit: [P3; N],
+    /// Every target is of even step and lies on a line through its voxel's
+    /// centre ([`LazyTargets`] then tests edge sides by [`CentreCross`]).
+    centred: bool,
     /// Per target: the [`forms_reached`] bits every triangle that meets
     /// one of its translates by whole voxels must have.
     needs: [u16; N],
@@ -546,6 +553,8 @@ impl<const N: usize> TargetSet<N> {
         let mut inv = [[0.0; 3]; N];
         let mut needs = [0u16; N];
         let mut step = [0i64; N];
+        let mut unit = [[0; 3]; N];
+        let mut centred = true;
         let mut n = 0;
         while n < list.len() {
             seg[n] = list[n];
@@ -553,9 +562,20 @@ impl<const N: usize> TargetSet<N> {
             inv[n] = reciprocals(d);
             needs[n] = Self::needs(o, d);
             step[n] = even_step(d);
+            if step[n] == 0 {
+                centred = false;
+            } else {
+                unit[n] = [d[0] / step[n], d[1] / step[n], d[2] / step[n]];
+                // The line through `o` along `d` holds the centre iff
+                // (centre − o) × d = 0.
+                let r = [H - o[0], H - o[1], H - o[2]];
+                if r[1] * d[2] != r[2] * d[1] || r[2] * d[0] != r[0] * d[2] || r[0] * d[1] != r[1] * d[0] {
+                    centred = false;
+                }
+            }
             n += 1;
         }
-        TargetSet { seg, inv, step, needs, len: list.len() }
+        TargetSet { seg, inv, step, unit, centred, needs, len: list.len() }
     }
 
     /// The [`forms_reached`] bits a triangle meeting a whole-voxel
@@ -614,13 +634,14 @@ pub(crate) const DIAGONAL_SET: TargetSet<4> = TargetSet::new(&DIAGONALS);
 /// [`CROSSHAIR`] as a [`TargetSet`].
 pub(crate) const CROSSHAIR_SET: TargetSet<3> = TargetSet::new(&CROSSHAIR);
 
-/// One triangle against a fixed set of target segments. A target is
-/// decided by the cheapest test first: whether its end points straddle the
-/// (displaced) plane, from the voxel corner's plane value computed once
-/// per voxel (and each target's offset and direction plane values once per
-/// triangle); then, for small triangles, [`segment_may_meet_box`]; then
-/// the edge orientations, each direction's exact setup made on its first
-/// use. A small triangle is decided by a few comparisons for most targets.
+/// One triangle against a fixed set of target segments. A voxel's targets
+/// are decided by the cheapest test first: which of them cross the
+/// (displaced) plane, as a bit mask from the voxel corner's plane value
+/// (each target's plane interval made once per triangle); then, for small
+/// triangles, the box filter; then the edge sides. For a [centred
+/// set](TargetSet) those are additions on the voxel's [`CentreCross`],
+/// with no per-direction setup; for any other set, one-shot triple
+/// products ([`TriSetup::segment_hits_once`]).
 pub(crate) struct LazyTargets<'t, T, const N: usize> {
     tri: &'t LatticeTriangle,
     s: TriSetup<T>,
@@ -629,45 +650,43 @@ pub(crate) struct LazyTargets<'t, T, const N: usize> {
     /// Box-filter targets first (small triangles).
     filter: bool,
     set: &'t TargetSet<N>,
-    /// Per target: the plane value of its start offset and of its direction.
-    planes: [(T, T); N],
+    /// Per target: the plane values `n·o` and `n·(o + d)` of its start
+    /// and end offsets `o`, `o + d`. It crosses the plane in the voxel with
+    /// low corner `c` iff exactly one is `>= t = bn − n·(c − a)`. Targets
+    /// past the set's length have equal ones, so never cross.
+    cross: [(T, T); N],
     /// The targets that may meet the triangle (bit `n`): for small
     /// triangles, those whose [`TargetSet`] forms the box reaches.
     live: u32,
-    /// Each direction's exact setup once made: kept by the caller, as
-    /// moving a kilobyte or more per triangle showed in profiles.
-    setups: &'t mut DirCache<T, N>,
+    /// Per edge `i`: `A_i × A_{i+1}` and `A_{i+1} − A_i` (relative to
+    /// the first vertex), for [`CentreCross`] (centred sets only).
+    k: [[T; 3]; 3],
+    e: [[T; 3]; 3],
 }
 
-/// Sets of more targets than this decide a small triangle's targets by
-/// [`TriSetup::segment_hits_once`] instead of cached direction setups: the
-/// tunnels' 18 or 26 directions (−10 % at 128 on the bunny), not the four
-/// diagonals, whose setups a small triangle's voxels share (+10–20 % there).
-const ONCE_ABOVE: usize = 4;
-
-/// The direction setups of [`LazyTargets`], on the caller's stack.
-pub(crate) type DirCache<T, const N: usize> = [Option<DirSetup<T>>; N];
+/// Per edge `i` of a triangle: `W_i = (A_i − c) × (A_{i+1} − c)` for a
+/// voxel's centre `c`. A line through `c` along `u` passes the edge on the
+/// side of the sign of `u·W_i` (the orientation of the line and the edge,
+/// the same for every point of the line, so for every target on it), so
+/// one voxel's targets through its centre are decided by additions, with
+/// no per-direction setup. Ties (`u·W_i = 0`) take the bias of the tie
+/// rule's displacement, as [`DirSetup`] does.
+type CentreCross<T> = [[T; 3]; 3];
 
 impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
     /// Setup for `tri` against the targets of `set` (`N` is sized by the
-    /// caller, as a few bytes per triangle matter at small grids), with
-    /// `setups` a fresh `[None; N]`.
-    /// Triangles wider than two voxels meet most targets' boxes, so theirs
-    /// are set up at once and the filter is skipped.
+    /// caller, as a few bytes per triangle matter at small grids).
+    /// Triangles wider than two voxels meet most targets' boxes, so the
+    /// box filter is skipped for them.
     #[inline(always)]
-    pub fn new(tri: &'t LatticeTriangle, set: &'t TargetSet<N>, setups: &'t mut DirCache<T, N>) -> Self {
+    pub fn new(tri: &'t LatticeTriangle, set: &'t TargetSet<N>) -> Self {
         let (lo, hi) = tri.bounds();
         let s = TriSetup::new(tri);
         let filter = (0..3).all(|c| hi[c] - lo[c] <= 2 * ONE);
-        let targets = set.segments();
-        if !filter {
-            for (slot, (_, d)) in setups.iter_mut().zip(targets) {
-                *slot = Some(s.dir(tri, *d));
-            }
-        }
-        let mut planes = [(T::ZERO, T::ZERO); N];
-        for (pl, (o, d)) in planes.iter_mut().zip(targets) {
-            *pl = (dot(s.n, o.map(T::from_i64)), dot(s.n, d.map(T::from_i64)));
+        let mut cross = [(T::ZERO, T::ZERO); N];
+        for (x, (o, d)) in cross.iter_mut().zip(set.segments()) {
+            let start = dot(s.n, o.map(T::from_i64));
+            *x = (start, start + dot(s.n, d.map(T::from_i64)));
         }
         let mut live = u32::MAX.checked_shr(32 - set.len as u32).unwrap_or(0);
         // Triangles under half a voxel (most at 32³) miss most forms; at
@@ -680,61 +699,127 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
                 }
             }
         }
-        LazyTargets { tri, s, lo, hi, filter, set, planes, live, setups }
+        let (mut k, mut e) = ([[T::ZERO; 3]; 3], [[T::ZERO; 3]; 3]);
+        if set.centred {
+            for i in 0..3 {
+                let (a, b) = (s.rel[i], s.rel[(i + 1) % 3]);
+                k[i] = crs(a, b);
+                e[i] = std::array::from_fn(|c| b[c] - a[c]);
+            }
+        }
+        LazyTargets { tri, s, lo, hi, filter, set, cross, live, k, e }
+    }
+
+    /// The live targets of the voxel with low corner plane value `vc` whose
+    /// displaced segments cross the plane (bit `n`), branch-free over the
+    /// whole set (the tunnels' 26 targets).
+    #[inline(always)]
+    fn crossing(&self, vc: T) -> u32 {
+        let t = self.s.bn - vc;
+        let mut mask = 0u32;
+        for (n, &(start, end)) in self.cross.iter().enumerate() {
+            mask |= ((start >= t) as u32 ^ (end >= t) as u32) << n;
+        }
+        mask & self.live
+    }
+
+    /// The [`CentreCross`] of the voxel whose low corner is `pc`
+    /// (relative to the first vertex): `A_i × A_{i+1} − c × e_i`.
+    #[inline(always)]
+    fn centre_cross(&self, pc: [T; 3]) -> CentreCross<T> {
+        let h = T::from_i64(H);
+        let c = pc.map(|x| x + h);
+        std::array::from_fn(|i| {
+            let x = crs(c, self.e[i]);
+            let k = self.k[i];
+            [k[0] - x[0], k[1] - x[1], k[2] - x[2]]
+        })
+    }
+
+    /// Does the line of target `n` (through the voxel's centre) pass the
+    /// triangle, given the voxel's [`CentreCross`]? With the plane test,
+    /// the same decision as [`segment_meets_triangle`].
+    #[inline(always)]
+    fn centre_line_hits(&self, n: usize, w: &CentreCross<T>) -> bool {
+        let u = self.set.unit[n].map(T::from_i64);
+        let side = |i: usize| {
+            let o = dot(u, w[i]);
+            if o != T::ZERO {
+                o > T::ZERO
+            } else {
+                // `o >= be` with the tie bias `be` (0 or 1) of −(e × d).
+                let m = crate::geom::lattice::cross(self.tri.edge(i), self.set.seg[n].1);
+                bias([-m[0], -m[1], -m[2]]) == 0
+            }
+        };
+        let s0 = side(0);
+        s0 == side(1) && s0 == side(2)
+    }
+
+    /// For a small triangle: may target `n` of the voxel with low corner
+    /// `c` meet the triangle's box?
+    #[inline(always)]
+    fn in_box(&self, n: usize, c: P3) -> bool {
+        let (o, d) = self.set.seg[n];
+        !self.filter
+            || match self.set.step[n] {
+                0 => segment_may_meet_box_inv(add(c, o), d, self.set.inv[n], self.lo, self.hi),
+                m => segment_may_meet_box_even(add(c, o), d, m, self.lo, self.hi),
+            }
+    }
+
+    /// The edge tests of a crossing target `n` of a set that is not
+    /// centred, from the voxel's low corner `pc` relative to the triangle
+    /// and its plane value `vc`.
+    #[inline(always)]
+    fn edges_once(&self, n: usize, pc: [T; 3], vc: T) -> bool {
+        let (o, d) = self.set.seg[n];
+        let ot = o.map(T::from_i64);
+        let p = std::array::from_fn(|a| pc[a] + ot[a]);
+        self.s.segment_hits_once(self.tri, p, d, vc + self.s.plane(ot))
     }
 
     /// Does the displaced target `n` of voxel `ijk` meet the triangle?
     /// The same decision as [`segment_meets_triangle`].
     #[inline]
-    pub fn hits(&mut self, n: usize, ijk: [i64; 3]) -> bool {
-        if self.live >> n & 1 == 0 {
-            return false;
-        }
+    pub fn hits(&self, n: usize, ijk: [i64; 3]) -> bool {
         let c = corner(ijk);
         let pc = self.s.local(c);
         let vc = self.s.plane(pc);
-        self.hits_from(n, c, pc, vc)
-    }
-
-    /// [`Self::hits`] given the voxel's low corner `c`, it relative to the
-    /// triangle (`pc`) and its plane value `vc`.
-    #[inline(always)]
-    fn hits_from(&mut self, n: usize, c: P3, pc: [T; 3], vc: T) -> bool {
-        let (o, d) = self.set.seg[n];
-        let s = &self.s;
-        let (no, nd) = self.planes[n];
-        let vp = vc + no;
-        if (vp >= s.bn) == (vp + nd >= s.bn) {
+        if self.crossing(vc) >> n & 1 == 0 || !self.in_box(n, c) {
             return false;
         }
-        if self.filter {
-            let a = add(c, o);
-            let may = match self.set.step[n] {
-                0 => segment_may_meet_box_inv(a, d, self.set.inv[n], self.lo, self.hi),
-                m => segment_may_meet_box_even(a, d, m, self.lo, self.hi),
-            };
-            if !may {
-                return false;
-            }
+        if self.set.centred {
+            self.centre_line_hits(n, &self.centre_cross(pc))
+        } else {
+            self.edges_once(n, pc, vc)
         }
-        let tri = self.tri;
-        let p = std::array::from_fn(|a| pc[a] + T::from_i64(o[a]));
-        if self.filter && N > ONCE_ABOVE {
-            // Many directions, each met by few voxels of a small triangle:
-            // a direction's setup would rarely be used twice.
-            return s.segment_hits_once(tri, p, d, vp);
-        }
-        let ds = self.setups[n].get_or_insert_with(|| s.dir(tri, d));
-        s.segment_hits_with(ds, p, vp)
     }
 
     /// Does any of the voxel's targets meet the triangle?
     #[inline]
-    pub fn any(&mut self, ijk: [i64; 3]) -> bool {
+    pub fn any(&self, ijk: [i64; 3]) -> bool {
         let c = corner(ijk);
         let pc = self.s.local(c);
         let vc = self.s.plane(pc);
-        (0..self.set.len).any(|n| self.live >> n & 1 != 0 && self.hits_from(n, c, pc, vc))
+        let mut mask = self.crossing(vc);
+        let mut w = None;
+        while mask != 0 {
+            let n = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            if !self.in_box(n, c) {
+                continue;
+            }
+            let hit = if self.set.centred {
+                self.centre_line_hits(n, w.get_or_insert_with(|| self.centre_cross(pc)))
+            } else {
+                self.edges_once(n, pc, vc)
+            };
+            if hit {
+                return true;
+            }
+        }
+        false
     }
 }
 
@@ -762,8 +847,7 @@ pub(crate) fn targets_in_box<const N: usize>(
 ) {
     debug_assert!(fits_i64(tri));
     // Every target lies in its closed voxel: only `cover`'s voxels can hit.
-    let mut setups = [None; N];
-    let mut lazy = LazyTargets::<i64, N>::new(tri, targets, &mut setups);
+    let lazy = LazyTargets::<i64, N>::new(tri, targets);
     let keep = |ijk: [i64; 3]| lazy.any(ijk);
     cover_triangle(tri, lo, hi, Traversal::Auto, &mut FilterUnset { slab, keep });
 }
@@ -810,8 +894,7 @@ mod tests {
             }
             if t.normal() != [0, 0, 0] && fits_i64(&t) {
                 let targets = TargetSet::<1>::new(&[(a, d)]);
-                let mut setups = [None; 1];
-                let mut lazy = LazyTargets::<i64, 1>::new(&t, &targets, &mut setups);
+                let lazy = LazyTargets::<i64, 1>::new(&t, &targets);
                 proptest::prop_assert_eq!(lazy.hits(0, [0, 0, 0]), segment_meets_triangle(seg, t.v, true));
                 let s = TriSetup::<i64>::new(&t);
                 let p = s.local(a);
@@ -926,13 +1009,12 @@ mod tests {
                     }
                 }
             }
-            // The lazy tests (plane first, box filter, setups on first use),
+            // The lazy tests (plane mask first, box filter, edge sides),
             // one target at a time and any of a voxel's, in either order.
             for targets in [&DIAGONALS[..], &CROSSHAIR[..]] {
                 let set = TargetSet::<4>::new(targets);
-                let (mut narrow_setups, mut wide_setups) = ([None; 4], [None; 4]);
-                let mut lazy = LazyTargets::<i64, 4>::new(t, &set, &mut narrow_setups);
-                let mut wide = LazyTargets::<i128, 4>::new(t, &set, &mut wide_setups);
+                let lazy = LazyTargets::<i64, 4>::new(t, &set);
+                let wide = LazyTargets::<i128, 4>::new(t, &set);
                 for k in (-1..3).rev() {
                     for j in -1..3 {
                         for i in -1..3 {

@@ -116,8 +116,7 @@ fn filtered<T: PlaneInt>(
     traversal: Traversal,
     slab: &mut BrickSlab<'_>,
 ) {
-    let mut setups = [None; 26];
-    let mut targets = LazyTargets::<T, 26>::new(tri, dirs, &mut setups);
+    let targets = LazyTargets::<T, 26>::new(tri, dirs);
     let keep = |ijk: [i64; 3]| targets.any(ijk);
     cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
 }
