@@ -29,17 +29,17 @@
 //!
 //! **Fast path.** `cover`'s exact traversal enumerates candidates not yet
 //! set; each gets its seven segment tests, cheapest first: the ends'
-//! sides of the displaced plane, a box filter, then the three edge
-//! orientations as exact triple products (`i64` relative to the triangle;
-//! the targets' directions differ per voxel, so nothing is set up per
-//! direction).
+//! sides of the displaced plane, then the three edge orientations. All
+//! seven segments lie on lines through the voxel's random point `m`, so
+//! these are dot products with one cross product per edge at `m`, exact
+//! (`i64` relative to the triangle; nothing is set up per direction).
 //!
 //! **Reference:** [`reference::bubble`], the same targets for every voxel
 //! of each triangle's bounding box.
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, FilterUnset, Kernel};
-use super::targets::{fits_i64, segment_may_meet_box, TriSetup};
+use super::targets::{fits_i64, TriSetup};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -131,8 +131,8 @@ impl Kernel<LatticeTriangle> for BubbleKernel {
 }
 
 /// The definition over `cover`'s voxels: each random target first past the
-/// plane test (its ends on both sides of the displaced plane) and the box
-/// filter, then the exact segment test [`TriSetup::segment_hits_once`]
+/// plane test (its ends on both sides of the displaced plane), then its
+/// line's edge sides from the voxel's random point's [`PivotCross`]
 /// (the same decision as [`segment_meets_triangle`], without its generic
 /// 128-bit determinants or a per-direction setup).
 #[allow(clippy::too_many_arguments)]
@@ -145,7 +145,6 @@ fn filtered<T: PlaneInt>(
     traversal: Traversal,
     slab: &mut BrickSlab<'_>,
 ) {
-    let (blo, bhi) = tri.bounds();
     let s = TriSetup::<T>::new(tri);
     let shift: [i64; 3] = offset.map(|o| o * ONE);
     let keep = |ijk: [i64; 3]| {
@@ -158,19 +157,20 @@ fn filtered<T: PlaneInt>(
             (a, s.local(a))
         };
         let (m, pm) = local(ts[0][0]);
-        let vm = s.plane(pm);
-        let inside = vm >= s.bn;
-        let crosses = |(a, pa): (P3, [T; 3]), va: T, b: P3| {
-            let d = std::array::from_fn(|c| b[c] - a[c]);
-            segment_may_meet_box(a, d, blo, bhi) && s.segment_hits_once(tri, pa, d, va)
+        let inside = s.plane(pm) >= s.bn;
+        // All seven lines pass through `m`: their edge sides come from one
+        // pivot cross, made for the first segment that crosses the plane.
+        let mut w = None;
+        let mut line = |a: P3, b: P3| {
+            let d: P3 = std::array::from_fn(|c| b[c] - a[c]);
+            s.line_hits(tri, w.get_or_insert_with(|| s.pivot_cross(pm)), d.map(T::from_i64), d)
         };
         ts[..6].iter().any(|seg| {
             let (f, pf) = local(seg[1]);
-            (s.plane(pf) >= s.bn) != inside && crosses((m, pm), vm, f)
+            (s.plane(pf) >= s.bn) != inside && line(m, f)
         }) || {
             let (c, pc) = local(ts[6][0]);
-            let vc = s.plane(pc);
-            (vc >= s.bn) != inside && crosses((c, pc), vc, m)
+            (s.plane(pc) >= s.bn) != inside && line(c, m)
         }
     };
     cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
