@@ -35,7 +35,7 @@
 //! triangle's bounding box.
 
 use super::cover::cover_triangle;
-use super::driver::{run_mesh, Filter, Kernel};
+use super::driver::{run_mesh, FilterUnset, Kernel};
 use super::targets::{dominant_axes, fits_i64, is_tiny, PixelTest, TriSetup};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
@@ -123,7 +123,7 @@ fn filtered<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], trav
         };
         columns::<T>(tri, lo, hi, edge_tests, slab);
     } else {
-        cover_triangle(tri, lo, hi, traversal, &mut Filter { slab, keep });
+        cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
     }
 }
 
