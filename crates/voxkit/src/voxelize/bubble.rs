@@ -50,16 +50,42 @@ use crate::mesh::MeshRef;
 
 /// A well-mixed 64-bit hash of the seed and four words (SplitMix64 rounds).
 fn hash(seed: u64, words: [i64; 4]) -> u64 {
-    let mut x = seed ^ 0x9e37_79b9_7f4a_7c15;
-    for w in words {
-        x ^= w as u64;
-        x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = x;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        x = z ^ (z >> 31);
-    }
-    x
+    words.iter().fold(start(seed), |x, &w| round(x, w))
+}
+
+/// The state [`hash`] starts from.
+#[inline(always)]
+fn start(seed: u64) -> u64 {
+    seed ^ 0x9e37_79b9_7f4a_7c15
+}
+
+/// One SplitMix64 round of [`hash`], taking in the word `w`.
+#[inline(always)]
+fn round(x: u64, w: i64) -> u64 {
+    let x = (x ^ w as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
+    let z = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    let z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// [`voxel_point`] and [`face_points`] of voxel `ijk` at once, the same
+/// values: the seven hashes share their first words (`i`, then `j`, then
+/// `k`, each either the voxel's or one more), so 16 rounds make them
+/// instead of 28.
+#[inline]
+pub fn points(seed: u64, ijk: [i64; 3]) -> (P3, [P3; 6]) {
+    let [i, j, k] = ijk;
+    let (a, b) = (round(start(seed), i), round(start(seed), i + 1));
+    let (aa, ab, ba) = (round(a, j), round(a, j + 1), round(b, j));
+    let (aaa, aab, aba, baa) = (round(aa, k), round(aa, k + 1), round(ab, k), round(ba, k));
+    // Face hashes by face (low and high per axis), then the voxel's.
+    let h = [round(aaa, 0), round(baa, 0), round(aaa, 1), round(aba, 1), round(aaa, 2), round(aab, 2), round(aaa, 3)];
+    let voxel = std::array::from_fn(|a| ijk[a] * ONE + offset(h[6], a as u32));
+    let faces = std::array::from_fn(|f| {
+        let axis = f / 2;
+        std::array::from_fn(|a| (ijk[a] + (a == axis && f % 2 == 1) as i64) * ONE + if a == axis { 0 } else { offset(h[f], a as u32) })
+    });
+    (voxel, faces)
 }
 
 /// A lattice offset strictly inside a voxel side: `1 ..= ONE − 1`.
@@ -80,20 +106,23 @@ pub fn face_point(seed: u64, ijk: [i64; 3], axis: usize) -> P3 {
     std::array::from_fn(|a| ijk[a] * ONE + if a == axis { 0 } else { offset(h, a as u32) })
 }
 
+/// The random points of voxel `ijk`'s six faces (low and high face per axis).
+pub fn face_points(seed: u64, ijk: [i64; 3]) -> [P3; 6] {
+    std::array::from_fn(|f| {
+        let axis = f / 2;
+        let mut v = ijk;
+        v[axis] += (f % 2) as i64;
+        face_point(seed, v, axis)
+    })
+}
+
 /// The seven target segments of voxel `ijk`: from its random point to its
 /// six faces' (low and high face per axis), then from its centre to its
 /// random point.
 pub fn targets(seed: u64, ijk: [i64; 3]) -> [[P3; 2]; 7] {
     let m = voxel_point(seed, ijk);
-    std::array::from_fn(|f| {
-        if f == 6 {
-            return [ijk.map(|c| c * ONE + ONE / 2), m];
-        }
-        let axis = f / 2;
-        let mut v = ijk;
-        v[axis] += (f % 2) as i64;
-        [m, face_point(seed, v, axis)]
-    })
+    let faces = face_points(seed, ijk);
+    std::array::from_fn(|f| if f == 6 { [ijk.map(|c| c * ONE + ONE / 2), m] } else { [m, faces[f]] })
 }
 
 /// Does `t` meet one of voxel `ijk`'s targets?
@@ -148,7 +177,7 @@ fn filtered<T: PlaneInt>(
     let s = TriSetup::<T>::new(tri);
     let shift: [i64; 3] = offset.map(|o| o * ONE);
     let keep = |ijk: [i64; 3]| {
-        let ts = targets(seed, std::array::from_fn(|a| ijk[a] + offset[a]));
+        let g: [i64; 3] = std::array::from_fn(|a| ijk[a] + offset[a]);
         // Cheapest first: a segment whose ends lie on one side of the
         // displaced plane misses; most targets are decided here. The
         // voxel's random point starts six of them and ends the seventh.
@@ -156,7 +185,8 @@ fn filtered<T: PlaneInt>(
             let a: P3 = std::array::from_fn(|c| p[c] - shift[c]);
             (a, s.local(a))
         };
-        let (m, pm) = local(ts[0][0]);
+        let (m, faces) = points(seed, g);
+        let (m, pm) = local(m);
         let inside = s.plane(pm) >= s.bn;
         // All seven lines pass through `m`: their edge sides come from one
         // pivot cross, made for the first segment that crosses the plane.
@@ -165,13 +195,14 @@ fn filtered<T: PlaneInt>(
             let d: P3 = std::array::from_fn(|c| b[c] - a[c]);
             s.line_hits(tri, w.get_or_insert_with(|| s.pivot_cross(pm)), d.map(T::from_i64), d)
         };
-        ts[..6].iter().any(|seg| {
-            let (f, pf) = local(seg[1]);
-            (s.plane(pf) >= s.bn) != inside && line(m, f)
-        }) || {
-            let (c, pc) = local(ts[6][0]);
-            (s.plane(pc) >= s.bn) != inside && line(c, m)
+        let (c, pc) = local(g.map(|x| x * ONE + ONE / 2));
+        if (s.plane(pc) >= s.bn) != inside && line(c, m) {
+            return true;
         }
+        faces.iter().any(|&f| {
+            let (f, pf) = local(f);
+            (s.plane(pf) >= s.bn) != inside && line(m, f)
+        })
     };
     cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
 }
@@ -208,5 +239,14 @@ mod tests {
             }
         }
         assert_ne!(voxel_point(1, [0, 0, 0]), voxel_point(2, [0, 0, 0]));
+    }
+
+    #[test]
+    fn shared_hash_rounds_give_the_same_points() {
+        for seed in [0, 7, u64::MAX] {
+            for ijk in [[0, 0, 0], [-1, 5, -9], [1 << 40, -(1 << 33), 77]] {
+                assert_eq!(points(seed, ijk), (voxel_point(seed, ijk), face_points(seed, ijk)), "{seed} {ijk:?}");
+            }
+        }
     }
 }
