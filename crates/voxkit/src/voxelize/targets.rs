@@ -492,6 +492,8 @@ pub(crate) struct TargetSet<const N: usize> {
     /// centre ([`LazyTargets`] then tests edge sides from the centre's
     /// [`PivotCross`]).
     centred: bool,
+    /// Every target starts at the same offset (the tunnels').
+    common_start: bool,
     /// Per target: the [`forms_reached`] bits every triangle that meets
     /// one of its translates by whole voxels must have.
     needs: [u16; N],
@@ -509,11 +511,16 @@ impl<const N: usize> TargetSet<N> {
         let mut needs = [0u16; N];
         let mut unit = [[0; 3]; N];
         let mut centred = true;
+        let mut common_start = true;
         let mut n = 0;
         while n < list.len() {
             seg[n] = list[n];
             let (o, d) = list[n];
             needs[n] = Self::needs(o, d);
+            let o0 = list[0].0;
+            if o[0] != o0[0] || o[1] != o0[1] || o[2] != o0[2] {
+                common_start = false;
+            }
             let m = even_step(d);
             // The line through `o` along `d` holds the centre iff
             // (centre − o) × d = 0.
@@ -525,7 +532,7 @@ impl<const N: usize> TargetSet<N> {
             }
             n += 1;
         }
-        TargetSet { seg, unit, centred, needs, len: list.len() }
+        TargetSet { seg, unit, centred, common_start, needs, len: list.len() }
     }
 
     /// The [`forms_reached`] bits a triangle meeting a whole-voxel
@@ -598,9 +605,10 @@ pub(crate) struct LazyTargets<'t, T, const N: usize> {
     set: &'t TargetSet<N>,
     /// Per target: the plane values `n·o` and `n·(o + d)` of its start
     /// and end offsets `o`, `o + d`. It crosses the plane in the voxel with
-    /// low corner `c` iff exactly one is `>= t = bn − n·(c − a)`. Targets
-    /// past the set's length have equal ones, so never cross.
-    cross: [(T, T); N],
+    /// low corner `c` iff exactly one is `>= t = bn − n·(c − a)`. (Bits of
+    /// targets past the set's length are cleared by `live`.)
+    start: [T; N],
+    end: [T; N],
     /// The targets that may meet the triangle (bit `n`): for small
     /// triangles, those whose [`TargetSet`] forms the box reaches.
     live: u32,
@@ -613,10 +621,10 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
     pub fn new(tri: &'t LatticeTriangle, set: &'t TargetSet<N>) -> Self {
         let (lo, hi) = tri.bounds();
         let s = TriSetup::new(tri);
-        let mut cross = [(T::ZERO, T::ZERO); N];
-        for (x, (o, d)) in cross.iter_mut().zip(set.segments()) {
-            let start = dot(s.n, o.map(T::from_i64));
-            *x = (start, start + dot(s.n, d.map(T::from_i64)));
+        let (mut start, mut end) = ([T::ZERO; N], [T::ZERO; N]);
+        for (n, (o, d)) in set.segments().iter().enumerate() {
+            start[n] = dot(s.n, o.map(T::from_i64));
+            end[n] = start[n] + dot(s.n, d.map(T::from_i64));
         }
         let mut live = u32::MAX.checked_shr(32 - set.len as u32).unwrap_or(0);
         // Triangles under half a voxel (most at 32³) miss most forms; at
@@ -629,7 +637,7 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
                 }
             }
         }
-        LazyTargets { tri, s, set, cross, live }
+        LazyTargets { tri, s, set, start, end, live }
     }
 
     /// The live targets of the voxel with low corner plane value `vc` whose
@@ -639,8 +647,15 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
     fn crossing(&self, vc: T) -> u32 {
         let t = self.s.bn - vc;
         let mut mask = 0u32;
-        for (n, &(start, end)) in self.cross.iter().enumerate() {
-            mask |= ((start >= t) as u32 ^ (end >= t) as u32) << n;
+        if self.set.common_start {
+            let side = (self.start[0] >= t) as u32;
+            for (n, &end) in self.end.iter().enumerate() {
+                mask |= ((end >= t) as u32 ^ side) << n;
+            }
+        } else {
+            for n in 0..N {
+                mask |= ((self.start[n] >= t) as u32 ^ (self.end[n] >= t) as u32) << n;
+            }
         }
         mask & self.live
     }
@@ -678,8 +693,8 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
         let c = corner(ijk);
         let pc = self.s.local(c);
         let vc = self.s.plane(pc);
-        let (t, (start, end)) = (self.s.bn - vc, self.cross[n]);
-        if self.live >> n & 1 == 0 || (start >= t) == (end >= t) {
+        let t = self.s.bn - vc;
+        if self.live >> n & 1 == 0 || (self.start[n] >= t) == (self.end[n] >= t) {
             return false;
         }
         if self.set.centred {
