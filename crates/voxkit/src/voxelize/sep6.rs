@@ -20,14 +20,17 @@
 //! found by one exact division — and thinness proves no other voxel of the
 //! column is. For a pixel whose square meets the projection but whose centre
 //! does not, the two perpendicular crosshair segments are tested exactly for
-//! the few voxels around the plane's depth. All tests are exact integers
-//! (`i64` relative to the triangle, `i128` for huge triangles).
+//! the few voxels around the plane's depth. Triangles in a box of at most
+//! 27 voxels (most at 128³) take the same column rule along all three
+//! axes instead, for the pixel centres inside their box only. All tests
+//! are exact integers (`i64` relative to the triangle, `i128` for huge
+//! triangles).
 //!
 //! **Reference:** [`reference::sep6`], the definition evaluated with the
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
 use super::driver::{run_mesh, run_slabs, Kernel};
-use super::targets::{dominant_axes, fits_i64, is_tiny, targets_in_box, PixelTest, TriSetup, CROSSHAIR_SET};
+use super::targets::{dominant_axes, fits_i64, is_tiny, PixelTest, TriSetup, CROSSHAIR_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -50,14 +53,65 @@ pub fn sep6_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>
 
 struct Sep6Kernel;
 
-/// A triangle whose box [`is_tiny`]: its crosshair targets one by one,
-/// unless its box holds mid-planes on fewer than two axes (then it meets
-/// no crosshair segment, `TargetSet::may_meet`).
+/// A triangle whose box [`is_tiny`], by the crosshair segments' lines: for
+/// each axis `a` the triangle's plane is not parallel to, the `a`-lines
+/// through pixel centres (`p`, `q` at `m·ONE + H`) that the (displaced)
+/// line meets the triangle on, each setting the one voxel of its column
+/// whose `a` segment straddles the plane ([`TriSetup::column_voxel`], as
+/// Laine's algorithm does along the dominant axis). Every crosshair hit
+/// is one of these, whatever the axis, so this is the definition; a
+/// triangle about a voxel wide has about one such line per axis, against
+/// `cover`'s traversal of its box and three targets per candidate. Only
+/// pixel centres in the triangle's box (grown by a lattice unit for the
+/// tie rule) can be inside it. Nothing to do if the box holds mid-planes
+/// on fewer than two axes (`TargetSet::may_meet`).
 #[inline(never)]
 fn tiny(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     let (blo, bhi) = tri.bounds();
-    if CROSSHAIR_SET.may_meet(blo, bhi) {
-        targets_in_box(tri, &CROSSHAIR_SET, lo, hi, slab);
+    if !CROSSHAIR_SET.may_meet(blo, bhi) {
+        return;
+    }
+    let s = TriSetup::<i64>::new(tri);
+    // Pixel indices along `c` whose centre is in the grown box and the voxel box.
+    let centres = |c: usize| {
+        let first = -(H + 1 - blo[c]).div_euclid(ONE);
+        let last = (bhi[c] + 1 - H).div_euclid(ONE);
+        (first.max(lo[c]), last.min(hi[c]))
+    };
+    for a in 0..3 {
+        if s.n[a] == 0 {
+            // Parallel lines never cross the displaced plane.
+            continue;
+        }
+        let (p, q) = ((a + 1) % 3, (a + 2) % 3);
+        let ((p0, p1), (q0, q1)) = (centres(p), centres(q));
+        let mut d = [0; 3];
+        d[a] = ONE;
+        let mut unit = [0; 3];
+        unit[a] = 1;
+        for iq in q0..=q1 {
+            for ip in p0..=p1 {
+                let mut c = s.a;
+                (c[p], c[q]) = (ip * ONE + H, iq * ONE + H);
+                let pc = s.local(c);
+                // The pivot cross's `a` components: the line's edge sides.
+                let w = std::array::from_fn(|i| {
+                    let (x, y) = (s.rel[i], s.rel[(i + 1) % 3]);
+                    let mut wi = [0; 3];
+                    wi[a] = (x[p] - pc[p]) * (y[q] - pc[q]) - (x[q] - pc[q]) * (y[p] - pc[p]);
+                    wi
+                });
+                if !s.line_hits(tri, &w, unit, d) {
+                    continue;
+                }
+                let t = s.column_voxel(a, s.n[a], s.n[p] * pc[p] + s.n[q] * pc[q]);
+                if t >= lo[a] && t <= hi[a] {
+                    let mut ijk = [0u32; 3];
+                    (ijk[a], ijk[p], ijk[q]) = (t as u32, ip as u32, iq as u32);
+                    slab.set(ijk[0], ijk[1], ijk[2]);
+                }
+            }
+        }
     }
 }
 
