@@ -23,13 +23,10 @@
 //! `LazyTargets` decides the targets of a voxel that lie on lines through
 //! its centre from one cross product per triangle edge.
 
-use super::cover::cover_triangle;
-use super::driver::{box_volume, FilterUnset};
-use super::Traversal;
+use super::driver::box_volume;
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{LatticeSegment, LatticeTriangle};
 use crate::geom::perturb::{bias, segment_meets_square, segment_meets_triangle, triangle_meets_square, P3};
-use crate::grid::bricks::BrickSlab;
 
 const H: i64 = ONE / 2;
 
@@ -317,6 +314,23 @@ impl<T: PlaneInt> TriSetup<T> {
             // positive iff W <= a_w + floor((v0 − bn) / −n_w)
             let w_star = T::from_i64(self.a[w]) + (v0 - self.bn).div_floor(-nw);
             w_star.div_floor(one)
+        }
+    }
+
+    /// Along a line `p + λ·u` (`u` of steps −1, 0, 1, `λ` in lattice
+    /// units) whose plane value is `v0 + λ·g` (`g ≠ 0`; `v0 = plane(p)`,
+    /// relative to `a`): the `m` whose displaced segment `λ ∈ [m·ONE,
+    /// (m + 1)·ONE]` straddles the plane (exactly one does).
+    #[inline(always)]
+    pub fn straddling_step(&self, g: T, v0: T) -> T {
+        let one = T::from_i64(ONE);
+        if g > T::ZERO {
+            // Positive iff λ >= ceil((bn − v0) / g).
+            let first = -(v0 - self.bn).div_floor(g);
+            (first - T::from_i64(1)).div_floor(one)
+        } else {
+            // Positive iff λ <= floor((v0 − bn) / −g).
+            (v0 - self.bn).div_floor(-g).div_floor(one)
         }
     }
 
@@ -728,33 +742,15 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
     }
 }
 
-/// Largest voxel box a kernel decides voxel by voxel with
-/// [`targets_in_box`] instead of its projection: for a triangle about a
-/// voxel in size, a few box filters beat setting up the projection.
+/// Largest voxel box for which `sep26`, `sep6` and `ss6` take their short
+/// path instead of setting up the projection: for a triangle about a
+/// voxel in size, a few lines or candidates beat the projection's setup.
 pub(crate) const TINY_BOX: i64 = 27;
 
 /// Is the inclusive box `[lo, hi]` at most [`TINY_BOX`] voxels?
 #[inline(always)]
 pub(crate) fn is_tiny(lo: [i64; 3], hi: [i64; 3]) -> bool {
     box_volume(lo, hi) <= TINY_BOX
-}
-
-/// Sets the voxels of `[lo, hi]` one of whose `targets` (start offset from
-/// the low corner, direction) meets `tri`: the definition of a target
-/// mode, voxel by voxel, for triangles whose box [`is_tiny`]. Voxels
-/// already set are skipped.
-pub(crate) fn targets_in_box<const N: usize>(
-    tri: &LatticeTriangle,
-    targets: &TargetSet<N>,
-    lo: [i64; 3],
-    hi: [i64; 3],
-    slab: &mut BrickSlab<'_>,
-) {
-    debug_assert!(fits_i64(tri));
-    // Every target lies in its closed voxel: only `cover`'s voxels can hit.
-    let lazy = LazyTargets::<i64, N>::new(tri, targets);
-    let keep = |ijk: [i64; 3]| lazy.any(ijk);
-    cover_triangle(tri, lo, hi, Traversal::Auto, &mut FilterUnset { slab, keep });
 }
 
 #[cfg(test)]
