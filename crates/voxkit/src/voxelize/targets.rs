@@ -27,6 +27,7 @@ use super::driver::box_volume;
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{LatticeSegment, LatticeTriangle};
 use crate::geom::perturb::{bias, segment_meets_square, segment_meets_triangle, triangle_meets_square, P3};
+use crate::grid::bricks::BrickSlab;
 
 const H: i64 = ONE / 2;
 
@@ -739,6 +740,71 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
             }
         }
         false
+    }
+}
+
+/// Sets the voxels of `[lo, hi]` one of whose space diagonals the (small,
+/// `i64`) triangle meets, by the diagonals' lines. For each diagonal direction `u` the
+/// triangle's plane is not parallel to, the lines along `u` through voxel
+/// corners are the lattice points of an oblique projection along `u`
+/// onto a lattice plane `z = z₀` near the triangle; each inside the
+/// projected triangle's box whose (displaced) line meets the triangle
+/// sets the voxel whose diagonal on that line straddles the plane
+/// ([`TriSetup::straddling_step`]). Every diagonal hit is one of these,
+/// so this is the definition; a triangle about a voxel wide has a handful
+/// of such lines, against `cover`'s traversal of its box and four targets
+/// per candidate.
+pub(crate) fn diagonal_lines(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+    let blo = tri.bounds().0;
+    let s = TriSetup::<i64>::new(tri);
+    let z0 = blo[2].div_euclid(ONE) * ONE;
+    // Per edge `A × B` (relative to the first vertex): with it a line
+    // direction's edge orientations `u·(A × B) − p·(e × u)` need no
+    // further products per direction than `e × u` (as `DirSetup`, without
+    // its tie biases, derived only on a tie).
+    let ab: [[i64; 3]; 3] = std::array::from_fn(|i| crate::geom::lattice::cross(s.rel[i], s.rel[(i + 1) % 3]));
+    let dot = |a: [i64; 3], b: [i64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    for (_, d) in DIAGONALS {
+        let u = d.map(i64::signum);
+        let g = s.n[0] * u[0] + s.n[1] * u[1] + s.n[2] * u[2];
+        if g == 0 {
+            // Parallel lines never cross the displaced plane.
+            continue;
+        }
+        // Along u to z = z0: (x − u_x·u_z·(z − z0), y − u_y·u_z·(z − z0)).
+        let proj = |p: [i64; 3], c: usize| p[c] - u[c] * u[2] * (p[2] - z0);
+        let range = |c: usize| {
+            let (mut l, mut h) = (i64::MAX, i64::MIN);
+            for p in tri.v {
+                (l, h) = (l.min(proj(p, c)), h.max(proj(p, c)));
+            }
+            (-(-l).div_euclid(ONE), h.div_euclid(ONE))
+        };
+        let ((x0, x1), (y0, y1)) = (range(0), range(1));
+        if x0 > x1 || y0 > y1 {
+            continue;
+        }
+        let m: [[i64; 3]; 3] = std::array::from_fn(|i| crate::geom::lattice::cross(tri.edge(i), u));
+        let c: [i64; 3] = std::array::from_fn(|i| dot(u, ab[i]));
+        for ky in y0..=y1 {
+            for kx in x0..=x1 {
+                let k = [kx * ONE, ky * ONE, z0];
+                let pk = s.local(k);
+                let side = |i: usize| match c[i] - dot(pk, m[i]) {
+                    0 => bias(m[i].map(|x| -x)) == 0,
+                    o => o > 0,
+                };
+                let s0 = side(0);
+                if s0 != side(1) || s0 != side(2) {
+                    continue;
+                }
+                let m = s.straddling_step(g, s.plane(pk));
+                let ijk: [i64; 3] = std::array::from_fn(|c| k[c].div_euclid(ONE) + if u[c] > 0 { m } else { -m - 1 });
+                if (0..3).all(|c| ijk[c] >= lo[c] && ijk[c] <= hi[c]) {
+                    slab.set(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
+                }
+            }
+        }
     }
 }
 
