@@ -641,7 +641,7 @@ fn columns_of<T: crate::geom::fixed::PlaneInt>(
                 continue;
             }
             let v0 = T::from_i64(n[u]) * pc[u] + T::from_i64(n[v]) * pc[v];
-            let tw = s.column_voxel(w, T::from_i64(n[w]), v0).to_i128();
+            let tw = s.straddling_step(T::from_i64(n[w]), v0, T::from_i64(s.a[w])).to_i128();
             if tw < 0 || tw >= dims[w] as i128 {
                 continue;
             }

@@ -30,7 +30,7 @@
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
 use super::driver::{run_mesh, run_slabs, Kernel};
-use super::targets::{dominant_axes, fits_i64, is_tiny, PixelTest, TriSetup, CROSSHAIR_SET};
+use super::targets::{all_one_side, dominant_axes, edge_side, fits_i64, is_tiny, PixelTest, TriSetup, CROSSHAIR_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -57,7 +57,7 @@ struct Sep6Kernel;
 /// each axis `a` the triangle's plane is not parallel to, the `a`-lines
 /// through pixel centres (`p`, `q` at `m·ONE + H`) that the (displaced)
 /// line meets the triangle on, each setting the one voxel of its column
-/// whose `a` segment straddles the plane ([`TriSetup::column_voxel`], as
+/// whose `a` segment straddles the plane ([`TriSetup::straddling_step`], as
 /// Laine's algorithm does along the dominant axis). Every crosshair hit
 /// is one of these, whatever the axis, so this is the definition; a
 /// triangle about a voxel wide has about one such line per axis, against
@@ -87,24 +87,22 @@ fn tiny(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<
         let ((p0, p1), (q0, q1)) = (centres(p), centres(q));
         let mut d = [0; 3];
         d[a] = ONE;
-        let mut unit = [0; 3];
-        unit[a] = 1;
         for iq in q0..=q1 {
             for ip in p0..=p1 {
                 let mut c = s.a;
                 (c[p], c[q]) = (ip * ONE + H, iq * ONE + H);
                 let pc = s.local(c);
-                // The pivot cross's `a` components: the line's edge sides.
-                let w = std::array::from_fn(|i| {
+                // The line's orientation against edge `i`: the `a`
+                // component of the pivot cross, a 2D edge function.
+                let side = |i: usize| {
                     let (x, y) = (s.rel[i], s.rel[(i + 1) % 3]);
-                    let mut wi = [0; 3];
-                    wi[a] = (x[p] - pc[p]) * (y[q] - pc[q]) - (x[q] - pc[q]) * (y[p] - pc[p]);
-                    wi
-                });
-                if !s.line_hits(tri, &w, unit, d) {
+                    let o = (x[p] - pc[p]) * (y[q] - pc[q]) - (x[q] - pc[q]) * (y[p] - pc[p]);
+                    edge_side(o, || crate::geom::lattice::cross(tri.edge(i), d))
+                };
+                if !all_one_side(side) {
                     continue;
                 }
-                let t = s.column_voxel(a, s.n[a], s.n[p] * pc[p] + s.n[q] * pc[q]);
+                let t = s.straddling_step(s.n[a], s.n[p] * pc[p] + s.n[q] * pc[q], s.a[a]);
                 if t >= lo[a] && t <= hi[a] {
                     let mut ijk = [0u32; 3];
                     (ijk[a], ijk[p], ijk[q]) = (t as u32, ip as u32, iq as u32);
@@ -175,7 +173,7 @@ fn project<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab:
             // Plane value along the column: V(W) = v0 + n_w·(W − a_w).
             let v0 = nu * pc[u] + nv * pc[v];
             if inside[0] == inside[1] && inside[1] == inside[2] {
-                let t = s.column_voxel(w, nw, v0);
+                let t = s.straddling_step(nw, v0, T::from_i64(s.a[w]));
                 if t >= T::from_i64(lo[w]) && t <= T::from_i64(hi[w]) {
                     emit(slab, iu, iv, t.to_i128() as i64);
                 }

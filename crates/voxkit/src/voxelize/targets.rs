@@ -191,6 +191,30 @@ fn crs<T: PlaneInt>(a: [T; 3], b: [T; 3]) -> [T; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
+/// The side of an edge a displaced target line passes on, from its
+/// orientation value `o` against the edge (as `d·W_i` of [`PivotCross`]):
+/// positive, or on a tie (`o = 0`) the bias of the tie rule's
+/// displacement, `−(e × d)`, with `e_x_d` giving `e × d` (only needed on
+/// a tie).
+#[inline(always)]
+pub(crate) fn edge_side<T: PlaneInt>(o: T, e_x_d: impl FnOnce() -> P3) -> bool {
+    if o != T::ZERO {
+        o > T::ZERO
+    } else {
+        // `o >= be` with the tie bias `be` (0 or 1) of −(e × d).
+        let m = e_x_d();
+        bias([-m[0], -m[1], -m[2]]) == 0
+    }
+}
+
+/// Does a line pass inside the triangle: on one side of all three edges
+/// (`side(i)` for edge `i`, as [`edge_side`])?
+#[inline(always)]
+pub(crate) fn all_one_side(side: impl Fn(usize) -> bool) -> bool {
+    let s0 = side(0);
+    s0 == side(1) && s0 == side(2)
+}
+
 impl<T: PlaneInt> TriSetup<T> {
     /// Setup for `t`.
     pub fn new(t: &LatticeTriangle) -> TriSetup<T> {
@@ -286,52 +310,28 @@ impl<T: PlaneInt> TriSetup<T> {
     /// rule's displacement, `−(e_i × d)`, as [`DirSetup`] does.
     #[inline(always)]
     pub fn line_hits(&self, t: &LatticeTriangle, w: &PivotCross<T>, dt: [T; 3], d: P3) -> bool {
-        let side = |i: usize| {
-            let o = dot(dt, w[i]);
-            if o != T::ZERO {
-                o > T::ZERO
-            } else {
-                // `o >= be` with the tie bias `be` (0 or 1) of −(e × d).
-                let m = crate::geom::lattice::cross(t.edge(i), d);
-                bias([-m[0], -m[1], -m[2]]) == 0
-            }
-        };
-        let s0 = side(0);
-        s0 == side(1) && s0 == side(2)
-    }
-
-    /// For a `w`-line that meets the triangle, with plane value
-    /// `v0 = n_u·p_u + n_v·p_v` (relative to `a`) along it: the voxel index
-    /// `t` whose displaced `w` crosshair segment `[t·ONE, (t+1)·ONE]`
-    /// straddles the plane — the one voxel of the column `sep6` sets.
-    #[inline(always)]
-    pub fn column_voxel(&self, w: usize, nw: T, v0: T) -> T {
-        let one = T::from_i64(ONE);
-        if nw > T::ZERO {
-            // positive iff W >= a_w + ceil((bn − v0) / n_w)
-            let w_star = T::from_i64(self.a[w]) - (v0 - self.bn).div_floor(nw);
-            (w_star - T::from_i64(1)).div_floor(one)
-        } else {
-            // positive iff W <= a_w + floor((v0 − bn) / −n_w)
-            let w_star = T::from_i64(self.a[w]) + (v0 - self.bn).div_floor(-nw);
-            w_star.div_floor(one)
-        }
+        all_one_side(|i| edge_side(dot(dt, w[i]), || crate::geom::lattice::cross(t.edge(i), d)))
     }
 
     /// Along a line `p + λ·u` (`u` of steps −1, 0, 1, `λ` in lattice
-    /// units) whose plane value is `v0 + λ·g` (`g ≠ 0`; `v0 = plane(p)`,
-    /// relative to `a`): the `m` whose displaced segment `λ ∈ [m·ONE,
-    /// (m + 1)·ONE]` straddles the plane (exactly one does).
+    /// units, so the line moves one voxel per `ONE` of `λ` on every axis
+    /// `u` moves on) whose plane value (relative to `a`) is
+    /// `v0 + (λ − at)·g` (`g ≠ 0`): the `m` whose displaced segment
+    /// `λ ∈ [m·ONE, (m + 1)·ONE]` straddles the plane (exactly one does).
+    /// A diagonal's line from a lattice point has `at = 0`; a crosshair's
+    /// `w`-line has `λ = W`, `g = n_w` and `at = a_w`, and `m` is the voxel
+    /// index of the one voxel of the column `sep6` sets (Laine's column
+    /// rule).
     #[inline(always)]
-    pub fn straddling_step(&self, g: T, v0: T) -> T {
+    pub fn straddling_step(&self, g: T, v0: T, at: T) -> T {
         let one = T::from_i64(ONE);
         if g > T::ZERO {
-            // Positive iff λ >= ceil((bn − v0) / g).
-            let first = -(v0 - self.bn).div_floor(g);
+            // Positive iff λ >= at + ceil((bn − v0) / g).
+            let first = at - (v0 - self.bn).div_floor(g);
             (first - T::from_i64(1)).div_floor(one)
         } else {
-            // Positive iff λ <= floor((v0 − bn) / −g).
-            (v0 - self.bn).div_floor(-g).div_floor(one)
+            // Positive iff λ <= at + floor((v0 − bn) / −g).
+            (at + (v0 - self.bn).div_floor(-g)).div_floor(one)
         }
     }
 
@@ -763,7 +763,6 @@ pub(crate) fn diagonal_lines(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], 
     // further products per direction than `e × u` (as `DirSetup`, without
     // its tie biases, derived only on a tie).
     let ab: [[i64; 3]; 3] = std::array::from_fn(|i| crate::geom::lattice::cross(s.rel[i], s.rel[(i + 1) % 3]));
-    let dot = |a: [i64; 3], b: [i64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     for (_, d) in DIAGONALS {
         let u = d.map(i64::signum);
         let g = s.n[0] * u[0] + s.n[1] * u[1] + s.n[2] * u[2];
@@ -790,15 +789,10 @@ pub(crate) fn diagonal_lines(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], 
             for kx in x0..=x1 {
                 let k = [kx * ONE, ky * ONE, z0];
                 let pk = s.local(k);
-                let side = |i: usize| match c[i] - dot(pk, m[i]) {
-                    0 => bias(m[i].map(|x| -x)) == 0,
-                    o => o > 0,
-                };
-                let s0 = side(0);
-                if s0 != side(1) || s0 != side(2) {
+                if !all_one_side(|i| edge_side(c[i] - dot(pk, m[i]), || m[i])) {
                     continue;
                 }
-                let m = s.straddling_step(g, s.plane(pk));
+                let m = s.straddling_step(g, s.plane(pk), 0);
                 let ijk: [i64; 3] = std::array::from_fn(|c| k[c].div_euclid(ONE) + if u[c] > 0 { m } else { -m - 1 });
                 if (0..3).all(|c| ijk[c] >= lo[c] && ijk[c] <= hi[c]) {
                     slab.set(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
