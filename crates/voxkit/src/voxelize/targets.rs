@@ -509,6 +509,17 @@ pub(crate) struct TargetSet<const N: usize> {
     centred: bool,
     /// Every target starts at the same offset (the tunnels').
     common_start: bool,
+    /// The [`even_step`] every target shares (centred sets), else 0.
+    common_step: i64,
+    /// Per target of a centred set: its unit direction's index in
+    /// [`unit_table`].
+    line: [u8; N],
+    /// For a set of opposite pairs (the tunnels': centred, one start and
+    /// one step, each target's opposite in the set too), the number of
+    /// lines through the centre they lie on, else 0; [`Self::pair`] holds
+    /// each line's two targets.
+    lines: usize,
+    pair: [(u8, u8); 13],
     /// Per target: the [`forms_reached`] bits every triangle that meets
     /// one of its translates by whole voxels must have.
     needs: [u16; N],
@@ -527,6 +538,8 @@ impl<const N: usize> TargetSet<N> {
         let mut unit = [[0; 3]; N];
         let mut centred = true;
         let mut common_start = true;
+        let mut common_step = even_step(list[0].1);
+        let mut line = [0u8; N];
         let mut n = 0;
         while n < list.len() {
             seg[n] = list[n];
@@ -543,11 +556,51 @@ impl<const N: usize> TargetSet<N> {
             if m == 0 || r[1] * d[2] != r[2] * d[1] || r[2] * d[0] != r[0] * d[2] || r[0] * d[1] != r[1] * d[0] {
                 centred = false;
             } else {
-                unit[n] = [d[0] / m, d[1] / m, d[2] / m];
+                let u = [d[0] / m, d[1] / m, d[2] / m];
+                unit[n] = u;
+                line[n] = (9 * (u[2] + 1) + 3 * (u[1] + 1) + (u[0] + 1)) as u8;
+            }
+            if m != common_step {
+                common_step = 0;
             }
             n += 1;
         }
-        TargetSet { seg, unit, centred, common_start, needs, len: list.len() }
+        if !centred {
+            common_step = 0;
+        }
+        let (lines, pair) = Self::pairs(&unit, list.len(), centred && common_start && common_step != 0);
+        TargetSet { seg, unit, centred, common_start, common_step, line, lines, pair, needs, len: list.len() }
+    }
+
+    /// The lines of a set of opposite pairs ([`Self::lines`]), if `maybe`
+    /// and every unit direction's opposite is in the set once.
+    const fn pairs(unit: &[P3; N], len: usize, maybe: bool) -> (usize, [(u8, u8); 13]) {
+        let mut pair = [(0u8, 0u8); 13];
+        let mut lines = 0;
+        let mut n = 0;
+        while maybe && n < len {
+            let u = unit[n];
+            let (mut found, mut m) = (0, 0);
+            while m < len {
+                let v = unit[m];
+                if v[0] == -u[0] && v[1] == -u[1] && v[2] == -u[2] {
+                    found += 1;
+                    if m > n && lines < 13 {
+                        pair[lines] = (n as u8, m as u8);
+                        lines += 1;
+                    }
+                }
+                m += 1;
+            }
+            if found != 1 {
+                return (0, [(0, 0); 13]);
+            }
+            n += 1;
+        }
+        if 2 * lines != len {
+            return (0, [(0, 0); 13]);
+        }
+        (lines, pair)
     }
 
     /// The [`forms_reached`] bits a triangle meeting a whole-voxel
@@ -588,6 +641,19 @@ impl<const N: usize> TargetSet<N> {
         &self.seg[..self.len]
     }
 
+    /// The targets (bit `n`) that can, in some voxel, meet a triangle
+    /// whose vertices lie in the closed lattice box `[lo, hi]`: those
+    /// whose [`Self::needs`] the box reaches ([`forms_reached`]).
+    #[inline(always)]
+    pub fn live(&self, lo: P3, hi: P3) -> u32 {
+        let reached = forms_reached(lo, hi);
+        let mut live = 0u32;
+        for (n, needs) in self.needs[..self.len].iter().enumerate() {
+            live |= ((needs & !reached == 0) as u32) << n;
+        }
+        live
+    }
+
     /// Can one of the targets, in some voxel, meet a triangle whose
     /// vertices lie in the closed lattice box `[lo, hi]`? Only if the box
     /// reaches every form one target [`Self::needs`] ([`forms_reached`]).
@@ -598,6 +664,14 @@ impl<const N: usize> TargetSet<N> {
         let reached = forms_reached(lo, hi);
         self.needs[..self.len].iter().any(|n| n & !reached == 0)
     }
+}
+
+/// `v·u` for the 27 directions `u` of components −1, 0, 1, at index
+/// `9(u_z + 1) + 3(u_y + 1) + (u_x + 1)`, by additions.
+#[inline(always)]
+fn unit_table<T: PlaneInt>(v: [T; 3]) -> [T; 27] {
+    let (x, y, z) = ([-v[0], T::ZERO, v[0]], [-v[1], T::ZERO, v[1]], [-v[2], T::ZERO, v[2]]);
+    std::array::from_fn(|i| z[i / 9] + y[i / 3 % 3] + x[i % 3])
 }
 
 /// [`DIAGONALS`] as a [`TargetSet`].
@@ -621,12 +695,18 @@ pub(crate) struct LazyTargets<'t, T, const N: usize> {
     /// Per target: the plane values `n·o` and `n·(o + d)` of its start
     /// and end offsets `o`, `o + d`. It crosses the plane in the voxel with
     /// low corner `c` iff exactly one is `>= t = bn − n·(c − a)`. (Bits of
-    /// targets past the set's length are cleared by `live`.)
+    /// targets past the set's length are cleared by `live`.) A set of
+    /// opposite pairs sets only `start[0]` and uses [`Self::kabs`].
     start: [T; N],
     end: [T; N],
     /// The targets that may meet the triangle (bit `n`): for small
     /// triangles, those whose [`TargetSet`] forms the box reaches.
     live: u32,
+    /// For a set of opposite pairs: per line `l` of [`TargetSet::pair`],
+    /// `|n·d|` of its targets (their end's plane value less the common
+    /// start's), and the lines one of whose targets is live (bit `l`).
+    kabs: [T; 13],
+    line_live: u32,
 }
 
 impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
@@ -635,24 +715,46 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
     #[inline(always)]
     pub fn new(tri: &'t LatticeTriangle, set: &'t TargetSet<N>) -> Self {
         let (lo, hi) = tri.bounds();
-        let s = TriSetup::new(tri);
-        let (mut start, mut end) = ([T::ZERO; N], [T::ZERO; N]);
-        for (n, (o, d)) in set.segments().iter().enumerate() {
-            start[n] = dot(s.n, o.map(T::from_i64));
-            end[n] = start[n] + dot(s.n, d.map(T::from_i64));
-        }
-        let mut live = u32::MAX.checked_shr(32 - set.len as u32).unwrap_or(0);
+        let all = u32::MAX.checked_shr(32 - set.len as u32).unwrap_or(0);
         // Triangles under half a voxel (most at 32³) miss most forms; at
         // about a voxel (128³) they reach nearly all, and the test cost 3 %.
-        if (0..3).all(|c| hi[c] - lo[c] <= H) {
-            let reached = forms_reached(lo, hi);
-            for (n, needs) in set.needs[..set.len].iter().enumerate() {
-                if needs & !reached != 0 {
-                    live &= !(1 << n);
+        let live = if (0..3).all(|c| hi[c] - lo[c] <= H) { set.live(lo, hi) } else { all };
+        Self::with_live(tri, set, live)
+    }
+
+    /// [`Self::new`] with the live targets given (bit `n`; at least those
+    /// [`TargetSet::live`] gives for the triangle's bounds).
+    #[inline(always)]
+    pub fn with_live(tri: &'t LatticeTriangle, set: &'t TargetSet<N>, live: u32) -> Self {
+        let s = TriSetup::new(tri);
+        let (mut start, mut end) = ([T::ZERO; N], [T::ZERO; N]);
+        let (mut kabs, mut line_live) = ([T::ZERO; 13], 0u32);
+        if set.common_start && set.common_step != 0 {
+            // One start; each end from the table of `n·u` over unit
+            // directions `u`, by additions (26 targets for the tunnels).
+            let s0 = dot(s.n, set.seg[0].0.map(T::from_i64));
+            let table = unit_table(s.n.map(|c| c * T::from_i64(set.common_step)));
+            start[0] = s0;
+            if set.lines > 0 {
+                // Per line only; `end` is left unset (see `hits`).
+                for (l, &(a, b)) in set.pair[..set.lines].iter().enumerate() {
+                    let k = table[set.line[a as usize] as usize];
+                    kabs[l] = if k < T::ZERO { -k } else { k };
+                    line_live |= ((live >> a | live >> b) & 1) << l;
+                }
+            } else {
+                for n in 0..set.len {
+                    start[n] = s0;
+                    end[n] = s0 + table[set.line[n] as usize];
                 }
             }
+        } else {
+            for (n, (o, d)) in set.segments().iter().enumerate() {
+                start[n] = dot(s.n, o.map(T::from_i64));
+                end[n] = start[n] + dot(s.n, d.map(T::from_i64));
+            }
         }
-        LazyTargets { tri, s, set, start, end, live }
+        LazyTargets { tri, s, set, start, end, live, kabs, line_live }
     }
 
     /// The live targets of the voxel with low corner plane value `vc` whose
@@ -709,7 +811,13 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
         let pc = self.s.local(c);
         let vc = self.s.plane(pc);
         let t = self.s.bn - vc;
-        if self.live >> n & 1 == 0 || (self.start[n] >= t) == (self.end[n] >= t) {
+        // A set of opposite pairs keeps only the common start.
+        let (start, end) = if self.set.lines > 0 {
+            (self.start[0], self.start[0] + dot(self.s.n, self.set.seg[n].1.map(T::from_i64)))
+        } else {
+            (self.start[n], self.end[n])
+        };
+        if self.live >> n & 1 == 0 || (start >= t) == (end >= t) {
             return false;
         }
         if self.set.centred {
@@ -725,6 +833,9 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
         let c = corner(ijk);
         let pc = self.s.local(c);
         let vc = self.s.plane(pc);
+        if self.set.lines > 0 {
+            return self.any_line(pc, vc);
+        }
         let mut mask = self.crossing(vc);
         let mut w = None;
         while mask != 0 {
@@ -736,6 +847,38 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
                 self.edges_once(n, pc, vc)
             };
             if hit {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// [`Self::any`] for a set of opposite pairs. With `x` the common
+    /// start's plane value less the threshold, the target along `u`
+    /// crosses iff `x >= 0` and `x + k < 0` or the other way round, `k =
+    /// n·d`; its opposite, the same with `−k`. So one of a line's two
+    /// crosses iff `|k| > x` (`x >= 0`) or `|k| >= −x`: one comparison per
+    /// line, not per target. A line that crosses the plane is not parallel
+    /// to it, and then its edge sides along `−u` are those along `u`
+    /// flipped, ties included, so [`TriSetup::line_hits`] along one
+    /// direction decides the line and with it the crossing target.
+    #[inline(always)]
+    fn any_line(&self, pc: [T; 3], vc: T) -> bool {
+        let x = self.start[0] - (self.s.bn - vc);
+        let y = if x >= T::ZERO { x + T::from_i64(1) } else { -x };
+        let mut mask = 0u32;
+        for (l, &k) in self.kabs.iter().enumerate() {
+            mask |= ((k >= y) as u32) << l;
+        }
+        mask &= self.line_live;
+        if mask == 0 {
+            return false;
+        }
+        let w = self.centre_cross(pc);
+        while mask != 0 {
+            let l = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            if self.centre_line_hits(self.set.pair[l].0 as usize, &w) {
                 return true;
             }
         }
@@ -944,19 +1087,67 @@ mod tests {
         assert_eq!(TargetSet::<1>::new(&[([0, 0, 0], [ONE, H, 0])]).needs[0], 0);
     }
 
-    #[test]
-    fn fast_segment_test_matches_the_definition() {
-        // Triangles through corners, along faces, on centre planes: the
-        // degenerate touches the perturbation must decide.
-        let tris = [
+    /// Triangles through corners, along faces, on centre planes: the
+    /// degenerate touches the perturbation must decide.
+    fn touching_triangles() -> [LatticeTriangle; 7] {
+        [
             lt([[0, 0, 0], [2 * ONE, 0, 0], [0, 2 * ONE, 0]]),
             lt([[0, 0, H], [2 * ONE, 0, H], [0, 2 * ONE, H]]),
             lt([[0, 0, 0], [ONE, ONE, ONE], [2 * ONE, 0, ONE]]),
             lt([[H, -ONE, -ONE], [H, 3 * ONE, -ONE], [H, -ONE, 3 * ONE]]),
             lt([[0, 0, 0], [ONE, 0, ONE], [0, ONE, ONE]]),
             lt([[ONE, 0, 0], [0, ONE, 0], [0, 0, ONE]]),
-        ];
-        for t in &tris {
+            lt([[H, H, 0], [2 * ONE + H, H, ONE], [H, ONE + H, 2 * ONE]]),
+        ]
+    }
+
+    #[test]
+    fn sets_of_opposite_pairs_are_found_and_match_the_definition() {
+        use crate::voxelize::tunnel::{targets, TunnelTarget};
+        let t26 = targets(TunnelTarget::TwentySix);
+        let t18 = targets(TunnelTarget::Eighteen);
+        let pair = [([H, H, H], [H, 0, -H]), ([H, H, H], [-H, 0, H])];
+        assert_eq!(TargetSet::<26>::new(&t26).lines, 13);
+        assert_eq!(TargetSet::<26>::new(&t18).lines, 9);
+        assert_eq!(TargetSet::<26>::new(&pair).lines, 1);
+        // A pair need not start at the centre, only on a line through it.
+        let face = [([0, H, H], [H, 0, 0]), ([0, H, H], [-H, 0, 0])];
+        assert_eq!(TargetSet::<26>::new(&face).lines, 1);
+        // Not pairs: one side only, off the centre, the voxel's diagonals.
+        assert_eq!(TargetSet::<26>::new(&t26[..13]).lines, 0);
+        assert_eq!(TargetSet::<26>::new(&[([0, 0, H], [H, 0, 0]), ([0, 0, H], [-H, 0, 0])]).lines, 0);
+        assert_eq!(DIAGONAL_SET.lines, 0);
+        for t in &touching_triangles() {
+            for list in [&t26[..], &t18[..], &pair[..], &face[..]] {
+                let set = TargetSet::<26>::new(list);
+                let lazy = LazyTargets::<i64, 26>::new(t, &set);
+                let wide = LazyTargets::<i128, 26>::new(t, &set);
+                for k in -1..3 {
+                    for j in -1..3 {
+                        for i in -1..3 {
+                            let ijk = [i, j, k];
+                            let want: Vec<bool> = list
+                                .iter()
+                                .map(|(o, d)| {
+                                    let p = add(corner(ijk), *o);
+                                    segment_meets_triangle([p, add(p, *d)], t.v, true)
+                                })
+                                .collect();
+                            assert_eq!(lazy.any(ijk), want.contains(&true), "{t:?} {ijk:?}");
+                            assert_eq!(wide.any(ijk), want.contains(&true), "{t:?} {ijk:?}");
+                            for (n, w) in want.iter().enumerate() {
+                                assert_eq!(lazy.hits(n, ijk), *w, "{t:?} {ijk:?} target {n}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fast_segment_test_matches_the_definition() {
+        for t in &touching_triangles() {
             let s64 = TriSetup::<i64>::new(t);
             let s128 = TriSetup::<i128>::new(t);
             for (o, d) in DIAGONALS.iter().chain(CROSSHAIR.iter()) {

@@ -22,9 +22,12 @@
 //! sep26`, and both are subsets of `cover` (every target lies in the
 //! closed voxel). `voxkit check` counts 6-, 18- and 26-tunnels.
 //!
-//! **Fast path.** `cover`'s exact traversal enumerates candidates; each
-//! gets the segment tests of its targets (`TriSetup`, one direction setup
-//! per target direction and triangle, `i64` for all but huge triangles).
+//! **Fast path.** `cover`'s exact traversal enumerates candidates not yet
+//! set; each gets the tests of its targets (`LazyTargets`, `i64` for all
+//! but huge triangles). The targets come in opposite pairs on the 13 (9)
+//! lines through the centre, so one comparison per line says whether one
+//! of its two targets crosses the plane, and the line's edge sides come
+//! from the centre's pivot cross, three dot products per line.
 //!
 //! **Reference:** [`reference::tunnel`], every target of every voxel of each
 //! triangle's bounding box with the generic `i128` predicate.
@@ -97,13 +100,14 @@ impl Kernel<LatticeTriangle> for TunnelKernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
         // Integer tests first: most triangles at 32³ pass no target line.
         let (blo, bhi) = tri.bounds();
-        if !self.dirs.may_meet(blo, bhi) {
+        let live = self.dirs.live(blo, bhi);
+        if live == 0 {
             return;
         }
         if fits_i64(tri) {
-            filtered::<i64>(tri, &self.dirs, lo, hi, self.traversal, slab);
+            filtered::<i64>(tri, &self.dirs, live, lo, hi, self.traversal, slab);
         } else {
-            filtered::<i128>(tri, &self.dirs, lo, hi, self.traversal, slab);
+            filtered::<i128>(tri, &self.dirs, live, lo, hi, self.traversal, slab);
         }
     }
 }
@@ -111,12 +115,13 @@ impl Kernel<LatticeTriangle> for TunnelKernel {
 fn filtered<T: PlaneInt>(
     tri: &LatticeTriangle,
     dirs: &TargetSet<26>,
+    live: u32,
     lo: [i64; 3],
     hi: [i64; 3],
     traversal: Traversal,
     slab: &mut BrickSlab<'_>,
 ) {
-    let targets = LazyTargets::<T, 26>::new(tri, dirs);
+    let targets = LazyTargets::<T, 26>::with_live(tri, dirs, live);
     let keep = |ijk: [i64; 3]| targets.any(ijk);
     cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
 }
