@@ -520,11 +520,21 @@ pub(crate) struct TargetSet<const N: usize> {
     /// each line's two targets.
     lines: usize,
     pair: [(u8, u8); 13],
+    /// Per line `l < 13`: its `+` target's index in [`unit_table`]; past
+    /// [`Self::lines`], the zero direction's (13), whose `n·u` is 0.
+    pair_unit: [u8; 13],
     /// Per target: the [`forms_reached`] bits every triangle that meets
     /// one of its translates by whole voxels must have.
     needs: [u16; N],
+    /// Per value of [`forms_reached`]: the live targets (bit `n`), those
+    /// whose [`Self::needs`] it has, and their lines (bit `l`).
+    live_of: [u32; 512],
+    lines_live_of: [u16; 512],
     len: usize,
 }
+
+/// Every [`forms_reached`] bit.
+pub(crate) const ALL_FORMS: u16 = (1 << 9) - 1;
 
 /// The axis pairs of the [`forms_reached`] pair forms.
 const PAIRS: [(usize, usize); 3] = [(0, 1), (1, 2), (0, 2)];
@@ -569,7 +579,30 @@ impl<const N: usize> TargetSet<N> {
             common_step = 0;
         }
         let (lines, pair) = Self::pairs(&unit, list.len(), centred && common_start && common_step != 0);
-        TargetSet { seg, unit, centred, common_start, common_step, line, lines, pair, needs, len: list.len() }
+        let mut pair_unit = [13u8; 13];
+        let mut live_of = [0u32; 512];
+        let mut lines_live_of = [0u16; 512];
+        let mut r = 0;
+        while r < 512 {
+            let mut n = 0;
+            while n < list.len() {
+                if needs[n] & !(r as u16) == 0 {
+                    live_of[r] |= 1 << n;
+                }
+                n += 1;
+            }
+            let mut l = 0;
+            while l < lines {
+                let (a, b) = pair[l];
+                if (live_of[r] >> a | live_of[r] >> b) & 1 != 0 {
+                    lines_live_of[r] |= 1 << l;
+                }
+                pair_unit[l] = line[a as usize];
+                l += 1;
+            }
+            r += 1;
+        }
+        TargetSet { seg, unit, centred, common_start, common_step, line, lines, pair, pair_unit, live_of, lines_live_of, needs, len: list.len() }
     }
 
     /// The lines of a set of opposite pairs ([`Self::lines`]), if `maybe`
@@ -641,19 +674,6 @@ impl<const N: usize> TargetSet<N> {
         &self.seg[..self.len]
     }
 
-    /// The targets (bit `n`) that can, in some voxel, meet a triangle
-    /// whose vertices lie in the closed lattice box `[lo, hi]`: those
-    /// whose [`Self::needs`] the box reaches ([`forms_reached`]).
-    #[inline(always)]
-    pub fn live(&self, lo: P3, hi: P3) -> u32 {
-        let reached = forms_reached(lo, hi);
-        let mut live = 0u32;
-        for (n, needs) in self.needs[..self.len].iter().enumerate() {
-            live |= ((needs & !reached == 0) as u32) << n;
-        }
-        live
-    }
-
     /// Can one of the targets, in some voxel, meet a triangle whose
     /// vertices lie in the closed lattice box `[lo, hi]`? Only if the box
     /// reaches every form one target [`Self::needs`] ([`forms_reached`]).
@@ -661,8 +681,17 @@ impl<const N: usize> TargetSet<N> {
     /// integer comparisons, before any setup.
     #[inline(always)]
     pub fn may_meet(&self, lo: P3, hi: P3) -> bool {
+        // Not by the table: for a set known at compile time only the
+        // forms its targets need are computed (sep6 at 32: −7 %).
         let reached = forms_reached(lo, hi);
         self.needs[..self.len].iter().any(|n| n & !reached == 0)
+    }
+
+    /// [`Self::may_meet`] given the box's [`forms_reached`] bits, by
+    /// table (for a set of many targets).
+    #[inline(always)]
+    pub fn may_meet_reached(&self, reached: u16) -> bool {
+        self.live_of[reached as usize] != 0
     }
 }
 
@@ -715,20 +744,21 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
     #[inline(always)]
     pub fn new(tri: &'t LatticeTriangle, set: &'t TargetSet<N>) -> Self {
         let (lo, hi) = tri.bounds();
-        let all = u32::MAX.checked_shr(32 - set.len as u32).unwrap_or(0);
         // Triangles under half a voxel (most at 32³) miss most forms; at
         // about a voxel (128³) they reach nearly all, and the test cost 3 %.
-        let live = if (0..3).all(|c| hi[c] - lo[c] <= H) { set.live(lo, hi) } else { all };
-        Self::with_live(tri, set, live)
+        let reached = if (0..3).all(|c| hi[c] - lo[c] <= H) { forms_reached(lo, hi) } else { ALL_FORMS };
+        Self::with_reached(tri, set, reached)
     }
 
-    /// [`Self::new`] with the live targets given (bit `n`; at least those
-    /// [`TargetSet::live`] gives for the triangle's bounds).
+    /// [`Self::new`] given the [`forms_reached`] bits of the triangle's
+    /// bounds (or more: all of them, [`ALL_FORMS`], keeps every target).
     #[inline(always)]
-    pub fn with_live(tri: &'t LatticeTriangle, set: &'t TargetSet<N>, live: u32) -> Self {
+    pub fn with_reached(tri: &'t LatticeTriangle, set: &'t TargetSet<N>, reached: u16) -> Self {
+        let live = set.live_of[reached as usize];
         let s = TriSetup::new(tri);
         let (mut start, mut end) = ([T::ZERO; N], [T::ZERO; N]);
-        let (mut kabs, mut line_live) = ([T::ZERO; 13], 0u32);
+        let mut kabs = [T::ZERO; 13];
+        let line_live = set.lines_live_of[reached as usize] as u32;
         if set.common_start && set.common_step != 0 {
             // One start; each end from the table of `n·u` over unit
             // directions `u`, by additions (26 targets for the tunnels).
@@ -736,11 +766,11 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
             let table = unit_table(s.n.map(|c| c * T::from_i64(set.common_step)));
             start[0] = s0;
             if set.lines > 0 {
-                // Per line only; `end` is left unset (see `hits`).
-                for (l, &(a, b)) in set.pair[..set.lines].iter().enumerate() {
-                    let k = table[set.line[a as usize] as usize];
-                    kabs[l] = if k < T::ZERO { -k } else { k };
-                    line_live |= ((live >> a | live >> b) & 1) << l;
+                // Per line only (0 past the set's lines); `end` is left
+                // unset (see `hits`).
+                for (k, &u) in kabs.iter_mut().zip(&set.pair_unit) {
+                    let v = table[u as usize];
+                    *k = if v < T::ZERO { -v } else { v };
                 }
             } else {
                 for n in 0..set.len {
@@ -1046,7 +1076,7 @@ mod tests {
                 .into_iter()
                 .chain(DIAGONALS)
                 .chain(CROSSHAIR)
-                .map(|t| (t, TargetSet::<1>::new(&[t]).needs[0]))
+                .map(|t| (t, TargetSet::<1>::needs(t.0, t.1)))
                 .collect();
             for k in -2..3 {
                 for j in -2..3 {
@@ -1080,11 +1110,11 @@ mod tests {
     fn target_sets_need_their_forms() {
         // The diagonals need two pair forms, the crosshair two mid-planes,
         // a tunnel target to an edge midpoint one of each.
-        assert!(DIAGONAL_SET.needs.iter().all(|n| n.count_ones() == 3));
-        assert!(CROSSHAIR_SET.needs.iter().all(|n| *n & 0b111 != 0 && n.count_ones() == 2));
-        assert_eq!(TargetSet::<1>::new(&[([H, H, H], [H, H, 0])]).needs[0], 1 << 2 | 1 << 4);
+        assert!(DIAGONALS.iter().all(|&(o, d)| TargetSet::<4>::needs(o, d).count_ones() == 3));
+        assert!(CROSSHAIR.iter().all(|&(o, d)| TargetSet::<3>::needs(o, d) & 0b111 != 0 && TargetSet::<3>::needs(o, d).count_ones() == 2));
+        assert_eq!(TargetSet::<1>::needs([H, H, H], [H, H, 0]), 1 << 2 | 1 << 4);
         // Unequal steps need nothing.
-        assert_eq!(TargetSet::<1>::new(&[([0, 0, 0], [ONE, H, 0])]).needs[0], 0);
+        assert_eq!(TargetSet::<1>::needs([0, 0, 0], [ONE, H, 0]), 0);
     }
 
     /// Triangles through corners, along faces, on centre planes: the

@@ -34,7 +34,7 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, FilterUnset, Kernel};
-use super::targets::{fits_i64, LazyTargets, TargetSet};
+use super::targets::{fits_i64, forms_reached, LazyTargets, TargetSet};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -100,14 +100,14 @@ impl Kernel<LatticeTriangle> for TunnelKernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
         // Integer tests first: most triangles at 32³ pass no target line.
         let (blo, bhi) = tri.bounds();
-        let live = self.dirs.live(blo, bhi);
-        if live == 0 {
+        let reached = forms_reached(blo, bhi);
+        if !self.dirs.may_meet_reached(reached) {
             return;
         }
         if fits_i64(tri) {
-            filtered::<i64>(tri, &self.dirs, live, lo, hi, self.traversal, slab);
+            filtered::<i64>(tri, &self.dirs, reached, lo, hi, self.traversal, slab);
         } else {
-            filtered::<i128>(tri, &self.dirs, live, lo, hi, self.traversal, slab);
+            filtered::<i128>(tri, &self.dirs, reached, lo, hi, self.traversal, slab);
         }
     }
 }
@@ -115,13 +115,13 @@ impl Kernel<LatticeTriangle> for TunnelKernel {
 fn filtered<T: PlaneInt>(
     tri: &LatticeTriangle,
     dirs: &TargetSet<26>,
-    live: u32,
+    reached: u16,
     lo: [i64; 3],
     hi: [i64; 3],
     traversal: Traversal,
     slab: &mut BrickSlab<'_>,
 ) {
-    let targets = LazyTargets::<T, 26>::with_live(tri, dirs, live);
+    let targets = LazyTargets::<T, 26>::with_reached(tri, dirs, reached);
     let keep = |ijk: [i64; 3]| targets.any(ijk);
     cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
 }
