@@ -507,13 +507,8 @@ pub(crate) struct TargetSet<const N: usize> {
     /// centre ([`LazyTargets`] then tests edge sides from the centre's
     /// [`PivotCross`]).
     centred: bool,
-    /// Every target starts at the same offset (the tunnels').
-    common_start: bool,
     /// The [`even_step`] every target shares (centred sets), else 0.
     common_step: i64,
-    /// Per target of a centred set: its unit direction's index in
-    /// [`unit_table`].
-    line: [u8; N],
     /// For a set of opposite pairs (the tunnels': centred, one start and
     /// one step, each target's opposite in the set too), the number of
     /// lines through the centre they lie on, else 0; [`Self::pair`] holds
@@ -602,7 +597,7 @@ impl<const N: usize> TargetSet<N> {
             }
             r += 1;
         }
-        TargetSet { seg, unit, centred, common_start, common_step, line, lines, pair, pair_unit, live_of, lines_live_of, needs, len: list.len() }
+        TargetSet { seg, unit, centred, common_step, lines, pair, pair_unit, live_of, lines_live_of, needs, len: list.len() }
     }
 
     /// The lines of a set of opposite pairs ([`Self::lines`]), if `maybe`
@@ -674,6 +669,11 @@ impl<const N: usize> TargetSet<N> {
         &self.seg[..self.len]
     }
 
+    /// Is it a set of opposite pairs ([`PairedTargets`])?
+    pub fn paired(&self) -> bool {
+        self.lines > 0
+    }
+
     /// Can one of the targets, in some voxel, meet a triangle whose
     /// vertices lie in the closed lattice box `[lo, hi]`? Only if the box
     /// reaches every form one target [`Self::needs`] ([`forms_reached`]).
@@ -709,33 +709,27 @@ pub(crate) const DIAGONAL_SET: TargetSet<4> = TargetSet::new(&DIAGONALS);
 /// [`CROSSHAIR`] as a [`TargetSet`].
 pub(crate) const CROSSHAIR_SET: TargetSet<3> = TargetSet::new(&CROSSHAIR);
 
-/// One triangle against a fixed set of target segments. A voxel's targets
-/// are decided by the cheapest test first: which of them cross the
-/// (displaced) plane, as a bit mask from the voxel corner's plane value
-/// (each target's end plane values made once per triangle); then the edge
-/// sides. For a [centred set](TargetSet) those are three dot products with
-/// the voxel centre's [`PivotCross`], with no per-direction setup (cheaper
-/// than a segment/triangle-box filter in front: −7 to −14 % at 128³
-/// without one); for any other set, [`TriSetup::segment_hits_once`].
+/// One triangle against a fixed set of target segments, one target at a
+/// time ([`Self::hits`]; the alternating-diagonal mode's test). First the
+/// plane test, from the target's end plane values made once per triangle;
+/// then the edge sides: for a [centred set](TargetSet) three dot products
+/// with the voxel centre's [`PivotCross`], with no per-direction setup
+/// (cheaper than a segment/triangle-box filter in front: −7 to −14 % at
+/// 128³ without one); for any other set, [`TriSetup::segment_hits_once`].
+/// All of a voxel's targets at once, for a set of opposite pairs:
+/// [`PairedTargets`].
 pub(crate) struct LazyTargets<'t, T, const N: usize> {
     tri: &'t LatticeTriangle,
     s: TriSetup<T>,
     set: &'t TargetSet<N>,
     /// Per target: the plane values `n·o` and `n·(o + d)` of its start
     /// and end offsets `o`, `o + d`. It crosses the plane in the voxel with
-    /// low corner `c` iff exactly one is `>= t = bn − n·(c − a)`. (Bits of
-    /// targets past the set's length are cleared by `live`.) A set of
-    /// opposite pairs sets only `start[0]` and uses [`Self::kabs`].
+    /// low corner `c` iff exactly one is `>= t = bn − n·(c − a)`.
     start: [T; N],
     end: [T; N],
     /// The targets that may meet the triangle (bit `n`): for small
     /// triangles, those whose [`TargetSet`] forms the box reaches.
     live: u32,
-    /// For a set of opposite pairs: per line `l` of [`TargetSet::pair`],
-    /// `|n·d|` of its targets (their end's plane value less the common
-    /// start's), and the lines one of whose targets is live (bit `l`).
-    kabs: [T; 13],
-    line_live: u32,
 }
 
 impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
@@ -747,64 +741,13 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
         // Triangles under half a voxel (most at 32³) miss most forms; at
         // about a voxel (128³) they reach nearly all, and the test cost 3 %.
         let reached = if (0..3).all(|c| hi[c] - lo[c] <= H) { forms_reached(lo, hi) } else { ALL_FORMS };
-        Self::with_reached(tri, set, reached)
-    }
-
-    /// [`Self::new`] given the [`forms_reached`] bits of the triangle's
-    /// bounds (or more: all of them, [`ALL_FORMS`], keeps every target).
-    #[inline(always)]
-    pub fn with_reached(tri: &'t LatticeTriangle, set: &'t TargetSet<N>, reached: u16) -> Self {
-        let live = set.live_of[reached as usize];
         let s = TriSetup::new(tri);
         let (mut start, mut end) = ([T::ZERO; N], [T::ZERO; N]);
-        let mut kabs = [T::ZERO; 13];
-        let line_live = set.lines_live_of[reached as usize] as u32;
-        if set.common_start && set.common_step != 0 {
-            // One start; each end from the table of `n·u` over unit
-            // directions `u`, by additions (26 targets for the tunnels).
-            let s0 = dot(s.n, set.seg[0].0.map(T::from_i64));
-            let table = unit_table(s.n.map(|c| c * T::from_i64(set.common_step)));
-            start[0] = s0;
-            if set.lines > 0 {
-                // Per line only (0 past the set's lines); `end` is left
-                // unset (see `hits`).
-                for (k, &u) in kabs.iter_mut().zip(&set.pair_unit) {
-                    let v = table[u as usize];
-                    *k = if v < T::ZERO { -v } else { v };
-                }
-            } else {
-                for n in 0..set.len {
-                    start[n] = s0;
-                    end[n] = s0 + table[set.line[n] as usize];
-                }
-            }
-        } else {
-            for (n, (o, d)) in set.segments().iter().enumerate() {
-                start[n] = dot(s.n, o.map(T::from_i64));
-                end[n] = start[n] + dot(s.n, d.map(T::from_i64));
-            }
+        for (n, (o, d)) in set.segments().iter().enumerate() {
+            start[n] = dot(s.n, o.map(T::from_i64));
+            end[n] = start[n] + dot(s.n, d.map(T::from_i64));
         }
-        LazyTargets { tri, s, set, start, end, live, kabs, line_live }
-    }
-
-    /// The live targets of the voxel with low corner plane value `vc` whose
-    /// displaced segments cross the plane (bit `n`), branch-free over the
-    /// whole set (the tunnels' 26 targets).
-    #[inline(always)]
-    fn crossing(&self, vc: T) -> u32 {
-        let t = self.s.bn - vc;
-        let mut mask = 0u32;
-        if self.set.common_start {
-            let side = (self.start[0] >= t) as u32;
-            for (n, &end) in self.end.iter().enumerate() {
-                mask |= ((end >= t) as u32 ^ side) << n;
-            }
-        } else {
-            for n in 0..N {
-                mask |= ((self.start[n] >= t) as u32 ^ (self.end[n] >= t) as u32) << n;
-            }
-        }
-        mask & self.live
+        LazyTargets { tri, s, set, start, end, live: set.live_of[reached as usize] }
     }
 
     /// The [`PivotCross`] of the centre of the voxel whose low corner is
@@ -841,13 +784,7 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
         let pc = self.s.local(c);
         let vc = self.s.plane(pc);
         let t = self.s.bn - vc;
-        // A set of opposite pairs keeps only the common start.
-        let (start, end) = if self.set.lines > 0 {
-            (self.start[0], self.start[0] + dot(self.s.n, self.set.seg[n].1.map(T::from_i64)))
-        } else {
-            (self.start[n], self.end[n])
-        };
-        if self.live >> n & 1 == 0 || (start >= t) == (end >= t) {
+        if self.live >> n & 1 == 0 || (self.start[n] >= t) == (self.end[n] >= t) {
             return false;
         }
         if self.set.centred {
@@ -857,58 +794,71 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
         }
     }
 
-    /// Does any of the voxel's targets meet the triangle?
-    #[inline]
-    pub fn any(&self, ijk: [i64; 3]) -> bool {
-        let c = corner(ijk);
-        let pc = self.s.local(c);
-        let vc = self.s.plane(pc);
-        if self.set.lines > 0 {
-            return self.any_line(pc, vc);
-        }
-        let mut mask = self.crossing(vc);
-        let mut w = None;
-        while mask != 0 {
-            let n = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            let hit = if self.set.centred {
-                self.centre_line_hits(n, w.get_or_insert_with(|| self.centre_cross(pc)))
+}
+
+/// Does any of a voxel's targets meet one triangle, for a set of opposite
+/// pairs ([`TargetSet::paired`]: the tunnels'), line by line. With `x` the common start's plane value
+/// less the voxel's threshold, the target along `u` crosses the plane iff
+/// `x >= 0` and `x + k < 0` or the other way round (`k = n·d`); its
+/// opposite, the same with `−k`. So one of a line's two crosses iff
+/// `|k| > x` (`x >= 0`) or `|k| >= −x`: one comparison per line, not per
+/// target. A line that crosses the plane is not parallel to it, and then
+/// its edge sides along `−u` are those along `u` flipped, ties included,
+/// so [`TriSetup::line_hits`] along one direction decides the line and
+/// with it the crossing target. Keeps per triangle only `|k|` per line.
+pub(crate) struct PairedTargets<'t, T, const N: usize> {
+    tri: &'t LatticeTriangle,
+    s: TriSetup<T>,
+    set: &'t TargetSet<N>,
+    /// The common start's plane value `n·o`.
+    start: T,
+    /// Per line `l` of [`TargetSet::pair`]: `|n·d|` of its targets (0 past
+    /// the set's lines).
+    kabs: [T; 13],
+    /// The lines one of whose targets may meet the triangle (bit `l`).
+    live: u32,
+}
+
+impl<'t, T: PlaneInt, const N: usize> PairedTargets<'t, T, N> {
+    /// Setup for `tri` against `set` (a set of opposite pairs), given the
+    /// [`forms_reached`] bits of the triangle's bounds.
+    #[inline(always)]
+    pub fn new(tri: &'t LatticeTriangle, set: &'t TargetSet<N>, reached: u16) -> Self {
+        debug_assert!(set.lines > 0, "not a set of opposite pairs");
+        let s = TriSetup::new(tri);
+        let start = dot(s.n, set.seg[0].0.map(T::from_i64));
+        let table = unit_table(s.n.map(|c| c * T::from_i64(set.common_step)));
+        let kabs = set.pair_unit.map(|u| {
+            let v = table[u as usize];
+            if v < T::ZERO {
+                -v
             } else {
-                self.edges_once(n, pc, vc)
-            };
-            if hit {
-                return true;
+                v
             }
-        }
-        false
+        });
+        PairedTargets { tri, s, set, start, kabs, live: set.lines_live_of[reached as usize] as u32 }
     }
 
-    /// [`Self::any`] for a set of opposite pairs. With `x` the common
-    /// start's plane value less the threshold, the target along `u`
-    /// crosses iff `x >= 0` and `x + k < 0` or the other way round, `k =
-    /// n·d`; its opposite, the same with `−k`. So one of a line's two
-    /// crosses iff `|k| > x` (`x >= 0`) or `|k| >= −x`: one comparison per
-    /// line, not per target. A line that crosses the plane is not parallel
-    /// to it, and then its edge sides along `−u` are those along `u`
-    /// flipped, ties included, so [`TriSetup::line_hits`] along one
-    /// direction decides the line and with it the crossing target.
+    /// Does any of voxel `ijk`'s targets meet the triangle?
     #[inline(always)]
-    fn any_line(&self, pc: [T; 3], vc: T) -> bool {
-        let x = self.start[0] - (self.s.bn - vc);
+    pub fn any(&self, ijk: [i64; 3]) -> bool {
+        let pc = self.s.local(corner(ijk));
+        let x = self.start - (self.s.bn - self.s.plane(pc));
         let y = if x >= T::ZERO { x + T::from_i64(1) } else { -x };
         let mut mask = 0u32;
         for (l, &k) in self.kabs.iter().enumerate() {
             mask |= ((k >= y) as u32) << l;
         }
-        mask &= self.line_live;
+        mask &= self.live;
         if mask == 0 {
             return false;
         }
-        let w = self.centre_cross(pc);
+        let w = self.s.pivot_cross(pc.map(|x| x + T::from_i64(H)));
         while mask != 0 {
             let l = mask.trailing_zeros() as usize;
             mask &= mask - 1;
-            if self.centre_line_hits(self.set.pair[l].0 as usize, &w) {
+            let n = self.set.pair[l].0 as usize;
+            if self.s.line_hits(self.tri, &w, self.set.unit[n].map(T::from_i64), self.set.seg[n].1) {
                 return true;
             }
         }
@@ -1033,7 +983,6 @@ mod tests {
                 proptest::prop_assert_eq!(targets.centred, even_step(d) != 0 && on_line);
                 let lazy = LazyTargets::<i64, 1>::new(&t, &targets);
                 proptest::prop_assert_eq!(lazy.hits(0, [0, 0, 0]), want);
-                proptest::prop_assert_eq!(lazy.any([0, 0, 0]), want);
                 let s = TriSetup::<i64>::new(&t);
                 let p = s.local(a);
                 proptest::prop_assert_eq!(s.segment_hits_once(&t, p, d, s.plane(p)), want);
@@ -1151,7 +1100,9 @@ mod tests {
             for list in [&t26[..], &t18[..], &pair[..], &face[..]] {
                 let set = TargetSet::<26>::new(list);
                 let lazy = LazyTargets::<i64, 26>::new(t, &set);
-                let wide = LazyTargets::<i128, 26>::new(t, &set);
+                let (lo, hi) = t.bounds();
+                let paired = PairedTargets::<i64, 26>::new(t, &set, forms_reached(lo, hi));
+                let wide = PairedTargets::<i128, 26>::new(t, &set, ALL_FORMS);
                 for k in -1..3 {
                     for j in -1..3 {
                         for i in -1..3 {
@@ -1163,7 +1114,7 @@ mod tests {
                                     segment_meets_triangle([p, add(p, *d)], t.v, true)
                                 })
                                 .collect();
-                            assert_eq!(lazy.any(ijk), want.contains(&true), "{t:?} {ijk:?}");
+                            assert_eq!(paired.any(ijk), want.contains(&true), "{t:?} {ijk:?}");
                             assert_eq!(wide.any(ijk), want.contains(&true), "{t:?} {ijk:?}");
                             for (n, w) in want.iter().enumerate() {
                                 assert_eq!(lazy.hits(n, ijk), *w, "{t:?} {ijk:?} target {n}");
@@ -1195,8 +1146,8 @@ mod tests {
                     }
                 }
             }
-            // The lazy tests (plane mask first, box filter, edge sides),
-            // one target at a time and any of a voxel's, in either order.
+            // The lazy tests (plane test, then edge sides), one target at a
+            // time, in either order.
             for targets in [&DIAGONALS[..], &CROSSHAIR[..]] {
                 let set = TargetSet::<4>::new(targets);
                 let lazy = LazyTargets::<i64, 4>::new(t, &set);
@@ -1212,7 +1163,6 @@ mod tests {
                                     segment_meets_triangle([p, add(p, *d)], t.v, true)
                                 })
                                 .collect();
-                            assert_eq!(lazy.any(ijk), want.contains(&true), "{t:?} {ijk:?}");
                             for (n, w) in want.iter().enumerate().rev() {
                                 assert_eq!(lazy.hits(n, ijk), *w, "{t:?} {ijk:?} target {n}");
                                 assert_eq!(wide.hits(n, ijk), *w);

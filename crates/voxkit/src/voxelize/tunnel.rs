@@ -34,7 +34,7 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, FilterUnset, Kernel};
-use super::targets::{fits_i64, forms_reached, LazyTargets, TargetSet};
+use super::targets::{fits_i64, forms_reached, PairedTargets, TargetSet};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -92,7 +92,9 @@ struct TunnelKernel {
 
 impl TunnelKernel {
     fn new(target: TunnelTarget, opts: &Options<'_>) -> TunnelKernel {
-        TunnelKernel { dirs: TargetSet::new(&targets(target)), traversal: opts.traversal }
+        let dirs = TargetSet::new(&targets(target));
+        assert!(dirs.paired(), "the tunnels' targets come in opposite pairs");
+        TunnelKernel { dirs, traversal: opts.traversal }
     }
 }
 
@@ -121,7 +123,7 @@ fn filtered<T: PlaneInt>(
     traversal: Traversal,
     slab: &mut BrickSlab<'_>,
 ) {
-    let targets = LazyTargets::<T, 26>::with_reached(tri, dirs, reached);
+    let targets = PairedTargets::<T, 26>::new(tri, dirs, reached);
     let keep = |ijk: [i64; 3]| targets.any(ijk);
     cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
 }
