@@ -878,48 +878,62 @@ impl<'t, T: PlaneInt, const N: usize> PairedTargets<'t, T, N> {
 /// of such lines, against `cover`'s traversal of its box and four targets
 /// per candidate.
 pub(crate) fn diagonal_lines(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
-    let blo = tri.bounds().0;
     let s = TriSetup::<i64>::new(tri);
-    let z0 = blo[2].div_euclid(ONE) * ONE;
+    let z0 = tri.bounds().0[2].div_euclid(ONE) * ONE;
     // Per edge `A × B` (relative to the first vertex): with it a line
     // direction's edge orientations `u·(A × B) − p·(e × u)` need no
     // further products per direction than `e × u` (as `DirSetup`, without
     // its tie biases, derived only on a tie).
     let ab: [[i64; 3]; 3] = std::array::from_fn(|i| crate::geom::lattice::cross(s.rel[i], s.rel[(i + 1) % 3]));
-    for (_, d) in DIAGONALS {
-        let u = d.map(i64::signum);
-        let g = s.n[0] * u[0] + s.n[1] * u[1] + s.n[2] * u[2];
-        if g == 0 {
-            // Parallel lines never cross the displaced plane.
-            continue;
+    // One instance per direction of `DIAGONALS` (a test checks the
+    // list): its steps are constants, so the products with them fold
+    // into additions (sep26 at 128³ on 1 thread: −18 %).
+    let (box_, dirs) = ((lo, hi), (tri, &s, &ab, z0));
+    diagonal_line_dir::<1, 1, 1>(dirs, box_, slab);
+    diagonal_line_dir::<-1, 1, 1>(dirs, box_, slab);
+    diagonal_line_dir::<1, -1, 1>(dirs, box_, slab);
+    diagonal_line_dir::<1, 1, -1>(dirs, box_, slab);
+}
+
+/// The lines along `u = (UX, UY, UZ)` of [`diagonal_lines`].
+#[inline(always)]
+fn diagonal_line_dir<const UX: i64, const UY: i64, const UZ: i64>(
+    (tri, s, ab, z0): (&LatticeTriangle, &TriSetup<i64>, &[[i64; 3]; 3], i64),
+    (lo, hi): ([i64; 3], [i64; 3]),
+    slab: &mut BrickSlab<'_>,
+) {
+    let u = [UX, UY, UZ];
+    let g = s.n[0] * UX + s.n[1] * UY + s.n[2] * UZ;
+    if g == 0 {
+        // Parallel lines never cross the displaced plane.
+        return;
+    }
+    // Along u to z = z0: (x − u_x·u_z·(z − z0), y − u_y·u_z·(z − z0)).
+    let proj = |p: [i64; 3], c: usize| p[c] - u[c] * UZ * (p[2] - z0);
+    let range = |c: usize| {
+        let (mut l, mut h) = (i64::MAX, i64::MIN);
+        for p in tri.v {
+            (l, h) = (l.min(proj(p, c)), h.max(proj(p, c)));
         }
-        // Along u to z = z0: (x − u_x·u_z·(z − z0), y − u_y·u_z·(z − z0)).
-        let proj = |p: [i64; 3], c: usize| p[c] - u[c] * u[2] * (p[2] - z0);
-        let range = |c: usize| {
-            let (mut l, mut h) = (i64::MAX, i64::MIN);
-            for p in tri.v {
-                (l, h) = (l.min(proj(p, c)), h.max(proj(p, c)));
+        (-(-l).div_euclid(ONE), h.div_euclid(ONE))
+    };
+    let ((x0, x1), (y0, y1)) = (range(0), range(1));
+    if x0 > x1 || y0 > y1 {
+        return;
+    }
+    let m: [[i64; 3]; 3] = std::array::from_fn(|i| crate::geom::lattice::cross(tri.edge(i), u));
+    let c: [i64; 3] = std::array::from_fn(|i| dot(u, ab[i]));
+    for ky in y0..=y1 {
+        for kx in x0..=x1 {
+            let k = [kx * ONE, ky * ONE, z0];
+            let pk = s.local(k);
+            if !all_one_side(|i| edge_side(c[i] - dot(pk, m[i]), || m[i])) {
+                continue;
             }
-            (-(-l).div_euclid(ONE), h.div_euclid(ONE))
-        };
-        let ((x0, x1), (y0, y1)) = (range(0), range(1));
-        if x0 > x1 || y0 > y1 {
-            continue;
-        }
-        let m: [[i64; 3]; 3] = std::array::from_fn(|i| crate::geom::lattice::cross(tri.edge(i), u));
-        let c: [i64; 3] = std::array::from_fn(|i| dot(u, ab[i]));
-        for ky in y0..=y1 {
-            for kx in x0..=x1 {
-                let k = [kx * ONE, ky * ONE, z0];
-                let pk = s.local(k);
-                if !all_one_side(|i| edge_side(c[i] - dot(pk, m[i]), || m[i])) {
-                    continue;
-                }
-                let m = s.straddling_step(g, s.plane(pk), 0);
-                let ijk: [i64; 3] = std::array::from_fn(|c| k[c].div_euclid(ONE) + if u[c] > 0 { m } else { -m - 1 });
-                if (0..3).all(|c| ijk[c] >= lo[c] && ijk[c] <= hi[c]) {
-                    slab.set(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
-                }
+            let m = s.straddling_step(g, s.plane(pk), 0);
+            let ijk: [i64; 3] = std::array::from_fn(|c| k[c].div_euclid(ONE) + if u[c] > 0 { m } else { -m - 1 });
+            if (0..3).all(|c| ijk[c] >= lo[c] && ijk[c] <= hi[c]) {
+                slab.set(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
             }
         }
     }
@@ -1053,6 +1067,12 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn diagonal_lines_walk_the_diagonals_directions() {
+        // `diagonal_lines` instantiates these four directions by hand.
+        assert_eq!(DIAGONALS.map(|(_, d)| d.map(i64::signum)), [[1, 1, 1], [-1, 1, 1], [1, -1, 1], [1, 1, -1]]);
     }
 
     #[test]
