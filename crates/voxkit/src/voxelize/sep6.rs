@@ -72,42 +72,56 @@ fn tiny(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<
         return;
     }
     let s = TriSetup::<i64>::new(tri);
+    // One instance per axis: its index arithmetic is constant (1 thread
+    // at 128³: −27 %, at 256³: −37 %).
+    tiny_axis::<0>(tri, &s, (blo, bhi), (lo, hi), slab);
+    tiny_axis::<1>(tri, &s, (blo, bhi), (lo, hi), slab);
+    tiny_axis::<2>(tri, &s, (blo, bhi), (lo, hi), slab);
+}
+
+/// The lines along axis `A` of [`tiny`].
+#[inline(always)]
+fn tiny_axis<const A: usize>(
+    tri: &LatticeTriangle,
+    s: &TriSetup<i64>,
+    (blo, bhi): ([i64; 3], [i64; 3]),
+    (lo, hi): ([i64; 3], [i64; 3]),
+    slab: &mut BrickSlab<'_>,
+) {
+    if s.n[A] == 0 {
+        // Parallel lines never cross the displaced plane.
+        return;
+    }
     // Pixel indices along `c` whose centre is in the grown box and the voxel box.
     let centres = |c: usize| {
         let first = -(H + 1 - blo[c]).div_euclid(ONE);
         let last = (bhi[c] + 1 - H).div_euclid(ONE);
         (first.max(lo[c]), last.min(hi[c]))
     };
-    for a in 0..3 {
-        if s.n[a] == 0 {
-            // Parallel lines never cross the displaced plane.
-            continue;
-        }
-        let (p, q) = ((a + 1) % 3, (a + 2) % 3);
-        let ((p0, p1), (q0, q1)) = (centres(p), centres(q));
-        let mut d = [0; 3];
-        d[a] = ONE;
-        for iq in q0..=q1 {
-            for ip in p0..=p1 {
-                let mut c = s.a;
-                (c[p], c[q]) = (ip * ONE + H, iq * ONE + H);
-                let pc = s.local(c);
-                // The line's orientation against edge `i`: the `a`
-                // component of the pivot cross, a 2D edge function.
-                let side = |i: usize| {
-                    let (x, y) = (s.rel[i], s.rel[(i + 1) % 3]);
-                    let o = (x[p] - pc[p]) * (y[q] - pc[q]) - (x[q] - pc[q]) * (y[p] - pc[p]);
-                    edge_side(o, || crate::geom::lattice::cross(tri.edge(i), d))
-                };
-                if !all_one_side(side) {
-                    continue;
-                }
-                let t = s.straddling_step(s.n[a], s.n[p] * pc[p] + s.n[q] * pc[q], s.a[a]);
-                if t >= lo[a] && t <= hi[a] {
-                    let mut ijk = [0u32; 3];
-                    (ijk[a], ijk[p], ijk[q]) = (t as u32, ip as u32, iq as u32);
-                    slab.set(ijk[0], ijk[1], ijk[2]);
-                }
+    let (a, p, q) = (A, (A + 1) % 3, (A + 2) % 3);
+    let ((p0, p1), (q0, q1)) = (centres(p), centres(q));
+    let mut d = [0; 3];
+    d[a] = ONE;
+    for iq in q0..=q1 {
+        for ip in p0..=p1 {
+            let mut c = s.a;
+            (c[p], c[q]) = (ip * ONE + H, iq * ONE + H);
+            let pc = s.local(c);
+            // The line's orientation against edge `i`: the `a`
+            // component of the pivot cross, a 2D edge function.
+            let side = |i: usize| {
+                let (x, y) = (s.rel[i], s.rel[(i + 1) % 3]);
+                let o = (x[p] - pc[p]) * (y[q] - pc[q]) - (x[q] - pc[q]) * (y[p] - pc[p]);
+                edge_side(o, || crate::geom::lattice::cross(tri.edge(i), d))
+            };
+            if !all_one_side(side) {
+                continue;
+            }
+            let t = s.straddling_step(s.n[a], s.n[p] * pc[p] + s.n[q] * pc[q], s.a[a]);
+            if t >= lo[a] && t <= hi[a] {
+                let mut ijk = [0u32; 3];
+                (ijk[a], ijk[p], ijk[q]) = (t as u32, ip as u32, iq as u32);
+                slab.set(ijk[0], ijk[1], ijk[2]);
             }
         }
     }
