@@ -217,30 +217,37 @@ fn small_triangle<O: Sink>(tri: &LatticeTriangle, (blo, bhi): ([i64; 3], [i64; 3
             let a = (0..3).find(|&a| !single[a]).unwrap_or(0);
             out.set_run(a, lo.map(|c| c as u32), (hi[a] - lo[a] + 1) as u32);
         }
-        1 => {
-            let r = (0..3).find(|&a| single[a]).unwrap_or(0);
-            let (p, q) = ((r + 1) % 3, (r + 2) % 3);
-            let n = tri.normal();
-            let e = edges_2d(tri, p, q, if n[r] >= 0 { 1 } else { -1 });
-            let mut ijk = [0u32; 3];
-            ijk[r] = lo[r] as u32;
-            for iq in lo[q]..=hi[q] {
-                let row: [i64; 3] = std::array::from_fn(|i| e[i].b * iq + e[i].c);
-                for ip in lo[p]..=hi[p] {
-                    if (e[0].a * ip + row[0]) | (e[1].a * ip + row[1]) | (e[2].a * ip + row[2]) >= 0 {
-                        ijk[p] = ip as u32;
-                        ijk[q] = iq as u32;
-                        out.set(ijk[0], ijk[1], ijk[2]);
-                    }
-                }
-            }
-        }
+        // One instance per axis: constant indexing.
+        1 if single[0] => one_slab::<O, 0>(tri, lo, hi, out),
+        1 if single[1] => one_slab::<O, 1>(tri, lo, hi, out),
+        1 => one_slab::<O, 2>(tri, lo, hi, out),
         _ if (0..3).all(|a| span[a].1 - span[a].0 < TINY) => {
             tiny_box(tri, span.map(|s| s.0), span.map(|s| (s.1 - s.0 + 1) as usize), lo, hi, out)
         }
         _ => return false,
     }
     true
+}
+
+/// [`small_triangle`] for a triangle inside one slab of axis `R`: the
+/// three edge functions of its projection along `R`, per square.
+#[inline(always)]
+fn one_slab<O: Sink, const R: usize>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
+    let (r, p, q) = (R, (R + 1) % 3, (R + 2) % 3);
+    let n = tri.normal();
+    let e = edges_2d(tri, p, q, if n[r] >= 0 { 1 } else { -1 });
+    let mut ijk = [0u32; 3];
+    ijk[r] = lo[r] as u32;
+    for iq in lo[q]..=hi[q] {
+        let row: [i64; 3] = std::array::from_fn(|i| e[i].b * iq + e[i].c);
+        for ip in lo[p]..=hi[p] {
+            if (e[0].a * ip + row[0]) | (e[1].a * ip + row[1]) | (e[2].a * ip + row[2]) >= 0 {
+                ijk[p] = ip as u32;
+                ijk[q] = iq as u32;
+                out.set(ijk[0], ijk[1], ijk[2]);
+            }
+        }
+    }
 }
 
 /// Largest voxel span per axis that [`tiny_box`] takes.
