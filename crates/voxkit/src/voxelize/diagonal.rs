@@ -18,15 +18,17 @@
 //! segment — but not the fewest voxels (README compares it with `sep6` and
 //! `ss6`).
 //!
-//! **Fast path.** `cover`'s exact traversal enumerates candidates; each
-//! gets one segment test (`TriSetup`, the four directions set up once per
-//! triangle).
+//! **Fast path.** Triangles of a few voxels walk the lines of the
+//! diagonals (`diagonal_lines`, only the lines through all-even corners,
+//! which carry exactly the voxels' own diagonals); the others take
+//! `cover`'s exact traversal as candidates, each with its one target's
+//! test (`LazyTargets`).
 //!
 //! **Reference:** [`reference::diagonal`].
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, Filter, Kernel};
-use super::targets::{fits_i64, is_tiny, LazyTargets, DIAGONALS, DIAGONAL_SET};
+use super::targets::{diagonal_lines, fits_i64, is_tiny, LazyTargets, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -82,10 +84,14 @@ struct DiagonalKernel {
 impl Kernel<LatticeTriangle> for DiagonalKernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
         // Integer test first: most triangles at 32³ pass no space diagonal.
+        // Then the tiny ones by the diagonals' lines.
         if is_tiny(lo, hi) {
             let (blo, bhi) = tri.bounds();
             if !DIAGONAL_SET.may_meet(blo, bhi) {
                 return;
+            }
+            if fits_i64(tri) {
+                return diagonal_lines::<true>(tri, lo, hi, slab);
             }
         }
         if fits_i64(tri) {

@@ -56,7 +56,7 @@ fn tiny(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<
     if !DIAGONAL_SET.may_meet(blo, bhi) {
         return;
     }
-    diagonal_lines(tri, lo, hi, slab);
+    diagonal_lines::<false>(tri, lo, hi, slab);
 }
 
 impl Kernel<LatticeTriangle> for Sep26Kernel {
