@@ -793,16 +793,15 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
             self.edges_once(n, pc, vc)
         }
     }
-
 }
 
 /// Does any of a voxel's targets meet one triangle, for a set of opposite
-/// pairs ([`TargetSet::paired`]: the tunnels'), line by line. With `x` the common start's plane value
-/// less the voxel's threshold, the target along `u` crosses the plane iff
-/// `x >= 0` and `x + k < 0` or the other way round (`k = n·d`); its
-/// opposite, the same with `−k`. So one of a line's two crosses iff
-/// `|k| > x` (`x >= 0`) or `|k| >= −x`: one comparison per line, not per
-/// target. A line that crosses the plane is not parallel to it, and then
+/// pairs ([`TargetSet::paired`]: the tunnels'), line by line. With `x`
+/// the common start's plane value less the voxel's threshold, the target
+/// along `u` crosses the plane iff `x >= 0` and `x + k < 0` or the other
+/// way round (`k = n·d`); its opposite, the same with `−k`. So one of a
+/// line's two crosses iff `|k| > x` (`x >= 0`) or `|k| >= −x`: one
+/// comparison per line, not per target. A line that crosses the plane is not parallel to it, and then
 /// its edge sides along `−u` are those along `u` flipped, ties included,
 /// so [`TriSetup::line_hits`] along one direction decides the line and
 /// with it the crossing target. Keeps per triangle only `|k|` per line.
