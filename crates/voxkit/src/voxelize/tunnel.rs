@@ -23,8 +23,8 @@
 //! closed voxel). `voxkit check` counts 6-, 18- and 26-tunnels.
 //!
 //! **Fast path.** `cover`'s exact traversal enumerates candidates not yet
-//! set; each gets the tests of its targets (`LazyTargets`, `i64` for all
-//! but huge triangles). The targets come in opposite pairs on the 13 (9)
+//! set; each gets the tests of its targets (`PairedTargets`, `i64` for
+//! all but huge triangles). The targets come in opposite pairs on the 13 (9)
 //! lines through the centre, so one comparison per line says whether one
 //! of its two targets crosses the plane, and the line's edge sides come
 //! from the centre's pivot cross, three dot products per line.
