@@ -293,6 +293,14 @@ impl<T: PlaneInt> TriSetup<T> {
         self.line_hits(t, &self.pivot_cross(p), dt, d)
     }
 
+    /// The [`PivotCross`] of the centre of the voxel whose low corner is
+    /// `pc` (relative to `a`).
+    #[inline(always)]
+    pub fn centre_cross(&self, pc: [T; 3]) -> PivotCross<T> {
+        let h = T::from_i64(H);
+        self.pivot_cross(pc.map(|x| x + h))
+    }
+
     /// The [`PivotCross`] of a point `p` relative to `a`.
     #[inline(always)]
     pub fn pivot_cross(&self, p: [T; 3]) -> PivotCross<T> {
@@ -750,14 +758,6 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
         LazyTargets { tri, s, set, start, end, live: set.live_of[reached as usize] }
     }
 
-    /// The [`PivotCross`] of the centre of the voxel whose low corner is
-    /// `pc` (relative to the first vertex).
-    #[inline(always)]
-    fn centre_cross(&self, pc: [T; 3]) -> PivotCross<T> {
-        let h = T::from_i64(H);
-        self.s.pivot_cross(pc.map(|x| x + h))
-    }
-
     /// Does the line of target `n` (through the voxel's centre) pass the
     /// triangle, given the centre's [`PivotCross`]?
     #[inline(always)]
@@ -788,7 +788,7 @@ impl<'t, T: PlaneInt, const N: usize> LazyTargets<'t, T, N> {
             return false;
         }
         if self.set.centred {
-            self.centre_line_hits(n, &self.centre_cross(pc))
+            self.centre_line_hits(n, &self.s.centre_cross(pc))
         } else {
             self.edges_once(n, pc, vc)
         }
@@ -852,7 +852,7 @@ impl<'t, T: PlaneInt, const N: usize> PairedTargets<'t, T, N> {
         if mask == 0 {
             return false;
         }
-        let w = self.s.pivot_cross(pc.map(|x| x + T::from_i64(H)));
+        let w = self.s.centre_cross(pc);
         while mask != 0 {
             let l = mask.trailing_zeros() as usize;
             mask &= mask - 1;
@@ -1106,6 +1106,17 @@ mod tests {
         assert_eq!(TargetSet::<1>::needs([0, 0, 0], [ONE, H, 0]), 0);
     }
 
+    /// Per target of `list` (offset from voxel `ijk`'s low corner,
+    /// direction): does it meet `t`, by the definition?
+    fn definition(list: &[(P3, P3)], t: &LatticeTriangle, ijk: [i64; 3]) -> Vec<bool> {
+        list.iter()
+            .map(|(o, d)| {
+                let p = add(corner(ijk), *o);
+                segment_meets_triangle([p, add(p, *d)], t.v, true)
+            })
+            .collect()
+    }
+
     /// Triangles through corners, along faces, on centre planes: the
     /// degenerate touches the perturbation must decide.
     fn touching_triangles() -> [LatticeTriangle; 7] {
@@ -1147,13 +1158,7 @@ mod tests {
                     for j in -1..3 {
                         for i in -1..3 {
                             let ijk = [i, j, k];
-                            let want: Vec<bool> = list
-                                .iter()
-                                .map(|(o, d)| {
-                                    let p = add(corner(ijk), *o);
-                                    segment_meets_triangle([p, add(p, *d)], t.v, true)
-                                })
-                                .collect();
+                            let want = definition(list, t, ijk);
                             assert_eq!(paired.any(ijk), want.contains(&true), "{t:?} {ijk:?}");
                             assert_eq!(wide.any(ijk), want.contains(&true), "{t:?} {ijk:?}");
                             for (n, w) in want.iter().enumerate() {
@@ -1196,13 +1201,7 @@ mod tests {
                     for j in -1..3 {
                         for i in -1..3 {
                             let ijk = [i, j, k];
-                            let want: Vec<bool> = targets
-                                .iter()
-                                .map(|(o, d)| {
-                                    let p = add(corner(ijk), *o);
-                                    segment_meets_triangle([p, add(p, *d)], t.v, true)
-                                })
-                                .collect();
+                            let want = definition(targets, t, ijk);
                             for (n, w) in want.iter().enumerate().rev() {
                                 assert_eq!(lazy.hits(n, ijk), *w, "{t:?} {ijk:?} target {n}");
                                 assert_eq!(wide.hits(n, ijk), *w);
