@@ -28,6 +28,7 @@ use super::targets::{diagonal_lines, dominant_axes, fits_i64, is_tiny, PixelTest
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
+use crate::geom::perturb::P3;
 use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
@@ -88,23 +89,31 @@ fn project<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab:
 #[inline(always)]
 fn project_w<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
     let s = TriSetup::<T>::new(tri);
-    let mut dirs = DIAGONALS.map(|(o, d)| {
-        let o = o.map(T::from_i64);
-        (o, s.plane(o), s.dir(tri, d))
-    });
     // The diagonal along which the plane value changes most (its signs
     // are the normal's) joins the voxel's lowest and highest corners, so
     // it crosses the plane wherever any diagonal does: tested first, it
-    // ends most hits' tests.
-    let steepest = (1..4).fold(0, |b, i| if dirs[i].2.nd.to_f64().abs() > dirs[b].2.nd.to_f64().abs() { i } else { b });
-    dirs.swap(0, steepest);
+    // ends most hits' tests. (Built in that order, not swapped after: a
+    // swap of two direction setups is a call to memmove.)
+    let n = tri.normal();
+    let slope = |d: P3| (n[0] as f64 * d[0] as f64 + n[1] as f64 * d[1] as f64 + n[2] as f64 * d[2] as f64).abs();
+    let steepest = (1..4).fold(0, |b, i| if slope(DIAGONALS[i].1) > slope(DIAGONALS[b].1) { i } else { b });
+    let dirs: [_; 4] = std::array::from_fn(|k| {
+        let (o, d) = DIAGONALS[if k == 0 {
+            steepest
+        } else if k == steepest {
+            0
+        } else {
+            k
+        }];
+        let o = o.map(T::from_i64);
+        (o, s.plane(o), s.dir(tri, d))
+    });
     let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
     debug_assert_eq!(dominant_axes(tri), (u, v, w));
     let pix = PixelTest::new(&s, tri, (u, v, w));
     // Some corner's displaced copy is on each side of the plane: with n
     // oriented so n_w > 0 (`flip`), the corners' values relative to the
     // first vertex reach `>= hi` and `<= lo` (the bias is 0 or 1).
-    let n = tri.normal();
     let bn = s.bn;
     let (shift_hi, shift_lo) = if n[w] > 0 { (bn, bn - T::from_i64(1)) } else { (T::from_i64(1) - bn, -bn) };
     let mut range = CoverSetup::<T>::new(tri, lo);
