@@ -18,6 +18,9 @@ const SHIFT: u32 = 3;
 /// One brick: word `z & 7`, bit `(y & 7) * 8 + (x & 7)`.
 pub type Brick = [u64; 8];
 
+/// Smallest brick index [`BrickBits::new`] zeroes in parallel.
+const PAR_ZERO_MIN: usize = 1 << 20;
+
 /// Sets voxel `(i, j, k)` in its brick `b` (only the coordinates' low
 /// three bits count: whole-grid and brick-local coordinates alike).
 #[inline(always)]
@@ -51,7 +54,10 @@ impl BrickBits {
     pub fn new(dims: [u32; 3]) -> BrickBits {
         let bdims = dims.map(|d| d.div_ceil(BRICK));
         let n = bdims.iter().map(|&b| b as usize).product();
-        BrickBits { dims, bdims, index: vec![0; n], bricks: Vec::new() }
+        // A large index is zeroed by every thread, not by one (`calloc`
+        // clears memory the allocator reuses serially: 4 ms at 1024³).
+        let index = if n >= PAR_ZERO_MIN { (0..n).into_par_iter().map(|_| 0).collect() } else { vec![0; n] };
+        BrickBits { dims, bdims, index, bricks: Vec::new() }
     }
 
     /// Voxels along x, y, z.
@@ -182,33 +188,48 @@ impl BrickBits {
             .map(|(n, index)| {
                 let bk0 = n as u32 * h;
                 let k0 = bk0 * BRICK;
-                SlabView { k0, k1: ((bk0 + h) * BRICK).min(nz), bk0, bx, by, index, pool: Vec::new(), last: (u64::MAX, 0) }
+                SlabView {
+                    k0,
+                    k1: ((bk0 + h) * BRICK).min(nz),
+                    bk0,
+                    bx,
+                    by,
+                    index,
+                    pool: Vec::new(),
+                    entries: Vec::new(),
+                    last: (u64::MAX, 0),
+                }
             })
             .collect()
     }
 
     /// Gathers the slabs' brick pools into the grid, in slab order, and
-    /// renumbers their index entries.
-    pub fn merge_slabs(&mut self, pools: Vec<(usize, Vec<Brick>)>) {
-        let layer = self.bdims[0] as usize * self.bdims[1] as usize;
+    /// renumbers their index entries: only the entries each pool lists,
+    /// not the whole index (most of which no slab touched).
+    pub fn merge_slabs(&mut self, pools: Vec<SlabPool>) {
         let mut offsets = Vec::with_capacity(pools.len());
         let mut total = self.bricks.len();
-        for (_, p) in &pools {
+        for p in &pools {
             offsets.push(total as u32);
-            total += p.len();
+            total += p.bricks.len();
         }
         // Each slab numbered its bricks from 1; shift them past earlier slabs.
-        let chunk_len = pools.first().map(|p| p.0).unwrap_or(layer).max(1);
-        self.index.par_chunks_mut(chunk_len).zip(offsets.par_iter()).for_each(|(idx, &off)| {
-            if off > 0 {
-                for e in idx.iter_mut().filter(|e| **e != 0) {
-                    *e += off;
-                }
+        let mut rest: &mut [u32] = &mut self.index;
+        let mut parts = Vec::with_capacity(pools.len());
+        for p in &pools {
+            let all = std::mem::take(&mut rest);
+            let (idx, tail) = all.split_at_mut(p.index_len.min(all.len()));
+            parts.push(idx);
+            rest = tail;
+        }
+        parts.into_par_iter().zip(pools.par_iter()).zip(offsets.par_iter()).for_each(|((idx, p), &off)| {
+            for (n, &e) in p.entries.iter().enumerate() {
+                idx[e as usize] = off + n as u32 + 1;
             }
         });
         self.bricks.reserve(total - self.bricks.len());
-        for (_, p) in pools {
-            self.bricks.extend(p);
+        for p in pools {
+            self.bricks.extend(p.bricks);
         }
     }
 
@@ -221,13 +242,14 @@ impl BrickBits {
         assert!(parts.iter().all(|p| p.dims == dims), "union of grids of different dims");
         let mut out = BrickBits::new(dims);
         let chunk = 1 << 14;
-        let pools: Vec<((usize, Vec<Brick>), u64)> = out
+        let pools: Vec<(SlabPool, u64)> = out
             .index
             .par_chunks_mut(chunk)
             .enumerate()
             .map(|(c, idx)| {
                 let base = c * chunk;
                 let mut pool = Vec::new();
+                let mut entries = Vec::new();
                 let mut count = 0;
                 for (e, slot) in idx.iter_mut().enumerate() {
                     let mut b: Brick = [0; 8];
@@ -244,10 +266,11 @@ impl BrickBits {
                     if any {
                         count += super::count_bits(b.iter());
                         pool.push(b);
+                        entries.push(e as u32);
                         *slot = pool.len() as u32;
                     }
                 }
-                ((idx.len(), pool), count)
+                (SlabPool { index_len: idx.len(), bricks: pool, entries }, count)
             })
             .collect();
         let count = pools.iter().map(|p| p.1).sum();
@@ -379,6 +402,8 @@ pub struct SlabView<'a> {
     by: u32,
     index: &'a mut [u32],
     pool: Vec<Brick>,
+    /// The index entry (in `index`) of each brick of `pool`, in order.
+    entries: Vec<u32>,
     /// The brick coordinates (packed by [`brick_key`]) and pool slot of
     /// the last voxel set: consecutive voxels mostly share a brick, and the
     /// key costs shifts where the index entry costs multiplications.
@@ -511,6 +536,7 @@ impl SlabView<'_> {
         let mut id = self.index[b];
         if id == 0 {
             self.pool.push([0; 8]);
+            self.entries.push(b as u32);
             id = self.pool.len() as u32;
             self.index[b] = id;
         }
@@ -524,8 +550,70 @@ impl SlabView<'_> {
     }
 
     /// Index entries this slab owns and its pool, for [`BrickBits::merge_slabs`].
-    pub fn into_pool(self) -> (usize, Vec<Brick>) {
-        (self.index.len(), self.pool)
+    pub fn into_pool(self) -> SlabPool {
+        SlabPool { index_len: self.index.len(), bricks: self.pool, entries: self.entries }
+    }
+}
+
+/// A filled slab's bricks, for [`BrickBits::merge_slabs`].
+pub struct SlabPool {
+    /// How many index entries the slab owned.
+    index_len: usize,
+    /// Its bricks, numbered from 1 in its index entries.
+    bricks: Vec<Brick>,
+    /// The index entry (relative to the slab's first) of each brick.
+    entries: Vec<u32>,
+}
+
+/// Most bricks a [`BoxBricks`] holds.
+pub const BOX_BRICKS_MAX: usize = 12;
+
+/// The bricks of one primitive's voxel box, on the stack: a kernel sets
+/// voxels here with plain index arithmetic (no brick lookup and no branch
+/// on which brick a voxel falls in), and [`BoxBricks::flush`] ORs each
+/// brick that got a voxel into the slab with one lookup.
+pub struct BoxBricks {
+    /// Brick coordinates of the box's low corner.
+    b0: [u32; 3],
+    /// Bricks along x, and in one xy layer.
+    nx: u32,
+    nxy: u32,
+    len: usize,
+    bricks: [Brick; BOX_BRICKS_MAX],
+}
+
+impl BoxBricks {
+    /// A buffer for the inclusive voxel box `[lo, hi]`, or `None` if it
+    /// touches more than [`BOX_BRICKS_MAX`] bricks.
+    #[inline(always)]
+    pub fn new(lo: [i64; 3], hi: [i64; 3]) -> Option<BoxBricks> {
+        let b0 = lo.map(|c| (c as u32) >> SHIFT);
+        let n: [u32; 3] = std::array::from_fn(|a| ((hi[a] as u32) >> SHIFT) - b0[a] + 1);
+        let len = (n[0] * n[1] * n[2]) as usize;
+        (len <= BOX_BRICKS_MAX).then(|| BoxBricks { b0, nx: n[0], nxy: n[0] * n[1], len, bricks: [[0; 8]; BOX_BRICKS_MAX] })
+    }
+
+    /// Sets voxel `(i, j, k)`, which must lie in the box.
+    #[inline(always)]
+    pub fn set(&mut self, i: u32, j: u32, k: u32) {
+        let b = ((k >> SHIFT) - self.b0[2]) * self.nxy + ((j >> SHIFT) - self.b0[1]) * self.nx + ((i >> SHIFT) - self.b0[0]);
+        set_in_brick(&mut self.bricks[b as usize], i, j, k);
+    }
+
+    /// ORs the buffered bricks into `slab` (the box must lie in its layers).
+    #[inline(always)]
+    pub fn flush(&self, slab: &mut SlabView<'_>) {
+        for (n, brick) in self.bricks[..self.len].iter().enumerate() {
+            if brick.iter().fold(0, |a, w| a | w) == 0 {
+                continue;
+            }
+            let n = n as u32;
+            let b = [self.b0[0] + n % self.nx, self.b0[1] + n % self.nxy / self.nx, self.b0[2] + n / self.nxy];
+            let slot = slab.slot(b[0] << SHIFT, b[1] << SHIFT, b[2] << SHIFT);
+            for (w, x) in slab.pool[slot].iter_mut().zip(brick) {
+                *w |= x;
+            }
+        }
     }
 }
 
@@ -640,6 +728,35 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn box_bricks_flush_the_voxels_set_in_them() {
+        let dims = [40, 33, 29];
+        for (lo, hi) in [([3i64, 5, 2], [17i64, 14, 9]), ([0, 0, 0], [7, 7, 7]), ([30, 20, 20], [39, 32, 28]), ([8, 8, 8], [8, 8, 8])] {
+            let mut buf = BoxBricks::new(lo, hi).expect("a small box");
+            let mut want = DenseBits::new(dims);
+            let mut n = 0u32;
+            for k in lo[2]..=hi[2] {
+                for j in lo[1]..=hi[1] {
+                    for i in lo[0]..=hi[0] {
+                        n += 1;
+                        // A scattered subset of the box, corners included.
+                        if n % 3 == 0 || [i, j, k] == lo || [i, j, k] == hi {
+                            buf.set(i as u32, j as u32, k as u32);
+                            want.set(i as u32, j as u32, k as u32);
+                        }
+                    }
+                }
+            }
+            let mut g = BrickBits::new(dims);
+            let mut slabs = g.slabs_mut(8);
+            buf.flush(&mut slabs[0]);
+            let pools = slabs.into_iter().map(|s| s.into_pool()).collect();
+            g.merge_slabs(pools);
+            assert_eq!(g.to_dense(), want, "{lo:?} {hi:?}");
+        }
+        assert!(BoxBricks::new([0, 0, 0], [31, 31, 0]).is_none(), "16 bricks do not fit");
     }
 
     #[test]

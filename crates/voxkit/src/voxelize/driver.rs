@@ -181,6 +181,13 @@ impl Sink for BrickSlab<'_> {
     }
 }
 
+impl Sink for crate::grid::bricks::BoxBricks {
+    #[inline(always)]
+    fn set(&mut self, i: u32, j: u32, k: u32) {
+        crate::grid::bricks::BoxBricks::set(self, i, j, k);
+    }
+}
+
 impl Sink for crate::grid::dense::DenseBits {
     #[inline(always)]
     fn set(&mut self, i: u32, j: u32, k: u32) {
@@ -224,6 +231,9 @@ impl<F: FnMut([i64; 3]) -> bool> Sink for FilterUnset<'_, '_, F> {
     }
 }
 
+/// Fewest primitives in one part of [`run_slabs`]' parallel binning.
+const BIN_PART_MIN: usize = 4096;
+
 /// Runs `kernel` over `tris` on a grid of `dims`, in parallel over z-slabs
 /// (whole brick layers). Returns the grid and the number of voxels set
 /// (counted by each slab's task while its bricks are still in cache).
@@ -237,29 +247,40 @@ pub fn run_slabs<P: Primitive, K: Kernel<P>>(kernel: &K, tris: &[P], dims: [u32;
         ((nz / (16 * threads)).clamp(BRICK, 64) / BRICK) * BRICK
     };
     let nslabs = nz.div_ceil(height) as usize;
-    let bounds: Vec<Option<([i64; 3], [i64; 3])>> = tris.par_iter().map(|t| t.voxel_bounds(dims)).collect();
-    let mut bins: Vec<Vec<u32>> = vec![Vec::new(); nslabs];
-    for (idx, b) in bounds.iter().enumerate() {
-        if let Some((lo, hi)) = b {
-            for s in (lo[2] as u32 / height)..=(hi[2] as u32 / height) {
-                bins[s as usize].push(idx as u32);
+    // Bins per contiguous part of the primitives, built in parallel; a
+    // slab reads its bin of every part in order. Boxes are recomputed in
+    // the slab (a few comparisons) rather than stored for every primitive.
+    let part = tris.len().div_ceil(rayon::current_num_threads() * 4).max(BIN_PART_MIN);
+    let bins: Vec<Vec<Vec<u32>>> = tris
+        .par_chunks(part)
+        .enumerate()
+        .map(|(c, chunk)| {
+            let mut bins: Vec<Vec<u32>> = vec![Vec::new(); nslabs];
+            for (n, t) in chunk.iter().enumerate() {
+                if let Some((lo, hi)) = t.voxel_bounds(dims) {
+                    for s in (lo[2] as u32 / height)..=(hi[2] as u32 / height) {
+                        bins[s as usize].push((c * part + n) as u32);
+                    }
+                }
             }
-        }
-    }
+            bins
+        })
+        .collect();
     if let Some(p) = opts.progress {
         p.set_total(nslabs as u64);
     }
     let slabs = grid.slabs_mut(height / BRICK);
-    let done: Vec<((usize, Vec<crate::grid::bricks::Brick>), u64)> = slabs
+    let done: Vec<(crate::grid::bricks::SlabPool, u64)> = slabs
         .into_par_iter()
-        .zip(bins.par_iter())
-        .map(|(mut slab, bin)| {
-            for &idx in bin {
-                let Some((mut lo, mut hi)) = bounds[idx as usize] else { continue };
+        .enumerate()
+        .map(|(n, mut slab)| {
+            for &idx in bins.iter().flat_map(|b| &b[n]) {
+                let t = &tris[idx as usize];
+                let Some((mut lo, mut hi)) = t.voxel_bounds(dims) else { continue };
                 lo[2] = lo[2].max(slab.k0 as i64);
                 hi[2] = hi[2].min(slab.k1 as i64 - 1);
                 if lo[2] <= hi[2] {
-                    run_unless_full(kernel, &tris[idx as usize], lo, hi, &mut slab);
+                    run_unless_full(kernel, t, lo, hi, &mut slab);
                 }
             }
             if let Some(p) = opts.progress {
