@@ -3,6 +3,7 @@
 
 use glam::DVec3;
 use proptest::prelude::*;
+use voxkit::voxelize::driver::Driver;
 use voxkit::voxelize::Mode;
 use voxkit::voxelize::{cover, Options};
 use voxkit::{DenseBits, GridSpec, Mesh};
@@ -64,10 +65,18 @@ fn nan_and_bad_indices_are_skipped_and_counted() {
     m.positions.push(DVec3::new(f64::NAN, 0.0, 0.0));
     m.triangles.push([0, 1, 3]);
     m.triangles.push([0, 1, 99]);
-    let (b, rep) = cover::cover(m.as_ref(), &unit_grid(4), &Options::default());
-    assert_eq!(rep.prepare.non_finite, 1);
-    assert_eq!(rep.prepare.invalid_index, 1);
-    assert!(b.count() > 0);
+    // A corner far outside: the triangle is clipped to the grid's margin.
+    m.positions.push(DVec3::new(1.0e12, 1.5, 1.5));
+    m.triangles.push([0, 2, 4]);
+    for driver in [Driver::Auto, Driver::Slabs, Driver::Triangles] {
+        let (b, rep) = cover::cover(m.as_ref(), &unit_grid(4), &Options { driver, ..Options::default() });
+        assert_eq!(rep.prepare.non_finite, 1, "{driver:?}");
+        assert_eq!(rep.prepare.invalid_index, 1, "{driver:?}");
+        assert_eq!(rep.prepare.input, 4, "{driver:?}");
+        let (want, wrep) = cover::reference::cover(m.as_ref(), &unit_grid(4));
+        assert_eq!(rep, wrep, "{driver:?}");
+        assert_eq!(b.to_dense(), want, "{driver:?}");
+    }
 }
 
 proptest! {

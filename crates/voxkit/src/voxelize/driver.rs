@@ -11,7 +11,7 @@
 use rayon::prelude::*;
 
 use super::{Options, Report};
-use crate::geom::lattice::{prepare, LatticeTriangle, PrepareStats, SnappedMesh};
+use crate::geom::lattice::{LatticeTriangle, PrepareStats, SnappedMesh};
 use crate::grid::bricks::{BrickBits, BrickSlab, BRICK};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
@@ -56,8 +56,8 @@ pub fn run_mesh<K: Kernel<LatticeTriangle>>(kernel: &K, mesh: MeshRef<'_>, grid:
     if triangles {
         run_triangles(kernel, mesh, grid, opts)
     } else {
-        let (tris, prepare) = prepare(mesh, grid);
-        let (bits, voxels) = run_slabs(kernel, &tris, grid.dims(), opts);
+        let items = Snapped { snapped: SnappedMesh::new(mesh, grid), tris: mesh.triangles };
+        let (bits, voxels, prepare) = slabs_over(kernel, &items, grid.dims(), opts);
         (bits, Report { prepare, voxels })
     }
 }
@@ -238,6 +238,62 @@ const BIN_PART_MIN: usize = 4096;
 /// (whole brick layers). Returns the grid and the number of voxels set
 /// (counted by each slab's task while its bricks are still in cache).
 pub fn run_slabs<P: Primitive, K: Kernel<P>>(kernel: &K, tris: &[P], dims: [u32; 3], opts: &Options<'_>) -> (BrickBits, u64) {
+    let (bits, voxels, _) = slabs_over(kernel, &Prepared { prims: tris, dims }, dims, opts);
+    (bits, voxels)
+}
+
+/// Where [`slabs_over`] takes its primitives from: item `idx` yields none,
+/// one or (clipped) several, each with its voxel box clamped to the grid.
+trait Items<P>: Sync {
+    /// How many items there are.
+    fn len(&self) -> usize;
+    /// Calls `f(primitive, lo, hi)` for each primitive of item `idx`,
+    /// counting the item in `st`.
+    fn each(&self, idx: usize, st: &mut PrepareStats, f: impl FnMut(&P, [i64; 3], [i64; 3]));
+}
+
+/// Primitives already on the lattice.
+struct Prepared<'a, P> {
+    prims: &'a [P],
+    dims: [u32; 3],
+}
+
+impl<P: Primitive> Items<P> for Prepared<'_, P> {
+    fn len(&self) -> usize {
+        self.prims.len()
+    }
+
+    #[inline(always)]
+    fn each(&self, idx: usize, _: &mut PrepareStats, mut f: impl FnMut(&P, [i64; 3], [i64; 3])) {
+        let p = &self.prims[idx];
+        if let Some((lo, hi)) = p.voxel_bounds(self.dims) {
+            f(p, lo, hi);
+        }
+    }
+}
+
+/// A mesh's triangles, prepared as they are read from its snapped
+/// vertices (again in each slab a triangle reaches: cheaper than storing
+/// every prepared triangle).
+struct Snapped<'a> {
+    snapped: SnappedMesh<'a>,
+    tris: &'a [[u32; 3]],
+}
+
+impl Items<LatticeTriangle> for Snapped<'_> {
+    fn len(&self) -> usize {
+        self.tris.len()
+    }
+
+    #[inline(always)]
+    fn each(&self, idx: usize, st: &mut PrepareStats, f: impl FnMut(&LatticeTriangle, [i64; 3], [i64; 3])) {
+        self.snapped.triangle(&self.tris[idx], st, f);
+    }
+}
+
+/// The slab driver over `items`; also returns the items' preparation
+/// counts (each item counted once, when it is binned).
+fn slabs_over<P, K: Kernel<P>, I: Items<P>>(kernel: &K, items: &I, dims: [u32; 3], opts: &Options<'_>) -> (BrickBits, u64, PrepareStats) {
     let mut grid = BrickBits::new(dims);
     let nz = dims[2];
     let height = if opts.slab_height > 0 {
@@ -247,25 +303,32 @@ pub fn run_slabs<P: Primitive, K: Kernel<P>>(kernel: &K, tris: &[P], dims: [u32;
         ((nz / (16 * threads)).clamp(BRICK, 64) / BRICK) * BRICK
     };
     let nslabs = nz.div_ceil(height) as usize;
-    // Bins per contiguous part of the primitives, built in parallel; a
-    // slab reads its bin of every part in order. Boxes are recomputed in
-    // the slab (a few comparisons) rather than stored for every primitive.
-    let part = tris.len().div_ceil(rayon::current_num_threads() * 4).max(BIN_PART_MIN);
-    let bins: Vec<Vec<Vec<u32>>> = tris
-        .par_chunks(part)
-        .enumerate()
-        .map(|(c, chunk)| {
+    // Bins per contiguous part of the items, built in parallel; a slab
+    // reads its bin of every part in order. Boxes are recomputed in the
+    // slab rather than stored for every primitive.
+    let n = items.len();
+    let part = n.div_ceil(rayon::current_num_threads() * 4).max(BIN_PART_MIN);
+    let binned: Vec<(Vec<Vec<u32>>, PrepareStats)> = (0..n.div_ceil(part))
+        .into_par_iter()
+        .map(|c| {
             let mut bins: Vec<Vec<u32>> = vec![Vec::new(); nslabs];
-            for (n, t) in chunk.iter().enumerate() {
-                if let Some((lo, hi)) = t.voxel_bounds(dims) {
-                    for s in (lo[2] as u32 / height)..=(hi[2] as u32 / height) {
-                        bins[s as usize].push((c * part + n) as u32);
+            let mut st = PrepareStats::default();
+            for idx in c * part..((c + 1) * part).min(n) {
+                let (mut zlo, mut zhi) = (i64::MAX, i64::MIN);
+                items.each(idx, &mut st, |_, lo, hi| {
+                    zlo = zlo.min(lo[2]);
+                    zhi = zhi.max(hi[2]);
+                });
+                if zlo <= zhi {
+                    for s in (zlo as u32 / height)..=(zhi as u32 / height) {
+                        bins[s as usize].push(idx as u32);
                     }
                 }
             }
-            bins
+            (bins, st)
         })
         .collect();
+    let prepare = binned.iter().fold(PrepareStats::default(), |a, b| a.merge(b.1));
     if let Some(p) = opts.progress {
         p.set_total(nslabs as u64);
     }
@@ -273,15 +336,16 @@ pub fn run_slabs<P: Primitive, K: Kernel<P>>(kernel: &K, tris: &[P], dims: [u32;
     let done: Vec<(crate::grid::bricks::SlabPool, u64)> = slabs
         .into_par_iter()
         .enumerate()
-        .map(|(n, mut slab)| {
-            for &idx in bins.iter().flat_map(|b| &b[n]) {
-                let t = &tris[idx as usize];
-                let Some((mut lo, mut hi)) = t.voxel_bounds(dims) else { continue };
-                lo[2] = lo[2].max(slab.k0 as i64);
-                hi[2] = hi[2].min(slab.k1 as i64 - 1);
-                if lo[2] <= hi[2] {
-                    run_unless_full(kernel, t, lo, hi, &mut slab);
-                }
+        .map(|(s, mut slab)| {
+            let mut st = PrepareStats::default();
+            for &idx in binned.iter().flat_map(|b| &b.0[s]) {
+                items.each(idx as usize, &mut st, |p, mut lo, mut hi| {
+                    lo[2] = lo[2].max(slab.k0 as i64);
+                    hi[2] = hi[2].min(slab.k1 as i64 - 1);
+                    if lo[2] <= hi[2] {
+                        run_unless_full(kernel, p, lo, hi, &mut slab);
+                    }
+                });
             }
             if let Some(p) = opts.progress {
                 p.advance(1);
@@ -292,5 +356,5 @@ pub fn run_slabs<P: Primitive, K: Kernel<P>>(kernel: &K, tris: &[P], dims: [u32;
         .collect();
     let count = done.iter().map(|d| d.1).sum();
     grid.merge_slabs(done.into_iter().map(|d| d.0).collect());
-    (grid, count)
+    (grid, count, prepare)
 }
