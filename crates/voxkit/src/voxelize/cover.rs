@@ -172,7 +172,7 @@ impl Kernel<LatticeTriangle> for CoverKernel {
 
 /// Smallest voxel box whose voxels [`CoverKernel`] collects in a
 /// [`BoxBricks`] before ORing them into the slab.
-const BUFFER_MIN_VOLUME: i64 = 256;
+pub(crate) const BUFFER_MIN_VOLUME: i64 = 256;
 
 /// Emits into `out` exactly the voxels of the inclusive index box `[lo, hi]`
 /// whose closed box meets `tri` (each at most once). Every mode whose

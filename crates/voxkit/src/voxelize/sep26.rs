@@ -22,14 +22,15 @@
 //! **Reference:** [`reference::sep26`], the definition evaluated with the
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
+use super::cover::BUFFER_MIN_VOLUME;
 use super::cover::{PlaneRange, Setup as CoverSetup};
-use super::driver::{run_mesh, run_slabs, Kernel};
+use super::driver::{box_volume, run_mesh, run_slabs, Kernel};
 use super::targets::{diagonal_lines, dominant_axes, fits_i64, is_tiny, PixelTest, TriSetup, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::P3;
-use crate::grid::bricks::{BrickBits, BrickSlab};
+use crate::grid::bricks::{BoxBricks, BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
 
@@ -79,15 +80,25 @@ impl Kernel<LatticeTriangle> for Sep26Kernel {
 /// thresholds moved by the perturbation's bias); then the diagonal tests
 /// for the edges the pixel is not strictly inside.
 fn project<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+    let mut buf = if box_volume(lo, hi) > BUFFER_MIN_VOLUME { BoxBricks::new(lo, hi) } else { None };
     match dominant_axes(tri).2 {
-        0 => project_w::<T, 0>(tri, lo, hi, slab),
-        1 => project_w::<T, 1>(tri, lo, hi, slab),
-        _ => project_w::<T, 2>(tri, lo, hi, slab),
+        0 => project_w::<T, 0>(tri, lo, hi, slab, buf.as_mut()),
+        1 => project_w::<T, 1>(tri, lo, hi, slab, buf.as_mut()),
+        _ => project_w::<T, 2>(tri, lo, hi, slab, buf.as_mut()),
+    }
+    if let Some(b) = &buf {
+        b.flush(slab);
     }
 }
 
 #[inline(always)]
-fn project_w<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+fn project_w<T: PlaneInt, const W: usize>(
+    tri: &LatticeTriangle,
+    lo: [i64; 3],
+    hi: [i64; 3],
+    slab: &mut BrickSlab<'_>,
+    mut buf: Option<&mut BoxBricks>,
+) {
     let s = TriSetup::<T>::new(tri);
     // The diagonal along which the plane value changes most (its signs
     // are the normal's) joins the voxel's lowest and highest corners, so
@@ -156,7 +167,10 @@ fn project_w<T: PlaneInt, const W: usize>(tri: &LatticeTriangle, lo: [i64; 3], h
                                 .any(|(o, vo, ds)| s.segment_hits_unsafe_edges(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]], vc + *vo, safe))
                         });
                     if hit {
-                        slab.set(ijk[0], ijk[1], ijk[2]);
+                        match buf.as_deref_mut() {
+                            Some(b) => b.set(ijk[0], ijk[1], ijk[2]),
+                            None => slab.set(ijk[0], ijk[1], ijk[2]),
+                        }
                     }
                 }
             }
