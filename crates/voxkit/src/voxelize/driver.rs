@@ -67,7 +67,7 @@ const MIN_PART: usize = 8192;
 
 /// The triangle-parallel driver: the mesh's vertices are snapped once,
 /// then each of up to one part per thread takes a contiguous range of
-/// triangles, prepares each as it reads it (exactly as [`prepare`] does)
+/// triangles, prepares each as it reads it (exactly as [`prepare`](crate::geom::lattice::prepare) does)
 /// and runs `kernel` on it over the whole grid, into a brick set of its
 /// own. The parts are merged by [`BrickBits::union_canonical`], so the
 /// result does not depend on the number of parts.
