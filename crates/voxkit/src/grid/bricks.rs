@@ -589,8 +589,16 @@ impl BoxBricks {
     pub fn new(lo: [i64; 3], hi: [i64; 3]) -> Option<BoxBricks> {
         let b0 = lo.map(|c| (c as u32) >> SHIFT);
         let n: [u32; 3] = std::array::from_fn(|a| ((hi[a] as u32) >> SHIFT) - b0[a] + 1);
-        let len = (n[0] * n[1] * n[2]) as usize;
-        (len <= BOX_BRICKS_MAX).then(|| BoxBricks { b0, nx: n[0], nxy: n[0] * n[1], len, bricks: [[0; 8]; BOX_BRICKS_MAX] })
+        // In u128 (three factors below 2^29): a huge box's brick count
+        // must not wrap to a small one.
+        let len = n.iter().map(|&c| c as u128).product::<u128>();
+        (len <= BOX_BRICKS_MAX as u128).then(|| BoxBricks {
+            b0,
+            nx: n[0],
+            nxy: n[0] * n[1],
+            len: len as usize,
+            bricks: [[0; 8]; BOX_BRICKS_MAX],
+        })
     }
 
     /// Sets voxel `(i, j, k)`, which must lie in the box.
@@ -757,6 +765,8 @@ mod tests {
             assert_eq!(g.to_dense(), want, "{lo:?} {hi:?}");
         }
         assert!(BoxBricks::new([0, 0, 0], [31, 31, 0]).is_none(), "16 bricks do not fit");
+        let far = (1i64 << 31) - 1;
+        assert!(BoxBricks::new([0, 0, 0], [far, far, far]).is_none(), "2^84 bricks do not wrap to a few");
     }
 
     #[test]
