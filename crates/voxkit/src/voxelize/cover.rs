@@ -28,11 +28,11 @@
 //! **Reference:** [`reference::cover`], the separating axis test on all
 //! thirteen axes for every voxel of each triangle's bounding box.
 
-use super::driver::{box_volume, run_mesh, run_slabs, Kernel, Sink};
+use super::driver::{buffered, run_mesh, run_slabs, Kernel, Sink};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{prepare, LatticeTriangle};
-use crate::grid::bricks::{BoxBricks, BrickBits, BrickSlab};
+use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::dense::DenseBits;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
@@ -159,20 +159,12 @@ struct CoverKernel {
 
 impl Kernel<LatticeTriangle> for CoverKernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
-        if box_volume(lo, hi) > BUFFER_MIN_VOLUME {
-            if let Some(mut buf) = BoxBricks::new(lo, hi) {
-                cover_triangle(tri, lo, hi, self.traversal, &mut buf);
-                buf.flush(slab);
-                return;
-            }
-        }
-        cover_triangle(tri, lo, hi, self.traversal, slab);
+        buffered(lo, hi, slab, |slab, buf| match buf {
+            Some(b) => cover_triangle(tri, lo, hi, self.traversal, b),
+            None => cover_triangle(tri, lo, hi, self.traversal, slab),
+        });
     }
 }
-
-/// Smallest voxel box whose voxels [`CoverKernel`] collects in a
-/// [`BoxBricks`] before ORing them into the slab.
-pub(crate) const BUFFER_MIN_VOLUME: i64 = 256;
 
 /// Emits into `out` exactly the voxels of the inclusive index box `[lo, hi]`
 /// whose closed box meets `tri` (each at most once). Every mode whose

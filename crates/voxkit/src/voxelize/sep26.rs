@@ -22,9 +22,8 @@
 //! **Reference:** [`reference::sep26`], the definition evaluated with the
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
-use super::cover::BUFFER_MIN_VOLUME;
 use super::cover::{PlaneRange, Setup as CoverSetup};
-use super::driver::{box_volume, run_mesh, run_slabs, Kernel};
+use super::driver::{buffered, run_mesh, run_slabs, Kernel};
 use super::targets::{diagonal_lines, dominant_axes, fits_i64, is_tiny, PixelTest, TriSetup, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
@@ -80,15 +79,11 @@ impl Kernel<LatticeTriangle> for Sep26Kernel {
 /// thresholds moved by the perturbation's bias); then the diagonal tests
 /// for the edges the pixel is not strictly inside.
 fn project<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
-    let mut buf = if box_volume(lo, hi) > BUFFER_MIN_VOLUME { BoxBricks::new(lo, hi) } else { None };
-    match dominant_axes(tri).2 {
-        0 => project_w::<T, 0>(tri, lo, hi, slab, buf.as_mut()),
-        1 => project_w::<T, 1>(tri, lo, hi, slab, buf.as_mut()),
-        _ => project_w::<T, 2>(tri, lo, hi, slab, buf.as_mut()),
-    }
-    if let Some(b) = &buf {
-        b.flush(slab);
-    }
+    buffered(lo, hi, slab, |slab, buf| match dominant_axes(tri).2 {
+        0 => project_w::<T, 0>(tri, lo, hi, slab, buf),
+        1 => project_w::<T, 1>(tri, lo, hi, slab, buf),
+        _ => project_w::<T, 2>(tri, lo, hi, slab, buf),
+    });
 }
 
 #[inline(always)]
