@@ -252,7 +252,8 @@ impl<F: FnMut([i64; 3]) -> bool> Sink for FilterUnset<'_, '_, F> {
     }
 }
 
-/// Fewest primitives in one part of [`run_slabs`]' parallel binning.
+/// Fewest items in one part of the slab driver's parallel binning
+/// ([`slabs_over`], which both `run_mesh` and [`run_slabs`] use).
 const BIN_PART_MIN: usize = 4096;
 
 /// Runs `kernel` over `tris` on a grid of `dims`, in parallel over z-slabs
