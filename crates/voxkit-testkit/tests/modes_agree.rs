@@ -61,7 +61,7 @@ fn huge_triangles_take_the_wide_arithmetic_path() {
 #[test]
 fn single_large_triangles_on_half_voxels() {
     // One triangle per mesh (no neighbour hides a wrong voxel), a few to a
-    // dozen voxels wide so the column paths run, vertices on grid planes
+    // dozen voxels wide so the column paths and the target lines' spans run, vertices on grid planes
     // and voxel-centre planes so ties are common.
     use rand::Rng;
     let mut r = rng(0x5516);
@@ -71,7 +71,7 @@ fn single_large_triangles_on_half_voxels() {
             DVec3::new(r.random_range(2..28) as f64, r.random_range(2..26) as f64, r.random_range(2..30) as f64) * 0.5
         };
         let m = soup(&[[p(&mut r), p(&mut r), p(&mut r)]]);
-        for mode in [Mode::Sep26, Mode::Sep6, Mode::Ss6] {
+        for mode in [Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Diagonal] {
             agree_mode(mode, &m, &grid).unwrap_or_else(|e| panic!("triangle {n}: {e}"));
         }
     }

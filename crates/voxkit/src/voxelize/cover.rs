@@ -412,7 +412,7 @@ pub(crate) fn cover_triangle_runs<O: Sink>(tri: &LatticeTriangle, lo: [i64; 3], 
 /// integer `x`, stepped along `y` (Bresenham-style: one division at the
 /// start, then an addition and a comparison per step).
 #[derive(Clone, Copy, Debug)]
-enum Walker {
+pub(crate) enum Walker {
     /// `a > 0`: `x >= lo`; `lo = ceil(-(b·y + c) / a)`, `r = a·lo + b·y + c ∈ [0, a)`.
     Lower { lo: i64, r: i64, q: i64, m: i64, d: i64 },
     /// `a < 0`: `x <= hi`; `hi = floor((b·y + c) / -a)`, `r = (b·y + c) - (-a)·hi ∈ [0, -a)`.
@@ -423,7 +423,7 @@ enum Walker {
 
 impl Walker {
     #[inline(always)]
-    fn new(a: i64, b: i64, c: i64, y0: i64) -> Walker {
+    pub(crate) fn new(a: i64, b: i64, c: i64, y0: i64) -> Walker {
         let n = b * y0 + c;
         if a > 0 {
             let (q0, r0) = div_floor(n, a);
@@ -442,7 +442,7 @@ impl Walker {
 
     /// Moves to `y + 1`.
     #[inline(always)]
-    fn step(&mut self) {
+    pub(crate) fn step(&mut self) {
         match self {
             Walker::Lower { lo, r, q, m, d } => {
                 *lo += *q;
@@ -466,7 +466,7 @@ impl Walker {
 
     /// Intersects `[lo, hi]` with the allowed range at the current `y`.
     #[inline(always)]
-    fn clip(&self, lo: &mut i64, hi: &mut i64) {
+    pub(crate) fn clip(&self, lo: &mut i64, hi: &mut i64) {
         match *self {
             Walker::Lower { lo: l, .. } => *lo = (*lo).max(l),
             Walker::Upper { hi: h, .. } => *hi = (*hi).min(h),

@@ -18,11 +18,14 @@
 //! segment — but not the fewest voxels (README compares it with `sep6` and
 //! `ss6`).
 //!
-//! **Fast path.** Triangles of a few voxels walk the lines of the
-//! diagonals (`diagonal_lines`, only the lines through all-even corners,
-//! which carry exactly the voxels' own diagonals); the others take
-//! `cover`'s exact traversal as candidates, each with its one target's
-//! test (`LazyTargets`).
+//! **Fast path.** By the lines of the diagonals through all-even corners,
+//! which carry exactly the voxels' own diagonals: each such line that
+//! meets the triangle sets the voxel whose diagonal on it straddles the
+//! plane. Triangles of a few voxels test their few lines one by one
+//! (`diagonal_lines`); larger ones take them row by row as exact spans
+//! ([`super::line_spans`]); huge ones (beyond `i64`) take `cover`'s exact
+//! traversal as candidates, each with its one target's test
+//! (`LazyTargets`, `i128`).
 //!
 //! **Reference:** [`reference::diagonal`].
 
@@ -95,7 +98,11 @@ impl Kernel<LatticeTriangle> for DiagonalKernel {
             }
         }
         if fits_i64(tri) {
-            filtered::<i64>(tri, lo, hi, self.traversal, slab);
+            let sp = super::line_spans::SpanSetup::new(tri);
+            super::driver::buffered(lo, hi, slab, |slab, buf| match buf {
+                Some(b) => sp.diagonals(2, lo, hi, b),
+                None => sp.diagonals(2, lo, hi, slab),
+            });
         } else {
             filtered::<i128>(tri, lo, hi, self.traversal, slab);
         }

@@ -23,6 +23,7 @@ pub mod driver;
 pub mod fill;
 pub mod ilv;
 pub mod line;
+pub(crate) mod line_spans;
 pub mod pos;
 pub mod scanline;
 pub mod sep26;

@@ -13,18 +13,20 @@
 //! 6-separating; it is thin: a planar triangle sets at most one voxel per
 //! column along its normal's dominant axis; it is a subset of `cover`.
 //!
-//! **Fast path** (Laine's algorithm). Project each triangle along the
-//! dominant axis `w` of its normal. For a pixel whose (displaced) centre
-//! lies inside the projection, the `w` crosshair segment of exactly one
-//! voxel of the column is hit — the one whose segment straddles the plane,
-//! found by one exact division — and thinness proves no other voxel of the
-//! column is. For a pixel whose square meets the projection but whose centre
-//! does not, the two perpendicular crosshair segments are tested exactly for
-//! the few voxels around the plane's depth. Triangles in a box of at most
-//! 27 voxels (most at 128³) take the same column rule along all three
-//! axes instead, for the pixel centres inside their box only. All tests
-//! are exact integers (`i64` relative to the triangle, `i128` for huge
-//! triangles).
+//! **Fast path** (Laine's column rule, on all three axes). A line through
+//! pixel centres along an axis the plane is not parallel to, if it meets
+//! the (displaced) triangle, hits the crosshair segment of exactly one
+//! voxel of its column — the one whose segment straddles the plane — and
+//! every crosshair hit is one of these. Triangles in a box of at most 27
+//! voxels (most at 128³) test the few such lines in their box one by one
+//! (`tiny`); larger ones take each axis's lines row by row as exact spans,
+//! with the straddling voxel stepped along the row
+//! ([`super::line_spans`]); huge ones (beyond `i64`) take Laine's
+//! single-projection algorithm (`project`, in `i128`): along the dominant
+//! axis `w` the column rule, and for a pixel whose square meets the
+//! projection but whose centre does not, exact tests of the two
+//! perpendicular segments of the few voxels around the plane's depth. All
+//! tests are exact integers.
 //!
 //! **Reference:** [`reference::sep6`], the definition evaluated with the
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
@@ -134,7 +136,11 @@ impl Kernel<LatticeTriangle> for Sep6Kernel {
         } else if is_tiny(lo, hi) {
             tiny(tri, lo, hi, slab);
         } else {
-            project::<i64>(tri, lo, hi, slab);
+            let sp = super::line_spans::SpanSetup::new(tri);
+            super::driver::buffered(lo, hi, slab, |slab, buf| match buf {
+                Some(b) => sp.crosshair(lo, hi, b),
+                None => sp.crosshair(lo, hi, slab),
+            });
         }
     }
 }
