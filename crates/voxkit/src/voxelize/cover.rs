@@ -594,56 +594,70 @@ impl<T: PlaneInt> PlaneRange<T> {
 /// only when rows are long.
 const SMALL_BOX: i64 = 1024;
 
-/// Scans every column of the box in the dominant projection, with the
-/// dominant-plane edge functions kept as running sums (additions only, no
-/// per-row setup), and tracks along each row the exact range of `t` where
-/// the plane crosses the voxel (it moves by at most one per column since
-/// `|n_u| <= n_w`). Only the voxels in that range get the remaining six
-/// edge tests. Same predicates as [`traverse`], so the same voxels.
+/// Scans the box row by row in the dominant projection: in each row the
+/// exact span of columns whose square meets the projected triangle (the
+/// three dominant-plane edge functions solved for the column, one
+/// division each), and along it, incrementally, the exact range of `t`
+/// where the plane crosses the voxel (it moves by at most one per column
+/// since `|n_u| <= n_w`). Only the voxels in that range get the remaining
+/// six edge tests. Same predicates as [`traverse`], so the same voxels.
 #[inline(always)]
 fn scan_box<O: Sink, const W: usize>(s: &Setup<i64>, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     let (u, v, w) = ((W + 1) % 3, (W + 2) % 3, W);
     let (nu, nw) = (s.n[u], s.n[w]);
     let (uv, vw, wu) = (s.uv, s.vw, s.wu);
-    // wu edge functions at (t = 0, iu = lo_u); each column adds `b`.
-    let wu_row0: [i64; 3] = std::array::from_fn(|i| wu[i].b * lo[u] + wu[i].c);
     for iv in lo[v]..=hi[v] {
-        let mut fuv: [i64; 3] = std::array::from_fn(|i| uv[i].a * lo[u] + uv[i].b * iv + uv[i].c);
+        // The row's columns whose square meets the projected triangle: the
+        // uv edge functions `a·iu + r >= 0`, each solved for `iu` (the
+        // f64 estimate of `div_floor` made exact), so columns outside are
+        // never visited.
+        let (mut a0, mut a1) = (lo[u], hi[u]);
+        for e in &uv {
+            let r = e.b * iv + e.c;
+            if e.a > 0 {
+                a0 = a0.max(-div_floor(r, e.a).0);
+            } else if e.a < 0 {
+                a1 = a1.min(div_floor(r, -e.a).0);
+            } else if r < 0 {
+                a1 = a0 - 1;
+            }
+        }
+        if a0 > a1 {
+            continue;
+        }
         let rvw: [i64; 3] = std::array::from_fn(|i| vw[i].a * iv + vw[i].c);
-        let mut rwu = wu_row0;
-        let mut plane = PlaneRange::at::<W>(s, lo[u], iv);
-        let mut iu = lo[u];
+        // wu edge functions at (t = 0, iu = a0); each column adds `b`.
+        let mut rwu: [i64; 3] = std::array::from_fn(|i| wu[i].b * a0 + wu[i].c);
+        let mut plane = PlaneRange::at::<W>(s, a0, iv);
+        let mut iu = a0;
         loop {
-            // `x | y | z` is negative iff one of them is: one branch per test group.
-            if (fuv[0] | fuv[1] | fuv[2]) >= 0 {
-                let (ta, tb) = (plane.t0.max(lo[w]), plane.t1.min(hi[w]));
-                if ta <= tb {
-                    // The six remaining edge functions at t = ta, then stepped along t.
-                    let mut f: [i64; 3] = std::array::from_fn(|i| vw[i].b * ta + rvw[i]);
-                    let mut g: [i64; 3] = std::array::from_fn(|i| wu[i].a * ta + rwu[i]);
-                    let mut t = ta;
-                    loop {
-                        if (f[0] | f[1] | f[2] | g[0] | g[1] | g[2]) >= 0 {
-                            set::<O, W>(out, iu, iv, t);
-                        }
-                        if t == tb {
-                            break;
-                        }
-                        t += 1;
-                        for i in 0..3 {
-                            f[i] += vw[i].b;
-                            g[i] += wu[i].a;
-                        }
+            let (ta, tb) = (plane.t0.max(lo[w]), plane.t1.min(hi[w]));
+            if ta <= tb {
+                // The six remaining edge functions at t = ta, then stepped along t.
+                let mut f: [i64; 3] = std::array::from_fn(|i| vw[i].b * ta + rvw[i]);
+                let mut g: [i64; 3] = std::array::from_fn(|i| wu[i].a * ta + rwu[i]);
+                let mut t = ta;
+                loop {
+                    // `x | y | z` is negative iff one of them is: one branch per test group.
+                    if (f[0] | f[1] | f[2] | g[0] | g[1] | g[2]) >= 0 {
+                        set::<O, W>(out, iu, iv, t);
+                    }
+                    if t == tb {
+                        break;
+                    }
+                    t += 1;
+                    for i in 0..3 {
+                        f[i] += vw[i].b;
+                        g[i] += wu[i].a;
                     }
                 }
             }
-            if iu == hi[u] {
+            if iu == a1 {
                 break;
             }
             iu += 1;
             plane.next_column(nu, nw);
             for i in 0..3 {
-                fuv[i] += uv[i].a;
                 rwu[i] += wu[i].b;
             }
         }
