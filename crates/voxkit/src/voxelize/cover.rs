@@ -828,7 +828,7 @@ pub(crate) fn run<O: Sink, const W: usize>(out: &mut O, axis: usize, iu: i64, iv
 
 /// `floor(n / d)` for `d > 0`, as an index.
 #[inline(always)]
-fn floor_div<T: PlaneInt>(n: T, d: T) -> i64 {
+pub(crate) fn floor_div<T: PlaneInt>(n: T, d: T) -> i64 {
     let (n, d) = (n.to_i128(), d.to_i128());
     const FAST: i128 = 1 << 62;
     if n.abs() < FAST && d < FAST && d >= ONE as i128 {
@@ -840,7 +840,7 @@ fn floor_div<T: PlaneInt>(n: T, d: T) -> i64 {
 
 /// `ceil(n / d)` for `d > 0`, as an index.
 #[inline(always)]
-fn ceil_div<T: PlaneInt>(n: T, d: T) -> i64 {
+pub(crate) fn ceil_div<T: PlaneInt>(n: T, d: T) -> i64 {
     -floor_div(-n, d)
 }
 

@@ -433,6 +433,15 @@ impl<T: PlaneInt> PixelBounds<T> {
         std::array::from_fn(|i| next.0[i] - self.0[i])
     }
 
+    /// Moves `k` pixels along the row.
+    #[inline(always)]
+    pub fn advance(&mut self, delta: &[T; 6], k: T) {
+        #[allow(clippy::needless_range_loop)]
+        for i in 0..6 {
+            self.0[i] = self.0[i] + delta[i] * k;
+        }
+    }
+
     /// Moves to the next pixel of the row.
     #[inline(always)]
     pub fn step(&mut self, delta: &[T; 6]) {
