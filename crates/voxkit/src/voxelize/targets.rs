@@ -215,6 +215,23 @@ pub(crate) fn all_one_side(side: impl Fn(usize) -> bool) -> bool {
     s0 == side(1) && s0 == side(2)
 }
 
+impl<T: PlaneInt> DirSetup<T> {
+    /// How [`TriSetup::line_values`] change when the line's point moves
+    /// one voxel (`ONE`) along `axis`.
+    #[inline(always)]
+    pub fn line_steps(&self, axis: usize) -> [T; 3] {
+        let one = T::from_i64(ONE);
+        self.m.map(|m| T::ZERO - m[axis] * one)
+    }
+
+    /// Does a segment of this direction that crosses the displaced plane,
+    /// with these [`TriSetup::line_values`], meet the triangle?
+    #[inline(always)]
+    pub fn inside(&self, o: &[T; 3]) -> bool {
+        ((o[0] >= self.be[0]) == self.pos) & ((o[1] >= self.be[1]) == self.pos) & ((o[2] >= self.be[2]) == self.pos)
+    }
+}
+
 impl<T: PlaneInt> TriSetup<T> {
     /// Setup for `t`.
     pub fn new(t: &LatticeTriangle) -> TriSetup<T> {
