@@ -21,7 +21,8 @@
 //! **Cost.** Per triangle: constant setup; then, for each column of the
 //! dominant-axis projection, a few additions to track the plane's range
 //! exactly; and per candidate voxel (those the plane crosses) at most six
-//! integer edge tests. Small triangles scan their box's columns; large ones
+//! integer edge tests. Small triangles scan, row by row, the span of their
+//! box's columns inside the projection (one division per edge); large ones
 //! walk rows with exact incremental edge bounds, so their work is
 //! proportional to their area, not to their bounding box.
 //!
