@@ -323,6 +323,33 @@ mod tests {
     }
 
     #[test]
+    fn triangles_near_the_i64_bound() {
+        // About 60 voxels wide (the largest `fits_i64` takes), slanted on
+        // every axis and nearly parallel to a diagonal or an axis: the
+        // widest plane and orientation values, and rows whose straddling
+        // index jumps far per line.
+        let o = 3 * ONE + 17;
+        for v in [
+            [[o, o, o], [o + 61 * ONE - 5, o + 7 * ONE, o + 29 * ONE], [o + 13 * ONE, o + 60 * ONE, o + 3 * ONE + 1]],
+            [[o, o, o], [o + 59 * ONE, o + 59 * ONE + 3, o + 58 * ONE], [o + 2, o + 60 * ONE, o + 61 * ONE - 1]],
+            [[o, o, o], [o + 60 * ONE, o + 1, o + 2], [o + 3, o + 60 * ONE + 1, o + ONE / 3]],
+        ] {
+            let t = LatticeTriangle { v };
+            assert!(fits_i64(&t), "{t:?}");
+            let (blo, bhi) = t.bounds();
+            let lo: [i64; 3] = std::array::from_fn(|c| crate::geom::fixed::voxel_span(blo[c], bhi[c]).0);
+            let hi: [i64; 3] = std::array::from_fn(|c| crate::geom::fixed::voxel_span(blo[c], bhi[c]).1);
+            let sp = SpanSetup::new(&t);
+            let mut got = Collect::default();
+            sp.crosshair(lo, hi, &mut got);
+            assert_eq!(got.0, definition(lo, hi, |ijk| sep6_hit(&t, ijk)), "crosshair {t:?}");
+            let mut got = Collect::default();
+            sp.diagonals(2, lo, hi, &mut got);
+            assert_eq!(got.0, definition(lo, hi, |ijk| crate::voxelize::diagonal::reference::hit(&t, ijk)), "alternating {t:?}");
+        }
+    }
+
+    #[test]
     fn negative_coordinates_and_far_triangles() {
         // Voxel indices below zero (a tile's shifted triangles reach
         // them) and near the lattice's far end: floor divisions, not
