@@ -24,7 +24,7 @@
 //! **Reference:** [`reference::sep26`], the definition evaluated with the
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
-use super::cover::{ceil_div, floor_div, PlaneRange, Setup as CoverSetup};
+use super::cover::{PlaneRange, Setup as CoverSetup};
 use super::driver::{buffered, run_mesh, run_slabs, Kernel};
 use super::targets::{diagonal_lines, dominant_axes, fits_i64, is_tiny, PixelTest, TriSetup, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report};
@@ -139,19 +139,8 @@ fn project_w<T: PlaneInt, const W: usize>(
         let mut c = s.a;
         (c[u], c[v]) = (lo[u] * ONE + H, iv * ONE + H);
         let mut b = pix.bounds(&s, s.local(c));
-        // The row's columns whose pixel meets the projection: the bounds
-        // that say so are affine along the row, each solved for the
-        // column, so pixels outside are never visited.
-        let (mut a0, mut a1) = (lo[u], hi[u]);
-        for (&r, &d) in b.0[3..].iter().zip(&delta[3..]) {
-            if d > T::ZERO {
-                a0 = a0.max(lo[u] + ceil_div(-r, d));
-            } else if d < T::ZERO {
-                a1 = a1.min(lo[u] + floor_div(r, -d));
-            } else if r < T::ZERO {
-                a1 = a0 - 1;
-            }
-        }
+        // Only the row's pixels that meet the projection.
+        let (a0, a1) = b.row_span(&delta, lo[u], hi[u]);
         if a0 > a1 {
             continue;
         }

@@ -183,20 +183,28 @@ fn columns<T: PlaneInt, const W: usize>(
         c[v] = iv * ONE + H;
         let pc = s.local(c);
         let mut b = pix.bounds(&s, pc);
-        let k = nu * pc[u] + nv * pc[v] + kw;
+        // Only the row's pixels that meet the projection: where the
+        // square misses it, a `w` diamond test fails.
+        let (a0, a1) = b.row_span(&delta, lo[u], hi[u]);
+        if a0 > a1 {
+            continue;
+        }
+        b.advance(&delta, t(a0 - lo[u]));
+        let k = nu * pc[u] + nv * pc[v] + kw + du * t(a0 - lo[u]);
         let mut q = k.div_floor(d);
         let mut rem = k - q * d;
-        let mut iu = lo[u];
+        let mut iu = a0;
         loop {
+            debug_assert!(!b.misses());
             let tw = lo[w] - q.to_i128() as i64;
-            if tw >= lo[w] && tw <= hi[w] && !b.misses() {
+            if tw >= lo[w] && tw <= hi[w] {
                 let mut ijk = [0i64; 3];
                 (ijk[u], ijk[v], ijk[w]) = (iu, iv, tw);
                 if b.strictly_inside_edges() == [true; 3] || edge_tests(ijk) {
                     slab.set(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
                 }
             }
-            if iu == hi[u] {
+            if iu == a1 {
                 break;
             }
             iu += 1;

@@ -450,6 +450,26 @@ impl<T: PlaneInt> PixelBounds<T> {
         std::array::from_fn(|i| next.0[i] - self.0[i])
     }
 
+    /// The pixels `lo ..= hi` of a row, the first of which these bounds
+    /// are, that meet the projected triangle (empty if `lo > hi` on
+    /// return): the bounds [`Self::misses`] reads are affine along the
+    /// row (`delta` per pixel), each solved for the pixel with one exact
+    /// division, so pixels outside need not be visited.
+    #[inline(always)]
+    pub fn row_span(&self, delta: &[T; 6], lo: i64, hi: i64) -> (i64, i64) {
+        let (mut a0, mut a1) = (lo, hi);
+        for (&r, &d) in self.0[3..].iter().zip(&delta[3..]) {
+            if d > T::ZERO {
+                a0 = a0.max(lo + super::cover::ceil_div(T::ZERO - r, d));
+            } else if d < T::ZERO {
+                a1 = a1.min(lo + super::cover::floor_div(r, T::ZERO - d));
+            } else if r < T::ZERO {
+                a1 = a0 - 1;
+            }
+        }
+        (a0, a1)
+    }
+
     /// Moves `k` pixels along the row.
     #[inline(always)]
     pub fn advance(&mut self, delta: &[T; 6], k: T) {
