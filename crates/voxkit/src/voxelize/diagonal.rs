@@ -23,7 +23,7 @@
 //! meets the triangle sets the voxel whose diagonal on it straddles the
 //! plane. Triangles of a few voxels test their few lines one by one
 //! (`diagonal_lines`); larger ones take them row by row as exact spans
-//! ([`super::line_spans`]); huge ones (beyond `i64`) take `cover`'s exact
+//! (`line_spans.rs`); huge ones (beyond `i64`) take `cover`'s exact
 //! traversal as candidates, each with its one target's test
 //! (`LazyTargets`, `i128`).
 //!

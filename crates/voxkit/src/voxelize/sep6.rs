@@ -21,7 +21,7 @@
 //! voxels (most at 128³) test the few such lines in their box one by one
 //! (`tiny`); larger ones take each axis's lines row by row as exact spans,
 //! with the straddling voxel stepped along the row
-//! ([`super::line_spans`]); huge ones (beyond `i64`) take Laine's
+//! (`line_spans.rs`); huge ones (beyond `i64`) take Laine's
 //! single-projection algorithm (`project`, in `i128`): along the dominant
 //! axis `w` the column rule, and for a pixel whose square meets the
 //! projection but whose centre does not, exact tests of the two
