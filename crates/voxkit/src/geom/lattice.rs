@@ -45,7 +45,11 @@ impl LatticeTriangle {
 
     /// Zero area: the three vertices are collinear (or coincide).
     pub fn is_degenerate(&self) -> bool {
-        self.normal() == [0, 0, 0]
+        // Component by component: compared as an array, the three values
+        // just computed were stored and reloaded as one wide load, which
+        // stalled on the stores (store forwarding; 5 % of `cover` at 128³).
+        let n = self.normal();
+        (n[0] | n[1] | n[2]) == 0
     }
 
     /// Per-axis `(min, max)` lattice coordinates.

@@ -226,7 +226,12 @@ fn small_triangle<O: Sink>(tri: &LatticeTriangle, (blo, bhi): ([i64; 3], [i64; 3
         1 if single[1] => one_slab::<O, 1>(tri, lo, hi, out),
         1 => one_slab::<O, 2>(tri, lo, hi, out),
         _ if (0..3).all(|a| span[a].1 - span[a].0 < TINY) => {
-            tiny_box(tri, span.map(|s| s.0), span.map(|s| (s.1 - s.0 + 1) as usize), lo, hi, out)
+            let n = span.map(|s| (s.1 - s.0 + 1) as usize);
+            // Decided here, where the spans are in registers: compared as
+            // an array in `tiny_box`, they were one wide load that stalled
+            // on the narrow stores just made (store forwarding).
+            let octant = (n[0] == 2) & (n[1] == 2) & (n[2] == 2);
+            tiny_box(tri, span.map(|s| s.0), n, octant, lo, hi, out)
         }
         _ => return false,
     }
@@ -266,10 +271,10 @@ const TINY: i64 = 4;
 /// other ten axes, so this is the definition, not an approximation. Only
 /// voxels of `[lo, hi]` are emitted.
 #[inline(never)]
-fn tiny_box<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], n: [usize; 3], lo: [i64; 3], hi: [i64; 3], out: &mut O) {
-    // Most tiny triangles span 2×2×2 voxels (about two thirds at 128³ on
-    // the bunny): those take the octant test.
-    if n == [2; 3] {
+fn tiny_box<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], n: [usize; 3], octant: bool, lo: [i64; 3], hi: [i64; 3], out: &mut O) {
+    // Most tiny triangles span 2×2×2 voxels (`octant`; about two thirds at
+    // 128³ on the bunny): those take the octant test.
+    if octant {
         octants(tri, base, lo, hi, out)
     } else {
         tiny_box_n(tri, base, n, lo, hi, out)

@@ -94,7 +94,15 @@ pub fn run_triangles<K: Kernel<LatticeTriangle>>(
             let mut slabs = bits.slabs_mut(layers);
             let mut slab = slabs.pop().expect("one slab holds the whole grid");
             for tri in &mesh.triangles[part * n / parts..(part + 1) * n / parts] {
-                snapped.triangle(tri, &mut st, |t, lo, hi| run_unless_full(kernel, t, lo, hi, &mut slab));
+                // Inlined: as a call (`triangle` calls it from two places),
+                // its first loads of `lo` and `hi` stalled on the stores
+                // just made (store forwarding).
+                snapped.triangle(
+                    tri,
+                    &mut st,
+                    #[inline(always)]
+                    |t, lo, hi| run_unless_full(kernel, t, lo, hi, &mut slab),
+                );
             }
             let pool = slab.into_pool();
             bits.merge_slabs(vec![pool]);
