@@ -484,8 +484,14 @@ impl SlabView<'_> {
         let (l0, l1, l2) = (lo[0] as u32, lo[1] as u32, lo[2] as u32);
         let (h0, h1, h2) = (hi[0] as u32, hi[1] as u32, hi[2] as u32);
         if (l0 ^ h0) | (l1 ^ h1) | (l2 ^ h2) >= BRICK {
-            return self.all_set_across(lo, hi);
+            return self.all_set_across([l0, l1, l2], [h0, h1, h2]);
         }
+        self.all_set_in_brick([l0, l1, l2], [h0, h1, h2])
+    }
+
+    /// [`Self::all_set`] for a box inside one brick.
+    #[inline(always)]
+    fn all_set_in_brick(&self, [l0, l1, l2]: [u32; 3], [h0, h1, h2]: [u32; 3]) -> bool {
         let key = brick_key(l0, l1, l2);
         let slot = if self.last.0 == key {
             self.last.1
@@ -507,10 +513,32 @@ impl SlabView<'_> {
         all
     }
 
-    /// [`Self::all_set`] for a box across brick borders, voxel by voxel.
+    /// [`Self::all_set`] for a box across brick borders: the box cut by
+    /// the brick borders, each part by [`Self::all_set_in_brick`].
     #[inline(never)]
-    fn all_set_across(&self, lo: [i64; 3], hi: [i64; 3]) -> bool {
-        (lo[2]..=hi[2]).all(|k| (lo[1]..=hi[1]).all(|j| (lo[0]..=hi[0]).all(|i| self.get(i as u32, j as u32, k as u32))))
+    fn all_set_across(&self, lo: [u32; 3], hi: [u32; 3]) -> bool {
+        // The parts' bounds along one axis: from `lo` to the end of its
+        // brick, then brick by brick, clamped to `hi`.
+        let next = |c: u32| (c | (BRICK - 1)) + 1;
+        let mut k = lo[2];
+        while k <= hi[2] {
+            let k1 = (next(k) - 1).min(hi[2]);
+            let mut j = lo[1];
+            while j <= hi[1] {
+                let j1 = (next(j) - 1).min(hi[1]);
+                let mut i = lo[0];
+                while i <= hi[0] {
+                    let i1 = (next(i) - 1).min(hi[0]);
+                    if !self.all_set_in_brick([i, j, k], [i1, j1, k1]) {
+                        return false;
+                    }
+                    i = i1 + 1;
+                }
+                j = j1 + 1;
+            }
+            k = k1 + 1;
+        }
+        true
     }
 
     /// The pool slot of the brick holding voxel `(i, j, k)`, allocating it
@@ -696,6 +724,26 @@ mod tests {
             }
         }
         assert!(full > 0 && full < checked, "{full} of {checked} boxes full");
+    }
+
+    #[test]
+    fn all_set_across_a_missing_brick_is_false() {
+        // Only brick (0, 0, 0) is allocated, and full.
+        let mut grid = BrickBits::new([20, 20, 20]);
+        let mut slabs = grid.slabs_mut(8);
+        let slab = &mut slabs[0];
+        for k in 0..8 {
+            for j in 0..8 {
+                for i in 0..8 {
+                    slab.set(i, j, k);
+                }
+            }
+        }
+        assert!(slab.all_set([5, 5, 5], [7, 7, 7]));
+        assert!(slab.all_set([0, 0, 0], [7, 7, 7]));
+        for hi in [[8i64, 7, 7], [7, 8, 7], [7, 7, 8], [9, 9, 9]] {
+            assert!(!slab.all_set([6, 6, 6], hi), "{hi:?}");
+        }
     }
 
     fn random_pair(dims: [u32; 3], n: usize, seed: u64) -> (BrickBits, DenseBits) {
