@@ -176,7 +176,8 @@ fn filtered<T: PlaneInt>(
 ) {
     let s = TriSetup::<T>::new(tri);
     let shift: [i64; 3] = offset.map(|o| o * ONE);
-    let keep = |ijk: [i64; 3]| {
+    let keep = |i: i64, j: i64, k: i64| {
+        let ijk = [i, j, k];
         let g: [i64; 3] = std::array::from_fn(|a| ijk[a] + offset[a]);
         // Cheapest first: a segment whose ends lie on one side of the
         // displaced plane misses; most targets are decided here. The

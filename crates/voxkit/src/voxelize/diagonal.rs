@@ -111,7 +111,7 @@ impl Kernel<LatticeTriangle> for DiagonalKernel {
 
 fn filtered<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], traversal: Traversal, slab: &mut BrickSlab<'_>) {
     let targets = LazyTargets::<T, 4>::new(tri, &DIAGONAL_SET);
-    let keep = |ijk: [i64; 3]| targets.hits(which(ijk), ijk);
+    let keep = |i: i64, j: i64, k: i64| targets.hits(which([i, j, k]), [i, j, k]);
     cover_triangle(tri, lo, hi, traversal, &mut Filter { slab, keep });
 }
 

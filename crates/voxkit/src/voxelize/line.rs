@@ -95,7 +95,7 @@ struct LineKernel {
 
 impl Kernel<Element> for LineKernel {
     fn run(&self, e: &Element, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
-        let keep = |ijk: [i64; 3]| self.target.hit(e, ijk);
+        let keep = |i: i64, j: i64, k: i64| self.target.hit(e, [i, j, k]);
         match e {
             Element::Triangle(t) => cover_triangle(t, lo, hi, self.traversal, &mut Filter { slab, keep }),
             Element::Segment(s) => match self.target {

@@ -145,7 +145,8 @@ impl Kernel<LatticeTriangle> for ScanKernel {
 fn targets<T: PlaneInt, const N: usize>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], segs: &[(P3, P3); N], slab: &mut BrickSlab<'_>) {
     let s = TriSetup::<T>::new(tri);
     let dirs: [DirSetup<T>; N] = std::array::from_fn(|i| s.dir(tri, segs[i].1));
-    let keep = |ijk: [i64; 3]| {
+    let keep = |i: i64, j: i64, k: i64| {
+        let ijk = [i, j, k];
         (0..N).any(|i| {
             let o = segs[i].0;
             s.segment_hits(&dirs[i], s.local([ijk[0] * ONE + o[0], ijk[1] * ONE + o[1], ijk[2] * ONE + o[2]]))

@@ -114,7 +114,8 @@ fn filtered<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], trav
     diamond_tests(tri, n, &mut tests, (0, 1, 2));
     diamond_tests(tri, n, &mut tests, (1, 2, 0));
     diamond_tests(tri, n, &mut tests, (2, 0, 1));
-    let keep = |ijk: [i64; 3]| {
+    let keep = |i: i64, j: i64, k: i64| {
+        let ijk = [i, j, k];
         let d: [T; 3] = std::array::from_fn(|x| t(ijk[x] * ONE + H - a[x]));
         tests.iter().all(|l| l.g[0] * d[0] + l.g[1] * d[1] + l.g[2] * d[2] + l.c >= T::ZERO)
     };

@@ -124,7 +124,7 @@ fn filtered<T: PlaneInt>(
     slab: &mut BrickSlab<'_>,
 ) {
     let targets = PairedTargets::<T, 26>::new(tri, dirs, reached);
-    let keep = |ijk: [i64; 3]| targets.any(ijk);
+    let keep = |i: i64, j: i64, k: i64| targets.any([i, j, k]);
     cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
 }
 
