@@ -565,13 +565,15 @@ pub(crate) struct TargetSet<const N: usize> {
     common_step: i64,
     /// For a set of opposite pairs (the tunnels': centred, one start and
     /// one step, each target's opposite in the set too), the number of
-    /// lines through the centre they lie on, else 0; [`Self::pair`] holds
-    /// each line's two targets.
+    /// lines through the centre they lie on, else 0.
     lines: usize,
-    pair: [(u8, u8); 13],
     /// Per line `l < 13`: its `+` target's index in [`unit_table`]; past
     /// [`Self::lines`], the zero direction's (13), whose `n·u` is 0.
     pair_unit: [u8; 13],
+    /// Per line `l < 13` ([`PairedTargets`]): the unit direction and the
+    /// step of its `+` target, indexed by `l & 31` (no bounds check).
+    line_unit: [P3; 32],
+    line_d: [P3; 32],
     /// Per target: the [`forms_reached`] bits every triangle that meets
     /// one of its translates by whole voxels must have.
     needs: [u16; N],
@@ -629,6 +631,14 @@ impl<const N: usize> TargetSet<N> {
         }
         let (lines, pair) = Self::pairs(&unit, list.len(), centred && common_start && common_step != 0);
         let mut pair_unit = [13u8; 13];
+        let mut line_unit = [[0i64; 3]; 32];
+        let mut line_d = [[0i64; 3]; 32];
+        let mut l = 0;
+        while l < lines {
+            line_unit[l] = unit[pair[l].0 as usize];
+            line_d[l] = seg[pair[l].0 as usize].1;
+            l += 1;
+        }
         let mut live_of = [0u32; 512];
         let mut lines_live_of = [0u16; 512];
         let mut r = 0;
@@ -651,7 +661,7 @@ impl<const N: usize> TargetSet<N> {
             }
             r += 1;
         }
-        TargetSet { seg, unit, centred, common_step, lines, pair, pair_unit, live_of, lines_live_of, needs, len: list.len() }
+        TargetSet { seg, unit, centred, common_step, lines, pair_unit, line_unit, line_d, live_of, lines_live_of, needs, len: list.len() }
     }
 
     /// The lines of a set of opposite pairs ([`Self::lines`]), if `maybe`
@@ -857,7 +867,7 @@ pub(crate) struct PairedTargets<'t, T, const N: usize> {
     set: &'t TargetSet<N>,
     /// The common start's plane value `n·o`.
     start: T,
-    /// Per line `l` of [`TargetSet::pair`]: `|n·d|` of its targets (0 past
+    /// Per line `l` of the set: `|n·d|` of its targets (0 past
     /// the set's lines).
     kabs: [T; 13],
     /// The lines one of whose targets may meet the triangle (bit `l`).
@@ -902,8 +912,8 @@ impl<'t, T: PlaneInt, const N: usize> PairedTargets<'t, T, N> {
         while mask != 0 {
             let l = mask.trailing_zeros() as usize;
             mask &= mask - 1;
-            let n = self.set.pair[l].0 as usize;
-            if self.s.line_hits(self.tri, &w, self.set.unit[n].map(T::from_i64), self.set.seg[n].1) {
+            let l = l & 31;
+            if self.s.line_hits(self.tri, &w, self.set.line_unit[l].map(T::from_i64), self.set.line_d[l]) {
                 return true;
             }
         }
