@@ -517,18 +517,18 @@ impl SlabView<'_> {
     /// the brick borders, each part by [`Self::all_set_in_brick`].
     #[inline(never)]
     fn all_set_across(&self, lo: [u32; 3], hi: [u32; 3]) -> bool {
-        // The parts' bounds along one axis: from `lo` to the end of its
-        // brick, then brick by brick, clamped to `hi`.
-        let next = |c: u32| (c | (BRICK - 1)) + 1;
+        // Each part runs from its first voxel to the end of that voxel's
+        // brick, clamped to `hi`.
+        let end = |c: u32, h: u32| (c | (BRICK - 1)).min(h);
         let mut k = lo[2];
         while k <= hi[2] {
-            let k1 = (next(k) - 1).min(hi[2]);
+            let k1 = end(k, hi[2]);
             let mut j = lo[1];
             while j <= hi[1] {
-                let j1 = (next(j) - 1).min(hi[1]);
+                let j1 = end(j, hi[1]);
                 let mut i = lo[0];
                 while i <= hi[0] {
-                    let i1 = (next(i) - 1).min(hi[0]);
+                    let i1 = end(i, hi[0]);
                     if !self.all_set_in_brick([i, j, k], [i1, j1, k1]) {
                         return false;
                     }

@@ -635,8 +635,10 @@ impl<const N: usize> TargetSet<N> {
         let mut line_d = [[0i64; 3]; 32];
         let mut l = 0;
         while l < lines {
-            line_unit[l] = unit[pair[l].0 as usize];
-            line_d[l] = seg[pair[l].0 as usize].1;
+            let a = pair[l].0 as usize;
+            pair_unit[l] = line[a];
+            line_unit[l] = unit[a];
+            line_d[l] = seg[a].1;
             l += 1;
         }
         let mut live_of = [0u32; 512];
@@ -656,7 +658,6 @@ impl<const N: usize> TargetSet<N> {
                 if (live_of[r] >> a | live_of[r] >> b) & 1 != 0 {
                     lines_live_of[r] |= 1 << l;
                 }
-                pair_unit[l] = line[a as usize];
                 l += 1;
             }
             r += 1;
