@@ -135,15 +135,17 @@ pub fn agree_mode(mode: Mode, mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits,
     }
     for threads in [1, 2, 8] {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| e.to_string())?;
-        for (slab_height, traversal, driver) in [
-            (0, Traversal::Auto, Driver::Auto),
-            (0, Traversal::Auto, Driver::Slabs),
-            (0, Traversal::Auto, Driver::Triangles),
-            (1, Traversal::WalkRows, Driver::Slabs),
-            (7, Traversal::ScanBoxes, Driver::Slabs),
-            (0, Traversal::WalkRows, Driver::Triangles),
+        // A deferral limit of 1 has a slab run its put-off tests before
+        // each next triangle (the slab driver's; the other defers none).
+        for (slab_height, traversal, driver, defer_limit) in [
+            (0, Traversal::Auto, Driver::Auto, 0),
+            (0, Traversal::Auto, Driver::Slabs, 1),
+            (0, Traversal::Auto, Driver::Triangles, 0),
+            (1, Traversal::WalkRows, Driver::Slabs, 0),
+            (7, Traversal::ScanBoxes, Driver::Slabs, 1),
+            (0, Traversal::WalkRows, Driver::Triangles, 0),
         ] {
-            let opts = Options { slab_height, traversal, driver, ..Options::default() };
+            let opts = Options { slab_height, traversal, driver, defer_limit, ..Options::default() };
             let (fast, frep) = pool.install(|| voxelize::fast(mode, mesh.as_ref(), grid, &opts));
             if fast.count() != frep.voxels {
                 return Err(format!("fast report says {} voxels, grid has {}", frep.voxels, fast.count()));
@@ -151,7 +153,7 @@ pub fn agree_mode(mode: Mode, mesh: &Mesh, grid: &GridSpec) -> Result<DenseBits,
             let fast = fast.to_dense();
             if let Some(v) = reference.first_difference(&fast) {
                 return Err(format!(
-                    "{} fast (threads {threads}, slab height {slab_height}, {traversal:?}, {driver:?}) differs from reference at voxel {v:?}: reference {}, fast {}",
+                    "{} fast (threads {threads}, slab height {slab_height}, {traversal:?}, {driver:?}, deferral limit {defer_limit}) differs from reference at voxel {v:?}: reference {}, fast {}",
                     mode.name(),
                     reference.get(v[0], v[1], v[2]),
                     fast.get(v[0], v[1], v[2])

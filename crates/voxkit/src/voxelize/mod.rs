@@ -209,6 +209,11 @@ pub struct Options<'a> {
     /// Parallel driver of the fast paths. Default: [`driver::Driver::Auto`].
     /// The result does not depend on it.
     pub driver: driver::Driver,
+    /// Voxel tests a slab of the slab driver may put off
+    /// ([`driver::Deferred`]) before the driver has them run; `0`
+    /// (default) means 2^18. The result does not depend on it (tests pin
+    /// 1).
+    pub defer_limit: usize,
 }
 
 /// What a voxelization did.

@@ -15,17 +15,21 @@
 //! voxels around the plane's depth; an exact corner-sign test (a plane that
 //! separates a voxel's corners crosses one of its space diagonals, and the
 //! steepest of them, joining the lowest and highest corners, always);
-//! then the diagonal tests, only for the edges the pixel is not strictly
-//! inside of: the steepest diagonal's edge values stepped along the
-//! column by additions, the other three only where it misses. Triangles in a box of at most 27 voxels go by the diagonals' lines
-//! instead (`tiny`). Exact integers (`i64` relative to the triangle for
+//! then, in pixels not strictly inside all three edges, the steepest
+//! diagonal's edge values stepped along the column by additions. Where
+//! it misses, the other three: with the slab driver, put off until the
+//! slab's other triangles have run (the driver's `Deferred`) and tested
+//! only if none of those set the voxel (the union is the same; at 1024³
+//! on the bunny 98 % of the 1.9 M put-off voxels are set by then);
+//! otherwise at once, for the edges the pixel is not strictly inside of. Triangles in a
+//! box of at most 27 voxels go by the diagonals' lines instead (`tiny`). Exact integers (`i64` relative to the triangle for
 //! all but huge triangles, `TriSetup`), parallel over z-slabs like `cover`.
 //!
 //! **Reference:** [`reference::sep26`], the definition evaluated with the
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
 use super::cover::{PlaneRange, Setup as CoverSetup};
-use super::driver::{buffered, run_mesh, run_slabs, Kernel};
+use super::driver::{buffered, run_mesh, run_slabs, Deferred, Kernel};
 use super::targets::{diagonal_lines, dominant_axes, fits_i64, is_tiny, PixelTest, TriSetup, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
@@ -64,12 +68,61 @@ fn tiny(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<
 
 impl Kernel<LatticeTriangle> for Sep26Kernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+        self.run_deferring(tri, lo, hi, slab, &mut Deferred::off());
+    }
+
+    #[inline(always)]
+    fn run_deferring(
+        &self,
+        tri: &LatticeTriangle,
+        lo: [i64; 3],
+        hi: [i64; 3],
+        slab: &mut BrickSlab<'_>,
+        deferred: &mut Deferred<LatticeTriangle>,
+    ) {
         if !fits_i64(tri) {
-            project::<i128>(tri, lo, hi, slab);
+            project::<i128>(tri, lo, hi, slab, deferred);
         } else if is_tiny(lo, hi) {
             tiny(tri, lo, hi, slab);
         } else {
-            project::<i64>(tri, lo, hi, slab);
+            project::<i64>(tri, lo, hi, slab, deferred);
+        }
+    }
+
+    fn finish(&self, deferred: &mut Deferred<LatticeTriangle>, slab: &mut BrickSlab<'_>) {
+        deferred.drain(|tri, voxels| {
+            if fits_i64(tri) {
+                retest::<i64>(tri, voxels, slab);
+            } else {
+                retest::<i128>(tri, voxels, slab);
+            }
+        });
+    }
+}
+
+/// The deferred voxels of `tri` (those [`project`] found its steepest
+/// diagonal to miss, in columns near its edges): each still unset once
+/// the slab's other triangles have run gets the definition, all four
+/// diagonals. At 1024³ on the bunny fewer than 2 % are still unset.
+#[inline(never)]
+fn retest<T: PlaneInt>(tri: &LatticeTriangle, voxels: &[[u32; 3]], slab: &mut BrickSlab<'_>) {
+    let mut setup = None;
+    for &[i, j, k] in voxels {
+        if slab.get(i, j, k) {
+            continue;
+        }
+        let (s, dirs) = setup.get_or_insert_with(|| {
+            let s = TriSetup::<T>::new(tri);
+            let dirs = DIAGONALS.map(|(o, d)| {
+                let o = o.map(T::from_i64);
+                (o, s.plane(o), s.dir(tri, d))
+            });
+            (s, dirs)
+        });
+        let p = s.local([i, j, k].map(|c| c as i64 * ONE));
+        let vc = s.plane(p);
+        if dirs.iter().any(|(o, vo, ds)| s.segment_hits_with(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]], vc + *vo)) {
+            slab.set(i, j, k);
         }
     }
 }
@@ -80,12 +133,20 @@ impl Kernel<LatticeTriangle> for Sep26Kernel {
 /// (tracked along the row by `cover`'s exact plane range, with its
 /// thresholds moved by the perturbation's bias); then the diagonal tests
 /// for the edges the pixel is not strictly inside.
-fn project<T: PlaneInt>(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
+fn project<T: PlaneInt>(
+    tri: &LatticeTriangle,
+    lo: [i64; 3],
+    hi: [i64; 3],
+    slab: &mut BrickSlab<'_>,
+    deferred: &mut Deferred<LatticeTriangle>,
+) {
+    let mark = deferred.mark();
     buffered(lo, hi, slab, |slab, buf| match dominant_axes(tri).2 {
-        0 => project_w::<T, 0>(tri, lo, hi, slab, buf),
-        1 => project_w::<T, 1>(tri, lo, hi, slab, buf),
-        _ => project_w::<T, 2>(tri, lo, hi, slab, buf),
+        0 => project_w::<T, 0>(tri, lo, hi, slab, buf, deferred),
+        1 => project_w::<T, 1>(tri, lo, hi, slab, buf, deferred),
+        _ => project_w::<T, 2>(tri, lo, hi, slab, buf, deferred),
     });
+    deferred.close(tri, mark);
 }
 
 #[inline(always)]
@@ -95,7 +156,9 @@ fn project_w<T: PlaneInt, const W: usize>(
     hi: [i64; 3],
     slab: &mut BrickSlab<'_>,
     mut buf: Option<&mut BoxBricks>,
+    deferred: &mut Deferred<LatticeTriangle>,
 ) {
+    let defer = deferred.is_on();
     let s = TriSetup::<T>::new(tri);
     // The diagonal along which the plane value changes most (its signs
     // are the normal's) joins the voxel's lowest and highest corners, so
@@ -170,10 +233,12 @@ fn project_w<T: PlaneInt, const W: usize>(
                     let mut ijk = [0u32; 3];
                     (ijk[u], ijk[v], ijk[w]) = (iu as u32, iv as u32, t as u32);
                     // The corners straddle the plane, so the steepest
-                    // diagonal crosses it; the others only where it misses
-                    // the triangle. (Testing them measured faster than first
-                    // looking up whether a neighbour has set the voxel: the
-                    // lookups miss the cache.)
+                    // diagonal crosses it; the other three only matter
+                    // where it misses the triangle. With the slab driver
+                    // they are tested later, and only if no other
+                    // triangle has set the voxel by then (at 1024³, 1.9 M
+                    // voxels here, 32 k of them still unset then);
+                    // otherwise now, for the edges not known to pass.
                     let others = || {
                         let mut corner = [0i64; 3];
                         (corner[u], corner[v], corner[w]) = (iu * ONE, iv * ONE, t * ONE);
@@ -183,7 +248,14 @@ fn project_w<T: PlaneInt, const W: usize>(
                             .iter()
                             .any(|(o, vo, ds)| s.segment_hits_unsafe_edges(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]], vc + *vo, safe))
                     };
-                    let hit = all_safe || dirs[0].2.inside(&steep) || others();
+                    let hit = all_safe
+                        || dirs[0].2.inside(&steep)
+                        || if defer {
+                            deferred.push(ijk[0], ijk[1], ijk[2]);
+                            false
+                        } else {
+                            others()
+                        };
                     if hit {
                         match buf.as_deref_mut() {
                             Some(b) => b.set(ijk[0], ijk[1], ijk[2]),
