@@ -236,7 +236,7 @@ const DEFERRED_MAX: usize = 1 << 18;
 
 impl<P> Deferred<P> {
     /// An empty list, [full](Self::is_full) from `limit` voxels on (`0`:
-    /// [`DEFERRED_MAX`]).
+    /// 2^18).
     pub fn new(limit: usize) -> Self {
         Deferred { groups: Vec::new(), voxels: Vec::new(), limit: if limit == 0 { DEFERRED_MAX } else { limit }, on: true }
     }
