@@ -21,8 +21,9 @@
 //! slab's other triangles have run (the driver's `Deferred`) and tested
 //! only if none of those set the voxel (the union is the same; at 1024³
 //! on the bunny 98 % of the 1.9 M put-off voxels are set by then);
-//! otherwise at once, for the edges the pixel is not strictly inside of. Triangles in a
-//! box of at most 27 voxels go by the diagonals' lines instead (`tiny`). Exact integers (`i64` relative to the triangle for
+//! otherwise at once, for the edges the pixel is not strictly inside of.
+//! Triangles in a box of at most 27 voxels go by the diagonals' lines
+//! instead (`tiny`). Exact integers (`i64` relative to the triangle for
 //! all but huge triangles, `TriSetup`), parallel over z-slabs like `cover`.
 //!
 //! **Reference:** [`reference::sep26`], the definition evaluated with the
@@ -30,7 +31,7 @@
 
 use super::cover::{PlaneRange, Setup as CoverSetup};
 use super::driver::{buffered, run_mesh, run_slabs, Deferred, Kernel};
-use super::targets::{diagonal_lines, dominant_axes, fits_i64, is_tiny, PixelTest, TriSetup, DIAGONALS, DIAGONAL_SET};
+use super::targets::{diagonal_lines, dominant_axes, fits_i64, is_tiny, LazyTargets, PixelTest, TriSetup, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -103,25 +104,18 @@ impl Kernel<LatticeTriangle> for Sep26Kernel {
 /// The deferred voxels of `tri` (those [`project`] found its steepest
 /// diagonal to miss, in columns near its edges): each still unset once
 /// the slab's other triangles have run gets the definition, all four
-/// diagonals. At 1024³ on the bunny fewer than 2 % are still unset.
+/// diagonals ([`LazyTargets`], set up only if one is still unset). At
+/// 1024³ on the bunny fewer than 2 % are.
 #[inline(never)]
 fn retest<T: PlaneInt>(tri: &LatticeTriangle, voxels: &[[u32; 3]], slab: &mut BrickSlab<'_>) {
-    let mut setup = None;
+    let mut targets = None;
     for &[i, j, k] in voxels {
         if slab.get(i, j, k) {
             continue;
         }
-        let (s, dirs) = setup.get_or_insert_with(|| {
-            let s = TriSetup::<T>::new(tri);
-            let dirs = DIAGONALS.map(|(o, d)| {
-                let o = o.map(T::from_i64);
-                (o, s.plane(o), s.dir(tri, d))
-            });
-            (s, dirs)
-        });
-        let p = s.local([i, j, k].map(|c| c as i64 * ONE));
-        let vc = s.plane(p);
-        if dirs.iter().any(|(o, vo, ds)| s.segment_hits_with(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]], vc + *vo)) {
+        let t = targets.get_or_insert_with(|| LazyTargets::<T, 4>::new(tri, &DIAGONAL_SET));
+        let ijk = [i, j, k].map(|c| c as i64);
+        if (0..4).any(|n| t.hits(n, ijk)) {
             slab.set(i, j, k);
         }
     }
@@ -141,16 +135,16 @@ fn project<T: PlaneInt>(
     deferred: &mut Deferred<LatticeTriangle>,
 ) {
     let mark = deferred.mark();
-    buffered(lo, hi, slab, |slab, buf| match dominant_axes(tri).2 {
-        // Whether to put tests off is a constant of each instance: the
-        // path that tests at once stays as it was without the option
-        // (a run-time choice measured 3 % slower at 512³).
-        0 if deferred.is_on() => project_deferring::<T, 0>(tri, lo, hi, slab, buf, deferred),
-        1 if deferred.is_on() => project_deferring::<T, 1>(tri, lo, hi, slab, buf, deferred),
-        _ if deferred.is_on() => project_deferring::<T, 2>(tri, lo, hi, slab, buf, deferred),
-        0 => project_w::<T, 0, false>(tri, lo, hi, slab, buf, deferred),
-        1 => project_w::<T, 1, false>(tri, lo, hi, slab, buf, deferred),
-        _ => project_w::<T, 2, false>(tri, lo, hi, slab, buf, deferred),
+    // Whether to put tests off is a constant of each instance: the path
+    // that tests at once stays as it was without the option (a run-time
+    // choice measured 3 % slower at 512³).
+    buffered(lo, hi, slab, |slab, buf| match (deferred.is_on(), dominant_axes(tri).2) {
+        (true, 0) => project_deferring::<T, 0>(tri, lo, hi, slab, buf, deferred),
+        (true, 1) => project_deferring::<T, 1>(tri, lo, hi, slab, buf, deferred),
+        (true, _) => project_deferring::<T, 2>(tri, lo, hi, slab, buf, deferred),
+        (false, 0) => project_w::<T, 0, false>(tri, lo, hi, slab, buf, deferred),
+        (false, 1) => project_w::<T, 1, false>(tri, lo, hi, slab, buf, deferred),
+        (false, _) => project_w::<T, 2, false>(tri, lo, hi, slab, buf, deferred),
     });
     deferred.close(tri, mark);
 }
