@@ -7,7 +7,8 @@ use voxkit::voxelize::Mode;
 use voxkit::GridSpec;
 use voxkit_testkit::{agree_mode, box_mesh, random_rotation, rng, rotated, shared_mesh, soup, SHARED_MESHES};
 
-const SURFACE: [Mode; 7] = [Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Tunnel18, Mode::Tunnel26, Mode::Bubble { seed: 7 }, Mode::Diagonal];
+const SURFACE: [Mode; 8] =
+    [Mode::Sep26, Mode::Sep6, Mode::Ss6, Mode::Pos, Mode::Tunnel18, Mode::Tunnel26, Mode::Bubble { seed: 7 }, Mode::Diagonal];
 
 #[test]
 fn every_shared_mesh_every_surface_mode() {

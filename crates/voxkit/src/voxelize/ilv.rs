@@ -33,7 +33,7 @@
 
 use glam::DVec3;
 
-use crate::geom::fixed::ONE;
+use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{snap_segment, SnappedSegment};
 use crate::grid::spec::GridSpec;
 
@@ -51,14 +51,36 @@ use crate::grid::spec::GridSpec;
 ///   "incomplete in 2D cases" the seed's authors ran into.
 /// - Ties (the segment through an edge or corner of voxels) go to the lowest
 ///   axis, which keeps the path 6-connected and the result deterministic.
+#[inline]
 pub fn voxel_line(p0: [i64; 3], p1: [i64; 3], mut mark: impl FnMut([i64; 3])) {
     let d: [i64; 3] = std::array::from_fn(|a| p1[a] - p0[a]);
+    if d == [0, 0, 0] {
+        // `pos` joins many voxels to themselves.
+        mark(p0);
+        return;
+    }
+    // With every |Δ| < 2^20 the walk's values stay below 2^62: a product
+    // of two deltas (2^40) times twice the steps plus one (2^21).
+    if d.iter().all(|x| x.abs() < NARROW_DELTA) {
+        walk_ilv::<i64>(p0, d, mark)
+    } else {
+        walk_ilv::<i128>(p0, d, mark)
+    }
+}
+
+/// Largest `|Δ|` (exclusive) for which [`voxel_line`] walks in `i64`.
+const NARROW_DELTA: i64 = 1 << 20;
+
+/// [`voxel_line`] from `p0` by `d`, in `T` (wide enough for
+/// `(2·max|Δ| + 1) · Π|Δ|`).
+#[inline(always)]
+fn walk_ilv<T: PlaneInt + Ord>(p0: [i64; 3], d: [i64; 3], mut mark: impl FnMut([i64; 3])) {
     let step: [i64; 3] = d.map(i64::signum);
     // Deviation: products over the non-zero deltas only (see above).
-    let m = products(d.map(|x| x as i128));
+    let m: [T; 3] = products(d);
     // Next crossing parameter of each axis, times 2·Π|Δ|: the first face is
     // half a voxel away (M), each further one a whole voxel (2M).
-    let mut next: [i128; 3] = m;
+    let mut next: [T; 3] = m;
     let mut left: [i64; 3] = d.map(i64::abs);
     let mut p = p0;
     // Deviation: the start voxel is marked too.
@@ -73,7 +95,7 @@ pub fn voxel_line(p0: [i64; 3], p1: [i64; 3], mut mark: impl FnMut([i64; 3])) {
         }
         p[a] += step[a];
         left[a] -= 1;
-        next[a] += 2 * m[a];
+        next[a] = next[a] + m[a] + m[a];
         mark(p);
     }
 }
@@ -93,7 +115,7 @@ pub fn voxel_of(p: [i64; 3]) -> [i64; 3] {
 /// axis first.
 pub fn lattice_path(a: [i64; 3], b: [i64; 3], mut mark: impl FnMut([i64; 3])) {
     let d: [i64; 3] = std::array::from_fn(|x| b[x] - a[x]);
-    let m = products(d.map(|x| x as i128));
+    let m = products::<i128>(d);
     let mut p = voxel_of(a);
     let end = voxel_of(b);
     let mut left: [i64; 3] = std::array::from_fn(|x| (end[x] - p[x]).abs());
@@ -143,8 +165,8 @@ pub fn segment_voxels(grid: &GridSpec, a: DVec3, b: DVec3) -> Vec<[u32; 3]> {
 /// `M[a] = Π |Δ_b|` over the other axes with non-zero delta (`1` when there
 /// is none): a crossing `t` along axis `a` is `dist / |Δ_a|`, which times
 /// `Π |Δ|` is `dist · M[a]`, an integer.
-fn products(d: [i128; 3]) -> [i128; 3] {
-    std::array::from_fn(|a| (0..3).filter(|&b| b != a && d[b] != 0).map(|b| d[b].abs()).product())
+fn products<T: PlaneInt>(d: [i64; 3]) -> [T; 3] {
+    std::array::from_fn(|a| (0..3).filter(|&b| b != a && d[b] != 0).fold(T::from_i64(1), |m, b| m * T::from_i64(d[b].abs())))
 }
 
 #[cfg(test)]
@@ -211,12 +233,41 @@ mod tests {
         assert!(segment_voxels(&grid, DVec3::splat(100.0), DVec3::splat(101.0)).is_empty());
     }
 
+    /// A fold of a walk's voxels, in order, and their number.
+    fn fingerprint(walk: impl FnOnce(&mut dyn FnMut([i64; 3]))) -> (u64, u64) {
+        let (mut h, mut n) = (0xcbf2_9ce4_8422_2325u64, 0u64);
+        walk(&mut |p| {
+            for c in p {
+                h = (h ^ c as u64).wrapping_mul(0x0000_0100_0000_01b3);
+            }
+            n += 1;
+        });
+        (h, n)
+    }
+
+    #[test]
+    fn the_narrow_walk_equals_the_wide_one_up_to_its_bound() {
+        // Deltas just inside the i64 bound, where its values come nearest
+        // to overflowing, and a few ordinary ones.
+        let b = NARROW_DELTA - 1;
+        for d in [[b, b - 1, b - 7], [-b, b, -3], [b, 0, -b], [5, -b, 1], [3, 4, -5], [0, 0, 0], [-1, 0, 2]] {
+            let p0 = [-7, 3, 1 << 21];
+            let narrow = fingerprint(|mark| walk_ilv::<i64>(p0, d, mark));
+            let wide = fingerprint(|mark| walk_ilv::<i128>(p0, d, mark));
+            assert_eq!(narrow, wide, "delta {d:?}");
+            assert_eq!(narrow.1 as i64, d.iter().map(|x| x.abs()).sum::<i64>() + 1);
+        }
+    }
+
     proptest! {
         #[test]
         fn voxel_line_is_a_six_connected_path_through_the_segment(
             p0 in prop::array::uniform3(-40i64..40), p1 in prop::array::uniform3(-40i64..40)
         ) {
             let v = collect_voxel_line(p0, p1);
+            let d = std::array::from_fn(|a| p1[a] - p0[a]);
+            let wide = fingerprint(|mark| walk_ilv::<i128>(p0, d, mark));
+            prop_assert_eq!(fingerprint(|mark| v.iter().for_each(|&p| mark(p))), wide);
             prop_assert_eq!(v[0], p0);
             prop_assert_eq!(*v.last().unwrap(), p1);
             prop_assert_eq!(v.len() as i64, (0..3).map(|a| (p1[a] - p0[a]).abs()).sum::<i64>() + 1);

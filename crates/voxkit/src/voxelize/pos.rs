@@ -35,11 +35,17 @@
 //!    so every voxel of the longer sub-sequence starts or ends a scanline.
 //! 6. The slice at `P0[axis] + i + 1/2` is the voxel layer `P0[axis] + i`.
 //!
-//! **Fast path** ([`pos`]): parallel over z-slabs; scanlines whose voxel
-//! box misses the slab are skipped. **Reference** ([`reference::pos`]): the
-//! same walk per triangle, serially, into a dense grid.
+//! **Fast path** ([`pos`]): the drivers every surface mode runs on
+//! (triangles in parallel on small grids, z-slabs on large ones; on slabs,
+//! scanlines whose voxel box misses the slab are skipped); a triangle whose
+//! three vertices lie in one voxel marks that voxel, which is what the walk
+//! gives it, and the edge chains go into per-thread buffers instead of new
+//! vectors. **Reference** ([`reference::pos`]): the same walk per triangle,
+//! serially, into a dense grid, with new chains for each.
 
-use super::driver::{run_slabs, Kernel, Sink};
+use std::cell::RefCell;
+
+use super::driver::{run_mesh, run_slabs, Kernel, Sink};
 use super::ilv::{voxel_line, voxel_of};
 use super::{Options, Report};
 use crate::geom::lattice::{prepare, LatticeTriangle};
@@ -49,9 +55,7 @@ use crate::mesh::MeshRef;
 
 /// `pos`, parallel over z-slabs, into sparse bricks.
 pub fn pos(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBits, Report) {
-    let (tris, prepare_stats) = prepare(mesh, grid);
-    let (bits, voxels) = run_slabs(&PosKernel, &tris, grid.dims(), opts);
-    (bits, Report { prepare: prepare_stats, voxels })
+    run_mesh(&PosKernel, mesh, grid, opts)
 }
 
 /// `pos` on already prepared triangles.
@@ -61,41 +65,67 @@ pub fn pos_lattice(tris: &[LatticeTriangle], dims: [u32; 3], opts: &Options<'_>)
 
 struct PosKernel;
 
+thread_local! {
+    /// Each worker thread's edge chains, kept between triangles.
+    static CHAINS: RefCell<Chains> = const { RefCell::new(Chains { q1: Vec::new(), q2: Vec::new() }) };
+}
+
 impl Kernel<LatticeTriangle> for PosKernel {
     fn run(&self, tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], slab: &mut BrickSlab<'_>) {
-        pos_triangle(tri, lo, hi, slab);
+        // Deviation: (1) the voxel containing each snapped vertex.
+        let v = tri.v.map(voxel_of);
+        if v[0] == v[1] && v[1] == v[2] {
+            // Every chain and scanline is this one voxel.
+            if (0..3).all(|a| lo[a] <= v[0][a] && v[0][a] <= hi[a]) {
+                slab.set(v[0][0] as u32, v[0][1] as u32, v[0][2] as u32);
+            }
+            return;
+        }
+        CHAINS.with_borrow_mut(|chains| pos_triangle(v, lo, hi, slab, chains));
     }
 }
 
-/// Algorithm 1 for one triangle, emitting the voxels that fall in the
-/// inclusive box `[lo, hi]`.
-fn pos_triangle(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], out: &mut impl Sink) {
+/// The two edge chains of Algorithm 1: `P0→P1→P2` and `P0→P2`.
+struct Chains {
+    q1: Vec<[i64; 3]>,
+    q2: Vec<[i64; 3]>,
+}
+
+/// Algorithm 1 for one triangle whose vertices lie in the voxels `v`,
+/// emitting the voxels that fall in the inclusive box `[lo, hi]`, with
+/// `chains` as its buffers (emptied first).
+fn pos_triangle(v: [[i64; 3]; 3], lo: [i64; 3], hi: [i64; 3], out: &mut impl Sink, chains: &mut Chains) {
     let inside = |p: [i64; 3]| (0..3).all(|a| lo[a] <= p[a] && p[a] <= hi[a]);
     let mut mark = |p: [i64; 3]| {
         if inside(p) {
             out.set(p[0] as u32, p[1] as u32, p[2] as u32);
         }
     };
-    // Deviation: (1) the voxel containing each snapped vertex.
-    let v = tri.v.map(voxel_of);
     // Deviation: (2) the axis of largest spread.
     let spread = |a: usize| v.iter().map(|p| p[a]).max().unwrap_or(0) - v.iter().map(|p| p[a]).min().unwrap_or(0);
     let axis = (0..3).fold(0, |best, a| if spread(a) > spread(best) { a } else { best });
-    let mut order = [0usize, 1, 2];
-    order.sort_by_key(|&i| v[i][axis]);
-    let [p0, p1, p2] = order.map(|i| v[i]);
+    // Sorted along the axis, stably (equal vertices keep their order): a
+    // bubble sort of three.
+    let mut order = v;
+    for (x, y) in [(0, 1), (1, 2), (0, 1)] {
+        if order[x][axis] > order[y][axis] {
+            order.swap(x, y);
+        }
+    }
+    let [p0, p1, p2] = order;
 
     // Edges. Deviation: (4) Q1 is the chain P0→P1→P2, P1 once.
-    let mut q1 = Vec::new();
+    let Chains { q1, q2 } = chains;
+    q1.clear();
+    q2.clear();
     voxel_line(p0, p1, |p| q1.push(p));
     voxel_line(p1, p2, |p| {
         if p != p1 {
             q1.push(p)
         }
     });
-    let mut q2 = Vec::new();
     voxel_line(p0, p2, |p| q2.push(p));
-    for &p in q1.iter().chain(&q2) {
+    for &p in q1.iter().chain(q2.iter()) {
         mark(p);
     }
 
@@ -104,7 +134,7 @@ fn pos_triangle(tri: &LatticeTriangle, lo: [i64; 3], hi: [i64; 3], out: &mut imp
     let (mut a, mut b) = (0usize, 0usize);
     for layer in p0[axis]..=p2[axis] {
         let run = |q: &[[i64; 3]], from: usize| q[from..].iter().take_while(|p| p[axis] == layer).count();
-        let (n1, n2) = (run(&q1, a), run(&q2, b));
+        let (n1, n2) = (run(q1, a), run(q2, b));
         // Deviation: (6) the slice is the voxel layer; scanlines stay in it.
         if lo[axis] <= layer && layer <= hi[axis] && n1 > 0 && n2 > 0 {
             for t in 0..n1.max(n2) {
@@ -134,7 +164,8 @@ pub mod reference {
         let mut bits = DenseBits::new(dims);
         let hi = dims.map(|d| d as i64 - 1);
         for t in &tris {
-            pos_triangle(t, [0; 3], hi, &mut bits);
+            let mut chains = Chains { q1: Vec::new(), q2: Vec::new() };
+            pos_triangle(t.v.map(voxel_of), [0; 3], hi, &mut bits, &mut chains);
         }
         let voxels = bits.count();
         (bits, Report { prepare: prepare_stats, voxels })
