@@ -18,6 +18,7 @@
 //! also those outside the grid (they change the parity inside it).
 
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 use super::super::voxelize::targets::TriSetup;
 use crate::geom::fixed::{snap, PlaneInt, DIRECT_LIMIT_VOXELS, ONE};
@@ -71,48 +72,97 @@ pub enum ClassifyError {
 
 /// Snaps every triangle of `mesh` (invalid and non-finite ones are
 /// skipped) and counts boundary edges.
+///
+/// Each position is snapped once. Edges are keyed by point numbers (one
+/// per distinct snapped point, so positions that snap to one point are one
+/// end) and bucketed by their lower end; the direction of use is the order
+/// of the numbers (any order of the points gives the same counts).
 pub fn snap_all(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<Snapped, ClassifyError> {
+    let corners: Vec<Corner> = mesh
+        .positions
+        .par_iter()
+        .with_min_len(4096)
+        .map(|p| {
+            let g = grid.to_grid_units(*p);
+            if !g.is_finite() {
+                Corner::Invalid
+            } else if g.abs().max_element() > DIRECT_LIMIT_VOXELS {
+                Corner::TooFar
+            } else {
+                Corner::At([snap(g.x), snap(g.y), snap(g.z)])
+            }
+        })
+        .collect();
+    // Point numbers, in the order of first use by a position.
+    let mut numbers: FxHashMap<[i64; 3], u32> = FxHashMap::with_capacity_and_hasher(corners.len(), Default::default());
+    let number: Vec<u32> = corners
+        .iter()
+        .map(|c| match c {
+            Corner::At(p) => {
+                let next = numbers.len() as u32;
+                *numbers.entry(*p).or_insert(next)
+            }
+            _ => u32::MAX,
+        })
+        .collect();
     let mut triangles = Vec::with_capacity(mesh.triangles.len());
+    let mut ends: Vec<[u32; 3]> = Vec::with_capacity(mesh.triangles.len());
     for t in mesh.triangles {
         let mut v = [[0i64; 3]; 3];
         let mut ok = true;
         for (c, &idx) in t.iter().enumerate() {
-            match mesh.positions.get(idx as usize).map(|p| grid.to_grid_units(*p)) {
-                Some(g) if g.is_finite() => {
-                    if g.abs().max_element() > DIRECT_LIMIT_VOXELS {
-                        return Err(ClassifyError::TooFar(DIRECT_LIMIT_VOXELS as u64));
-                    }
-                    v[c] = [snap(g.x), snap(g.y), snap(g.z)];
-                }
-                _ => ok = false,
+            match corners.get(idx as usize) {
+                Some(Corner::At(p)) => v[c] = *p,
+                Some(Corner::TooFar) => return Err(ClassifyError::TooFar(DIRECT_LIMIT_VOXELS as u64)),
+                Some(Corner::Invalid) | None => ok = false,
             }
         }
         if ok {
             triangles.push(LatticeTriangle { v });
+            ends.push(t.map(|i| number[i as usize]));
         }
     }
-    // Undirected key, and +1 / −1 for the direction of use.
-    let mut edges: Vec<([i64; 3], [i64; 3], i8)> = triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |i| (t.v[i], t.v[(i + 1) % 3])))
-        .filter(|(a, b)| a != b)
-        .map(|(a, b)| if a < b { (a, b, 1) } else { (b, a, -1) })
-        .collect();
-    edges.par_sort_unstable();
-    let (mut boundary_edges, mut unbalanced_edges) = (0, 0);
-    let mut i = 0;
-    while i < edges.len() {
-        let mut j = i;
-        let mut balance = 0i64;
-        while j < edges.len() && (edges[j].0, edges[j].1) == (edges[i].0, edges[i].1) {
-            balance += edges[j].2 as i64;
-            j += 1;
-        }
-        boundary_edges += (j - i) % 2;
-        unbalanced_edges += (balance != 0) as usize;
-        i = j;
-    }
+    let (boundary_edges, unbalanced_edges) = count_edges(&ends, numbers.len());
     Ok(Snapped { triangles, boundary_edges, unbalanced_edges })
+}
+
+/// A mesh position on the lattice (see [`snap_all`]).
+#[derive(Clone, Copy)]
+enum Corner {
+    /// Not finite: triangles using it are skipped.
+    Invalid,
+    /// Beyond the exact lattice: a triangle using it is an error.
+    TooFar,
+    /// Its lattice point.
+    At([i64; 3]),
+}
+
+/// The edges of triangles with corners numbered `ends` (numbers below
+/// `points`) used an odd number of times, and those not used equally
+/// often in both directions. An edge joining a point to itself is none.
+fn count_edges(ends: &[[u32; 3]], points: usize) -> (usize, usize) {
+    let edges = || ends.iter().flat_map(|e| (0..3).map(move |i| (e[i], e[(i + 1) % 3]))).filter(|(a, b)| a != b);
+    // Each edge in the bucket of its lower end.
+    let start = row_starts(points, edges().map(|(a, b)| a.min(b) as usize));
+    let mut fill = start.clone();
+    // Each use as `hi · 2 + (1 if from the higher end)`.
+    let mut bucket = vec![0u64; start[points]];
+    for (a, b) in edges() {
+        let (lo, use_) = if a < b { (a, (b as u64) << 1) } else { (b, (a as u64) << 1 | 1) };
+        bucket[fill[lo as usize]] = use_;
+        fill[lo as usize] += 1;
+    }
+    let (mut boundary, mut unbalanced) = (0, 0);
+    for p in 0..points {
+        let b = &mut bucket[start[p]..start[p + 1]];
+        b.sort_unstable();
+        for uses in b.chunk_by(|x, y| x >> 1 == y >> 1) {
+            boundary += uses.len() % 2;
+            let back = uses.iter().filter(|&&u| u & 1 == 1).count();
+            unbalanced += (2 * back != uses.len()) as usize;
+        }
+    }
+    (boundary, unbalanced)
 }
 
 /// Per row `(j, k)` of a grid, the sorted voxel indices `i` at which the
@@ -209,12 +259,17 @@ fn crossings(t: &LatticeTriangle, dims: [u32; 3], planes: &std::ops::Range<u32>,
     let (lo, hi) = t.bounds();
     let rows = |a: usize, range: (i64, i64)| {
         // Rows whose centre coordinate lies in [lo, hi] (with one of margin
-        // for the displacement; the exact test decides).
-        let first = ((lo[a] - H - 1).div_euclid(ONE)).max(range.0);
+        // for the displacement; the exact test decides): the first is
+        // ceil((lo − 1 − H) / ONE).
+        let first = (-(H + 1 - lo[a]).div_euclid(ONE)).max(range.0);
         let last = ((hi[a] - H + 1).div_euclid(ONE)).min(range.1 - 1);
         first..=last
     };
     let (rj, rk) = (rows(1, (0, dims[1] as i64)), rows(2, (planes.start as i64, planes.end as i64)));
+    if rj.is_empty() || rk.is_empty() {
+        // No row's centre line within reach (most small triangles).
+        return;
+    }
     if crate::voxelize::targets::fits_i64(t) {
         crossings_in::<i64>(t, n, dims, planes.start, rj, rk, out);
     } else {
@@ -316,5 +371,64 @@ mod tests {
         m.triangles.pop();
         let grid = GridSpec::new(DVec3::ZERO, 1.0, [9, 9, 9]).unwrap();
         assert_eq!(snap_all(m.as_ref(), &grid).unwrap().boundary_edges, 3);
+    }
+    /// The closedness counts by their definition: every use of an edge
+    /// keyed by its two snapped points, sorted.
+    fn counts_by_points(s: &Snapped) -> (usize, usize) {
+        let mut edges: Vec<([i64; 3], [i64; 3], i64)> = s
+            .triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |i| (t.v[i], t.v[(i + 1) % 3])))
+            .filter(|(a, b)| a != b)
+            .map(|(a, b)| if a < b { (a, b, 1) } else { (b, a, -1) })
+            .collect();
+        edges.sort();
+        let (mut boundary, mut unbalanced) = (0, 0);
+        for uses in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+            boundary += uses.len() % 2;
+            unbalanced += (uses.iter().map(|u| u.2).sum::<i64>() != 0) as usize;
+        }
+        (boundary, unbalanced)
+    }
+
+    #[test]
+    fn edge_counts_match_their_definition() {
+        // Positions on a coarse lattice, some repeated and some a hair apart
+        // (one snapped point), a non-finite one and indices past the end;
+        // triangles in random orientations, repeated, and degenerate.
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut r = |n: u64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x % n
+        };
+        let grid = GridSpec::new(DVec3::ZERO, 1.0, [8, 8, 8]).unwrap();
+        for round in 0..200 {
+            let mut positions: Vec<DVec3> =
+                (0..6 + r(10)).map(|_| DVec3::new(r(4) as f64, r(4) as f64, r(3) as f64) * 0.5 + DVec3::splat(1.0)).collect();
+            for i in 0..r(4) as usize {
+                let p = positions[i];
+                positions.push(p + DVec3::splat(1e-12));
+            }
+            if round % 5 == 0 {
+                positions.push(DVec3::new(f64::NAN, 1.0, 1.0));
+            }
+            let n = positions.len() as u64;
+            let triangles: Vec<[u32; 3]> = (0..2 + r(20)).map(|_| [r(n + 1), r(n), r(n)].map(|i| i as u32)).collect();
+            let mesh = Mesh { positions, triangles, segments: Vec::new() };
+            let s = snap_all(mesh.as_ref(), &grid).unwrap();
+            assert_eq!((s.boundary_edges, s.unbalanced_edges), counts_by_points(&s), "round {round}");
+        }
+        // A closed cube, then one face turned over: the same boundary, two
+        // unbalanced edges per turned triangle's shared edges.
+        let mut m = cube(2.0, 6.0);
+        let s = snap_all(m.as_ref(), &grid).unwrap();
+        assert_eq!((s.boundary_edges, s.unbalanced_edges), (0, 0));
+        m.triangles[0].swap(1, 2);
+        let s = snap_all(m.as_ref(), &grid).unwrap();
+        assert_eq!((s.boundary_edges, s.unbalanced_edges), counts_by_points(&s));
+        assert_eq!(s.boundary_edges, 0);
+        assert!(s.unbalanced_edges > 0);
     }
 }

@@ -148,7 +148,8 @@ fn row_spans(row_hits: &[(u32, u32, i8)], nx: u32, rule: Rule, mut span: impl Fn
 /// Shared row filler: per row, walks the crossings in order and fills the
 /// spans where `rule` says inside.
 fn fill(snapped: &Snapped, dims: [u32; 3], rule: Rule) -> (DenseBits, SolidReport) {
-    let hits = row_crossings(&snapped.crossing_triangles(), dims);
+    // Zero-area triangles cross no ray (`row_crossings` skips them).
+    let hits = row_crossings(&snapped.triangles, dims);
     let mut bits = DenseBits::new(dims);
     let nx = dims[0];
     // Row r's crossings are hits[start[r] .. start[r + 1]].
@@ -343,7 +344,8 @@ pub(crate) fn bricks_of_spans(spans: &[Vec<(u32, u32)>; 64], dims: [u32; 3], bj:
 /// Shared sparse filler: brick rows in parallel, each from its 64 voxel
 /// rows' crossings (found by binary search in the sorted crossings).
 fn fill_sparse(snapped: &Snapped, dims: [u32; 3], rule: Rule) -> (SparseBricks, SolidReport) {
-    let hits = row_crossings(&snapped.crossing_triangles(), dims);
+    // Zero-area triangles cross no ray (`row_crossings` skips them).
+    let hits = row_crossings(&snapped.triangles, dims);
     let out = by_brick_rows(dims, |bj, bk| brick_row(&hits, dims, bj, bk, rule));
     drop(hits);
     let mut rep = inspect(snapped);
