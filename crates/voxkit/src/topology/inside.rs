@@ -233,7 +233,7 @@ pub fn row_crossings(tris: &[LatticeTriangle], dims: [u32; 3]) -> Vec<(u32, u32,
 /// [`row_crossings`] of the rows in the planes `planes` only, numbered
 /// from the first of them (`row = (k − planes.start)·ny + j`).
 pub fn row_crossings_in(tris: &[LatticeTriangle], dims: [u32; 3], planes: std::ops::Range<u32>) -> Vec<(u32, u32, i8)> {
-    let mut hits: Vec<(u32, u32, i8)> = tris
+    let hits: Vec<(u32, u32, i8)> = tris
         .par_chunks(1024)
         .flat_map_iter(|chunk| {
             let mut out = Vec::new();
@@ -243,8 +243,19 @@ pub fn row_crossings_in(tris: &[LatticeTriangle], dims: [u32; 3], planes: std::o
             out
         })
         .collect();
-    hits.par_sort_unstable();
-    hits
+    // By row (a counting sort), then each row's few by `i0`.
+    let rows = dims[1] as usize * planes.len();
+    let start = row_starts(rows, hits.iter().map(|h| h.0 as usize));
+    let mut fill = start.clone();
+    let mut sorted = vec![(0, 0, 0); hits.len()];
+    for h in hits {
+        sorted[fill[h.0 as usize]] = h;
+        fill[h.0 as usize] += 1;
+    }
+    for r in 0..rows {
+        sorted[start[r]..start[r + 1]].sort_unstable();
+    }
+    sorted
 }
 
 /// Appends `(row, i0, sign)` for every row whose centre line crosses `t`,
