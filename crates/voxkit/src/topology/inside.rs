@@ -37,9 +37,16 @@ pub struct Snapped {
     /// Edges (by snapped end points) used by an odd number of triangles.
     pub boundary_edges: usize,
     /// Edges not used equally often in both directions (0 for a closed,
-    /// consistently oriented surface).
+    /// consistently oriented surface): the length of [`Self::net_edges`].
     pub unbalanced_edges: usize,
+    /// Those edges as `(a, b, uses a → b − uses b → a)` with `a < b`
+    /// (lexicographic), sorted: the boundary a closed surface lacks.
+    pub net_edges: Vec<NetEdge>,
 }
+
+/// An edge `(a, b)`, `a < b`, and how many more times it is used from `a`
+/// to `b` than back ([`Snapped::net_edges`]).
+pub type NetEdge = ([i64; 3], [i64; 3], i64);
 
 impl Snapped {
     /// The triangles that can cross a ray: all but the zero-area ones.
@@ -122,8 +129,24 @@ pub fn snap_all(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<Snapped, ClassifyE
             ends.push(t.map(|i| number[i as usize]));
         }
     }
-    let (boundary_edges, unbalanced_edges) = count_edges(&ends, numbers.len());
-    Ok(Snapped { triangles, boundary_edges, unbalanced_edges })
+    let (boundary_edges, net) = count_edges(&ends, numbers.len());
+    let mut point = vec![[0i64; 3]; numbers.len()];
+    for (p, n) in numbers {
+        point[n as usize] = p;
+    }
+    let mut net_edges: Vec<NetEdge> = net
+        .into_iter()
+        .map(|(lo, hi, balance)| {
+            let (a, b) = (point[lo as usize], point[hi as usize]);
+            if a < b {
+                (a, b, balance)
+            } else {
+                (b, a, -balance)
+            }
+        })
+        .collect();
+    net_edges.sort_unstable();
+    Ok(Snapped { triangles, boundary_edges, unbalanced_edges: net_edges.len(), net_edges })
 }
 
 /// A mesh position on the lattice (see [`snap_all`]).
@@ -139,8 +162,9 @@ enum Corner {
 
 /// The edges of triangles with corners numbered `ends` (numbers below
 /// `points`) used an odd number of times, and those not used equally
-/// often in both directions. An edge joining a point to itself is none.
-fn count_edges(ends: &[[u32; 3]], points: usize) -> (usize, usize) {
+/// often in both directions, as `(lo, hi, uses lo → hi − uses hi → lo)`.
+/// An edge joining a point to itself is none.
+fn count_edges(ends: &[[u32; 3]], points: usize) -> (usize, Vec<(u32, u32, i64)>) {
     let edges = || ends.iter().flat_map(|e| (0..3).map(move |i| (e[i], e[(i + 1) % 3]))).filter(|(a, b)| a != b);
     // Each edge in the bucket of its lower end.
     let start = row_starts(points, edges().map(|(a, b)| a.min(b) as usize));
@@ -152,14 +176,17 @@ fn count_edges(ends: &[[u32; 3]], points: usize) -> (usize, usize) {
         bucket[fill[lo as usize]] = use_;
         fill[lo as usize] += 1;
     }
-    let (mut boundary, mut unbalanced) = (0, 0);
+    let (mut boundary, mut unbalanced) = (0, Vec::new());
     for p in 0..points {
         let b = &mut bucket[start[p]..start[p + 1]];
         b.sort_unstable();
         for uses in b.chunk_by(|x, y| x >> 1 == y >> 1) {
             boundary += uses.len() % 2;
-            let back = uses.iter().filter(|&&u| u & 1 == 1).count();
-            unbalanced += (2 * back != uses.len()) as usize;
+            let back = uses.iter().filter(|&&u| u & 1 == 1).count() as i64;
+            let balance = uses.len() as i64 - 2 * back;
+            if balance != 0 {
+                unbalanced.push((p as u32, (uses[0] >> 1) as u32, balance));
+            }
         }
     }
     (boundary, unbalanced)
@@ -385,7 +412,7 @@ mod tests {
     }
     /// The closedness counts by their definition: every use of an edge
     /// keyed by its two snapped points, sorted.
-    fn counts_by_points(s: &Snapped) -> (usize, usize) {
+    fn counts_by_points(s: &Snapped) -> (usize, Vec<NetEdge>) {
         let mut edges: Vec<([i64; 3], [i64; 3], i64)> = s
             .triangles
             .iter()
@@ -394,12 +421,15 @@ mod tests {
             .map(|(a, b)| if a < b { (a, b, 1) } else { (b, a, -1) })
             .collect();
         edges.sort();
-        let (mut boundary, mut unbalanced) = (0, 0);
+        let (mut boundary, mut net) = (0, Vec::new());
         for uses in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
             boundary += uses.len() % 2;
-            unbalanced += (uses.iter().map(|u| u.2).sum::<i64>() != 0) as usize;
+            let balance = uses.iter().map(|u| u.2).sum::<i64>();
+            if balance != 0 {
+                net.push((uses[0].0, uses[0].1, balance));
+            }
         }
-        (boundary, unbalanced)
+        (boundary, net)
     }
 
     #[test]
@@ -429,7 +459,8 @@ mod tests {
             let triangles: Vec<[u32; 3]> = (0..2 + r(20)).map(|_| [r(n + 1), r(n), r(n)].map(|i| i as u32)).collect();
             let mesh = Mesh { positions, triangles, segments: Vec::new() };
             let s = snap_all(mesh.as_ref(), &grid).unwrap();
-            assert_eq!((s.boundary_edges, s.unbalanced_edges), counts_by_points(&s), "round {round}");
+            assert_eq!((s.boundary_edges, s.net_edges.clone()), counts_by_points(&s), "round {round}");
+            assert_eq!(s.unbalanced_edges, s.net_edges.len());
         }
         // A closed cube, then one face turned over: the same boundary, two
         // unbalanced edges per turned triangle's shared edges.
@@ -438,7 +469,7 @@ mod tests {
         assert_eq!((s.boundary_edges, s.unbalanced_edges), (0, 0));
         m.triangles[0].swap(1, 2);
         let s = snap_all(m.as_ref(), &grid).unwrap();
-        assert_eq!((s.boundary_edges, s.unbalanced_edges), counts_by_points(&s));
+        assert_eq!((s.boundary_edges, s.net_edges.clone()), counts_by_points(&s));
         assert_eq!(s.boundary_edges, 0);
         assert!(s.unbalanced_edges > 0);
     }

@@ -36,10 +36,9 @@
 //! **Reference:** [`reference::winding`], the direct sum over all triangles
 //! for every voxel centre (small grids).
 
-use std::collections::HashMap;
-
 use glam::DVec3;
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 use super::solid::{bricks_of_spans, by_brick_rows, push_span, SolidReport};
 use crate::geom::fixed::ONE;
@@ -50,7 +49,7 @@ use crate::grid::dense::DenseBits;
 use crate::grid::sparse::SparseBricks;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
-use crate::topology::inside::{row_crossings, row_starts, snap_all, ClassifyError, Snapped};
+use crate::topology::inside::{row_crossings, row_starts, snap_all, ClassifyError, NetEdge, Snapped};
 
 /// What the winding-number solid did beyond [`SolidReport`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -94,32 +93,19 @@ pub fn winding_of(t: &[P3; 3], q: P3) -> f64 {
     (2.0 * det.atan2(denom)) / (4.0 * std::f64::consts::PI)
 }
 
-/// The oriented boundary of `tris` as closed cycles of lattice points.
-fn boundary_cycles(tris: &[LatticeTriangle]) -> Vec<Vec<P3>> {
-    let mut net: HashMap<(P3, P3), i64> = HashMap::new();
-    for t in tris {
-        for i in 0..3 {
-            let (a, b) = (t.v[i], t.v[(i + 1) % 3]);
-            if a == b {
-                continue;
-            }
-            if a < b {
-                *net.entry((a, b)).or_default() += 1;
-            } else {
-                *net.entry((b, a)).or_default() -= 1;
-            }
-        }
-    }
+/// The oriented boundary of a mesh, from its [`Snapped::net_edges`], as
+/// closed cycles of lattice points.
+fn boundary_cycles(net: &[NetEdge]) -> Vec<Vec<P3>> {
     // Outgoing boundary half-edges per vertex (with multiplicity), in a
     // deterministic order.
     let mut half: Vec<(P3, P3)> = Vec::new();
-    for (&(a, b), &n) in &net {
+    for &(a, b, n) in net {
         for _ in 0..n.unsigned_abs() {
             half.push(if n > 0 { (a, b) } else { (b, a) });
         }
     }
     half.sort_unstable();
-    let mut out: HashMap<P3, Vec<P3>> = HashMap::new();
+    let mut out: FxHashMap<P3, Vec<P3>> = FxHashMap::default();
     for &(a, b) in half.iter().rev() {
         out.entry(a).or_default().push(b);
     }
@@ -539,13 +525,18 @@ struct Plan {
 
 impl Plan {
     fn new(snapped: &Snapped, dims: [u32; 3]) -> Plan {
-        let cycles = boundary_cycles(&snapped.triangles);
+        let cycles = boundary_cycles(&snapped.net_edges);
         let caps = caps(&cycles);
-        let mut closed = snapped.crossing_triangles();
-        for c in &caps {
-            closed.extend(c.tris.iter().map(|&v| LatticeTriangle { v }).filter(|t| !t.is_degenerate()));
-        }
-        let hits = row_crossings(&closed, dims);
+        // Zero-area triangles cross no ray (`row_crossings` skips them).
+        let hits = if caps.is_empty() {
+            row_crossings(&snapped.triangles, dims)
+        } else {
+            let mut closed = snapped.triangles.clone();
+            for c in &caps {
+                closed.extend(c.tris.iter().map(|&v| LatticeTriangle { v }));
+            }
+            row_crossings(&closed, dims)
+        };
         let rows = dims[1] as usize * dims[2] as usize;
         let start = row_starts(rows, hits.iter().map(|h| h.0 as usize));
         // Voxels whose decision needs w_cap: octree refinement from blocks
