@@ -53,7 +53,7 @@ use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
 
-/// `pos`, parallel over z-slabs, into sparse bricks.
+/// `pos` on the drivers every surface mode runs on, into sparse bricks.
 pub fn pos(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> (BrickBits, Report) {
     run_mesh(&PosKernel, mesh, grid, opts)
 }
