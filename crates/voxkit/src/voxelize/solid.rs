@@ -67,7 +67,7 @@ pub fn inspect(s: &Snapped) -> SolidReport {
     SolidReport {
         triangles: s.triangles.len() as u64,
         boundary_edges: s.boundary_edges as u64,
-        unbalanced_edges: s.unbalanced_edges as u64,
+        unbalanced_edges: s.unbalanced_edges() as u64,
         voxels: 0,
     }
 }
