@@ -26,8 +26,10 @@
 //! set; each gets the tests of its targets (`PairedTargets`, `i64` for
 //! all but huge triangles). The targets come in opposite pairs on the 13 (9)
 //! lines through the centre, so one comparison per line says whether one
-//! of its two targets crosses the plane, and the line's edge sides come
-//! from the centre's pivot cross, three dot products per line.
+//! of its two targets crosses the plane, and the lines' edge sides come
+//! from the centre's pivot cross: for all lines at once from a table
+//! keyed by each cross product's sign pattern, or, where a line may lie
+//! on an edge's plane (a tie), three dot products per line.
 //!
 //! **Reference:** [`reference::tunnel`], every target of every voxel of each
 //! triangle's bounding box with the generic `i128` predicate.
