@@ -825,26 +825,30 @@ const fn unit_positive(u: P3, key: usize) -> bool {
         }
         c += 1;
     }
-    match (pos, neg) {
-        (_, 0) => pos != 0,
-        (0, _) => false,
-        // One against one: a − b, b − c, a − c.
-        (0b001, 0b010) => key_bit(key, 0),
-        (0b010, 0b001) => !key_bit(key, 0),
-        (0b010, 0b100) => key_bit(key, 1),
-        (0b100, 0b010) => !key_bit(key, 1),
-        (0b001, 0b100) => key_bit(key, 2),
-        (0b100, 0b001) => !key_bit(key, 2),
-        // Two against one: a + b − c, a + c − b, b + c − a.
-        (0b011, 0b100) => key_bit(key, 3),
-        (0b100, 0b011) => !key_bit(key, 3),
-        (0b101, 0b010) => key_bit(key, 4),
-        (0b010, 0b101) => !key_bit(key, 4),
-        (0b110, 0b001) => key_bit(key, 5),
-        (0b001, 0b110) => !key_bit(key, 5),
-        _ => false,
+    if neg == 0 {
+        return pos != 0;
     }
+    // Both signs: `u'·(a, b, c)` is the sum over `pos` less the sum over
+    // `neg`, one of the key's differences (bit `b`, as `KEY_SIDES[b]`)
+    // or its negation.
+    let mut b = 0;
+    while b < 6 {
+        let (p, n) = KEY_SIDES[b];
+        if pos == p && neg == n {
+            return key_bit(key, b);
+        }
+        if pos == n && neg == p {
+            return !key_bit(key, b);
+        }
+        b += 1;
+    }
+    false
 }
+
+/// The axes (bit `c` for `a, b, c`) summed on the positive and on the
+/// negative side of each of [`sign_key`]'s six differences: `a − b`,
+/// `b − c`, `a − c`, `a + b − c`, `a + c − b`, `b + c − a`.
+const KEY_SIDES: [(usize, usize); 6] = [(0b001, 0b010), (0b010, 0b100), (0b001, 0b100), (0b011, 0b100), (0b101, 0b010), (0b110, 0b001)];
 
 /// Difference `b` of a [`sign_key`]: positive?
 const fn key_bit(key: usize, b: usize) -> bool {
