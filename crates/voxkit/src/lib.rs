@@ -36,6 +36,9 @@ pub mod render;
 pub mod topology;
 pub mod voxelize;
 
+#[cfg(test)]
+mod test_rng;
+
 pub use geom::aabb::Aabb;
 pub use grid::bricks::BrickBits;
 pub use grid::dense::DenseBits;

@@ -305,14 +305,11 @@ mod tests {
 
     fn blob(dims: [u32; 3], seed: u64, fill: u64) -> DenseBits {
         let mut b = DenseBits::new(dims);
-        let mut x = seed | 1;
+        let mut rng = crate::test_rng::Xorshift(seed | 1);
         for k in 0..dims[2] {
             for j in 0..dims[1] {
                 for i in 0..dims[0] {
-                    x ^= x << 13;
-                    x ^= x >> 7;
-                    x ^= x << 17;
-                    if x % 100 < fill {
+                    if rng.below(100) < fill {
                         b.set(i, j, k);
                     }
                 }

@@ -130,13 +130,10 @@ mod tests {
 
     #[test]
     fn snap_is_f64_round() {
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rng = crate::test_rng::Xorshift(0x9e37_79b9_7f4a_7c15);
         let mut cases = vec![0.5, -0.5, 1.5, -1.5, 2.5, -2.5, 0.49999999999999994, -0.49999999999999994, 1e5, -1e5];
         for _ in 0..100_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            let u = (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0e5 - 1.0e5;
+            let u = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 2.0e5 - 1.0e5;
             cases.push(u);
             // Exact halves of the lattice.
             cases.push(((u * 8192.0).round() + 1.0) / 8192.0);

@@ -699,14 +699,11 @@ mod tests {
         let mut grid = BrickBits::new(dims);
         let mut slabs = grid.slabs_mut(8);
         let slab = &mut slabs[0];
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rng = crate::test_rng::Xorshift(0x9e37_79b9_7f4a_7c15);
         for k in 0..dims[2] {
             for j in 0..dims[1] {
                 for i in 0..dims[0] {
-                    x ^= x << 13;
-                    x ^= x >> 7;
-                    x ^= x << 17;
-                    if x % 16 != 0 {
+                    if rng.below(16) != 0 {
                         slab.set(i, j, k);
                     }
                 }

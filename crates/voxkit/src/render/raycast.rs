@@ -498,16 +498,6 @@ mod tests {
         b
     }
 
-    /// A xorshift generator.
-    fn xorshift(mut x: u64) -> impl FnMut() -> u64 {
-        move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        }
-    }
-
     /// The DDA's hit and the slab test's agree (rays through a shared edge
     /// or corner may report a different voxel at the same parameter).
     fn assert_same_hit(fast: Option<Hit>, slow: Option<([u32; 3], f64)>, round: usize) {
@@ -520,7 +510,8 @@ mod tests {
 
     #[test]
     fn dda_finds_the_same_first_voxel_as_the_slab_test() {
-        let mut r = xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut rng = crate::test_rng::Xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut r = || rng.next_u64();
         for round in 0..60 {
             let dims = [5 + (r() % 20) as u32, 5 + (r() % 20) as u32, 5 + (r() % 20) as u32];
             let n = 1 + r() % 40;
@@ -542,7 +533,8 @@ mod tests {
     /// slab test, and the same pictures.
     #[test]
     fn sparse_grids_over_many_blocks_render_like_dense_ones() {
-        let mut r = xorshift(0x2545_f491_4f6c_dd1d);
+        let mut rng = crate::test_rng::Xorshift(0x2545_f491_4f6c_dd1d);
+        let mut r = || rng.next_u64();
         for round in 0..6 {
             let dims = [70 + (r() % 120) as u32, 65 + (r() % 100) as u32, 66 + (r() % 90) as u32];
             let mut dense = BrickBits::new(dims);

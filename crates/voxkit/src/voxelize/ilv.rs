@@ -204,13 +204,8 @@ mod tests {
     #[test]
     fn world_segments_walk_the_voxels_line6_sets() {
         let grid = GridSpec::new(DVec3::new(-1.0, 0.5, 2.0), 0.5, [9, 7, 8]).unwrap();
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut r = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x % 10_000) as f64 / 10_000.0
-        };
+        let mut rng = crate::test_rng::Xorshift(0x2545_f491_4f6c_dd1d);
+        let mut r = || rng.below(10_000) as f64 / 10_000.0;
         for _ in 0..300 {
             let mut p = || DVec3::new(-1.5 + 5.5 * r(), 0.0 + 4.5 * r(), 1.5 + 5.0 * r());
             let (a, b) = (p(), p());

@@ -1347,17 +1347,11 @@ mod tests {
         let set = TargetSet::<26>::new(&targets(TunnelTarget::TwentySix));
         let units: Vec<P3> = (0..27).map(|i| [i % 3 - 1, i / 3 % 3 - 1, i / 9 - 1]).filter(|u| *u != [0; 3]).collect();
         // Small components (ties on most vectors) and wide ones.
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut next = |range: i64| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x % (2 * range as u64 + 1)) as i64 - range
-        };
+        let mut rng = crate::test_rng::Xorshift(0x2545_f491_4f6c_dd1d);
         let (mut ties, mut decided) = (0, 0);
         for n in 0..20_000 {
             let range = if n % 2 == 0 { 12 } else { 1 << 40 };
-            let w = [next(range), next(range), next(range)];
+            let w = [rng.signed(range), rng.signed(range), rng.signed(range)];
             let (key, tie) = sign_key(w);
             let (key128, tie128) = sign_key(w.map(i128::from));
             assert_eq!((key, tie), (key128, tie128), "{w:?}");

@@ -658,21 +658,15 @@ mod tests {
     /// (including points in a cap triangle's plane and on its vertices).
     #[test]
     fn cap_winding_equals_the_sum_of_its_triangles() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = |n: i64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % (2 * n as u64 + 1)) as i64 - n
-        };
+        let mut rng = crate::test_rng::Xorshift(0x9e37_79b9_7f4a_7c15);
         let mut scratch = Vec::new();
         let mut wrapped = 0;
         for round in 0..200 {
             let n = 3 + (round % 40) as usize;
-            let cycle: Vec<P3> = (0..n).map(|_| [next(8) * ONE / 2, next(8) * ONE / 2, next(2) * ONE / 2]).collect();
+            let cycle: Vec<P3> = (0..n).map(|_| [rng.signed(8) * ONE / 2, rng.signed(8) * ONE / 2, rng.signed(2) * ONE / 2]).collect();
             let cap = &caps(&[cycle])[0];
             for _ in 0..50 {
-                let q = [next(12) * ONE / 2, next(12) * ONE / 2, next(4) * ONE / 2];
+                let q = [rng.signed(12) * ONE / 2, rng.signed(12) * ONE / 2, rng.signed(4) * ONE / 2];
                 let slow: f64 = cap.tris.iter().map(|t| winding_of(t, q)).sum();
                 let fast = cap.winding(q, &mut scratch);
                 assert!((slow - fast).abs() < 1e-9, "cycle {round}: {slow} vs {fast} at {q:?}");
