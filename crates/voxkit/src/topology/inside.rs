@@ -73,24 +73,6 @@ pub fn row_starts(rows: usize, row_of: impl Iterator<Item = usize>) -> Vec<usize
     start
 }
 
-/// The items `(bucket, item)` of `items()` (called twice, the same items
-/// each time; buckets below `buckets`) in bucket order, each bucket's
-/// sorted, with the buckets' starts as [`row_starts`] gives them: a
-/// counting sort by bucket, then a sort of each bucket's few.
-fn bucket_sorted<T: Ord + Copy + Default, I: Iterator<Item = (usize, T)>>(buckets: usize, items: impl Fn() -> I) -> (Vec<usize>, Vec<T>) {
-    let start = row_starts(buckets, items().map(|(b, _)| b));
-    let mut fill = start.clone();
-    let mut sorted = vec![T::default(); start[buckets]];
-    for (b, item) in items() {
-        sorted[fill[b]] = item;
-        fill[b] += 1;
-    }
-    for b in 0..buckets {
-        sorted[start[b]..start[b + 1]].sort_unstable();
-    }
-    (start, sorted)
-}
-
 /// Why a mesh cannot be classified.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum ClassifyError {
@@ -188,14 +170,21 @@ enum Corner {
 /// An edge joining a point to itself is none.
 fn count_edges(ends: &[[u32; 3]], points: usize) -> (usize, Vec<(u32, u32, i64)>) {
     let edges = || ends.iter().flat_map(|e| (0..3).map(move |i| (e[i], e[(i + 1) % 3]))).filter(|(a, b)| a != b);
-    // Each use in the bucket of the edge's lower end, as `hi · 2 + (1 if
-    // from the higher end)`.
-    let (start, bucket) = bucket_sorted(points, || {
-        edges().map(|(a, b)| if a < b { (a as usize, (b as u64) << 1) } else { (b as usize, (a as u64) << 1 | 1) })
-    });
+    // Each edge in the bucket of its lower end.
+    let start = row_starts(points, edges().map(|(a, b)| a.min(b) as usize));
+    let mut fill = start.clone();
+    // Each use as `hi · 2 + (1 if from the higher end)`.
+    let mut bucket = vec![0u64; start[points]];
+    for (a, b) in edges() {
+        let (lo, use_) = if a < b { (a, (b as u64) << 1) } else { (b, (a as u64) << 1 | 1) };
+        bucket[fill[lo as usize]] = use_;
+        fill[lo as usize] += 1;
+    }
     let (mut boundary, mut unbalanced) = (0, Vec::new());
     for p in 0..points {
-        for uses in bucket[start[p]..start[p + 1]].chunk_by(|x, y| x >> 1 == y >> 1) {
+        let b = &mut bucket[start[p]..start[p + 1]];
+        b.sort_unstable();
+        for uses in b.chunk_by(|x, y| x >> 1 == y >> 1) {
             boundary += uses.len() % 2;
             let back = uses.iter().filter(|&&u| u & 1 == 1).count() as i64;
             let balance = uses.len() as i64 - 2 * back;
@@ -286,7 +275,18 @@ pub fn row_crossings_in(tris: &[LatticeTriangle], dims: [u32; 3], planes: std::o
         })
         .collect();
     // By row (a counting sort), then each row's few by `i0`.
-    bucket_sorted(dims[1] as usize * planes.len(), || hits.iter().map(|&h| (h.0 as usize, h))).1
+    let rows = dims[1] as usize * planes.len();
+    let start = row_starts(rows, hits.iter().map(|h| h.0 as usize));
+    let mut fill = start.clone();
+    let mut sorted = vec![(0, 0, 0); hits.len()];
+    for h in hits {
+        sorted[fill[h.0 as usize]] = h;
+        fill[h.0 as usize] += 1;
+    }
+    for r in 0..rows {
+        sorted[start[r]..start[r + 1]].sort_unstable();
+    }
+    sorted
 }
 
 /// Appends `(row, i0, sign)` for every row whose centre line crosses `t`,
@@ -441,8 +441,13 @@ mod tests {
         // Positions on a coarse lattice, some repeated and some a hair apart
         // (one snapped point), a non-finite one and indices past the end;
         // triangles in random orientations, repeated, and degenerate.
-        let mut rng = crate::test_rng::Xorshift(0x9e37_79b9_7f4a_7c15);
-        let mut r = |n: u64| rng.below(n);
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut r = |n: u64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x % n
+        };
         let grid = GridSpec::new(DVec3::ZERO, 1.0, [8, 8, 8]).unwrap();
         for round in 0..200 {
             let mut positions: Vec<DVec3> =
