@@ -441,13 +441,8 @@ mod tests {
         // Positions on a coarse lattice, some repeated and some a hair apart
         // (one snapped point), a non-finite one and indices past the end;
         // triangles in random orientations, repeated, and degenerate.
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        let mut r = |n: u64| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x % n
-        };
+        let mut rng = crate::test_rng::Xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut r = |n: u64| rng.below(n);
         let grid = GridSpec::new(DVec3::ZERO, 1.0, [8, 8, 8]).unwrap();
         for round in 0..200 {
             let mut positions: Vec<DVec3> =
