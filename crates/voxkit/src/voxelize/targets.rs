@@ -23,6 +23,7 @@
 //! `LazyTargets` decides the targets of a voxel that lie on lines through
 //! its centre from one cross product per triangle edge.
 
+use super::cover::Divisor;
 use super::driver::box_volume;
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{LatticeSegment, LatticeTriangle};
@@ -421,6 +422,15 @@ impl<T: PlaneInt> PixelTest<T> {
     }
 }
 
+/// How [`PixelBounds`] change from one pixel of a row to the next, with
+/// the magnitudes of the changes [`PixelBounds::row_span`] divides by
+/// (once per row) as [`Divisor`]s, made once per triangle.
+#[derive(Clone, Copy)]
+pub(crate) struct RowDelta<T> {
+    step: [T; 6],
+    div: [Divisor<T>; 3],
+}
+
 /// A pixel's three edge values signed so that the projection's inside is
 /// positive, less (`[0..3]`) and plus (`[3..6]`) each edge's reach: the
 /// decision of [`PixelTest::misses`] and whether the square lies strictly
@@ -446,8 +456,19 @@ impl<T: PlaneInt> PixelBounds<T> {
 
     /// The difference `next − self` (both of one row), for [`Self::step`].
     #[inline(always)]
-    pub fn delta(&self, next: &PixelBounds<T>) -> [T; 6] {
-        std::array::from_fn(|i| next.0[i] - self.0[i])
+    pub fn delta(&self, next: &PixelBounds<T>) -> RowDelta<T> {
+        let step: [T; 6] = std::array::from_fn(|i| next.0[i] - self.0[i]);
+        let div = std::array::from_fn(|i| {
+            let d = step[3 + i];
+            Divisor::new(if d < T::ZERO {
+                T::ZERO - d
+            } else if d > T::ZERO {
+                d
+            } else {
+                T::from_i64(1)
+            })
+        });
+        RowDelta { step, div }
     }
 
     /// The pixels `lo ..= hi` of a row, the first of which these bounds
@@ -456,13 +477,13 @@ impl<T: PlaneInt> PixelBounds<T> {
     /// row (`delta` per pixel), each solved for the pixel with one exact
     /// division, so pixels outside need not be visited.
     #[inline(always)]
-    pub fn row_span(&self, delta: &[T; 6], lo: i64, hi: i64) -> (i64, i64) {
+    pub fn row_span(&self, delta: &RowDelta<T>, lo: i64, hi: i64) -> (i64, i64) {
         let (mut a0, mut a1) = (lo, hi);
-        for (&r, &d) in self.0[3..].iter().zip(&delta[3..]) {
+        for ((&r, &d), div) in self.0[3..].iter().zip(&delta.step[3..]).zip(&delta.div) {
             if d > T::ZERO {
-                a0 = a0.max(lo + super::cover::ceil_div(T::ZERO - r, d));
+                a0 = a0.max(lo + div.ceil(T::ZERO - r));
             } else if d < T::ZERO {
-                a1 = a1.min(lo + super::cover::floor_div(r, T::ZERO - d));
+                a1 = a1.min(lo + div.floor(r));
             } else if r < T::ZERO {
                 a1 = a0 - 1;
             }
@@ -472,19 +493,19 @@ impl<T: PlaneInt> PixelBounds<T> {
 
     /// Moves `k` pixels along the row.
     #[inline(always)]
-    pub fn advance(&mut self, delta: &[T; 6], k: T) {
+    pub fn advance(&mut self, delta: &RowDelta<T>, k: T) {
         #[allow(clippy::needless_range_loop)]
         for i in 0..6 {
-            self.0[i] = self.0[i] + delta[i] * k;
+            self.0[i] = self.0[i] + delta.step[i] * k;
         }
     }
 
     /// Moves to the next pixel of the row.
     #[inline(always)]
-    pub fn step(&mut self, delta: &[T; 6]) {
+    pub fn step(&mut self, delta: &RowDelta<T>) {
         #[allow(clippy::needless_range_loop)]
         for i in 0..6 {
-            self.0[i] = self.0[i] + delta[i];
+            self.0[i] = self.0[i] + delta.step[i];
         }
     }
 }
