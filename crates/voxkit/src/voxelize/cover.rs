@@ -350,24 +350,50 @@ fn octants<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], lo: [i64; 3], hi: [i6
     }
 }
 
-/// The body of [`tiny_box`] for spans other than 2×2×2.
+/// Bit of voxel `(i, j, k)` of a span in [`tiny_box_n`]'s masks is
+/// `i·STRIDE[0] + j·STRIDE[1] + k·STRIDE[2]` (4×4×4 voxels in 64 bits).
+const STRIDE: [i64; 3] = [1, TINY, TINY * TINY];
+
+/// Per axis `r`: a mask with a bit at every coordinate along `r` (`0..4`)
+/// and 0 on the other two. Multiplying a mask whose bits all have
+/// coordinate 0 along `r` by it copies each bit along `r` (no carries: the
+/// copies' bits are distinct).
+const SPREAD: [u64; 3] = [0xf, 0x1111, 0x0001_0001_0001_0001];
+
+/// The body of [`tiny_box`] for spans other than 2×2×2, by bit masks over
+/// the span's voxels (at most 4×4×4): per projection, the squares that
+/// pass their three edge tests, each copied along the projection's axis
+/// to the voxels over it; their `AND` holds the voxels whose three squares
+/// pass, and only those get the plane test. No branch per voxel on the
+/// tests' outcomes (at 256³ most boxes are 2–3 voxels a side, and those
+/// branches were the path's cost).
 #[inline(always)]
 fn tiny_box_n<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], n: [usize; 3], lo: [i64; 3], hi: [i64; 3], out: &mut O) {
     let rel = LatticeTriangle { v: tri.v.map(|p| std::array::from_fn(|a| p[a] - base[a] * ONE)) };
     let nrm = rel.normal();
-    // mask[r] bit (ip * TINY + iq): the square (ip, iq) of the projection
-    // along r, on axes p = r + 1, q = r + 2, passes its three edge tests.
-    let mut mask = [0u32; 3];
+    let mut cand = u64::MAX;
     for r in 0..3 {
         let (p, q) = ((r + 1) % 3, (r + 2) % 3);
         let e = edges_2d(&rel, p, q, if nrm[r] >= 0 { 1 } else { -1 });
+        // The squares (ip, iq) of the projection along r that pass, at
+        // the voxels of coordinate 0 along r.
+        let mut squares = 0u64;
         for ip in 0..n[p] as i64 {
             for iq in 0..n[q] as i64 {
-                if (e[0].a * ip + e[0].b * iq + e[0].c) | (e[1].a * ip + e[1].b * iq + e[1].c) | (e[2].a * ip + e[2].b * iq + e[2].c) >= 0 {
-                    mask[r] |= 1 << (ip * TINY + iq);
-                }
+                let pass =
+                    (e[0].a * ip + e[0].b * iq + e[0].c) | (e[1].a * ip + e[1].b * iq + e[1].c) | (e[2].a * ip + e[2].b * iq + e[2].c) >= 0;
+                squares |= (pass as u64) << (ip * STRIDE[p] + iq * STRIDE[q]);
             }
         }
+        cand &= squares * SPREAD[r];
+    }
+    // Only voxels of `[lo, hi]` (a slab or the grid may cut the span).
+    if (0..3).any(|a| base[a] < lo[a] || base[a] + n[a] as i64 - 1 > hi[a]) {
+        let range = |a: usize| {
+            let (from, to) = ((lo[a] - base[a]).max(0), (hi[a] - base[a]).min(n[a] as i64 - 1));
+            (from..=to).fold(0u64, |m, x| m | 1 << (x * STRIDE[a]))
+        };
+        cand &= range(0) * range(1) * range(2);
     }
     // Plane values at each voxel's lowest and highest corners along n.
     let n0 = nrm[0] * rel.v[0][0] + nrm[1] * rel.v[0][1] + nrm[2] * rel.v[0][2];
@@ -379,23 +405,19 @@ fn tiny_box_n<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], n: [usize; 3], lo:
             dmax += c * ONE;
         }
     }
-    let bit = |r: usize, ip: usize, iq: usize| (mask[r] >> (ip as i64 * TINY + iq as i64)) & 1 == 1;
-    for k in 0..n[2] {
-        for j in 0..n[1] {
-            for i in 0..n[0] {
-                // Projections: along x (y, z), along y (z, x), along z (x, y).
-                if !(bit(2, i, j) && bit(0, j, k) && bit(1, k, i)) {
-                    continue;
-                }
-                let g = (nrm[0] * i as i64 + nrm[1] * j as i64 + nrm[2] * k as i64) * ONE;
-                if g + dmin <= 0 && g + dmax >= 0 {
-                    let (gi, gj, gk) = (base[0] + i as i64, base[1] + j as i64, base[2] + k as i64);
-                    if gi >= lo[0] && gi <= hi[0] && gj >= lo[1] && gj <= hi[1] && gk >= lo[2] && gk <= hi[2] {
-                        out.set(gi as u32, gj as u32, gk as u32);
-                    }
-                }
-            }
-        }
+    let mut met = 0u64;
+    while cand != 0 {
+        let b = cand.trailing_zeros() as i64;
+        cand &= cand - 1;
+        let (i, j, k) = (b % TINY, b / TINY % TINY, b / (TINY * TINY));
+        let g = (nrm[0] * i + nrm[1] * j + nrm[2] * k) * ONE;
+        met |= (((g + dmin <= 0) & (g + dmax >= 0)) as u64) << b;
+    }
+    while met != 0 {
+        let b = met.trailing_zeros() as i64;
+        met &= met - 1;
+        let (i, j, k) = (b % TINY, b / TINY % TINY, b / (TINY * TINY));
+        out.set((base[0] + i) as u32, (base[1] + j) as u32, (base[2] + k) as u32);
     }
 }
 
@@ -1005,6 +1027,39 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Triangles whose span is up to 4 voxels a side (the tiny paths,
+    /// the bit masks of `tiny_box_n` among them), at random lattice
+    /// points, some on voxel faces (ties) and some past the grid's sides
+    /// (their boxes cut), against the separating axis test.
+    #[test]
+    fn tiny_spans_match_the_reference() {
+        let mut rng = crate::test_rng::Xorshift(0x7171_5a4e);
+        let dims = [5, 4, 6];
+        let mut tested = [0usize; 5];
+        for n in 0..20_000 {
+            // A corner in or just outside the grid; vertices within 4 voxels of it.
+            let corner: [i64; 3] = std::array::from_fn(|a| rng.signed(dims[a] as i64 + 1) * ONE);
+            let snap = n % 4 == 0;
+            let v: [[i64; 3]; 3] = std::array::from_fn(|_| {
+                std::array::from_fn(|a| {
+                    let off = rng.below(4 * ONE as u64 - 1) as i64;
+                    corner[a] + if snap { off / ONE * ONE } else { off }
+                })
+            });
+            let t = LatticeTriangle { v };
+            if t.normal() == [0; 3] {
+                continue;
+            }
+            let (lo, hi) = t.bounds();
+            let span = (0..3).map(|a| crate::geom::fixed::voxel_span(lo[a], hi[a])).map(|(a, b)| (b - a + 1) as usize).max().unwrap_or(0);
+            tested[span.min(4)] += 1;
+            let (fast, slow) = both(t, dims);
+            assert_eq!(fast, slow, "triangle {v:?}");
+        }
+        // Spans of 3 and 4 voxels were among them.
+        assert!(tested[3] > 1000 && tested[4] > 1000, "{tested:?}");
     }
 
     #[test]
