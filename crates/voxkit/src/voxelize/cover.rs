@@ -290,13 +290,8 @@ const LOWER: [u8; 3] = [0b0101_0101, 0b0011_0011, 0b0000_1111];
 /// slope `slope` along `c` increases (none if it is flat).
 #[inline(always)]
 fn rising(c: usize, slope: i64) -> u8 {
-    if slope > 0 {
-        UPPER[c]
-    } else if slope < 0 {
-        LOWER[c]
-    } else {
-        0
-    }
+    // Without branches: the slopes' signs are the triangle's, random.
+    (UPPER[c] & 0u8.wrapping_sub((slope > 0) as u8)) | (LOWER[c] & 0u8.wrapping_sub((slope < 0) as u8))
 }
 
 /// [`tiny_box`] for a span of 2×2×2 voxels: the triangle lies in the
@@ -335,9 +330,10 @@ fn octants<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], lo: [i64; 3], hi: [i6
             let e = rel.edge(i);
             let (a, b) = (-e[q] * sigma, e[p] * sigma);
             // The edge function a·(x_p − v_p) + b·(x_q − v_q) at P.
-            if a * v[i][p] + b * v[i][q] > 0 {
-                mask &= rising(p, a) | rising(q, b);
-            }
+            // Where the value at P is not positive, every octant keeps
+            // (all ones), without a branch.
+            let outside = a * v[i][p] + b * v[i][q] > 0;
+            mask &= rising(p, a) | rising(q, b) | 0u8.wrapping_sub(!outside as u8);
         }
     }
     while mask != 0 {
