@@ -476,6 +476,36 @@ impl SlabView<'_> {
         self.pool[slot][(k & 7) as usize] >> (((j & 7) << 3) | (i & 7)) & 1 == 1
     }
 
+    /// Which voxels of the 2×2×2 block from `(i, j, k)` are set (by this
+    /// slab): bit `di + 2·dj + 4·dk` for voxel `(i + di, j + dj, k + dk)`.
+    /// The block must lie in the slab's layers and the grid. One brick
+    /// lookup when the block lies in one brick (seven in eight blocks
+    /// along each axis), else one per voxel.
+    #[inline(always)]
+    pub fn block2_set(&self, i: u32, j: u32, k: u32) -> u8 {
+        if (i & 7) == 7 || (j & 7) == 7 || (k & 7) == 7 {
+            return (0..8).fold(0, |m, o| m | (self.get(i + (o & 1), j + (o >> 1 & 1), k + (o >> 2)) as u8) << o);
+        }
+        let key = brick_key(i, j, k);
+        let slot = if self.last.0 == key {
+            self.last.1
+        } else {
+            match self.index[self.entry(i, j, k)] {
+                0 => return 0,
+                id => id as usize - 1,
+            }
+        };
+        let brick = &self.pool[slot];
+        let shift = ((j & 7) << 3) | (i & 7);
+        // Per layer: bits (0, 0), (1, 0), (0, 1), (1, 1) of the block's
+        // column pairs, from bits 0, 1, 8, 9 of the shifted word.
+        let layer = |w: u64| {
+            let w = w >> shift;
+            (w & 3 | (w >> 6) & 0xc) as u8
+        };
+        layer(brick[(k & 7) as usize]) | layer(brick[(k & 7) as usize + 1]) << 4
+    }
+
     /// Are all voxels of the inclusive box `[lo, hi]` set (by this slab)?
     /// A box inside one brick (a small triangle's, mostly) is one brick
     /// lookup and a masked compare per brick word.
@@ -721,6 +751,38 @@ mod tests {
             }
         }
         assert!(full > 0 && full < checked, "{full} of {checked} boxes full");
+    }
+
+    #[test]
+    fn block2_set_agrees_with_single_voxels() {
+        // Every 2×2×2 block of a slab set at random (half its voxels),
+        // inside bricks and across their borders, some in bricks never
+        // allocated (the last brick column along x stays empty).
+        let dims = [20u32, 18, 16];
+        let mut grid = BrickBits::new(dims);
+        let mut slabs = grid.slabs_mut(2);
+        let slab = &mut slabs[0];
+        let mut rng = crate::test_rng::Xorshift(0x2b1c_3d4e_5f60_7182);
+        for k in 0..16 {
+            for j in 0..dims[1] {
+                for i in 0..16 {
+                    if rng.below(2) != 0 {
+                        slab.set(i, j, k);
+                    }
+                }
+            }
+        }
+        let mut seen = [false; 256];
+        for k in 0..15 {
+            for j in 0..dims[1] - 1 {
+                for i in 0..dims[0] - 1 {
+                    let want = (0..8).fold(0u8, |m, o| m | (slab.get(i + (o & 1), j + (o >> 1 & 1), k + (o >> 2)) as u8) << o);
+                    assert_eq!(slab.block2_set(i, j, k), want, "block at {:?}", [i, j, k]);
+                    seen[want as usize] = true;
+                }
+            }
+        }
+        assert!(seen.iter().filter(|&&s| s).count() > 200, "most of the 256 patterns occur");
     }
 
     #[test]

@@ -308,6 +308,18 @@ pub trait Sink {
             q[axis] += 1;
         }
     }
+
+    /// Emits the voxels `p + (o & 1, o >> 1 & 1, o >> 2)` of the 2×2×2
+    /// block from `p` for each bit `o` of `mask`, in order (all inside the
+    /// grid and the slab).
+    #[inline(always)]
+    fn set_block2(&mut self, p: [u32; 3], mut mask: u8) {
+        while mask != 0 {
+            let o = mask.trailing_zeros();
+            mask &= mask - 1;
+            self.set(p[0] + (o & 1), p[1] + (o >> 1 & 1), p[2] + (o >> 2));
+        }
+    }
 }
 
 impl Sink for BrickSlab<'_> {
@@ -373,6 +385,23 @@ impl<F: FnMut(i64, i64, i64) -> bool> Sink for FilterUnset<'_, '_, F> {
         // the stores just made (store forwarding).
         if !self.slab.get(i, j, k) && (self.keep)(i as i64, j as i64, k as i64) {
             self.slab.set(i, j, k);
+        }
+    }
+
+    /// The block's set voxels read at once ([`BrickSlab::block2_set`]),
+    /// without a branch per voxel on whether it is set; `keep` is asked
+    /// about the others, in order. (No voxel of the block is set between:
+    /// each is asked once.)
+    #[inline(always)]
+    fn set_block2(&mut self, p: [u32; 3], mask: u8) {
+        let mut mask = mask & !self.slab.block2_set(p[0], p[1], p[2]);
+        while mask != 0 {
+            let o = mask.trailing_zeros();
+            mask &= mask - 1;
+            let (i, j, k) = (p[0] + (o & 1), p[1] + (o >> 1 & 1), p[2] + (o >> 2));
+            if (self.keep)(i as i64, j as i64, k as i64) {
+                self.slab.set(i, j, k);
+            }
         }
     }
 }
