@@ -415,12 +415,7 @@ fn tiny_box_n<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], n: [usize; 3], lo:
         let g = (nrm[0] * i + nrm[1] * j + nrm[2] * k) * ONE;
         met |= (((g + dmin <= 0) & (g + dmax >= 0)) as u64) << b;
     }
-    while met != 0 {
-        let b = met.trailing_zeros() as i64;
-        met &= met - 1;
-        let (i, j, k) = (b % TINY, b / TINY % TINY, b / (TINY * TINY));
-        out.set((base[0] + i) as u32, (base[1] + j) as u32, (base[2] + k) as u32);
-    }
+    out.set_span4(base, met);
 }
 
 /// The row walk of [`cover_triangle`] with run emission: in each row, the

@@ -309,6 +309,18 @@ pub trait Sink {
         }
     }
 
+    /// Emits the voxels `p + (b % 4, b / 4 % 4, b / 16)` for each bit `b`
+    /// of `mask`, in order (all inside the grid and the slab; `p` itself
+    /// need not be).
+    #[inline(always)]
+    fn set_span4(&mut self, p: [i64; 3], mut mask: u64) {
+        while mask != 0 {
+            let b = mask.trailing_zeros() as i64;
+            mask &= mask - 1;
+            self.set((p[0] + b % 4) as u32, (p[1] + b / 4 % 4) as u32, (p[2] + b / 16) as u32);
+        }
+    }
+
     /// Emits the voxels `p + (o & 1, o >> 1 & 1, o >> 2)` of the 2×2×2
     /// block from `p` for each bit `o` of `mask`, in order (all inside the
     /// grid and the slab).
@@ -385,6 +397,29 @@ impl<F: FnMut(i64, i64, i64) -> bool> Sink for FilterUnset<'_, '_, F> {
         // the stores just made (store forwarding).
         if !self.slab.get(i, j, k) && (self.keep)(i as i64, j as i64, k as i64) {
             self.slab.set(i, j, k);
+        }
+    }
+
+    /// Which voxels are set, read into a mask first (no branch per voxel
+    /// on it); `keep` is asked about the others, in order.
+    #[inline(always)]
+    fn set_span4(&mut self, p: [i64; 3], mask: u64) {
+        let at = |b: i64| ((p[0] + b % 4) as u32, (p[1] + b / 4 % 4) as u32, (p[2] + b / 16) as u32);
+        let (mut rest, mut set) = (mask, 0u64);
+        while rest != 0 {
+            let b = rest.trailing_zeros();
+            rest &= rest - 1;
+            let (i, j, k) = at(b as i64);
+            set |= (self.slab.get(i, j, k) as u64) << b;
+        }
+        let mut rest = mask & !set;
+        while rest != 0 {
+            let b = rest.trailing_zeros() as i64;
+            rest &= rest - 1;
+            let (i, j, k) = at(b);
+            if (self.keep)(i as i64, j as i64, k as i64) {
+                self.slab.set(i, j, k);
+            }
         }
     }
 
