@@ -1020,9 +1020,11 @@ impl<'t, T: PlaneInt, const N: usize> PairedTargets<'t, T, N> {
         PairedTargets { tri, s, set, start, kabs, live: set.lines_live_of[reached as usize] as u32 }
     }
 
-    /// Does any of voxel `ijk`'s targets meet the triangle?
+    /// Does any of voxel `ijk`'s targets meet the triangle? With `TABLE`,
+    /// the crossing lines' edge sides from the sign tables (all lines at
+    /// once); without, line by line, stopping at the first that hits.
     #[inline(always)]
-    pub fn any(&self, ijk: [i64; 3]) -> bool {
+    pub fn any<const TABLE: bool>(&self, ijk: [i64; 3]) -> bool {
         let pc = self.s.local(corner(ijk));
         let x = self.start - (self.s.bn - self.s.plane(pc));
         let y = if x >= T::ZERO { x + T::from_i64(1) } else { -x };
@@ -1039,7 +1041,7 @@ impl<'t, T: PlaneInt, const N: usize> PairedTargets<'t, T, N> {
         let (k0, t0) = sign_key(w[0]);
         let (k1, t1) = sign_key(w[1]);
         let (k2, t2) = sign_key(w[2]);
-        if !(t0 | t1 | t2) {
+        if TABLE && !(t0 | t1 | t2) {
             let p = &self.set.line_positive;
             let (p0, p1, p2) = (p[k0 & 511], p[k1 & 511], p[k2 & 511]);
             return mask & !(p0 ^ p1) as u32 & !(p0 ^ p2) as u32 != 0;
@@ -1350,8 +1352,11 @@ mod tests {
                         for i in -1..3 {
                             let ijk = [i, j, k];
                             let want = definition(list, t, ijk);
-                            assert_eq!(paired.any(ijk), want.contains(&true), "{t:?} {ijk:?}");
-                            assert_eq!(wide.any(ijk), want.contains(&true), "{t:?} {ijk:?}");
+                            // Both ways of deciding the lines' edge sides.
+                            assert_eq!(paired.any::<true>(ijk), want.contains(&true), "{t:?} {ijk:?}");
+                            assert_eq!(paired.any::<false>(ijk), want.contains(&true), "{t:?} {ijk:?}");
+                            assert_eq!(wide.any::<true>(ijk), want.contains(&true), "{t:?} {ijk:?}");
+                            assert_eq!(wide.any::<false>(ijk), want.contains(&true), "{t:?} {ijk:?}");
                             for (n, w) in want.iter().enumerate() {
                                 assert_eq!(lazy.hits(n, ijk), *w, "{t:?} {ijk:?} target {n}");
                             }

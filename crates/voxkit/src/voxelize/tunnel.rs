@@ -27,15 +27,17 @@
 //! all but huge triangles). The targets come in opposite pairs on the 13 (9)
 //! lines through the centre, so one comparison per line says whether one
 //! of its two targets crosses the plane, and the lines' edge sides come
-//! from the centre's pivot cross: for all lines at once from a table
-//! keyed by each cross product's sign pattern, or, where a line may lie
-//! on an edge's plane (a tie), three dot products per line.
+//! from the centre's pivot cross: for a triangle in a box of at most
+//! 64 voxels (`TABLE_BOX`), for all lines at once from a table keyed by each
+//! cross product's sign pattern; for larger ones, or where a line may lie
+//! on an edge's plane (a tie), three dot products per line, stopping at
+//! the first line that hits.
 //!
 //! **Reference:** [`reference::tunnel`], every target of every voxel of each
 //! triangle's bounding box with the generic `i128` predicate.
 
 use super::cover::cover_triangle;
-use super::driver::{run_mesh, FilterUnset, Kernel};
+use super::driver::{box_volume, run_mesh, FilterUnset, Kernel};
 use super::targets::{fits_i64, forms_reached, PairedTargets, TargetSet};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
@@ -87,6 +89,14 @@ pub fn tunnel_lattice(tris: &[LatticeTriangle], dims: [u32; 3], target: TunnelTa
     super::driver::run_slabs(&TunnelKernel::new(target, opts), tris, dims, opts).0
 }
 
+/// Largest voxel box of a triangle whose candidates take the sign tables
+/// ([`PairedTargets::any`]); larger triangles' go line by line. In a large
+/// triangle's voxels the first line tested usually passes, so stopping
+/// there beats deciding all lines: 1024³ on the bunny, 1 thread, 157 →
+/// 138 ms with this bound (all by tables before), 128³–512³ unchanged
+/// (the 27 voxels of `is_tiny` were 3 % slower at 256³).
+const TABLE_BOX: i64 = 64;
+
 struct TunnelKernel {
     dirs: TargetSet<26>,
     traversal: Traversal,
@@ -108,15 +118,17 @@ impl Kernel<LatticeTriangle> for TunnelKernel {
         if !self.dirs.may_meet_reached(reached) {
             return;
         }
-        if fits_i64(tri) {
-            filtered::<i64>(tri, &self.dirs, reached, lo, hi, self.traversal, slab);
+        if !fits_i64(tri) {
+            filtered::<i128, false>(tri, &self.dirs, reached, lo, hi, self.traversal, slab);
+        } else if box_volume(lo, hi) <= TABLE_BOX {
+            filtered::<i64, true>(tri, &self.dirs, reached, lo, hi, self.traversal, slab);
         } else {
-            filtered::<i128>(tri, &self.dirs, reached, lo, hi, self.traversal, slab);
+            filtered::<i64, false>(tri, &self.dirs, reached, lo, hi, self.traversal, slab);
         }
     }
 }
 
-fn filtered<T: PlaneInt>(
+fn filtered<T: PlaneInt, const TABLE: bool>(
     tri: &LatticeTriangle,
     dirs: &TargetSet<26>,
     reached: u16,
@@ -126,7 +138,7 @@ fn filtered<T: PlaneInt>(
     slab: &mut BrickSlab<'_>,
 ) {
     let targets = PairedTargets::<T, 26>::new(tri, dirs, reached);
-    let keep = |i: i64, j: i64, k: i64| targets.any([i, j, k]);
+    let keep = |i: i64, j: i64, k: i64| targets.any::<TABLE>([i, j, k]);
     cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
 }
 
