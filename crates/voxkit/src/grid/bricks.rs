@@ -721,6 +721,21 @@ mod tests {
         }
     }
 
+    /// Sets the voxels of `[0, upto)` in `slab` but about one in `one_in`,
+    /// drawn from `seed`, in order `i`, then `j`, then `k`.
+    fn set_at_random(slab: &mut BrickSlab<'_>, upto: [u32; 3], seed: u64, one_in: u64) {
+        let mut rng = crate::test_rng::Xorshift(seed);
+        for k in 0..upto[2] {
+            for j in 0..upto[1] {
+                for i in 0..upto[0] {
+                    if rng.below(one_in) != 0 {
+                        slab.set(i, j, k);
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn all_set_agrees_with_single_voxels() {
         // Boxes inside one brick and across brick borders, over a slab
@@ -729,16 +744,7 @@ mod tests {
         let mut grid = BrickBits::new(dims);
         let mut slabs = grid.slabs_mut(8);
         let slab = &mut slabs[0];
-        let mut rng = crate::test_rng::Xorshift(0x9e37_79b9_7f4a_7c15);
-        for k in 0..dims[2] {
-            for j in 0..dims[1] {
-                for i in 0..dims[0] {
-                    if rng.below(16) != 0 {
-                        slab.set(i, j, k);
-                    }
-                }
-            }
-        }
+        set_at_random(slab, dims, 0x9e37_79b9_7f4a_7c15, 16);
         let (mut full, mut checked) = (0, 0);
         for lo in [[0i64, 0, 0], [3, 5, 6], [6, 7, 7], [7, 1, 4], [9, 9, 15]] {
             for ext in [[0i64, 0, 0], [1, 0, 0], [0, 1, 1], [1, 1, 1], [0, 2, 1], [2, 0, 0], [3, 3, 3]] {
@@ -762,16 +768,7 @@ mod tests {
         let mut grid = BrickBits::new(dims);
         let mut slabs = grid.slabs_mut(2);
         let slab = &mut slabs[0];
-        let mut rng = crate::test_rng::Xorshift(0x2b1c_3d4e_5f60_7182);
-        for k in 0..16 {
-            for j in 0..dims[1] {
-                for i in 0..16 {
-                    if rng.below(2) != 0 {
-                        slab.set(i, j, k);
-                    }
-                }
-            }
-        }
+        set_at_random(slab, [16, dims[1], 16], 0x2b1c_3d4e_5f60_7182, 2);
         let mut seen = [false; 256];
         for k in 0..15 {
             for j in 0..dims[1] - 1 {
