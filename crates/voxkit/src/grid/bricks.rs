@@ -28,6 +28,13 @@ pub fn set_in_brick(b: &mut Brick, i: u32, j: u32, k: u32) {
     b[(k & 7) as usize] |= 1u64 << (((j & 7) << 3) | (i & 7));
 }
 
+/// The offset `(di, dj, dk)` from a 2×2×2 block's first voxel of bit `o`
+/// (`di + 2·dj + 4·dk`) of a block mask ([`SlabView::block2_set`]).
+#[inline(always)]
+pub fn block2_offset(o: u32) -> [u32; 3] {
+    [o & 1, o >> 1 & 1, o >> 2]
+}
+
 /// A sparse grid of bits in 8×8×8 bricks.
 ///
 /// # Guarantees
@@ -477,14 +484,18 @@ impl SlabView<'_> {
     }
 
     /// Which voxels of the 2×2×2 block from `(i, j, k)` are set (by this
-    /// slab): bit `di + 2·dj + 4·dk` for voxel `(i + di, j + dj, k + dk)`.
+    /// slab): bit `di + 2·dj + 4·dk` for voxel `(i + di, j + dj, k + dk)`
+    /// ([`block2_offset`]).
     /// The block must lie in the slab's layers and the grid. One brick
     /// lookup when the block lies in one brick (seven in eight blocks
     /// along each axis), else one per voxel.
     #[inline(always)]
     pub fn block2_set(&self, i: u32, j: u32, k: u32) -> u8 {
         if (i & 7) == 7 || (j & 7) == 7 || (k & 7) == 7 {
-            return (0..8).fold(0, |m, o| m | (self.get(i + (o & 1), j + (o >> 1 & 1), k + (o >> 2)) as u8) << o);
+            return (0..8).fold(0, |m, o| {
+                let [di, dj, dk] = block2_offset(o);
+                m | (self.get(i + di, j + dj, k + dk) as u8) << o
+            });
         }
         let key = brick_key(i, j, k);
         let slot = if self.last.0 == key {
@@ -773,7 +784,10 @@ mod tests {
         for k in 0..15 {
             for j in 0..dims[1] - 1 {
                 for i in 0..dims[0] - 1 {
-                    let want = (0..8).fold(0u8, |m, o| m | (slab.get(i + (o & 1), j + (o >> 1 & 1), k + (o >> 2)) as u8) << o);
+                    let want = (0..8).fold(0u8, |m, o| {
+                        let [di, dj, dk] = block2_offset(o);
+                        m | (slab.get(i + di, j + dj, k + dk) as u8) << o
+                    });
                     assert_eq!(slab.block2_set(i, j, k), want, "block at {:?}", [i, j, k]);
                     seen[want as usize] = true;
                 }

@@ -29,11 +29,11 @@
 //! **Reference:** [`reference::cover`], the separating axis test on all
 //! thirteen axes for every voxel of each triangle's bounding box.
 
-use super::driver::{buffered, run_mesh, run_slabs, Kernel, Sink};
+use super::driver::{buffered, run_mesh, run_slabs, span4_offset, Kernel, Sink, SPAN4_STRIDE};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::{prepare, LatticeTriangle};
-use crate::grid::bricks::{BrickBits, BrickSlab};
+use crate::grid::bricks::{block2_offset, BrickBits, BrickSlab};
 use crate::grid::dense::DenseBits;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
@@ -343,18 +343,19 @@ fn octants<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], lo: [i64; 3], hi: [i6
         return;
     }
     while mask != 0 {
-        let o = mask.trailing_zeros() as i64;
+        let d = block2_offset(mask.trailing_zeros());
         mask &= mask - 1;
-        let ijk = [base[0] + (o & 1), base[1] + (o >> 1 & 1), base[2] + (o >> 2)];
+        let ijk: [i64; 3] = std::array::from_fn(|a| base[a] + d[a] as i64);
         if (0..3).all(|a| ijk[a] >= lo[a] && ijk[a] <= hi[a]) {
             out.set(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
         }
     }
 }
 
-/// Bit of voxel `(i, j, k)` of a span in [`tiny_box_n`]'s masks is
-/// `i·STRIDE[0] + j·STRIDE[1] + k·STRIDE[2]` (4×4×4 voxels in 64 bits).
-const STRIDE: [i64; 3] = [1, TINY, TINY * TINY];
+/// [`tiny_box_n`]'s masks are those of `Sink::set_span4` (4×4×4 voxels
+/// in 64 bits, bit `i + 4j + 16k`): spans up to [`TINY`] fit.
+const STRIDE: [i64; 3] = SPAN4_STRIDE;
+const _: () = assert!(TINY <= 4, "tiny spans must fit a 4×4×4 mask");
 
 /// Per axis `r`: a mask with a bit at every coordinate along `r` (`0..4`)
 /// and 0 on the other two. Multiplying a mask whose bits all have
@@ -409,9 +410,9 @@ fn tiny_box_n<O: Sink>(tri: &LatticeTriangle, base: [i64; 3], n: [usize; 3], lo:
     }
     let mut met = 0u64;
     while cand != 0 {
-        let b = cand.trailing_zeros() as i64;
+        let b = cand.trailing_zeros();
         cand &= cand - 1;
-        let (i, j, k) = (b % TINY, b / TINY % TINY, b / (TINY * TINY));
+        let [i, j, k] = span4_offset(b);
         let g = (nrm[0] * i + nrm[1] * j + nrm[2] * k) * ONE;
         met |= (((g + dmin <= 0) & (g + dmax >= 0)) as u64) << b;
     }

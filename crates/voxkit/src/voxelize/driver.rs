@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use super::{Options, Report};
 use crate::geom::lattice::{LatticeTriangle, PrepareStats, SnappedMesh};
-use crate::grid::bricks::{BoxBricks, BrickBits, BrickSlab, BRICK};
+use crate::grid::bricks::{block2_offset, BoxBricks, BrickBits, BrickSlab, BRICK};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
 
@@ -310,28 +310,50 @@ pub trait Sink {
     }
 
     /// Emits the voxels `p + (b % 4, b / 4 % 4, b / 16)` for each bit `b`
-    /// of `mask`, in order (all inside the grid and the slab; `p` itself
-    /// need not be).
+    /// of `mask` (`span4_voxel`), in order (all inside the grid and the
+    /// slab; `p` itself need not be).
     #[inline(always)]
     fn set_span4(&mut self, p: [i64; 3], mut mask: u64) {
         while mask != 0 {
-            let b = mask.trailing_zeros() as i64;
+            let b = mask.trailing_zeros();
             mask &= mask - 1;
-            self.set((p[0] + b % 4) as u32, (p[1] + b / 4 % 4) as u32, (p[2] + b / 16) as u32);
+            let [i, j, k] = span4_voxel(p, b);
+            self.set(i, j, k);
         }
     }
 
-    /// Emits the voxels `p + (o & 1, o >> 1 & 1, o >> 2)` of the 2×2×2
-    /// block from `p` for each bit `o` of `mask`, in order (all inside the
-    /// grid and the slab).
+    /// Emits the voxels `p +` [`block2_offset`]`(o)` of the 2×2×2 block
+    /// from `p` for each bit `o` of `mask`, in order (all inside the grid
+    /// and the slab).
     #[inline(always)]
     fn set_block2(&mut self, p: [u32; 3], mut mask: u8) {
         while mask != 0 {
             let o = mask.trailing_zeros();
             mask &= mask - 1;
-            self.set(p[0] + (o & 1), p[1] + (o >> 1 & 1), p[2] + (o >> 2));
+            let d = block2_offset(o);
+            self.set(p[0] + d[0], p[1] + d[1], p[2] + d[2]);
         }
     }
+}
+
+/// Bit `b` of a [`Sink::set_span4`] mask is the voxel `(b % 4, b / 4 % 4,
+/// b / 16)` from the span's first: these strides along each axis.
+pub(crate) const SPAN4_STRIDE: [i64; 3] = [1, 4, 16];
+
+/// The voxel offset `(b % 4, b / 4 % 4, b / 16)` of bit `b` of a
+/// [`Sink::set_span4`] mask.
+#[inline(always)]
+pub(crate) fn span4_offset(b: u32) -> [i64; 3] {
+    let b = b as i64;
+    [b % 4, b / 4 % 4, b / 16]
+}
+
+/// The voxel of bit `b` of a [`Sink::set_span4`] mask whose span starts
+/// at `p`.
+#[inline(always)]
+fn span4_voxel(p: [i64; 3], b: u32) -> [u32; 3] {
+    let d = span4_offset(b);
+    std::array::from_fn(|a| (p[a] + d[a]) as u32)
 }
 
 impl Sink for BrickSlab<'_> {
@@ -404,19 +426,18 @@ impl<F: FnMut(i64, i64, i64) -> bool> Sink for FilterUnset<'_, '_, F> {
     /// on it); `keep` is asked about the others, in order.
     #[inline(always)]
     fn set_span4(&mut self, p: [i64; 3], mask: u64) {
-        let at = |b: i64| ((p[0] + b % 4) as u32, (p[1] + b / 4 % 4) as u32, (p[2] + b / 16) as u32);
         let (mut rest, mut set) = (mask, 0u64);
         while rest != 0 {
             let b = rest.trailing_zeros();
             rest &= rest - 1;
-            let (i, j, k) = at(b as i64);
+            let [i, j, k] = span4_voxel(p, b);
             set |= (self.slab.get(i, j, k) as u64) << b;
         }
         let mut rest = mask & !set;
         while rest != 0 {
-            let b = rest.trailing_zeros() as i64;
+            let b = rest.trailing_zeros();
             rest &= rest - 1;
-            let (i, j, k) = at(b);
+            let [i, j, k] = span4_voxel(p, b);
             if (self.keep)(i as i64, j as i64, k as i64) {
                 self.slab.set(i, j, k);
             }
@@ -431,9 +452,9 @@ impl<F: FnMut(i64, i64, i64) -> bool> Sink for FilterUnset<'_, '_, F> {
     fn set_block2(&mut self, p: [u32; 3], mask: u8) {
         let mut mask = mask & !self.slab.block2_set(p[0], p[1], p[2]);
         while mask != 0 {
-            let o = mask.trailing_zeros();
+            let d = block2_offset(mask.trailing_zeros());
             mask &= mask - 1;
-            let (i, j, k) = (p[0] + (o & 1), p[1] + (o >> 1 & 1), p[2] + (o >> 2));
+            let (i, j, k) = (p[0] + d[0], p[1] + d[1], p[2] + d[2]);
             if (self.keep)(i as i64, j as i64, k as i64) {
                 self.slab.set(i, j, k);
             }

@@ -1037,14 +1037,16 @@ impl<'t, T: PlaneInt, const N: usize> PairedTargets<'t, T, N> {
             return false;
         }
         let w = self.s.centre_cross(pc);
-        // Without ties, every line's three edge sides from tables.
-        let (k0, t0) = sign_key(w[0]);
-        let (k1, t1) = sign_key(w[1]);
-        let (k2, t2) = sign_key(w[2]);
-        if TABLE && !(t0 | t1 | t2) {
-            let p = &self.set.line_positive;
-            let (p0, p1, p2) = (p[k0 & 511], p[k1 & 511], p[k2 & 511]);
-            return mask & !(p0 ^ p1) as u32 & !(p0 ^ p2) as u32 != 0;
+        if TABLE {
+            // Without ties, every line's three edge sides from tables.
+            let (k0, t0) = sign_key(w[0]);
+            let (k1, t1) = sign_key(w[1]);
+            let (k2, t2) = sign_key(w[2]);
+            if !(t0 | t1 | t2) {
+                let p = &self.set.line_positive;
+                let (p0, p1, p2) = (p[k0 & 511], p[k1 & 511], p[k2 & 511]);
+                return mask & !(p0 ^ p1) as u32 & !(p0 ^ p2) as u32 != 0;
+            }
         }
         while mask != 0 {
             let l = mask.trailing_zeros() as usize;
