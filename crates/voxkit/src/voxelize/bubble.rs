@@ -28,8 +28,10 @@
 //! [`crate::geom::perturb`].
 //!
 //! **Fast path.** `cover`'s exact traversal enumerates candidates not yet
-//! set; each gets its seven segment tests, cheapest first: the ends'
-//! sides of the displaced plane, then the three edge orientations. All
+//! set; each gets its seven segment tests: first every segment's plane
+//! test (its ends' sides of the displaced plane), gathered into a mask
+//! without a branch per segment, then the three edge orientations of
+//! the segments that cross the plane. All
 //! seven segments lie on lines through the voxel's random point `m`, so
 //! these are dot products with one cross product per edge at `m`, exact
 //! (`i64` relative to the triangle; nothing is set up per direction).
@@ -44,7 +46,7 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, FilterUnset, Kernel};
-use super::targets::{fits_i64, is_tiny, TriSetup};
+use super::targets::{dot, fits_i64, is_tiny, TriSetup};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
@@ -302,36 +304,46 @@ fn hits<T: PlaneInt>(s: &TriSetup<T>, steps: &Steps<T>, tri: &LatticeTriangle, i
     let pc = s.local(ijk.map(|c| c * ONE));
     let vc = s.plane(pc);
     let m = o.m.map(|x| T::from_i64(x as i64));
-    let pm = [pc[0] + m[0], pc[1] + m[1], pc[2] + m[2]];
     let inside = vc + n[0] * m[0] + n[1] * m[1] + n[2] * m[2] >= s.bn;
-    // All seven lines pass through the random point: their edge sides
-    // come from one pivot cross, made for the first segment that crosses
-    // the plane. Cheapest first: a segment whose ends lie on one side of
-    // the displaced plane misses.
-    let mut w = None;
-    let mut line = |d: P3| s.line_hits(tri, w.get_or_insert_with(|| s.pivot_cross(pm)), d.map(T::from_i64), d);
     let mi = o.m.map(|x| x as i64);
-    // From the centre to the random point.
-    if (vc + steps.centre >= s.bn) != inside && line(mi.map(|x| x - ONE / 2)) {
-        return true;
-    }
-    (0..6).any(|f| {
+    // Every segment's direction (from the centre to the random point,
+    // then from the random point to each face's) and which of them cross
+    // the displaced plane, as a mask: no branch per segment on its plane
+    // test, whose outcome is a coin toss.
+    let mut dirs = [mi.map(|x| x - ONE / 2); 7];
+    let mut crossing = ((vc + steps.centre >= s.bn) != inside) as u32;
+    for f in 0..6 {
         let (axis, high) = (f / 2, f % 2 == 1);
         let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
         let [fb, fc] = o.faces[f].map(|x| x as i64);
-        let mut v = vc + n[b] * T::from_i64(fb) + n[c] * T::from_i64(fc);
-        if high {
-            v = v + steps.across[axis];
-        }
-        if (v >= s.bn) == inside {
-            return false;
-        }
-        let mut d = [0; 3];
+        let v = vc + n[b] * T::from_i64(fb) + n[c] * T::from_i64(fc) + if high { steps.across[axis] } else { T::ZERO };
+        crossing |= (((v >= s.bn) != inside) as u32) << (f + 1);
+        let d = &mut dirs[f + 1];
         d[axis] = if high { ONE } else { 0 } - mi[axis];
         d[b] = fb - mi[b];
         d[c] = fc - mi[c];
-        line(d)
-    })
+    }
+    if crossing == 0 {
+        return false;
+    }
+    // All seven lines pass through the random point: their edge sides
+    // come from its one pivot cross.
+    let w = s.pivot_cross(std::array::from_fn(|a| pc[a] + m[a]));
+    let mut hit = false;
+    while crossing != 0 {
+        let d = dirs[crossing.trailing_zeros() as usize];
+        crossing &= crossing - 1;
+        let dt = d.map(T::from_i64);
+        let o = w.map(|wi| dot(dt, wi));
+        hit |= if (o[0] == T::ZERO) | (o[1] == T::ZERO) | (o[2] == T::ZERO) {
+            // A tie (rare): the tie rule's bias decides.
+            s.line_hits(tri, &w, dt, d)
+        } else {
+            let (a, b, c) = (o[0] > T::ZERO, o[1] > T::ZERO, o[2] > T::ZERO);
+            (a == b) & (a == c)
+        };
+    }
+    hit
 }
 
 /// The slow, obviously correct definition.
