@@ -268,11 +268,11 @@ fn filtered<T: PlaneInt>(
         CACHE.with(|cache| {
             let cache = &mut *cache.borrow_mut();
             cache.for_seed(seed);
-            let keep = |i, j, k| hits(&s, &steps, tri, [i, j, k], cache.get(g(i, j, k)));
+            let keep = |i, j, k| hits::<T, false>(&s, &steps, tri, [i, j, k], cache.get(g(i, j, k)));
             cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
         });
     } else {
-        let keep = |i, j, k| hits(&s, &steps, tri, [i, j, k], offsets(seed, g(i, j, k)));
+        let keep = |i, j, k| hits::<T, true>(&s, &steps, tri, [i, j, k], offsets(seed, g(i, j, k)));
         cover_triangle(tri, lo, hi, traversal, &mut FilterUnset { slab, keep });
     }
 }
@@ -298,8 +298,12 @@ impl<T: PlaneInt> Steps<T> {
 /// [`PivotCross`] (the same decision as [`segment_meets_triangle`],
 /// without its generic 128-bit determinants or a per-direction setup).
 /// Plane values are the voxel's low corner's plus the points' offsets'.
+/// `STOP_AT_HIT`: return at the first segment that meets the triangle
+/// (large triangles, where most candidates are hit: at 1024³ on the bunny
+/// 7 % faster), else test every crossing segment with no branch on each
+/// outcome (tiny triangles: 32³ 4 % faster).
 #[inline(always)]
-fn hits<T: PlaneInt>(s: &TriSetup<T>, steps: &Steps<T>, tri: &LatticeTriangle, ijk: [i64; 3], o: Offsets) -> bool {
+fn hits<T: PlaneInt, const STOP_AT_HIT: bool>(s: &TriSetup<T>, steps: &Steps<T>, tri: &LatticeTriangle, ijk: [i64; 3], o: Offsets) -> bool {
     let n = s.n;
     let pc = s.local(ijk.map(|c| c * ONE));
     let vc = s.plane(pc);
@@ -329,21 +333,25 @@ fn hits<T: PlaneInt>(s: &TriSetup<T>, steps: &Steps<T>, tri: &LatticeTriangle, i
     // All seven lines pass through the random point: their edge sides
     // come from its one pivot cross.
     let w = s.pivot_cross(std::array::from_fn(|a| pc[a] + m[a]));
-    let mut hit = false;
+    let mut any = false;
     while crossing != 0 {
         let d = dirs[crossing.trailing_zeros() as usize];
         crossing &= crossing - 1;
         let dt = d.map(T::from_i64);
         let o = w.map(|wi| dot(dt, wi));
-        hit |= if (o[0] == T::ZERO) | (o[1] == T::ZERO) | (o[2] == T::ZERO) {
+        let hit = if (o[0] == T::ZERO) | (o[1] == T::ZERO) | (o[2] == T::ZERO) {
             // A tie (rare): the tie rule's bias decides.
             s.line_hits(tri, &w, dt, d)
         } else {
             let (a, b, c) = (o[0] > T::ZERO, o[1] > T::ZERO, o[2] > T::ZERO);
             (a == b) & (a == c)
         };
+        if STOP_AT_HIT && hit {
+            return true;
+        }
+        any |= hit;
     }
-    hit
+    any
 }
 
 /// The slow, obviously correct definition.
