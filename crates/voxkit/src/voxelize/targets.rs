@@ -235,10 +235,19 @@ impl<T: PlaneInt> DirSetup<T> {
 
 impl<T: PlaneInt> TriSetup<T> {
     /// Setup for `t`.
+    #[inline(always)]
     pub fn new(t: &LatticeTriangle) -> TriSetup<T> {
         let a = t.v[0];
         let n = t.normal();
-        TriSetup { a, rel: t.v.map(|p| std::array::from_fn(|c| T::from_i64(p[c] - a[c]))), n: n.map(T::from_i64), bn: T::from_i64(bias(n)) }
+        // Element by element: as `map`s, these were a call of their own
+        // (`try_map`, not inlined; `bubble` at 32³: 4 % of the time).
+        let rel = |p: P3| [T::from_i64(p[0] - a[0]), T::from_i64(p[1] - a[1]), T::from_i64(p[2] - a[2])];
+        TriSetup {
+            a,
+            rel: [rel(t.v[0]), rel(t.v[1]), rel(t.v[2])],
+            n: [T::from_i64(n[0]), T::from_i64(n[1]), T::from_i64(n[2])],
+            bn: T::from_i64(bias(n)),
+        }
     }
 
     /// Setup for target segments of direction `d` (lattice units).
