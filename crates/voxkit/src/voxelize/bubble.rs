@@ -231,6 +231,14 @@ struct OffsetCache {
     slots: Vec<([i64; 3], Offsets)>,
 }
 
+/// The [`OffsetCache`] slot of voxel `g` (index in the whole grid): the
+/// low [`CACHE_BITS`] of each axis.
+#[inline(always)]
+fn slot(g: [i64; 3]) -> usize {
+    let mask = (1 << CACHE_BITS) - 1;
+    ((g[0] & mask) | (g[1] & mask) << CACHE_BITS | (g[2] & mask) << (2 * CACHE_BITS)) as usize
+}
+
 impl OffsetCache {
     /// Empties the cache unless it holds offsets of `seed`.
     fn for_seed(&mut self, seed: u64) {
@@ -249,13 +257,11 @@ impl OffsetCache {
     #[inline(always)]
     fn prefetch(&self, lo: [i64; 3], hi: [i64; 3]) {
         // Loads nothing waits on but their sum, which is kept.
-        let mask = (1 << CACHE_BITS) - 1;
         let mut x = 0;
         for k in lo[2]..=hi[2] {
             for j in lo[1]..=hi[1] {
                 for i in [lo[0], hi[0]] {
-                    let slot = ((i & mask) | (j & mask) << CACHE_BITS | (k & mask) << (2 * CACHE_BITS)) as usize;
-                    x ^= self.slots[slot].0[0];
+                    x ^= self.slots[slot([i, j, k])].0[0];
                 }
             }
         }
@@ -266,9 +272,7 @@ impl OffsetCache {
     /// [`Self::for_seed`].
     #[inline(always)]
     fn get(&mut self, g: [i64; 3]) -> Offsets {
-        let mask = (1 << CACHE_BITS) - 1;
-        let slot = ((g[0] & mask) | (g[1] & mask) << CACHE_BITS | (g[2] & mask) << (2 * CACHE_BITS)) as usize;
-        let entry = &mut self.slots[slot];
+        let entry = &mut self.slots[slot(g)];
         if entry.0 != g {
             *entry = (g, offsets(self.seed, g));
         }
