@@ -1,7 +1,7 @@
-"""Interoperability check: voxkit's outputs read by real third-party readers.
+"""Interoperability check: topovox's outputs read by real third-party readers.
 
 NumPy reads the .npy files; the `binvox` package from PyPI reads the
-.binvox file; both must hold exactly the voxels of voxkit's text list, with
+.binvox file; both must hold exactly the voxels of topovox's text list, with
 the grid placement reported by `--json`. For the textured spot: VTK's own
 XML reader (`vtk` package) reads the .vti, `nbtlib` the .schem, `plyfile`
 the point cloud and `pygltflib` the .glb; each must agree with the .npy and
@@ -16,9 +16,9 @@ import numpy as np
 from oracle import Oracle, text_voxels
 from binvox import Binvox
 
-VOXKIT = sys.argv[1]
+TOPOVOX = sys.argv[1]
 MESHES = Path(sys.argv[2])
-ORACLE = Oracle(VOXKIT)
+ORACLE = Oracle(TOPOVOX)
 check, voxelize = ORACLE.check, ORACLE.voxelize
 
 
@@ -129,7 +129,7 @@ with tempfile.TemporaryDirectory() as d:
     check("glb bounds inside the grid", np.all(np.array(acc.min) >= np.array(summary["origin"]) - 1e-5) and np.all(np.array(acc.max) <= hi + 1e-5))
 
     # .vox, parsed here from the published format (MagicaVoxel-file-format-vox.txt
-    # and -extension.txt), independently of the dot_vox crate voxkit uses.
+    # and -extension.txt), independently of the dot_vox crate topovox uses.
     import struct
     raw = (d / "s.vox").read_bytes()
     check("vox magic and version 150", raw[:4] == b"VOX " and struct.unpack("<i", raw[4:8])[0] == 150)
@@ -178,7 +178,7 @@ with tempfile.TemporaryDirectory() as d:
     check("cow solid voxel mesh encloses exactly the voxels' volume (trimesh)", abs(tc.volume - vol) < 1e-9 + 1e-6 * vol, (tc.volume, vol))
 
     # Zarr v3: the `zarr` package opens it as one array equal to the .npy,
-    # Dask reads it chunk by chunk; a tiled run's array has voxkit's count.
+    # Dask reads it chunk by chunk; a tiled run's array has topovox's count.
     import zarr
     import dask.array as da
     s = voxelize(MESHES / "stanford-bunny.obj", d / "b.zarr", "--resolution", "300")
@@ -187,10 +187,10 @@ with tempfile.TemporaryDirectory() as d:
     check("zarr: shape, bool, 64³ chunks", z.shape == tuple(s["dims"]) and z.dtype == bool and z.chunks == (64, 64, 64), (z.shape, z.dtype, z.chunks))
     check("zarr: sharded, shards of at most 512 in whole chunks", all(c % 64 == 0 and c <= 512 for c in z.shards), z.shards)
     check("zarr: every voxel = the .npy", np.array_equal(z[:], np.load(d / "b.npy") > 0))
-    check("zarr: grid placement in attributes", z.attrs["voxkit"]["voxel_size"] == s["voxel_size"] and z.attrs["voxkit"]["origin"] == s["origin"])
+    check("zarr: grid placement in attributes", z.attrs["topovox"]["voxel_size"] == s["voxel_size"] and z.attrs["topovox"]["origin"] == s["origin"])
     s = voxelize(MESHES / "stanford-bunny.obj", d / "t.zarr", "--resolution", "2048", "--mode", "sep6", "--tile", "256")
     n = int(da.from_zarr(str(d / "t.zarr")).sum().compute())
-    check("zarr: tiled sep6 at 2048 read by Dask has voxkit's count", s["method"] == "tiled" and n == s["voxels"], (n, s["voxels"]))
+    check("zarr: tiled sep6 at 2048 read by Dask has topovox's count", s["method"] == "tiled" and n == s["voxels"], (n, s["voxels"]))
 
     # --attributes: a Zarr group of `voxels` and attribute arrays with the
     # same chunking, equal to the .vti arrays VTK read above (same run);
@@ -215,7 +215,7 @@ with tempfile.TemporaryDirectory() as d:
 
     # .npz of sparse coordinates: NumPy's own loader reads the (k, 3)
     # indices and the grid; scattered into a grid they equal the .npy; a
-    # tiled run past --max-memory writes one too, with voxkit's count.
+    # tiled run past --max-memory writes one too, with topovox's count.
     s = voxelize(MESHES / "stanford-bunny.obj", d / "b.npz", "--resolution", "300")
     with np.load(d / "b.npz") as z:
         idx, dims = z["indices"], z["dims"]
@@ -228,6 +228,6 @@ with tempfile.TemporaryDirectory() as d:
         check("npz: ordered by k, then j, then i", bool((np.diff(order) > 0).all()))
     s = voxelize(MESHES / "stanford-bunny.obj", d / "t.npz", "--resolution", "3000", "--max-memory", "64M")
     with np.load(d / "t.npz") as z:
-        check("npz: tiled run past --max-memory has voxkit's count", s["method"] == "tiled" and z["indices"].shape[0] == s["voxels"], (s["method"], z["indices"].shape, s["voxels"]))
+        check("npz: tiled run past --max-memory has topovox's count", s["method"] == "tiled" and z["indices"].shape[0] == s["voxels"], (s["method"], z["indices"].shape, s["voxels"]))
 
 ORACLE.finish()

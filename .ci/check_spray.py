@@ -1,9 +1,9 @@
-"""`voxkit spray`'s point cloud read by a standard PLY reader (plyfile): as
+"""`topovox spray`'s point cloud read by a standard PLY reader (plyfile): as
 many points as the summary says, every point on the mesh's surface (closest
 points by trimesh, within a stated epsilon), unit normals facing the camera,
 finite light terms, some points lit and some in shadow.
 
-Usage: check_spray.py VOXKIT OUTDIR
+Usage: check_spray.py TOPOVOX OUTDIR
 """
 import json
 import subprocess
@@ -16,16 +16,16 @@ from plyfile import PlyData
 
 from oracle import Oracle
 
-voxkit, out = sys.argv[1], Path(sys.argv[2])
-o = Oracle(voxkit)
+topovox, out = sys.argv[1], Path(sys.argv[2])
+o = Oracle(topovox)
 obj, cloud = out / "spray-cornell.obj", out / "spray.ply"
-subprocess.run([voxkit, "scene", "cornell", "-o", str(obj)], check=True, capture_output=True)
+subprocess.run([topovox, "scene", "cornell", "-o", str(obj)], check=True, capture_output=True)
 eye, target = np.array([0.5, 0.6, 2.3]), np.array([0.45, 0.4, 0.0])
 cam = ",".join(str(v) for v in [*eye, *target, 50])
-r = subprocess.run([voxkit, "spray", str(obj), "-o", str(cloud), "--rays", "20000", "--camera", cam, "--size", "400x400", "--json"],
+r = subprocess.run([topovox, "spray", str(obj), "-o", str(cloud), "--rays", "20000", "--camera", cam, "--size", "400x400", "--json"],
                    capture_output=True, text=True)
 if r.returncode != 0:
-    raise SystemExit(f"voxkit spray failed: {r.stderr}")
+    raise SystemExit(f"topovox spray failed: {r.stderr}")
 summary = json.loads(r.stdout)
 v = PlyData.read(str(cloud))["vertex"]
 o.check("plyfile reads as many points as the summary says", v.count == summary["points"] > 10000, (v.count, summary["points"]))

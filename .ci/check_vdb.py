@@ -1,9 +1,9 @@
 """OpenVDB's own reader (Debian's python3-openvdb, module `pyopenvdb`)
-reads voxkit's .vdb files: every active voxel equals voxkit's text list of
+reads topovox's .vdb files: every active voxel equals topovox's text list of
 the same run, the transform takes index (i, j, k) to the voxel's centre,
-and a grid past memory (tiled, --max-memory) has the voxel count voxkit
+and a grid past memory (tiled, --max-memory) has the voxel count topovox
 reports. Run with the system Python that has pyopenvdb:
-    /usr/bin/python3 .ci/check_vdb.py target/release/voxkit ../shared/meshes
+    /usr/bin/python3 .ci/check_vdb.py target/release/topovox ../shared/meshes
 Prints 'N passed, M failed'.
 """
 import re
@@ -17,9 +17,9 @@ import numpy as np
 from oracle import Oracle, text_voxels
 import pyopenvdb as vdb
 
-VOXKIT = sys.argv[1]
+TOPOVOX = sys.argv[1]
 MESHES = Path(sys.argv[2])
-ORACLE = Oracle(VOXKIT)
+ORACLE = Oracle(TOPOVOX)
 check, voxelize = ORACLE.check, ORACLE.voxelize
 
 
@@ -37,7 +37,7 @@ def active(path):
 
 
 def vti_arrays(path):
-    """The cell arrays of a voxkit .vti (appended raw, zlib blocks, UInt64
+    """The cell arrays of a topovox .vti (appended raw, zlib blocks, UInt64
     headers), read with the standard library: {name: array (nx, ny, nz[, c])}."""
     raw = Path(path).read_bytes()
     head, data = raw.split(b'<AppendedData encoding="raw">', 1)
@@ -98,16 +98,16 @@ with tempfile.TemporaryDirectory() as d:
         want = text_voxels(d / "v.txt")
         check(f"{name}: pyopenvdb reads a BoolGrid", isinstance(g, vdb.BoolGrid), type(g))
         check(f"{name}: every active voxel = the dense run's voxels", got.shape == want.shape and (got == want).all(), (got.shape, want.shape))
-        check(f"{name}: activeVoxelCount = voxkit's count", g.activeVoxelCount() == s["voxels"], (g.activeVoxelCount(), s["voxels"]))
+        check(f"{name}: activeVoxelCount = topovox's count", g.activeVoxelCount() == s["voxels"], (g.activeVoxelCount(), s["voxels"]))
         vs = s["voxel_size"]
         o = np.array(s["origin"])
         centre = np.array(g.transform.indexToWorld((3, 4, 5)))
         check(f"{name}: index (3,4,5) -> that voxel's centre", np.allclose(centre, o + (np.array([3, 4, 5]) + 0.5) * vs, rtol=0, atol=1e-9 * max(1, abs(o).max())), centre)
         check(f"{name}: voxel size", abs(g.transform.voxelSize()[0] - vs) <= 1e-12 * vs)
-        check(f"{name}: metadata dims", tuple(g.metadata["voxkit_dims"]) == tuple(s["dims"]), g.metadata)
-        # voxkit reads its own file back.
-        r = subprocess.run([VOXKIT, "convert", str(d / "v.vdb"), str(d / "back.txt")], capture_output=True, text=True)
-        check(f"{name}: voxkit convert reads the .vdb", r.returncode == 0 and (text_voxels(d / "back.txt") == want).all(), r.stderr)
+        check(f"{name}: metadata dims", tuple(g.metadata["topovox_dims"]) == tuple(s["dims"]), g.metadata)
+        # topovox reads its own file back.
+        r = subprocess.run([TOPOVOX, "convert", str(d / "v.vdb"), str(d / "back.txt")], capture_output=True, text=True)
+        check(f"{name}: topovox convert reads the .vdb", r.returncode == 0 and (text_voxels(d / "back.txt") == want).all(), r.stderr)
 
     # Sparse solids: interiors written as active tiles (8³, and 128³ where
     # a whole 16³ node is inside), equal to the dense run's .npy.
@@ -128,11 +128,11 @@ with tempfile.TemporaryDirectory() as d:
         check(f"{name}: runs tiled with full bricks", s["tile"] == 64 and s["solid"]["full_bricks"] > 0, s)
         check(f"{name}: the interior is active tiles", tiles > 0, tiles)
         check(f"{name}: every active voxel = the dense run's .npy", got.shape == want.shape and (got == want).all(), (got.shape, want.shape))
-        check(f"{name}: activeVoxelCount = voxkit's count", g.activeVoxelCount() == s["voxels"], (g.activeVoxelCount(), s["voxels"]))
+        check(f"{name}: activeVoxelCount = topovox's count", g.activeVoxelCount() == s["voxels"], (g.activeVoxelCount(), s["voxels"]))
 
     # --attributes: Cd, normal, coverage and material grids over the same
     # voxels, equal to the .vti arrays of the same run (read here without
-    # voxkit); a solid's interior is tiles in `voxels`, leaves in the others.
+    # topovox); a solid's interior is tiles in `voxels`, leaves in the others.
     for mode in ["cover", "solid"]:
         name = f"spot-textured.obj 64 {mode} --attributes"
         s = voxelize(MESHES / "spot-textured.obj", d / "a.vdb", "--resolution", "64", "--mode", mode, "--attributes")
@@ -162,8 +162,8 @@ with tempfile.TemporaryDirectory() as d:
     s = voxelize(MESHES / "stanford-bunny.obj", d / "big.vdb", "--resolution", "4096", "--max-memory", "1G")
     g = vdb.read(str(d / "big.vdb"), "voxels")
     check("bunny at 4096 with --max-memory 1G runs tiled", s["method"] == "tiled" and s["tile"] == 512, s["method"])
-    check("bunny at 4096: pyopenvdb's active count = voxkit's", g.activeVoxelCount() == s["voxels"], (g.activeVoxelCount(), s["voxels"]))
-    r = subprocess.run([VOXKIT, "voxelize", str(MESHES / "stanford-bunny.obj"), "-o", str(d / "big.npy"), "--resolution", "4096", "--max-memory", "1G"], capture_output=True, text=True)
+    check("bunny at 4096: pyopenvdb's active count = topovox's", g.activeVoxelCount() == s["voxels"], (g.activeVoxelCount(), s["voxels"]))
+    r = subprocess.run([TOPOVOX, "voxelize", str(MESHES / "stanford-bunny.obj"), "-o", str(d / "big.npy"), "--resolution", "4096", "--max-memory", "1G"], capture_output=True, text=True)
     check("a dense format past --max-memory is one line naming the sparse formats", r.returncode != 0 and ".vdb" in r.stderr and r.stderr.count("\n") == 1, r.stderr)
 
 ORACLE.finish()

@@ -1,4 +1,4 @@
-"""Shared by the interoperability checks: run voxkit, count checks."""
+"""Shared by the interoperability checks: run topovox, count checks."""
 import json
 import subprocess
 import sys
@@ -8,8 +8,8 @@ import numpy as np
 
 
 class Oracle:
-    def __init__(self, voxkit):
-        self.voxkit = voxkit
+    def __init__(self, topovox):
+        self.topovox = topovox
         self.passed = 0
         self.failed = 0
 
@@ -22,9 +22,9 @@ class Oracle:
             print(f"FAIL {name} {detail}")
 
     def voxelize(self, mesh, out, *extra):
-        r = subprocess.run([self.voxkit, "voxelize", str(mesh), "-o", str(out), "--json", *extra], capture_output=True, text=True)
+        r = subprocess.run([self.topovox, "voxelize", str(mesh), "-o", str(out), "--json", *extra], capture_output=True, text=True)
         if r.returncode != 0:
-            raise SystemExit(f"voxkit failed: {r.stderr}")
+            raise SystemExit(f"topovox failed: {r.stderr}")
         return json.loads(r.stdout)
 
     def finish(self):
@@ -33,6 +33,6 @@ class Oracle:
 
 
 def text_voxels(path):
-    """voxkit's text list of voxels as a sorted (n, 3) int64 array."""
+    """topovox's text list of voxels as a sorted (n, 3) int64 array."""
     rows = [l.split() for l in Path(path).read_text().splitlines() if l and not l.startswith("#")]
     return np.array(sorted((int(a), int(b), int(c)) for a, b, c in rows), dtype=np.int64).reshape(-1, 3)

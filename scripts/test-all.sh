@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Every test of voxkit: the Rust workspace (cargo test), then the Python
+# Every test of topovox: the Rust workspace (cargo test), then the Python
 # package built from this checkout and its pytest suite (CLI parity,
 # arrays, errors, formats, batches, Dask and Ray). Works on a fresh machine
 # with the Rust toolchain and Python >= 3.9: it makes its own virtual
@@ -21,6 +21,6 @@ VPY=target/venv/bin/python
 "$VPY" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps ./python
 
 echo "== pytest"
-# Run from the repository root so `import voxkit` finds the installed
-# package, not the sources in python/voxkit.
-VOXKIT_BIN="$PWD/target/release/voxkit" "$VPY" -m pytest -q python/tests
+# Run from the repository root so `import topovox` finds the installed
+# package, not the sources in python/topovox.
+TOPOVOX_BIN="$PWD/target/release/topovox" "$VPY" -m pytest -q python/tests

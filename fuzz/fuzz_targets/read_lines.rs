@@ -5,9 +5,9 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(
-    init: voxkit_fuzz::fence_panics(),
+    init: topovox_fuzz::fence_panics(),
     |data: &[u8]| {
-    if let Ok(m) = voxkit_io::read_mesh_bytes(data, voxkit_io::MeshFormat::Polyline, None) {
+    if let Ok(m) = topovox_io::read_mesh_bytes(data, topovox_io::MeshFormat::Polyline, None) {
         assert!(m.mesh.segments.iter().flatten().all(|&i| (i as usize) < m.mesh.positions.len()));
         assert!(m.mesh.positions.iter().all(|p| p.is_finite()));
     }

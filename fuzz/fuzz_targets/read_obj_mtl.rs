@@ -14,14 +14,14 @@ use libfuzzer_sys::fuzz_target;
 fn folder() -> &'static PathBuf {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let d = std::env::temp_dir().join(format!("voxkit-fuzz-obj-mtl-{}", std::process::id()));
+        let d = std::env::temp_dir().join(format!("topovox-fuzz-obj-mtl-{}", std::process::id()));
         std::fs::create_dir_all(d.join("model")).expect("temp folder");
         d
     })
 }
 
 fuzz_target!(
-    init: voxkit_fuzz::fence_panics(),
+    init: topovox_fuzz::fence_panics(),
     |data: &[u8]| {
     let mut parts = data.split(|&b| b == 0xFF);
     let (obj, mtl, png) = (parts.next().unwrap_or(&[]), parts.next().unwrap_or(&[]), parts.next().unwrap_or(&[]));
@@ -32,7 +32,7 @@ fuzz_target!(
     if std::fs::write(&o, &text).is_err() || std::fs::write(&m, mtl).is_err() || std::fs::write(&t, png).is_err() {
         return;
     }
-    if let Ok(loaded) = voxkit_io::read_mesh(&o) {
+    if let Ok(loaded) = topovox_io::read_mesh(&o) {
         assert!(loaded.mesh.triangles.iter().flatten().all(|&i| (i as usize) < loaded.mesh.positions.len()));
         let root = std::fs::canonicalize(&dir).expect("folder");
         assert!(loaded.sources.iter().all(|s| s.starts_with(&root)), "read outside the folder: {:?}", loaded.sources);

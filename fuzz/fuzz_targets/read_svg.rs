@@ -1,16 +1,16 @@
-//! Fuzzes the SVG reader of `voxkit raster`, then rasterizes what it reads
+//! Fuzzes the SVG reader of `topovox raster`, then rasterizes what it reads
 //! in every 2D mode on a small grid: outlines or an error, never a panic;
 //! each fast path equals its reference.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use voxkit::glam::DVec2;
-use voxkit::raster::{self, Grid2, RasterMode};
+use topovox::glam::DVec2;
+use topovox::raster::{self, Grid2, RasterMode};
 
 fuzz_target!(
-    init: voxkit_fuzz::fence_panics(),
+    init: topovox_fuzz::fence_panics(),
     |data: &[u8]| {
-    let Ok(svg) = voxkit_io::svg::read(data, &voxkit_io::svg::SvgOptions { tolerance: Some(0.05) }) else { return };
+    let Ok(svg) = topovox_io::svg::read(data, &topovox_io::svg::SvgOptions { tolerance: Some(0.05) }) else { return };
     assert!(svg.outlines.iter().flat_map(|o| &o.points).all(|p| p.is_finite()));
     let Ok(grid) = Grid2::new(DVec2::splat(-2.0), 0.5, [24, 24]) else { return };
     if svg.outlines.iter().map(|o| o.points.len()).sum::<usize>() > 2000 {

@@ -3,12 +3,12 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use voxkit::attributes::Wrap;
+use topovox::attributes::Wrap;
 
 fuzz_target!(
-    init: voxkit_fuzz::fence_panics(),
+    init: topovox_fuzz::fence_panics(),
     |data: &[u8]| {
-    if let Ok(t) = voxkit_io::texture::decode(data, "fuzz", [Wrap::Repeat; 2]) {
+    if let Ok(t) = topovox_io::texture::decode(data, "fuzz", [Wrap::Repeat; 2]) {
         assert_eq!(t.rgba.len(), t.width as usize * t.height as usize * 4);
     }
     }

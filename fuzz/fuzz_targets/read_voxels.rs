@@ -2,15 +2,15 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use voxkit_io::VoxelFormat;
+use topovox_io::VoxelFormat;
 
 fuzz_target!(
-    init: voxkit_fuzz::fence_panics(),
+    init: topovox_fuzz::fence_panics(),
     |data: &[u8]| {
     for f in
         [VoxelFormat::Npy, VoxelFormat::Binvox, VoxelFormat::Vox, VoxelFormat::Text, VoxelFormat::Schem, VoxelFormat::Vti, VoxelFormat::Ply, VoxelFormat::Vdb]
     {
-        let _ = voxkit_io::read_voxels_bytes(data, f);
+        let _ = topovox_io::read_voxels_bytes(data, f);
     }
     }
 );

@@ -4,10 +4,10 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use voxkit::glam::DVec3;
-use voxkit::voxelize::driver::Driver;
-use voxkit::voxelize::{self, Mode, Options};
-use voxkit::{GridSpec, Mesh};
+use topovox::glam::DVec3;
+use topovox::voxelize::driver::Driver;
+use topovox::voxelize::{self, Mode, Options};
+use topovox::{GridSpec, Mesh};
 
 fuzz_target!(|data: &[u8]| {
     let coords: Vec<f64> = data.chunks_exact(2).map(|c| i16::from_le_bytes([c[0], c[1]]) as f64 / 2048.0).collect();

@@ -5,4 +5,4 @@
 
 use libfuzzer_sys::fuzz_target;
 
-fuzz_target!(init: voxkit_fuzz::fence_panics(), |data: &[u8]| voxkit_fuzz::check_voxels(data, voxkit_io::VoxelFormat::Binvox));
+fuzz_target!(init: topovox_fuzz::fence_panics(), |data: &[u8]| topovox_fuzz::check_voxels(data, topovox_io::VoxelFormat::Binvox));

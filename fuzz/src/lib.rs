@@ -1,15 +1,15 @@
 //! What the fuzz targets share: the panic hook that lets fenced panics of
 //! third-party parsers pass, and the checks on voxels a reader returns.
 
-use voxkit_io::VoxelFormat;
+use topovox_io::VoxelFormat;
 
-/// Installs a panic hook under which only panics outside voxkit-io's fence
+/// Installs a panic hook under which only panics outside topovox-io's fence
 /// are crashes: third-party parsers that panic on malformed input run
 /// inside the fence, which turns the panic into an error (as the CLI does).
 pub fn fence_panics() {
     let abort = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
-        if !voxkit_io::panic_is_fenced() {
+        if !topovox_io::panic_is_fenced() {
             abort(info)
         }
     }));
@@ -27,11 +27,11 @@ pub fn check_voxels(data: &[u8], format: VoxelFormat) {
     // The sparse .vdb and .npz readers never panic either, and where both
     // readers succeed they give the same voxels and attributes.
     let sparse = match format {
-        VoxelFormat::Vdb => voxkit_io::vdb::read_sparse(data, true).ok(),
-        VoxelFormat::Npz => voxkit_io::npz::read_sparse_from(std::io::Cursor::new(data), data.len() as u64).ok(),
+        VoxelFormat::Vdb => topovox_io::vdb::read_sparse(data, true).ok(),
+        VoxelFormat::Npz => topovox_io::npz::read_sparse_from(std::io::Cursor::new(data), data.len() as u64).ok(),
         _ => None,
     };
-    let Ok(v) = voxkit_io::read_voxels_bytes(data, format) else { return };
+    let Ok(v) = topovox_io::read_voxels_bytes(data, format) else { return };
     let [nx, ny, nz] = v.bits.dims();
     if (nx as u64).div_ceil(64) * ny as u64 * nz as u64 > MAX_VISITED_WORDS {
         return;
@@ -40,7 +40,7 @@ pub fn check_voxels(data: &[u8], format: VoxelFormat) {
         assert_eq!(s.bits.dims(), v.bits.dims());
         assert_eq!(s.bits.count(), v.bits.count());
         assert_eq!(format!("{:?}", s.placement), format!("{:?}", v.placement)); // NaN-proof
-        voxkit::VoxelSource::for_each_set(&s.bits, &mut |i, j, k| assert!(v.bits.get(i, j, k)));
+        topovox::VoxelSource::for_each_set(&s.bits, &mut |i, j, k| assert!(v.bits.get(i, j, k)));
         // As text, NaN-proof too: a float attribute read from the file may
         // be NaN, which both readers pass on alike (`==` would fail on it).
         assert_eq!(format!("{:?}", s.attributes), format!("{:?}", v.attributes));

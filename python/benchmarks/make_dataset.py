@@ -11,7 +11,7 @@ import sys
 
 import numpy as np
 
-import voxkit
+import topovox
 
 
 def random_rotation(rng: np.random.Generator) -> np.ndarray:
@@ -34,7 +34,7 @@ def write_stl(path: pathlib.Path, v: np.ndarray, f: np.ndarray) -> None:
     rec = np.zeros(len(f), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
     rec["n"], rec["v"] = n, tri
     with open(path, "wb") as out:
-        out.write(b"voxkit benchmark dataset".ljust(80, b" "))
+        out.write(b"topovox benchmark dataset".ljust(80, b" "))
         out.write(np.uint32(len(f)).tobytes())
         out.write(rec.tobytes())
 
@@ -47,7 +47,7 @@ def main() -> int:
     ap.add_argument("--shared", type=pathlib.Path, default=pathlib.Path(__file__).resolve().parents[3] / "shared" / "meshes")
     a = ap.parse_args()
     sources = sorted(p for p in a.shared.glob("*.obj"))
-    meshes = [(p.stem, voxkit.load_mesh(p)) for p in sources]
+    meshes = [(p.stem, topovox.load_mesh(p)) for p in sources]
     rng = np.random.default_rng(a.seed)
     a.out.mkdir(parents=True, exist_ok=True)
     for i in range(a.count):

@@ -1,9 +1,9 @@
-//! `voxkit._voxkit`: the native half of the voxkit Python package.
+//! `topovox._topovox`: the native half of the topovox Python package.
 //!
-//! Everything here runs what the `voxkit` command line runs (the
-//! `voxkit-job` crate), so a Python call and a CLI call with the same
+//! Everything here runs what the `topovox` command line runs (the
+//! `topovox-job` crate), so a Python call and a CLI call with the same
 //! options give the same voxels, bit for bit. The Python half
-//! (`python/voxkit/__init__.py`) accepts mesh-like objects, documents the
+//! (`python/topovox/__init__.py`) accepts mesh-like objects, documents the
 //! API and adds `to_trimesh`, Dask and Ray.
 //!
 //! - Arrays in are copied once, into the voxelizer's own types; arrays out
@@ -13,7 +13,7 @@
 //! - Errors are Python exceptions with the CLI's one-line messages:
 //!   `ValueError` for bad arguments and bad arrays, `OSError` subclasses
 //!   for files (`FileNotFoundError`, `PermissionError`, or
-//!   `voxkit.FileFormatError` for malformed content), `RuntimeError` for
+//!   `topovox.FileFormatError` for malformed content), `RuntimeError` for
 //!   failures while running (no GPU, not enough memory).
 
 use std::path::PathBuf;
@@ -26,13 +26,13 @@ use pyo3::exceptions::{PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPe
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use serde_json::Value;
-use voxkit::attributes::carry::CarryOptions;
-use voxkit::attributes::{ColourRule, VoxelAttributes, NO_MATERIAL};
-use voxkit::{GridSpec, VoxelSource};
-use voxkit_io::LoadedMesh;
-use voxkit_job::{GridOptions, GridRequest, JobError, Voxels};
+use topovox::attributes::carry::CarryOptions;
+use topovox::attributes::{ColourRule, VoxelAttributes, NO_MATERIAL};
+use topovox::{GridSpec, VoxelSource};
+use topovox_io::LoadedMesh;
+use topovox_job::{GridOptions, GridRequest, JobError, Voxels};
 
-pyo3::create_exception!(_voxkit, FileFormatError, PyOSError, "A file's content does not follow its format (the message names the file).");
+pyo3::create_exception!(_topovox, FileFormatError, PyOSError, "A file's content does not follow its format (the message names the file).");
 
 /// A [`JobError`] as the Python exception the package documents.
 fn py_err(e: JobError) -> PyErr {
@@ -43,11 +43,11 @@ fn py_err(e: JobError) -> PyErr {
     }
 }
 
-fn io_err(e: voxkit_io::IoError) -> PyErr {
+fn io_err(e: topovox_io::IoError) -> PyErr {
     use std::io::ErrorKind as K;
     let msg = e.to_string();
     match &e.kind {
-        voxkit_io::ErrorKind::Read(x) | voxkit_io::ErrorKind::Write(x) => match x.kind() {
+        topovox_io::ErrorKind::Read(x) | topovox_io::ErrorKind::Write(x) => match x.kind() {
             K::NotFound => PyFileNotFoundError::new_err(msg),
             K::PermissionDenied => PyPermissionError::new_err(msg),
             K::IsADirectory => PyIsADirectoryError::new_err(msg),
@@ -62,7 +62,7 @@ fn value_err(msg: impl Into<String>) -> PyErr {
 }
 
 /// A triangle mesh (and polylines), as read from a file or built from arrays.
-#[pyclass(module = "voxkit._voxkit", name = "Mesh", frozen)]
+#[pyclass(module = "topovox._topovox", name = "Mesh", frozen)]
 struct Mesh {
     inner: Arc<LoadedMesh>,
     path: Option<PathBuf>,
@@ -151,7 +151,7 @@ impl Mesh {
         let positions = points_from("vertices", vertices)?;
         let triangles = faces.map(|f| indices_from::<3>("faces", f)).transpose()?.unwrap_or_default();
         let segs = segments.map(|s| indices_from::<2>("segments", s)).transpose()?.unwrap_or_default();
-        let loaded = py.detach(|| voxkit_io::validate_mesh(positions, triangles, segs)).map_err(|k| value_err(k.to_string()))?;
+        let loaded = py.detach(|| topovox_io::validate_mesh(positions, triangles, segs)).map_err(|k| value_err(k.to_string()))?;
         Ok(Mesh { inner: Arc::new(loaded), path: None })
     }
 
@@ -236,7 +236,7 @@ impl Mesh {
     fn __repr__(&self) -> String {
         let r = &self.inner.report;
         let from = self.path.as_ref().map(|p| format!(" from {:?}", p.display().to_string())).unwrap_or_default();
-        format!("<voxkit.Mesh {} vertices, {} triangles, {} segments{from}>", r.vertices, r.triangles, r.segments)
+        format!("<topovox.Mesh {} vertices, {} triangles, {} segments{from}>", r.vertices, r.triangles, r.segments)
     }
 }
 
@@ -245,12 +245,12 @@ impl Mesh {
 #[pyo3(signature = (path, allow_external_paths=false))]
 fn load_mesh(py: Python<'_>, path: PathBuf, allow_external_paths: bool) -> PyResult<Mesh> {
     let p = path.clone();
-    let loaded = py.detach(move || voxkit_io::read_mesh_with(&p, &voxkit_io::ReadOptions { allow_external_paths })).map_err(io_err)?;
+    let loaded = py.detach(move || topovox_io::read_mesh_with(&p, &topovox_io::ReadOptions { allow_external_paths })).map_err(io_err)?;
     Ok(Mesh { inner: Arc::new(loaded), path: Some(path) })
 }
 
 /// A voxel grid: where the voxels are, which are set, and what they carry.
-#[pyclass(module = "voxkit._voxkit", name = "VoxelGrid", frozen)]
+#[pyclass(module = "topovox._topovox", name = "VoxelGrid", frozen)]
 struct VoxelGrid {
     inner: Arc<GridData>,
 }
@@ -348,10 +348,10 @@ impl VoxelGrid {
     fn occupancy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<bool>>> {
         let [nx, ny, nz] = self.inner.grid.dims().map(|d| d as usize);
         let bytes = nx.checked_mul(ny).and_then(|n| n.checked_mul(nz)).ok_or_else(|| value_err("grid too large to densify"))?;
-        if voxkit_job::available_memory().is_some_and(|m| bytes as u64 > m / 2) {
+        if topovox_job::available_memory().is_some_and(|m| bytes as u64 > m / 2) {
             return Err(PyRuntimeError::new_err(format!(
                 "a dense {nx}x{ny}x{nz} occupancy needs {}; use .indices() for the set voxels",
-                voxkit_job::bytes(bytes as u64)
+                topovox_job::bytes(bytes as u64)
             )));
         }
         let inner = self.inner.clone();
@@ -422,22 +422,22 @@ impl VoxelGrid {
         watertight: bool,
         triangulate: bool,
     ) -> PyResult<()> {
-        let target = voxkit_job::output::output_format(format.as_deref(), &path).map_err(py_err)?;
-        voxkit_job::output::check_output_path(&path).map_err(py_err)?;
-        let blocks = block_palette.as_deref().map(voxkit_io::schem::BlockPalette::read).transpose().map_err(io_err)?;
-        let opts = voxkit_io::WriteOptions {
+        let target = topovox_job::output::output_format(format.as_deref(), &path).map_err(py_err)?;
+        topovox_job::output::check_output_path(&path).map_err(py_err)?;
+        let blocks = block_palette.as_deref().map(topovox_io::schem::BlockPalette::read).transpose().map_err(io_err)?;
+        let opts = topovox_io::WriteOptions {
             dither,
             blocks,
             up: up_of(up)?,
-            mesh: voxkit_io::voxel_mesh::MeshOptions { watertight, triangulate },
+            mesh: topovox_io::voxel_mesh::MeshOptions { watertight, triangulate },
         };
         let inner = self.inner.clone();
-        py.detach(move || voxkit_job::output::write(&path, target, &inner.voxels, &inner.grid, inner.attrs.as_ref(), &opts))
+        py.detach(move || topovox_job::output::write(&path, target, &inner.voxels, &inner.grid, inner.attrs.as_ref(), &opts))
             .map_err(py_err)?;
         Ok(())
     }
 
-    /// check(mesh=None) -> dict: the `voxkit check` report (components,
+    /// check(mesh=None) -> dict: the `topovox check` report (components,
     /// thick voxels; with the mesh: closedness, separation with witnesses,
     /// thinness, tunnels). A tiled grid (past memory) is checked window by
     /// window without a dense copy (`sparse` is true in the report).
@@ -449,11 +449,11 @@ impl VoxelGrid {
             .detach(move || {
                 let mesh = m.as_ref().map(|m| (m.mesh.as_ref(), &inner.grid, "grid"));
                 match &inner.voxels {
-                    voxkit_job::Voxels::Sparse(s) => {
-                        let layers = voxkit_job::check::window_layers(s.dims(), voxkit_job::budget(None));
-                        voxkit_job::check::report_sparse(s, mesh, layers)
+                    topovox_job::Voxels::Sparse(s) => {
+                        let layers = topovox_job::check::window_layers(s.dims(), topovox_job::budget(None));
+                        topovox_job::check::report_sparse(s, mesh, layers)
                     }
-                    voxels => voxkit_job::check::report(&voxels.to_dense(), mesh),
+                    voxels => topovox_job::check::report(&voxels.to_dense(), mesh),
                 }
             })
             .map_err(py_err)?;
@@ -513,7 +513,7 @@ impl VoxelGrid {
     fn __repr__(&self) -> String {
         let [x, y, z] = self.inner.grid.dims();
         let mode = self.inner.facts.get("mode").and_then(Value::as_str).map(|m| format!(" {m}")).unwrap_or_default();
-        format!("<voxkit.VoxelGrid{mode} {x}x{y}x{z}, {} voxels, voxel size {}>", self.inner.voxels.count(), self.inner.grid.voxel_size())
+        format!("<topovox.VoxelGrid{mode} {x}x{y}x{z}, {} voxels, voxel size {}>", self.inner.voxels.count(), self.inner.grid.voxel_size())
     }
 }
 
@@ -528,8 +528,8 @@ type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>, Option<Vec<[u8; 3]>>);
 /// Greedy quads of the voxels (coloured when the grid has colours), with
 /// their T-junctions split (watertight), as world-space triangles.
 fn greedy_triangles(g: &GridData) -> Triangles {
-    use voxkit::attributes::quantize;
-    use voxkit::export::greedy::{greedy_quads, greedy_quads_by_class};
+    use topovox::attributes::quantize;
+    use topovox::export::greedy::{greedy_quads, greedy_quads_by_class};
     let dense = g.voxels.to_dense();
     let coloured = g.attrs.as_ref().and_then(|a| a.colour.as_ref().map(|c| (a, c)));
     let (palette, quads) = match coloured {
@@ -546,7 +546,7 @@ fn greedy_triangles(g: &GridData) -> Triangles {
     let mut verts = Vec::with_capacity(quads.len() * 2);
     let mut faces = Vec::with_capacity(quads.len() * 3);
     let mut colours = palette.as_ref().map(|_| Vec::with_capacity(quads.len() * 3));
-    for f in voxkit::export::watertight::conform(&quads) {
+    for f in topovox::export::watertight::conform(&quads) {
         let ids: Vec<u32> = f
             .vertices
             .iter()
@@ -561,7 +561,7 @@ fn greedy_triangles(g: &GridData) -> Triangles {
             faces.push([ids[0], ids[t], ids[t + 1]]);
             if let (Some(out), Some(p)) = (colours.as_mut(), palette.as_ref()) {
                 out.push(
-                    f.class.checked_sub(1).and_then(|i| p.get(i as usize)).copied().unwrap_or(voxkit::attributes::carry::DEFAULT_COLOUR),
+                    f.class.checked_sub(1).and_then(|i| p.get(i as usize)).copied().unwrap_or(topovox::attributes::carry::DEFAULT_COLOUR),
                 );
             }
         }
@@ -592,29 +592,29 @@ fn plan_of(
     seed: u64,
     tile: Option<u32>,
     max_memory: Option<&str>,
-) -> Result<voxkit_job::Plan, JobError> {
-    let request = voxkit_job::Request {
-        mode: voxkit_job::Mode::parse(mode)?,
-        method: voxkit_job::Method::parse(method)?,
+) -> Result<topovox_job::Plan, JobError> {
+    let request = topovox_job::Request {
+        mode: topovox_job::Mode::parse(mode)?,
+        method: topovox_job::Method::parse(method)?,
         grid: GridRequest::new(grid)?,
-        surface: surface.map(voxkit_job::Mode::parse).transpose()?,
+        surface: surface.map(topovox_job::Mode::parse).transpose()?,
         fill: match fill {
             None => None,
-            Some("flood") => Some(voxkit_job::Fill::Flood),
+            Some("flood") => Some(topovox_job::Fill::Flood),
             Some(f) => return Err(JobError::invalid(format!("unknown fill {f:?} (expected \"flood\")"))),
         },
         hollow,
         gpu_path: match gpu_path {
-            "compute" => voxkit_job::GpuPath::Compute,
-            "raster" => voxkit_job::GpuPath::Raster,
-            "msaa-approx" => voxkit_job::GpuPath::MsaaApprox,
+            "compute" => topovox_job::GpuPath::Compute,
+            "raster" => topovox_job::GpuPath::Raster,
+            "msaa-approx" => topovox_job::GpuPath::MsaaApprox,
             p => return Err(JobError::invalid(format!("unknown gpu_path {p:?} (expected compute, raster or msaa-approx)"))),
         },
         seed,
         tile,
-        max_memory: max_memory.map(voxkit_job::parse_size).transpose()?,
+        max_memory: max_memory.map(topovox_job::parse_size).transpose()?,
     };
-    voxkit_job::Plan::new(request)
+    topovox_job::Plan::new(request)
 }
 
 fn colour_rule(rule: &str) -> Result<ColourRule, JobError> {
@@ -625,7 +625,7 @@ fn colour_rule(rule: &str) -> Result<ColourRule, JobError> {
     }
 }
 
-/// The native voxelize: see `voxkit.voxelize` for the documentation.
+/// The native voxelize: see `topovox.voxelize` for the documentation.
 #[pyfunction]
 #[pyo3(signature = (mesh, *, mode="cover", resolution=None, voxel_size=None, origin=None, dims=None, pad=None, method="auto", threads=None,
     attributes=false, colour_rule="dominant", normals=false, surface=None, fill=None, hollow=None, gpu_path="compute", seed=0,
@@ -656,16 +656,16 @@ fn voxelize(
     let grid = grid_options(resolution, voxel_size, origin, dims, pad);
     let plan = plan_of(mode, method, &grid, surface, fill, hollow, gpu_path, seed, tile, max_memory).map_err(py_err)?;
     let carry = CarryOptions { rule: self::colour_rule(colour_rule).map_err(py_err)?, normals };
-    let pool = threads.map(voxkit_job::pool).transpose().map_err(py_err)?;
+    let pool = threads.map(topovox_job::pool).transpose().map_err(py_err)?;
     let inner = mesh.inner.clone();
     let name = mesh.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into());
     let data = py
         .detach(move || {
             let run = || -> Result<GridData, JobError> {
-                let v = voxkit_job::voxelize(&plan, inner.mesh.as_ref(), &name, None)?;
+                let v = topovox_job::voxelize(&plan, inner.mesh.as_ref(), &name, None)?;
                 let attrs = if attributes && !plan.is_line() {
-                    voxkit_job::check_attributes_carried(&plan, &v)?;
-                    voxkit_job::attributes(&plan, inner.mesh.as_ref(), &inner.appearance, &v, &carry)
+                    topovox_job::check_attributes_carried(&plan, &v)?;
+                    topovox_job::attributes(&plan, inner.mesh.as_ref(), &inner.appearance, &v, &carry)
                 } else {
                     None
                 };
@@ -683,8 +683,8 @@ fn voxelize(
 }
 
 /// `x`, `y` or `z` as an up axis.
-fn up_of(up: &str) -> PyResult<voxkit_io::orient::Up> {
-    voxkit_io::orient::Up::from_name(up).ok_or_else(|| value_err(format!("up must be \"x\", \"y\" or \"z\"; got {up:?}")))
+fn up_of(up: &str) -> PyResult<topovox_io::orient::Up> {
+    topovox_io::orient::Up::from_name(up).ok_or_else(|| value_err(format!("up must be \"x\", \"y\" or \"z\"; got {up:?}")))
 }
 
 /// load_voxels(path, origin=None, voxel_size=None, up="y") -> VoxelGrid
@@ -693,7 +693,7 @@ fn up_of(up: &str) -> PyResult<voxkit_io::orient::Up> {
 fn load_voxels(py: Python<'_>, path: PathBuf, origin: Option<Vec<f64>>, voxel_size: Option<f64>, up: &str) -> PyResult<VoxelGrid> {
     let p = path.clone();
     let up = up_of(up)?;
-    let loaded = py.detach(move || voxkit_io::read_voxels_with(&p, up)).map_err(io_err)?;
+    let loaded = py.detach(move || topovox_io::read_voxels_with(&p, up)).map_err(io_err)?;
     let dims = loaded.bits.dims();
     let o = match origin {
         Some(o) if o.len() == 3 => DVec3::new(o[0], o[1], o[2]),
@@ -708,7 +708,7 @@ fn load_voxels(py: Python<'_>, path: PathBuf, origin: Option<Vec<f64>>, voxel_si
 
 /// The options of a batch, validated, and its fingerprint.
 #[allow(clippy::too_many_arguments)]
-fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_job::batch::BatchOptions, Option<usize>)> {
+fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(topovox_job::batch::BatchOptions, Option<usize>)> {
     let get_str = |k: &str| -> PyResult<Option<String>> { options.get_item(k)?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose() };
     let get_u64 = |k: &str| -> PyResult<Option<u64>> { options.get_item(k)?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose() };
     let known = [
@@ -758,11 +758,11 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
     let hollow = get_u64("hollow")?.map(|h| h as u32);
     let seed = get_u64("seed")?.unwrap_or(0);
     let plan = plan_of(&mode, &method, &grid, surface.as_deref(), fill.as_deref(), hollow, &gpu_path, seed, None, None).map_err(py_err)?;
-    let target = voxkit_job::output::Output::from_name(format)
-        .ok_or_else(|| value_err(format!("unknown format {format:?} (expected one of: {})", voxkit_job::output::Output::names())))?;
+    let target = topovox_job::output::Output::from_name(format)
+        .ok_or_else(|| value_err(format!("unknown format {format:?} (expected one of: {})", topovox_job::output::Output::names())))?;
     let threads = get_u64("threads")?.map(|t| t as usize);
     let jobs = get_u64("jobs")?.map(|t| t as usize);
-    let fingerprint = voxkit_job::batch::fingerprint(&voxkit_job::batch::FingerprintParts {
+    let fingerprint = topovox_job::batch::fingerprint(&topovox_job::batch::FingerprintParts {
         mode: &mode,
         method: &method,
         grid: &grid,
@@ -780,19 +780,19 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
         triangulate,
         seed,
     });
-    let opts = voxkit_job::batch::BatchOptions {
+    let opts = topovox_job::batch::BatchOptions {
         plan,
         format: target,
         carry: CarryOptions { rule: self::colour_rule(&rule).map_err(py_err)?, normals: normals || attributes },
         attributes,
-        write: voxkit_io::WriteOptions {
+        write: topovox_io::WriteOptions {
             dither,
             blocks: None,
             up: up_axis,
-            mesh: voxkit_io::voxel_mesh::MeshOptions { watertight, triangulate },
+            mesh: topovox_io::voxel_mesh::MeshOptions { watertight, triangulate },
         },
         threads,
-        read: voxkit_io::ReadOptions {
+        read: topovox_io::ReadOptions {
             allow_external_paths: options
                 .get_item("allow_external_paths")?
                 .filter(|v| !v.is_none())
@@ -805,7 +805,7 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(voxkit_
     Ok((opts, jobs))
 }
 
-/// The native batch: see `voxkit.batch`.
+/// The native batch: see `topovox.batch`.
 #[pyfunction]
 #[pyo3(signature = (inputs, out_dir, format="npy", glob=None, options=None))]
 fn batch<'py>(
@@ -819,12 +819,12 @@ fn batch<'py>(
     let empty = PyDict::new(py);
     let (opts, jobs) = batch_options(options.unwrap_or(&empty), format)?;
     let summary = py
-        .detach(move || -> Result<voxkit_job::batch::Summary, JobError> {
-            let files = voxkit_job::batch::collect_inputs(&inputs, glob.as_deref())?;
+        .detach(move || -> Result<topovox_job::batch::Summary, JobError> {
+            let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref())?;
             let ext = opts.format.name().replace("npy-bool", "npy");
-            let items = voxkit_job::batch::plan_items(&files, &out_dir, &ext)?;
-            let pool = voxkit_job::pool(jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)))?;
-            pool.install(|| voxkit_job::batch::run(&items, &out_dir, &opts, &voxkit_job::batch::Silent))
+            let items = topovox_job::batch::plan_items(&files, &out_dir, &ext)?;
+            let pool = topovox_job::pool(jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)))?;
+            pool.install(|| topovox_job::batch::run(&items, &out_dir, &opts, &topovox_job::batch::Silent))
         })
         .map_err(py_err)?;
     to_py(py, &summary.to_json())
@@ -845,11 +845,11 @@ fn batch_plan<'py>(
 ) -> PyResult<BatchListing<'py>> {
     let empty = PyDict::new(py);
     let (opts, _) = batch_options(options.unwrap_or(&empty), format)?;
-    let files = voxkit_job::batch::collect_inputs(&inputs, glob.as_deref()).map_err(py_err)?;
+    let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref()).map_err(py_err)?;
     let ext = opts.format.name().replace("npy-bool", "npy");
-    let items = voxkit_job::batch::plan_items(&files, &out_dir, &ext).map_err(py_err)?;
-    std::fs::create_dir_all(&out_dir).map_err(|e| io_err(voxkit_io::IoError::new(&out_dir, voxkit_io::ErrorKind::Write(e))))?;
-    let manifest = voxkit_job::batch::Manifest::open(&out_dir).map_err(py_err)?;
+    let items = topovox_job::batch::plan_items(&files, &out_dir, &ext).map_err(py_err)?;
+    std::fs::create_dir_all(&out_dir).map_err(|e| io_err(topovox_io::IoError::new(&out_dir, topovox_io::ErrorKind::Write(e))))?;
+    let manifest = topovox_job::batch::Manifest::open(&out_dir).map_err(py_err)?;
     let listed = items
         .iter()
         .map(|i| (i.input.display().to_string(), i.output.display().to_string(), manifest.is_done(i, &opts.fingerprint)))
@@ -871,8 +871,8 @@ fn process_one<'py>(
     let empty = PyDict::new(py);
     let (mut opts, _) = batch_options(options.unwrap_or(&empty), format)?;
     opts.threads = opts.threads.or(Some(1));
-    let item = voxkit_job::batch::Item { input, output };
-    let record = py.detach(move || voxkit_job::batch::process_one(&item, &opts));
+    let item = topovox_job::batch::Item { input, output };
+    let record = py.detach(move || topovox_job::batch::process_one(&item, &opts));
     to_py(py, &record)
 }
 
@@ -881,7 +881,7 @@ fn process_one<'py>(
 #[pyfunction]
 fn append_manifest(py: Python<'_>, out_dir: PathBuf, records: Vec<String>) -> PyResult<()> {
     py.detach(move || -> Result<(), JobError> {
-        let m = voxkit_job::batch::Manifest::open(&out_dir)?;
+        let m = topovox_job::batch::Manifest::open(&out_dir)?;
         for r in records {
             let v: Value = serde_json::from_str(&r).map_err(|e| JobError::invalid(format!("manifest record is not JSON: {e}")))?;
             m.append(&v)?;
@@ -892,7 +892,7 @@ fn append_manifest(py: Python<'_>, out_dir: PathBuf, records: Vec<String>) -> Py
 }
 
 #[pymodule]
-fn _voxkit(m: &Bound<'_, PyModule>) -> PyResult<()> {
+fn _topovox(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("FileFormatError", m.py().get_type::<FileFormatError>())?;
     m.add_class::<Mesh>()?;

@@ -11,11 +11,11 @@ REPO = pathlib.Path(__file__).resolve().parents[2]
 
 
 def shared_meshes() -> pathlib.Path:
-    env = os.environ.get("VOXKIT_SHARED")
+    env = os.environ.get("TOPOVOX_SHARED")
     root = pathlib.Path(env) if env else REPO.parent / "shared"
     d = root / "meshes"
     if not d.is_dir():
-        pytest.fail(f"shared meshes not found at {d} (set VOXKIT_SHARED)")
+        pytest.fail(f"shared meshes not found at {d} (set TOPOVOX_SHARED)")
     return d
 
 
@@ -26,11 +26,11 @@ def meshes() -> pathlib.Path:
 
 @pytest.fixture(scope="session")
 def cli() -> pathlib.Path:
-    """The `voxkit` binary: $VOXKIT_BIN, else target/release/voxkit (built if missing)."""
-    env = os.environ.get("VOXKIT_BIN")
-    path = pathlib.Path(env) if env else REPO / "target" / "release" / "voxkit"
+    """The `topovox` binary: $TOPOVOX_BIN, else target/release/topovox (built if missing)."""
+    env = os.environ.get("TOPOVOX_BIN")
+    path = pathlib.Path(env) if env else REPO / "target" / "release" / "topovox"
     if not path.exists():
-        subprocess.run(["cargo", "build", "--release", "-p", "voxkit-cli"], cwd=REPO, check=True)
+        subprocess.run(["cargo", "build", "--release", "-p", "topovox-cli"], cwd=REPO, check=True)
     return path
 
 

@@ -1,4 +1,4 @@
-"""Whole datasets: `voxkit batch`, `voxkit.batch`, and the Dask and Ray
+"""Whole datasets: `topovox batch`, `topovox.batch`, and the Dask and Ray
 helpers write the same outputs and manifest lines, and resume each other."""
 
 import json
@@ -7,7 +7,7 @@ import shutil
 import numpy as np
 import pytest
 
-import voxkit
+import topovox
 from conftest import run_cli
 
 MESHES = ["cow.obj", "suzanne.obj", "teapot.obj", "woody.obj", "beetle.obj", "alligator.obj"]
@@ -27,7 +27,7 @@ def dataset(tmp_path, meshes):
 
 
 def manifest(out):
-    """The manifest's records; a torn line (a crash mid-write) is skipped, as voxkit does."""
+    """The manifest's records; a torn line (a crash mid-write) is skipped, as topovox does."""
     records = []
     for line in (out / "manifest.jsonl").read_text().splitlines():
         try:
@@ -47,7 +47,7 @@ def test_python_batch_equals_cli_batch_and_resumes(tmp_path, dataset, cli):
     assert r.returncode == 1 and "1 of 7 meshes failed" in r.stderr
     summary = json.loads(r.stdout)
     assert (summary["done"], summary["failed"], summary["skipped"]) == (6, 1, 0)
-    s = voxkit.batch(dataset, py_out, resolution=32, mode="sep6")
+    s = topovox.batch(dataset, py_out, resolution=32, mode="sep6")
     assert (s["done"], s["failed"], s["skipped"]) == (6, 1, 0)
     a, b = outputs(cli_out), outputs(py_out)
     assert a.keys() == b.keys() and len(a) == 6
@@ -55,7 +55,7 @@ def test_python_batch_equals_cli_batch_and_resumes(tmp_path, dataset, cli):
     for k in a:
         assert np.array_equal(a[k], b[k]), k
     # The same voxels as voxelize().
-    one = voxkit.voxelize(voxkit.load_mesh(dataset / "b" / "deep" / "cow.obj"), mode="sep6", resolution=32).occupancy
+    one = topovox.voxelize(topovox.load_mesh(dataset / "b" / "deep" / "cow.obj"), mode="sep6", resolution=32).occupancy
     assert np.array_equal(b["b/deep/cow.npy"].astype(bool), one)
     lines = manifest(py_out)
     assert {line["status"] for line in lines} == {"done", "failed"}
@@ -64,25 +64,25 @@ def test_python_batch_equals_cli_batch_and_resumes(tmp_path, dataset, cli):
     done = [line for line in lines if line["status"] == "done"][0]
     assert set(done) >= {"input", "output", "grid", "voxels", "times", "options", "error"}
     # Resuming: the done ones are skipped, the failed one is tried again.
-    s2 = voxkit.batch(dataset, py_out, resolution=32, mode="sep6")
+    s2 = topovox.batch(dataset, py_out, resolution=32, mode="sep6")
     assert (s2["done"], s2["failed"], s2["skipped"]) == (0, 1, 6)
     # The CLI resumes the Python run (same options, same manifest).
     r2 = json.loads(run_cli(cli, "batch", dataset, "-o", py_out, "--resolution", 32, "--mode", "sep6", "--json", check=False).stdout)
     assert r2["skipped"] == 6
     # Other options redo everything.
-    s3 = voxkit.batch(dataset, py_out, resolution=16, mode="sep6")
+    s3 = topovox.batch(dataset, py_out, resolution=16, mode="sep6")
     assert s3["done"] == 6
 
 
 def test_a_deleted_or_torn_output_is_redone(tmp_path, dataset):
     out = tmp_path / "o"
-    voxkit.batch(dataset, out, resolution=16, glob="**/*.obj")
+    topovox.batch(dataset, out, resolution=16, glob="**/*.obj")
     victim = out / "a" / "suzanne.npy"
     victim.unlink()
     # A torn manifest line (a crash mid-write) is ignored.
     with open(out / "manifest.jsonl", "a") as f:
         f.write('{"input": "x", "status": "do')
-    s = voxkit.batch(dataset, out, resolution=16, glob="**/*.obj")
+    s = topovox.batch(dataset, out, resolution=16, glob="**/*.obj")
     assert (s["done"], s["skipped"]) == (1, 5) and victim.exists()
     # The records after the torn line start on lines of their own.
     assert any(r["input"].endswith("suzanne.obj") and r["status"] == "done" for r in manifest(out)[-2:])
@@ -90,26 +90,26 @@ def test_a_deleted_or_torn_output_is_redone(tmp_path, dataset):
 
 def test_batch_errors(tmp_path, dataset, meshes):
     with pytest.raises(ValueError, match="no input meshes found"):
-        voxkit.batch(dataset, tmp_path / "o", glob="**/*.stl")
+        topovox.batch(dataset, tmp_path / "o", glob="**/*.stl")
     clash = tmp_path / "clash"
     clash.mkdir()
     shutil.copy(meshes / "cow.obj", clash / "m.obj")
     (clash / "m.stl").write_bytes(b"solid x\nendsolid x\n")
     with pytest.raises(ValueError, match="would both be written to"):
-        voxkit.batch(clash, tmp_path / "o2")
+        topovox.batch(clash, tmp_path / "o2")
     with pytest.raises(ValueError, match="unknown batch option"):
-        voxkit.batch(dataset, tmp_path / "o3", resolutoin=3)
+        topovox.batch(dataset, tmp_path / "o3", resolutoin=3)
     with pytest.raises(FileNotFoundError):
-        voxkit.batch(tmp_path / "missing", tmp_path / "o4")
+        topovox.batch(tmp_path / "missing", tmp_path / "o4")
 
 
 def test_dask_local_cluster_writes_what_batch_writes(tmp_path, dataset):
     dask = pytest.importorskip("dask")
     distributed = pytest.importorskip("dask.distributed")
-    import voxkit.dask as vd
+    import topovox.dask as vd
 
     ref = tmp_path / "ref"
-    voxkit.batch(dataset, ref, resolution=24, glob="**/*.obj")
+    topovox.batch(dataset, ref, resolution=24, glob="**/*.obj")
     out = tmp_path / "dask"
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         with distributed.Client(cluster):
@@ -122,17 +122,17 @@ def test_dask_local_cluster_writes_what_batch_writes(tmp_path, dataset):
     for k in a:
         assert np.array_equal(a[k], b[k]), k
     assert len(manifest(out)) == 7
-    # voxkit batch resumes the Dask run.
-    s = voxkit.batch(dataset, out, resolution=24, glob="**/*.obj")
+    # topovox batch resumes the Dask run.
+    s = topovox.batch(dataset, out, resolution=24, glob="**/*.obj")
     assert s["skipped"] == 6
 
 
 def test_ray_tasks_write_what_batch_writes(tmp_path, dataset):
     ray = pytest.importorskip("ray")
-    import voxkit.ray as vr
+    import topovox.ray as vr
 
     ref = tmp_path / "ref"
-    voxkit.batch(dataset, ref, resolution=24, glob="**/*.obj")
+    topovox.batch(dataset, ref, resolution=24, glob="**/*.obj")
     out = tmp_path / "ray"
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, ignore_reinit_error=True)
     try:
@@ -144,7 +144,7 @@ def test_ray_tasks_write_what_batch_writes(tmp_path, dataset):
     assert a.keys() == b.keys()
     for k in a:
         assert np.array_equal(a[k], b[k]), k
-    s = voxkit.batch(dataset, out, resolution=24, glob="**/*.obj")
+    s = topovox.batch(dataset, out, resolution=24, glob="**/*.obj")
     assert s["skipped"] == 6
 
 
@@ -158,8 +158,8 @@ def test_batch_attributes_into_vdb(tmp_path, meshes, cli):
     shutil.copy(meshes / "spot.mtl", src)
     shutil.copy(meshes / "spot_texture.png", src)
     plain, py_out, cli_out = tmp_path / "plain", tmp_path / "py", tmp_path / "cli"
-    assert voxkit.batch(src, plain, format="vdb", resolution=24)["done"] == 1
-    assert voxkit.batch(src, py_out, format="vdb", resolution=24, attributes=True)["done"] == 1
+    assert topovox.batch(src, plain, format="vdb", resolution=24)["done"] == 1
+    assert topovox.batch(src, py_out, format="vdb", resolution=24, attributes=True)["done"] == 1
     run_cli(cli, "batch", src, "-o", cli_out, "--format", "vdb", "--resolution", 24, "--attributes", "--json")
     a, b = (py_out / "spot-textured.vdb").read_bytes(), (cli_out / "spot-textured.vdb").read_bytes()
     assert a == b
@@ -169,4 +169,4 @@ def test_batch_attributes_into_vdb(tmp_path, meshes, cli):
     assert manifest(py_out)[0]["options"]["attributes"] is True
     assert "attributes" not in manifest(plain)[0]["options"]
     # Other options redo the mesh: attributes asked for after a plain run.
-    assert voxkit.batch(src, plain, format="vdb", resolution=24, attributes=True)["done"] == 1
+    assert topovox.batch(src, plain, format="vdb", resolution=24, attributes=True)["done"] == 1

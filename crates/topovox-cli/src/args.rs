@@ -1,0 +1,742 @@
+//! Raw command-line arguments (stage one of two: see `plan.rs`).
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+/// topovox: voxelize triangle meshes with guaranteed topology.
+#[derive(Parser, Debug)]
+#[command(name = "topovox", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Voxelize a mesh into a voxel file (.npy, .binvox, .vox, .txt).
+    Voxelize(VoxelizeArgs),
+    /// Print a report of a mesh file: vertices, triangles, degenerate triangles, bounds.
+    Info(InfoArgs),
+    /// Benchmark voxelization (medians over repeats) on a mesh at several resolutions.
+    Bench(BenchArgs),
+    /// Certify a voxel file's topology: components, and with the source mesh
+    /// separation (with a witness), thinness and tunnels.
+    Check(CheckArgs),
+    /// Compare a mode's voxels with reference modes on meshes: voxels
+    /// missing and extra, and whether `check` certifies 6-separation (the
+    /// gap table of the published `pos` algorithm).
+    Gaps(GapsArgs),
+    /// Render a voxel file or a mesh to a PNG picture (CPU ray casting; with
+    /// --gpu, the GPU renderer: clusters, one multi-draw-indirect call, GPU
+    /// frustum culling, light grid, Blinn–Phong).
+    Render(RenderArgs),
+    /// Open a window on a mesh (and its voxels) with the GPU renderer:
+    /// orbit and fly camera, keys switching culling, prepass and gamma.
+    View(ViewArgs),
+    /// Write a bundled test scene (OBJ + MTL, textures as PNG beside): the
+    /// Cornell box, a city of about a million triangles with 169 emissive
+    /// street lamps and cut-out foliage, or the alpha test's three quads.
+    Scene(SceneArgs),
+    /// Spray rays from a camera into a mesh: each hit becomes a point with
+    /// its albedo, emission and light term (Lambert term and attenuation
+    /// towards light samples on the emissive triangles, shadow rays), saved
+    /// as PLY and drawn by render --gpu --points and view --points.
+    Spray(SprayArgs),
+    /// Convert a voxel file to another voxel format, or to a mesh of the voxels (.obj, greedy quads).
+    Convert(ConvertArgs),
+    /// Voxelize whole datasets: one output per input mesh, a manifest of
+    /// JSON lines, resumable, a bad mesh recorded without stopping the rest.
+    Batch(BatchArgs),
+    /// Rasterize an SVG's outlines in 2D with a connectivity guarantee
+    /// (curve4, curve8, diamond) or fill them (nonzero rule).
+    Raster(RasterArgs),
+}
+
+/// Voxelization modes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Mode {
+    /// Conservative surface: every voxel whose closed box meets a triangle.
+    Cover,
+    /// Laine's minimal 26-separating surface (space-diagonal target).
+    Sep26,
+    /// Laine's thin 6-separating surface (3D crosshair target).
+    Sep6,
+    /// Schwarz–Seidel 6-separating surface.
+    Ss6,
+    /// Solid: voxels whose centre is inside.
+    Solid,
+    /// Solid united with a surface mode (--surface), so thin parts never vanish.
+    #[value(name = "solid+surface")]
+    SolidSurface,
+    /// 6-connected polyline voxelization.
+    Line6,
+    /// 26-connected polyline voxelization.
+    Line26,
+    /// Projected optimal scanline, as published.
+    Pos,
+    /// 18-tunnel-free surface: targets from the centre to face centres and edge midpoints.
+    Tunnel18,
+    /// 26-tunnel-free surface: also from the centre to the corners.
+    Tunnel26,
+    /// Randomized 6-separating surface: the crosshair's joins at random points (--seed).
+    Bubble,
+    /// 6-separating surface from one alternating body diagonal per voxel.
+    Diagonal,
+}
+
+/// Extra baselines of `topovox bench`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Baseline {
+    /// The brute-force loop: bounding box × f64 triangle/box test, one thread.
+    Brute,
+}
+
+/// Solid filling strategies other than the inside test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Fill {
+    /// Everything not reachable from the grid boundary through unset voxels of a surface shell.
+    Flood,
+}
+
+/// Voxelization methods.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Method {
+    /// The fastest correct method for the mode.
+    Auto,
+    /// The slow brute-force reference implementation of the mode.
+    Reference,
+    /// The triangle/box fast path (Schwarz & Seidel 2010), parallel.
+    Fast,
+    /// Projected optimal scanline fast path.
+    Scanline,
+    /// GPU (wgpu).
+    Gpu,
+    /// Solid by ray parity.
+    Parity,
+    /// Solid by generalized winding number.
+    Winding,
+}
+
+/// How the grid is chosen.
+#[derive(Args, Debug, Clone, Default)]
+pub struct GridArgs {
+    /// Fit the grid so the longest side of the mesh's bounding box spans N voxels (default 128).
+    #[arg(long, value_name = "N")]
+    pub resolution: Option<u64>,
+    /// Voxel edge length; alone, fits the grid to the mesh's bounding box.
+    #[arg(long, value_name = "S")]
+    pub voxel_size: Option<f64>,
+    /// Explicit grid origin (with --voxel-size and --dims).
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', allow_hyphen_values = true)]
+    pub origin: Option<Vec<f64>>,
+    /// Explicit grid dims (with --origin and --voxel-size).
+    #[arg(long, value_name = "NX,NY,NZ", value_delimiter = ',')]
+    pub dims: Option<Vec<u64>>,
+    /// Empty voxels added on every side of a fitted grid (default 0).
+    #[arg(long, value_name = "P")]
+    pub pad: Option<u32>,
+}
+
+/// Grids past memory: the tiled path and the memory it may use.
+#[derive(Args, Debug, Default)]
+pub struct MemoryArgs {
+    /// Memory the run may use, e.g. 8G or 512M (default: nine tenths of
+    /// what is available). Surface and line modes on grids that do not fit densely
+    /// run tile by tile into sparse storage; write those to .vdb, .txt or .ply.
+    #[arg(long, value_name = "SIZE")]
+    pub max_memory: Option<String>,
+    /// Run the surface or line mode tile by tile with tiles of N voxels (a multiple
+    /// of 8; default: only when the grid does not fit in --max-memory, with
+    /// tiles of 512). Same voxels either way.
+    #[arg(long, value_name = "N")]
+    pub tile: Option<u32>,
+}
+
+#[derive(Args, Debug)]
+pub struct VoxelizeArgs {
+    /// Input mesh (.obj, .stl, .ply, .gltf, .glb).
+    pub mesh: PathBuf,
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder: absolute paths,
+    /// `../`, links leading out. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
+    /// Output file: .npy, .binvox, .vox, .txt, .schem, .vti, .ply (voxels),
+    /// or .obj / .glb (a mesh of the voxels); the format comes from the
+    /// extension unless --format is given. `-` writes to standard output
+    /// (with --format).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Voxelization mode.
+    #[arg(long, value_enum, default_value = "cover")]
+    pub mode: Mode,
+    /// Method.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub method: Method,
+    /// `bubble`: the seed of its random points (same seed, same voxels; default 0).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Solid modes: the surface mode of `solid+surface` and of the
+    /// `--fill flood` shell (default cover).
+    #[arg(long, value_enum, value_name = "MODE")]
+    pub surface: Option<Mode>,
+    /// Solid modes: `flood` fills everything a surface shell encloses
+    /// (everything not reachable from the grid boundary through unset voxels).
+    #[arg(long, value_enum)]
+    pub fill: Option<Fill>,
+    /// Solid modes: keep only the voxels touching the outside through a face
+    /// (6) or also an edge or corner (26).
+    #[arg(long, value_name = "6|26", value_parser = clap::builder::PossibleValuesParser::new(["6", "26"]))]
+    pub hollow: Option<String>,
+    #[command(flatten)]
+    pub grid: GridArgs,
+    #[command(flatten)]
+    pub memory: MemoryArgs,
+    /// With --method gpu: `compute` (default), `raster` (the rasterizer path, same voxels), or
+    /// `msaa-approx` (rasterizer with 4x MSAA instead of conservative coverage: approximate, misses
+    /// voxels; the summary says how many).
+    #[arg(long, value_enum, default_value = "compute", value_name = "PATH")]
+    pub gpu_path: GpuPathArg,
+    /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, or obj / glb for a mesh of the voxels (default: from the extension).
+    #[arg(long, value_name = "FORMAT")]
+    pub format: Option<String>,
+    /// Also render the result to this PNG (see `topovox render` for --view, --size, --up, --outline).
+    #[arg(long, value_name = "PNG")]
+    pub preview: Option<PathBuf>,
+    #[command(flatten)]
+    pub picture: PictureArgs,
+    #[command(flatten)]
+    pub export: ExportArgs,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress bar and no summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Colour and attribute options of the writers.
+#[derive(Args, Debug, Clone, Default)]
+pub struct ExportArgs {
+    /// How the colours of the surface inside a voxel combine: `dominant` (the colour covering the most area; never a new colour) or `blend` (area-weighted mean in linear light).
+    #[arg(long, value_enum, default_value = "dominant", value_name = "RULE")]
+    pub colour_rule: ColourRule,
+    /// .vti: also store each voxel's average surface normal.
+    #[arg(long)]
+    pub normals: bool,
+    /// .vdb and .zarr: also write what the surface carries into each voxel.
+    /// .vdb: grids over the same voxels beside the `voxels` bool grid: `Cd`
+    /// (colour, linear RGB; when the mesh has colours), `normal`, `coverage`
+    /// (surface area inside the voxel over a voxel face's) and `material`
+    /// (the id as a float, -1 for none). .zarr: a group of arrays `voxels`,
+    /// `colour` (uint8 sRGB, last axis of 3), `normal` (float32, 3),
+    /// `coverage` (float32) and `material` (int32, -1 for none).
+    #[arg(long)]
+    pub attributes: bool,
+    /// .vox: dither colours onto the 255-colour palette (error diffusion; off by default).
+    #[arg(long)]
+    pub dither: bool,
+    /// .schem: a colour -> block table, `namespace:block R G B` per line (default: the built-in table).
+    #[arg(long, value_name = "FILE")]
+    pub block_palette: Option<PathBuf>,
+    /// The axis of the mesh (and the voxel grid) that points up: .vox and
+    /// .schem are rotated (never mirrored) so the model stands upright in
+    /// MagicaVoxel (z-up) and Minecraft (y-up), and --preview draws it up.
+    /// Default: y, as for most OBJ, glTF, PLY and STL models.
+    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
+    pub up: Option<String>,
+    /// .obj and .glb meshes of the voxels: `on` (default) splits the greedy
+    /// quads at T-junctions so every edge is shared (watertight, for 3D
+    /// printing and booleans); `off` keeps the plain quads.
+    #[arg(long, value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub watertight: Option<String>,
+    /// .obj meshes of the voxels: triangles only (quads split in two); for
+    /// readers that take only triangles, such as Open3D.
+    #[arg(long)]
+    pub triangulate: bool,
+}
+
+/// `--gpu-path`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum GpuPathArg {
+    /// Compute shaders, one workgroup per triangle.
+    #[default]
+    Compute,
+    /// The rasterizer: dominant-axis projection, conservative coverage, exact tests per fragment.
+    Raster,
+    /// The rasterizer with 4x MSAA: approximate.
+    MsaaApprox,
+}
+
+/// `--colour-rule`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum ColourRule {
+    /// The colour covering the most area.
+    #[default]
+    Dominant,
+    /// The area-weighted mean, in linear light.
+    Blend,
+}
+
+/// How a picture is taken.
+#[derive(Args, Debug, Clone)]
+pub struct PictureArgs {
+    /// Camera: iso, x, y, z (from that axis's positive side), or AZIMUTH,ELEVATION in degrees.
+    #[arg(long, default_value = "iso", value_name = "VIEW")]
+    pub view: String,
+    /// Picture size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1024x768", value_name = "WxH")]
+    pub size: String,
+    /// Draw the outline of the source mesh's silhouette over the voxels (mesh inputs and --preview).
+    #[arg(long)]
+    pub outline: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder: absolute paths,
+    /// `../`, links leading out. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
+    /// A voxel file (.npy, .binvox, .vox, .txt) or a mesh (voxelized first, with --mode and the grid options).
+    pub input: PathBuf,
+    /// Output picture (.png).
+    #[arg(short, long, value_name = "PNG")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub picture: PictureArgs,
+    /// The axis drawn pointing up: x, y or z (default y: OBJ and glTF
+    /// models are usually y-up). For .vox and .schem inputs, also the axis
+    /// they were written with (`--up` of voxelize), unless they record it.
+    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
+    pub up: Option<String>,
+    /// For a mesh: the surface mode to voxelize with.
+    #[arg(long, value_enum, default_value = "cover")]
+    pub mode: Mode,
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// For a mesh: how surface colours combine in a voxel (dominant or blend).
+    #[arg(long, value_enum, default_value = "dominant", value_name = "RULE")]
+    pub colour_rule: ColourRule,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub gpu: GpuRenderArgs,
+}
+
+/// The GPU renderer's options (`render --gpu`).
+#[derive(Args, Debug)]
+pub struct GpuRenderArgs {
+    /// Draw the input itself (a mesh with its materials, or a voxel file's
+    /// greedy quads) with the GPU renderer instead of ray casting voxels.
+    #[arg(long)]
+    pub gpu: bool,
+    /// --gpu: camera eye, target and vertical field of view in degrees
+    /// (default: the whole scene from above-front-right, 45°).
+    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
+    pub camera: Option<String>,
+    /// --gpu: cluster culling: none, frustum, occlusion (frustum, then
+    /// Hi-Z occlusion against the depth of the frustum survivors), or
+    /// occlusion-two-pass (the depth of the previous frame's clusters).
+    #[arg(long, default_value = "occlusion", value_name = "none|frustum|occlusion|occlusion-two-pass",
+          value_parser = clap::builder::PossibleValuesParser::new(["none", "frustum", "occlusion", "occlusion-two-pass"]))]
+    pub culling: String,
+    /// --gpu: a depth-only pass before shading.
+    #[arg(long, default_value = "off", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub prepass: String,
+    /// --gpu: colour surfaces by their light-grid cell's list length (blue:
+    /// no light, red: the longest list) instead of shading them.
+    #[arg(long, default_value = "off", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub light_grid: String,
+    /// --gpu: linear to sRGB on output.
+    #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub gamma: String,
+    /// --gpu: a camera path, one camera per line as for --camera (`#`
+    /// starts a comment); frame N is written to OUT with `-NNNN` before
+    /// the extension.
+    #[arg(long, value_name = "FILE", conflicts_with = "camera")]
+    pub frames: Option<PathBuf>,
+    /// --gpu: render every frame this many times and report the median
+    /// times (for measuring).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub repeat: u32,
+    /// --gpu: write the frame's statistics (clusters kept, triangles
+    /// drawn, lights, light grid, the draw call, frame times) as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub stats_json: Option<PathBuf>,
+    /// --gpu: also draw this point cloud of `topovox spray` (its stored
+    /// light term, lit towards the viewer each frame).
+    #[arg(long, value_name = "PLY")]
+    pub points: Option<PathBuf>,
+    /// --gpu: draw every cluster's box over the picture, green where the
+    /// cluster was drawn, red where culling dropped it.
+    #[arg(long, default_value = "off", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub boxes: String,
+    /// --gpu: draw the scene's triangles (off: only the --points cloud).
+    #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub mesh: String,
+}
+
+/// `topovox spray`: rays from a camera into a scene, hits as a point cloud.
+#[derive(Args, Debug)]
+pub struct SprayArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
+    /// A mesh (with its materials; emissive ones are the lights) or a voxel file (its greedy quads).
+    pub input: PathBuf,
+    /// Output point cloud (.ply).
+    #[arg(short, long, value_name = "PLY")]
+    pub output: PathBuf,
+    /// Rays cast (each hit is a point).
+    #[arg(long, default_value_t = 1_000_000, value_name = "N")]
+    pub rays: usize,
+    /// Light samples per point, drawn uniformly over the emissive triangles.
+    #[arg(long, default_value_t = 16, value_name = "K")]
+    pub light_samples: u32,
+    /// Shadow rays towards the light samples.
+    #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub shadows: String,
+    /// Seed of the random rays and samples (the cloud is the same for a seed, whatever the thread count).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Camera eye, target and vertical field of view in degrees (default:
+    /// the whole scene from above-front-right, 45°, as render --gpu).
+    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
+    pub camera: Option<String>,
+    /// The camera's picture, WIDTHxHEIGHT: rays fill its aspect.
+    #[arg(long, default_value = "1280x720", value_name = "WxH")]
+    pub size: String,
+    /// The axis pointing up: x, y or z (default y).
+    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
+    pub up: Option<String>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct ViewArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
+    /// A mesh (drawn with its materials) or a voxel file (drawn as quads).
+    pub input: PathBuf,
+    /// Also draw this voxel file beside the mesh (or over it: --layout).
+    #[arg(long, value_name = "FILE", conflicts_with = "mode")]
+    pub voxels: Option<PathBuf>,
+    /// Also voxelize the mesh with this surface mode (and the grid
+    /// options) and draw the voxels beside it.
+    #[arg(long, value_enum)]
+    pub mode: Option<Mode>,
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// Voxels beside the mesh (side) or in its place (overlay).
+    #[arg(long, default_value = "side", value_parser = clap::builder::PossibleValuesParser::new(["side", "overlay"]))]
+    pub layout: String,
+    /// Window size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_name = "WxH")]
+    pub size: String,
+    /// The axis pointing up: x, y or z (default y).
+    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
+    pub up: Option<String>,
+    /// Starting camera: eye, target, vertical field of view in degrees.
+    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
+    pub camera: Option<String>,
+    /// Starting culling: none, frustum, occlusion or occlusion-two-pass (key C cycles).
+    #[arg(long, default_value = "occlusion", value_parser = clap::builder::PossibleValuesParser::new(["none", "frustum", "occlusion", "occlusion-two-pass"]))]
+    pub culling: String,
+    /// Starting Z-prepass (key Z toggles).
+    #[arg(long, default_value = "off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub prepass: String,
+    /// Starting gamma correction (key G toggles).
+    #[arg(long, default_value = "on", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
+    pub gamma: String,
+    /// Scripted run: close after N frames (with --screenshot, save the last).
+    #[arg(long, value_name = "N")]
+    pub frames: Option<u32>,
+    /// With --frames: the last frame as PNG.
+    #[arg(long, value_name = "PNG", requires = "frames")]
+    pub screenshot: Option<PathBuf>,
+    /// A point cloud of `topovox spray` to draw (key P adds to it).
+    #[arg(long, value_name = "PLY")]
+    pub points: Option<PathBuf>,
+    /// On closing, write every point (given and sprayed) to this PLY.
+    #[arg(long, value_name = "PLY")]
+    pub save_points: Option<PathBuf>,
+    /// Rays per spray at the cursor (key P, middle button).
+    #[arg(long, default_value_t = 20_000, value_name = "N")]
+    pub spray_rays: usize,
+    /// Half-angle of the spray's cone in degrees.
+    #[arg(long, default_value_t = 2.0, value_name = "DEG")]
+    pub spray_degrees: f32,
+    /// Print one JSON object on stdout when the window closes.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct SceneArgs {
+    /// Which scene: cornell, city, or cut-outs (three quads, the front one
+    /// cut out in a checkerboard: the alpha test's scene).
+    #[arg(value_parser = clap::builder::PossibleValuesParser::new(["cornell", "city", "cut-outs"]))]
+    pub name: String,
+    /// Output OBJ; its MTL is written beside it with the same stem.
+    #[arg(short, long, value_name = "OBJ")]
+    pub output: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct CheckArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder: absolute paths,
+    /// `../`, links leading out. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
+    /// Voxel file (any format topovox reads: .npy, .binvox, .vox, .vti,
+    /// .vdb, .zarr, .npz, ...).
+    pub voxels: PathBuf,
+    /// The source mesh (a closed surface for the separation checks).
+    #[arg(long)]
+    pub mesh: Option<PathBuf>,
+    /// The grid the voxels were made on, when the file does not carry it
+    /// (npy, vox); without these the grid is inferred as the mesh's fitted
+    /// grid at resolution = the largest dimension.
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// .vox and .schem files: the up axis they were written with (`--up` of
+    /// voxelize; default y), when the file does not record it.
+    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
+    pub up: Option<String>,
+    /// Check without a dense grid, window by window (.vdb, .zarr and .npz
+    /// only; chosen by itself when the grid does not fit in memory densely).
+    /// Same report.
+    #[arg(long)]
+    pub sparse: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder: absolute paths,
+    /// `../`, links leading out. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
+    /// Input mesh.
+    pub mesh: PathBuf,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Mesh to voxelize.
+    #[arg(long, default_value = "../shared/meshes/stanford-bunny.obj")]
+    pub mesh: PathBuf,
+    /// Resolutions (longest side in voxels).
+    #[arg(long, value_delimiter = ',', default_value = "128,256,512,1024")]
+    pub resolutions: Vec<u64>,
+    /// Modes to measure (surface and line modes).
+    #[arg(long, value_delimiter = ',', default_value = "cover")]
+    pub modes: Vec<Mode>,
+    /// Thread counts to measure.
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    pub threads: Vec<usize>,
+    /// Repeats per measurement (the median is reported).
+    #[arg(long, default_value_t = 9)]
+    pub repeats: usize,
+    /// Resolution at which the reference path is timed as the baseline.
+    #[arg(long, default_value_t = 128)]
+    pub reference_resolution: u64,
+    /// A second baseline: `brute` times, at every resolution and in
+    /// alternation with the measured paths, the brute-force loop a short C
+    /// program would be (every voxel of each triangle's bounding box, the
+    /// f64 triangle/box test, one thread), and adds a "vs brute" column.
+    #[arg(long, value_enum)]
+    pub baseline: Option<Baseline>,
+    /// Split every triangle into four this many times before measuring
+    /// (e.g. 2 turns the 69k-triangle bunny into 1.1M triangles).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=5))]
+    pub subdivide: u32,
+    /// Also time carrying colours into the `cover` voxels (dominant and
+    /// blend), a coloured 1024x768 picture and the .vox and .vti writers,
+    /// against voxelization as the baseline (the mesh must have colours).
+    #[arg(long)]
+    pub attributes: bool,
+    /// Time `cover` on the GPU (upload, GPU, download separately) against
+    /// the CPU fast path as the baseline.
+    #[arg(long)]
+    pub gpu: bool,
+    /// Print JSON lines instead of a Markdown table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct GapsArgs {
+    /// Meshes to compare on.
+    #[arg(required = true)]
+    pub meshes: Vec<PathBuf>,
+    /// The mode under test.
+    #[arg(long, default_value = "pos")]
+    pub mode: Mode,
+    /// Modes it is compared against (voxels they set that it lacks).
+    #[arg(long, value_delimiter = ',', default_value = "sep6,cover")]
+    pub against: Vec<Mode>,
+    /// Resolutions (longest side in voxels).
+    #[arg(long, value_delimiter = ',', default_value = "128,256,512,1024")]
+    pub resolutions: Vec<u64>,
+    /// Print JSON lines instead of a Markdown table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct ConvertArgs {
+    /// Voxel file written by topovox (.npy, .binvox, .vox, .txt, .schem, .vti, .ply).
+    pub input: PathBuf,
+    /// Output voxel file, or `.obj` / `.glb` for a mesh of the voxels; the format comes from the extension unless --format is given.
+    pub output: PathBuf,
+    /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, obj or glb (default: from the extension).
+    #[arg(long, value_name = "FORMAT")]
+    pub format: Option<String>,
+    #[command(flatten)]
+    pub export: ExportArgs,
+    /// Grid origin X,Y,Z for formats that record it (binvox, txt), when the input does not carry it (default 0,0,0).
+    #[arg(long, value_delimiter = ',', value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub origin: Option<Vec<f64>>,
+    /// Voxel size for formats that record it, when the input does not carry it (default 1).
+    #[arg(long, value_name = "S")]
+    pub voxel_size: Option<f64>,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct BatchArgs {
+    /// Read files the model names (OBJ material libraries and textures,
+    /// glTF buffers and images) even outside its folder: absolute paths,
+    /// `../`, links leading out. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
+    /// Input meshes, or folders searched (recursively) for them.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Output folder: each output mirrors its input's path below the
+    /// inputs' common folder, with the format's extension; the manifest is
+    /// `manifest.jsonl` in it.
+    #[arg(short, long, value_name = "OUT_DIR")]
+    pub output: PathBuf,
+    /// Which files of the input folders to take, e.g. '**/*.obj' (default:
+    /// every mesh extension topovox reads).
+    #[arg(long, value_name = "PATTERN")]
+    pub glob: Option<String>,
+    /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, obj or glb.
+    #[arg(long, default_value = "npy", value_name = "FORMAT")]
+    pub format: String,
+    /// Voxelization mode.
+    #[arg(long, value_enum, default_value = "cover")]
+    pub mode: Mode,
+    /// Method.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub method: Method,
+    /// `bubble`: the seed of its random points (same seed, same voxels; default 0).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Solid modes: the surface mode of `solid+surface` and of the `--fill flood` shell.
+    #[arg(long, value_enum, value_name = "MODE")]
+    pub surface: Option<Mode>,
+    /// Solid modes: `flood` fills everything a surface shell encloses.
+    #[arg(long, value_enum)]
+    pub fill: Option<Fill>,
+    /// Solid modes: keep only the voxels touching the outside through a face (6) or also an edge or corner (26).
+    #[arg(long, value_name = "6|26", value_parser = clap::builder::PossibleValuesParser::new(["6", "26"]))]
+    pub hollow: Option<String>,
+    #[command(flatten)]
+    pub grid: GridArgs,
+    #[command(flatten)]
+    pub memory: MemoryArgs,
+    /// With --method gpu: compute, raster or msaa-approx.
+    #[arg(long, value_enum, default_value = "compute", value_name = "PATH")]
+    pub gpu_path: GpuPathArg,
+    #[command(flatten)]
+    pub export: ExportArgs,
+    /// Meshes processed at once (default: all cores); each is voxelized on the same threads.
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress bar and no summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// 2D rasterization modes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum RasterModeArg {
+    /// 4-connected, 8-separating curves (the two pixel diagonals).
+    Curve4,
+    /// 8-connected, 4-separating curves (the crosshair).
+    Curve8,
+    /// The diamond target: the rule graphics APIs use for lines.
+    Diamond,
+    /// Filled outlines, nonzero winding at the pixel centre.
+    Fill,
+}
+
+#[derive(Args, Debug)]
+pub struct RasterArgs {
+    /// Input SVG: <path>, <polyline>, <polygon>, <line>, <rect>, <circle>, <ellipse>.
+    pub input: PathBuf,
+    /// Output: .png (black on white) or .npy (uint8, shape (W, H), [i, j]).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Rasterization mode.
+    #[arg(long, value_enum, default_value = "curve8")]
+    pub mode: RasterModeArg,
+    /// Fit the grid so the longest side of the drawing spans N pixels (default 128).
+    #[arg(long, value_name = "N")]
+    pub resolution: Option<u64>,
+    /// Pixel size in SVG user units; alone, fits the grid to the drawing.
+    #[arg(long, value_name = "S")]
+    pub pixel_size: Option<f64>,
+    /// Explicit grid origin X,Y (with --pixel-size and --dims).
+    #[arg(long, value_name = "X,Y", value_delimiter = ',', allow_hyphen_values = true)]
+    pub origin: Option<Vec<f64>>,
+    /// Explicit grid dims W,H (with --origin and --pixel-size).
+    #[arg(long, value_name = "W,H", value_delimiter = ',')]
+    pub dims: Option<Vec<u64>>,
+    /// Curves and arcs are flattened until every chord lies within this
+    /// distance of the curve (SVG user units; default 1e-5 of the drawing's extent).
+    #[arg(long, value_name = "T")]
+    pub tolerance: Option<f64>,
+    /// `fast` (default) or `reference` (brute force from the definition; the same pixels).
+    #[arg(long, default_value = "fast", value_parser = clap::builder::PossibleValuesParser::new(["fast", "reference"]))]
+    pub method: String,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
+}

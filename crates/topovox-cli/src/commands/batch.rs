@@ -1,0 +1,109 @@
+//! `topovox batch INPUTS... -o OUT_DIR`: whole datasets (see `topovox_job::batch`).
+
+use anyhow::{bail, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde_json::Value;
+use topovox::attributes::carry::CarryOptions;
+use topovox_job::batch::{self, BatchOptions, BatchProgress, FingerprintParts};
+
+use crate::args::{BatchArgs, Fill};
+
+/// The bar: meshes done of all, meshes per second, time to go.
+struct Bar(ProgressBar);
+
+impl BatchProgress for Bar {
+    fn start(&self, total: u64, skipped: u64) {
+        self.0.set_length(total);
+        self.0.set_position(skipped);
+        self.0.reset_eta();
+    }
+
+    fn finished(&self, record: &Value) {
+        if record["status"] != "done" {
+            self.0.println(format!("topovox: failed: {}", record["error"].as_str().unwrap_or("?")));
+        }
+        self.0.inc(1);
+    }
+}
+
+pub fn run(a: &BatchArgs) -> Result<()> {
+    let plan = crate::plan::plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path, a.seed, &a.memory)?;
+    let Some(format) = topovox_job::output::Output::from_name(&a.format) else {
+        bail!("unknown --format {:?} (expected one of: {})", a.format, topovox_job::output::Output::names());
+    };
+    let write = crate::commands::export::writer_options(&a.export)?;
+    let colour_rule = format!("{:?}", a.export.colour_rule).to_lowercase();
+    let gpu_path = crate::plan::gpu_path_name(a.gpu_path).0;
+    let fingerprint = batch::fingerprint(&FingerprintParts {
+        mode: crate::plan::mode_name(a.mode),
+        method: topovox_job::Method::from(a.method).name(),
+        grid: &crate::plan::grid_options(&a.grid),
+        surface: a.surface.map(crate::plan::mode_name),
+        fill: a.fill.map(|f| match f {
+            Fill::Flood => "flood",
+        }),
+        hollow: a.hollow.as_deref().and_then(|h| h.parse().ok()),
+        gpu_path,
+        format: format.name(),
+        colour_rule: &colour_rule,
+        normals: a.export.normals,
+        attributes: a.export.attributes,
+        dither: a.export.dither,
+        up: crate::commands::export::up(&a.export).name(),
+        watertight: a.export.watertight.as_deref() != Some("off"),
+        triangulate: a.export.triangulate,
+        seed: a.seed,
+    });
+    let opts = BatchOptions {
+        plan,
+        format,
+        carry: CarryOptions {
+            rule: crate::commands::export::colour_rule(a.export.colour_rule),
+            normals: a.export.normals || a.export.attributes,
+        },
+        attributes: a.export.attributes,
+        write,
+        threads: None,
+        read: topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
+        fingerprint,
+    };
+    let files = batch::collect_inputs(&a.inputs, a.glob.as_deref())?;
+    let ext = format.name().replace("npy-bool", "npy");
+    let items = batch::plan_items(&files, &a.output, &ext)?;
+    let pool = crate::thread_pool(a.jobs)?;
+
+    use std::io::IsTerminal;
+    let target =
+        if !a.quiet && !a.json && std::io::stderr().is_terminal() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
+    let pb = ProgressBar::with_draw_target(None, target);
+    pb.set_style(
+        ProgressStyle::with_template("[{bar:30}] {pos}/{len} meshes, {per_sec}, {eta} to go ({elapsed})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let bar = Bar(pb);
+    let summary = pool.install(|| batch::run(&items, &a.output, &opts, &bar))?;
+    bar.0.finish_and_clear();
+    let total = summary.done + summary.skipped + summary.failed;
+    if a.json {
+        let mut v = summary.to_json();
+        v["total"] = total.into();
+        v["jobs"] = pool.current_num_threads().into();
+        v["meshes_per_s"] = (summary.done as f64 / summary.total_s.max(1e-9)).into();
+        crate::print_stdout(&v.to_string())?;
+    } else if !a.quiet {
+        crate::print_stdout(&format!(
+            "batch: {} done, {} skipped (already done), {} failed, of {total} meshes in {:.2} s ({:.1} meshes/s) -> {} (manifest {})",
+            summary.done,
+            summary.skipped,
+            summary.failed,
+            summary.total_s,
+            summary.done as f64 / summary.total_s.max(1e-9),
+            a.output.display(),
+            summary.manifest.display()
+        ))?;
+    }
+    if summary.failed > 0 {
+        bail!("{} of {total} meshes failed; their errors are in {}", summary.failed, summary.manifest.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,129 @@
+//! `topovox check VOXELS [--mesh MESH]`: certify a voxel file's topology.
+
+use std::time::Instant;
+
+use anyhow::{bail, Result};
+use serde_json::{json, Value};
+
+use crate::args::CheckArgs;
+
+pub fn run(a: &CheckArgs) -> Result<()> {
+    let t0 = Instant::now();
+    let pool = crate::thread_pool(a.threads)?;
+    let up = a.up.as_deref().and_then(topovox_io::orient::Up::from_name).unwrap_or_default();
+    let sparse_format = topovox_io::VoxelFormat::from_path(&a.voxels).is_some_and(topovox_io::VoxelFormat::reads_sparsely);
+    if a.sparse && !sparse_format {
+        bail!("{}: --sparse reads only .vdb, .zarr and .npz files", a.voxels.display());
+    }
+    let voxels = if a.sparse {
+        Voxels::Sparse(topovox_io::read_voxels_sparse(&a.voxels, false)?)
+    } else {
+        match topovox_io::read_voxels_with(&a.voxels, up) {
+            Ok(l) => Voxels::Dense(l),
+            // Past memory: checked window by window.
+            Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && sparse_format => {
+                Voxels::Sparse(topovox_io::read_voxels_sparse(&a.voxels, false)?)
+            }
+            Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) => {
+                bail!("{e}; grids past memory are checked from .vdb, .zarr or .npz files (window by window)")
+            }
+            Err(e) => return Err(e.into()),
+        }
+    };
+    let (dims, placement) = match &voxels {
+        Voxels::Dense(l) => (l.bits.dims(), l.placement),
+        Voxels::Sparse(s) => (s.bits.dims(), s.placement),
+    };
+    let mesh = match &a.mesh {
+        Some(path) => {
+            let m = topovox_io::read_mesh_with(path, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
+            for w in &m.warnings {
+                eprintln!("topovox: warning: {}: {w}", path.display());
+            }
+            let (grid, source) = topovox_job::check::check_grid(
+                dims,
+                placement,
+                &crate::plan::grid_options(&a.grid),
+                &m.report.bounds,
+                &a.voxels.display().to_string(),
+                &path.display().to_string(),
+            )?;
+            Some((m, grid, source))
+        }
+        None => None,
+    };
+    let mesh = mesh.as_ref().map(|(m, g, s)| (m.mesh.as_ref(), g, *s));
+    let mut v = pool.install(|| match &voxels {
+        Voxels::Dense(l) => topovox_job::check::report(&l.bits, mesh),
+        Voxels::Sparse(s) => {
+            let layers = topovox_job::check::window_layers(dims, topovox_job::budget(None));
+            topovox_job::check::report_sparse(&s.bits, mesh, layers)
+        }
+    })?;
+    v["check_s"] = json!(t0.elapsed().as_secs_f64());
+    if a.json {
+        return crate::print_stdout(&v.to_string());
+    }
+    crate::print_stdout(&text(&v, a))
+}
+
+/// The voxels, read densely or (past memory, or with `--sparse`) as bricks.
+enum Voxels {
+    Dense(topovox_io::LoadedVoxels),
+    Sparse(topovox_io::SparseVoxels),
+}
+
+fn text(v: &Value, a: &CheckArgs) -> String {
+    let yes_no = |b: &Value| match b.as_bool() {
+        Some(true) => "yes",
+        Some(false) => "NO",
+        None => "n/a",
+    };
+    let mut s = format!(
+        "{}: {} voxels on {}; components: {} (6-connected), {} (26-connected); thick voxels: {}",
+        a.voxels.display(),
+        v["voxels"],
+        v["dims"],
+        v["components_6"],
+        v["components_26"],
+        v["thick_voxels"]
+    );
+    if let Some(mesh) = &a.mesh {
+        s += &format!("\nmesh {}: grid from {}", mesh.display(), v["grid"]["source"].as_str().unwrap_or("?"));
+        if v["closed"].as_bool() == Some(true) {
+            s += &format!(
+                "\n  closed surface; {} voxel centres inside\n  6-separating: {}\n  26-separating: {}\n  removable keeping 6-separation: {}",
+                v["inside_voxels"],
+                yes_no(&v["separating_6"]),
+                yes_no(&v["separating_26"]),
+                v["thin_removable"]
+            );
+            for c in ["6", "26"] {
+                if let Some(w) = v[format!("witness_{c}")].as_object() {
+                    s += &format!("\n  {c}-leak: unset {c}-neighbours {} (inside) and {} (outside)", w["inside"], w["outside"]);
+                }
+            }
+        } else {
+            s += &format!("\n  not a closed surface ({} boundary edges, or no triangles): separation needs one", v["boundary_edges"]);
+        }
+        let c = &v["columns"];
+        s += &format!(
+            "\n  runs along each triangle's dominant axis at its columns: {} x1, {} x2, {} x3+ (max {}), {} holes",
+            c["one"], c["two"], c["three_or_more"], c["max"], c["empty"]
+        );
+        s += &format!(
+            "\n  6-tunnel-free: {} ({} tunnels)\n  18-tunnel-free: {} ({} tunnels)\n  26-tunnel-free: {} ({} tunnels)",
+            yes_no(&v["tunnel_free_6"]),
+            v["tunnels_6"],
+            yes_no(&v["tunnel_free_18"]),
+            v["tunnels_18"],
+            yes_no(&v["tunnel_free_26"]),
+            v["tunnels_26"]
+        );
+    }
+    let how = match v["windows"].as_u64() {
+        Some(n) => format!(" without a dense grid, in {n} window{}", if n == 1 { "" } else { "s" }),
+        None => String::new(),
+    };
+    s + &format!("\nchecked{how} in {:.2} s", v["check_s"].as_f64().unwrap_or(0.0))
+}

@@ -1,0 +1,200 @@
+//! `topovox render`: a PNG picture of a voxel file or of a mesh's voxels,
+//! and the picture behind `voxelize --preview`.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use serde_json::json;
+use topovox::attributes::carry::{carry, CarryOptions};
+use topovox::attributes::VoxelAttributes;
+use topovox::glam::DVec3;
+use topovox::grid::sparse::SparseBricks;
+use topovox::render::raycast::{render_grid, render_with, Image, RenderGrid, RenderOptions, View};
+use topovox::voxelize::{self, Options};
+use topovox::{BrickBits, VoxelSource};
+
+use crate::args::{PictureArgs, RenderArgs};
+use crate::plan;
+
+/// Largest picture side and pixel count accepted.
+const MAX_SIDE: u32 = 16_384;
+const MAX_PIXELS: u64 = 64 << 20;
+
+/// Validates the picture options.
+pub fn options(p: &PictureArgs, up: Option<&str>) -> Result<RenderOptions> {
+    let view = match p.view.as_str() {
+        "iso" => View::Iso,
+        "x" => View::Axis(0),
+        "y" => View::Axis(1),
+        "z" => View::Axis(2),
+        other => {
+            let parts: Vec<&str> = other.split(',').collect();
+            let angles: Option<Vec<f64>> = parts.iter().map(|s| s.trim().parse::<f64>().ok().filter(|v| v.is_finite())).collect();
+            match angles.as_deref() {
+                Some([az, el]) => View::Angles(*az, *el),
+                _ => bail!("--view takes iso, x, y, z or AZIMUTH,ELEVATION in degrees, not {other:?}"),
+            }
+        }
+    };
+    let (width, height) = parse_size(&p.size)?;
+    let up = up_axis(up);
+    Ok(RenderOptions { width, height, view, up, ..RenderOptions::default() })
+}
+
+/// Parses `--size WIDTHxHEIGHT` within the picture limits.
+pub fn parse_size(text: &str) -> Result<(u32, u32)> {
+    let size: Option<(u32, u32)> = text.split_once(['x', 'X']).and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
+    let Some((width, height)) = size else { bail!("--size takes WIDTHxHEIGHT in pixels, e.g. 1024x768, not {text:?}") };
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE || width as u64 * height as u64 > MAX_PIXELS {
+        bail!("--size {width}x{height}: each side must be 1..={MAX_SIDE} and the picture at most {MAX_PIXELS} pixels");
+    }
+    Ok((width, height))
+}
+
+/// The `--up` axis's index (default y).
+pub fn up_axis(up: Option<&str>) -> usize {
+    match up {
+        Some("x") => 0,
+        Some("z") => 2,
+        _ => 1,
+    }
+}
+
+/// A mesh's triangles in grid units, for the silhouette outline.
+pub fn outline_triangles(mesh: topovox::MeshRef<'_>, grid: &topovox::GridSpec) -> Vec<[DVec3; 3]> {
+    mesh.triangles
+        .iter()
+        .filter_map(|t| {
+            let p = [0, 1, 2].map(|c| mesh.positions.get(t[c] as usize).map(|&p| grid.to_grid_units(p)));
+            Some([p[0]?, p[1]?, p[2]?])
+        })
+        .collect()
+}
+
+/// Renders `bits` (coloured by `colours` where present, with the outline of
+/// `outline`'s triangles) and writes the PNG atomically.
+pub fn picture(
+    bits: &dyn VoxelSource,
+    path: &Path,
+    o: &RenderOptions,
+    colours: Option<&VoxelAttributes>,
+    outline: Option<&[[DVec3; 3]]>,
+) -> Result<Image> {
+    let bricks = BrickBits::from_source(bits);
+    let img = render_with(&bricks, o, colours, outline);
+    topovox_io::write_png(path, img.width, img.height, &img.rgb)?;
+    Ok(img)
+}
+
+/// [`picture`] of a grid held as sparse bricks (past memory), without a
+/// dense grid or brick index: the ray caster indexes 64³-voxel blocks.
+pub fn picture_sparse(
+    bits: &SparseBricks,
+    path: &Path,
+    o: &RenderOptions,
+    colours: Option<&VoxelAttributes>,
+    outline: Option<&[[DVec3; 3]]>,
+) -> Result<Image> {
+    let Some(grid) = RenderGrid::from_sparse(bits) else {
+        let [x, y, z] = bits.dims();
+        bail!("grid {x}x{y}x{z} is too large to render: its index of 64^3-voxel blocks would pass 1 GiB");
+    };
+    let img = render_grid(&grid, o, colours, outline);
+    topovox_io::write_png(path, img.width, img.height, &img.rgb)?;
+    Ok(img)
+}
+
+/// Refuses an output that is not a `.png` or whose folder does not exist.
+pub fn check_png_path(path: &Path) -> Result<()> {
+    if path.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("png")) != Some(true) {
+        bail!("{}: pictures are written as PNG; give a .png file name", path.display());
+    }
+    Ok(topovox_job::output::check_output_path(path)?)
+}
+
+pub fn run(a: &RenderArgs) -> Result<()> {
+    if a.gpu.gpu {
+        #[cfg(feature = "gpu")]
+        return crate::commands::render_gpu::run(a);
+        #[cfg(not(feature = "gpu"))]
+        bail!("--gpu: this topovox was built without the gpu feature");
+    }
+    let g = &a.gpu;
+    if g.camera.is_some()
+        || g.frames.is_some()
+        || g.repeat != 1
+        || g.stats_json.is_some()
+        || g.culling != "occlusion"
+        || g.prepass != "off"
+        || g.gamma != "on"
+        || g.light_grid != "off"
+    {
+        bail!("--camera, --frames, --repeat, --culling, --prepass, --gamma, --light-grid and --stats-json belong to the GPU renderer; add --gpu");
+    }
+    let t0 = Instant::now();
+    let o = options(&a.picture, a.up.as_deref())?;
+    check_png_path(&a.output)?;
+    let pool = crate::thread_pool(a.threads)?;
+    topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.input))?;
+    let (bits, what, colours, outline): (Box<dyn VoxelSource + Send>, &str, _, _) = if topovox_io::is_voxel_file(&a.input) {
+        if a.picture.outline {
+            bail!("--outline draws the source mesh's silhouette; it needs a mesh input (or voxelize --preview)");
+        }
+        // .vox and .schem are rotated back so the --up axis is up again.
+        let up = a.up.as_deref().and_then(topovox_io::orient::Up::from_name).unwrap_or_default();
+        use topovox_io::VoxelFormat as F;
+        match topovox_io::read_voxels_with(&a.input, up) {
+            Ok(loaded) => (Box::new(loaded.bits), "voxel file", loaded.attributes, None),
+            // A .vdb, .zarr or .npz grid past memory: drawn from its bricks.
+            Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && F::from_path(&a.input).is_some_and(F::reads_sparsely) => {
+                let sparse = topovox_io::read_voxels_sparse(&a.input, false)?;
+                if sparse.attributes_left {
+                    eprintln!("topovox: warning: {}: drawn without its colours: the grid does not fit densely", a.input.display());
+                }
+                let img = pool.install(|| picture_sparse(&sparse.bits, &a.output, &o, None, None))?;
+                return summary(a, &img, "voxel file", &sparse.bits, t0);
+            }
+            Err(e) => return Err(e.into()),
+        }
+    } else {
+        let (mode, _) = topovox_job::resolve_method(a.mode.into(), topovox_job::Method::Fast)
+            .context("render voxelizes meshes with a surface or line mode; voxelize solids to a file first")?;
+        let loaded = topovox_io::read_mesh_with(&a.input, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
+        topovox_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
+        let grid = plan::grid_request(&a.grid)?.fit(&loaded.report.bounds)?;
+        plan::check_memory(&grid)?;
+        for w in &loaded.warnings {
+            eprintln!("topovox: warning: {}: {w}", a.input.display());
+        }
+        let (b, _) = pool.install(|| voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &Options::default()));
+        let colours = loaded.appearance.has_colour().then(|| {
+            let opts = CarryOptions { rule: crate::commands::export::colour_rule(a.colour_rule), normals: false };
+            pool.install(|| carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &b, &opts))
+        });
+        let outline = a.picture.outline.then(|| outline_triangles(loaded.mesh.as_ref(), &grid));
+        (Box::new(b), "mesh", colours, outline)
+    };
+    let img = pool.install(|| picture(bits.as_ref(), &a.output, &o, colours.as_ref(), outline.as_deref()))?;
+    summary(a, &img, what, bits.as_ref(), t0)
+}
+
+/// Prints what `render` drew.
+fn summary(a: &RenderArgs, img: &Image, what: &str, bits: &dyn VoxelSource, t0: Instant) -> Result<()> {
+    let total_s = t0.elapsed().as_secs_f64();
+    if a.json {
+        let v = json!({"input": a.input, "kind": what, "output": a.output, "width": img.width, "height": img.height,
+            "dims": bits.dims(), "voxels": bits.count(), "covered_pixels": img.covered, "total_s": total_s});
+        return crate::print_stdout(&v.to_string());
+    }
+    crate::print_stdout(&format!(
+        "render: {}x{} picture of {} voxels ({}, grid {:?}) in {:.2} s -> {}",
+        img.width,
+        img.height,
+        bits.count(),
+        what,
+        bits.dims(),
+        total_s,
+        a.output.display()
+    ))
+}

@@ -1,0 +1,257 @@
+//! `topovox render --gpu`: one frame of the GPU renderer (`topovox-view`),
+//! headless, of a mesh with its materials or of a voxel file's greedy
+//! quads; the picture as PNG and the frame's statistics as JSON.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use serde_json::json;
+use topovox::glam::Vec3;
+use topovox_view::{Camera, Culling, FrameOptions, FrameStats, Renderer, Scene};
+
+use crate::args::RenderArgs;
+use crate::commands::render::{check_png_path, options};
+
+/// Voxel quads' material: light grey, rough.
+const VOXEL_COLOUR: [f32; 3] = [0.72, 0.72, 0.70];
+
+/// Adds a voxel file's greedy quads, placed where the file says (else
+/// voxel `(i, j, k)` at `(i, j, k)`), moved by `offset`.
+pub(crate) fn add_voxel_file(scene: &mut Scene, path: &Path, up: Option<&str>, offset: Vec3) -> Result<()> {
+    let upname = up.and_then(topovox_io::orient::Up::from_name).unwrap_or_default();
+    let loaded = topovox_io::read_voxels_with(path, upname)?;
+    let (origin, size) = loaded.placement.map(|(o, s)| (o.as_vec3(), s as f32)).unwrap_or((Vec3::ZERO, 1.0));
+    add_voxels(scene, &loaded.bits, origin + offset, size);
+    Ok(())
+}
+
+/// Adds voxels as greedy quads of one clay material.
+pub(crate) fn add_voxels(scene: &mut Scene, bits: &topovox::grid::dense::DenseBits, origin: Vec3, size: f32) {
+    let quads = topovox::export::greedy::greedy_quads(bits);
+    let m = scene.add_material(topovox_view::scene::ShadeMaterial::new(VOXEL_COLOUR, [0.0; 3], 0.7));
+    scene.add_quads(&quads, origin, size, m);
+}
+
+/// Loads a mesh with its materials, or a voxel file's greedy quads, as a
+/// scene; the kind loaded ("mesh" or "voxel file"). None of `outputs` may
+/// be a file the mesh reads.
+pub(crate) fn load_scene(input: &Path, up: Option<&str>, allow_external_paths: bool, outputs: &[PathBuf]) -> Result<(Scene, &'static str)> {
+    let mut scene = Scene::default();
+    if topovox_io::is_voxel_file(input) {
+        add_voxel_file(&mut scene, input, up, Vec3::ZERO)?;
+        return Ok((scene, "voxel file"));
+    }
+    let loaded = topovox_io::read_mesh_with(input, &topovox_io::ReadOptions { allow_external_paths })?;
+    for out in outputs {
+        topovox_io::atomic::refuse_overwriting_inputs(out, &loaded.sources)?;
+    }
+    for w in &loaded.warnings {
+        eprintln!("topovox: warning: {}: {w}", input.display());
+    }
+    scene.add_mesh(loaded.mesh.as_ref(), &loaded.appearance);
+    Ok((scene, "mesh"))
+}
+
+/// Reads a spray cloud (`topovox spray`'s PLY).
+pub(crate) fn read_points(path: &Path) -> Result<Vec<topovox_view::spray::SprayPoint>> {
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    topovox_io::fenced(|| topovox_view::spray::read_ply(&bytes))
+        .unwrap_or_else(|msg| Err(format!("the PLY parser crashed on it ({msg})")))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
+/// Parses `EX,EY,EZ,TX,TY,TZ[,FOV]`.
+pub(crate) fn parse_camera(s: &str, up: Vec3) -> Result<Camera> {
+    let v: Option<Vec<f32>> = s.split(',').map(|x| x.trim().parse::<f32>().ok().filter(|v| v.is_finite())).collect();
+    let Some(v) = v.filter(|v| v.len() == 6 || v.len() == 7) else {
+        bail!("--camera takes EX,EY,EZ,TX,TY,TZ[,FOV]: an eye, a target and a vertical field of view in degrees, not {s:?}")
+    };
+    let (eye, target) = (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]));
+    let fov_deg = v.get(6).copied().unwrap_or(45.0);
+    if !(fov_deg > 0.5 && fov_deg < 179.0) {
+        bail!("--camera: the field of view must be between 0.5 and 179 degrees, not {fov_deg}");
+    }
+    if (eye - target).length() <= f32::EPSILON * eye.abs().max(target.abs()).max_element().max(1.0) {
+        bail!("--camera: the eye and the target must differ");
+    }
+    Ok(Camera { eye, target, up, fov_deg })
+}
+
+pub fn run(a: &RenderArgs) -> Result<()> {
+    let g = &a.gpu;
+    if a.picture.outline {
+        bail!("--outline belongs to the CPU ray caster; leave out --gpu");
+    }
+    if a.picture.view != "iso" {
+        bail!("--gpu places its camera with --camera EX,EY,EZ,TX,TY,TZ[,FOV], not --view");
+    }
+    let o = options(&a.picture, a.up.as_deref())?;
+    if g.repeat == 0 || g.repeat > 1000 {
+        bail!("--repeat must be 1..=1000, not {}", g.repeat);
+    }
+    check_png_path(&a.output)?;
+    let mut outputs: Vec<PathBuf> = vec![a.output.clone()];
+    if let Some(p) = &g.stats_json {
+        topovox_job::output::check_output_path(p)?;
+        if topovox_io::atomic::same_file(p, &a.output) {
+            bail!("--stats-json {} is the picture's own path", p.display());
+        }
+        outputs.push(p.clone());
+    }
+    for out in &outputs {
+        topovox_io::atomic::refuse_overwriting_inputs(out, std::slice::from_ref(&a.input))?;
+    }
+    let mut up = Vec3::ZERO;
+    up[o.up] = 1.0;
+
+    let t0 = std::time::Instant::now();
+    let (scene, kind) = load_scene(&a.input, a.up.as_deref(), a.allow_external_paths, &outputs)?;
+    let load_s = t0.elapsed().as_secs_f64();
+    let bounds = scene.bounds().with_context(|| format!("{}: nothing to draw (no triangle with area)", a.input.display()))?;
+    let points = match &g.points {
+        Some(p) => read_points(p)?,
+        None => Vec::new(),
+    };
+    let cameras: Vec<Camera> = match (&g.camera, &g.frames) {
+        (Some(s), _) => vec![parse_camera(s, up)?],
+        (None, Some(path)) => read_camera_path(path, up)?,
+        (None, None) => vec![Camera::framing(bounds.0, bounds.1, o.up)],
+    };
+    let outputs_png: Vec<PathBuf> =
+        if cameras.len() == 1 { vec![a.output.clone()] } else { (0..cameras.len()).map(|n| numbered(&a.output, n)).collect() };
+    for out in &outputs_png {
+        topovox_io::atomic::refuse_overwriting_inputs(out, std::slice::from_ref(&a.input))?;
+    }
+    let renderer = Renderer::new()?;
+    let t1 = std::time::Instant::now();
+    let mut uploaded = renderer.upload(&scene)?;
+    renderer.add_points(&mut uploaded, &points)?;
+    let upload_s = t1.elapsed().as_secs_f64();
+    let culling = Culling::from_name(&g.culling).expect("clap checked the name");
+    let mut frames = Vec::with_capacity(cameras.len());
+    for (camera, out) in cameras.iter().zip(&outputs_png) {
+        let opts = FrameOptions {
+            width: o.width,
+            height: o.height,
+            camera: *camera,
+            culling,
+            prepass: g.prepass == "on",
+            gamma: g.gamma == "on",
+            light_grid_view: g.light_grid == "on",
+            read_hiz: false,
+            mesh: g.mesh == "on",
+            boxes: g.boxes == "on",
+        };
+        // Every run's statistics, the last run's picture.
+        let mut frame = renderer.render(&uploaded, &opts)?;
+        let mut runs = vec![frame.stats.clone()];
+        for _ in 1..g.repeat {
+            frame = renderer.render(&uploaded, &opts)?;
+            runs.push(frame.stats.clone());
+        }
+        let median = |f: &dyn Fn(&FrameStats) -> Option<f64>| -> Option<f64> {
+            let mut v: Vec<f64> = runs.iter().filter_map(f).collect();
+            v.sort_by(f64::total_cmp);
+            (!v.is_empty()).then(|| v[v.len() / 2])
+        };
+        topovox_io::write_png(out, frame.width, frame.height, &frame.rgb())?;
+        let s = &frame.stats;
+        frames.push(json!({
+            "output": out,
+            "camera": {"eye": camera.eye.to_array(), "target": camera.target.to_array(), "up": camera.up.to_array(), "fov_deg": camera.fov_deg},
+            "clusters_after_frustum": s.clusters_after_frustum,
+            "clusters_after_occlusion": s.clusters_after_occlusion,
+            "triangles_drawn": s.triangles_drawn,
+            "points_drawn": s.points_drawn,
+            "frame_ms": {
+                "repeats": g.repeat,
+                "cpu": median(&|s| Some(s.cpu_ms)),
+                "gpu_cull": median(&|s| s.gpu.map(|t| t.cull_ms)),
+                "gpu_depth_pass": median(&|s| s.gpu.map(|t| t.depth_ms)),
+                "gpu_hiz": median(&|s| s.gpu.map(|t| t.hiz_ms)),
+                "gpu_shade": median(&|s| s.gpu.map(|t| t.shade_ms)),
+            },
+        }));
+    }
+    let first = &frames[0];
+    let (total, mean, max) = uploaded.grid.stats();
+    let stats = json!({
+        "input": a.input,
+        "kind": kind,
+        "output": a.output,
+        "adapter": renderer.adapter(),
+        "width": o.width,
+        "height": o.height,
+        "camera": first["camera"],
+        "culling": g.culling,
+        "prepass": g.prepass == "on",
+        "gamma": g.gamma == "on",
+        "clusters": uploaded.clusters.len(),
+        "clusters_after_frustum": first["clusters_after_frustum"],
+        "clusters_after_occlusion": first["clusters_after_occlusion"],
+        "triangles": uploaded.triangles,
+        "triangles_drawn": first["triangles_drawn"],
+        "points": g.points,
+        "points_drawn": first["points_drawn"],
+        "lights": uploaded.lights.lights,
+        "emissive_triangles": uploaded.lights.emissive_triangles,
+        "light_grid": {"cells": uploaded.grid.ranges.len(), "total": total, "mean": mean, "max": max, "built_on": "gpu", "build_ms": uploaded.grid_ms},
+        "multi_draw": "multi_draw_indexed_indirect",
+        "frame_ms": first["frame_ms"],
+        "frames": frames,
+        "load_s": load_s,
+        "upload_s": upload_s,
+    });
+    if let Some(p) = &g.stats_json {
+        let text = serde_json::to_string_pretty(&stats)?;
+        topovox_io::atomic::write_atomically(p, |w| w.write_all(text.as_bytes()))?;
+    }
+    if a.json {
+        return crate::print_stdout(&stats.to_string());
+    }
+    crate::print_stdout(&format!(
+        "render --gpu: {} frame(s) {}x{} of {} triangles ({}), first: {} of {} clusters drawn, {} lights, {:.1} ms -> {}",
+        stats["frames"].as_array().map_or(0, Vec::len),
+        o.width,
+        o.height,
+        uploaded.triangles,
+        kind,
+        stats["clusters_after_occlusion"].as_u64().or(stats["clusters_after_frustum"].as_u64()).unwrap_or(0),
+        uploaded.clusters.len(),
+        uploaded.lights.lights,
+        stats["frame_ms"]["cpu"].as_f64().unwrap_or(0.0),
+        a.output.display()
+    ))
+}
+
+/// `out.png` → `out-0003.png` for frame 3.
+fn numbered(out: &Path, n: usize) -> PathBuf {
+    let stem = out.file_stem().and_then(|s| s.to_str()).unwrap_or("frame");
+    let ext = out.extension().and_then(|s| s.to_str()).unwrap_or("png");
+    out.with_file_name(format!("{stem}-{n:04}.{ext}"))
+}
+
+/// Reads a camera path: one `EX,EY,EZ,TX,TY,TZ[,FOV]` per line, `#` comments.
+fn read_camera_path(path: &Path, up: Vec3) -> Result<Vec<Camera>> {
+    let size = std::fs::metadata(path).with_context(|| format!("{}: cannot read the camera path", path.display()))?.len();
+    if size > 1 << 20 {
+        bail!("{}: a camera path of {size} bytes; at most 1 MiB", path.display());
+    }
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read the camera path", path.display()))?;
+    let text = String::from_utf8(bytes).map_err(|_| anyhow::anyhow!("{}: the camera path is not UTF-8 text", path.display()))?;
+    let mut cams = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        cams.push(parse_camera(line, up).with_context(|| format!("{} line {}", path.display(), n + 1))?);
+        if cams.len() > 10_000 {
+            bail!("{}: more than 10000 cameras", path.display());
+        }
+    }
+    if cams.is_empty() {
+        bail!("{}: no camera in the path (one EX,EY,EZ,TX,TY,TZ[,FOV] per line)", path.display());
+    }
+    Ok(cams)
+}

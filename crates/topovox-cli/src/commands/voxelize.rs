@@ -1,0 +1,177 @@
+//! `topovox voxelize MESH -o OUT`.
+
+use std::time::Instant;
+
+use anyhow::Result;
+use serde_json::json;
+use topovox::attributes::carry::CarryOptions;
+use topovox_job::output::{check_output_path, output_format};
+
+use crate::args::VoxelizeArgs;
+use crate::plan;
+use crate::progress::Bar;
+
+pub fn run(a: &VoxelizeArgs) -> Result<()> {
+    let t_total = Instant::now();
+    // Validate everything that does not need the mesh first.
+    let plan = plan::voxelize_plan(a)?;
+    let format = output_format(a.format.as_deref(), &a.output)?;
+    check_output_path(&a.output)?;
+    // Nothing is read or written before we know no output is an input.
+    topovox_job::output::refuse_overwriting(&a.output, format, std::slice::from_ref(&a.mesh))?;
+    if let Some(p) = &a.preview {
+        topovox_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.mesh))?;
+    }
+    let write_opts = crate::commands::export::writer_options(&a.export)?;
+    if !a.quiet && !a.json {
+        crate::commands::export::warn_unused(&a.export, format, &a.output, true, a.preview.is_some());
+    }
+    let preview = match &a.preview {
+        Some(p) => {
+            crate::commands::render::check_png_path(p)?;
+            Some((p, crate::commands::render::options(&a.picture, a.export.up.as_deref())?))
+        }
+        None => None,
+    };
+    let pool = crate::thread_pool(a.threads)?;
+    let threads = pool.current_num_threads();
+
+    let bar = Bar::new(a.quiet || a.json);
+    bar.phase("loading mesh");
+    let t_load = Instant::now();
+    let loaded = topovox_io::read_mesh_with(&a.mesh, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
+    let load_s = t_load.elapsed().as_secs_f64();
+    // Nor any file the mesh led to (its .mtl, textures, buffers).
+    topovox_job::output::refuse_overwriting(&a.output, format, &loaded.sources)?;
+    if let Some(p) = &a.preview {
+        topovox_io::atomic::refuse_overwriting_inputs(p, &loaded.sources)?;
+    }
+    for w in &loaded.warnings {
+        eprintln!("topovox: warning: {}: {w}", a.mesh.display());
+    }
+    // A dense format for a grid past memory is refused before any work.
+    let fitted = plan.request.grid.fit(&loaded.mesh.as_ref().bounds())?;
+    topovox_job::output::check_fits(format, &fitted, plan.request.max_memory)?;
+    bar.phase(if plan.surface_method == topovox_job::SurfaceMethod::Reference { "voxelizing (reference, serial)" } else { "voxelizing" });
+    let name = a.mesh.display().to_string();
+    let v = pool.install(|| topovox_job::voxelize(&plan, loaded.mesh.as_ref(), &name, Some(&bar)))?;
+    for w in &v.warnings {
+        eprintln!("topovox: warning: {w}");
+    }
+    let grid = v.grid;
+
+    // Attributes: colours for the formats that store them (and the preview),
+    // every array (coverage, material, normal) for .vti, and for .vdb and
+    // .zarr with --attributes; tiled grids too, while they fit in memory.
+    let every = topovox_job::every_attribute(format, a.export.attributes);
+    let app = &loaded.appearance;
+    let want_colour = app.has_colour() && (format.has_colour() || preview.is_some());
+    let t_attr = Instant::now();
+    if (want_colour || every) && !plan.is_line() {
+        topovox_job::check_attributes_carried(&plan, &v)?;
+    }
+    let attrs = (want_colour || every).then(|| {
+        bar.phase("carrying colours into voxels");
+        let opts = CarryOptions {
+            rule: crate::commands::export::colour_rule(a.export.colour_rule),
+            normals: a.export.normals || a.export.attributes,
+        };
+        pool.install(|| topovox_job::attributes(&plan, loaded.mesh.as_ref(), app, &v, &opts))
+    });
+    let attrs = attrs.flatten();
+    let attributes_s = t_attr.elapsed().as_secs_f64();
+    if format.has_colour() && !app.has_colour() && !a.quiet && !a.json {
+        eprintln!("topovox: note: {} has no colours (materials, textures or vertex colours); voxels get one colour", a.mesh.display());
+    }
+
+    bar.phase("writing");
+    let t_write = Instant::now();
+    let export_facts = pool.install(|| topovox_job::output::write(&a.output, format, &v.voxels, &grid, attrs.as_ref(), &write_opts))?;
+    let write_s = t_write.elapsed().as_secs_f64();
+    if let Some((path, o)) = &preview {
+        bar.phase("rendering the preview");
+        let outline = a.picture.outline.then(|| crate::commands::render::outline_triangles(loaded.mesh.as_ref(), &grid));
+        match &v.voxels {
+            topovox_job::Voxels::Sparse(sparse) => {
+                pool.install(|| crate::commands::render::picture_sparse(sparse, path, o, attrs.as_ref(), outline.as_deref()))?
+            }
+            voxels => pool.install(|| crate::commands::render::picture(voxels, path, o, attrs.as_ref(), outline.as_deref()))?,
+        };
+    }
+    bar.finish();
+    let total_s = t_total.elapsed().as_secs_f64();
+
+    let o = grid.origin();
+    let dims = grid.dims();
+    // With `-o -` the voxels are on stdout: the summary goes to stderr.
+    let to_stdout = a.output.as_os_str() == "-";
+    if a.json {
+        let mut j = v.facts(&plan);
+        let extra = json!({
+            "load_s": load_s,
+            "write_s": write_s,
+            "attributes_s": attributes_s,
+            "attributes": attrs.as_ref().map(|t| json!({
+                "colour": t.colour.is_some(),
+                "colour_rule": format!("{:?}", a.export.colour_rule).to_lowercase(),
+                "material": t.material.is_some(),
+                "normal": t.normal.is_some(),
+                "coverage": t.coverage.is_some(),
+            })),
+            "export": export_facts,
+            "preview": a.preview,
+            "total_s": total_s,
+            "threads": threads,
+            "input": a.mesh.display().to_string(),
+            "output": a.output.display().to_string(),
+            "format": format.name(),
+            "mesh": {
+                "vertices": loaded.report.vertices,
+                "triangles": loaded.report.triangles,
+                "degenerate": loaded.report.degenerate,
+                "segments": loaded.report.segments,
+            },
+            "warnings": loaded.warnings,
+        });
+        if let (Some(obj), Some(add)) = (j.as_object_mut(), extra.as_object()) {
+            obj.extend(add.clone());
+        }
+        summary(to_stdout, &j.to_string())?;
+    } else if !a.quiet {
+        let method = match v.solid.get("closed").and_then(|c| c.as_bool()) {
+            Some(true) => format!("{} (mesh closed)", v.method),
+            Some(false) => format!("{} (mesh not closed)", v.method),
+            None => v.method.to_string(),
+        };
+        summary(
+            to_stdout,
+            &format!(
+                "{}: {} voxels set on grid {}x{}x{} (origin {}, {}, {}; voxel size {}) by {} in {:.1} ms; total {:.2} s -> {}",
+                plan::mode_name(a.mode),
+                v.report.voxels,
+                dims[0],
+                dims[1],
+                dims[2],
+                o.x,
+                o.y,
+                o.z,
+                grid.voxel_size(),
+                method,
+                v.voxelize_s * 1e3,
+                total_s,
+                a.output.display()
+            ),
+        )?;
+    }
+    Ok(())
+}
+
+/// Prints the summary on stdout, or on stderr when the voxels went to stdout.
+fn summary(voxels_on_stdout: bool, line: &str) -> Result<()> {
+    if voxels_on_stdout {
+        eprintln!("{line}");
+        Ok(())
+    } else {
+        crate::print_stdout(line)
+    }
+}

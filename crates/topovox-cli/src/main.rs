@@ -1,0 +1,76 @@
+//! The `topovox` command-line tool: arguments → plan → `commands/*`.
+
+mod args;
+mod commands;
+mod plan;
+mod progress;
+
+use std::io::Write;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::Parser;
+
+use args::{Cli, Command};
+
+fn main() -> ExitCode {
+    // Panics inside third-party parsers are turned into errors by topovox-io;
+    // keep them silent. Any other panic is a bug: say so in one line.
+    std::panic::set_hook(Box::new(|info| {
+        if !topovox_io::panic_is_fenced() {
+            eprintln!("topovox: internal error (please report): {info}");
+        }
+    }));
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Voxelize(a) => commands::voxelize::run(a),
+        Command::Info(a) => commands::info::run(a),
+        Command::Bench(a) => commands::bench::run(a),
+        Command::Check(a) => commands::check::run(a),
+        Command::Gaps(a) => commands::gaps::run(a),
+        Command::Render(a) => commands::render::run(a),
+        #[cfg(feature = "gpu")]
+        Command::Scene(a) => commands::scene::run(a),
+        #[cfg(feature = "gpu")]
+        Command::View(a) => commands::view::run(a),
+        #[cfg(feature = "gpu")]
+        Command::Spray(a) => commands::spray::run(a),
+        #[cfg(not(feature = "gpu"))]
+        Command::Spray(_) => Err(anyhow::anyhow!("this topovox was built without the gpu feature, which holds the ray spray")),
+        #[cfg(not(feature = "gpu"))]
+        Command::View(_) => Err(anyhow::anyhow!("this topovox was built without the gpu feature, which holds the viewer")),
+        #[cfg(not(feature = "gpu"))]
+        Command::Scene(_) => Err(anyhow::anyhow!("this topovox was built without the gpu feature, which holds the scene generators")),
+        Command::Convert(a) => commands::convert::run(a),
+        Command::Batch(a) => commands::batch::run(a),
+        Command::Raster(a) => commands::raster::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("topovox: error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| c.downcast_ref::<std::io::Error>().is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe))
+}
+
+/// Prints a line on stdout; a closed pipe surfaces as an error that `main` ignores.
+pub(crate) fn print_stdout(s: &str) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "{s}")?;
+    out.flush()?;
+    Ok(())
+}
+
+/// A rayon pool with `threads` workers (default: all cores).
+pub(crate) fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    if threads == Some(0) {
+        anyhow::bail!("--threads must be at least 1");
+    }
+    rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start worker threads")
+}

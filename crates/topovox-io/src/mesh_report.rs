@@ -1,0 +1,109 @@
+//! A loaded mesh with its report and warnings, and the validation every
+//! reader ends with.
+
+use glam::DVec3;
+use topovox::attributes::Appearance;
+use topovox::{Aabb, Mesh};
+
+use crate::error::ErrorKind;
+
+/// Facts about a loaded mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeshReport {
+    /// Vertices.
+    pub vertices: usize,
+    /// Triangles (after fan triangulation of polygons).
+    pub triangles: usize,
+    /// Triangles with repeated indices or zero area; voxelizers skip them.
+    pub degenerate: usize,
+    /// Line segments (polyline input).
+    pub segments: usize,
+    /// Bounding box of the vertices used by triangles and segments.
+    pub bounds: Aabb,
+}
+
+/// A mesh as read from a file.
+#[derive(Clone, Debug)]
+pub struct LoadedMesh {
+    /// The geometry.
+    pub mesh: Mesh,
+    /// Counts and bounds.
+    pub report: MeshReport,
+    /// Non-fatal problems (for example a missing material library).
+    pub warnings: Vec<String>,
+    /// Materials, textures, UVs and vertex colours, aligned with the
+    /// triangles and vertices of `mesh` (empty lists where the file has none).
+    pub appearance: Appearance,
+    /// The files it was read from: the mesh file and every file it named
+    /// that was read (material libraries, textures, buffers), resolved.
+    /// Writers refuse to write over any of them.
+    pub sources: Vec<std::path::PathBuf>,
+}
+
+/// Validates and packages reader output: every coordinate finite, every
+/// index in range, at least one triangle.
+pub(crate) fn finish(positions: Vec<DVec3>, triangles: Vec<[i64; 3]>, warnings: Vec<String>) -> Result<LoadedMesh, ErrorKind> {
+    finish_with_segments(positions, triangles, Vec::new(), warnings)
+}
+
+/// A mesh built by a caller from arrays (the Python package's numpy input),
+/// validated as every reader's output is: every coordinate finite, every
+/// index in range, at least one triangle or segment.
+pub fn validate_mesh(positions: Vec<DVec3>, triangles: Vec<[i64; 3]>, segments: Vec<[i64; 2]>) -> Result<LoadedMesh, ErrorKind> {
+    finish_with_segments(positions, triangles, segments, Vec::new())
+}
+
+/// [`finish`] for input that may carry line segments: at least one
+/// triangle or segment.
+pub(crate) fn finish_with_segments(
+    positions: Vec<DVec3>,
+    triangles: Vec<[i64; 3]>,
+    segments: Vec<[i64; 2]>,
+    warnings: Vec<String>,
+) -> Result<LoadedMesh, ErrorKind> {
+    for (index, p) in positions.iter().enumerate() {
+        if let Some(&value) = p.to_array().iter().find(|c| !c.is_finite()) {
+            return Err(ErrorKind::NonFinite { index, value });
+        }
+    }
+    let count = positions.len();
+    let tris = checked_indices(&triangles, count, |face, index| ErrorKind::IndexOutOfRange { face, index, count })?;
+    let segs = checked_indices(&segments, count, |line, index| ErrorKind::SegmentIndexOutOfRange { line, index, count })?;
+    if tris.is_empty() && segs.is_empty() {
+        return Err(ErrorKind::Empty);
+    }
+    let mesh = Mesh { positions, triangles: tris, segments: segs };
+    let r = mesh.as_ref();
+    let report = MeshReport {
+        vertices: count,
+        triangles: mesh.triangles.len(),
+        degenerate: r.degenerate_count(),
+        segments: mesh.segments.len(),
+        bounds: r.bounds(),
+    };
+    Ok(LoadedMesh { mesh, report, warnings, appearance: Appearance::default(), sources: Vec::new() })
+}
+
+/// Converts index tuples to `u32`, or the error `bad(element, index)` for
+/// the first index outside `0..count`.
+fn checked_indices<const N: usize>(
+    items: &[[i64; N]],
+    count: usize,
+    bad: impl Fn(usize, i64) -> ErrorKind,
+) -> Result<Vec<[u32; N]>, ErrorKind> {
+    items
+        .iter()
+        .enumerate()
+        .map(|(e, t)| match t.iter().find(|&&i| i < 0 || i as usize >= count) {
+            Some(&index) => Err(bad(e, index)),
+            None => Ok(t.map(|i| i as u32)),
+        })
+        .collect()
+}
+
+/// Fan-triangulates a polygon given by vertex indices: (0,1,2), (0,2,3), …
+pub(crate) fn fan(poly: &[i64], out: &mut Vec<[i64; 3]>) {
+    for w in 1..poly.len().saturating_sub(1) {
+        out.push([poly[0], poly[w], poly[w + 1]]);
+    }
+}

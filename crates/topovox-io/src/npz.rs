@@ -1,0 +1,317 @@
+//! NumPy `.npz` of sparse coordinates: the set voxels as a `(k, 3)` array
+//! of indices and the grid beside them, for grids of any size.
+//!
+//! The archive is what `numpy.savez` writes (a ZIP of uncompressed `.npy`
+//! members), so `numpy.load("out.npz")` reads it:
+//!
+//! | member | dtype | shape | holds |
+//! |---|---|---|---|
+//! | `indices` | `int32` | `(k, 3)` | row `n` is the `(i, j, k)` of the `n`-th set voxel, ordered by `k`, then `j`, then `i` |
+//! | `dims` | `int64` | `(3,)` | the grid's `(nx, ny, nz)` |
+//! | `origin` | `float64` | `(3,)` | the world position of voxel `(0, 0, 0)`'s low corner |
+//! | `voxel_size` | `float64` | `()` | the voxel's edge length |
+//!
+//! A dense grid comes back with `grid = np.zeros(dims, bool);
+//! grid[tuple(indices.T)] = True`. The writer streams: it holds one buffer
+//! of coordinates, never the grid or the whole list, and writes through
+//! the `zip` crate's streaming writer (sizes and checksums in data
+//! descriptors, ZIP64 past 4 GiB), so it needs no seeking and also writes
+//! to standard output. The `.npy` headers are [`crate::npy`]'s.
+
+use std::io::{Read, Seek, Write};
+
+use glam::DVec3;
+use std::collections::HashMap;
+
+use topovox::grid::bricks::{set_in_brick, Brick};
+use topovox::grid::sparse::SparseBricks;
+use topovox::{GridSpec, VoxelSource};
+
+use crate::error::ErrorKind;
+use crate::npy::{header, header_field};
+use crate::{LoadedVoxels, SparseVoxels};
+
+const FORMAT: &str = "npz";
+
+/// Writes the set voxels of `bits` on `grid` as an `.npz` archive.
+pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
+    let dims = bits.dims();
+    let count = bits.count();
+    let index_bytes = count.checked_mul(12).ok_or_else(|| std::io::Error::other("too many voxels for an .npz index array"))?;
+    let mut zip = zip::ZipWriter::new_stream(w);
+    let small = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    // ZIP64 fields for the index member when it may pass 4 GiB.
+    let large = small.large_file(index_bytes > u32::MAX as u64 / 2);
+    let member = |zip: &mut zip::ZipWriter<_>, name: &str, header: Vec<u8>, data: &[u8]| -> std::io::Result<()> {
+        zip.start_file(name, small).map_err(std::io::Error::other)?;
+        zip.write_all(&header)?;
+        zip.write_all(data)
+    };
+    let o = grid.origin();
+    let dims_le: Vec<u8> = dims.iter().flat_map(|&d| (d as i64).to_le_bytes()).collect();
+    member(&mut zip, "dims.npy", header("<i8", "(3,)"), &dims_le)?;
+    let origin_le: Vec<u8> = [o.x, o.y, o.z].iter().flat_map(|c| c.to_le_bytes()).collect();
+    member(&mut zip, "origin.npy", header("<f8", "(3,)"), &origin_le)?;
+    member(&mut zip, "voxel_size.npy", header("<f8", "()"), &grid.voxel_size().to_le_bytes())?;
+
+    zip.start_file("indices.npy", large).map_err(std::io::Error::other)?;
+    zip.write_all(&header("<i4", &format!("({count}, 3)")))?;
+    let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
+    let mut result = Ok(());
+    bits.for_each_set(&mut |i, j, k| {
+        if result.is_err() {
+            return;
+        }
+        for c in [i, j, k] {
+            buf.extend_from_slice(&(c as i32).to_le_bytes());
+        }
+        if buf.len() >= 1 << 16 {
+            result = zip.write_all(&buf);
+            buf.clear();
+        }
+    });
+    result?;
+    zip.write_all(&buf)?;
+    zip.finish().map_err(std::io::Error::other)?;
+    Ok(())
+}
+
+/// A member's `.npy` header: dtype and shape.
+struct Header {
+    descr: String,
+    shape: Vec<u64>,
+}
+
+/// Reads a member's `.npy` header (version 1, 2 or 3, C order).
+fn read_header(r: &mut impl Read, name: &str) -> Result<Header, ErrorKind> {
+    let bad = |d: String| ErrorKind::malformed("npz", format!("member {name}: {d}"));
+    let mut magic = [0u8; 8];
+    r.read_exact(&mut magic).map_err(|_| bad("shorter than an .npy header".into()))?;
+    if &magic[..6] != b"\x93NUMPY" {
+        return Err(bad("not an .npy array".into()));
+    }
+    let len = match magic[6] {
+        1 => {
+            let mut l = [0u8; 2];
+            r.read_exact(&mut l).map_err(|_| bad("header cut short".into()))?;
+            u16::from_le_bytes(l) as usize
+        }
+        2 | 3 => {
+            let mut l = [0u8; 4];
+            r.read_exact(&mut l).map_err(|_| bad("header cut short".into()))?;
+            u32::from_le_bytes(l) as usize
+        }
+        v => return Err(bad(format!("unknown .npy version {v}"))),
+    };
+    if len > 1 << 16 {
+        return Err(bad(format!("header of {len} bytes")));
+    }
+    let mut text = vec![0u8; len];
+    r.read_exact(&mut text).map_err(|_| bad("header cut short".into()))?;
+    let text = String::from_utf8(text).map_err(|_| bad("header is not text".into()))?;
+    let field = |key: &str| header_field(&text, key);
+    let descr =
+        field("descr").and_then(|v| v.strip_prefix('\'')).and_then(|v| v.split('\'').next()).ok_or_else(|| bad("no dtype".into()))?;
+    if !field("fortran_order").is_some_and(|v| v.starts_with("False")) {
+        return Err(bad("only C-ordered arrays are read".into()));
+    }
+    let shape_text =
+        field("shape").and_then(|v| v.strip_prefix('(')).and_then(|v| v.split(')').next()).ok_or_else(|| bad("no shape".into()))?;
+    let shape = shape_text
+        .split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|s| s.trim_end_matches('L').parse::<u64>())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|_| bad(format!("shape ({shape_text}) is not a tuple of sizes")))?;
+    Ok(Header { descr: descr.to_string(), shape })
+}
+
+/// Reads `n` numbers of `descr` (little- or big-endian integers of 1, 2, 4
+/// or 8 bytes, or 8-byte floats) as `f64`.
+fn read_numbers(r: &mut impl Read, descr: &str, n: usize, name: &str) -> Result<Vec<f64>, ErrorKind> {
+    let bad = |d: String| ErrorKind::malformed("npz", format!("member {name}: {d}"));
+    if !descr.is_ascii() {
+        return Err(bad(format!("dtype {descr:?} (expected integers or float64)")));
+    }
+    let (order, kind) = descr.split_at(1.min(descr.len()));
+    let big = order == ">";
+    let size: usize = kind.get(1..).and_then(|s| s.parse().ok()).ok_or_else(|| bad(format!("dtype {descr:?}")))?;
+    if !matches!((kind.as_bytes().first(), size), (Some(b'i' | b'u'), 1 | 2 | 4 | 8) | (Some(b'f'), 8))
+        || !matches!(order, "<" | ">" | "|" | "=")
+    {
+        return Err(bad(format!("dtype {descr:?} (expected integers or float64)")));
+    }
+    let mut raw = vec![0u8; size];
+    let mut out = Vec::with_capacity(n.min(1 << 20));
+    for _ in 0..n {
+        r.read_exact(&mut raw).map_err(|_| bad("data cut short".into()))?;
+        if big {
+            raw.reverse();
+        }
+        let mut b = [0u8; 8];
+        b[..size].copy_from_slice(&raw);
+        let v = match kind.as_bytes()[0] {
+            b'f' => f64::from_le_bytes(b),
+            b'u' => u64::from_le_bytes(b) as f64,
+            _ => {
+                let shift = 64 - 8 * size as u32;
+                ((i64::from_le_bytes(b) << shift) >> shift) as f64
+            }
+        };
+        out.push(v);
+    }
+    Ok(out)
+}
+
+/// Reads an `.npz` of sparse coordinates (as [`write()`] makes, or any
+/// `numpy.savez` with an `indices` array of shape `(k, 3)`, integer
+/// dtype); `dims` is read when present, else the smallest grid holding
+/// every voxel; `origin` and `voxel_size`, when present, place the grid.
+pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
+    read_from(std::io::Cursor::new(bytes), bytes.len() as u64)
+}
+
+/// [`read()`] from a seekable reader of `total` bytes (a file: the index
+/// array is streamed into the grid, never held whole).
+pub fn read_from<R: Read + Seek>(r: R, total: u64) -> Result<LoadedVoxels, ErrorKind> {
+    let (grid, placement) = read_into(r, total, false)?;
+    match grid {
+        Read3::Dense(bits) => Ok(LoadedVoxels { bits, placement, attributes: None }),
+        Read3::Sparse(_) => unreachable!("asked for a dense grid"),
+    }
+}
+
+/// [`read_from`] without a dense grid: the indices gathered into bricks,
+/// for grids past memory.
+pub fn read_sparse_from<R: Read + Seek>(r: R, total: u64) -> Result<SparseVoxels, ErrorKind> {
+    let (grid, placement) = read_into(r, total, true)?;
+    match grid {
+        Read3::Sparse(bits) => Ok(SparseVoxels { bits, placement, attributes_left: false, attributes: None }),
+        Read3::Dense(_) => unreachable!("asked for sparse bricks"),
+    }
+}
+
+/// The voxels read: a dense grid, or sparse bricks.
+enum Read3 {
+    Dense(topovox::DenseBits),
+    Sparse(SparseBricks),
+}
+
+/// Where indices go while they are read.
+enum Sink {
+    Dense(topovox::DenseBits),
+    Bricks(HashMap<[u32; 3], Brick>),
+    /// Without recorded dims, the grid is sized after reading them all.
+    List(Vec<[u32; 3]>),
+}
+
+fn set_in(bricks: &mut HashMap<[u32; 3], Brick>, q: [u32; 3]) {
+    set_in_brick(bricks.entry(q.map(|c| c / 8)).or_insert([0; 8]), q[0], q[1], q[2]);
+}
+
+fn read_into<R: Read + Seek>(r: R, total: u64, sparse: bool) -> Result<(Read3, Option<(DVec3, f64)>), ErrorKind> {
+    let mut zip = zip::ZipArchive::new(r).map_err(|e| ErrorKind::malformed(FORMAT, format!("not a ZIP archive ({e})")))?;
+    let small = |zip: &mut zip::ZipArchive<R>, name: &str, n: usize| -> Result<Option<Vec<f64>>, ErrorKind> {
+        let Ok(mut f) = zip.by_name(name) else { return Ok(None) };
+        let h = read_header(&mut f, name)?;
+        if h.shape.iter().product::<u64>() != n as u64 {
+            return Err(ErrorKind::malformed(FORMAT, format!("member {name}: shape {:?}, expected {n} values", h.shape)));
+        }
+        read_numbers(&mut f, &h.descr, n, name).map(Some)
+    };
+    let dims = small(&mut zip, "dims.npy", 3)?;
+    let origin = small(&mut zip, "origin.npy", 3)?;
+    let size = small(&mut zip, "voxel_size.npy", 1)?;
+    let name = "indices.npy";
+    let mut f = zip.by_name(name).map_err(|_| ErrorKind::malformed(FORMAT, "no 'indices' array"))?;
+    let h = read_header(&mut f, name)?;
+    let [k, 3] = h.shape[..] else {
+        return Err(ErrorKind::malformed(FORMAT, format!("'indices' has shape {:?}, expected (k, 3)", h.shape)));
+    };
+    if h.descr.contains('f') {
+        return Err(ErrorKind::malformed(FORMAT, format!("'indices' has dtype {:?}, expected integers", h.descr)));
+    }
+    // A hostile header can claim more rows than the archive holds.
+    let elem: u64 = h.descr.get(2..).and_then(|s| s.parse().ok()).unwrap_or(8);
+    if k.saturating_mul(3 * elem) > f.size() || f.size() > total.saturating_mul(1 << 10) {
+        return Err(ErrorKind::malformed(FORMAT, format!("'indices' claims {k} rows, more than its {} bytes hold", f.size())));
+    }
+    let max = topovox::grid::spec::MAX_DIM as f64;
+    let check = |v: f64| v >= 0.0 && v < max && v.fract() == 0.0;
+    let dims = match dims {
+        Some(d) => {
+            if !d.iter().all(|&c| (1.0..=max).contains(&c) && c.fract() == 0.0) {
+                return Err(ErrorKind::malformed(FORMAT, format!("grid dims {d:?} out of range")));
+            }
+            Some([d[0] as u32, d[1] as u32, d[2] as u32])
+        }
+        None => None,
+    };
+    // Indices come in chunks; without dims the grid is sized after reading them all.
+    let mut sink = match dims {
+        Some(d) if sparse => {
+            if d.iter().any(|&x| x > SparseBricks::MAX_DIM) {
+                return Err(ErrorKind::malformed(FORMAT, format!("grid dims {d:?} beyond {} voxels per axis", SparseBricks::MAX_DIM)));
+            }
+            Sink::Bricks(HashMap::new())
+        }
+        Some(d) => Sink::Dense(crate::dense_grid(d)?),
+        None => Sink::List(Vec::new()),
+    };
+    let mut left = k as usize;
+    while left > 0 {
+        let n = left.min(1 << 16);
+        let v = read_numbers(&mut f, &h.descr, 3 * n, name)?;
+        for p in v.chunks_exact(3) {
+            if !p.iter().all(|&c| check(c)) {
+                return Err(ErrorKind::malformed(FORMAT, format!("index {p:?} is not a voxel of a grid")));
+            }
+            let q = [p[0] as u32, p[1] as u32, p[2] as u32];
+            if let Some(d) = dims {
+                if (0..3).any(|a| q[a] >= d[a]) {
+                    return Err(ErrorKind::malformed(FORMAT, format!("index {q:?} lies outside the {d:?} grid")));
+                }
+            }
+            match &mut sink {
+                Sink::Dense(b) => b.set(q[0], q[1], q[2]),
+                Sink::Bricks(b) => set_in(b, q),
+                Sink::List(v) => v.push(q),
+            }
+        }
+        left -= n;
+    }
+    let grid = match sink {
+        Sink::Dense(b) => Read3::Dense(b),
+        Sink::Bricks(b) => Read3::Sparse(SparseBricks::from_parts(dims.expect("bricks need dims"), b.into_iter().collect(), Vec::new())),
+        Sink::List(voxels) => {
+            let mut d = [1u32; 3];
+            for v in &voxels {
+                for a in 0..3 {
+                    d[a] = d[a].max(v[a] + 1);
+                }
+            }
+            if sparse {
+                let mut b = HashMap::new();
+                for v in voxels {
+                    set_in(&mut b, v);
+                }
+                Read3::Sparse(SparseBricks::from_parts(d, b.into_iter().collect(), Vec::new()))
+            } else {
+                let mut b = crate::dense_grid(d)?;
+                for v in voxels {
+                    b.set(v[0], v[1], v[2]);
+                }
+                Read3::Dense(b)
+            }
+        }
+    };
+    let placement = match (origin, size) {
+        (Some(o), Some(s)) if o.iter().all(|c| c.is_finite()) && s[0].is_finite() && s[0] > 0.0 => {
+            Some((DVec3::new(o[0], o[1], o[2]), s[0]))
+        }
+        (None, None) => None,
+        _ => return Err(ErrorKind::malformed(FORMAT, "origin and voxel_size must both be finite, the size positive")),
+    };
+    Ok((grid, placement))
+}

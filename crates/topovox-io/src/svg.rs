@@ -1,0 +1,393 @@
+//! SVG input for `topovox raster`: outlines in the plane, through the
+//! `roxmltree` (XML) and `svgtypes` (path data, points, transforms) crates.
+//!
+//! Read: `<path d>` (every command: `M L H V Z` absolute and relative;
+//! `C S Q T A` curves and arcs are flattened, below), `<polyline>`,
+//! `<polygon>`, `<line>`, `<rect>` (square corners), `<circle>` and
+//! `<ellipse>` (flattened), each with the `transform`s of the element and
+//! its ancestors applied. Elements inside `<defs>`, `<clipPath>`,
+//! `<mask>`, `<marker>`, `<pattern>` and `<symbol>` are not drawn and are
+//! skipped; `<use>`, rounded rectangles and lengths with units other than
+//! `px` are refused with an error naming them (never drawn wrongly);
+//! `<text>` and `<image>` are skipped with a warning.
+//!
+//! Coordinates: SVG user units are the plane's coordinates (`x → i`,
+//! `y → j`, no flip). **Flattening:** curves are split until every chord
+//! lies within the tolerance of the curve (`tolerance`, in user units;
+//! default `1e-5` × the drawing's extent, well under a pixel at any
+//! resolution topovox allows).
+
+use glam::DVec2;
+use topovox::raster::Outline;
+
+use crate::error::ErrorKind;
+
+/// How an SVG is read.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SvgOptions {
+    /// Largest distance of a flattened chord from its curve, in user units
+    /// (default: `1e-5` × the drawing's extent).
+    pub tolerance: Option<f64>,
+}
+
+/// Outlines read from an SVG, and warnings.
+#[derive(Clone, Debug, Default)]
+pub struct LoadedSvg {
+    /// Polylines (closed by `Z`, `<polygon>`, `<rect>`, circles, ellipses).
+    pub outlines: Vec<Outline>,
+    /// Skipped elements.
+    pub warnings: Vec<String>,
+}
+
+/// A path in user units before flattening.
+#[derive(Clone, Debug)]
+enum Piece {
+    Move(DVec2),
+    Line(DVec2),
+    Cubic(DVec2, DVec2, DVec2),
+    Close,
+}
+
+#[derive(Clone, Copy)]
+struct Affine([f64; 6]);
+
+impl Affine {
+    const ID: Affine = Affine([1.0, 0.0, 0.0, 1.0, 0.0, 0.0]);
+
+    fn then(self, inner: Affine) -> Affine {
+        // self ∘ inner: parent transform applied after the child's.
+        let [a, b, c, d, e, f] = self.0;
+        let [a2, b2, c2, d2, e2, f2] = inner.0;
+        Affine([a * a2 + c * b2, b * a2 + d * b2, a * c2 + c * d2, b * c2 + d * d2, a * e2 + c * f2 + e, b * e2 + d * f2 + f])
+    }
+
+    fn apply(self, p: DVec2) -> DVec2 {
+        let [a, b, c, d, e, f] = self.0;
+        DVec2::new(a * p.x + c * p.y + e, b * p.x + d * p.y + f)
+    }
+}
+
+/// Parses SVG bytes into outlines.
+pub fn read(bytes: &[u8], opts: &SvgOptions) -> Result<LoadedSvg, ErrorKind> {
+    let text = std::str::from_utf8(bytes).map_err(|e| ErrorKind::malformed("SVG", format!("not UTF-8 ({e})")))?;
+    let doc = roxmltree::Document::parse(text).map_err(|e| ErrorKind::malformed("SVG", e))?;
+    let mut paths: Vec<Vec<Piece>> = Vec::new();
+    let mut warnings = Vec::new();
+    walk(doc.root_element(), Affine::ID, &mut paths, &mut warnings)?;
+    // The drawing's extent (end and control points) sets the default tolerance.
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in paths.iter().flatten() {
+        let pts: &[DVec2] = match p {
+            Piece::Move(a) | Piece::Line(a) => std::slice::from_ref(a),
+            Piece::Cubic(a, b, c) => &[*a, *b, *c][..],
+            Piece::Close => &[],
+        };
+        for q in pts {
+            lo = lo.min(*q);
+            hi = hi.max(*q);
+        }
+    }
+    let extent = (hi - lo).max_element();
+    let tol = match opts.tolerance {
+        Some(t) if t.is_finite() && t > 0.0 => t,
+        Some(t) => return Err(ErrorKind::malformed("SVG", format!("tolerance must be a positive number, got {t}"))),
+        None if extent.is_finite() && extent > 0.0 => extent * 1e-5,
+        None => 1e-9,
+    };
+    let mut outlines = Vec::new();
+    let mut total = 0usize;
+    for pieces in paths {
+        let mut cur = Outline::default();
+        let mut at = DVec2::ZERO;
+        let mut start = DVec2::ZERO;
+        let push = |o: &mut Outline, out: &mut Vec<Outline>| {
+            if o.points.len() >= 2 {
+                out.push(std::mem::take(o));
+            } else {
+                o.points.clear();
+                o.closed = false;
+            }
+        };
+        for p in pieces {
+            match p {
+                Piece::Move(a) => {
+                    push(&mut cur, &mut outlines);
+                    cur.points.push(a);
+                    (at, start) = (a, a);
+                }
+                Piece::Line(a) => {
+                    if cur.points.is_empty() {
+                        cur.points.push(at);
+                    }
+                    cur.points.push(a);
+                    at = a;
+                }
+                Piece::Cubic(c1, c2, a) => {
+                    if cur.points.is_empty() {
+                        cur.points.push(at);
+                    }
+                    let before = cur.points.len();
+                    flatten_cubic(at, c1, c2, a, tol, 0, &mut cur.points);
+                    at = a;
+                    total += cur.points.len() - before;
+                    if total > MAX_POINTS {
+                        return Err(ErrorKind::malformed(
+                            "SVG",
+                            format!("flattening the curves needs more than {MAX_POINTS} points at tolerance {tol}; raise --tolerance"),
+                        ));
+                    }
+                }
+                Piece::Close => {
+                    cur.closed = true;
+                    if cur.points.last() == Some(&start) && cur.points.len() > 1 {
+                        cur.points.pop();
+                    }
+                    push(&mut cur, &mut outlines);
+                    at = start;
+                }
+            }
+        }
+        push(&mut cur, &mut outlines);
+    }
+    if outlines.iter().all(|o| o.points.is_empty()) {
+        return Err(ErrorKind::malformed("SVG", "no path, polyline, polygon, line, rect, circle or ellipse with at least two points"));
+    }
+    for (n, o) in outlines.iter().enumerate() {
+        if let Some(p) = o.points.iter().find(|p| !p.is_finite()) {
+            return Err(ErrorKind::malformed("SVG", format!("outline {n} has a non-finite point {p}")));
+        }
+    }
+    Ok(LoadedSvg { outlines, warnings })
+}
+
+/// Largest magnitude of a number in path data. Arcs become cubics inside
+/// `svgtypes`, which splits an arc more finely the larger it is against a
+/// fixed tolerance: an arc to 1e110 took minutes (found by fuzzing).
+const MAX_PATH_NUMBER: f64 = 1e12;
+
+/// Refuses path data holding a number beyond [`MAX_PATH_NUMBER`].
+fn check_path_numbers(d: &str) -> Result<(), ErrorKind> {
+    use svgtypes::PathSegment as P;
+    for seg in svgtypes::PathParser::from(d) {
+        let Ok(seg) = seg else { break }; // the simplifying parser reports it
+        let nums: &[f64] = match &seg {
+            P::MoveTo { x, y, .. } | P::LineTo { x, y, .. } | P::SmoothQuadratic { x, y, .. } => &[*x, *y],
+            P::HorizontalLineTo { x, .. } => &[*x],
+            P::VerticalLineTo { y, .. } => &[*y],
+            P::CurveTo { x1, y1, x2, y2, x, y, .. } => &[*x1, *y1, *x2, *y2, *x, *y],
+            P::SmoothCurveTo { x2, y2, x, y, .. } => &[*x2, *y2, *x, *y],
+            P::Quadratic { x1, y1, x, y, .. } => &[*x1, *y1, *x, *y],
+            P::EllipticalArc { rx, ry, x, y, .. } => &[*rx, *ry, *x, *y],
+            P::ClosePath { .. } => &[],
+        };
+        if let Some(v) = nums.iter().find(|v| v.is_nan() || v.abs() > MAX_PATH_NUMBER) {
+            return Err(ErrorKind::malformed("SVG", format!("<path> d: number {v} beyond {MAX_PATH_NUMBER:e}")));
+        }
+    }
+    Ok(())
+}
+
+/// Most points the flattened curves of one file may have (a hostile file's
+/// curves at a tiny tolerance would otherwise take minutes and gigabytes).
+const MAX_POINTS: usize = 1 << 24;
+
+/// Appends the points after `p0` of the cubic `p0 c1 c2 p3`, split until
+/// the control points lie within `tol` of the chord.
+fn flatten_cubic(p0: DVec2, c1: DVec2, c2: DVec2, p3: DVec2, tol: f64, depth: u32, out: &mut Vec<DVec2>) {
+    let chord = p3 - p0;
+    let len = chord.length();
+    let dist = |q: DVec2| if len > 0.0 { (q - p0).perp_dot(chord).abs() / len } else { (q - p0).length() };
+    // A non-finite point ends the split (the outline is refused below).
+    let finite = p0.is_finite() && c1.is_finite() && c2.is_finite() && p3.is_finite();
+    if depth >= 24 || !finite || (dist(c1) <= tol && dist(c2) <= tol) {
+        out.push(p3);
+        return;
+    }
+    let (m01, m12, m23) = ((p0 + c1) * 0.5, (c1 + c2) * 0.5, (c2 + p3) * 0.5);
+    let (a, b) = ((m01 + m12) * 0.5, (m12 + m23) * 0.5);
+    let mid = (a + b) * 0.5;
+    flatten_cubic(p0, m01, a, mid, tol, depth + 1, out);
+    flatten_cubic(mid, b, m23, p3, tol, depth + 1, out);
+}
+
+fn number(node: roxmltree::Node<'_, '_>, name: &str, default: f64) -> Result<f64, ErrorKind> {
+    let Some(v) = node.attribute(name) else { return Ok(default) };
+    let l: svgtypes::Length =
+        v.parse().map_err(|e| ErrorKind::malformed("SVG", format!("<{}> {name}={v:?}: {e}", node.tag_name().name())))?;
+    match l.unit {
+        svgtypes::LengthUnit::None | svgtypes::LengthUnit::Px => Ok(l.number),
+        u => Err(ErrorKind::Unsupported(format!("<{}> {name}={v:?}: unit {u:?} (give plain numbers or px)", node.tag_name().name()))),
+    }
+}
+
+fn walk(node: roxmltree::Node<'_, '_>, parent: Affine, out: &mut Vec<Vec<Piece>>, warnings: &mut Vec<String>) -> Result<(), ErrorKind> {
+    if !node.is_element() {
+        return Ok(());
+    }
+    let name = node.tag_name().name();
+    if matches!(name, "defs" | "clipPath" | "mask" | "marker" | "pattern" | "symbol" | "metadata" | "title" | "desc" | "style") {
+        return Ok(());
+    }
+    let local = match node.attribute("transform") {
+        Some(t) => {
+            let ts: svgtypes::Transform = t.parse().map_err(|e| ErrorKind::malformed("SVG", format!("<{name}> transform={t:?}: {e}")))?;
+            Affine([ts.a, ts.b, ts.c, ts.d, ts.e, ts.f])
+        }
+        None => Affine::ID,
+    };
+    let m = parent.then(local);
+    let p = |x: f64, y: f64| m.apply(DVec2::new(x, y));
+    match name {
+        "path" => {
+            let d = node.attribute("d").unwrap_or("");
+            check_path_numbers(d)?;
+            let mut pieces = Vec::new();
+            // The current point and the subpath's start, in plane coordinates.
+            let (mut at, mut start) = (DVec2::ZERO, DVec2::ZERO);
+            for seg in svgtypes::SimplifyingPathParser::from(d) {
+                let seg = seg.map_err(|e| ErrorKind::malformed("SVG", format!("<path> d: {e}")))?;
+                use svgtypes::SimplePathSegment as S;
+                let piece = match seg {
+                    S::MoveTo { x, y } => {
+                        start = p(x, y);
+                        Piece::Move(start)
+                    }
+                    S::LineTo { x, y } => Piece::Line(p(x, y)),
+                    S::CurveTo { x1, y1, x2, y2, x, y } => Piece::Cubic(p(x1, y1), p(x2, y2), p(x, y)),
+                    S::Quadratic { x1, y1, x, y } => {
+                        // Elevated to a cubic from the current point.
+                        let (q, end) = (p(x1, y1), p(x, y));
+                        Piece::Cubic(at + (q - at) * (2.0 / 3.0), end + (q - end) * (2.0 / 3.0), end)
+                    }
+                    S::ClosePath => Piece::Close,
+                };
+                at = match &piece {
+                    Piece::Move(a) | Piece::Line(a) | Piece::Cubic(_, _, a) => *a,
+                    Piece::Close => start,
+                };
+                pieces.push(piece);
+            }
+            out.push(pieces);
+        }
+        "polyline" | "polygon" => {
+            let pts: Vec<DVec2> = svgtypes::PointsParser::from(node.attribute("points").unwrap_or("")).map(|(x, y)| p(x, y)).collect();
+            let mut pieces: Vec<Piece> =
+                pts.iter().enumerate().map(|(i, &q)| if i == 0 { Piece::Move(q) } else { Piece::Line(q) }).collect();
+            if name == "polygon" {
+                pieces.push(Piece::Close);
+            }
+            out.push(pieces);
+        }
+        "line" => {
+            let (x1, y1, x2, y2) = (number(node, "x1", 0.0)?, number(node, "y1", 0.0)?, number(node, "x2", 0.0)?, number(node, "y2", 0.0)?);
+            out.push(vec![Piece::Move(p(x1, y1)), Piece::Line(p(x2, y2))]);
+        }
+        "rect" => {
+            if number(node, "rx", 0.0)? != 0.0 || number(node, "ry", 0.0)? != 0.0 {
+                return Err(ErrorKind::Unsupported("<rect> with rounded corners (rx/ry); draw it as a <path>".into()));
+            }
+            let (x, y, w, h) =
+                (number(node, "x", 0.0)?, number(node, "y", 0.0)?, number(node, "width", 0.0)?, number(node, "height", 0.0)?);
+            out.push(vec![
+                Piece::Move(p(x, y)),
+                Piece::Line(p(x + w, y)),
+                Piece::Line(p(x + w, y + h)),
+                Piece::Line(p(x, y + h)),
+                Piece::Close,
+            ]);
+        }
+        "circle" | "ellipse" => {
+            let (cx, cy) = (number(node, "cx", 0.0)?, number(node, "cy", 0.0)?);
+            let (rx, ry) = if name == "circle" {
+                let r = number(node, "r", 0.0)?;
+                (r, r)
+            } else {
+                (number(node, "rx", 0.0)?, number(node, "ry", 0.0)?)
+            };
+            // Four cubic quarter arcs (kappa = 0.5523), flattened like paths.
+            let k = 0.552_284_749_830_793_4;
+            let q = |ax: f64, ay: f64| p(cx + ax, cy + ay);
+            out.push(vec![
+                Piece::Move(q(rx, 0.0)),
+                Piece::Cubic(q(rx, k * ry), q(k * rx, ry), q(0.0, ry)),
+                Piece::Cubic(q(-k * rx, ry), q(-rx, k * ry), q(-rx, 0.0)),
+                Piece::Cubic(q(-rx, -k * ry), q(-k * rx, -ry), q(0.0, -ry)),
+                Piece::Cubic(q(k * rx, -ry), q(rx, -k * ry), q(rx, 0.0)),
+                Piece::Close,
+            ]);
+        }
+        "use" => return Err(ErrorKind::Unsupported("<use> references (inline the referenced shapes)".into())),
+        "text" | "image" | "foreignObject" => warnings.push(format!("<{name}> is not an outline; skipped")),
+        _ => {}
+    }
+    for child in node.children() {
+        walk(child, m, out, warnings)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn outlines(svg: &str) -> Vec<Outline> {
+        read(svg.as_bytes(), &SvgOptions::default()).unwrap().outlines
+    }
+
+    #[test]
+    fn path_commands_absolute_and_relative() {
+        let o = outlines(r#"<svg><path d="M 1 2 L 5 2 l 0 3 H 1 v -1 Z m 10 0 h 2"/></svg>"#);
+        assert_eq!(o.len(), 2);
+        assert!(o[0].closed);
+        assert_eq!(o[0].points, vec![DVec2::new(1., 2.), DVec2::new(5., 2.), DVec2::new(5., 5.), DVec2::new(1., 5.), DVec2::new(1., 4.)]);
+        assert_eq!(o[1].points, vec![DVec2::new(11., 2.), DVec2::new(13., 2.)]);
+        assert!(!o[1].closed);
+    }
+
+    #[test]
+    fn transforms_compose_and_shapes_close() {
+        let o = outlines(
+            r#"<svg><g transform="translate(10 0)"><polygon points="0,0 1,0 0,1" transform="scale(2)"/></g><polyline points="0 0 3 3"/></svg>"#,
+        );
+        assert_eq!(o[0].points, vec![DVec2::new(10., 0.), DVec2::new(12., 0.), DVec2::new(10., 2.)]);
+        assert!(o[0].closed && !o[1].closed);
+    }
+
+    #[test]
+    fn huge_arcs_end_quickly() {
+        // Fuzzing found this: arcs to 1e31 and 1e110 split to the depth
+        // limit on every piece (non-finite distances), for minutes.
+        let svg = br#"<svg><path d="M0 8 L4 4 h3 v-3 z m1 1 c 1 1 2 2 3 0 s 1 1 2 2 q 1 1 2 0 t 0 1 a 2 2 0 0 1 99999999999999999999999999999992 3 0 s 1 1 2 2 q 1 1 2 0 t 0 1 a 2 2 0 0 1 9999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999993 3"/></svg>"#;
+        let t = std::time::Instant::now();
+        let _ = read(svg, &SvgOptions::default());
+        assert!(t.elapsed().as_secs_f64() < 5.0, "took {:?}", t.elapsed());
+        let tiny = br#"<svg><circle cx="0" cy="0" r="10"/></svg>"#;
+        assert!(read(tiny, &SvgOptions { tolerance: Some(1e-300) }).is_err());
+    }
+
+    #[test]
+    fn curves_are_flattened_within_the_tolerance() {
+        let o = read(br#"<svg><circle cx="0" cy="0" r="10"/></svg>"#, &SvgOptions { tolerance: Some(0.01) }).unwrap().outlines;
+        assert!(o[0].points.len() > 40, "{}", o[0].points.len());
+        // Chords within 0.01 plus the cubic's own error (~0.0003 r) of the circle.
+        for w in o[0].points.windows(2) {
+            let mid = (w[0] + w[1]) * 0.5;
+            assert!((mid.length() - 10.0).abs() < 0.015, "{}", mid.length());
+        }
+        let arc = outlines(r#"<svg><path d="M 0 0 A 5 5 0 0 1 10 0"/></svg>"#);
+        assert!(arc[0].points.len() > 8);
+    }
+
+    #[test]
+    fn unsupported_input_is_an_error() {
+        for svg in [
+            r##"<svg><use href="#a"/></svg>"##,
+            r#"<svg><rect width="1" height="1" rx="0.2"/></svg>"#,
+            r#"<svg><line x2="1cm"/></svg>"#,
+            "<svg/>",
+            "not xml",
+        ] {
+            assert!(read(svg.as_bytes(), &SvgOptions::default()).is_err(), "{svg}");
+        }
+    }
+}

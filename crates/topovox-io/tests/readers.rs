@@ -1,0 +1,223 @@
+//! Each reader on small files built here, with known answers.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use topovox_io::read_mesh;
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("topovox-io-readers-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+fn write(name: &str, bytes: &[u8]) -> PathBuf {
+    let p = tmp(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn shared(name: &str) -> PathBuf {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes").join(name);
+    assert!(p.exists(), "shared mesh {} missing", p.display());
+    p
+}
+
+#[test]
+fn obj_polygons_are_fanned_and_negative_indices_resolved() {
+    let p = write("quad.obj", b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf -5 -4 -3 -2\nf 1 2 5\n");
+    let m = read_mesh(&p).unwrap();
+    assert_eq!(m.report.triangles, 3);
+    assert_eq!(m.mesh.triangles[0], [0, 1, 2]);
+    assert_eq!(m.mesh.triangles[1], [0, 2, 3]);
+    assert_eq!(m.mesh.triangles[2], [0, 1, 4]);
+    assert_eq!(m.report.bounds.max, DVec3::ONE);
+}
+
+#[test]
+fn obj_with_missing_mtl_warns() {
+    let m = read_mesh(&shared("beetle.obj")).unwrap();
+    assert!(m.report.triangles >= 2053, "{}", m.report.triangles);
+    assert!(m.warnings.iter().any(|w| w.contains(".mtl")), "{:?}", m.warnings);
+}
+
+#[test]
+fn suzanne_quads_become_triangles() {
+    let m = read_mesh(&shared("suzanne.obj")).unwrap();
+    assert_eq!(m.report.vertices, 507);
+    assert!(m.report.triangles > 500, "{}", m.report.triangles);
+}
+
+fn cube_tris() -> Vec<[[f32; 3]; 3]> {
+    let c = |i: u32| [(i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32];
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    quads.iter().flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]]).collect()
+}
+
+#[test]
+fn stl_ascii_and_binary_agree() {
+    let tris = cube_tris();
+    let mut ascii = String::from("solid cube\n");
+    let mut bin = vec![b' '; 80];
+    bin.extend((tris.len() as u32).to_le_bytes());
+    for t in &tris {
+        ascii += "facet normal 0 0 0\nouter loop\n";
+        bin.extend([0u8; 12]);
+        for v in t {
+            ascii += &format!("vertex {} {} {}\n", v[0], v[1], v[2]);
+            for c in v {
+                bin.extend(c.to_le_bytes());
+            }
+        }
+        ascii += "endloop\nendfacet\n";
+        bin.extend([0u8; 2]);
+    }
+    ascii += "endsolid cube\n";
+    let a = read_mesh(&write("cube_ascii.stl", ascii.as_bytes())).unwrap();
+    let b = read_mesh(&write("cube_bin.stl", &bin)).unwrap();
+    for m in [&a, &b] {
+        assert_eq!(m.report.triangles, 12);
+        assert_eq!(m.report.vertices, 8);
+        assert_eq!(m.report.bounds.min, DVec3::ZERO);
+    }
+}
+
+#[test]
+fn ply_ascii_and_binary_with_polygons() {
+    let header = |fmt: &str| {
+        format!("ply\nformat {fmt} 1.0\ncomment test\nelement vertex 4\nproperty float x\nproperty float y\nproperty double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n")
+    };
+    let pts = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.5]];
+    let mut ascii = header("ascii");
+    for p in pts {
+        ascii += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    ascii += "4 0 1 2 3\n";
+    let mut le = header("binary_little_endian").into_bytes();
+    let mut be = header("binary_big_endian").into_bytes();
+    for p in pts {
+        le.extend(p[0].to_le_bytes());
+        le.extend(p[1].to_le_bytes());
+        le.extend((p[2] as f64).to_le_bytes());
+        be.extend(p[0].to_be_bytes());
+        be.extend(p[1].to_be_bytes());
+        be.extend((p[2] as f64).to_be_bytes());
+    }
+    le.push(4);
+    be.push(4);
+    for i in 0..4i32 {
+        le.extend(i.to_le_bytes());
+        be.extend(i.to_be_bytes());
+    }
+    for (name, bytes) in [("a.ply", ascii.into_bytes()), ("le.ply", le), ("be.ply", be)] {
+        let m = read_mesh(&write(name, &bytes)).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(m.mesh.triangles, vec![[0, 1, 2], [0, 2, 3]], "{name}");
+        assert_eq!(m.report.bounds.max, DVec3::new(1.0, 1.0, 0.5), "{name}");
+    }
+}
+
+/// A glTF document with one triangle (mesh 0) instanced by a parent node
+/// (translation 10,0,0) and its child (scale 2): the triangle appears twice.
+fn gltf_json(uri: Option<&str>, byte_len: usize) -> String {
+    let buffer = match uri {
+        Some(u) => format!(r#"{{"byteLength": {byte_len}, "uri": "{u}"}}"#),
+        None => format!(r#"{{"byteLength": {byte_len}}}"#),
+    };
+    format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}],
+        "nodes": [{{"mesh": 0, "translation": [10, 0, 0], "children": [1]}}, {{"mesh": 0, "scale": [2, 2, 2]}}],
+        "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}],
+        "accessors": [
+          {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+          {{"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}}],
+        "bufferViews": [{{"buffer": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 6}}],
+        "buffers": [{buffer}]}}"#
+    )
+}
+
+fn gltf_bin() -> Vec<u8> {
+    let mut b = Vec::new();
+    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        b.extend(v.to_le_bytes());
+    }
+    for i in [0u16, 1, 2] {
+        b.extend(i.to_le_bytes());
+    }
+    b
+}
+
+fn check_gltf(path: &Path) {
+    let m = read_mesh(path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(m.report.triangles, 2);
+    let b = m.report.bounds;
+    // Parent at x = 10; child scaled by 2 inside the parent: x in [10, 12].
+    assert_eq!(b.min, DVec3::new(10.0, 0.0, 0.0));
+    assert_eq!(b.max, DVec3::new(12.0, 2.0, 0.0));
+}
+
+#[test]
+fn gltf_with_external_buffer_and_node_transforms() {
+    let bin = gltf_bin();
+    write("tri.bin", &bin);
+    check_gltf(&write("tri.gltf", gltf_json(Some("tri.bin"), bin.len()).as_bytes()));
+}
+
+#[test]
+fn glb_with_binary_chunk() {
+    let mut bin = gltf_bin();
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let mut json = gltf_json(None, bin.len()).into_bytes();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let mut glb = Vec::new();
+    glb.extend(b"glTF");
+    glb.extend(2u32.to_le_bytes());
+    glb.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(&json);
+    glb.extend((bin.len() as u32).to_le_bytes());
+    glb.extend(b"BIN\0");
+    glb.extend(&bin);
+    check_gltf(&write("tri.glb", &glb));
+}
+
+#[test]
+fn obj_polylines_become_segments_next_to_faces() {
+    // A triangle, a 3-point polyline (tobj alone would read it as a
+    // triangle) with a relative index and a v/vt form, and a 2-point line.
+    let p = write("lines.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 2 2 2\nl 1 4 -3/1\nvt 0 0\nl 2 3\n");
+    let m = topovox_io::read_mesh(&p).unwrap();
+    assert_eq!((m.report.triangles, m.report.segments), (1, 3));
+    let seg = |s: [u32; 2]| [m.mesh.positions[s[0] as usize], m.mesh.positions[s[1] as usize]];
+    let v = |x: f64, y: f64, z: f64| glam::DVec3::new(x, y, z);
+    assert_eq!(seg(m.mesh.segments[0]), [v(0., 0., 0.), v(2., 2., 2.)]);
+    assert_eq!(seg(m.mesh.segments[1]), [v(2., 2., 2.), v(1., 0., 0.)]);
+    assert_eq!(seg(m.mesh.segments[2]), [v(1., 0., 0.), v(0., 1., 0.)]);
+    assert_eq!(m.report.bounds.max, v(2., 2., 2.));
+}
+
+#[test]
+fn text_polylines() {
+    let p = write("poly.lines", b"# two polylines\n0 0 0 1 1 1 2 0 0\n\n5,5,5, 6,6,6\n");
+    let m = topovox_io::read_mesh(&p).unwrap();
+    assert_eq!((m.report.triangles, m.report.segments, m.report.vertices), (0, 3, 5));
+}
+
+#[test]
+fn gltf_alpha_modes_become_cutoffs() {
+    // Three materials: MASK with a cutoff, MASK with glTF's default (0.5),
+    // BLEND (drawn opaque); the triangle uses the first.
+    let bin = gltf_bin();
+    write("alpha.bin", &bin);
+    let json = gltf_json(Some("alpha.bin"), bin.len()).replace(r#""indices": 1}"#, r#""indices": 1, "material": 0}"#).replace(
+        r#""buffers":"#,
+        r#""materials": [{"alphaMode": "MASK", "alphaCutoff": 0.3}, {"alphaMode": "MASK"}, {"alphaMode": "BLEND"}], "buffers":"#,
+    );
+    let m = read_mesh(&write("alpha.gltf", json.as_bytes())).unwrap_or_else(|e| panic!("{e}"));
+    let cut: Vec<Option<f32>> = m.appearance.materials.iter().map(|m| m.alpha_cutoff).collect();
+    assert_eq!(cut, [Some(0.3), Some(0.5), None, None], "the last is glTF's default material");
+}

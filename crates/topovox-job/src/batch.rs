@@ -1,0 +1,426 @@
+//! Whole datasets: one output per input mesh, a manifest of JSON lines
+//! written as it goes, resumable, one bad mesh never stopping the rest.
+//!
+//! `topovox batch`, `topovox.batch` in Python and the Dask and Ray helpers
+//! all use this module, so their outputs and manifest lines are the same
+//! and a run started by one can be resumed by another.
+//!
+//! - Inputs are files or folders; folders are walked (sorted, so the order
+//!   does not depend on the file system) for meshes matching a glob
+//!   (default: every mesh extension topovox reads).
+//! - Each output mirrors its input's path below the inputs' common folder,
+//!   with the format's extension. Two inputs mapping to one output (`a.obj`
+//!   and `a.stl`) are refused before any work.
+//! - `manifest.jsonl` in the output folder gets one line per mesh as it
+//!   finishes: input, output, status (`done` or `failed`), options, grid,
+//!   voxels, times, error. Each line is written whole with one call;
+//!   a torn last line (a crash mid-write) is ignored when reading.
+//! - A mesh is skipped when the manifest says it was done with the same
+//!   options and its output is still there with the recorded size
+//!   (outputs are written to a temporary file and renamed, so an output
+//!   that exists is complete). Failed meshes are tried again.
+
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde_json::{json, Value};
+use topovox::attributes::carry::CarryOptions;
+use topovox_io::WriteOptions;
+
+use crate::error::{JobError, Result};
+use crate::output::Output;
+use crate::plan::Plan;
+
+/// The manifest's file name in the output folder.
+pub const MANIFEST: &str = "manifest.jsonl";
+
+/// Mesh extensions taken from folders when no glob is given.
+pub const MESH_EXTENSIONS: [&str; 6] = ["obj", "stl", "ply", "gltf", "glb", "lines"];
+
+/// What every mesh of a batch gets done to it.
+#[derive(Clone, Debug)]
+pub struct BatchOptions {
+    /// The voxelization.
+    pub plan: Plan,
+    /// The output format.
+    pub format: Output,
+    /// Colour rule and normals, when the format stores attributes.
+    pub carry: CarryOptions,
+    /// `--attributes`: every attribute array into `.vdb` and `.zarr` outputs.
+    pub attributes: bool,
+    /// Writer options.
+    pub write: WriteOptions,
+    /// Worker threads per mesh (`None`: share the batch's pool).
+    pub threads: Option<usize>,
+    /// How meshes are read (external paths allowed or not).
+    pub read: topovox_io::ReadOptions,
+    /// The options as the user gave them, recorded in each manifest line
+    /// and compared on resume.
+    pub fingerprint: Value,
+}
+
+/// One input and where its output goes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Item {
+    /// The mesh.
+    pub input: PathBuf,
+    /// Its output.
+    pub output: PathBuf,
+}
+
+/// Expands `inputs` (files and folders) into mesh files, sorted within
+/// each folder; `glob` (e.g. `**/*.obj`) filters the files found in
+/// folders, relative to that folder. Files named directly are kept.
+pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>) -> Result<Vec<PathBuf>> {
+    let matcher = match glob {
+        Some(g) => Some(
+            globset::GlobBuilder::new(g)
+                .literal_separator(true)
+                .build()
+                .map_err(|e| JobError::invalid(format!("--glob {g:?}: {e}")))?
+                .compile_matcher(),
+        ),
+        None => None,
+    };
+    let mut out = Vec::new();
+    for input in inputs {
+        let meta = std::fs::metadata(input).map_err(|e| JobError::Io(topovox_io::IoError::new(input, topovox_io::ErrorKind::Read(e))))?;
+        if !meta.is_dir() {
+            out.push(input.clone());
+            continue;
+        }
+        for entry in walkdir::WalkDir::new(input).follow_links(true).sort_by_file_name() {
+            let entry = entry.map_err(|e| JobError::failed(format!("{}: cannot list: {e}", input.display())))?;
+            if !entry.file_type().is_file() {
+                continue;
+            }
+            let path = entry.path();
+            let keep = match &matcher {
+                Some(m) => path.strip_prefix(input).is_ok_and(|rel| m.is_match(rel)),
+                None => {
+                    path.extension().and_then(|e| e.to_str()).is_some_and(|e| MESH_EXTENSIONS.iter().any(|m| m.eq_ignore_ascii_case(e)))
+                }
+            };
+            if keep {
+                out.push(path.to_path_buf());
+            }
+        }
+    }
+    if out.is_empty() {
+        return Err(JobError::invalid("no input meshes found (give mesh files, or folders holding them; see --glob)"));
+    }
+    Ok(out)
+}
+
+/// The folder every input lies in (the deepest common one).
+fn common_folder(inputs: &[PathBuf]) -> PathBuf {
+    let dirs: Vec<PathBuf> = inputs.iter().map(|p| absolute(p).parent().map(Path::to_path_buf).unwrap_or_default()).collect();
+    let mut common = dirs.first().cloned().unwrap_or_default();
+    for d in &dirs[1..] {
+        while !d.starts_with(&common) {
+            if !common.pop() {
+                break;
+            }
+        }
+    }
+    common
+}
+
+fn absolute(p: &Path) -> PathBuf {
+    std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf())
+}
+
+/// Pairs each input with its output under `out_dir`: the input's path
+/// below the common folder of all inputs, with `ext`. Refuses two inputs
+/// with one output, and an output that is an input.
+pub fn plan_items(inputs: &[PathBuf], out_dir: &Path, ext: &str) -> Result<Vec<Item>> {
+    let common = common_folder(inputs);
+    let mut seen: HashMap<PathBuf, &Path> = HashMap::new();
+    let mut items = Vec::with_capacity(inputs.len());
+    for input in inputs {
+        let abs = absolute(input);
+        let rel = abs.strip_prefix(&common).unwrap_or(&abs);
+        let output = out_dir.join(rel).with_extension(ext);
+        if let Some(other) = seen.insert(output.clone(), input) {
+            return Err(JobError::invalid(format!(
+                "{} and {} would both be written to {}; batch them separately or rename one",
+                other.display(),
+                input.display(),
+                output.display()
+            )));
+        }
+        if absolute(&output) == abs {
+            return Err(JobError::invalid(format!(
+                "{}: the output would overwrite the input; choose another output folder",
+                input.display()
+            )));
+        }
+        items.push(Item { input: input.clone(), output });
+    }
+    Ok(items)
+}
+
+/// The manifest: the lines read back on resume, and appending new ones.
+pub struct Manifest {
+    path: PathBuf,
+    file: Mutex<std::fs::File>,
+    /// The last `done` line per input path.
+    done: HashMap<String, Value>,
+}
+
+impl Manifest {
+    /// Opens (creating) `out_dir/manifest.jsonl` for appending and reads
+    /// the lines already there; lines that do not parse (a torn last line)
+    /// are ignored.
+    pub fn open(out_dir: &Path) -> Result<Manifest> {
+        let path = out_dir.join(MANIFEST);
+        let io = |e| JobError::Io(topovox_io::IoError::new(&path, topovox_io::ErrorKind::Write(e)));
+        let mut done = HashMap::new();
+        if let Ok(text) = std::fs::read_to_string(&path) {
+            for line in text.lines() {
+                let Ok(v) = serde_json::from_str::<Value>(line) else { continue };
+                if let (Some(input), Some("done")) = (v["input"].as_str(), v["status"].as_str()) {
+                    done.insert(input.to_string(), v.clone());
+                }
+            }
+            // A torn last line: start the next one on a line of its own.
+            if !text.is_empty() && !text.ends_with('\n') {
+                let mut f = std::fs::OpenOptions::new().append(true).open(&path).map_err(io)?;
+                f.write_all(b"\n").map_err(io)?;
+            }
+        }
+        let file = std::fs::OpenOptions::new().create(true).append(true).open(&path).map_err(io)?;
+        Ok(Manifest { path: path.clone(), file: Mutex::new(file), done })
+    }
+
+    /// The manifest's path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Whether `item` was done with these options and its output is still
+    /// there, complete (the recorded size).
+    pub fn is_done(&self, item: &Item, fingerprint: &Value) -> bool {
+        let Some(v) = self.done.get(&item.input.display().to_string()) else { return false };
+        let same = v["options"] == *fingerprint && v["output"].as_str() == Some(&item.output.display().to_string());
+        let size = std::fs::metadata(&item.output).map(|m| m.len()).ok();
+        same && size.is_some() && v["output_bytes"].as_u64() == size
+    }
+
+    /// Appends one record as one line, with one write.
+    pub fn append(&self, record: &Value) -> Result<()> {
+        let mut line = record.to_string();
+        line.push('\n');
+        let mut f = self.file.lock().unwrap_or_else(|e| e.into_inner());
+        f.write_all(line.as_bytes())
+            .and_then(|_| f.flush())
+            .map_err(|e| JobError::Io(topovox_io::IoError::new(&self.path, topovox_io::ErrorKind::Write(e))))
+    }
+}
+
+/// Voxelizes one mesh and writes its output; never fails: a failure is
+/// the record's `error`. The record is what the manifest gets.
+pub fn process_one(item: &Item, opts: &BatchOptions) -> Value {
+    let t0 = Instant::now();
+    let mut record = json!({
+        "input": item.input.display().to_string(),
+        "output": item.output.display().to_string(),
+        "options": opts.fingerprint,
+    });
+    let result = (|| -> Result<Value> {
+        if let Some(dir) = item.output.parent() {
+            std::fs::create_dir_all(dir).map_err(|e| JobError::Io(topovox_io::IoError::new(dir, topovox_io::ErrorKind::Write(e))))?;
+        }
+        let t = Instant::now();
+        let loaded = topovox_io::read_mesh_with(&item.input, &opts.read)?;
+        let load_s = t.elapsed().as_secs_f64();
+        crate::output::refuse_overwriting(&item.output, opts.format, &loaded.sources)?;
+        let name = item.input.display().to_string();
+        let run = || -> Result<Value> {
+            let v = crate::voxelize(&opts.plan, loaded.mesh.as_ref(), &name, None)?;
+            let t = Instant::now();
+            let attrs = crate::run::attributes_for(&opts.plan, &loaded, &v, opts.format, (false, opts.attributes), &opts.carry)?;
+            let attributes_s = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            crate::output::write(&item.output, opts.format, &v.voxels, &v.grid, attrs.as_ref(), &opts.write)?;
+            let write_s = t.elapsed().as_secs_f64();
+            let o = v.grid.origin();
+            let mut warnings = loaded.warnings.clone();
+            warnings.extend(v.warnings.iter().cloned());
+            Ok(json!({
+                "grid": {"origin": [o.x, o.y, o.z], "voxel_size": v.grid.voxel_size(), "dims": v.grid.dims()},
+                "voxels": v.report.voxels,
+                "method": v.method,
+                "triangles": loaded.report.triangles,
+                "times": {"load_s": load_s, "voxelize_s": v.voxelize_s, "attributes_s": attributes_s, "write_s": write_s},
+                "warnings": warnings,
+            }))
+        };
+        match opts.threads {
+            Some(n) => crate::pool(n)?.install(run),
+            None => run(),
+        }
+    })();
+    match result {
+        Ok(facts) => {
+            if let (Some(r), Some(f)) = (record.as_object_mut(), facts.as_object()) {
+                r.extend(f.clone());
+            }
+            record["status"] = json!("done");
+            record["output_bytes"] = json!(std::fs::metadata(&item.output).map(|m| m.len()).ok());
+            record["error"] = Value::Null;
+        }
+        Err(e) => {
+            record["status"] = json!("failed");
+            record["error"] = json!(e.to_string());
+        }
+    }
+    record["times"]["total_s"] = json!(t0.elapsed().as_secs_f64());
+    record
+}
+
+/// Told about a batch's progress (the CLI draws a bar; core never prints).
+pub trait BatchProgress: Sync {
+    /// `total` meshes to go, `skipped` of them already done.
+    fn start(&self, total: u64, skipped: u64);
+    /// One mesh finished (its manifest record).
+    fn finished(&self, record: &Value);
+}
+
+/// No progress reporting.
+pub struct Silent;
+
+impl BatchProgress for Silent {
+    fn start(&self, _total: u64, _skipped: u64) {}
+    fn finished(&self, _record: &Value) {}
+}
+
+/// What a batch did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Summary {
+    /// Meshes voxelized and written now.
+    pub done: u64,
+    /// Meshes skipped as already done.
+    pub skipped: u64,
+    /// Meshes that failed (recorded in the manifest).
+    pub failed: u64,
+    /// Wall-clock seconds.
+    pub total_s: f64,
+    /// The manifest.
+    pub manifest: PathBuf,
+}
+
+impl Summary {
+    /// As JSON.
+    pub fn to_json(&self) -> Value {
+        json!({"done": self.done, "skipped": self.skipped, "failed": self.failed, "total_s": self.total_s,
+            "manifest": self.manifest.display().to_string()})
+    }
+}
+
+/// Runs a whole batch on the current rayon pool (meshes in parallel, each
+/// voxelized in parallel too, on the same pool).
+pub fn run(items: &[Item], out_dir: &Path, opts: &BatchOptions, progress: &dyn BatchProgress) -> Result<Summary> {
+    let t0 = Instant::now();
+    std::fs::create_dir_all(out_dir).map_err(|e| JobError::Io(topovox_io::IoError::new(out_dir, topovox_io::ErrorKind::Write(e))))?;
+    let manifest = Manifest::open(out_dir)?;
+    let todo: Vec<&Item> = items.iter().filter(|i| !manifest.is_done(i, &opts.fingerprint)).collect();
+    let skipped = (items.len() - todo.len()) as u64;
+    progress.start(items.len() as u64, skipped);
+    let failed = std::sync::atomic::AtomicU64::new(0);
+    let first_error = Mutex::new(None);
+    todo.par_iter().with_max_len(1).for_each(|item| {
+        let record = process_one(item, opts);
+        if record["status"] != "done" {
+            failed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        }
+        if let Err(e) = manifest.append(&record) {
+            first_error.lock().unwrap_or_else(|e| e.into_inner()).get_or_insert(e);
+        }
+        progress.finished(&record);
+    });
+    if let Some(e) = first_error.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        return Err(e);
+    }
+    let failed = failed.into_inner();
+    Ok(Summary {
+        done: todo.len() as u64 - failed,
+        skipped,
+        failed,
+        total_s: t0.elapsed().as_secs_f64(),
+        manifest: manifest.path().to_path_buf(),
+    })
+}
+
+/// The options that decide a batch's outputs, as given.
+pub struct FingerprintParts<'a> {
+    /// Mode name.
+    pub mode: &'a str,
+    /// Method name.
+    pub method: &'a str,
+    /// Grid options.
+    pub grid: &'a crate::grid::GridOptions,
+    /// Solid surface mode.
+    pub surface: Option<&'a str>,
+    /// Solid fill.
+    pub fill: Option<&'a str>,
+    /// Solid hollow connectivity.
+    pub hollow: Option<u32>,
+    /// GPU path.
+    pub gpu_path: &'a str,
+    /// Output format name.
+    pub format: &'a str,
+    /// Colour rule name.
+    pub colour_rule: &'a str,
+    /// Normals carried.
+    pub normals: bool,
+    /// Every attribute array into `.vdb` and `.zarr` (`--attributes`).
+    pub attributes: bool,
+    /// `.vox` dithering.
+    pub dither: bool,
+    /// `.vox`/`.schem` up axis.
+    pub up: &'a str,
+    /// `.obj`/`.glb` T-junctions split.
+    pub watertight: bool,
+    /// `.obj` triangles only.
+    pub triangulate: bool,
+    /// `bubble`'s seed.
+    pub seed: u64,
+}
+
+/// The options as one JSON object (keys sorted, defaults filled in), the
+/// same from the CLI and from Python: what the manifest records and a
+/// resumed run compares.
+pub fn fingerprint(p: &FingerprintParts<'_>) -> Value {
+    let g = p.grid;
+    let mut v = json!({
+        "mode": p.mode,
+        "method": p.method,
+        "resolution": g.resolution.or((!g.any()).then_some(128)),
+        "voxel_size": g.voxel_size,
+        "origin": g.origin,
+        "dims": g.dims,
+        "pad": g.pad.unwrap_or(0),
+        "surface": p.surface,
+        "fill": p.fill,
+        "hollow": p.hollow,
+        "gpu_path": p.gpu_path,
+        "format": p.format,
+        "colour_rule": p.colour_rule,
+        "normals": p.normals,
+        "dither": p.dither,
+        "up": p.up,
+        "watertight": p.watertight,
+        "triangulate": p.triangulate,
+        "seed": p.seed,
+    });
+    // Only when set, so manifests written before the option existed still resume.
+    if p.attributes {
+        v["attributes"] = json!(true);
+    }
+    v
+}

@@ -1,0 +1,117 @@
+//! Certifying voxels against their mesh (`topovox check`): which grid they
+//! are on, and the report as one JSON object.
+
+use serde_json::{json, Value};
+use topovox::grid::sparse::SparseBricks;
+use topovox::topology::{certify, certify_sparse, CheckReport};
+use topovox::{DenseBits, GridSpec, MeshRef};
+
+use crate::error::{JobError, Result};
+use crate::grid::{GridOptions, GridRequest};
+
+/// The grid to check voxels of `dims` against a mesh with `bounds` on:
+/// the grid options if any were given, else the placement the voxel file
+/// records, else the fitted grid at resolution = the largest dimension.
+/// Returns the grid and where it came from (`options`, `file`, `inferred`).
+pub fn check_grid(
+    dims: [u32; 3],
+    placement: Option<(glam::DVec3, f64)>,
+    options: &GridOptions,
+    bounds: &topovox::Aabb,
+    voxels_name: &str,
+    mesh_name: &str,
+) -> Result<(GridSpec, &'static str)> {
+    let (grid, source) = if options.any() {
+        (GridRequest::new(options)?.fit(bounds)?, "options")
+    } else if let Some((origin, s)) = placement {
+        (
+            GridSpec::new(origin, s, dims.map(u64::from)).map_err(|e| JobError::invalid(format!("invalid grid in the voxel file: {e}")))?,
+            "file",
+        )
+    } else {
+        let n = *dims.iter().max().unwrap_or(&1) as u64;
+        (GridSpec::from_resolution(bounds, n).map_err(|e| JobError::invalid(format!("invalid grid: {e}")))?, "inferred")
+    };
+    if grid.dims() != dims {
+        let [x, y, z] = grid.dims();
+        return Err(JobError::invalid(format!(
+            "{voxels_name}: holds a {}x{}x{} grid but the {} grid for {mesh_name} is {x}x{y}x{z}; pass the grid options used to voxelize it",
+            dims[0],
+            dims[1],
+            dims[2],
+            if source == "inferred" { "fitted" } else { source },
+        )));
+    }
+    Ok((grid, source))
+}
+
+/// Certifies `bits` (with the mesh and its grid, if given; `source` says
+/// where the grid came from): the report `topovox check --json` prints,
+/// without the timing.
+pub fn report(bits: &DenseBits, mesh: Option<(MeshRef<'_>, &GridSpec, &str)>) -> Result<Value> {
+    let report = certify(bits, mesh.map(|(m, g, _)| (m, g))).map_err(|e| JobError::invalid(e.to_string()))?;
+    let mut v = to_json(&report, bits.dims(), mesh.map(|(_, g, s)| (g, s)));
+    v["sparse"] = json!(false);
+    Ok(v)
+}
+
+/// Brick layers (8 planes each) per window of [`report_sparse`] for a grid
+/// of `dims` within `budget` bytes: a window's brick index, parity and
+/// run rows take about `bx·by·4 + 80·ny` bytes per layer; a quarter of the
+/// budget goes to them (the rest to the grid's bricks and the mesh), and
+/// at most [`WINDOW_BYTES`]: larger windows save nothing but memory (the
+/// work follows the voxels and rows, not the windows).
+pub fn window_layers(dims: [u32; 3], budget: u64) -> u32 {
+    let per_layer = dims[0].div_ceil(8) as u64 * dims[1].div_ceil(8) as u64 * 4 + 80 * dims[1] as u64;
+    ((budget / 4).min(WINDOW_BYTES) / per_layer.max(1)).clamp(1, dims[2].div_ceil(8).max(1) as u64) as u32
+}
+
+/// Most bytes a window's index and rows take (see [`window_layers`]).
+pub const WINDOW_BYTES: u64 = 512 << 20;
+
+/// [`report`] for a grid held as sparse bricks, checked window by window
+/// ([`topovox::topology::certify_sparse`]) in windows of `layers` brick
+/// layers; the report is the same, with `sparse` true and the number of
+/// windows.
+pub fn report_sparse(bits: &SparseBricks, mesh: Option<(MeshRef<'_>, &GridSpec, &str)>, layers: u32) -> Result<Value> {
+    let report = certify_sparse(bits, mesh.map(|(m, g, _)| (m, g)), layers).map_err(|e| JobError::invalid(e.to_string()))?;
+    let mut v = to_json(&report, bits.dims(), mesh.map(|(_, g, s)| (g, s)));
+    v["sparse"] = json!(true);
+    v["windows"] = json!(topovox::topology::certify::sparse_windows(bits.dims(), layers));
+    Ok(v)
+}
+
+fn to_json(report: &CheckReport, dims: [u32; 3], grid: Option<(&GridSpec, &str)>) -> Value {
+    let facts = report.mesh.as_ref();
+    let sep = facts.and_then(|f| f.separation.as_ref());
+    let witness = |w: Option<[[u32; 3]; 2]>| w.map(|p| json!({"inside": p[0], "outside": p[1]}));
+    json!({
+        "voxels": report.voxels,
+        "dims": dims,
+        "components_6": report.components_6,
+        "components_26": report.components_26,
+        "thick_voxels": report.thick_voxels,
+        "closed": facts.map(|f| f.closed),
+        "boundary_edges": facts.map(|f| f.boundary_edges),
+        "separating_6": sep.map(|s| s.witness_6.is_none()),
+        "separating_26": sep.map(|s| s.witness_26.is_none()),
+        "witness_6": sep.and_then(|s| witness(s.witness_6)),
+        "witness_26": sep.and_then(|s| witness(s.witness_26)),
+        "inside_voxels": sep.map(|s| s.inside_voxels),
+        "thin_removable": sep.map(|s| s.thin_removable),
+        "tunnels_6": facts.map(|f| f.tunnels_6),
+        "tunnels_18": facts.map(|f| f.tunnels_18),
+        "tunnels_26": facts.map(|f| f.tunnels_26),
+        "tunnel_free_6": facts.map(|f| f.tunnels_6 == 0),
+        "tunnel_free_18": facts.map(|f| f.tunnels_18 == 0),
+        "tunnel_free_26": facts.map(|f| f.tunnels_26 == 0),
+        "columns": facts.map(|f| {
+            let c = f.columns;
+            json!({"samples": c.samples, "empty": c.empty, "one": c.one, "two": c.two, "three_or_more": c.more, "max": c.max})
+        }),
+        "grid": grid.map(|(g, source)| {
+            let o = g.origin();
+            json!({"origin": [o.x, o.y, o.z], "voxel_size": g.voxel_size(), "dims": g.dims(), "source": source})
+        }),
+    })
+}

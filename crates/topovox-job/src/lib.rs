@@ -1,0 +1,62 @@
+//! # topovox-job
+//!
+//! A voxelization job as the `topovox` command line, the Python package and
+//! `topovox batch` run it, so all three take the same options, fit the same
+//! grids, pick the same paths and produce the same voxels, bit for bit:
+//!
+//! - [`GridOptions`] → [`GridRequest`] (validated before the mesh is read)
+//!   → a [`topovox::GridSpec`] fitted to the mesh;
+//! - [`Request`] (mode, method, solid options) → [`Plan`] (validated) →
+//!   [`voxelize`] on a mesh → [`Voxelized`] (voxels, grid, the path that
+//!   ran, facts for summaries);
+//! - [`attributes`] carries colours into them; [`output::write`] writes
+//!   any format; [`check::report`] certifies them.
+//!
+//! Errors are one [`JobError`]: bad options ([`JobError::Invalid`]), file
+//! problems naming the file ([`JobError::Io`]), or failures while running.
+
+mod error;
+mod grid;
+mod memory;
+mod plan;
+mod run;
+mod solid;
+
+pub mod batch;
+pub mod check;
+pub mod output;
+
+pub use error::{JobError, Result};
+pub use grid::{GridOptions, GridRequest};
+pub use memory::{available_memory, budget, bytes, check_memory, dense_fits, parse_size, peak_memory};
+pub use plan::{
+    auto_method, gpu_has, resolve_method, Fill, GpuPath, Method, Mode, Plan, Request, SolidMethod, SolidPlan, SurfaceMethod,
+    GPU_AUTO_MIN_SIDE,
+};
+pub use run::{
+    attributes, attributes_for, check_attributes_carried, every_attribute, voxelize, Voxelized, Voxels, ATTRIBUTE_BYTES_PER_VOXEL,
+};
+pub use solid::Outcome as SolidOutcome;
+
+/// A rayon pool of `threads` workers, made once per count and kept (jobs
+/// that ask for a thread count run on it).
+pub fn pool(threads: usize) -> Result<std::sync::Arc<rayon::ThreadPool>> {
+    use std::collections::HashMap;
+    use std::sync::{Arc, Mutex, OnceLock};
+    static POOLS: OnceLock<Mutex<HashMap<usize, Arc<rayon::ThreadPool>>>> = OnceLock::new();
+    if threads == 0 {
+        return Err(JobError::invalid("threads must be at least 1"));
+    }
+    let mut pools = POOLS.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(p) = pools.get(&threads) {
+        return Ok(p.clone());
+    }
+    let p = Arc::new(
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| JobError::failed(format!("cannot start {threads} threads: {e}")))?,
+    );
+    pools.insert(threads, p.clone());
+    Ok(p)
+}

@@ -1,0 +1,85 @@
+//! How much memory there is, and refusing grids that cannot fit.
+
+use topovox::GridSpec;
+
+use crate::error::{JobError, Result};
+
+pub use topovox_io::{available_memory, bytes};
+
+/// Grids whose dense storage is below this are not checked (every machine
+/// topovox runs on has that much; reading `/proc/meminfo` per job would cost
+/// more than a small job itself).
+const UNCHECKED_BYTES: u64 = 256 << 20;
+
+/// The memory a run may use: `max_memory` if given, else nine tenths of
+/// the available memory (headroom for the mesh, the writer's buffers and
+/// the system); `u64::MAX` when neither is known.
+pub fn budget(max_memory: Option<u64>) -> u64 {
+    max_memory.or_else(|| available_memory().map(|a| a / 10 * 9)).unwrap_or(u64::MAX)
+}
+
+/// True when a dense grid of `grid` (1 bit per voxel) fits in `budget`.
+pub fn dense_fits(grid: &GridSpec, budget: u64) -> bool {
+    let need = grid.dense_bytes();
+    need < UNCHECKED_BYTES || need <= budget
+}
+
+/// Fails if a dense grid of `grid` would not fit in `budget` (see
+/// [`budget`]); `why` names what needs it dense.
+pub fn check_memory(grid: &GridSpec, budget: u64, why: &str) -> Result<()> {
+    if dense_fits(grid, budget) {
+        return Ok(());
+    }
+    let [x, y, z] = grid.dims();
+    Err(JobError::failed(format!(
+        "grid {x}x{y}x{z} needs {} of dense storage (1 bit per voxel) for {why}, more than the {} this run may use; lower the resolution, raise --max-memory, or use a surface mode with --method auto/fast (tiled, sparse)",
+        bytes(grid.dense_bytes()),
+        bytes(budget)
+    )))
+}
+
+/// Parses a memory size: bytes, or a number with `K`, `M`, `G`, `T`
+/// (powers of 1024; `KiB`/`KB`/… accepted the same), e.g. `8G`, `1.5GiB`.
+pub fn parse_size(s: &str) -> Result<u64> {
+    let t = s.trim();
+    let split = t.find(|c: char| !(c.is_ascii_digit() || c == '.')).unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let shift = match unit.trim().to_ascii_lowercase().as_str() {
+        "" | "b" => 0,
+        "k" | "kb" | "kib" => 10,
+        "m" | "mb" | "mib" => 20,
+        "g" | "gb" | "gib" => 30,
+        "t" | "tb" | "tib" => 40,
+        _ => return Err(JobError::invalid(format!("--max-memory {s:?}: unknown unit (use bytes or K, M, G, T)"))),
+    };
+    let v: f64 = num.parse().map_err(|_| JobError::invalid(format!("--max-memory {s:?}: not a size (e.g. 8G, 512M)")))?;
+    let b = v * (1u64 << shift) as f64;
+    if !(b.is_finite() && b >= (1u64 << 20) as f64 && b < 1.8e19) {
+        return Err(JobError::invalid(format!("--max-memory {s:?}: must be at least 1M")));
+    }
+    Ok(b as u64)
+}
+
+/// The process's peak resident memory so far (`VmHWM`), if the OS says.
+pub fn peak_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = text.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes() {
+        assert_eq!(parse_size("8G").unwrap(), 8 << 30);
+        assert_eq!(parse_size("1.5GiB").unwrap(), 3 << 29);
+        assert_eq!(parse_size("512m").unwrap(), 512 << 20);
+        assert_eq!(parse_size("2097152").unwrap(), 2 << 20);
+        for bad in ["", "G", "8X", "-1G", "100", "nanG"] {
+            assert!(parse_size(bad).is_err(), "{bad}");
+        }
+    }
+}

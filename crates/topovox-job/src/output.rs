@@ -1,0 +1,181 @@
+//! Outputs: which format a path names, and writing voxels with their
+//! attributes in it — every voxel format, and the mesh of the voxels
+//! (`.obj`, `.glb`).
+
+use std::path::Path;
+
+use serde_json::{json, Value};
+use topovox::attributes::{quantize, VoxelAttributes};
+use topovox::export::greedy::greedy_quads_by_class;
+use topovox::{DenseBits, GridSpec, VoxelSource};
+use topovox_io::{VoxelFormat, WriteOptions};
+
+use crate::error::{JobError, Result};
+
+/// What an output file holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// A voxel format.
+    Voxels(VoxelFormat),
+    /// A mesh of the voxels (greedy quads).
+    Mesh(MeshKind),
+}
+
+/// Mesh formats for the voxels' boundary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshKind {
+    /// Wavefront OBJ (+ MTL with colours).
+    Obj,
+    /// Binary glTF.
+    Glb,
+}
+
+impl Output {
+    /// The `--format` name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Output::Voxels(f) => f.name(),
+            Output::Mesh(MeshKind::Obj) => "obj",
+            Output::Mesh(MeshKind::Glb) => "glb",
+        }
+    }
+
+    /// True when the output stores colours.
+    pub fn has_colour(self) -> bool {
+        match self {
+            Output::Voxels(f) => f.has_colour(),
+            Output::Mesh(_) => true,
+        }
+    }
+
+    /// The format called `name` (a voxel format, `obj` or `glb`).
+    pub fn from_name(name: &str) -> Option<Output> {
+        match name.to_ascii_lowercase().as_str() {
+            "obj" => Some(Output::Mesh(MeshKind::Obj)),
+            "glb" => Some(Output::Mesh(MeshKind::Glb)),
+            n => VoxelFormat::from_name(n).map(Output::Voxels),
+        }
+    }
+
+    /// Every output format name, for messages.
+    pub fn names() -> String {
+        format!("{}, obj, glb", VoxelFormat::NAMES)
+    }
+}
+
+/// The output format: `format` if given, else the extension of `output`.
+pub fn output_format(format: Option<&str>, output: &Path) -> Result<Output> {
+    match format {
+        Some(f) => {
+            Output::from_name(f).ok_or_else(|| JobError::invalid(format!("unknown --format {f:?} (expected one of: {})", Output::names())))
+        }
+        None => output.extension().and_then(|e| e.to_str()).and_then(Output::from_name).ok_or_else(|| {
+            JobError::invalid(format!(
+                "{}: cannot tell the output format from the extension (use one of: {}, or --format)",
+                output.display(),
+                Output::names()
+            ))
+        }),
+    }
+}
+
+/// True for the formats written from the set voxels alone (no dense
+/// buffer of the grid): `.vdb`, `.zarr` (only chunks holding voxels),
+/// `.npz` (the voxels' indices), `.txt`, `.ply`.
+pub fn is_sparse(target: Output) -> bool {
+    matches!(target, Output::Voxels(VoxelFormat::Vdb | VoxelFormat::Zarr | VoxelFormat::Npz | VoxelFormat::Text | VoxelFormat::Ply))
+}
+
+/// Refuses a dense format for a grid that cannot be dense in the memory
+/// the run may use (`max_memory`, else nine tenths of what is available).
+pub fn check_fits(target: Output, grid: &GridSpec, max_memory: Option<u64>) -> Result<()> {
+    let budget = crate::memory::budget(max_memory);
+    if is_sparse(target) || crate::memory::dense_fits(grid, budget) {
+        return Ok(());
+    }
+    let [x, y, z] = grid.dims();
+    Err(JobError::invalid(format!(
+        "grid {x}x{y}x{z} cannot be held densely ({} at 1 bit per voxel, more than the {} this run may use) and .{} is a dense format; write .vdb (OpenVDB), .zarr (Zarr v3), .npz (NumPy indices), .txt or .ply, which hold only the set voxels",
+        crate::memory::bytes(grid.dense_bytes()),
+        crate::memory::bytes(budget),
+        target.name()
+    )))
+}
+
+/// Every file writing `out` as `target` creates: the output, and for an
+/// `.obj` the `.mtl` beside it (named after the output's stem).
+pub fn files_written(out: &Path, target: Output) -> Vec<std::path::PathBuf> {
+    let mut v = vec![out.to_path_buf()];
+    if target == Output::Mesh(MeshKind::Obj) && out.as_os_str() != "-" {
+        v.push(out.with_extension("mtl"));
+    }
+    v
+}
+
+/// Refuses, before anything is written, an output (or a file written beside
+/// it) that is one of `inputs` by identity — the same file by any name,
+/// link or hard link: one line naming both.
+pub fn refuse_overwriting(out: &Path, target: Output, inputs: &[std::path::PathBuf]) -> Result<()> {
+    for f in files_written(out, target) {
+        topovox_io::atomic::refuse_overwriting_inputs(&f, inputs)?;
+    }
+    Ok(())
+}
+
+/// Checks, before any work, that `out` can be created: its folder exists
+/// and it is not a folder itself (`-` is standard output).
+pub fn check_output_path(out: &Path) -> Result<()> {
+    if out.as_os_str() == "-" {
+        return Ok(());
+    }
+    let dir = match out.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(JobError::invalid(format!("{}: cannot write: directory {} does not exist", out.display(), dir.display())));
+    }
+    let zarr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("zarr"));
+    if out.is_dir() && !(zarr && out.join("zarr.json").is_file()) {
+        return Err(JobError::invalid(format!("{}: cannot write: it is a directory", out.display())));
+    }
+    Ok(())
+}
+
+/// Writes `bits` (with `attrs`) to `out` as `target`; returns facts for
+/// the summaries.
+pub fn write(
+    out: &Path,
+    target: Output,
+    bits: &dyn VoxelSource,
+    grid: &GridSpec,
+    attrs: Option<&VoxelAttributes>,
+    opts: &WriteOptions,
+) -> Result<Value> {
+    match target {
+        Output::Voxels(f) => {
+            topovox_io::write_voxels_with(out, f, bits, grid, attrs, opts)?;
+            Ok(json!({"colours": attrs.and_then(|a| a.colour.as_ref()).is_some() && f.has_colour()}))
+        }
+        Output::Mesh(kind) => {
+            let mut dense = DenseBits::new(bits.dims());
+            bits.for_each_set(&mut |i, j, k| dense.set(i, j, k));
+            let coloured = attrs.and_then(|a| a.colour.as_ref().map(|c| (a, c)));
+            let (palette, quads) = match coloured {
+                Some((a, colours)) => {
+                    let palette = quantize::palette(colours, 255);
+                    let index = quantize::map_to_palette(colours, &palette);
+                    let class = move |i: u32, j: u32, k: u32| a.slot(i, j, k).map(|s| index[s] as u32 + 1).unwrap_or(0);
+                    (Some(palette), greedy_quads_by_class(&dense, &class))
+                }
+                None => (None, topovox::export::greedy::greedy_quads(&dense)),
+            };
+            let vertices = match kind {
+                MeshKind::Obj => topovox_io::voxel_mesh::write_quads_obj(out, &quads, grid, palette.as_deref(), &opts.mesh)?,
+                MeshKind::Glb => topovox_io::voxel_mesh::write_quads_glb(out, &quads, grid, palette.as_deref(), &opts.mesh)?,
+            };
+            Ok(json!({"quads": quads.len(), "vertices": vertices, "colours": palette.as_ref().map(|p| p.len()),
+                "watertight": opts.mesh.watertight, "triangulated": opts.mesh.triangulate}))
+        }
+    }
+}

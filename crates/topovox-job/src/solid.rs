@@ -1,0 +1,245 @@
+//! The solid modes: choosing the method, running it, and the
+//! `solid+surface`, `fill flood` and `hollow` variants.
+
+use serde_json::{json, Value};
+use topovox::grid::dense::DenseBits;
+use topovox::grid::sparse::SparseBricks;
+use topovox::voxelize::{self, fill, solid, winding, Options};
+use topovox::{GridSpec, MeshRef};
+
+use crate::error::{JobError, Result};
+use crate::plan::{SolidMethod, SolidPlan};
+
+/// A solid and what was done to get it.
+pub struct Outcome {
+    /// The voxels.
+    pub bits: DenseBits,
+    /// The method that ran.
+    pub method: &'static str,
+    /// Facts for the summary and JSON.
+    pub facts: Value,
+    /// Things the user should know (an open mesh under parity, a leaking shell).
+    pub warnings: Vec<String>,
+}
+
+/// Parity on the GPU (the same voxels as `--method parity`).
+#[cfg(feature = "gpu")]
+fn gpu_parity(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, solid::SolidReport)> {
+    let gpu = topovox_gpu::Gpu::new().map_err(|e| JobError::failed(format!("--method gpu: {e}")))?;
+    let (bits, r) = gpu.solid_parity(mesh, grid).map_err(|e| JobError::failed(format!("--method gpu: {e}")))?;
+    Ok((bits, r.solid))
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_parity(_mesh: MeshRef<'_>, _grid: &GridSpec) -> Result<(DenseBits, solid::SolidReport)> {
+    Err(JobError::invalid("--method gpu: this topovox was built without the `gpu` feature"))
+}
+
+/// Makes the solid `plan` asks for; `name` names the mesh in warnings.
+pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opts: &Options<'_>) -> Result<Outcome> {
+    let mut warnings = Vec::new();
+    let (mut bits, method, mut facts) = if plan.method == SolidMethod::Flood {
+        let surface = plan.surface.unwrap_or(voxelize::Mode::Cover);
+        let shell = voxelize::fast(surface, mesh, grid, opts).0.to_dense();
+        let (bits, rep) = fill::flood_fill(&shell);
+        if rep.enclosed == 0 {
+            warnings.push(flood_leak_warning(surface));
+        }
+        (bits, "flood", json!({"shell": surface.name(), "shell_voxels": rep.shell, "enclosed_voxels": rep.enclosed}))
+    } else {
+        // Snapped once: the closedness test and whichever method runs share it.
+        let snapped = topovox::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+        let inspect = solid::inspect(&snapped);
+        let dims = grid.dims();
+        let watertight = inspect.watertight();
+        let open = || {
+            format!(
+                "{name}: not closed and consistently oriented ({} boundary edges, {} inconsistently oriented edges)",
+                inspect.boundary_edges, inspect.unbalanced_edges
+            )
+        };
+        let mut gwn = None;
+        let (bits, rep, method) = match plan.method {
+            SolidMethod::Parity => {
+                if !watertight {
+                    warnings.push(format!("{}: ray parity may streak through holes", open()));
+                }
+                let (b, r) = solid::parity_snapped(&snapped, dims);
+                (b, r, "parity")
+            }
+            SolidMethod::Auto if watertight => {
+                let (b, r) = solid::parity_snapped(&snapped, dims);
+                (b, r, "parity")
+            }
+            SolidMethod::Winding if watertight => {
+                let (b, r) = solid::winding_closed_snapped(&snapped, dims);
+                (b, r, "winding")
+            }
+            SolidMethod::Auto | SolidMethod::Winding => {
+                let (b, r) = winding::winding_snapped(&snapped, dims);
+                gwn = Some(json!({"boundary_cycles": r.cycles, "cap_triangles": r.cap_triangles, "evaluated_voxels": r.evaluated}));
+                (b, r.solid, "winding")
+            }
+            SolidMethod::Reference if watertight => {
+                let (b, r) = solid::reference::solid(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+                (b, r, "reference")
+            }
+            SolidMethod::Reference => {
+                let b = winding::reference::winding(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+                let mut r = inspect;
+                r.voxels = b.count();
+                (b, r, "reference")
+            }
+            SolidMethod::GpuParity => {
+                if !watertight {
+                    warnings.push(format!("{}: ray parity may streak through holes", open()));
+                }
+                let (b, r) = gpu_parity(mesh, grid)?;
+                (b, r, "gpu-parity")
+            }
+            SolidMethod::Flood => unreachable!("handled above"),
+        };
+        let mut facts = mesh_facts(&rep);
+        facts["generalized_winding"] = gwn.unwrap_or(Value::Null);
+        (bits, method, facts)
+    };
+    if plan.surface.is_some() && plan.method != SolidMethod::Flood {
+        let surface = plan.surface.unwrap_or(voxelize::Mode::Cover);
+        let (shell, _) = voxelize::fast(surface, mesh, grid, opts);
+        topovox::VoxelSource::for_each_set(&shell, &mut |i, j, k| bits.set(i, j, k));
+        facts["surface"] = json!(surface.name());
+    }
+    if let Some(conn) = plan.hollow {
+        bits = fill::hollow(&bits, conn);
+        facts["hollow"] = json!(if conn == topovox::topology::runs::Connectivity::Six { 6 } else { 26 });
+    }
+    Ok(Outcome { bits, method, facts, warnings })
+}
+
+/// Whether `plan` has a sparse path (for grids past memory): parity, the
+/// winding numbers (closed and generalized) and flood fills, alone or with
+/// a surface, hollowed or not; not the brute-force reference or the GPU.
+pub fn has_sparse_path(plan: &SolidPlan) -> bool {
+    matches!(plan.method, SolidMethod::Auto | SolidMethod::Parity | SolidMethod::Winding | SolidMethod::Flood)
+}
+
+/// A sparse solid and what was done to get it (see [`run_sparse`]).
+pub struct SparseOutcome {
+    /// The voxels: sparse bricks, the interior as runs of full bricks.
+    pub bits: SparseBricks,
+    /// The method that ran.
+    pub method: &'static str,
+    /// Facts for the summary and JSON.
+    pub facts: Value,
+    /// Things the user should know.
+    pub warnings: Vec<String>,
+}
+
+/// Makes the solid `plan` asks for without a dense grid: rows of crossings
+/// turned brick row by brick row into sparse bricks and full runs, united
+/// with the tiled surface (tiles of `tile`) for `solid+surface`. Parity,
+/// the closed winding number and, for open meshes, the generalized one;
+/// flood fills fill a tiled shell plane by plane.
+pub fn run_sparse(
+    plan: &SolidPlan,
+    mesh: MeshRef<'_>,
+    name: &str,
+    grid: &GridSpec,
+    tile: u32,
+    opts: &Options<'_>,
+) -> Result<SparseOutcome> {
+    if !has_sparse_path(plan) {
+        return Err(JobError::invalid(format!(
+            "{name}: this solid (reference or gpu) has no sparse path yet; parity, the winding numbers and flood fills do"
+        )));
+    }
+    if plan.method == SolidMethod::Flood {
+        let surface = plan.surface.unwrap_or(voxelize::Mode::Cover);
+        let (shell, _) = voxelize::tiled::tiled(surface, mesh, grid, tile, opts).map_err(|e| JobError::invalid(e.to_string()))?;
+        let (bits, rep) = fill::flood_fill_sparse(&shell);
+        drop(shell);
+        let mut warnings = Vec::new();
+        if rep.enclosed == 0 {
+            warnings.push(flood_leak_warning(surface));
+        }
+        let mut facts =
+            json!({"shell": surface.name(), "shell_voxels": rep.shell, "enclosed_voxels": rep.enclosed, "full_bricks": bits.full_bricks()});
+        let bits = hollow_sparse(plan, bits, &mut facts);
+        return Ok(SparseOutcome { bits, method: "flood", facts, warnings });
+    }
+    let snapped = topovox::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+    let inspect = solid::inspect(&snapped);
+    let mut warnings = Vec::new();
+    let open = format!(
+        "{name}: not closed and consistently oriented ({} boundary edges, {} inconsistently oriented edges)",
+        inspect.boundary_edges, inspect.unbalanced_edges
+    );
+    let dims = grid.dims();
+    let mut gwn = None;
+    let (bits, rep, method) = match plan.method {
+        SolidMethod::Parity => {
+            if !inspect.watertight() {
+                warnings.push(format!("{open}: ray parity may streak through holes"));
+            }
+            let (b, r) = solid::parity_sparse(&snapped, dims);
+            (b, r, "parity")
+        }
+        _ if !inspect.watertight() => {
+            let (b, r) = winding::winding_sparse(&snapped, dims);
+            gwn = Some(json!({"boundary_cycles": r.cycles, "cap_triangles": r.cap_triangles, "evaluated_voxels": r.evaluated}));
+            (b, r.solid, "winding")
+        }
+        SolidMethod::Winding => {
+            let (b, r) = solid::winding_closed_sparse(&snapped, dims);
+            (b, r, "winding")
+        }
+        _ => {
+            let (b, r) = solid::parity_sparse(&snapped, dims);
+            (b, r, "parity")
+        }
+    };
+    drop(snapped);
+    let mut facts = mesh_facts(&rep);
+    facts["generalized_winding"] = gwn.unwrap_or(Value::Null);
+    facts["full_bricks"] = json!(bits.full_bricks());
+    let bits = match plan.surface {
+        Some(surface) => {
+            let (shell, _) = voxelize::tiled::tiled(surface, mesh, grid, tile, opts).map_err(|e| JobError::invalid(e.to_string()))?;
+            facts["surface"] = json!(surface.name());
+            bits.union(&shell)
+        }
+        None => bits,
+    };
+    let bits = hollow_sparse(plan, bits, &mut facts);
+    Ok(SparseOutcome { bits, method, facts, warnings })
+}
+
+/// `--hollow` on a sparse solid, if the plan asks.
+fn hollow_sparse(plan: &SolidPlan, bits: SparseBricks, facts: &mut Value) -> SparseBricks {
+    match plan.hollow {
+        Some(conn) => {
+            facts["hollow"] = json!(if conn == topovox::topology::runs::Connectivity::Six { 6 } else { 26 });
+            fill::hollow_sparse(&bits, conn)
+        }
+        None => bits,
+    }
+}
+
+/// The warning of a flood fill that enclosed nothing.
+fn flood_leak_warning(surface: voxelize::Mode) -> String {
+    format!(
+        "the {} shell encloses no voxel: it leaks through a hole wider than the shell, or the mesh is too thin for this grid",
+        surface.name()
+    )
+}
+
+/// What the solid learned about the mesh's closedness, as the JSON summary
+/// reports it (dense and sparse runs alike).
+fn mesh_facts(rep: &solid::SolidReport) -> Value {
+    json!({
+        "closed": rep.boundary_edges == 0,
+        "consistently_oriented": rep.unbalanced_edges == 0,
+        "boundary_edges": rep.boundary_edges,
+        "inconsistent_edges": rep.unbalanced_edges,
+    })
+}

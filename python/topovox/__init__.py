@@ -1,0 +1,261 @@
+"""topovox: triangle meshes (and polylines) to voxel grids with a stated,
+tested topological guarantee, fast, as NumPy arrays.
+
+The voxels are exactly those the ``topovox`` command line writes for the same
+options (both run the same Rust code), bit for bit.
+
+>>> import topovox
+>>> mesh = topovox.load_mesh("bunny.obj")
+>>> grid = topovox.voxelize(mesh, mode="sep6", resolution=128)
+>>> grid.occupancy.shape        # (nx, ny, nz), element [i, j, k]
+>>> grid.save("bunny.binvox")
+
+Modes (``mode=``):
+
+- ``cover``: every voxel whose closed box meets a triangle (26-separating).
+- ``sep26``: Laine's space-diagonal target (26-separating, subset of cover).
+- ``sep6``: Laine's 3D crosshair (6-separating, thin).
+- ``ss6``: Schwarz-Seidel's 6-separating test.
+- ``tunnel18``, ``tunnel26``: 18- and 26-tunnel-free (Laine's targets from
+  the centre to face centres and edge midpoints, and corners).
+- ``bubble``: randomized 6-separating targets (``seed=``).
+- ``diagonal``: one alternating body diagonal per voxel (6-separating).
+- ``line26``, ``line6``: polylines, 26- or 6-connected.
+- ``pos``: the published projected optimal scanline algorithm (no guarantee).
+- ``solid``: voxels whose centre is inside (winding number; ray parity on
+  closed meshes); ``solid+surface``: united with a surface mode
+  (``surface=``); ``fill="flood"`` and ``hollow=6|26`` as in the CLI.
+
+Grids: ``resolution=N`` (the longest side of the bounding box spans N
+voxels; the default is 128), ``voxel_size=S`` (fitted to the bounding box),
+or ``origin=(x, y, z), voxel_size=S, dims=(nx, ny, nz)`` exactly; ``pad=P``
+adds empty voxels around a fitted grid. Voxel ``(i, j, k)`` is the closed
+box ``[origin + (i, j, k) * s, origin + (i + 1, j + 1, k + 1) * s]``.
+
+Errors: ``ValueError`` for bad arguments and bad arrays, ``OSError``
+subclasses for files (``FileNotFoundError``, ``PermissionError``,
+:class:`FileFormatError` for malformed content), ``RuntimeError`` for
+failures while running (no GPU, not enough memory). The messages are the
+command line's.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Iterable, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _topovox
+from ._topovox import FileFormatError, Mesh, VoxelGrid, load_mesh, load_voxels
+
+__version__ = _topovox.__version__
+
+__all__ = [
+    "Mesh",
+    "VoxelGrid",
+    "FileFormatError",
+    "load_mesh",
+    "load_voxels",
+    "voxelize",
+    "batch",
+    "MODES",
+    "METHODS",
+    "FORMATS",
+]
+
+#: Every mode, as ``voxelize(mode=...)`` takes it.
+MODES = ("cover", "sep26", "sep6", "ss6", "tunnel18", "tunnel26", "bubble", "diagonal", "solid", "solid+surface", "line6", "line26", "pos")
+#: Every method, as ``voxelize(method=...)`` takes it.
+METHODS = ("auto", "reference", "fast", "scanline", "gpu", "parity", "winding")
+#: Every output format ``VoxelGrid.save`` and ``batch`` write.
+FORMATS = ("npy", "npy-bool", "npz", "binvox", "vox", "txt", "schem", "vti", "ply", "vdb", "zarr", "obj", "glb")
+
+MeshLike = Union[Mesh, Any]
+
+
+def _as_float_points(a: Any, name: str) -> np.ndarray:
+    """float64/float32 arrays pass through untouched (the native side copies
+    them once, strided or not); anything else is converted."""
+    if isinstance(a, np.ndarray) and a.dtype in (np.float64, np.float32):
+        return a
+    try:
+        return np.asarray(a, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name} must be an (n, 3) array of numbers: {e}") from None
+
+
+def _as_index_array(a: Any, name: str) -> np.ndarray:
+    if isinstance(a, np.ndarray) and a.dtype in (np.int64, np.int32, np.uint32, np.uint64):
+        return a
+    arr = np.asarray(a)
+    if arr.dtype.kind == "f":
+        if not np.all(np.isfinite(arr)) or not np.all(arr == np.floor(arr)):
+            raise ValueError(f"{name} must hold integer vertex indices; got non-integer values")
+    elif arr.dtype.kind not in "iub":
+        raise ValueError(f"{name} must be an integer array; got dtype {arr.dtype}")
+    return arr.astype(np.int64)
+
+
+def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray], faces: Optional[Any] = None) -> Mesh:
+    """A :class:`Mesh` from a topovox mesh, anything with ``.vertices`` and
+    ``.faces`` (a ``trimesh.Trimesh``), or a vertex array and ``faces``.
+    Arrays are copied once, into the voxelizer's own storage."""
+    if isinstance(mesh_or_vertices, Mesh):
+        if faces is not None:
+            raise ValueError("faces is given twice: by the Mesh and by faces=")
+        return mesh_or_vertices
+    if faces is None and hasattr(mesh_or_vertices, "vertices") and hasattr(mesh_or_vertices, "faces"):
+        return Mesh(
+            _as_float_points(mesh_or_vertices.vertices, "vertices"),
+            _as_index_array(mesh_or_vertices.faces, "faces"),
+        )
+    if faces is None:
+        raise ValueError("give a topovox.Mesh, an object with .vertices and .faces, or vertices and faces arrays")
+    return Mesh(_as_float_points(mesh_or_vertices, "vertices"), _as_index_array(faces, "faces"))
+
+
+def voxelize(
+    mesh_or_vertices: Union[MeshLike, np.ndarray],
+    faces: Optional[Any] = None,
+    *,
+    mode: str = "cover",
+    resolution: Optional[int] = None,
+    voxel_size: Optional[float] = None,
+    origin: Optional[Sequence[float]] = None,
+    dims: Optional[Sequence[int]] = None,
+    pad: int = 0,
+    method: str = "auto",
+    threads: Optional[int] = None,
+    attributes: bool = False,
+    colour_rule: str = "dominant",
+    normals: bool = False,
+    surface: Optional[str] = None,
+    fill: Optional[str] = None,
+    hollow: Optional[int] = None,
+    gpu_path: str = "compute",
+    seed: int = 0,
+    tile: Optional[int] = None,
+    max_memory: Optional[Union[int, str]] = None,
+) -> VoxelGrid:
+    """Voxelizes a mesh; returns a :class:`VoxelGrid`.
+
+    Args:
+        mesh_or_vertices: a :class:`Mesh` (``load_mesh``), anything with
+            ``.vertices`` and ``.faces`` (a ``trimesh.Trimesh``), or an
+            ``(n, 3)`` vertex array (float64 or float32; other dtypes are
+            converted) with ``faces``.
+        faces: ``(m, 3)`` integer vertex indices, when vertices are given.
+        mode: one of :data:`MODES` (see the module documentation).
+        resolution: the longest side of the bounding box spans this many
+            voxels (default 128 when no grid option is given).
+        voxel_size: the voxel edge; alone, the grid is fitted to the mesh.
+        origin, dims: with ``voxel_size``, an explicit grid; triangles
+            outside it are clipped, never wrapped.
+        pad: empty voxels added on every side of a fitted grid.
+        method: one of :data:`METHODS`. ``auto`` picks the fastest path that
+            gives the mode's exact voxels; every method gives the same voxels.
+        threads: worker threads (default: all cores).
+        attributes: also carry colours, material ids, coverage (and
+            ``normals=True``: normals) from the mesh into the voxels.
+        colour_rule: ``dominant`` (the colour covering the most area) or
+            ``blend`` (area-weighted mean in linear light).
+        surface: solid modes: the surface of ``solid+surface`` and of a
+            flood fill's shell (cover, sep26, sep6 or ss6).
+        fill: solid modes: ``"flood"`` fills what a surface shell encloses.
+        hollow: solid modes: keep the voxels 6- or 26-adjacent to the outside.
+        gpu_path: with ``method="gpu"``: ``compute``, ``raster`` or
+            ``msaa-approx``.
+        seed: ``bubble``: the seed of the random target points (same seed,
+            same voxels).
+        tile: run the surface or line mode tile by tile with tiles of this many
+            voxels (a multiple of 8); same voxels. By default only grids
+            that do not fit in ``max_memory`` run tiled.
+        max_memory: memory the run may use, bytes or a string such as
+            ``"8G"`` (default: nine tenths of what is available). Tiled
+            grids are sparse: use :meth:`VoxelGrid.indices` or
+            ``save("x.vdb")`` / ``save("x.zarr")`` rather than ``occupancy``.
+
+    The GIL is released while voxelizing, so threads voxelize in parallel.
+
+    Raises:
+        ValueError: bad arguments or arrays (wrong shape, NaN, indices out
+            of range), the CLI's message.
+        RuntimeError: the job could not run (no GPU, not enough memory).
+    """
+    mesh = as_mesh(mesh_or_vertices, faces)
+    return _topovox.voxelize(
+        mesh,
+        mode=mode,
+        resolution=None if resolution is None else _count(resolution, "resolution"),
+        voxel_size=None if voxel_size is None else float(voxel_size),
+        origin=None if origin is None else [float(x) for x in origin],
+        dims=None if dims is None else [_count(d, "dims") for d in dims],
+        pad=_count(pad, "pad") if pad else None,
+        method=method,
+        threads=None if threads is None else _count(threads, "threads"),
+        attributes=bool(attributes),
+        colour_rule=colour_rule,
+        normals=bool(normals),
+        surface=surface,
+        fill=fill,
+        hollow=None if hollow is None else _count(hollow, "hollow"),
+        gpu_path=gpu_path,
+        seed=_count(seed, "seed"),
+        tile=None if tile is None else _count(tile, "tile"),
+        max_memory=None if max_memory is None else str(max_memory),
+    )
+
+
+def _count(x: Any, name: str) -> int:
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or x < 0:
+        raise ValueError(f"{name} must be a non-negative integer; got {x!r}")
+    return int(x)
+
+
+def _options(options: dict) -> dict:
+    out = {}
+    for k, v in options.items():
+        if v is None:
+            continue
+        if k in ("origin",):
+            v = [float(x) for x in v]
+        elif k in ("dims",):
+            v = [_count(d, "dims") for d in v]
+        elif k in ("resolution", "pad", "threads", "jobs", "hollow", "seed"):
+            v = _count(v, k)
+        elif k == "voxel_size":
+            v = float(v)
+        out[k] = v
+    return out
+
+
+def batch(
+    paths: Union[str, os.PathLike, Iterable[Union[str, os.PathLike]]],
+    out_dir: Union[str, os.PathLike],
+    *,
+    format: str = "npy",
+    glob: Optional[str] = None,
+    jobs: Optional[int] = None,
+    **options: Any,
+) -> dict:
+    """Voxelizes every mesh of ``paths`` (files, or folders walked for
+    meshes; ``glob`` such as ``"**/*.obj"`` filters them) into ``out_dir``,
+    as ``topovox batch`` does: one output per input, named after the input's
+    path below the inputs' common folder with the format's extension; a
+    manifest ``out_dir/manifest.jsonl`` (one JSON line per mesh: input,
+    output, status, options, grid, voxels, times, error) written as it goes;
+    meshes already done with the same options are skipped, so an
+    interrupted batch resumes; a bad mesh is recorded and the batch goes on.
+
+    ``options`` are :func:`voxelize`'s (mode, resolution, method, …) plus
+    ``colour_rule``, ``normals`` and ``dither`` for coloured formats and
+    ``attributes=True`` for every attribute grid in ``.vdb`` outputs;
+    ``jobs`` meshes run at once (default: all cores).
+
+    Returns the summary: ``{"done", "skipped", "failed", "total_s", "manifest"}``.
+    """
+    if isinstance(paths, (str, os.PathLike)):
+        paths = [paths]
+    opts = _options(dict(options, jobs=jobs))
+    return _topovox.batch([os.fspath(p) for p in paths], os.fspath(out_dir), format=format, glob=glob, options=opts)

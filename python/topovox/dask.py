@@ -1,0 +1,49 @@
+"""Voxelize many meshes on a Dask cluster: one task per mesh in a
+``dask.bag``, writing the same outputs and manifest lines as
+``topovox batch`` (so either can resume the other's run).
+
+>>> from dask.distributed import Client, LocalCluster
+>>> client = Client(LocalCluster(n_workers=2, threads_per_worker=1))
+>>> bag = topovox.dask.voxelize_paths(["meshes/"], "out/", format="npy", resolution=64)
+>>> records = bag.compute()          # one manifest record per mesh
+
+On a real cluster, give every worker the same view of the inputs and of
+``out_dir``: a shared file system path (NFS, Lustre), or an fsspec URL for
+the outputs (``s3://bucket/voxels``; each task writes locally and uploads;
+the manifest is appended through fsspec, so the file system must support
+appending — otherwise use a shared path for ``out_dir``).
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Iterable, Optional, Union
+
+from . import _paths
+
+
+def voxelize_paths(
+    paths: Union[str, os.PathLike, Iterable[Union[str, os.PathLike]]],
+    out_dir: Union[str, os.PathLike],
+    *,
+    format: str = "npy",
+    glob: Optional[str] = None,
+    npartitions: Optional[int] = None,
+    **options: Any,
+):
+    """A ``dask.bag.Bag`` with one task per mesh still to do (meshes the
+    manifest records as done with the same options are left out). Computing
+    it voxelizes each mesh (``options`` as :func:`topovox.voxelize` takes
+    them, plus ``colour_rule``, ``normals``, ``dither``), writes its output
+    and appends its manifest line; its elements are the manifest records.
+    Each task voxelizes on one thread (``threads=`` to change): the cluster
+    supplies the parallelism."""
+    import dask.bag as db
+
+    out_dir = os.fspath(out_dir)
+    opts = _paths.options_dict(options)
+    todo, _ = _paths.plan(paths, out_dir, format, glob, opts)
+    if not todo:
+        return db.from_sequence([], npartitions=1)
+    bag = db.from_sequence(todo, npartitions=npartitions or len(todo))
+    return bag.map(lambda pair: _paths.process(pair[0], pair[1], out_dir, format, opts))
