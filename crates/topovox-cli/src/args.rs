@@ -14,7 +14,7 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Voxelize a mesh into a voxel file (.npy, .binvox, .vox, .txt).
+    /// Voxelize a mesh into a voxel file (.npy, .npz, .vdb, .zarr, .vox, .binvox, .schem, .vti, .ply, .txt) or a mesh of the voxels.
     Voxelize(VoxelizeArgs),
     /// Print a report of a mesh file: vertices, triangles, degenerate triangles, bounds.
     Info(InfoArgs),
@@ -162,8 +162,8 @@ pub struct VoxelizeArgs {
     /// `../`, links leading out. Off by default.
     #[arg(long)]
     pub allow_external_paths: bool,
-    /// Output file: .npy, .binvox, .vox, .txt, .schem, .vti, .ply (voxels),
-    /// or .obj / .glb (a mesh of the voxels); the format comes from the
+    /// Output file: .npy, .npz, .binvox, .vox, .txt, .schem, .vti, .ply,
+    /// .vdb, .zarr (voxels), or .obj / .glb (a mesh of the voxels); the format comes from the
     /// extension unless --format is given. `-` writes to standard output
     /// (with --format).
     #[arg(short, long, value_name = "OUT")]
@@ -303,7 +303,7 @@ pub struct RenderArgs {
     /// `../`, links leading out. Off by default.
     #[arg(long)]
     pub allow_external_paths: bool,
-    /// A voxel file (.npy, .binvox, .vox, .txt) or a mesh (voxelized first, with --mode and the grid options).
+    /// A voxel file (any format topovox writes) or a mesh (voxelized first, with --mode and the grid options).
     pub input: PathBuf,
     /// Output picture (.png).
     #[arg(short, long, value_name = "PNG")]
@@ -614,7 +614,7 @@ pub struct GapsArgs {
 
 #[derive(Args, Debug)]
 pub struct ConvertArgs {
-    /// Voxel file written by topovox (.npy, .binvox, .vox, .txt, .schem, .vti, .ply).
+    /// Voxel file written by topovox (.npy, .npz, .binvox, .vox, .txt, .schem, .vti, .ply, .vdb, .zarr).
     pub input: PathBuf,
     /// Output voxel file, or `.obj` / `.glb` for a mesh of the voxels; the format comes from the extension unless --format is given.
     pub output: PathBuf,

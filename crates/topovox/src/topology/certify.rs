@@ -23,6 +23,19 @@
 //!   thinness is "every run is 1".
 //!
 //! Inside/outside comes from [`super::inside`]; all tests are exact.
+//!
+//! # Why it scales
+//!
+//! Separation needs no flood fill: a leaking path of unset voxels must step
+//! between two adjacent unset voxels of different class, and classes change
+//! along a row only at the parity toggles, so each pair of neighbouring rows
+//! is compared at its toggles (one merged walk per row pair, only for row
+//! pairs holding a toggle). Components are union–find over runs along `i`
+//! (a few million at 1024³). Tunnels enumerate, per triangle, the
+//! centre-to-centre segments whose bounding box meets it, visiting in each
+//! row only the voxels whose plane value lets a segment cross. Past memory
+//! the same code runs per window of brick layers, so work follows the set
+//! voxels and the rows the surface crosses, never the grid's volume.
 
 use std::ops::Range;
 

@@ -28,6 +28,49 @@
 //!
 //! **Reference:** [`reference::cover`], the separating axis test on all
 //! thirteen axes for every voxel of each triangle's bounding box.
+//!
+//! # Implementation notes
+//!
+//! `cover_triangle` is also the candidate enumerator of the modes below
+//! (each is a subset of `cover`). Short paths for small triangles: one
+//! voxel, one run (single-voxel span on two axes: no test), one 2D
+//! projection test (single-voxel span on one axis), the octant test for
+//! 2×2×2 spans (one plane and nine edge values at the block's centre
+//! lattice point, each selecting a mask of octants), the tiny-box SAT with
+//! per-projection bit masks (other spans up to 4: each projection's
+//! passing squares copied along its axis into a 64-bit mask of the 4×4×4
+//! span and ANDed), with no branch per voxel on a test's outcome. Both
+//! hand their voxels over as one mask (`Sink::set_block2`, `set_span4`),
+//! so `FilterUnset` reads which are already set in one go. Boxes up to 1024
+//! voxels: each row's span of columns inside the projection (the three
+//! edge functions solved per row), the plane's range of `t` tracked along
+//! it, six incremental edge tests per candidate; larger ones: row walkers.
+//!
+//! Per triangle (Schwarz & Seidel 2010, in exact integers):
+//! 1. Setup: normal `n`, dominant axis `w` (largest `|n_w|`), and the three
+//!    projections' edge functions with critical-corner offsets (`uv` = the
+//!    dominant plane, `vw`, `wu`). Plane values are computed relative to the
+//!    traversed box's corner, in `i64` for triangles under ~126 voxels across
+//!    and `i128` above that.
+//! 2. Along a row of the dominant projection, the range of voxels the plane
+//!    crosses moves by at most one per column (`|n_u| ≤ n_w`), so it is
+//!    tracked exactly with additions only.
+//! 3. Two traversals (`Options::traversal`; the result does not depend on it):
+//!    - *scan* (small boxes, the common case): every column of the box, the
+//!      dominant-plane edge functions as running sums; in the plane's range,
+//!      the six other edge tests per voxel.
+//!    - *walk rows* (large triangles): Bresenham-style edge walkers (one
+//!      division per edge, then an add and a compare per row) give each row's
+//!      exact column span, its *interior* span (square entirely inside the
+//!      projected triangle: the plane test alone decides there, since a plane
+//!      point inside the voxel projects inside the triangle) and the `t` range
+//!      allowed by the `vw` edges; boundary columns test the `wu` edges.
+//!
+//! Deviation from the paper: the paper tests every voxel of the bounding box
+//! with the plane test and all three projections; we enumerate only the
+//! voxels the plane crosses and only test what is not implied. The result is
+//! the same set, which the tests check against the brute-force SAT reference
+//! for every traversal, thread count and slab height (`topovox_testkit::agree`).
 
 use super::driver::{buffered, run_mesh, run_slabs, span4_offset, Kernel, Sink, SPAN4_STRIDE};
 use super::{Options, Report, Traversal};

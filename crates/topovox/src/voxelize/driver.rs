@@ -7,6 +7,35 @@
 //! bricks from its own pool; kernels only OR bits in. Pools are merged in
 //! slab order, so the result is bit-identical for any thread count and slab
 //! height.
+//!
+//! # Implementation notes
+//!
+//! Two parallel drivers for a per-triangle `Kernel`.
+//! *Triangles* (grids up to 512³): the mesh's vertices are snapped once
+//! (`SnappedMesh`), each thread takes a contiguous range of triangles,
+//! prepares each as it reads it and runs the kernel over the whole grid into
+//! its own bricks; the parts are merged by union in index order. *Slabs*
+//! (larger grids): bins triangles into z-slabs of whole brick layers (in
+//! parallel parts) and runs the kernel on each slab as one rayon task,
+//! preparing each triangle from the snapped vertices as the slab reads it
+//! (no list of prepared triangles is stored); each slab owns its
+//! brick-index entries and fills its own brick pool; pools are merged in
+//! slab order, renumbering only the entries each slab allocated. `cover`
+//! and `sep26` collect a larger triangle's voxels in `BoxBricks` (its
+//! box's bricks, on the stack; `driver::buffered`) and OR each into the
+//! slab once. A `Sink` receives voxels; `Filter` puts a mode's exact
+//! predicate in front of a slab (`FilterUnset` asks it only about voxels not
+//! yet set; both hand it the voxel as three values, not an array). Both
+//! drivers skip a kernel whose small box (up to 8 voxels) is already all
+//! set, brick by brick with a bit mask: kernels only set voxels of their
+//! box. At small grids the per-triangle path is short enough that a wide
+//! load of an array just written by narrow stores (a store-forwarding
+//! stall) shows in the profile; BENCHMARKS.md lists the ones removed. In
+//! the slab driver a kernel may put costly voxel tests off (`Deferred`,
+//! `Kernel::run_deferring`/`finish`) until the slab's other triangles have
+//! run, and then test only the voxels still unset: the union is the same.
+//! `sep26` does so for voxels whose steepest diagonal misses; the triangle
+//! driver takes none (its whole-grid lookups miss the cache).
 
 use rayon::prelude::*;
 

@@ -22,6 +22,81 @@
 //! triangle and a fixed segment direction, for the fast paths, and
 //! `LazyTargets` decides the targets of a voxel that lie on lines through
 //! its centre from one cross product per triangle edge.
+//!
+//! # Implementation notes
+//!
+//! Laine's targets (diagonals, crosshair, bisecting
+//! squares, faces), their definitional `*_hit` tests, and `TriSetup`, the
+//! same segment test specialised per triangle and direction in `i64`.
+//! Every target of `sep26`, `sep6`, `diagonal` and the tunnels lies on a
+//! line through its voxel's centre `c`, so one `PivotCross` per voxel
+//! (`(A_i − c) × (A_{i+1} − c)` per edge) decides all of them by dot
+//! products, with no per-direction setup (`edge_side` holds the tie rule
+//! for a line's side of an edge). `TargetSet` holds a kernel's targets:
+//! whether they are centred, their unit steps, whether they come in
+//! opposite pairs, and per box of reached forms which are live (a table).
+//! `PairedTargets` (the tunnels) asks per line through the centre, one
+//! comparison of `|n·d|` each, whether one of its two targets crosses the
+//! plane, then the crossing lines' edge sides all at once: the sign of
+//! `u·W` for every unit direction `u` follows from `W`'s signs and six
+//! comparisons of its magnitudes (`sign_key`), so a table per key gives
+//! each edge's positive lines (for triangles in a box of at most 64
+//! voxels; larger ones, and ties, go one line at a time and stop at the
+//! first hit); `LazyTargets` tests one target at a
+//! time (`diagonal`'s big triangles), and other sets take
+//! `segment_hits_once`, the same test from the segment's start (`bubble`
+//! pivots at each voxel's random point, which all seven of its targets'
+//! lines pass through; for triangles in a box of at most 27 voxels the
+//! points come from a per-thread cache of recent voxels, not the hash,
+//! and the seven plane tests make a mask rather than seven branches).
+//! `diagonal_lines` walks the diagonals' lines through voxel corners for
+//! small triangles, one instance per direction so its products with the
+//! steps fold away: all of them for `sep26`,
+//! only those through all-even corners for `diagonal` (they carry exactly
+//! each voxel's own diagonal). `straddling_step` finds the one target on
+//! a line that straddles the plane (Laine's column rule is its axis case);
+//! `forms_reached` and `TargetSet::may_meet` are integer
+//! tests on a triangle's box that rule out crosshair, tunnel or diagonal
+//! targets before any setup (most triangles at 32³): each target of a
+//! `TargetSet` needs some invariant forms (a coordinate on a voxel
+//! mid-plane, `x_p ± x_q` on a multiple of `ONE`) that the box must
+//! reach.
+//!
+//! The target modes' fast paths (`sep26.rs`, `sep6.rs`, `ss6.rs`, `line.rs`):
+//!
+//! - `ss6`: its plane test passes exactly one voxel per column of the
+//!   dominant projection, tracked along each row by a remainder (`columns`);
+//!   pixels strictly inside the projection set it untested, the others run
+//!   the nine edge tests on it. Boxes of at most 27 voxels take `cover`'s
+//!   traversal with the test as a `Filter`.
+//! - `line*` on triangles: `cover`'s traversal enumerates each
+//!   triangle's candidates (every target lies in the closed voxel, and the
+//!   perturbed hit implies the closed touch), and a `Filter` applies the
+//!   mode's exact test.
+//! - `sep26`: its own walk of the dominant projection's columns; per column
+//!   the two to four voxels around the plane's depth get an exact corner-sign
+//!   test (a plane that separates a voxel's corners crosses one of its space
+//!   diagonals: opposite corners average to the centre's value), then the
+//!   diagonal tests (the steepest diagonal first: it crosses wherever any
+//!   does; none for a voxel a neighbour has set), skipping the edges whose
+//!   half-plane contains the whole pixel.
+//! - `sep6`: Laine's single 2D projection. Pixels whose displaced centre is
+//!   inside the projection emit exactly one voxel, found by one exact
+//!   division (thinness proves no other voxel of the column is hit); pixels
+//!   whose square meets the projection test the two perpendicular crosshair
+//!   segments for the two or three voxels around the plane's depth.
+//! - `line*` on segments: each layer along the segment's dominant axis tests
+//!   the voxels within one voxel of its span there.
+//!
+//! - `voxelize/sep26.rs`, `sep6.rs` (triangles in a box of at most 27
+//! voxels go by their targets' lines one by one: the crosshair's axis
+//! lines through pixel centres, the diagonals' lines through corners found
+//! in an oblique projection, each line meeting the triangle setting its one
+//! straddling voxel; larger ones: `sep26` by Laine's single projection,
+//! `sep6` by the spans below, Laine's single projection only beyond
+//! `i64`), `ss6.rs` (Schwarz–Seidel 6-separating), `diagonal.rs`,
+//! `line.rs` (`line26`, `line6`): one mode per file, each with `pub mod
+//! reference`.
 
 use super::cover::Divisor;
 use super::driver::box_volume;
