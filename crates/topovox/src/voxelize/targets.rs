@@ -88,15 +88,13 @@
 //! - `line*` on segments: each layer along the segment's dominant axis tests
 //!   the voxels within one voxel of its span there.
 //!
-//! - `voxelize/sep26.rs`, `sep6.rs` (triangles in a box of at most 27
-//! voxels go by their targets' lines one by one: the crosshair's axis
-//! lines through pixel centres, the diagonals' lines through corners found
-//! in an oblique projection, each line meeting the triangle setting its one
-//! straddling voxel; larger ones: `sep26` by Laine's single projection,
-//! `sep6` by the spans below, Laine's single projection only beyond
-//! `i64`), `ss6.rs` (Schwarz–Seidel 6-separating), `diagonal.rs`,
-//! `line.rs` (`line26`, `line6`): one mode per file, each with `pub mod
-//! reference`.
+//! Tiny triangles: in `sep26.rs` and `sep6.rs`, triangles in a box of at
+//! most 27 voxels go by their targets' lines one by one (the crosshair's
+//! axis lines through pixel centres, the diagonals' lines through corners
+//! found in an oblique projection), each line meeting the triangle setting
+//! its one straddling voxel; larger ones: `sep26` by Laine's single
+//! projection, `sep6` by `line_spans.rs`, Laine's single projection only
+//! beyond `i64`.
 
 use super::cover::Divisor;
 use super::driver::box_volume;
