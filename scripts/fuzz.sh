@@ -4,10 +4,10 @@
 # toolchain (RUSTC_BOOTSTRAP lets it pass the sanitizer flags; a nightly
 # toolchain works too). Prints one line per target: executions and result.
 # A crash stops the script with libFuzzer's report and the crashing input
-# under fuzz/artifacts/TARGET/. Allocations are limited by resident memory
-# (4 GiB), not by size: readers may allocate a grid a file claims when it
-# fits in memory (they refuse larger ones), and such a grid stays mostly
-# untouched.
+# under fuzz/artifacts/TARGET/. Memory is limited to 2 GiB (resident, and
+# any single allocation): the targets cap dense reads at 512 MiB
+# (topovox_io::set_dense_read_budget), so a small file claiming a huge
+# grid must be refused or read sparsely, never allocated.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH="${1:-20}"
@@ -18,7 +18,7 @@ scratch="$(mktemp -d)"
 for t in $(cargo fuzz list); do
     mkdir -p "$scratch/$t"
     log="$scratch/$t.log"
-    if ! cargo fuzz run -O "$t" "$scratch/$t" "fuzz/seeds/$t" -- -max_total_time="$SECONDS_EACH" -timeout=10 -rss_limit_mb=4096 -malloc_limit_mb=65536 >"$log" 2>&1; then
+    if ! cargo fuzz run -O "$t" "$scratch/$t" "fuzz/seeds/$t" -- -max_total_time="$SECONDS_EACH" -timeout=10 -rss_limit_mb=2048 >"$log" 2>&1; then
         tail -40 "$log"
         echo "fuzz target $t FAILED (input saved under fuzz/artifacts/$t)"
         exit 1

@@ -7,6 +7,10 @@ use topovox_io::VoxelFormat;
 /// are crashes: third-party parsers that panic on malformed input run
 /// inside the fence, which turns the panic into an error (as the CLI does).
 pub fn fence_panics() {
+    // Dense reads stay well inside libFuzzer's 2 GB memory limit: a file
+    // claiming a larger grid is refused as too large (the CLI then reads it
+    // sparsely), which is the answer the targets check for.
+    topovox_io::set_dense_read_budget(512 << 20);
     let abort = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
         if !topovox_io::panic_is_fenced() {
@@ -32,11 +36,17 @@ pub fn check_voxels(data: &[u8], format: VoxelFormat) {
         _ => None,
     };
     let Ok(v) = topovox_io::read_voxels_bytes(data, format) else { return };
+    check_loaded(&v, sparse.as_ref());
+}
+
+/// The checks on what a dense reader returned, and where the sparse reader
+/// succeeded too, that both agree.
+pub fn check_loaded(v: &topovox_io::LoadedVoxels, sparse: Option<&topovox_io::SparseVoxels>) {
     let [nx, ny, nz] = v.bits.dims();
     if (nx as u64).div_ceil(64) * ny as u64 * nz as u64 > MAX_VISITED_WORDS {
         return;
     }
-    if let Some(s) = &sparse {
+    if let Some(s) = sparse {
         assert_eq!(s.bits.dims(), v.bits.dims());
         assert_eq!(s.bits.count(), v.bits.count());
         assert_eq!(format!("{:?}", s.placement), format!("{:?}", v.placement)); // NaN-proof
@@ -54,4 +64,48 @@ pub fn check_voxels(data: &[u8], format: VoxelFormat) {
     if let Some(a) = &v.attributes {
         assert!(a.keys.len() as u64 <= n);
     }
+}
+
+/// Where a file of a fuzzed Zarr folder starts: this line, then its path
+/// (relative to the folder) up to a newline, then its bytes.
+pub const ZARR_FILE_MARK: &[u8] = b"\n@@FILE ";
+
+/// Lays `data` out as a Zarr folder at `dir` (emptied first): the bytes up
+/// to the first [`ZARR_FILE_MARK`] are `zarr.json`, then each marked part
+/// is one more file. Paths are kept only if every component is a plain
+/// name (letters, digits, `.`, `_`, `-`; not `.` or `..`), so the harness
+/// itself never writes outside `dir`; what the reader does with the
+/// names in `zarr.json` (separators, keys) is what is fuzzed.
+pub fn zarr_folder(data: &[u8], dir: &std::path::Path) {
+    let _ = std::fs::remove_dir_all(dir);
+    std::fs::create_dir_all(dir).expect("scratch folder");
+    let mut parts = split(data, ZARR_FILE_MARK).into_iter();
+    let _ = std::fs::write(dir.join("zarr.json"), parts.next().unwrap_or_default());
+    for part in parts.take(64) {
+        let (name, bytes) = match part.iter().position(|&b| b == b'\n') {
+            Some(n) => (&part[..n], &part[n + 1..]),
+            None => (part, &[][..]),
+        };
+        let Ok(name) = std::str::from_utf8(name) else { continue };
+        let plain = |c: &str| !c.is_empty() && c != "." && c != ".." && c.bytes().all(|b| b.is_ascii_alphanumeric() || b"._-".contains(&b));
+        if name.is_empty() || !name.split('/').all(plain) {
+            continue;
+        }
+        let path = dir.join(name);
+        if let Some(parent) = path.parent() {
+            let _ = std::fs::create_dir_all(parent);
+        }
+        let _ = std::fs::write(path, bytes);
+    }
+}
+
+fn split<'a>(data: &'a [u8], mark: &[u8]) -> Vec<&'a [u8]> {
+    let mut out = Vec::new();
+    let mut rest = data;
+    while let Some(at) = rest.windows(mark.len()).position(|w| w == mark) {
+        out.push(&rest[..at]);
+        rest = &rest[at + mark.len()..];
+    }
+    out.push(rest);
+    out
 }

@@ -480,13 +480,15 @@ impl VoxelGrid {
     /// T-junctions split so it is watertight, as triangles with shared
     /// vertices): `(vertices (n, 3) float64, faces (m, 3) int64,
     /// face_colours (m, 3) uint8 or None)`.
-    fn greedy_mesh<'py>(&self, py: Python<'py>) -> MeshArrays<'py> {
+    fn greedy_mesh<'py>(&self, py: Python<'py>) -> PyResult<MeshArrays<'py>> {
+        let g = &self.inner.grid;
+        topovox_job::check_memory(g, topovox_job::budget(None), "a mesh of the voxels").map_err(py_err)?;
         let inner = self.inner.clone();
         let (verts, faces, colours) = py.detach(move || greedy_triangles(&inner));
         let v = Array2::from_shape_fn((verts.len(), 3), |(n, c)| verts[n][c]).into_pyarray(py);
         let f = Array2::from_shape_fn((faces.len(), 3), |(n, c)| faces[n][c] as i64).into_pyarray(py);
         let c = colours.map(|c| Array2::from_shape_fn((c.len(), 3), |(n, k)| c[n][k]).into_pyarray(py));
-        (v, f, c)
+        Ok((v, f, c))
     }
 
     /// to_trimesh() -> trimesh.Trimesh: the mesh of the voxels (boundary
@@ -496,7 +498,7 @@ impl VoxelGrid {
         let trimesh = py.import("trimesh").map_err(|e| {
             pyo3::exceptions::PyImportError::new_err(format!("VoxelGrid.to_trimesh needs trimesh (pip install trimesh): {e}"))
         })?;
-        let (v, f, c) = self.greedy_mesh(py);
+        let (v, f, c) = self.greedy_mesh(py)?;
         let kwargs = PyDict::new(py);
         kwargs.set_item("vertices", v)?;
         kwargs.set_item("faces", f)?;
@@ -687,13 +689,21 @@ fn up_of(up: &str) -> PyResult<topovox_io::orient::Up> {
     topovox_io::orient::Up::from_name(up).ok_or_else(|| value_err(format!("up must be \"x\", \"y\" or \"z\"; got {up:?}")))
 }
 
-/// load_voxels(path, origin=None, voxel_size=None, up="y") -> VoxelGrid
+/// load_voxels(path, origin=None, voxel_size=None, up="y", allow_external_paths=False) -> VoxelGrid
 #[pyfunction]
-#[pyo3(signature = (path, origin=None, voxel_size=None, up="y"))]
-fn load_voxels(py: Python<'_>, path: PathBuf, origin: Option<Vec<f64>>, voxel_size: Option<f64>, up: &str) -> PyResult<VoxelGrid> {
+#[pyo3(signature = (path, origin=None, voxel_size=None, up="y", allow_external_paths=false))]
+fn load_voxels(
+    py: Python<'_>,
+    path: PathBuf,
+    origin: Option<Vec<f64>>,
+    voxel_size: Option<f64>,
+    up: &str,
+    allow_external_paths: bool,
+) -> PyResult<VoxelGrid> {
     let p = path.clone();
     let up = up_of(up)?;
-    let loaded = py.detach(move || topovox_io::read_voxels_with(&p, up)).map_err(io_err)?;
+    let opts = topovox_io::ReadOptions { allow_external_paths };
+    let loaded = py.detach(move || topovox_io::read_voxels_opts(&p, up, &opts)).map_err(io_err)?;
     let dims = loaded.bits.dims();
     let o = match origin {
         Some(o) if o.len() == 3 => DVec3::new(o[0], o[1], o[2]),
@@ -823,7 +833,8 @@ fn batch<'py>(
             let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref())?;
             let ext = opts.format.name().replace("npy-bool", "npy");
             let items = topovox_job::batch::plan_items(&files, &out_dir, &ext)?;
-            let pool = topovox_job::pool(jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)))?;
+            let pool =
+                topovox_job::pool_for(jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)), "jobs")?;
             pool.install(|| topovox_job::batch::run(&items, &out_dir, &opts, &topovox_job::batch::Silent))
         })
         .map_err(py_err)?;

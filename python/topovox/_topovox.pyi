@@ -71,7 +71,13 @@ class VoxelGrid:
     def to_trimesh(self) -> Any: ...
 
 def load_mesh(path: Union[str, PathLike[str]], allow_external_paths: bool = False) -> Mesh: ...
-def load_voxels(path: Union[str, PathLike[str]], origin: Optional[Sequence[float]] = None, voxel_size: Optional[float] = None) -> VoxelGrid: ...
+def load_voxels(
+    path: Union[str, PathLike[str]],
+    origin: Optional[Sequence[float]] = None,
+    voxel_size: Optional[float] = None,
+    up: str = "y",
+    allow_external_paths: bool = False,
+) -> VoxelGrid: ...
 def voxelize(
     mesh: Mesh,
     *,

@@ -614,6 +614,10 @@ pub struct GapsArgs {
 
 #[derive(Args, Debug)]
 pub struct ConvertArgs {
+    /// Read a voxel folder (.zarr) through links that lead outside it. Off
+    /// by default: a link inside the folder must stay inside.
+    #[arg(long)]
+    pub allow_external_paths: bool,
     /// Voxel file written by topovox (.npy, .npz, .binvox, .vox, .txt, .schem, .vti, .ply, .vdb, .zarr).
     pub input: PathBuf,
     /// Output voxel file, or `.obj` / `.glb` for a mesh of the voxels; the format comes from the extension unless --format is given.

@@ -22,6 +22,7 @@ fn main() -> ExitCode {
         }
     }));
     let cli = Cli::parse();
+    remove_temporaries_on_interrupt();
     let result = match &cli.command {
         Command::Voxelize(a) => commands::voxelize::run(a),
         Command::Info(a) => commands::info::run(a),
@@ -55,6 +56,22 @@ fn main() -> ExitCode {
     }
 }
 
+/// On Ctrl-C (SIGINT) or SIGTERM, removes the temporaries of the outputs
+/// being written and exits at once with 130 or 143, as a shell expects: an
+/// interrupted run leaves neither a partial output nor a temporary behind.
+fn remove_temporaries_on_interrupt() {
+    #[cfg(unix)]
+    {
+        use signal_hook::consts::{SIGINT, SIGTERM};
+        let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else { return };
+        std::thread::spawn(move || {
+            if let Some(sig) = signals.forever().next() {
+                topovox_io::atomic::remove_live_temporaries(Some(128 + sig));
+            }
+        });
+    }
+}
+
 fn is_broken_pipe(e: &anyhow::Error) -> bool {
     e.chain().any(|c| c.downcast_ref::<std::io::Error>().is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe))
 }
@@ -69,8 +86,13 @@ pub(crate) fn print_stdout(s: &str) -> Result<()> {
 
 /// A rayon pool with `threads` workers (default: all cores).
 pub(crate) fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
-    if threads == Some(0) {
-        anyhow::bail!("--threads must be at least 1");
+    thread_pool_for(threads, "--threads")
+}
+
+/// [`thread_pool`], the count named `what` (`--jobs`) in errors.
+pub(crate) fn thread_pool_for(threads: Option<usize>, what: &str) -> Result<rayon::ThreadPool> {
+    if let Some(n) = threads {
+        topovox_job::check_threads(n, what)?;
     }
     rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start worker threads")
 }

@@ -9,10 +9,18 @@
 //!   over it would replace the device node or pipe with a regular file.
 //!   Write errors are reported (`/dev/full`: no space left on device).
 //! - `-` is standard output.
+//! - Temporaries are named `.NAME.topovox-tmp-PID-N`, unique per write
+//!   (the counter `N`; created exclusively), so threads saving to one path
+//!   never share one. Those of a process that is interrupted are removed
+//!   by its signal handler ([`remove_live_temporaries`]); those a killed
+//!   process left behind are removed by the next write of the same output
+//!   ([`remove_stale_temporaries`]).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 
 use crate::error::{ErrorKind, IoError};
 
@@ -45,37 +53,187 @@ pub fn target(path: &Path) -> Target {
 /// files (on any error the temporary file is removed and `path` is
 /// untouched), directly for special files and standard output.
 pub fn write_atomically(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<(), IoError> {
+    stage(path, fill)?.commit()
+}
+
+/// Output written but not yet in place: for a regular file, a complete
+/// temporary file beside it, renamed over it by [`Staged::commit`] and
+/// removed if the `Staged` is dropped uncommitted. Staging several files
+/// and committing them in order replaces them together as far as a file
+/// system allows: nothing is renamed until every one is complete (the
+/// `.obj` and its `.mtl`).
+#[must_use = "a staged output is removed unless committed"]
+pub struct Staged {
+    path: PathBuf,
+    temp: Option<Temporary>,
+}
+
+impl Staged {
+    /// Renames the temporary file over the output (nothing to do for
+    /// special files and standard output, written in place).
+    pub fn commit(mut self) -> Result<(), IoError> {
+        match self.temp.take() {
+            None => Ok(()),
+            Some(t) => t.rename_to(&self.path).map_err(|e| IoError::new(&self.path, ErrorKind::Write(e))),
+        }
+    }
+}
+
+/// Writes `path`'s bytes through `fill` to where [`Target`] says, without
+/// putting a regular file in place yet (see [`Staged`]).
+pub fn stage(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<Staged, IoError> {
     let err = |e| IoError::new(path, ErrorKind::Write(e));
     match target(path) {
         Target::Stdout => {
             let out = std::io::stdout();
             let mut w = BufWriter::with_capacity(1 << 20, out.lock());
-            fill(&mut w).and_then(|_| w.flush()).map_err(err)
+            fill(&mut w).and_then(|_| w.flush()).map_err(err)?;
+            Ok(Staged { path: path.to_path_buf(), temp: None })
         }
         Target::Special(p) => {
             let file = std::fs::OpenOptions::new().write(true).open(&p).map_err(err)?;
             let mut w = BufWriter::with_capacity(1 << 20, file);
-            fill(&mut w).and_then(|_| w.flush()).map_err(err)
+            fill(&mut w).and_then(|_| w.flush()).map_err(err)?;
+            Ok(Staged { path: path.to_path_buf(), temp: None })
         }
         Target::Regular(real) => {
-            let tmp = temp_path(&real);
-            let file = File::create(&tmp).map_err(err)?;
+            remove_stale_temporaries(&real);
+            let (temp, file) = Temporary::create_file(&real).map_err(err)?;
             let mut w = BufWriter::with_capacity(1 << 20, file);
-            let result = fill(&mut w).and_then(|_| w.flush());
+            fill(&mut w).and_then(|_| w.flush()).map_err(err)?;
             drop(w);
-            let result = result.and_then(|_| std::fs::rename(&tmp, &real));
-            if let Err(e) = result {
-                let _ = std::fs::remove_file(&tmp);
-                return Err(err(e));
-            }
-            Ok(())
+            Ok(Staged { path: real, temp: Some(temp) })
         }
     }
 }
 
-fn temp_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    path.with_file_name(format!(".{name}.topovox-tmp-{}", std::process::id()))
+/// The marker in every temporary name, between the output's name and the
+/// writing process's id: `.NAME.topovox-tmp-PID-N`.
+const TEMP_MARK: &str = ".topovox-tmp-";
+
+/// Temporaries this process is writing, removed by
+/// [`remove_live_temporaries`] when the process is interrupted.
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Makes every temporary name unique within the process (several threads
+/// may write the same output at once).
+static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A temporary file or folder beside an output, unique to this write
+/// (process id and a counter, created exclusively), registered while it
+/// exists and removed when dropped unless renamed into place.
+pub(crate) struct Temporary {
+    path: PathBuf,
+}
+
+impl Temporary {
+    /// A new temporary name for `output`, registered as live.
+    fn name_for(output: &Path) -> Temporary {
+        let name = output.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let path = output.with_file_name(format!(".{name}{TEMP_MARK}{}-{n}", std::process::id()));
+        live().push(path.clone());
+        Temporary { path }
+    }
+
+    /// A new, exclusively created temporary file for `output`.
+    fn create_file(output: &Path) -> std::io::Result<(Temporary, File)> {
+        let t = Temporary::name_for(output);
+        let file = std::fs::OpenOptions::new().write(true).create_new(true).open(&t.path)?;
+        Ok((t, file))
+    }
+
+    /// A new, exclusively created temporary folder for `output`.
+    pub(crate) fn create_dir(output: &Path) -> std::io::Result<Temporary> {
+        let t = Temporary::name_for(output);
+        std::fs::create_dir(&t.path)?;
+        Ok(t)
+    }
+
+    /// Where it is.
+    pub(crate) fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Renames it to `to`; on failure it is removed.
+    pub(crate) fn rename_to(self, to: &Path) -> std::io::Result<()> {
+        std::fs::rename(&self.path, to)?;
+        forget_live(&self.path);
+        std::mem::forget(self);
+        Ok(())
+    }
+}
+
+impl Drop for Temporary {
+    fn drop(&mut self) {
+        remove_path(&self.path);
+        forget_live(&self.path);
+    }
+}
+
+fn forget_live(path: &Path) {
+    live().retain(|p| p != path);
+}
+
+fn remove_path(path: &Path) {
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.is_dir() => {
+            let _ = std::fs::remove_dir_all(path);
+        }
+        Ok(_) => {
+            let _ = std::fs::remove_file(path);
+        }
+        Err(_) => {}
+    }
+}
+
+/// Removes every temporary this process is writing: for a signal handler
+/// that is about to end the process (the CLI's Ctrl-C), so an interrupted
+/// run leaves nothing behind. Holds the registry until the process ends
+/// if `then_exit` is given, so no new temporary appears meanwhile.
+pub fn remove_live_temporaries(then_exit: Option<i32>) {
+    let mut live = live();
+    for p in live.drain(..) {
+        remove_path(&p);
+    }
+    if let Some(code) = then_exit {
+        std::process::exit(code);
+    }
+}
+
+/// Removes the temporaries of `output` that an earlier run left behind
+/// (killed before it could clean up): names `.NAME.topovox-tmp-PID…`
+/// beside it whose process `PID` is gone. Only where that can be told
+/// (Linux's `/proc`); elsewhere they are left alone.
+pub fn remove_stale_temporaries(output: &Path) {
+    let Some(name) = output.file_name().map(|n| n.to_string_lossy().into_owned()) else { return };
+    let dir = match output.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let prefix = format!(".{name}{TEMP_MARK}");
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let Some(rest) = file_name.to_str().and_then(|f| f.strip_prefix(&prefix)) else { continue };
+        let pid = rest.split('-').next().and_then(|p| p.parse::<u32>().ok());
+        if pid.is_some_and(|pid| process_is_gone(pid)) {
+            remove_path(&entry.path());
+        }
+    }
+}
+
+/// True when no process `pid` runs (Linux: no `/proc/PID`); false where it
+/// cannot be told.
+fn process_is_gone(pid: u32) -> bool {
+    if pid == std::process::id() {
+        return false;
+    }
+    cfg!(target_os = "linux") && Path::new("/proc/self").exists() && !Path::new("/proc").join(pid.to_string()).exists()
 }
 
 /// The same file by identity (device and inode on Unix; the resolved path

@@ -328,12 +328,18 @@ pub fn read_voxels(path: &Path) -> Result<LoadedVoxels, IoError> {
 /// [`read_voxels`], `.vox` and `.schem` files without a recorded up axis
 /// being rotated back by `up` (see [`orient`]).
 pub fn read_voxels_with(path: &Path, up: orient::Up) -> Result<LoadedVoxels, IoError> {
+    read_voxels_opts(path, up, &ReadOptions::default())
+}
+
+/// [`read_voxels_with`]; `opts` says whether a voxel folder (`.zarr`) may
+/// be read through links that lead outside it.
+pub fn read_voxels_opts(path: &Path, up: orient::Up, opts: &ReadOptions) -> Result<LoadedVoxels, IoError> {
     let format = VoxelFormat::from_path(path).ok_or_else(|| {
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_string();
         IoError::new(path, ErrorKind::UnknownFormat { ext, expected: VoxelFormat::NAMES })
     })?;
     if format == VoxelFormat::Zarr {
-        return zarr::read(path);
+        return zarr::read(path, opts);
     }
     if matches!(format, VoxelFormat::Npy | VoxelFormat::NpyBool) {
         let file = std::fs::File::open(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
@@ -372,12 +378,17 @@ pub struct SparseVoxels {
 /// With `attributes`, the attribute grids or arrays of a `.vdb` or `.zarr`
 /// written with `--attributes` are read too (about 32 bytes per set voxel).
 pub fn read_voxels_sparse(path: &Path, attributes: bool) -> Result<SparseVoxels, IoError> {
+    read_voxels_sparse_opts(path, attributes, &ReadOptions::default())
+}
+
+/// [`read_voxels_sparse`]; `opts` as for [`read_voxels_opts`].
+pub fn read_voxels_sparse_opts(path: &Path, attributes: bool, opts: &ReadOptions) -> Result<SparseVoxels, IoError> {
     match VoxelFormat::from_path(path) {
         Some(VoxelFormat::Vdb) => {
             let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
             fence("VDB", || vdb::read_sparse(&bytes, attributes)).map_err(|k| IoError::new(path, k))
         }
-        Some(VoxelFormat::Zarr) => zarr::read_sparse(path, attributes),
+        Some(VoxelFormat::Zarr) => zarr::read_sparse(path, attributes, opts),
         Some(VoxelFormat::Npz) => {
             let file = std::fs::File::open(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
             let total = file.metadata().map_err(|e| IoError::new(path, ErrorKind::Read(e)))?.len();
@@ -433,18 +444,33 @@ pub fn bytes(n: u64) -> String {
     }
 }
 
+/// The most memory a dense read may take, set by [`set_dense_read_budget`]
+/// (0: nine tenths of the available memory).
+static DENSE_READ_BUDGET: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Caps the memory the readers may give a dense grid (the CLI's
+/// `--max-memory`; a fuzzer's memory limit): a file claiming a larger
+/// grid is refused with [`ErrorKind::TooLarge`], and callers that can
+/// read it sparsely ([`read_voxels_sparse`]) do. `0` restores the default,
+/// nine tenths of the available memory.
+pub fn set_dense_read_budget(bytes: u64) {
+    DENSE_READ_BUDGET.store(bytes, std::sync::atomic::Ordering::Relaxed);
+}
+
 /// A dense grid for a reader, refused when the file claims one that would
-/// not fit in memory (a hostile file of a few bytes can claim billions of
-/// voxels; allocating them would abort the process).
+/// not fit in the memory a read may take (a hostile file of a few bytes
+/// can claim billions of voxels; allocating them would abort the process).
 pub(crate) fn dense_grid(dims: [u32; 3]) -> Result<topovox::DenseBits, ErrorKind> {
     // In u128: three u32 extents overflow u64.
     let need = u64::try_from((dims[0] as u128).div_ceil(64) * 8 * dims[1] as u128 * dims[2] as u128).unwrap_or(u64::MAX);
+    let budget = DENSE_READ_BUDGET.load(std::sync::atomic::Ordering::Relaxed);
     // Small grids are never refused: reading /proc per file costs more.
     // Where the available memory cannot be read, 1 TiB stands for it.
-    if need > 64 << 20 {
-        let avail = available_memory().unwrap_or(1 << 40);
-        if need > avail / 10 * 9 {
-            return Err(ErrorKind::TooLarge { dims, need: bytes(need), available: bytes(avail) });
+    if need > 64 << 20 || (budget != 0 && need > budget) {
+        let avail = available_memory().unwrap_or(1 << 40) / 10 * 9;
+        let limit = if budget == 0 { avail } else { budget.min(avail) };
+        if need > limit {
+            return Err(ErrorKind::TooLarge { dims, need: bytes(need), available: bytes(limit) });
         }
     }
     Ok(topovox::DenseBits::new(dims))

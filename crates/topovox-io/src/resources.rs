@@ -5,7 +5,9 @@
 //! read: a reference is resolved against the folder, symbolic links and
 //! `..` included, and refused if the real file lies elsewhere — so a model
 //! uploaded to a service cannot make it read (or leak) files it never meant
-//! to open. [`ReadOptions::allow_external_paths`] lifts this.
+//! to open. [`ReadOptions::allow_external_paths`] lifts this. Whatever the
+//! option, only regular files are read: a FIFO or a device named by a
+//! model would hang the reader or never end.
 
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -55,6 +57,11 @@ impl Resources {
                 reference.display(),
                 if base.as_os_str().is_empty() { Path::new(".") } else { base }.display()
             ));
+        }
+        // Only regular files: a FIFO would hang the read, a device such as
+        // /dev/zero would never end.
+        if std::fs::metadata(&real).is_ok_and(|m| !m.is_file()) {
+            return Err(format!("{} is not a regular file (a device, a FIFO or a folder) and is not read", reference.display()));
         }
         self.used.lock().unwrap_or_else(|e| e.into_inner()).push(real.clone());
         Ok(real)

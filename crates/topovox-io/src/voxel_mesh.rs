@@ -14,7 +14,7 @@ use topovox::attributes::colour::to_linear;
 use topovox::export::greedy::Quad;
 use topovox::GridSpec;
 
-use crate::atomic::write_atomically;
+use crate::atomic::{stage, write_atomically};
 use crate::error::IoError;
 
 /// How a mesh of the voxels is built.
@@ -95,17 +95,20 @@ pub fn write_quads_obj(
         ));
     }
     let mtl = palette.map(|p| (path.with_extension("mtl"), p));
-    if let Some((mtl_path, p)) = &mtl {
-        write_atomically(mtl_path, |w| {
+    // Both files are complete before either is renamed into place, the
+    // `.mtl` first: a failure (a full disk) leaves the old pair intact.
+    let staged_mtl = match &mtl {
+        None => None,
+        Some((mtl_path, p)) => Some(stage(mtl_path, |w| {
             writeln!(w, "# topovox: one material per voxel colour")?;
             for (i, c) in p.iter().enumerate() {
                 let [r, g, b] = c.map(|v| v as f64 / 255.0);
                 writeln!(w, "newmtl c{i}\nKd {r:.6} {g:.6} {b:.6}\nKa 0 0 0\nKs 0 0 0\nillum 1\n")?;
             }
             Ok(())
-        })?;
-    }
-    write_atomically(path, |w| {
+        })?),
+    };
+    let staged_obj = stage(path, |w| {
         writeln!(
             w,
             "# topovox: {} faces from {} greedy quads of the voxels' boundary faces{}",
@@ -133,6 +136,10 @@ pub fn write_quads_obj(
         }
         Ok(())
     })?;
+    if let Some(m) = staged_mtl {
+        m.commit()?;
+    }
+    staged_obj.commit()?;
     Ok(order.len())
 }
 

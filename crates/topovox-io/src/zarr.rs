@@ -53,7 +53,9 @@ use topovox::grid::bricks::{set_in_brick, Brick};
 use topovox::grid::sparse::SparseBricks;
 use topovox::{GridSpec, VoxelSource};
 
+use crate::atomic::Temporary;
 use crate::error::{ErrorKind, IoError};
+use crate::resources::ReadOptions;
 use crate::{LoadedVoxels, SparseVoxels};
 
 /// Chunk edge in voxels (8 bricks).
@@ -218,19 +220,70 @@ fn io(path: &Path, e: std::io::Error) -> IoError {
 
 /// Writes `bits` on `grid` as a Zarr v3 array directory at `path`; with
 /// `attrs` that have any array, a group holding the `voxels` array and one
-/// array per attribute.
+/// array per attribute. An existing `path` is replaced only if it is an
+/// empty folder or an array or group topovox wrote, holding nothing else
+/// ([`check_replaceable`]); the new one is written to a temporary folder
+/// beside it first.
 pub fn write(path: &Path, bits: &dyn VoxelSource, grid: &GridSpec, attrs: Option<&VoxelAttributes>) -> Result<(), IoError> {
-    if path.exists() && !path.join("zarr.json").is_file() {
-        return Err(io(path, std::io::Error::other("exists and is not a Zarr array; topovox replaces only Zarr arrays")));
-    }
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.topovox-tmp-{}", std::process::id()));
+    check_replaceable(path)?;
+    crate::atomic::remove_stale_temporaries(path);
+    let tmp = Temporary::create_dir(path).map_err(|e| io(path, e))?;
     let extra = attrs.map(attribute_arrays).unwrap_or_default();
-    let result = fill_all(&tmp, bits, grid, extra).and_then(|_| replace(&tmp, path));
-    if result.is_err() {
-        let _ = std::fs::remove_dir_all(&tmp);
+    fill_all(tmp.path(), bits, grid, extra).map_err(|e| io(path, e))?;
+    replace(tmp, path).map_err(|e| io(path, e))
+}
+
+/// Refuses to write over `path` unless it does not exist, is an empty
+/// folder, or is a Zarr array or group that topovox wrote (its
+/// attributes say so) holding only what topovox writes there: replacing
+/// a folder deletes it, so anything else of the user's is never touched.
+pub fn check_replaceable(path: &Path) -> Result<(), IoError> {
+    let refuse = |why: String| {
+        Err(io(path, std::io::Error::other(format!("{why}; refusing to replace it (topovox replaces only its own Zarr arrays)"))))
+    };
+    let meta = match std::fs::symlink_metadata(path) {
+        Err(_) => return Ok(()),
+        Ok(m) => m,
+    };
+    if !meta.is_dir() {
+        return refuse("exists and is not a folder".into());
     }
-    result.map_err(|e| io(path, e))
+    let entries: Vec<String> =
+        std::fs::read_dir(path).map_err(|e| io(path, e))?.flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+    if entries.is_empty() {
+        return Ok(());
+    }
+    let node: Option<Value> = std::fs::symlink_metadata(path.join("zarr.json"))
+        .ok()
+        .filter(|m| m.is_file() && m.len() <= MAX_JSON_BYTES)
+        .and_then(|_| std::fs::read(path.join("zarr.json")).ok())
+        .and_then(|b| serde_json::from_slice(&b).ok());
+    let Some(node) = node else {
+        return refuse("exists and is not a Zarr array (no readable zarr.json)".into());
+    };
+    let ours = match &node["attributes"]["topovox"] {
+        Value::Null => &node["attributes"][crate::former_name::ZARR_ATTRIBUTES],
+        v => v,
+    };
+    let allowed: Vec<String> = match (node["node_type"].as_str(), ours) {
+        (_, Value::Null) => return refuse("is a Zarr node topovox did not write".into()),
+        (Some("array"), _) => vec!["zarr.json".into(), "c".into()],
+        (Some("group"), v) => {
+            let arrays = v["arrays"].as_array().map(|a| a.iter().filter_map(|x| x.as_str().map(String::from)).collect::<Vec<_>>());
+            let Some(arrays) = arrays else { return refuse("is a Zarr group topovox did not write".into()) };
+            std::iter::once("zarr.json".to_string()).chain(arrays).collect()
+        }
+        _ => return refuse("is not a Zarr array or group".into()),
+    };
+    let mut others: Vec<&String> = entries.iter().filter(|e| !allowed.contains(e)).collect();
+    if !others.is_empty() {
+        others.sort();
+        return refuse(format!(
+            "holds files topovox did not write ({})",
+            others.iter().take(3).map(|s| s.as_str()).collect::<Vec<_>>().join(", ")
+        ));
+    }
+    Ok(())
 }
 
 /// The occupancy array at `dir`, or with `extra` arrays a group there
@@ -304,14 +357,18 @@ fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec, kinds: &[Kind<'_>])
 
 /// Renames `tmp` to `path`, moving an existing array aside first and
 /// removing it only once the new one is in place.
-fn replace(tmp: &Path, path: &Path) -> std::io::Result<()> {
-    if !path.exists() {
-        return std::fs::rename(tmp, path);
+fn replace(tmp: Temporary, path: &Path) -> std::io::Result<()> {
+    if std::fs::symlink_metadata(path).is_err() {
+        return tmp.rename_to(path);
     }
-    let old: PathBuf =
-        path.with_file_name(format!(".{}.topovox-old-{}", path.file_name().unwrap_or_default().to_string_lossy(), std::process::id()));
+    let name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
+    let old: PathBuf = path.with_file_name(format!(
+        ".{name}.topovox-old-{}-{}",
+        std::process::id(),
+        std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos()).unwrap_or(0)
+    ));
     std::fs::rename(path, &old)?;
-    if let Err(e) = std::fs::rename(tmp, path) {
+    if let Err(e) = tmp.rename_to(path) {
         let _ = std::fs::rename(&old, path);
         return Err(e);
     }
@@ -326,7 +383,9 @@ fn bad(what: impl Into<String>) -> ErrorKind {
 /// any chunk shape.
 const MAX_CHUNK_ELEMENTS: u64 = 1 << 30;
 
-/// Most chunks topovox looks for (each is a file lookup).
+/// Most chunk entries topovox lists in an array's folders (the chunks are
+/// found by listing, so this bounds the work a folder of junk can cause,
+/// not the size a `zarr.json` may claim).
 const MAX_CHUNKS: u64 = 1 << 24;
 
 /// How an array's chunk files are encoded.
@@ -399,10 +458,75 @@ struct ArrayMeta {
     attributes: Value,
 }
 
+/// The folder a Zarr hierarchy is read from: every file read below it is
+/// a regular file (not a device or a FIFO), read with a bound, and lies
+/// inside the folder once links are resolved, unless external paths are
+/// allowed.
+struct Store {
+    /// The folder the user named, canonical.
+    root: PathBuf,
+    allow_external: bool,
+}
+
+/// Largest `zarr.json` read (attributes included).
+const MAX_JSON_BYTES: u64 = 16 << 20;
+
+impl Store {
+    fn open(path: &Path, opts: &ReadOptions) -> Result<Store, IoError> {
+        let root = std::fs::canonicalize(path).map_err(|x| IoError::new(path, ErrorKind::Read(x)))?;
+        Ok(Store { root, allow_external: opts.allow_external_paths })
+    }
+
+    /// `path` (below the store), checked: inside the store once links are
+    /// resolved (unless allowed), and a regular file. `Ok(None)` when it
+    /// does not exist.
+    fn file(&self, path: &Path) -> Result<Option<PathBuf>, IoError> {
+        let real = match std::fs::canonicalize(path) {
+            Ok(r) => r,
+            Err(x) if x.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(x) => return Err(IoError::new(path, ErrorKind::Read(x))),
+        };
+        if !self.allow_external && !real.starts_with(&self.root) {
+            return Err(IoError::new(
+                path,
+                bad(format!(
+                    "a link leads outside the Zarr folder {} (to {}); not read (--allow-external-paths reads it)",
+                    self.root.display(),
+                    real.display()
+                )),
+            ));
+        }
+        let meta = std::fs::metadata(&real).map_err(|x| IoError::new(path, ErrorKind::Read(x)))?;
+        if !meta.is_file() {
+            return Err(IoError::new(path, bad("not a regular file (a device, a FIFO or a folder); not read")));
+        }
+        Ok(Some(real))
+    }
+
+    /// The bytes of the regular file `path` (see [`Store::file`]), at most
+    /// `max`; `Ok(None)` when it does not exist.
+    fn read(&self, path: &Path, max: u64) -> Result<Option<Vec<u8>>, IoError> {
+        let Some(real) = self.file(path)? else { return Ok(None) };
+        let e = |x| IoError::new(path, ErrorKind::Read(x));
+        let mut out = Vec::new();
+        std::fs::File::open(&real).map_err(e)?.take(max + 1).read_to_end(&mut out).map_err(e)?;
+        if out.len() as u64 > max {
+            return Err(IoError::new(path, bad(format!("larger than the {max} bytes it may hold"))));
+        }
+        Ok(Some(out))
+    }
+
+    /// Whether `dir` holds a `zarr.json` (checked like every file).
+    fn has_node(&self, dir: &Path) -> Result<bool, IoError> {
+        Ok(self.file(&dir.join("zarr.json"))?.is_some())
+    }
+}
+
 /// Reads `path/zarr.json`, which must be a Zarr v3 node.
-fn node(path: &Path) -> Result<Value, IoError> {
+fn node(store: &Store, path: &Path) -> Result<Value, IoError> {
     let e = |k| IoError::new(path, k);
-    let text = std::fs::read(path.join("zarr.json")).map_err(|x| e(ErrorKind::Read(x)))?;
+    let json = path.join("zarr.json");
+    let text = store.read(&json, MAX_JSON_BYTES)?.ok_or_else(|| e(ErrorKind::Read(std::io::ErrorKind::NotFound.into())))?;
     let m: Value = serde_json::from_slice(&text).map_err(|x| e(bad(format!("zarr.json: {x}"))))?;
     if m["zarr_format"] != 3 || !matches!(m["node_type"].as_str(), Some("array" | "group")) {
         return Err(e(bad("zarr.json is not a Zarr v3 array or group")));
@@ -452,7 +576,12 @@ fn array_meta(path: &Path, m: &Value, max_comps: u64) -> Result<ArrayMeta, IoErr
         return Err(e(bad(format!("chunk shape {chunk:?} is larger than topovox reads"))));
     }
     let sep = match m["chunk_key_encoding"]["name"].as_str() {
-        Some("default") => m["chunk_key_encoding"]["configuration"]["separator"].as_str().unwrap_or("/").to_string(),
+        Some("default") => match m["chunk_key_encoding"]["configuration"]["separator"].as_str().unwrap_or("/") {
+            // The only two the Zarr v3 specification allows: anything else
+            // would let a key name a path outside the array.
+            sep @ ("/" | ".") => sep.to_string(),
+            other => return Err(e(bad(format!("chunk key separator {other:?} (the specification allows \"/\" and \".\")")))),
+        },
         other => return Err(e(bad(format!("chunk_key_encoding {other:?} (topovox reads default)")))),
     };
     let codecs = m["codecs"].as_array().ok_or_else(|| e(bad("no codecs")))?;
@@ -482,65 +611,164 @@ fn array_meta(path: &Path, m: &Value, max_comps: u64) -> Result<ArrayMeta, IoErr
         }
         _ => Layout::Plain { gzip: chunk_codecs(codecs).map_err(e)? },
     };
-    let n = [0, 1, 2].map(|a| shape[a].div_ceil(chunk[a]));
-    if n.iter().product::<u64>() > MAX_CHUNKS {
-        return Err(e(bad(format!("{n:?} chunks, more than topovox looks for ({MAX_CHUNKS})"))));
-    }
     let data_type = m["data_type"].as_str().unwrap_or("").to_string();
     Ok(ArrayMeta { shape, chunk, comps, four_axes, data_type, sep, layout, attributes: m["attributes"].clone() })
 }
 
+/// The grid indices of the chunks the array at `path` stores, in C order,
+/// found by listing its folders (never by probing every index a shape
+/// allows: a hostile `zarr.json` can claim billions). Names that are not
+/// chunk keys of this array are ignored.
+fn stored_chunks(path: &Path, a: &ArrayMeta) -> Result<Vec<[u64; 3]>, IoError> {
+    let n = [0, 1, 2].map(|x| a.shape[x].div_ceil(a.chunk[x]));
+    let depth = if a.four_axes { 4 } else { 3 };
+    let index = |s: &str, axis: usize| -> Option<u64> {
+        let v = s.parse::<u64>().ok().filter(|v| v.to_string() == s)?;
+        if axis < 3 {
+            (v < n[axis]).then_some(v)
+        } else {
+            (v == 0).then_some(v)
+        }
+    };
+    let names = |dir: &Path| -> Result<Vec<String>, IoError> {
+        match std::fs::read_dir(dir) {
+            Ok(entries) => Ok(entries.flatten().filter_map(|e| e.file_name().into_string().ok()).collect()),
+            Err(x) if x.kind() == std::io::ErrorKind::NotFound || x.kind() == std::io::ErrorKind::NotADirectory => Ok(Vec::new()),
+            Err(x) => Err(IoError::new(dir, ErrorKind::Read(x))),
+        }
+    };
+    let mut found = Vec::new();
+    if a.sep == "." {
+        for name in names(path)? {
+            let parts: Vec<&str> = name.split('.').collect();
+            if parts.len() == depth + 1 && parts[0] == "c" {
+                let idx: Option<Vec<u64>> = parts[1..].iter().enumerate().map(|(x, p)| index(p, x)).collect();
+                if let Some(idx) = idx {
+                    found.push([idx[0], idx[1], idx[2]]);
+                }
+            }
+        }
+    } else {
+        // c/i/j/k (and /0): walk the folders level by level.
+        let mut level: Vec<(PathBuf, Vec<u64>)> = vec![(path.join("c"), Vec::new())];
+        for axis in 0..depth {
+            let mut next = Vec::new();
+            for (dir, idx) in &level {
+                for name in names(dir)? {
+                    if let Some(v) = index(&name, axis) {
+                        let mut idx = idx.clone();
+                        idx.push(v);
+                        next.push((dir.join(&name), idx));
+                    }
+                }
+            }
+            level = next;
+            if level.len() as u64 > MAX_CHUNKS {
+                return Err(IoError::new(path, bad(format!("more than {MAX_CHUNKS} chunk entries"))));
+            }
+        }
+        found.extend(level.into_iter().map(|(_, idx)| [idx[0], idx[1], idx[2]]));
+    }
+    found.sort_unstable();
+    found.dedup();
+    Ok(found)
+}
+
+/// The path of chunk `c` of the array at `path`, from validated parts only.
+fn chunk_path(path: &Path, a: &ArrayMeta, c: [u64; 3]) -> PathBuf {
+    let mut parts = vec!["c".to_string(), c[0].to_string(), c[1].to_string(), c[2].to_string()];
+    if a.four_axes {
+        parts.push("0".to_string()); // the one chunk along the component axis
+    }
+    if a.sep == "." {
+        path.join(parts.join("."))
+    } else {
+        parts.iter().fold(path.to_path_buf(), |p, x| p.join(x))
+    }
+}
+
+/// Largest file a chunk (or shard) of `a` can be: its elements' bytes,
+/// per inner chunk when sharded, with room for gzip's framing and for
+/// incompressible data, plus the shard index.
+fn max_chunk_file(a: &ArrayMeta, elem: u64) -> u64 {
+    let framed = |elements: u64| {
+        let raw = elements * a.comps * elem;
+        raw + raw / 64 + 1024
+    };
+    match a.layout {
+        Layout::Plain { .. } => framed(a.chunk.iter().product()),
+        Layout::Sharded { inner, .. } => {
+            let count = (0..3).map(|x| a.chunk[x] / inner[x]).product::<u64>();
+            count * (framed(inner.iter().product()) + 16) + 4
+        }
+    }
+}
+
 /// Calls `f(origin, shape, bytes)` for every chunk the array at `path`
 /// stores, decoded (C order, components last; `elem` bytes per component).
-fn for_each_chunk(path: &Path, a: &ArrayMeta, elem: u64, mut f: impl FnMut([u64; 3], [u64; 3], &[u8])) -> Result<(), IoError> {
-    let e = |k| IoError::new(path, k);
-    let n = [0, 1, 2].map(|x| a.shape[x].div_ceil(a.chunk[x]));
-    let bytes = |shape: [u64; 3]| shape.iter().product::<u64>() * a.comps * elem;
-    let sep = &a.sep;
+fn for_each_chunk(
+    store: &Store,
+    path: &Path,
+    a: &ArrayMeta,
+    elem: u64,
+    mut f: impl FnMut([u64; 3], [u64; 3], &[u8]),
+) -> Result<(), IoError> {
+    let max_file = max_chunk_file(a, elem);
     let mut buf = Vec::new();
-    for i in 0..n[0] {
-        for j in 0..n[1] {
-            for k in 0..n[2] {
-                let mut key = format!("c{sep}{i}{sep}{j}{sep}{k}");
-                if a.four_axes {
-                    key += &format!("{sep}0"); // the one chunk along the component axis
+    for c in stored_chunks(path, a)? {
+        let file = chunk_path(path, a, c);
+        let Some(raw) = store.read(&file, max_file)? else { continue };
+        let key = file.strip_prefix(path).unwrap_or(&file).display().to_string();
+        let at = |x: ErrorKind| match x {
+            ErrorKind::Malformed { format, detail } => {
+                IoError::new(path, ErrorKind::Malformed { format, detail: format!("{key}: {detail}") })
+            }
+            x => IoError::new(path, x),
+        };
+        let origin = [0, 1, 2].map(|x| c[x] * a.chunk[x]);
+        decode_chunk_file(&raw, a, elem, origin, &mut buf, &mut f).map_err(at)?;
+    }
+    Ok(())
+}
+
+/// Decodes one chunk file of `a` at `origin` (a plain chunk, or a shard of
+/// inner chunks) and hands each chunk to `f`.
+fn decode_chunk_file(
+    raw: &[u8],
+    a: &ArrayMeta,
+    elem: u64,
+    origin: [u64; 3],
+    buf: &mut Vec<u8>,
+    f: &mut impl FnMut([u64; 3], [u64; 3], &[u8]),
+) -> Result<(), ErrorKind> {
+    let bytes = |shape: [u64; 3]| shape.iter().product::<u64>() * a.comps * elem;
+    match a.layout {
+        Layout::Plain { gzip } => {
+            decode(raw, gzip, bytes(a.chunk), buf)?;
+            f(origin, a.chunk, buf);
+        }
+        Layout::Sharded { inner, gzip, checksum, at_end } => {
+            let per = [0, 1, 2].map(|x| a.chunk[x] / inner[x]);
+            let count = per.iter().product::<u64>() as usize;
+            let index_len = 16 * count + if checksum { 4 } else { 0 };
+            if index_len > raw.len() {
+                return Err(bad(format!("{} bytes, less than its shard index ({index_len})", raw.len())));
+            }
+            let index = if at_end { &raw[raw.len() - index_len..] } else { &raw[..index_len] };
+            let word = |x: usize| u64::from_le_bytes(index[8 * x..8 * x + 8].try_into().expect("8 bytes"));
+            for q in 0..count {
+                let (off, len) = (word(2 * q), word(2 * q + 1));
+                if off == EMPTY && len == EMPTY {
+                    continue;
                 }
-                let Ok(raw) = std::fs::read(path.join(&key)) else { continue };
-                let o = [i * a.chunk[0], j * a.chunk[1], k * a.chunk[2]];
-                let at = |x: ErrorKind| match x {
-                    ErrorKind::Malformed { format, detail } => e(ErrorKind::Malformed { format, detail: format!("{key}: {detail}") }),
-                    x => e(x),
+                let Some(bytes_at) =
+                    off.checked_add(len).filter(|&end| end <= raw.len() as u64).map(|end| &raw[off as usize..end as usize])
+                else {
+                    return Err(bad(format!("inner chunk {q} at bytes {off}+{len}, outside the shard")));
                 };
-                match a.layout {
-                    Layout::Plain { gzip } => {
-                        decode(&raw, gzip, bytes(a.chunk), &mut buf).map_err(at)?;
-                        f(o, a.chunk, &buf);
-                    }
-                    Layout::Sharded { inner, gzip, checksum, at_end } => {
-                        let per = [0, 1, 2].map(|x| a.chunk[x] / inner[x]);
-                        let count = per.iter().product::<u64>() as usize;
-                        let index_len = 16 * count + if checksum { 4 } else { 0 };
-                        if index_len > raw.len() {
-                            return Err(at(bad(format!("{} bytes, less than its shard index ({index_len})", raw.len()))));
-                        }
-                        let index = if at_end { &raw[raw.len() - index_len..] } else { &raw[..index_len] };
-                        let word = |x: usize| u64::from_le_bytes(index[8 * x..8 * x + 8].try_into().expect("8 bytes"));
-                        for q in 0..count {
-                            let (off, len) = (word(2 * q), word(2 * q + 1));
-                            if off == EMPTY && len == EMPTY {
-                                continue;
-                            }
-                            let Some(bytes_at) =
-                                off.checked_add(len).filter(|&end| end <= raw.len() as u64).map(|end| &raw[off as usize..end as usize])
-                            else {
-                                return Err(at(bad(format!("inner chunk {q} at bytes {off}+{len}, outside the shard"))));
-                            };
-                            decode(bytes_at, gzip, bytes(inner), &mut buf).map_err(at)?;
-                            let qi = [q as u64 / (per[1] * per[2]), (q as u64 / per[2]) % per[1], q as u64 % per[2]];
-                            f(std::array::from_fn(|x| o[x] + qi[x] * inner[x]), inner, &buf);
-                        }
-                    }
-                }
+                decode(bytes_at, gzip, bytes(inner), buf)?;
+                let qi = [q as u64 / (per[1] * per[2]), (q as u64 / per[2]) % per[1], q as u64 % per[2]];
+                f(std::array::from_fn(|x| origin[x] + qi[x] * inner[x]), inner, buf);
             }
         }
     }
@@ -567,20 +795,26 @@ fn read_placement(attributes: &Value) -> Option<(glam::DVec3, f64)> {
 /// same way by the `zarr` package. A group (topovox's layout with
 /// attributes) is read as its `voxels` array and the attribute arrays
 /// beside it (`colour`, `normal`, `coverage`, `material`).
-pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
-    let m = node(path)?;
+///
+/// Every file read lies inside `path` once links are resolved (unless
+/// `opts` allows external paths) and is a regular file, read with the
+/// bound its format allows; chunks are found by listing the folders, so
+/// the work follows what is stored, not what `zarr.json` claims.
+pub fn read(path: &Path, opts: &ReadOptions) -> Result<LoadedVoxels, IoError> {
+    let store = Store::open(path, opts)?;
+    let m = node(&store, path)?;
     if m["node_type"] == "array" {
-        return read_occupancy(path, &m);
+        return read_occupancy(&store, path, &m);
     }
     let voxels = path.join("voxels");
-    if !voxels.join("zarr.json").is_file() {
+    if !store.has_node(&voxels)? {
         return Err(IoError::new(path, bad("a Zarr group without a `voxels` array (topovox reads its own groups, or an array)")));
     }
-    let mut loaded = read_occupancy(&voxels, &node(&voxels)?)?;
+    let mut loaded = read_occupancy(&store, &voxels, &node(&store, &voxels)?)?;
     if loaded.placement.is_none() {
         loaded.placement = read_placement(&m["attributes"]);
     }
-    loaded.attributes = read_attributes(path, &loaded.bits)?;
+    loaded.attributes = read_attributes(&store, path, &loaded.bits)?;
     Ok(loaded)
 }
 
@@ -589,20 +823,20 @@ pub fn read(path: &Path) -> Result<LoadedVoxels, IoError> {
 /// when the group has none. Each stored chunk is visited row by row
 /// through the voxels' sorted keys, so the work follows the set voxels
 /// and the chunks' rows, not the chunks' volume.
-fn read_attributes(path: &Path, voxels: &dyn VoxelSource) -> Result<Option<VoxelAttributes>, IoError> {
+fn read_attributes(store: &Store, path: &Path, voxels: &dyn VoxelSource) -> Result<Option<VoxelAttributes>, IoError> {
     let dims = voxels.dims();
     let mut attrs = VoxelAttributes { dims, keys: Vec::new(), ..Default::default() };
     let mut any = false;
     for (name, data_type, comps) in [("colour", "uint8", 3), ("normal", "float32", 3), ("coverage", "float32", 1), ("material", "int32", 1)]
     {
         let dir = path.join(name);
-        if !dir.join("zarr.json").is_file() {
+        if !store.has_node(&dir)? {
             continue;
         }
         if !any {
             attrs.keys = VoxelAttributes::keys_of(voxels);
         }
-        let a = array_meta(&dir, &node(&dir)?, 3)?;
+        let a = array_meta(&dir, &node(store, &dir)?, 3)?;
         if a.data_type != data_type || a.comps != comps || a.shape != dims.map(u64::from) {
             return Err(IoError::new(
                 &dir,
@@ -618,7 +852,7 @@ fn read_attributes(path: &Path, voxels: &dyn VoxelSource) -> Result<Option<Voxel
         let fill: Vec<u8> = if name == "material" { (-1i32).to_le_bytes().to_vec() } else { vec![0; size] };
         let mut vals = fill.repeat(attrs.keys.len());
         let keys = &attrs.keys;
-        for_each_chunk(&dir, &a, elem as u64, |o, shape, buf| {
+        for_each_chunk(store, &dir, &a, elem as u64, |o, shape, buf| {
             // The chunk's rows along i (its elements are laid out i, j, k
             // with k fastest); each row's set voxels are a range of keys.
             let end = [0, 1, 2].map(|x| (o[x] + shape[x]).min(dims[x] as u64));
@@ -667,15 +901,19 @@ fn read_attributes(path: &Path, voxels: &dyn VoxelSource) -> Result<Option<Voxel
 /// Also the placement and, with `attributes`, a group's attribute arrays
 /// at the set voxels (about 32 bytes per voxel); otherwise whether any
 /// were left unread.
-pub fn read_sparse(path: &Path, attributes: bool) -> Result<SparseVoxels, IoError> {
-    let m = node(path)?;
+pub fn read_sparse(path: &Path, attributes: bool, opts: &ReadOptions) -> Result<SparseVoxels, IoError> {
+    let store = Store::open(path, opts)?;
+    let m = node(&store, path)?;
     let (dir, m, placement, attributes_left) = if m["node_type"] == "group" {
         let voxels = path.join("voxels");
-        if !voxels.join("zarr.json").is_file() {
+        if !store.has_node(&voxels)? {
             return Err(IoError::new(path, bad("a Zarr group without a `voxels` array (topovox reads its own groups, or an array)")));
         }
-        let attributes = ["colour", "normal", "coverage", "material"].iter().any(|n| path.join(n).join("zarr.json").is_file());
-        (voxels.clone(), node(&voxels)?, read_placement(&m["attributes"]), attributes)
+        let mut attributes = false;
+        for n in ["colour", "normal", "coverage", "material"] {
+            attributes |= store.has_node(&path.join(n))?;
+        }
+        (voxels.clone(), node(&store, &voxels)?, read_placement(&m["attributes"]), attributes)
     } else {
         (path.to_path_buf(), m, None, false)
     };
@@ -687,10 +925,10 @@ pub fn read_sparse(path: &Path, attributes: bool) -> Result<SparseVoxels, IoErro
         return Err(IoError::new(&dir, bad(format!("shape {:?} beyond {} voxels per axis", a.shape, SparseBricks::MAX_DIM))));
     }
     let mut bricks = Vec::new();
-    for_each_chunk(&dir, &a, 1, |o, shape, buf| place_bricks(&mut bricks, buf, o, shape, a.shape))?;
+    for_each_chunk(&store, &dir, &a, 1, |o, shape, buf| place_bricks(&mut bricks, buf, o, shape, a.shape))?;
     let placement = read_placement(&a.attributes).or(placement);
     let bits = SparseBricks::from_parts(a.shape.map(|d| d as u32), bricks, Vec::new());
-    let attrs = if attributes && attributes_left { read_attributes(path, &bits)? } else { None };
+    let attrs = if attributes && attributes_left { read_attributes(&store, path, &bits)? } else { None };
     Ok(SparseVoxels { bits, placement, attributes_left: attributes_left && attrs.is_none(), attributes: attrs })
 }
 
@@ -731,7 +969,7 @@ fn place_bricks(out: &mut Vec<([u32; 3], Brick)>, buf: &[u8], origin: [u64; 3], 
 }
 
 /// The occupancy array `m` at `path`.
-fn read_occupancy(path: &Path, m: &Value) -> Result<LoadedVoxels, IoError> {
+fn read_occupancy(store: &Store, path: &Path, m: &Value) -> Result<LoadedVoxels, IoError> {
     let e = |k| IoError::new(path, k);
     let a = array_meta(path, m, 1)?;
     if !matches!(a.data_type.as_str(), "bool" | "uint8") {
@@ -739,7 +977,7 @@ fn read_occupancy(path: &Path, m: &Value) -> Result<LoadedVoxels, IoError> {
     }
     let dims = a.shape.map(|d| d as u32);
     let mut bits = crate::dense_grid(dims).map_err(e)?;
-    for_each_chunk(path, &a, 1, |o, shape, buf| place(&mut bits, buf, o, shape, a.shape))?;
+    for_each_chunk(store, path, &a, 1, |o, shape, buf| place(&mut bits, buf, o, shape, a.shape))?;
     Ok(LoadedVoxels { bits, placement: read_placement(&a.attributes), attributes: None })
 }
 
@@ -761,7 +999,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let out = dir.join("v.zarr");
         write(&out, &d, &grid, None).unwrap();
-        let back = read(&out).unwrap();
+        let back = read(&out, &ReadOptions::default()).unwrap();
         assert_eq!(back.bits, d);
         assert_eq!(back.placement, Some((grid.origin(), 0.25)));
         // One shard (192 × 128 × 64 voxels) holds the whole grid.
@@ -770,7 +1008,7 @@ mod tests {
         let mut e = DenseBits::new(dims);
         e.set(5, 5, 5);
         write(&out, &e, &grid, None).unwrap();
-        assert_eq!(read(&out).unwrap().bits, e);
+        assert_eq!(read(&out, &ReadOptions::default()).unwrap().bits, e);
         let other = dir.join("other.zarr");
         std::fs::create_dir_all(&other).unwrap();
         std::fs::write(other.join("keep.txt"), "mine").unwrap();
@@ -799,8 +1037,8 @@ mod tests {
         let dir = scratch("shards");
         let out = dir.join("v.zarr");
         write(&out, &d, &grid, None).unwrap();
-        assert_eq!(read(&out).unwrap().bits, d);
-        assert_eq!(read_sparse(&out, false).unwrap().bits.to_dense(), d);
+        assert_eq!(read(&out, &ReadOptions::default()).unwrap().bits, d);
+        assert_eq!(read_sparse(&out, false, &ReadOptions::default()).unwrap().bits.to_dense(), d);
         assert!(out.join("c/0/0/0").is_file() && !out.join("c/1/0/0").exists() && out.join("c/2/0/0").is_file());
         // Shard (0, 0, 0): 8 × 2 × 1 chunks, of which (0, 0, 0) and (7, 1, 0) hold voxels.
         let shard = std::fs::read(out.join("c/0/0/0")).unwrap();
@@ -825,11 +1063,11 @@ mod tests {
         let mut enc = GzEncoder::new(Vec::new(), flate2::Compression::new(5));
         enc.write_all(&[0, 0, 0, 7, 1, 0, 0, 0, 0, 0, 0, 0]).unwrap();
         std::fs::write(out.join("c/1/0/0"), enc.finish().unwrap()).unwrap();
-        let back = read(&out).unwrap().bits;
+        let back = read(&out, &ReadOptions::default()).unwrap().bits;
         let mut set = Vec::new();
         back.for_each_set(|i, j, k| set.push([i, j, k]));
         assert_eq!(set, [[4, 0, 0], [3, 1, 1]]);
-        assert_eq!(read_sparse(&out, false).unwrap().bits.to_dense(), back, "chunks off the bricks (3 × 2 × 2)");
+        assert_eq!(read_sparse(&out, false, &ReadOptions::default()).unwrap().bits.to_dense(), back, "chunks off the bricks (3 × 2 × 2)");
 
         let mut d = DenseBits::new([8, 8, 8]);
         d.set(1, 1, 1);
@@ -841,7 +1079,7 @@ mod tests {
         let n = shard.len();
         shard[n - 16..n - 8].copy_from_slice(&(u64::MAX - 3).to_le_bytes());
         std::fs::write(&f, &shard).unwrap();
-        let e = read(&sharded).unwrap_err().to_string();
+        let e = read(&sharded, &ReadOptions::default()).unwrap_err().to_string();
         assert!(e.contains("c/0/0/0") && e.contains("outside the shard"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -876,13 +1114,13 @@ mod tests {
         let c: Value = serde_json::from_slice(&std::fs::read(out.join("colour/zarr.json")).unwrap()).unwrap();
         assert_eq!(c["shape"], json!([70, 9, 66, 3]));
         assert!(out.join("colour/c/0/0/0/0").is_file() && out.join("coverage/c/0/0/0").is_file());
-        let back = read(&out).unwrap();
+        let back = read(&out, &ReadOptions::default()).unwrap();
         assert_eq!(back.bits, d);
         assert_eq!(back.placement, Some((grid.origin(), 0.125)));
         assert_eq!(back.attributes.as_ref(), Some(&attrs));
-        let sparse = read_sparse(&out, false).unwrap();
+        let sparse = read_sparse(&out, false, &ReadOptions::default()).unwrap();
         assert_eq!((sparse.bits.to_dense(), sparse.placement, sparse.attributes_left), (d.clone(), back.placement, true));
-        let with = read_sparse(&out, true).unwrap();
+        let with = read_sparse(&out, true, &ReadOptions::default()).unwrap();
         assert_eq!((with.attributes.as_ref(), with.attributes_left), (Some(&attrs), false), "the sparse reader reads the same attributes");
         assert_eq!(sparse.bits.full_bricks(), 1, "the full brick is read as a run");
         // Without attributes: the plain array, as before.
@@ -890,7 +1128,7 @@ mod tests {
         let m: Value = serde_json::from_slice(&std::fs::read(out.join("zarr.json")).unwrap()).unwrap();
         assert_eq!(m["node_type"], "array");
         assert_eq!(m["codecs"][0]["configuration"]["codecs"][0], json!({"name": "bytes"}));
-        assert!(read(&out).unwrap().attributes.is_none() && !out.join("colour").exists());
+        assert!(read(&out, &ReadOptions::default()).unwrap().attributes.is_none() && !out.join("colour").exists());
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

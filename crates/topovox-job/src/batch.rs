@@ -164,6 +164,48 @@ pub fn plan_items(inputs: &[PathBuf], out_dir: &Path, ext: &str) -> Result<Vec<I
     Ok(items)
 }
 
+/// A path as the manifest keys it, losslessly: its text when it is UTF-8,
+/// else a NUL (which no file name holds) and its bytes in hex. Two names
+/// that display alike (`caf\xe9` and `caf\u{FFFD}`) never share a key.
+pub fn path_key(p: &Path) -> String {
+    match p.to_str() {
+        Some(s) => s.to_string(),
+        None => format!("\0{}", hex(&raw_bytes(p))),
+    }
+}
+
+fn raw_bytes(p: &Path) -> Vec<u8> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        p.as_os_str().as_bytes().to_vec()
+    }
+    #[cfg(not(unix))]
+    {
+        p.to_string_lossy().into_owned().into_bytes()
+    }
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// For a path that is not UTF-8, `NAME_raw`: its bytes in hex (the record's
+/// `NAME` is the lossy text, for people).
+fn record_raw_path(record: &mut Value, name: &str, p: &Path) {
+    if p.to_str().is_none() {
+        record[format!("{name}_raw")] = hex(&raw_bytes(p)).into();
+    }
+}
+
+/// The key of a record's path `name` (see [`path_key`]).
+fn recorded_key(v: &Value, name: &str) -> Option<String> {
+    match v[format!("{name}_raw")].as_str() {
+        Some(raw) => Some(format!("\0{raw}")),
+        None => v[name].as_str().map(String::from),
+    }
+}
+
 /// The manifest: the lines read back on resume, and appending new ones.
 pub struct Manifest {
     path: PathBuf,
@@ -183,8 +225,8 @@ impl Manifest {
         if let Ok(text) = std::fs::read_to_string(&path) {
             for line in text.lines() {
                 let Ok(v) = serde_json::from_str::<Value>(line) else { continue };
-                if let (Some(input), Some("done")) = (v["input"].as_str(), v["status"].as_str()) {
-                    done.insert(input.to_string(), v.clone());
+                if let (Some(input), Some("done")) = (recorded_key(&v, "input"), v["status"].as_str()) {
+                    done.insert(input, v.clone());
                 }
             }
             // A torn last line: start the next one on a line of its own.
@@ -205,8 +247,8 @@ impl Manifest {
     /// Whether `item` was done with these options and its output is still
     /// there, complete (the recorded size).
     pub fn is_done(&self, item: &Item, fingerprint: &Value) -> bool {
-        let Some(v) = self.done.get(&item.input.display().to_string()) else { return false };
-        let same = v["options"] == *fingerprint && v["output"].as_str() == Some(&item.output.display().to_string());
+        let Some(v) = self.done.get(&path_key(&item.input)) else { return false };
+        let same = v["options"] == *fingerprint && recorded_key(v, "output") == Some(path_key(&item.output));
         let size = std::fs::metadata(&item.output).map(|m| m.len()).ok();
         same && size.is_some() && v["output_bytes"].as_u64() == size
     }
@@ -231,6 +273,8 @@ pub fn process_one(item: &Item, opts: &BatchOptions) -> Value {
         "output": item.output.display().to_string(),
         "options": opts.fingerprint,
     });
+    record_raw_path(&mut record, "input", &item.input);
+    record_raw_path(&mut record, "output", &item.output);
     let result = (|| -> Result<Value> {
         if let Some(dir) = item.output.parent() {
             std::fs::create_dir_all(dir).map_err(|e| JobError::Io(topovox_io::IoError::new(dir, topovox_io::ErrorKind::Write(e))))?;
@@ -325,6 +369,9 @@ impl Summary {
 /// Runs a whole batch on the current rayon pool (meshes in parallel, each
 /// voxelized in parallel too, on the same pool).
 pub fn run(items: &[Item], out_dir: &Path, opts: &BatchOptions, progress: &dyn BatchProgress) -> Result<Summary> {
+    if let Some(n) = opts.threads {
+        crate::check_threads(n, "threads")?;
+    }
     let t0 = Instant::now();
     std::fs::create_dir_all(out_dir).map_err(|e| JobError::Io(topovox_io::IoError::new(out_dir, topovox_io::ErrorKind::Write(e))))?;
     let manifest = Manifest::open(out_dir)?;

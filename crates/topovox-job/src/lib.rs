@@ -38,15 +38,38 @@ pub use run::{
 };
 pub use solid::Outcome as SolidOutcome;
 
+/// The most worker threads any front end starts (`--threads`, `--jobs`,
+/// `threads=`, `jobs=`): far more than cores only costs memory and time
+/// (each thread reserves a stack), and a typo of a few zeros must not
+/// start a million.
+pub const MAX_THREADS: usize = 1024;
+
+/// Checks a thread count given as `what` (the option's name as the user
+/// wrote it: `--threads`, `--jobs`, `threads`): 1 to [`MAX_THREADS`].
+pub fn check_threads(threads: usize, what: &str) -> Result<()> {
+    if threads == 0 {
+        return Err(JobError::invalid(format!("{what} must be at least 1")));
+    }
+    if threads > MAX_THREADS {
+        let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+        return Err(JobError::invalid(format!("{what} {threads}: at most {MAX_THREADS} (this machine has {cores} cores)")));
+    }
+    Ok(())
+}
+
 /// A rayon pool of `threads` workers, made once per count and kept (jobs
-/// that ask for a thread count run on it).
+/// that ask for a thread count run on it); `threads` is checked by
+/// [`check_threads`].
 pub fn pool(threads: usize) -> Result<std::sync::Arc<rayon::ThreadPool>> {
+    pool_for(threads, "threads")
+}
+
+/// [`pool`], the count named `what` in errors.
+pub fn pool_for(threads: usize, what: &str) -> Result<std::sync::Arc<rayon::ThreadPool>> {
     use std::collections::HashMap;
     use std::sync::{Arc, Mutex, OnceLock};
     static POOLS: OnceLock<Mutex<HashMap<usize, Arc<rayon::ThreadPool>>>> = OnceLock::new();
-    if threads == 0 {
-        return Err(JobError::invalid("threads must be at least 1"));
-    }
+    check_threads(threads, what)?;
     let mut pools = POOLS.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
     if let Some(p) = pools.get(&threads) {
         return Ok(p.clone());

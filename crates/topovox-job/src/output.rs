@@ -143,7 +143,9 @@ pub fn check_output_path(out: &Path) -> Result<()> {
 }
 
 /// Writes `bits` (with `attrs`) to `out` as `target`; returns facts for
-/// the summaries.
+/// the summaries. A dense format (or a mesh of the voxels) for a grid that
+/// cannot be held densely is refused before anything is written
+/// ([`check_fits`]), whichever front end asks.
 pub fn write(
     out: &Path,
     target: Output,
@@ -152,6 +154,7 @@ pub fn write(
     attrs: Option<&VoxelAttributes>,
     opts: &WriteOptions,
 ) -> Result<Value> {
+    check_fits(target, grid, None)?;
     match target {
         Output::Voxels(f) => {
             topovox_io::write_voxels_with(out, f, bits, grid, attrs, opts)?;

@@ -70,7 +70,7 @@ pub fn run(a: &BatchArgs) -> Result<()> {
     let files = batch::collect_inputs(&a.inputs, a.glob.as_deref())?;
     let ext = format.name().replace("npy-bool", "npy");
     let items = batch::plan_items(&files, &a.output, &ext)?;
-    let pool = crate::thread_pool(a.jobs)?;
+    let pool = crate::thread_pool_for(a.jobs, "--jobs")?;
 
     use std::io::IsTerminal;
     let target =

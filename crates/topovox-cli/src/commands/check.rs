@@ -16,13 +16,21 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         bail!("{}: --sparse reads only .vdb, .zarr and .npz files", a.voxels.display());
     }
     let voxels = if a.sparse {
-        Voxels::Sparse(topovox_io::read_voxels_sparse(&a.voxels, false)?)
+        Voxels::Sparse(topovox_io::read_voxels_sparse_opts(
+            &a.voxels,
+            false,
+            &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
+        )?)
     } else {
-        match topovox_io::read_voxels_with(&a.voxels, up) {
+        match topovox_io::read_voxels_opts(&a.voxels, up, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths }) {
             Ok(l) => Voxels::Dense(l),
             // Past memory: checked window by window.
             Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && sparse_format => {
-                Voxels::Sparse(topovox_io::read_voxels_sparse(&a.voxels, false)?)
+                Voxels::Sparse(topovox_io::read_voxels_sparse_opts(
+                    &a.voxels,
+                    false,
+                    &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
+                )?)
             }
             Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) => {
                 bail!("{e}; grids past memory are checked from .vdb, .zarr or .npz files (window by window)")

@@ -17,12 +17,20 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
     let input_has_up = matches!(input_format, Some(F::Vox | F::Schem));
     crate::commands::export::warn_unused(&a.export, format, &a.output, false, input_has_up);
     // The up axis is the data's: .vox and .schem files are read back with it too.
-    let loaded = match topovox_io::read_voxels_with(&a.input, crate::commands::export::up(&a.export)) {
+    let loaded = match topovox_io::read_voxels_opts(
+        &a.input,
+        crate::commands::export::up(&a.export),
+        &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
+    ) {
         Ok(l) => l,
         // A .vdb or .zarr grid past memory, to a format that holds only the
         // set voxels: read and written without a dense grid.
         Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && topovox_job::output::is_sparse(format) => {
-            let sparse = match topovox_io::read_voxels_sparse(&a.input, false) {
+            let sparse = match topovox_io::read_voxels_sparse_opts(
+                &a.input,
+                false,
+                &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
+            ) {
                 Ok(s) => s,
                 // Formats read only densely: the grid's size is the error.
                 Err(s) if matches!(s.kind, topovox_io::ErrorKind::Unsupported(_)) && !input_format.is_some_and(F::reads_sparsely) => {
@@ -36,7 +44,12 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
             let need = sparse.bits.count().saturating_mul(topovox_job::ATTRIBUTE_BYTES_PER_VOXEL);
             let attributes = if sparse.attributes_left && wanted {
                 if need <= topovox_job::budget(None) {
-                    topovox_io::read_voxels_sparse(&a.input, true)?.attributes
+                    topovox_io::read_voxels_sparse_opts(
+                        &a.input,
+                        true,
+                        &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
+                    )?
+                    .attributes
                 } else {
                     eprintln!(
                         "topovox: warning: {}: its attributes are not carried: they would need {} of memory",

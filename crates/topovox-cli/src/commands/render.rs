@@ -144,11 +144,15 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         // .vox and .schem are rotated back so the --up axis is up again.
         let up = a.up.as_deref().and_then(topovox_io::orient::Up::from_name).unwrap_or_default();
         use topovox_io::VoxelFormat as F;
-        match topovox_io::read_voxels_with(&a.input, up) {
+        match topovox_io::read_voxels_opts(&a.input, up, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths }) {
             Ok(loaded) => (Box::new(loaded.bits), "voxel file", loaded.attributes, None),
             // A .vdb, .zarr or .npz grid past memory: drawn from its bricks.
             Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && F::from_path(&a.input).is_some_and(F::reads_sparsely) => {
-                let sparse = topovox_io::read_voxels_sparse(&a.input, false)?;
+                let sparse = topovox_io::read_voxels_sparse_opts(
+                    &a.input,
+                    false,
+                    &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
+                )?;
                 if sparse.attributes_left {
                     eprintln!("topovox: warning: {}: drawn without its colours: the grid does not fit densely", a.input.display());
                 }

@@ -24,8 +24,12 @@ pub fn run(a: &SceneArgs) -> Result<()> {
     for (t, file) in app.textures.iter().zip(&texture_files) {
         topovox_io::write_png_rgba(&a.output.with_file_name(file), t.width, t.height, &t.rgba)?;
     }
-    topovox_io::atomic::write_atomically(&mtl_path, |w| w.write_all(mtl.as_bytes()))?;
-    topovox_io::atomic::write_atomically(&a.output, |w| w.write_all(obj.as_bytes()))?;
+    // Both complete before either is in place, the .mtl first (see
+    // topovox_io::atomic::Staged).
+    let staged_mtl = topovox_io::atomic::stage(&mtl_path, |w| w.write_all(mtl.as_bytes()))?;
+    let staged_obj = topovox_io::atomic::stage(&a.output, |w| w.write_all(obj.as_bytes()))?;
+    staged_mtl.commit()?;
+    staged_obj.commit()?;
     crate::print_stdout(&format!(
         "scene {}: {} triangles, {} materials, {} textures -> {} and {}",
         a.name,

@@ -178,6 +178,16 @@ pub fn certify_sparse(bits: &SparseBricks, mesh: Option<(MeshRef<'_>, &GridSpec)
         let base = layers_held.start * BRICK;
         let planes = (layers_held.end * BRICK).min(dims[2]) - base;
         let owned = owned_layers.start * BRICK..(owned_layers.end * BRICK).min(dims[2]);
+        // A window without voxels (halo included) or triangles holds
+        // nothing to count, join or separate: skipped without building its
+        // brick index or rows, so an empty stretch of a vast grid costs
+        // nothing.
+        let mut any = false;
+        bits.for_each_brick_in_layers(layers_held.clone(), |_, _| any = true);
+        if !any && bin.is_empty() {
+            pass.empty_window(&owned);
+            continue;
+        }
         let window = BrickWindow::new(bits, layers_held, [dims[0], dims[1], planes]);
         let tris: Vec<LatticeTriangle> = pass.mesh.as_ref().map(|m| bin.iter().map(|&n| m.tris[n as usize]).collect()).unwrap_or_default();
         pass.window(&window, base, owned, &tris, &beyond);
@@ -391,6 +401,18 @@ impl Pass {
             *a += b;
         }
         m.columns = m.columns.add(columns(o, tris, self.dims, base, owned, beyond));
+    }
+
+    /// [`Pass::window`] for a window with no set voxel and no triangle:
+    /// nothing to add, and no run of its last plane for the next window to
+    /// join.
+    fn empty_window(&mut self, owned: &Range<u32>) {
+        if owned.is_empty() {
+            return;
+        }
+        for c in &mut self.components {
+            c.add_empty();
+        }
     }
 
     fn finish(self) -> CheckReport {

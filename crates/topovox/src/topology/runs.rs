@@ -393,6 +393,12 @@ impl StreamedComponents {
         ids
     }
 
+    /// Adds a window without set voxels: no labels, and nothing of its
+    /// last plane to join with the next window's first.
+    pub fn add_empty(&mut self) {
+        self.carry.clear();
+    }
+
     /// The global labels [`StreamedComponents::add`] gave `runs` when
     /// `base` labels existed before them, and how many it added: local
     /// components numbered from `base` in order of their first run.

@@ -1,0 +1,159 @@
+//! Promises kept under careless or hostile use (issue 44): bounded thread
+//! counts, batch manifests that never confuse two names, interrupts that
+//! leave nothing behind, and small files that claim huge grids.
+
+#![cfg(unix)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn topovox(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_topovox")).args(args).output().expect("run topovox")
+}
+
+fn folder(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("topovox-promises-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The one error line of a refused run.
+fn refused(out: &Output) -> String {
+    assert!(!out.status.success(), "succeeded: {}", String::from_utf8_lossy(&out.stdout));
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+    err
+}
+
+fn repo(rel: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)
+}
+
+#[test]
+fn thread_counts_past_the_bound_are_refused_by_name() {
+    let d = folder("threads");
+    let out = d.join("a.npy");
+    let mesh = repo("examples/meshes/box.obj");
+    for (flag, n) in [("--threads", "100000"), ("--threads", "1000000"), ("--threads", "0")] {
+        let e = refused(&topovox(&["voxelize", s(&mesh), "-o", s(&out), flag, n]));
+        assert!(e.contains("--threads"), "{e}");
+    }
+    for n in ["1000000", "0"] {
+        let e = refused(&topovox(&["batch", s(&mesh), "-o", s(&d.join("b")), "--jobs", n]));
+        assert!(e.contains("--jobs") && !e.contains("--threads"), "{e}");
+    }
+    let e = refused(&topovox(&["check", s(&out), "--threads", "5000"]));
+    assert!(e.contains("at most 1024"), "{e}");
+    assert!(topovox(&["voxelize", s(&mesh), "-o", s(&out), "--threads", "1024", "--resolution", "8"]).status.success());
+}
+
+#[test]
+fn names_that_are_not_utf8_keep_their_own_manifest_lines() {
+    use std::os::unix::ffi::OsStrExt;
+    let d = folder("names");
+    let inputs = d.join("in");
+    std::fs::create_dir_all(&inputs).unwrap();
+    let mesh = std::fs::read(repo("examples/meshes/box.obj")).unwrap();
+    // `caf\xe9.obj` (Latin-1) and `caf\u{FFFD}.obj` display alike.
+    let latin1 = inputs.join(std::ffi::OsStr::from_bytes(b"caf\xe9.obj"));
+    std::fs::write(&latin1, &mesh).unwrap();
+    std::fs::write(inputs.join("caf\u{FFFD}.obj"), &mesh).unwrap();
+    let out = d.join("out");
+    let run = || {
+        let o = topovox(&["batch", s(&inputs), "-o", s(&out), "--resolution", "8", "--json"]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
+    };
+    let first = run();
+    assert_eq!(first["done"], 2, "{first}");
+    let second = run();
+    assert_eq!((second["done"].as_u64(), second["skipped"].as_u64()), (Some(0), Some(2)), "{second}");
+}
+
+#[test]
+fn ctrl_c_ends_a_run_at_once_with_130_and_leaves_nothing() {
+    let d = folder("interrupt");
+    let out = d.join("bunny.vdb");
+    let mesh = repo("examples/meshes/cow.obj");
+    // Long enough to be interrupted mid-way (a solid of 10⁹ voxels).
+    let mut child = Command::new(env!("CARGO_BIN_EXE_topovox"))
+        .args(["voxelize", s(&mesh), "-o", s(&out), "--mode", "solid", "--resolution", "4096", "--quiet"])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(700));
+    let t = Instant::now();
+    assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
+    let status = child.wait().unwrap();
+    assert!(t.elapsed() < Duration::from_secs(30), "took {:?} to stop", t.elapsed());
+    assert_eq!(status.code(), Some(130), "{status:?}");
+    let left: Vec<String> = std::fs::read_dir(&d).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}
+
+#[test]
+fn small_files_claiming_huge_grids_are_refused_or_read_from_what_they_store() {
+    let d = folder("claims");
+    // 100 million rows of one voxel index, compressed to about a MB, no dims.
+    let npz = d.join("rows.npz");
+    make_repetitive_npz(&npz, 100_000_000);
+    let size = std::fs::metadata(&npz).unwrap().len();
+    assert!(size < 2 << 20, "{size} bytes");
+    let o = topovox(&["convert", s(&npz), s(&d.join("rows.txt"))]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(d.join("rows.txt")).unwrap();
+    assert_eq!(text.lines().filter(|l| !l.starts_with('#')).count(), 1, "{text}");
+    // A zarr.json claiming 65536 x 65536 x 1024 with nothing stored: checked
+    // from what is stored.
+    let z = d.join("claim.zarr");
+    std::fs::create_dir_all(&z).unwrap();
+    std::fs::write(
+        z.join("zarr.json"),
+        r#"{"zarr_format": 3, "node_type": "array", "shape": [65536, 65536, 1024], "data_type": "bool",
+            "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": [64, 64, 64]}},
+            "chunk_key_encoding": {"name": "default", "configuration": {"separator": "/"}},
+            "fill_value": false, "codecs": [{"name": "bytes"}]}"#,
+    )
+    .unwrap();
+    let o = topovox(&["check", s(&z), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["voxels"], 0, "{v}");
+}
+
+/// An `.npz` whose `indices` member is `rows` rows of zeros (int8),
+/// deflated, and no `dims`: what `np.savez_compressed` writes for
+/// `indices=np.zeros((rows, 3), np.int8)`.
+fn make_repetitive_npz(path: &Path, rows: u64) {
+    use std::io::Write;
+    let file = std::fs::File::create(path).unwrap();
+    let mut zip = zip::ZipWriter::new(file);
+    let opts = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated)
+        .compression_level(Some(1))
+        .large_file(true);
+    zip.start_file("indices.npy", opts).unwrap();
+    let dict = format!("{{'descr': '|i1', 'fortran_order': False, 'shape': ({rows}, 3), }}");
+    let mut header = dict.into_bytes();
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(b' ');
+    }
+    header.push(b'\n');
+    zip.write_all(b"\x93NUMPY\x01\x00").unwrap();
+    zip.write_all(&(header.len() as u16).to_le_bytes()).unwrap();
+    zip.write_all(&header).unwrap();
+    let zeros = vec![0u8; 1 << 20];
+    let mut left = rows * 3;
+    while left > 0 {
+        let n = left.min(zeros.len() as u64) as usize;
+        zip.write_all(&zeros[..n]).unwrap();
+        left -= n as u64;
+    }
+    zip.finish().unwrap();
+}

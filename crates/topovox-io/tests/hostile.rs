@@ -1,0 +1,296 @@
+//! Hostile files and concurrent writers (issue 44): nothing is read outside
+//! the folder the user named, special files are never read, nothing the
+//! user has is deleted or half-replaced, and writers never share a
+//! temporary.
+
+#![cfg(unix)]
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use glam::DVec3;
+use topovox::{DenseBits, GridSpec};
+use topovox_io::{read_voxels, read_voxels_opts, read_voxels_sparse, write_voxels, ReadOptions, VoxelFormat};
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("topovox-hostile-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn grid(dims: [u32; 3]) -> GridSpec {
+    GridSpec::new(DVec3::ZERO, 1.0, dims.map(u64::from)).unwrap()
+}
+
+fn some_voxels(dims: [u32; 3]) -> DenseBits {
+    let mut d = DenseBits::new(dims);
+    d.set(1, 2, 3);
+    d.set(dims[0] - 1, dims[1] - 1, dims[2] - 1);
+    d
+}
+
+/// A Zarr array of `dims` written by topovox at `dir/name.zarr`.
+fn zarr_array(dir: &Path, name: &str, dims: [u32; 3]) -> PathBuf {
+    let p = dir.join(format!("{name}.zarr"));
+    write_voxels(&p, VoxelFormat::Zarr, &some_voxels(dims), &grid(dims)).unwrap();
+    p
+}
+
+fn edit_json(path: &Path, f: impl FnOnce(&mut serde_json::Value)) {
+    let file = path.join("zarr.json");
+    let mut v: serde_json::Value = serde_json::from_slice(&std::fs::read(&file).unwrap()).unwrap();
+    f(&mut v);
+    std::fs::write(&file, serde_json::to_vec(&v).unwrap()).unwrap();
+}
+
+fn mkfifo(path: &Path) {
+    let ok = std::process::Command::new("mkfifo").arg(path).status().unwrap().success();
+    assert!(ok, "mkfifo {}", path.display());
+}
+
+/// Runs `f` on a thread and fails the test if it has not returned within
+/// a minute (a hang is the bug some of these tests catch).
+fn within_a_minute<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(f());
+    });
+    rx.recv_timeout(Duration::from_secs(60)).expect("hung: no answer within a minute")
+}
+
+#[test]
+fn zarr_separator_that_climbs_out_is_refused() {
+    let d = scratch("sep");
+    let a = zarr_array(&d, "sep", [64, 64, 128]);
+    // What the traversal would have read: a file outside the array.
+    std::fs::create_dir_all(d.join("OUT")).unwrap();
+    std::fs::write(d.join("OUT/1"), vec![1u8; 64 * 64 * 64]).unwrap();
+    edit_json(&a, |v| {
+        v["chunk_key_encoding"]["configuration"]["separator"] = "/../../OUT/".into();
+        v["codecs"] = serde_json::json!([{"name": "bytes"}]);
+        v["chunk_grid"]["configuration"]["chunk_shape"] = serde_json::json!([64, 64, 64]);
+    });
+    for e in [read_voxels(&a).unwrap_err().to_string(), read_voxels_sparse(&a, false).unwrap_err().to_string()] {
+        assert!(e.contains("separator") && e.contains("sep.zarr"), "{e}");
+    }
+}
+
+#[test]
+fn dot_separated_chunk_keys_still_read() {
+    let d = scratch("dot");
+    let a = d.join("dot.zarr");
+    std::fs::create_dir_all(&a).unwrap();
+    let meta = serde_json::json!({
+        "zarr_format": 3, "node_type": "array", "shape": [4, 4, 4], "data_type": "uint8",
+        "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": [2, 4, 4]}},
+        "chunk_key_encoding": {"name": "default", "configuration": {"separator": "."}},
+        "fill_value": 0, "codecs": [{"name": "bytes"}]
+    });
+    std::fs::write(a.join("zarr.json"), serde_json::to_vec(&meta).unwrap()).unwrap();
+    let mut chunk = vec![0u8; 32];
+    chunk[5] = 1; // (0, 1, 1) of chunk (1, 0, 0): voxel (2, 1, 1)
+    std::fs::write(a.join("c.1.0.0"), &chunk).unwrap();
+    std::fs::write(a.join("c.9.0.0"), &chunk).unwrap(); // not a chunk of this shape: ignored
+    let v = read_voxels(&a).unwrap();
+    assert_eq!(v.bits.count(), 1);
+    assert!(v.bits.get(2, 1, 1));
+}
+
+#[test]
+fn links_inside_a_zarr_folder_do_not_lead_outside() {
+    let d = scratch("links");
+    let inside = zarr_array(&d, "inside", [16, 16, 16]);
+    let other = zarr_array(&d, "other", [16, 16, 16]);
+    // A chunk file that is a link to another array's chunk.
+    std::fs::remove_file(inside.join("c/0/0/0")).unwrap();
+    std::os::unix::fs::symlink(other.join("c/0/0/0"), inside.join("c/0/0/0")).unwrap();
+    let e = read_voxels(&inside).unwrap_err().to_string();
+    assert!(e.contains("outside the Zarr folder") && e.contains("--allow-external-paths"), "{e}");
+    assert!(read_voxels_sparse(&inside, false).is_err());
+    // Allowed, it reads the other array's voxels.
+    let v = read_voxels_opts(&inside, Default::default(), &ReadOptions { allow_external_paths: true }).unwrap();
+    assert_eq!(v.bits.count(), 2);
+    // The whole `c/` folder as a link.
+    std::fs::remove_dir_all(inside.join("c")).unwrap();
+    std::os::unix::fs::symlink(other.join("c"), inside.join("c")).unwrap();
+    assert!(read_voxels(&inside).unwrap_err().to_string().contains("outside the Zarr folder"));
+    // An attribute array of a group pointing at another array.
+    let group = d.join("group.zarr");
+    std::fs::create_dir_all(&group).unwrap();
+    std::fs::write(group.join("zarr.json"), br#"{"zarr_format": 3, "node_type": "group", "attributes": {}}"#).unwrap();
+    std::os::unix::fs::symlink(&other, group.join("voxels")).unwrap();
+    assert!(read_voxels(&group).unwrap_err().to_string().contains("outside the Zarr folder"));
+}
+
+#[test]
+fn special_files_inside_a_zarr_folder_are_not_read() {
+    let d = scratch("special");
+    let a = zarr_array(&d, "fifo", [16, 16, 16]);
+    std::fs::remove_file(a.join("c/0/0/0")).unwrap();
+    mkfifo(&a.join("c/0/0/0"));
+    let p = a.clone();
+    let e = within_a_minute(move || read_voxels(&p).map(|_| ()).unwrap_err().to_string());
+    assert!(e.contains("not a regular file"), "{e}");
+    // A device (an endless stream of zeros) as a chunk, and as zarr.json.
+    std::fs::remove_file(a.join("c/0/0/0")).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", a.join("c/0/0/0")).unwrap();
+    let p = a.clone();
+    let e = within_a_minute(move || {
+        read_voxels_opts(&p, Default::default(), &ReadOptions { allow_external_paths: true }).unwrap_err().to_string()
+    });
+    assert!(e.contains("not a regular file"), "{e}");
+    std::fs::remove_file(a.join("zarr.json")).unwrap();
+    mkfifo(&a.join("zarr.json"));
+    let p = a.clone();
+    let e = within_a_minute(move || read_voxels_sparse(&p, false).unwrap_err().to_string());
+    assert!(e.contains("not a regular file"), "{e}");
+}
+
+#[test]
+fn an_mtllib_that_is_a_fifo_is_a_warning_not_a_hang() {
+    let d = scratch("mtlfifo");
+    mkfifo(&d.join("m.mtl"));
+    std::fs::write(d.join("a.obj"), "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let p = d.join("a.obj");
+    let loaded = within_a_minute(move || topovox_io::read_mesh(&p)).unwrap();
+    assert!(loaded.warnings.iter().any(|w| w.contains("not a regular file")), "{:?}", loaded.warnings);
+}
+
+#[test]
+fn a_zarr_claiming_a_vast_grid_reads_only_what_it_stores() {
+    let d = scratch("vast");
+    let a = zarr_array(&d, "vast", [64, 64, 64]);
+    // A billion chunks claimed, one stored.
+    edit_json(&a, |v| v["shape"] = serde_json::json!([65536, 65536, 65536]));
+    let s = read_voxels_sparse(&a, false).unwrap();
+    assert_eq!(s.bits.dims(), [65536, 65536, 65536]);
+    assert_eq!(s.bits.count(), 2);
+}
+
+#[test]
+fn writing_over_a_zarr_folder_that_is_not_ours_is_refused() {
+    let d = scratch("group");
+    let user = d.join("userdata.zarr");
+    std::fs::create_dir_all(user.join("mine")).unwrap();
+    std::fs::write(user.join("zarr.json"), br#"{"zarr_format": 3, "node_type": "group", "attributes": {}}"#).unwrap();
+    std::fs::write(user.join("README"), "my notes").unwrap();
+    let e = write_voxels(&user, VoxelFormat::Zarr, &some_voxels([8, 8, 8]), &grid([8, 8, 8])).unwrap_err().to_string();
+    assert!(e.contains("refusing to replace it"), "{e}");
+    assert_eq!(std::fs::read_to_string(user.join("README")).unwrap(), "my notes");
+    assert!(user.join("mine").is_dir());
+    // Our own array with a file of the user's put inside: refused too.
+    let ours = zarr_array(&d, "ours", [8, 8, 8]);
+    std::fs::write(ours.join("notes.txt"), "x").unwrap();
+    let e = write_voxels(&ours, VoxelFormat::Zarr, &some_voxels([8, 8, 8]), &grid([8, 8, 8])).unwrap_err().to_string();
+    assert!(e.contains("notes.txt"), "{e}");
+    // A plain folder with files, and a regular file: refused.
+    std::fs::create_dir_all(d.join("plain.zarr")).unwrap();
+    std::fs::write(d.join("plain.zarr/a"), "a").unwrap();
+    assert!(write_voxels(&d.join("plain.zarr"), VoxelFormat::Zarr, &some_voxels([8, 8, 8]), &grid([8, 8, 8])).is_err());
+    // Our own array, and an empty folder, are replaced.
+    std::fs::remove_file(ours.join("notes.txt")).unwrap();
+    write_voxels(&ours, VoxelFormat::Zarr, &some_voxels([9, 9, 9]), &grid([9, 9, 9])).unwrap();
+    assert_eq!(read_voxels(&ours).unwrap().bits.dims(), [9, 9, 9]);
+    std::fs::create_dir_all(d.join("empty.zarr")).unwrap();
+    write_voxels(&d.join("empty.zarr"), VoxelFormat::Zarr, &some_voxels([8, 8, 8]), &grid([8, 8, 8])).unwrap();
+    assert_eq!(read_voxels(&d.join("empty.zarr")).unwrap().bits.count(), 2);
+    assert_eq!(leftovers(&d), Vec::<String>::new());
+}
+
+/// Temporaries or moved-aside folders left in `dir`.
+fn leftovers(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".topovox-"))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn staged_outputs_are_put_in_place_only_when_all_are_complete() {
+    let d = scratch("pair");
+    let (obj, mtl) = (d.join("out.obj"), d.join("out.mtl"));
+    std::fs::write(&obj, "old obj").unwrap();
+    std::fs::write(&mtl, "old mtl").unwrap();
+    // The .mtl is complete, the .obj fails (a full disk): neither changes.
+    let m = topovox_io::atomic::stage(&mtl, |w| w.write_all(b"new mtl")).unwrap();
+    let o = topovox_io::atomic::stage(&obj, |w| {
+        w.write_all(b"new o")?;
+        Err(std::io::Error::other("No space left on device"))
+    });
+    assert!(o.is_err());
+    drop(m);
+    assert_eq!(std::fs::read_to_string(&obj).unwrap(), "old obj");
+    assert_eq!(std::fs::read_to_string(&mtl).unwrap(), "old mtl");
+    assert_eq!(leftovers(&d), Vec::<String>::new());
+}
+
+#[test]
+fn threads_saving_to_one_path_never_share_a_temporary() {
+    let d = scratch("threads");
+    let out = d.join("same.npy");
+    let contents: Vec<Vec<u8>> = (0..8u8).map(|t| vec![t; 200_000 + t as usize]).collect();
+    for _round in 0..5 {
+        std::thread::scope(|s| {
+            for c in &contents {
+                let out = &out;
+                s.spawn(move || {
+                    topovox_io::atomic::write_atomically(out, |w| {
+                        for part in c.chunks(4096) {
+                            w.write_all(part)?;
+                        }
+                        Ok(())
+                    })
+                    .unwrap()
+                });
+            }
+        });
+        let got = std::fs::read(&out).unwrap();
+        assert!(contents.contains(&got), "the file matches none of the writes ({} bytes)", got.len());
+        assert_eq!(leftovers(&d), Vec::<String>::new());
+    }
+}
+
+#[test]
+fn temporaries_of_a_killed_run_are_removed_by_the_next_write() {
+    let d = scratch("stale");
+    let out = d.join("out.txt");
+    // A pid above the kernel's limit is never a live process.
+    let dead = std::fs::read_to_string("/proc/sys/kernel/pid_max").map(|s| s.trim().parse::<u64>().unwrap() + 1).unwrap_or(99_999_999);
+    std::fs::write(d.join(format!(".out.txt.topovox-tmp-{dead}")), vec![0u8; 1000]).unwrap();
+    std::fs::write(d.join(format!(".out.txt.topovox-tmp-{dead}-3")), vec![0u8; 1000]).unwrap();
+    std::fs::create_dir_all(d.join(format!(".out.txt.topovox-tmp-{dead}-4/c"))).unwrap();
+    // A live process's temporary (ours) and someone else's file stay.
+    let mine = d.join(format!(".out.txt.topovox-tmp-{}-999", std::process::id()));
+    std::fs::write(&mine, "writing").unwrap();
+    std::fs::write(d.join(".out.txt.notes"), "keep").unwrap();
+    write_voxels(&out, VoxelFormat::Text, &some_voxels([4, 4, 4]), &grid([4, 4, 4])).unwrap();
+    assert_eq!(leftovers(&d), vec![mine.file_name().unwrap().to_string_lossy().into_owned()]);
+    assert!(d.join(".out.txt.notes").exists());
+}
+
+#[test]
+fn live_temporaries_are_removed_on_request() {
+    let d = scratch("live");
+    let out = d.join("big.txt");
+    let seen = std::sync::Mutex::new(Vec::new());
+    let r = topovox_io::atomic::write_atomically(&out, |w| {
+        w.write_all(b"partial")?;
+        w.flush()?;
+        seen.lock().unwrap().extend(leftovers(&d));
+        // What the CLI's signal handler does, mid-write.
+        topovox_io::atomic::remove_live_temporaries(None);
+        seen.lock().unwrap().push(format!("after: {:?}", leftovers(&d)));
+        Err(std::io::Error::other("interrupted"))
+    });
+    assert!(r.is_err());
+    let seen = seen.into_inner().unwrap();
+    assert_eq!(seen.len(), 2, "{seen:?}");
+    assert!(seen[0].starts_with(".big.txt.topovox-tmp-"), "{seen:?}");
+    assert_eq!(seen[1], "after: []");
+    assert!(!out.exists());
+}
