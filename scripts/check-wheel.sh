@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The wheel as a user gets it: the one scripts/test-all.sh built with
-# `maturin build --release` (target/wheels), checked by twine, installed
+# `maturin build --release` (target/dist), checked by twine, installed
 # into a fresh virtual environment that holds nothing else of ours (pip
 # brings NumPy, its only dependency), and the quick start of
 # python/README.md (its first `python` block) run there, outside the
@@ -8,9 +8,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-wheels=(target/wheels/topovox-*.whl)
+wheels=(target/dist/topovox-*.whl)
 if [ ! -f "${wheels[0]}" ]; then
-    echo "no wheel in target/wheels: run scripts/test-all.sh first (it builds it)" >&2
+    echo "no wheel in target/dist: run scripts/test-all.sh first (it builds it)" >&2
     exit 1
 fi
 echo "== twine check ${wheels[*]}"

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every test of topovox: the Rust workspace (cargo test), then the Python
 # wheel built from this checkout (maturin build --release, into
-# target/wheels), installed into its own virtual environment (target/venv)
+# target/dist), installed into its own virtual environment (target/venv)
 # with the test tools, and its pytest suite (CLI parity, arrays, errors,
 # formats, batches, Dask and Ray, and the docs' commands run as written).
 # Works on a fresh machine with the Rust toolchain and Python >= 3.9.
@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 echo "== cargo test --workspace --release"
 cargo test --workspace --release
 
-echo "== the Python wheel (maturin build --release) into target/wheels, installed into target/venv"
+echo "== the Python wheel (maturin build --release) into target/dist, installed into target/venv"
 PY="${PYTHON:-python3}"
 if [ ! -x target/venv/bin/python ]; then
     "$PY" -m venv target/venv
@@ -19,9 +19,9 @@ fi
 VPY=target/venv/bin/python
 "$VPY" -m pip install --quiet --disable-pip-version-check --upgrade pip
 "$VPY" -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" numpy pytest trimesh "dask[bag]" distributed ray fsspec
-rm -rf target/wheels
-"$VPY" -m maturin build --release --manifest-path python/Cargo.toml --out target/wheels
-"$VPY" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps target/wheels/topovox-*.whl
+rm -rf target/dist
+"$VPY" -m maturin build --release --manifest-path python/Cargo.toml --out target/dist
+"$VPY" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps target/dist/topovox-*.whl
 
 echo "== pytest"
 # Run from the repository root so `import topovox` finds the installed

@@ -615,6 +615,7 @@ fn plan_of(
         seed,
         tile,
         max_memory: max_memory.map(topovox_job::parse_size).transpose()?,
+        writer_bytes_per_brick: 0,
     };
     topovox_job::Plan::new(request)
 }
@@ -828,6 +829,9 @@ fn batch<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let empty = PyDict::new(py);
     let (opts, jobs) = batch_options(options.unwrap_or(&empty), format)?;
+    if let Some(n) = jobs {
+        topovox_job::check_threads(n, "jobs").map_err(py_err)?;
+    }
     let summary = py
         .detach(move || -> Result<topovox_job::batch::Summary, JobError> {
             let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref())?;

@@ -89,6 +89,7 @@ pub fn plan_from(
         seed,
         tile: memory.tile,
         max_memory: memory.max_memory.as_deref().map(topovox_job::parse_size).transpose()?,
+        writer_bytes_per_brick: 0,
     };
     Ok(topovox_job::Plan::new(request)?)
 }

@@ -157,3 +157,54 @@ fn make_repetitive_npz(path: &Path, rows: u64) {
     }
     zip.finish().unwrap();
 }
+
+#[test]
+fn max_memory_is_kept_or_the_run_is_refused_before_work() {
+    let d = folder("memory");
+    let mesh = repo("examples/meshes/cow.obj");
+    let out = d.join("cow.vdb");
+    let run = |bound: &str| topovox(&["voxelize", s(&mesh), "-o", s(&out), "--resolution", "4096", "--max-memory", bound, "--json"]);
+    // Too small: one line naming what it needs, before any work, nothing written.
+    let e = refused(&run("32M"));
+    assert!(e.contains("needs about") && e.contains("--max-memory"), "{e}");
+    assert!(!out.exists());
+    // Enough: the peak stays within the bound.
+    let o = run("256M");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let peak = v["peak_memory_bytes"].as_u64().unwrap();
+    assert!(peak <= 256 << 20, "peak {peak} bytes over the 256 MiB bound");
+}
+
+#[test]
+fn a_small_solid_in_a_vast_grid_follows_its_surface() {
+    let d = folder("vast-solid");
+    let tet = d.join("tet.obj");
+    std::fs::write(&tet, "v 10 10 10\nv 75 10 10\nv 10 75 10\nv 10 10 75\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n").unwrap();
+    // Closed (parity) and open (the generalized winding number).
+    let open = d.join("open.obj");
+    std::fs::write(&open, "v 10 10 10\nv 75 10 10\nv 10 75 10\nv 10 10 75\nf 1 3 2\nf 1 2 4\nf 1 4 3\n").unwrap();
+    for mesh in [&tet, &open] {
+        let o = topovox(&[
+            "voxelize",
+            s(mesh),
+            "-o",
+            s(&d.join("t.vdb")),
+            "--mode",
+            "solid",
+            "--origin",
+            "0,0,0",
+            "--voxel-size",
+            "1",
+            "--dims",
+            "65536,65536,65536",
+            "--max-memory",
+            "256M",
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}: {}", mesh.display(), String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert!(v["voxels"].as_u64().unwrap() > 40_000, "{v}");
+        assert!(v["peak_memory_bytes"].as_u64().unwrap() <= 256 << 20, "{v}");
+    }
+}

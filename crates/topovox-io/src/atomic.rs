@@ -221,7 +221,7 @@ pub fn remove_stale_temporaries(output: &Path) {
         let file_name = entry.file_name();
         let Some(rest) = file_name.to_str().and_then(|f| f.strip_prefix(&prefix)) else { continue };
         let pid = rest.split('-').next().and_then(|p| p.parse::<u32>().ok());
-        if pid.is_some_and(|pid| process_is_gone(pid)) {
+        if pid.is_some_and(process_is_gone) {
             remove_path(&entry.path());
         }
     }

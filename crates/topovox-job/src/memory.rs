@@ -1,6 +1,7 @@
 //! How much memory there is, and refusing grids that cannot fit.
 
-use topovox::GridSpec;
+use topovox::voxelize::{self, Mode, Options};
+use topovox::{GridSpec, MeshRef};
 
 use crate::error::{JobError, Result};
 
@@ -36,6 +37,40 @@ pub fn check_memory(grid: &GridSpec, budget: u64, why: &str) -> Result<()> {
         bytes(grid.dense_bytes()),
         bytes(budget)
     )))
+}
+
+/// Bytes per brick a tiled run holds: the 64-byte brick, its 8-byte key
+/// and, while the bricks are put in order, a 4-byte index.
+const BYTES_PER_BRICK: u64 = 76;
+
+/// What a tiled surface run is expected to hold, for a refusal before
+/// any work rather than a run past `--max-memory`.
+#[derive(Clone, Copy, Debug)]
+pub struct TiledEstimate {
+    /// At most this many bricks (8³ voxels) hold voxels.
+    pub bricks: u64,
+    /// About this many bytes at the peak.
+    pub bytes: u64,
+}
+
+/// The memory a tiled surface run of `mesh` on `grid` needs. Every voxel
+/// any surface or line mode sets lies in a brick the mesh meets, so the
+/// non-empty bricks are at most the `cover` voxels of the grid of bricks
+/// (voxels 8 times larger), found by a tiled run there (1/512 of the
+/// voxels). To that: the lattice triangles and their tile bins, and 48 MiB
+/// for the process, one tile and the writer's buffers.
+pub fn tiled_estimate(mesh: MeshRef<'_>, grid: &GridSpec) -> TiledEstimate {
+    let dims = grid.dims().map(|d| u64::from(d.div_ceil(8)));
+    let bricks = GridSpec::new(grid.origin(), grid.voxel_size() * 8.0, dims)
+        .ok()
+        .and_then(|coarse| voxelize::tiled::tiled(Mode::Cover, mesh, &coarse, voxelize::tiled::DEFAULT_TILE, &Options::default()).ok())
+        .map(|(b, _)| b.count())
+        .unwrap_or(0);
+    // Segments (polylines) set few voxels: a brick per 8 voxels of length
+    // at most, bounded here by the grid's longest axis per segment.
+    let segments = mesh.segments.len() as u64 * dims.iter().copied().max().unwrap_or(1);
+    let prims = (mesh.triangles.len() + mesh.segments.len()) as u64 * (80 + 16);
+    TiledEstimate { bricks: bricks + segments, bytes: (bricks + segments) * BYTES_PER_BRICK + prims + (48 << 20) }
 }
 
 /// Parses a memory size: bytes, or a number with `K`, `M`, `G`, `T`

@@ -86,6 +86,17 @@ pub fn is_sparse(target: Output) -> bool {
     matches!(target, Output::Voxels(VoxelFormat::Vdb | VoxelFormat::Zarr | VoxelFormat::Npz | VoxelFormat::Text | VoxelFormat::Ply))
 }
 
+/// Bytes the writer of `target` holds per non-empty 8³ brick while it
+/// writes: `.vdb` gathers them into its tree (origin and mask: 76 bytes),
+/// `.zarr` into shards (key and brick: 72); the others stream.
+pub fn writer_bytes_per_brick(target: Output) -> u64 {
+    match target {
+        Output::Voxels(VoxelFormat::Vdb) => 76,
+        Output::Voxels(VoxelFormat::Zarr) => 72,
+        _ => 0,
+    }
+}
+
 /// Refuses a dense format for a grid that cannot be dense in the memory
 /// the run may use (`max_memory`, else nine tenths of what is available).
 pub fn check_fits(target: Output, grid: &GridSpec, max_memory: Option<u64>) -> Result<()> {

@@ -349,6 +349,11 @@ pub struct Request {
     pub tile: Option<u32>,
     /// Memory the run may use (bytes); `None`: nine tenths of what is available.
     pub max_memory: Option<u64>,
+    /// Bytes the output's writer holds per non-empty brick
+    /// ([`crate::output::writer_bytes_per_brick`]; 0 when the voxels are
+    /// not written, or streamed), counted when a tiled run's memory is
+    /// checked before it starts.
+    pub writer_bytes_per_brick: u64,
 }
 
 impl Request {
@@ -365,6 +370,7 @@ impl Request {
             seed: 0,
             tile: None,
             max_memory: None,
+            writer_bytes_per_brick: 0,
         }
     }
 }

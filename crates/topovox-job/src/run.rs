@@ -123,7 +123,24 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
     } else {
         plan.surface_method
     };
-    let opts = Options { progress, ..Options::default() };
+    let mut opts = Options { progress, ..Options::default() };
+    if let (Some(_), None) = (tile, &plan.solid) {
+        // A tiled surface holds its non-empty bricks: refused before any
+        // work when they would not fit, and reserved at once otherwise.
+        let mut e = crate::memory::tiled_estimate(mesh, &grid);
+        e.bytes += e.bricks * plan.request.writer_bytes_per_brick;
+        if e.bytes > budget {
+            let [x, y, z] = grid.dims();
+            return Err(JobError::failed(format!(
+                "{name}: the surface on the {x}x{y}x{z} grid needs about {} (up to {} bricks of 8x8x8 voxels), more than the {} this run may use; raise --max-memory or lower the resolution",
+                crate::memory::bytes(e.bytes),
+                e.bricks,
+                crate::memory::bytes(budget)
+            )));
+        }
+        opts.brick_capacity = usize::try_from(e.bricks).unwrap_or(0);
+    }
+    let opts = opts;
     let mut gpu = Value::Null;
     let mut tile_kernel = None;
     let (voxels, report, method, solid) = if let (Some(t), Some(sp)) = (tile, &plan.solid) {

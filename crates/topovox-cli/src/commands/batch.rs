@@ -27,10 +27,12 @@ impl BatchProgress for Bar {
 }
 
 pub fn run(a: &BatchArgs) -> Result<()> {
-    let plan = crate::plan::plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path, a.seed, &a.memory)?;
+    let mut plan =
+        crate::plan::plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path, a.seed, &a.memory)?;
     let Some(format) = topovox_job::output::Output::from_name(&a.format) else {
         bail!("unknown --format {:?} (expected one of: {})", a.format, topovox_job::output::Output::names());
     };
+    plan.request.writer_bytes_per_brick = topovox_job::output::writer_bytes_per_brick(format);
     let write = crate::commands::export::writer_options(&a.export)?;
     let colour_rule = format!("{:?}", a.export.colour_rule).to_lowercase();
     let gpu_path = crate::plan::gpu_path_name(a.gpu_path).0;
@@ -67,10 +69,10 @@ pub fn run(a: &BatchArgs) -> Result<()> {
         read: topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
         fingerprint,
     };
+    let pool = crate::thread_pool_for(a.jobs, "--jobs")?;
     let files = batch::collect_inputs(&a.inputs, a.glob.as_deref())?;
     let ext = format.name().replace("npy-bool", "npy");
     let items = batch::plan_items(&files, &a.output, &ext)?;
-    let pool = crate::thread_pool_for(a.jobs, "--jobs")?;
 
     use std::io::IsTerminal;
     let target =

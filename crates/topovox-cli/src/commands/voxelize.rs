@@ -14,8 +14,9 @@ use crate::progress::Bar;
 pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let t_total = Instant::now();
     // Validate everything that does not need the mesh first.
-    let plan = plan::voxelize_plan(a)?;
+    let mut plan = plan::voxelize_plan(a)?;
     let format = output_format(a.format.as_deref(), &a.output)?;
+    plan.request.writer_bytes_per_brick = topovox_job::output::writer_bytes_per_brick(format);
     check_output_path(&a.output)?;
     // Nothing is read or written before we know no output is an input.
     topovox_job::output::refuse_overwriting(&a.output, format, std::slice::from_ref(&a.mesh))?;

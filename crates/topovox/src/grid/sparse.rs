@@ -11,6 +11,7 @@
 use super::bricks::{Brick, BrickBits, BRICK};
 use super::dense::DenseBits;
 use super::VoxelSource;
+use rayon::prelude::*;
 
 /// Bits per brick coordinate in a key (grids up to 2^24 voxels per axis).
 const KEY_BITS: u32 = 21;
@@ -185,37 +186,52 @@ impl SparseBricks {
         });
     }
 
+    /// Makes room for `additional` more bricks at once, so pushing tiles
+    /// never grows the vectors by doubling (which briefly holds twice the
+    /// bricks). Untouched room costs address space, not memory.
+    pub fn reserve(&mut self, additional: usize) {
+        self.keys.reserve_exact(additional);
+        self.bricks.reserve_exact(additional);
+    }
+
     /// Restores the order after [`SparseBricks::push_tile`] (tiles pushed
     /// in key order need no sort): sorts by key, merges repeated keys,
-    /// drops empty bricks.
+    /// drops empty bricks. In place: besides the bricks, it holds one
+    /// 4-byte index per brick.
     pub fn finish(&mut self) {
         if !self.keys.windows(2).all(|w| w[0] < w[1]) {
             let mut order: Vec<u32> = (0..self.keys.len() as u32).collect();
-            order.sort_by_key(|&n| (self.keys[n as usize], n));
-            let mut keys = Vec::with_capacity(order.len());
-            let mut bricks: Vec<Brick> = Vec::with_capacity(order.len());
-            for n in order {
-                let (k, b) = (self.keys[n as usize], self.bricks[n as usize]);
-                if keys.last() == Some(&k) {
-                    let last = bricks.last_mut().expect("a brick per key");
-                    for (w, x) in last.iter_mut().zip(b) {
-                        *w |= x;
+            order.par_sort_unstable_by_key(|&n| (self.keys[n as usize], n));
+            permute_in_place(&mut self.keys, &mut self.bricks, &mut order);
+            // Merge repeated keys (now adjacent) into their first brick.
+            let mut w = 0;
+            for r in 0..self.keys.len() {
+                if w > 0 && self.keys[w - 1] == self.keys[r] {
+                    let b = self.bricks[r];
+                    for (x, y) in self.bricks[w - 1].iter_mut().zip(b) {
+                        *x |= y;
                     }
                 } else {
-                    keys.push(k);
-                    bricks.push(b);
+                    self.keys[w] = self.keys[r];
+                    self.bricks[w] = self.bricks[r];
+                    w += 1;
                 }
             }
-            self.keys = keys;
-            self.bricks = bricks;
+            self.keys.truncate(w);
+            self.bricks.truncate(w);
         }
-        let keep: Vec<bool> = self.bricks.iter().map(|b| b.iter().any(|&w| w != 0)).collect();
-        if keep.iter().any(|&k| !k) {
-            let mut n = 0;
-            self.keys.retain(|_| (keep[n], n += 1).0);
-            let mut n = 0;
-            self.bricks.retain(|_| (keep[n], n += 1).0);
+        let mut w = 0;
+        for r in 0..self.keys.len() {
+            if self.bricks[r].iter().any(|&x| x != 0) {
+                self.keys[w] = self.keys[r];
+                self.bricks[w] = self.bricks[r];
+                w += 1;
+            }
         }
+        self.keys.truncate(w);
+        self.bricks.truncate(w);
+        self.keys.shrink_to_fit();
+        self.bricks.shrink_to_fit();
     }
 
     /// Voxels along x, y, z.
@@ -395,6 +411,32 @@ fn layer_voxels(keys: &[u64], bricks: &[Brick], f: &mut dyn FnMut(u32, u32, u32)
             }
         }
         start = end;
+    }
+}
+
+/// Reorders `keys` and `bricks` so that position `i` holds what was at
+/// `order[i]`, following the permutation's cycles (no second copy of the
+/// bricks); `order` is consumed (marked as it goes).
+fn permute_in_place(keys: &mut [u64], bricks: &mut [Brick], order: &mut [u32]) {
+    const DONE: u32 = u32::MAX;
+    for i in 0..order.len() {
+        if order[i] == DONE {
+            continue;
+        }
+        let (k0, b0) = (keys[i], bricks[i]);
+        let mut cur = i;
+        loop {
+            let next = order[cur] as usize;
+            order[cur] = DONE;
+            if next == i {
+                keys[cur] = k0;
+                bricks[cur] = b0;
+                break;
+            }
+            keys[cur] = keys[next];
+            bricks[cur] = bricks[next];
+            cur = next;
+        }
     }
 }
 

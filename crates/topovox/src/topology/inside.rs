@@ -274,8 +274,16 @@ pub fn row_crossings_in(tris: &[LatticeTriangle], dims: [u32; 3], planes: std::o
             out
         })
         .collect();
-    // By row (a counting sort), then each row's few by `i0`.
+    // By row, then each row's few by `i0`: a counting sort where the rows
+    // are few beside the hits; a plain sort where a per-row table would
+    // follow the grid rather than the surface (a small mesh in a 65536³
+    // grid would need 32 GiB of it). Both give the tuples in order.
     let rows = dims[1] as usize * planes.len();
+    if rows > 4 * hits.len() + 4096 {
+        let mut hits = hits;
+        hits.par_sort_unstable();
+        return hits;
+    }
     let start = row_starts(rows, hits.iter().map(|h| h.0 as usize));
     let mut fill = start.clone();
     let mut sorted = vec![(0, 0, 0); hits.len()];

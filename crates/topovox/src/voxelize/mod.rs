@@ -214,6 +214,10 @@ pub struct Options<'a> {
     /// (default) means 2^18. The result does not depend on it (tests pin
     /// 1).
     pub defer_limit: usize,
+    /// The tiled driver's expected number of non-empty bricks (`0`,
+    /// default: unknown), reserved up front so its result is never grown
+    /// by doubling. The result does not depend on it.
+    pub brick_capacity: usize,
 }
 
 /// What a voxelization did.

@@ -279,12 +279,11 @@ pub(crate) fn from_brick_rows(dims: [u32; 3], rows: impl IntoIterator<Item = Bri
 }
 
 /// A sparse grid built brick row by brick row in parallel: `row(bj, bk)`
-/// gives each row's bricks and full runs.
-pub(crate) fn by_brick_rows(dims: [u32; 3], row: impl Fn(u32, u32) -> BrickRow + Sync) -> SparseBricks {
-    let (by, bz) = (dims[1].div_ceil(BRICK) as u64, dims[2].div_ceil(BRICK) as u64);
-    let rows: Vec<BrickRow> =
-        (0..(by * bz) as usize).into_par_iter().with_min_len(16).map(|n| row((n as u64 % by) as u32, (n as u64 / by) as u32)).collect();
-    from_brick_rows(dims, rows)
+/// gives each row's bricks and full runs, for the brick rows `rows`
+/// (`(bk, bj)`, sorted) only: the others hold nothing.
+pub(crate) fn by_brick_rows_in(dims: [u32; 3], rows: Vec<(u32, u32)>, row: impl Fn(u32, u32) -> BrickRow + Sync) -> SparseBricks {
+    let built: Vec<BrickRow> = rows.into_par_iter().with_min_len(16).map(|(bk, bj)| row(bj, bk)).collect();
+    from_brick_rows(dims, built)
 }
 
 /// The bricks of brick row `(bj, bk)` from the inside spans of its 64
@@ -346,7 +345,15 @@ pub(crate) fn bricks_of_spans(spans: &[Vec<(u32, u32)>; 64], dims: [u32; 3], bj:
 fn fill_sparse(snapped: &Snapped, dims: [u32; 3], rule: Rule) -> (SparseBricks, SolidReport) {
     // Zero-area triangles cross no ray (`row_crossings` skips them).
     let hits = row_crossings(&snapped.triangles, dims);
-    let out = by_brick_rows(dims, |bj, bk| brick_row(&hits, dims, bj, bk, rule));
+    // Only brick rows some ray crossing lies in can hold inside voxels (a
+    // row without crossings is outside under either rule): the work and
+    // memory follow the surface, not the grid's rows.
+    let ny = dims[1] as u64;
+    let mut rows: Vec<(u32, u32)> = hits.iter().map(|h| ((h.0 as u64 / ny) as u32 / BRICK, (h.0 as u64 % ny) as u32 / BRICK)).collect();
+    rows.dedup();
+    rows.par_sort_unstable();
+    rows.dedup();
+    let out = by_brick_rows_in(dims, rows, |bj, bk| brick_row(&hits, dims, bj, bk, rule));
     drop(hits);
     let mut rep = inspect(snapped);
     rep.voxels = out.count();

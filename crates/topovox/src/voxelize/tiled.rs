@@ -218,6 +218,7 @@ fn by_tiles<P: Primitive, E>(
     }
     let inner = Options { progress: None, ..*opts };
     let mut out = SparseBricks::new(dims);
+    out.reserve(opts.brick_capacity);
     let mut local: Vec<P> = Vec::new();
     let mut voxels = 0;
     for (s, &start) in starts.iter().enumerate() {

@@ -40,7 +40,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
-use super::solid::{bricks_of_spans, by_brick_rows, push_span, SolidReport};
+use super::solid::{bricks_of_spans, by_brick_rows_in, push_span, SolidReport};
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::{orient, P3};
@@ -49,7 +49,7 @@ use crate::grid::dense::DenseBits;
 use crate::grid::sparse::SparseBricks;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
-use crate::topology::inside::{row_crossings, row_starts, snap_all, ClassifyError, NetEdge, Snapped};
+use crate::topology::inside::{row_crossings, snap_all, ClassifyError, NetEdge, Snapped};
 
 /// What the winding-number solid did beyond [`SolidReport`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -405,6 +405,39 @@ enum Rule {
 
 /// Refines the block at `min` of edge `size` (clipped to the grid), pushing
 /// the spans whose rule is not the default.
+/// The top blocks (of `TOP`³ voxels, by their index) that [`refine`] may
+/// not settle at once: those within reach of some cap. A block farther
+/// from every cap than the distance at which that cap's bound drops below
+/// 0.49 / (number of caps) is settled by the bounds' sum, so only the
+/// blocks around the caps are visited, however large the grid.
+fn blocks_near_caps(caps: &[Cap], dims: [u32; 3]) -> Vec<[u32; 3]> {
+    let nb = dims.map(|d| d.div_ceil(TOP));
+    let rho = TOP as f64 * 3f64.sqrt() / 2.0;
+    let share = 0.49 / caps.len().max(1) as f64;
+    let mut blocks = Vec::new();
+    for c in caps {
+        // bound < share once d > sqrt(area / (4π·share)), d = |q − centre| − radius − rho.
+        let reach = c.radius + rho + (c.area / (4.0 * std::f64::consts::PI * share)).sqrt() + 1.0;
+        let range: Vec<std::ops::Range<u32>> = (0..3)
+            .map(|a| {
+                let lo = ((c.centre[a] - reach) / TOP as f64).floor().max(0.0);
+                let hi = ((c.centre[a] + reach) / TOP as f64).floor() + 1.0;
+                (lo.min(nb[a] as f64) as u32)..(hi.min(nb[a] as f64) as u32)
+            })
+            .collect();
+        for k in range[2].clone() {
+            for j in range[1].clone() {
+                for i in range[0].clone() {
+                    blocks.push([i, j, k]);
+                }
+            }
+        }
+    }
+    blocks.sort_unstable_by_key(|b| [b[2], b[1], b[0]]);
+    blocks.dedup();
+    blocks
+}
+
 fn refine(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut Vec<Span>) {
     if (0..3).any(|a| min[a] >= dims[a]) {
         return;
@@ -497,7 +530,7 @@ pub fn winding_snapped(snapped: &Snapped, dims: [u32; 3]) -> (DenseBits, Winding
 /// bricks with the interior as runs of full bricks. The same voxels.
 pub fn winding_sparse(snapped: &Snapped, dims: [u32; 3]) -> (SparseBricks, WindingReport) {
     let plan = Plan::new(snapped, dims);
-    let out = by_brick_rows(dims, |bj, bk| {
+    let out = by_brick_rows_in(dims, plan.brick_rows(), |bj, bk| {
         let mut spans: [Vec<(u32, u32)>; 64] = std::array::from_fn(|_| Vec::new());
         for dk in 0..BRICK.min(dims[2] - bk * BRICK) {
             for dj in 0..BRICK.min(dims[1] - bj * BRICK) {
@@ -517,10 +550,10 @@ struct Plan {
     dims: [u32; 3],
     cycles: u64,
     cap_triangles: u64,
+    /// Crossings of mesh + caps, sorted by row.
     hits: Vec<(u32, u32, i8)>,
-    start: Vec<usize>,
+    /// Spans whose decision needs the caps, sorted by row.
     needed: Vec<Span>,
-    nstart: Vec<usize>,
 }
 
 impl Plan {
@@ -537,16 +570,13 @@ impl Plan {
             }
             row_crossings(&closed, dims)
         };
-        let rows = dims[1] as usize * dims[2] as usize;
-        let start = row_starts(rows, hits.iter().map(|h| h.0 as usize));
         // Voxels whose decision needs w_cap: octree refinement from blocks
         // of TOP³ voxels. A block is settled (inside iff J ≠ 0) when
         // |w_cap| stays below 1/2 over it, by each cap's sphere bound or by
         // w_cap at its centre plus a Lipschitz bound; otherwise its eight
         // children are refined, down to single voxels, where w_cap at the
         // centre is the value used.
-        let nb = dims.map(|d| d.div_ceil(TOP));
-        let blocks: Vec<[u32; 3]> = (0..nb[2]).flat_map(|k| (0..nb[1]).flat_map(move |j| (0..nb[0]).map(move |i| [i, j, k]))).collect();
+        let blocks = blocks_near_caps(&caps, dims);
         let mut needed: Vec<Span> = if caps.is_empty() {
             Vec::new()
         } else {
@@ -560,17 +590,33 @@ impl Plan {
                 .collect()
         };
         needed.par_sort_unstable_by_key(|s| (s.row, s.i0));
-        let nstart = row_starts(rows, needed.iter().map(|n| n.row as usize));
         let cap_triangles = caps.iter().map(|c| c.tris.len() as u64).sum();
-        Plan { dims, cycles: cycles.len() as u64, cap_triangles, hits, start, needed, nstart }
+        Plan { dims, cycles: cycles.len() as u64, cap_triangles, hits, needed }
+    }
+
+    /// The brick rows `(bk, bj)` that can hold inside voxels, sorted: those
+    /// of a crossing or a span that needs the caps (elsewhere `J = 0` and
+    /// the caps are settled below ½: outside).
+    fn brick_rows(&self) -> Vec<(u32, u32)> {
+        let ny = self.dims[1];
+        let of = |r: u32| (r / ny / BRICK, r % ny / BRICK);
+        let mut rows: Vec<(u32, u32)> = self.hits.iter().map(|h| of(h.0)).chain(self.needed.iter().map(|s| of(s.row))).collect();
+        rows.par_sort_unstable();
+        rows.dedup();
+        rows
     }
 
     /// Appends the inside spans of row `r` (`k·ny + j`) to `out`, in
     /// order, maximal (adjacent spans joined).
     fn row(&self, r: usize, out: &mut Vec<(u32, u32)>) {
         let nx = self.dims[0];
-        let row_hits = &self.hits[self.start[r]..self.start[r + 1]];
-        let spans = &self.needed[self.nstart[r]..self.nstart[r + 1]];
+        // Both sorted by row: each row's part found by binary search (a
+        // per-row table would follow the grid, not the surface).
+        let r = r as u32;
+        let h0 = self.hits.partition_point(|h| h.0 < r);
+        let row_hits = &self.hits[h0..h0 + self.hits[h0..].partition_point(|h| h.0 == r)];
+        let n0 = self.needed.partition_point(|s| s.row < r);
+        let spans = &self.needed[n0..n0 + self.needed[n0..].partition_point(|s| s.row == r)];
         let (mut ptr, mut sp) = (0, 0);
         let mut w = 0i64;
         let mut i = 0u32;

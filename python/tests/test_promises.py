@@ -1,0 +1,82 @@
+"""Promises kept from Python under careless or hostile use (issue 44):
+threads saving to one path, grids too large to write densely, thread
+counts past the bound, voxel folders that link outside themselves."""
+
+import os
+import threading
+
+import numpy as np
+import pytest
+
+import topovox
+
+TETRA = (
+    np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float),
+    np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]),
+)
+
+
+def test_threads_saving_to_one_path_leave_one_whole_file(tmp_path):
+    grids = [topovox.voxelize(*TETRA, resolution=r) for r in (20, 24, 28, 32, 36, 40)]
+    wanted = [g.occupancy for g in grids]
+    out = tmp_path / "same.npy"
+    for _ in range(5):
+        errors = []
+
+        def save(g):
+            try:
+                g.save(out)
+            except Exception as e:  # noqa: BLE001 - any error fails the test below
+                errors.append(e)
+
+        threads = [threading.Thread(target=save, args=(g,)) for g in grids]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        assert errors == []
+        got = np.load(out).astype(bool)
+        assert any(got.shape == w.shape and (got == w).all() for w in wanted)
+        assert [p for p in os.listdir(tmp_path) if ".topovox-" in p] == []
+
+
+def huge():
+    """A small surface in a 65536³ grid (tiled, sparse)."""
+    v, f = TETRA
+    return topovox.voxelize(v * 40, f, origin=(0, 0, 0), voxel_size=1.0, dims=(65536, 65536, 65536))
+
+
+def test_grids_that_cannot_be_dense_are_refused_before_any_write(tmp_path):
+    g = huge()
+    assert g.count > 0
+    for name in ("x.npy", "x.binvox", "x.vti", "x.obj", "x.glb"):
+        with pytest.raises(ValueError, match="cannot be held densely"):
+            g.save(tmp_path / name)
+    assert os.listdir(tmp_path) == []
+    with pytest.raises(RuntimeError, match="dense storage"):
+        g.to_trimesh()
+    g.save(tmp_path / "x.vdb")  # sparse formats still work
+    assert (tmp_path / "x.vdb").stat().st_size > 0
+
+
+@pytest.mark.parametrize("threads", [0, 10**6])
+def test_thread_counts_past_the_bound_are_value_errors(threads):
+    with pytest.raises(ValueError, match="threads"):
+        topovox.voxelize(*TETRA, resolution=8, threads=threads)
+
+
+def test_batch_jobs_past_the_bound_name_jobs(tmp_path):
+    with pytest.raises(ValueError, match="jobs"):
+        topovox.batch([str(tmp_path)], str(tmp_path / "out"), jobs=10**6)
+
+
+def test_voxel_folders_do_not_lead_outside(tmp_path):
+    g = topovox.voxelize(*TETRA, resolution=16)
+    g.save(tmp_path / "a.zarr")
+    g.save(tmp_path / "b.zarr")
+    chunk = tmp_path / "a.zarr" / "c" / "0" / "0" / "0"
+    chunk.unlink()
+    chunk.symlink_to(tmp_path / "b.zarr" / "c" / "0" / "0" / "0")
+    with pytest.raises(topovox.FileFormatError, match="outside the Zarr folder"):
+        topovox.load_voxels(tmp_path / "a.zarr")
+    assert topovox.load_voxels(tmp_path / "a.zarr", allow_external_paths=True).count == g.count
