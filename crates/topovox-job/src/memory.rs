@@ -39,9 +39,12 @@ pub fn check_memory(grid: &GridSpec, budget: u64, why: &str) -> Result<()> {
     )))
 }
 
-/// Bytes per brick a tiled run holds: the 64-byte brick, its 8-byte key
-/// and, while the bricks are put in order, a 4-byte index.
-const BYTES_PER_BRICK: u64 = 76;
+/// Bytes per brick a tiled run holds: the 64-byte brick and its 8-byte key
+/// (the 4-byte index that puts them in order comes and goes within the
+/// base below). With the per-triangle and base terms of
+/// [`tiled_estimate`], measured on the bunny at 3000, 4096 and 8192 and
+/// the cow at 4096 to stay at or above the peak (2026-11-27).
+const BYTES_PER_BRICK: u64 = 72;
 
 /// What a tiled surface run is expected to hold, for a refusal before
 /// any work rather than a run past `--max-memory`.
@@ -57,8 +60,9 @@ pub struct TiledEstimate {
 /// any surface or line mode sets lies in a brick the mesh meets, so the
 /// non-empty bricks are at most the `cover` voxels of the grid of bricks
 /// (voxels 8 times larger), found by a tiled run there (1/512 of the
-/// voxels). To that: the lattice triangles and their tile bins, and 48 MiB
-/// for the process, one tile and the writer's buffers.
+/// voxels). To that: the lattice triangles and their tile bins (88 bytes
+/// a triangle), and 24 MiB for the process, the mesh as read, one tile and
+/// the writer's buffers.
 pub fn tiled_estimate(mesh: MeshRef<'_>, grid: &GridSpec) -> TiledEstimate {
     let dims = grid.dims().map(|d| u64::from(d.div_ceil(8)));
     let bricks = GridSpec::new(grid.origin(), grid.voxel_size() * 8.0, dims)
@@ -69,8 +73,8 @@ pub fn tiled_estimate(mesh: MeshRef<'_>, grid: &GridSpec) -> TiledEstimate {
     // Segments (polylines) set few voxels: a brick per 8 voxels of length
     // at most, bounded here by the grid's longest axis per segment.
     let segments = mesh.segments.len() as u64 * dims.iter().copied().max().unwrap_or(1);
-    let prims = (mesh.triangles.len() + mesh.segments.len()) as u64 * (80 + 16);
-    TiledEstimate { bricks: bricks + segments, bytes: (bricks + segments) * BYTES_PER_BRICK + prims + (48 << 20) }
+    let prims = (mesh.triangles.len() + mesh.segments.len()) as u64 * 88 + mesh.positions.len() as u64 * 24;
+    TiledEstimate { bricks: bricks + segments, bytes: (bricks + segments) * BYTES_PER_BRICK + prims + (24 << 20) }
 }
 
 /// Parses a memory size: bytes, or a number with `K`, `M`, `G`, `T`
