@@ -16,6 +16,7 @@
 //!   process left behind are removed by the next write of the same output
 //!   ([`remove_stale_temporaries`]).
 
+use std::collections::HashMap;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -83,25 +84,25 @@ impl Staged {
 /// putting a regular file in place yet (see [`Staged`]).
 pub fn stage(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<Staged, IoError> {
     let err = |e| IoError::new(path, ErrorKind::Write(e));
+    // Everything goes through one buffer, flushed before it is put in place.
+    let through = |out: &mut dyn Write| {
+        let mut w = BufWriter::with_capacity(1 << 20, out);
+        fill(&mut w).and_then(|_| w.flush())
+    };
     match target(path) {
         Target::Stdout => {
-            let out = std::io::stdout();
-            let mut w = BufWriter::with_capacity(1 << 20, out.lock());
-            fill(&mut w).and_then(|_| w.flush()).map_err(err)?;
+            through(&mut std::io::stdout().lock()).map_err(err)?;
             Ok(Staged { path: path.to_path_buf(), temp: None })
         }
         Target::Special(p) => {
-            let file = std::fs::OpenOptions::new().write(true).open(&p).map_err(err)?;
-            let mut w = BufWriter::with_capacity(1 << 20, file);
-            fill(&mut w).and_then(|_| w.flush()).map_err(err)?;
+            let mut file = std::fs::OpenOptions::new().write(true).open(&p).map_err(err)?;
+            through(&mut file).map_err(err)?;
             Ok(Staged { path: path.to_path_buf(), temp: None })
         }
         Target::Regular(real) => {
             remove_stale_temporaries(&real);
-            let (temp, file) = Temporary::create_file(&real).map_err(err)?;
-            let mut w = BufWriter::with_capacity(1 << 20, file);
-            fill(&mut w).and_then(|_| w.flush()).map_err(err)?;
-            drop(w);
+            let (temp, mut file) = Temporary::create_file(&real).map_err(err)?;
+            through(&mut file).map_err(err)?;
             Ok(Staged { path: real, temp: Some(temp) })
         }
     }
@@ -208,23 +209,40 @@ pub fn remove_live_temporaries(then_exit: Option<i32>) {
 /// Removes the temporaries of `output` that an earlier run left behind
 /// (killed before it could clean up): names `.NAME.topovox-tmp-PID…`
 /// beside it whose process `PID` is gone. Only where that can be told
-/// (Linux's `/proc`); elsewhere they are left alone.
+/// (Linux's `/proc`); elsewhere they are left alone. Each folder is listed
+/// once per process (a batch writes thousands of outputs into one): the
+/// stale names found then are kept and removed output by output.
 pub fn remove_stale_temporaries(output: &Path) {
+    static STALE: Mutex<Option<HashMap<PathBuf, Vec<String>>>> = Mutex::new(None);
     let Some(name) = output.file_name().map(|n| n.to_string_lossy().into_owned()) else { return };
     let dir = match output.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
     let prefix = format!(".{name}{TEMP_MARK}");
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    for entry in entries.flatten() {
-        let file_name = entry.file_name();
-        let Some(rest) = file_name.to_str().and_then(|f| f.strip_prefix(&prefix)) else { continue };
-        let pid = rest.split('-').next().and_then(|p| p.parse::<u32>().ok());
-        if pid.is_some_and(process_is_gone) {
-            remove_path(&entry.path());
+    let mut stale = STALE.lock().unwrap_or_else(|e| e.into_inner());
+    let names = stale.get_or_insert_with(HashMap::new).entry(dir.to_path_buf()).or_insert_with(|| stale_in(dir));
+    names.retain(|n| {
+        let ours = n.starts_with(&prefix);
+        if ours {
+            remove_path(&dir.join(n));
         }
-    }
+        !ours
+    });
+}
+
+/// The names in `dir` of temporaries (`….topovox-tmp-PID…`) whose process
+/// is gone.
+fn stale_in(dir: &Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(dir) else { return Vec::new() };
+    entries
+        .flatten()
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter(|n| {
+            let pid = n.split_once(TEMP_MARK).and_then(|(_, rest)| rest.split('-').next()?.parse::<u32>().ok());
+            pid.is_some_and(process_is_gone)
+        })
+        .collect()
 }
 
 /// True when no process `pid` runs (Linux: no `/proc/PID`); false where it

@@ -5,19 +5,16 @@
 
 #![cfg(unix)]
 
+mod common;
+
 use std::path::{Path, PathBuf};
+
+use common::{leftovers, scratch};
 use std::time::Duration;
 
 use glam::DVec3;
 use topovox::{DenseBits, GridSpec};
 use topovox_io::{read_voxels, read_voxels_opts, read_voxels_sparse, write_voxels, ReadOptions, VoxelFormat};
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("topovox-hostile-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn grid(dims: [u32; 3]) -> GridSpec {
     GridSpec::new(DVec3::ZERO, 1.0, dims.map(u64::from)).unwrap()
@@ -196,18 +193,6 @@ fn writing_over_a_zarr_folder_that_is_not_ours_is_refused() {
     write_voxels(&d.join("empty.zarr"), VoxelFormat::Zarr, &some_voxels([8, 8, 8]), &grid([8, 8, 8])).unwrap();
     assert_eq!(read_voxels(&d.join("empty.zarr")).unwrap().bits.count(), 2);
     assert_eq!(leftovers(&d), Vec::<String>::new());
-}
-
-/// Temporaries or moved-aside folders left in `dir`.
-fn leftovers(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .flatten()
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.contains(".topovox-"))
-        .collect();
-    v.sort();
-    v
 }
 
 #[test]

@@ -5,26 +5,9 @@
 
 #![cfg(unix)]
 
-use std::path::{Path, PathBuf};
+mod common;
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("topovox-interrupt-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Temporaries left in `dir`.
-fn leftovers(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .flatten()
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.contains(".topovox-"))
-        .collect();
-    v.sort();
-    v
-}
+use common::{leftovers, scratch};
 
 #[test]
 fn live_temporaries_are_removed_on_request() {

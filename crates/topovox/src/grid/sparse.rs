@@ -321,6 +321,15 @@ impl SparseBricks {
         self.for_each_brick_run_in(keys, |b, bits, n| (0..n).for_each(|x| f([b[0] + x, b[1], b[2]], bits)));
     }
 
+    /// Whether any brick (or run of full bricks) lies in the brick layers
+    /// `layers`: two binary searches, without visiting the bricks.
+    pub fn any_in_layers(&self, layers: std::ops::Range<u32>) -> bool {
+        let keys = key([0, 0, layers.start])..key([0, 0, layers.end]);
+        let first = self.keys.partition_point(|&k| k < keys.start);
+        let first_run = self.full.partition_point(|&(k, _)| k < keys.start);
+        self.keys.get(first).is_some_and(|k| keys.contains(k)) || self.full.get(first_run).is_some_and(|(k, _)| keys.contains(k))
+    }
+
     /// The same voxels, dense.
     pub fn to_dense(&self) -> DenseBits {
         let mut d = DenseBits::new(self.dims);

@@ -182,9 +182,7 @@ pub fn certify_sparse(bits: &SparseBricks, mesh: Option<(MeshRef<'_>, &GridSpec)
         // nothing to count, join or separate: skipped without building its
         // brick index or rows, so an empty stretch of a vast grid costs
         // nothing.
-        let mut any = false;
-        bits.for_each_brick_in_layers(layers_held.clone(), |_, _| any = true);
-        if !any && bin.is_empty() {
+        if bin.is_empty() && !bits.any_in_layers(layers_held.clone()) {
             pass.empty_window(&owned);
             continue;
         }

@@ -278,6 +278,17 @@ pub(crate) fn from_brick_rows(dims: [u32; 3], rows: impl IntoIterator<Item = Bri
     SparseBricks::from_sorted(dims, bricks, full)
 }
 
+/// The brick rows `(bk, bj)` holding the voxel rows `rows` (`k·ny + j`),
+/// sorted, each once.
+pub(crate) fn brick_rows_of(rows: impl Iterator<Item = u32>, dims: [u32; 3]) -> Vec<(u32, u32)> {
+    let ny = dims[1];
+    let mut out: Vec<(u32, u32)> = rows.map(|r| (r / ny / BRICK, r % ny / BRICK)).collect();
+    out.dedup();
+    out.par_sort_unstable();
+    out.dedup();
+    out
+}
+
 /// A sparse grid built brick row by brick row in parallel: `row(bj, bk)`
 /// gives each row's bricks and full runs, for the brick rows `rows`
 /// (`(bk, bj)`, sorted) only: the others hold nothing.
@@ -348,11 +359,7 @@ fn fill_sparse(snapped: &Snapped, dims: [u32; 3], rule: Rule) -> (SparseBricks, 
     // Only brick rows some ray crossing lies in can hold inside voxels (a
     // row without crossings is outside under either rule): the work and
     // memory follow the surface, not the grid's rows.
-    let ny = dims[1] as u64;
-    let mut rows: Vec<(u32, u32)> = hits.iter().map(|h| ((h.0 as u64 / ny) as u32 / BRICK, (h.0 as u64 % ny) as u32 / BRICK)).collect();
-    rows.dedup();
-    rows.par_sort_unstable();
-    rows.dedup();
+    let rows = brick_rows_of(hits.iter().map(|h| h.0), dims);
     let out = by_brick_rows_in(dims, rows, |bj, bk| brick_row(&hits, dims, bj, bk, rule));
     drop(hits);
     let mut rep = inspect(snapped);

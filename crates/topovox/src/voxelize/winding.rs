@@ -40,7 +40,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
-use super::solid::{bricks_of_spans, by_brick_rows_in, push_span, SolidReport};
+use super::solid::{brick_rows_of, bricks_of_spans, by_brick_rows_in, push_span, SolidReport};
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::{orient, P3};
@@ -598,12 +598,7 @@ impl Plan {
     /// of a crossing or a span that needs the caps (elsewhere `J = 0` and
     /// the caps are settled below ½: outside).
     fn brick_rows(&self) -> Vec<(u32, u32)> {
-        let ny = self.dims[1];
-        let of = |r: u32| (r / ny / BRICK, r % ny / BRICK);
-        let mut rows: Vec<(u32, u32)> = self.hits.iter().map(|h| of(h.0)).chain(self.needed.iter().map(|s| of(s.row))).collect();
-        rows.par_sort_unstable();
-        rows.dedup();
-        rows
+        brick_rows_of(self.hits.iter().map(|h| h.0).chain(self.needed.iter().map(|s| s.row)), self.dims)
     }
 
     /// Appends the inside spans of row `r` (`k·ny + j`) to `out`, in
