@@ -10,6 +10,8 @@
 //!   are new NumPy arrays.
 //! - The GIL is released while meshes load, voxelize, carry colours, write
 //!   and check (`Python::detach`).
+//! - Ctrl-C stops `voxelize`, `VoxelGrid.save` and `batch` within about a
+//!   second, with `KeyboardInterrupt` and no output ([`interruptible`]).
 //! - Errors are Python exceptions with the CLI's one-line messages:
 //!   `ValueError` for bad arguments and bad arrays, `OSError` subclasses
 //!   for files (`FileNotFoundError`, `PermissionError`, or
@@ -22,12 +24,15 @@ use std::sync::Arc;
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{
+    PyFileNotFoundError, PyIsADirectoryError, PyKeyboardInterrupt, PyOSError, PyPermissionError, PyRuntimeError, PyValueError,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use serde_json::Value;
 use topovox::attributes::carry::CarryOptions;
 use topovox::attributes::{ColourRule, VoxelAttributes, NO_MATERIAL};
+use topovox::voxelize::Stop;
 use topovox::{GridSpec, VoxelSource};
 use topovox_io::LoadedMesh;
 use topovox_job::{GridOptions, GridRequest, JobError, Voxels};
@@ -40,7 +45,43 @@ fn py_err(e: JobError) -> PyErr {
         JobError::Invalid(m) => PyValueError::new_err(m),
         JobError::Failed(m) => PyRuntimeError::new_err(m),
         JobError::Io(io) => io_err(io),
+        JobError::Interrupted => PyKeyboardInterrupt::new_err("interrupted"),
     }
+}
+
+/// How often [`interruptible`] looks for a signal while the work runs.
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// Runs `work` on a thread of its own, without the GIL, while this thread
+/// runs Python's signal handlers every [`SIGNAL_POLL`]. When one raises
+/// (Ctrl-C: `KeyboardInterrupt`), `stop` is requested, the work is waited
+/// for (it gives up at its next look at `stop`: a slab, tile, brick row,
+/// mesh or buffered write) and the handler's exception is raised; what the
+/// work made is dropped. Outside the main thread Python runs no signal
+/// handlers, and this only runs the work.
+fn interruptible<T: Send>(py: Python<'_>, stop: &Stop, work: impl FnOnce() -> T + Send) -> PyResult<T> {
+    std::thread::scope(|s| {
+        let waiting = std::thread::current();
+        // The stack of the main thread the work would otherwise run on.
+        let worker = std::thread::Builder::new()
+            .stack_size(8 << 20)
+            .spawn_scoped(s, move || {
+                let r = work();
+                waiting.unpark();
+                r
+            })
+            .map_err(|e| PyRuntimeError::new_err(format!("cannot start a worker thread: {e}")))?;
+        while !worker.is_finished() {
+            py.detach(|| std::thread::park_timeout(SIGNAL_POLL));
+            if let Err(e) = py.check_signals() {
+                stop.request();
+                // Its result (incomplete, or an Interrupted error) is dropped.
+                let _ = py.detach(|| worker.join());
+                return Err(e);
+            }
+        }
+        worker.join().map_err(|p| std::panic::resume_unwind(p))
+    })
 }
 
 fn io_err(e: topovox_io::IoError) -> PyErr {
@@ -425,14 +466,16 @@ impl VoxelGrid {
         let target = topovox_job::output::output_format(format.as_deref(), &path).map_err(py_err)?;
         topovox_job::output::check_output_path(&path).map_err(py_err)?;
         let blocks = block_palette.as_deref().map(topovox_io::schem::BlockPalette::read).transpose().map_err(io_err)?;
+        let stop = Arc::new(Stop::new());
         let opts = topovox_io::WriteOptions {
             dither,
             blocks,
             up: up_of(up)?,
             mesh: topovox_io::voxel_mesh::MeshOptions { watertight, triangulate },
+            stop: Some(stop.clone()),
         };
-        let inner = self.inner.clone();
-        py.detach(move || topovox_job::output::write(&path, target, &inner.voxels, &inner.grid, inner.attrs.as_ref(), &opts))
+        let inner = &self.inner;
+        interruptible(py, &stop, || topovox_job::output::write(&path, target, &inner.voxels, &inner.grid, inner.attrs.as_ref(), &opts))?
             .map_err(py_err)?;
         Ok(())
     }
@@ -660,28 +703,28 @@ fn voxelize(
     let plan = plan_of(mode, method, &grid, surface, fill, hollow, gpu_path, seed, tile, max_memory).map_err(py_err)?;
     let carry = CarryOptions { rule: self::colour_rule(colour_rule).map_err(py_err)?, normals };
     let pool = threads.map(topovox_job::pool).transpose().map_err(py_err)?;
-    let inner = mesh.inner.clone();
+    let inner = &mesh.inner;
     let name = mesh.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into());
-    let data = py
-        .detach(move || {
-            let run = || -> Result<GridData, JobError> {
-                let v = topovox_job::voxelize(&plan, inner.mesh.as_ref(), &name, None)?;
-                let attrs = if attributes && !plan.is_line() {
-                    topovox_job::check_attributes_carried(&plan, &v)?;
-                    topovox_job::attributes(&plan, inner.mesh.as_ref(), &inner.appearance, &v, &carry)
-                } else {
-                    None
-                };
-                let mut facts = v.facts(&plan);
-                facts["warnings"] = serde_json::json!(v.warnings);
-                Ok(GridData { voxels: v.voxels, grid: v.grid, attrs, facts })
+    let stop = Stop::new();
+    let data = interruptible(py, &stop, || {
+        let run = || -> Result<GridData, JobError> {
+            let v = topovox_job::voxelize(&plan, inner.mesh.as_ref(), &name, None, Some(&stop))?;
+            let attrs = if attributes && !plan.is_line() {
+                topovox_job::check_attributes_carried(&plan, &v)?;
+                topovox_job::attributes(&plan, inner.mesh.as_ref(), &inner.appearance, &v, &carry)
+            } else {
+                None
             };
-            match pool {
-                Some(p) => p.install(run),
-                None => run(),
-            }
-        })
-        .map_err(py_err)?;
+            let mut facts = v.facts(&plan);
+            facts["warnings"] = serde_json::json!(v.warnings);
+            Ok(GridData { voxels: v.voxels, grid: v.grid, attrs, facts })
+        };
+        match pool {
+            Some(p) => p.install(run),
+            None => run(),
+        }
+    })?
+    .map_err(py_err)?;
     Ok(VoxelGrid { inner: Arc::new(data) })
 }
 
@@ -801,6 +844,7 @@ fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(topovox
             blocks: None,
             up: up_axis,
             mesh: topovox_io::voxel_mesh::MeshOptions { watertight, triangulate },
+            stop: None,
         },
         threads,
         read: topovox_io::ReadOptions {
@@ -832,16 +876,16 @@ fn batch<'py>(
     if let Some(n) = jobs {
         topovox_job::check_threads(n, "jobs").map_err(py_err)?;
     }
-    let summary = py
-        .detach(move || -> Result<topovox_job::batch::Summary, JobError> {
-            let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref())?;
-            let ext = opts.format.name().replace("npy-bool", "npy");
-            let items = topovox_job::batch::plan_items(&files, &out_dir, &ext)?;
-            let pool =
-                topovox_job::pool_for(jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)), "jobs")?;
-            pool.install(|| topovox_job::batch::run(&items, &out_dir, &opts, &topovox_job::batch::Silent))
-        })
-        .map_err(py_err)?;
+    let stop = Arc::new(Stop::new());
+    let summary = interruptible(py, &stop, || -> Result<topovox_job::batch::Summary, JobError> {
+        let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref())?;
+        let ext = opts.format.name().replace("npy-bool", "npy");
+        let items = topovox_job::batch::plan_items(&files, &out_dir, &ext)?;
+        let pool =
+            topovox_job::pool_for(jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)), "jobs")?;
+        pool.install(|| topovox_job::batch::run(&items, &out_dir, &opts, &topovox_job::batch::Silent, Some(&stop)))
+    })?
+    .map_err(py_err)?;
     to_py(py, &summary.to_json())
 }
 
@@ -887,7 +931,8 @@ fn process_one<'py>(
     let (mut opts, _) = batch_options(options.unwrap_or(&empty), format)?;
     opts.threads = opts.threads.or(Some(1));
     let item = topovox_job::batch::Item { input, output };
-    let record = py.detach(move || topovox_job::batch::process_one(&item, &opts));
+    // One mesh, run by a Dask or Ray worker (which interrupts its tasks its own way).
+    let record = py.detach(move || topovox_job::batch::process_one(&item, &opts, None));
     to_py(py, &record)
 }
 

@@ -178,6 +178,27 @@ fn max_memory_is_kept_or_the_run_is_refused_before_work() {
 }
 
 #[test]
+fn max_memory_is_kept_by_solids_of_open_meshes_or_refused_before_work() {
+    let d = folder("memory-solid");
+    let mesh = repo("../shared/meshes/stanford-bunny.obj");
+    let out = d.join("bunny.vdb");
+    let run = |bound: &str| {
+        topovox(&["voxelize", s(&mesh), "-o", s(&out), "--mode", "solid", "--resolution", "2048", "--max-memory", bound, "--json"])
+    };
+    // The generalized winding number, band by band: it peaked at 188 MB
+    // under 96M before, its crossings and cap spans held for the whole grid.
+    let e = refused(&run("48M"));
+    assert!(e.contains("the solid on the") && e.contains("needs about"), "{e}");
+    assert!(!out.exists());
+    let o = run("96M");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["method"], "winding", "{v}");
+    let peak = v["peak_memory_bytes"].as_u64().unwrap();
+    assert!(peak <= 96 << 20, "peak {peak} bytes over the 96 MiB bound");
+}
+
+#[test]
 fn a_small_solid_in_a_vast_grid_follows_its_surface() {
     let d = folder("vast-solid");
     let tet = d.join("tet.obj");

@@ -23,6 +23,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 
+use topovox::voxelize::Stop;
+
 use crate::error::{ErrorKind, IoError};
 
 /// Where [`write_atomically`] puts the bytes for `path`.
@@ -55,6 +57,51 @@ pub fn target(path: &Path) -> Target {
 /// untouched), directly for special files and standard output.
 pub fn write_atomically(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<(), IoError> {
     stage(path, fill)?.commit()
+}
+
+/// [`write_atomically`] that gives up once `stop` is requested: the
+/// writes fail from then on, and a complete temporary file is removed
+/// rather than put in place, so a stopped write leaves `path` as it was
+/// (a special file or standard output keeps what was written before).
+pub fn write_atomically_until(
+    path: &Path,
+    stop: Option<&Stop>,
+    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), IoError> {
+    let staged = stage(path, |w| fill(&mut Stopping { out: w, stop }))?;
+    check_stop(stop).map_err(|e| IoError::new(path, ErrorKind::Write(e)))?;
+    staged.commit()
+}
+
+/// The error of a write given up because a stop was requested.
+pub fn stopped() -> std::io::Error {
+    // Not `ErrorKind::Interrupted`: `write_all` retries those.
+    std::io::Error::other("interrupted")
+}
+
+/// `Err(`[`stopped`]`)` once `stop` is requested.
+pub fn check_stop(stop: Option<&Stop>) -> std::io::Result<()> {
+    match stop {
+        Some(s) if s.requested() => Err(stopped()),
+        _ => Ok(()),
+    }
+}
+
+/// A writer that fails once a stop is requested.
+struct Stopping<'a, 'b> {
+    out: &'a mut dyn Write,
+    stop: Option<&'b Stop>,
+}
+
+impl Write for Stopping<'_, '_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        check_stop(self.stop)?;
+        self.out.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.out.flush()
+    }
 }
 
 /// Output written but not yet in place: for a regular file, a complete

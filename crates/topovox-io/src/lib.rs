@@ -256,6 +256,9 @@ pub struct WriteOptions {
     pub up: orient::Up,
     /// `.obj` and `.glb` meshes of the voxels: watertight, triangles.
     pub mesh: voxel_mesh::MeshOptions,
+    /// Once requested, the write fails and nothing is put in place (see
+    /// [`atomic::write_atomically_until`]). Default: none.
+    pub stop: Option<std::sync::Arc<topovox::voxelize::Stop>>,
 }
 
 /// [`write_voxels`] with per-voxel attributes (colours for `.vox`,
@@ -276,9 +279,9 @@ pub fn write_voxels_with(
                 ErrorKind::Write(std::io::Error::other("a Zarr array is a directory; give a path ending in .zarr")),
             ));
         }
-        return zarr::write(path, bits, grid, attrs);
+        return zarr::write(path, bits, grid, attrs, opts.stop.as_deref());
     }
-    atomic::write_atomically(path, |w| match format {
+    atomic::write_atomically_until(path, opts.stop.as_deref(), |w| match format {
         VoxelFormat::Npy => npy::write(w, bits, npy::Dtype::U8),
         VoxelFormat::NpyBool => npy::write(w, bits, npy::Dtype::Bool),
         VoxelFormat::Binvox => binvox::write(w, bits, grid),

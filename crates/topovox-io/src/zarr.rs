@@ -51,6 +51,7 @@ use serde_json::{json, Value};
 use topovox::attributes::{VoxelAttributes, NO_MATERIAL};
 use topovox::grid::bricks::{set_in_brick, Brick};
 use topovox::grid::sparse::SparseBricks;
+use topovox::voxelize::Stop;
 use topovox::{GridSpec, VoxelSource};
 
 use crate::atomic::Temporary;
@@ -223,13 +224,21 @@ fn io(path: &Path, e: std::io::Error) -> IoError {
 /// array per attribute. An existing `path` is replaced only if it is an
 /// empty folder or an array or group topovox wrote, holding nothing else
 /// ([`check_replaceable`]); the new one is written to a temporary folder
-/// beside it first.
-pub fn write(path: &Path, bits: &dyn VoxelSource, grid: &GridSpec, attrs: Option<&VoxelAttributes>) -> Result<(), IoError> {
+/// beside it first. Once `stop` is requested the shards left are not
+/// written and the temporary folder is removed ([`crate::atomic::stopped`]).
+pub fn write(
+    path: &Path,
+    bits: &dyn VoxelSource,
+    grid: &GridSpec,
+    attrs: Option<&VoxelAttributes>,
+    stop: Option<&Stop>,
+) -> Result<(), IoError> {
     check_replaceable(path)?;
     crate::atomic::remove_stale_temporaries(path);
     let tmp = Temporary::create_dir(path).map_err(|e| io(path, e))?;
     let extra = attrs.map(attribute_arrays).unwrap_or_default();
-    fill_all(tmp.path(), bits, grid, extra).map_err(|e| io(path, e))?;
+    fill_all(tmp.path(), bits, grid, extra, stop).map_err(|e| io(path, e))?;
+    crate::atomic::check_stop(stop).map_err(|e| io(path, e))?;
     replace(tmp, path).map_err(|e| io(path, e))
 }
 
@@ -288,9 +297,9 @@ pub fn check_replaceable(path: &Path) -> Result<(), IoError> {
 
 /// The occupancy array at `dir`, or with `extra` arrays a group there
 /// holding `voxels` and them.
-fn fill_all(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec, extra: Vec<Kind<'_>>) -> std::io::Result<()> {
+fn fill_all(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec, extra: Vec<Kind<'_>>, stop: Option<&Stop>) -> std::io::Result<()> {
     if extra.is_empty() {
-        return fill(dir, bits, grid, &[occupancy()]);
+        return fill(dir, bits, grid, &[occupancy()], stop);
     }
     std::fs::create_dir_all(dir)?;
     let names: Vec<&str> = std::iter::once("voxels").chain(extra.iter().map(|k| k.name)).collect();
@@ -300,12 +309,12 @@ fn fill_all(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec, extra: Vec<Kind
     std::fs::write(dir.join("zarr.json"), serde_json::to_vec_pretty(&group).map_err(std::io::Error::other)?)?;
     let mut kinds = vec![occupancy()];
     kinds.extend(extra);
-    fill(dir, bits, grid, &kinds)
+    fill(dir, bits, grid, &kinds, stop)
 }
 
 /// Writes each of `kinds` as an array: at `dir` itself for the occupancy
 /// alone, else at `dir/NAME`. The bricks are gathered and sorted once.
-fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec, kinds: &[Kind<'_>]) -> std::io::Result<()> {
+fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec, kinds: &[Kind<'_>], stop: Option<&Stop>) -> std::io::Result<()> {
     let alone = kinds.len() == 1;
     let dir_of = |k: &Kind<'_>| if alone { dir.to_path_buf() } else { dir.join(k.name) };
     for k in kinds {
@@ -327,6 +336,7 @@ fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec, kinds: &[Kind<'_>])
     let shards = crate::runs(&bricks, |(b, _)| shard_of(chunk_of(b)));
     let work: Vec<(&Kind<'_>, &std::ops::Range<usize>)> = kinds.iter().flat_map(|k| shards.iter().map(move |r| (k, r))).collect();
     work.par_iter().try_for_each(|&(kind, r)| -> std::io::Result<()> {
+        crate::atomic::check_stop(stop)?;
         let s = shard_of(chunk_of(&bricks[r.start].0));
         let mut body = Vec::new();
         let mut index = vec![EMPTY; 2 * (inner[0] * inner[1] * inner[2]) as usize];
@@ -998,7 +1008,7 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         let out = dir.join("v.zarr");
-        write(&out, &d, &grid, None).unwrap();
+        write(&out, &d, &grid, None, None).unwrap();
         let back = read(&out, &ReadOptions::default()).unwrap();
         assert_eq!(back.bits, d);
         assert_eq!(back.placement, Some((grid.origin(), 0.25)));
@@ -1007,12 +1017,12 @@ mod tests {
         // Writing again replaces the array; a non-Zarr directory is refused.
         let mut e = DenseBits::new(dims);
         e.set(5, 5, 5);
-        write(&out, &e, &grid, None).unwrap();
+        write(&out, &e, &grid, None, None).unwrap();
         assert_eq!(read(&out, &ReadOptions::default()).unwrap().bits, e);
         let other = dir.join("other.zarr");
         std::fs::create_dir_all(&other).unwrap();
         std::fs::write(other.join("keep.txt"), "mine").unwrap();
-        assert!(write(&other, &e, &grid, None).is_err());
+        assert!(write(&other, &e, &grid, None, None).is_err());
         assert_eq!(std::fs::read_to_string(other.join("keep.txt")).unwrap(), "mine");
         let _ = std::fs::remove_dir_all(&dir);
     }
@@ -1036,7 +1046,7 @@ mod tests {
         let grid = GridSpec::new(glam::DVec3::ZERO, 1.0, dims.map(|x| x as u64)).unwrap();
         let dir = scratch("shards");
         let out = dir.join("v.zarr");
-        write(&out, &d, &grid, None).unwrap();
+        write(&out, &d, &grid, None, None).unwrap();
         assert_eq!(read(&out, &ReadOptions::default()).unwrap().bits, d);
         assert_eq!(read_sparse(&out, false, &ReadOptions::default()).unwrap().bits.to_dense(), d);
         assert!(out.join("c/0/0/0").is_file() && !out.join("c/1/0/0").exists() && out.join("c/2/0/0").is_file());
@@ -1073,7 +1083,7 @@ mod tests {
         d.set(1, 1, 1);
         let grid = GridSpec::new(glam::DVec3::ZERO, 1.0, [8, 8, 8]).unwrap();
         let sharded = dir.join("s.zarr");
-        write(&sharded, &d, &grid, None).unwrap();
+        write(&sharded, &d, &grid, None, None).unwrap();
         let f = sharded.join("c/0/0/0");
         let mut shard = std::fs::read(&f).unwrap();
         let n = shard.len();
@@ -1108,7 +1118,7 @@ mod tests {
         let grid = GridSpec::new(glam::DVec3::new(0.5, 1.0, -2.0), 0.125, dims.map(|x| x as u64)).unwrap();
         let dir = scratch("attrs");
         let out = dir.join("a.zarr");
-        write(&out, &d, &grid, Some(&attrs)).unwrap();
+        write(&out, &d, &grid, Some(&attrs), None).unwrap();
         let m: Value = serde_json::from_slice(&std::fs::read(out.join("zarr.json")).unwrap()).unwrap();
         assert_eq!(m["node_type"], "group");
         let c: Value = serde_json::from_slice(&std::fs::read(out.join("colour/zarr.json")).unwrap()).unwrap();
@@ -1124,7 +1134,7 @@ mod tests {
         assert_eq!((with.attributes.as_ref(), with.attributes_left), (Some(&attrs), false), "the sparse reader reads the same attributes");
         assert_eq!(sparse.bits.full_bricks(), 1, "the full brick is read as a run");
         // Without attributes: the plain array, as before.
-        write(&out, &d, &grid, None).unwrap();
+        write(&out, &d, &grid, None, None).unwrap();
         let m: Value = serde_json::from_slice(&std::fs::read(out.join("zarr.json")).unwrap()).unwrap();
         assert_eq!(m["node_type"], "array");
         assert_eq!(m["codecs"][0]["configuration"]["codecs"][0], json!({"name": "bytes"}));

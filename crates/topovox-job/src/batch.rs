@@ -23,12 +23,13 @@
 use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use topovox::attributes::carry::CarryOptions;
+use topovox::voxelize::Stop;
 use topovox_io::WriteOptions;
 
 use crate::error::{JobError, Result};
@@ -265,8 +266,10 @@ impl Manifest {
 }
 
 /// Voxelizes one mesh and writes its output; never fails: a failure is
-/// the record's `error`. The record is what the manifest gets.
-pub fn process_one(item: &Item, opts: &BatchOptions) -> Value {
+/// the record's `error`. The record is what the manifest gets, unless its
+/// `status` is `"interrupted"` (`stop` was requested: nothing was
+/// written, and the mesh is to be done again).
+pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -> Value {
     let t0 = Instant::now();
     let mut record = json!({
         "input": item.input.display().to_string(),
@@ -285,12 +288,13 @@ pub fn process_one(item: &Item, opts: &BatchOptions) -> Value {
         crate::output::refuse_overwriting(&item.output, opts.format, &loaded.sources)?;
         let name = item.input.display().to_string();
         let run = || -> Result<Value> {
-            let v = crate::voxelize(&opts.plan, loaded.mesh.as_ref(), &name, None)?;
+            let v = crate::voxelize(&opts.plan, loaded.mesh.as_ref(), &name, None, stop.map(|s| &**s))?;
             let t = Instant::now();
             let attrs = crate::run::attributes_for(&opts.plan, &loaded, &v, opts.format, (false, opts.attributes), &opts.carry)?;
             let attributes_s = t.elapsed().as_secs_f64();
             let t = Instant::now();
-            crate::output::write(&item.output, opts.format, &v.voxels, &v.grid, attrs.as_ref(), &opts.write)?;
+            let write = topovox_io::WriteOptions { stop: stop.cloned(), ..opts.write.clone() };
+            crate::output::write(&item.output, opts.format, &v.voxels, &v.grid, attrs.as_ref(), &write)?;
             let write_s = t.elapsed().as_secs_f64();
             let o = v.grid.origin();
             let mut warnings = loaded.warnings.clone();
@@ -317,6 +321,10 @@ pub fn process_one(item: &Item, opts: &BatchOptions) -> Value {
             record["status"] = json!("done");
             record["output_bytes"] = json!(std::fs::metadata(&item.output).map(|m| m.len()).ok());
             record["error"] = Value::Null;
+        }
+        Err(JobError::Interrupted) => {
+            record["status"] = json!("interrupted");
+            record["error"] = json!(JobError::Interrupted.to_string());
         }
         Err(e) => {
             record["status"] = json!("failed");
@@ -367,8 +375,10 @@ impl Summary {
 }
 
 /// Runs a whole batch on the current rayon pool (meshes in parallel, each
-/// voxelized in parallel too, on the same pool).
-pub fn run(items: &[Item], out_dir: &Path, opts: &BatchOptions, progress: &dyn BatchProgress) -> Result<Summary> {
+/// voxelized in parallel too, on the same pool). Once `stop` is requested
+/// no mesh is started, those under way give up, none of them is recorded,
+/// and the result is [`JobError::Interrupted`]: a later run does them.
+pub fn run(items: &[Item], out_dir: &Path, opts: &BatchOptions, progress: &dyn BatchProgress, stop: Option<&Arc<Stop>>) -> Result<Summary> {
     if let Some(n) = opts.threads {
         crate::check_threads(n, "threads")?;
     }
@@ -380,8 +390,15 @@ pub fn run(items: &[Item], out_dir: &Path, opts: &BatchOptions, progress: &dyn B
     progress.start(items.len() as u64, skipped);
     let failed = std::sync::atomic::AtomicU64::new(0);
     let first_error = Mutex::new(None);
+    let stopped = || stop.is_some_and(|s| s.requested());
     todo.par_iter().with_max_len(1).for_each(|item| {
-        let record = process_one(item, opts);
+        if stopped() {
+            return;
+        }
+        let record = process_one(item, opts, stop);
+        if record["status"] == "interrupted" {
+            return;
+        }
         if record["status"] != "done" {
             failed.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         }
@@ -392,6 +409,9 @@ pub fn run(items: &[Item], out_dir: &Path, opts: &BatchOptions, progress: &dyn B
     });
     if let Some(e) = first_error.into_inner().unwrap_or_else(|e| e.into_inner()) {
         return Err(e);
+    }
+    if stopped() {
+        return Err(JobError::Interrupted);
     }
     let failed = failed.into_inner();
     Ok(Summary {

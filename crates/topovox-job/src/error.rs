@@ -14,6 +14,10 @@ pub enum JobError {
     /// memory, a device error).
     #[error("{0}")]
     Failed(String),
+    /// The caller asked the job to stop ([`topovox::voxelize::Stop`]);
+    /// whatever it had done was discarded, nothing was written.
+    #[error("interrupted")]
+    Interrupted,
 }
 
 impl JobError {

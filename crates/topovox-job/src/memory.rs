@@ -77,6 +77,30 @@ pub fn tiled_estimate(mesh: MeshRef<'_>, grid: &GridSpec) -> TiledEstimate {
     TiledEstimate { bricks: bricks + segments, bytes: (bricks + segments) * BYTES_PER_BRICK + prims + (24 << 20) }
 }
 
+/// Bytes per triangle a sparse solid holds beyond a tiled surface: the
+/// snapped triangles, the copy closed by caps, and their band bins.
+const SOLID_BYTES_PER_TRIANGLE: u64 = 160;
+
+/// Bytes per surface brick a sparse solid holds beyond a tiled surface:
+/// the runs of full bricks between them, and one band's ray crossings and
+/// cap spans. Measured (with the terms above) on the bunny at 4096 and
+/// 8192 (28–29 bytes a brick past the rest) and the cow at 4096, solid
+/// and flood-filled (the cow's flood fill peaks at 120 MiB, estimated
+/// 132), to stay above the peak (2026-11-27).
+const SOLID_BYTES_PER_BRICK: u64 = 40;
+
+/// The memory a sparse solid of `mesh` on `grid` needs: the bricks the
+/// surface meets (the only ones stored; the interior is runs of full
+/// bricks) as for a tiled surface, and as many again for a flood fill
+/// (the tiled shell and the solid are both held, and its planes' runs),
+/// the runs and one band's crossings, and the triangles' copies.
+pub fn sparse_solid_estimate(mesh: MeshRef<'_>, grid: &GridSpec, flood: bool) -> TiledEstimate {
+    let e = tiled_estimate(mesh, grid);
+    let shell = if flood { e.bricks * (BYTES_PER_BRICK + SOLID_BYTES_PER_BRICK) } else { 0 };
+    let solid = e.bricks * SOLID_BYTES_PER_BRICK + mesh.triangles.len() as u64 * SOLID_BYTES_PER_TRIANGLE;
+    TiledEstimate { bricks: e.bricks, bytes: e.bytes + shell + solid }
+}
+
 /// Parses a memory size: bytes, or a number with `K`, `M`, `G`, `T`
 /// (powers of 1024; `KiB`/`KB`/… accepted the same), e.g. `8G`, `1.5GiB`.
 pub fn parse_size(s: &str) -> Result<u64> {

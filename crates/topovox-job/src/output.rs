@@ -157,7 +157,9 @@ pub fn check_output_path(out: &Path) -> Result<()> {
 /// Writes `bits` (with `attrs`) to `out` as `target`; returns facts for
 /// the summaries. A dense format (or a mesh of the voxels) for a grid that
 /// cannot be held densely is refused before anything is written
-/// ([`check_fits`]), whichever front end asks.
+/// ([`check_fits`]), whichever front end asks. Once `opts.stop` is
+/// requested the result is [`JobError::Interrupted`] and `out` is left as
+/// it was.
 pub fn write(
     out: &Path,
     target: Output,
@@ -165,6 +167,22 @@ pub fn write(
     grid: &GridSpec,
     attrs: Option<&VoxelAttributes>,
     opts: &WriteOptions,
+) -> Result<Value> {
+    let stopped = || opts.stop.as_ref().is_some_and(|s| s.requested());
+    match write_unless_stopped(out, target, bits, grid, attrs, opts, &stopped) {
+        Err(_) if stopped() => Err(JobError::Interrupted),
+        r => r,
+    }
+}
+
+fn write_unless_stopped(
+    out: &Path,
+    target: Output,
+    bits: &dyn VoxelSource,
+    grid: &GridSpec,
+    attrs: Option<&VoxelAttributes>,
+    opts: &WriteOptions,
+    stopped: &dyn Fn() -> bool,
 ) -> Result<Value> {
     check_fits(target, grid, None)?;
     match target {
@@ -185,6 +203,9 @@ pub fn write(
                 }
                 None => (None, topovox::export::greedy::greedy_quads(&dense)),
             };
+            if stopped() {
+                return Err(JobError::Interrupted);
+            }
             let vertices = match kind {
                 MeshKind::Obj => topovox_io::voxel_mesh::write_quads_obj(out, &quads, grid, palette.as_deref(), &opts.mesh)?,
                 MeshKind::Glb => topovox_io::voxel_mesh::write_quads_glb(out, &quads, grid, palette.as_deref(), &opts.mesh)?,

@@ -8,7 +8,7 @@ use topovox::attributes::carry::{carry, CarryOptions};
 use topovox::attributes::{Appearance, VoxelAttributes};
 use topovox::grid::bricks::BrickBits;
 use topovox::grid::sparse::SparseBricks;
-use topovox::voxelize::{self, Options, Progress, Report};
+use topovox::voxelize::{self, Options, Progress, Report, Stop};
 use topovox::{DenseBits, GridSpec, MeshRef, VoxelSource};
 
 use crate::error::{JobError, Result};
@@ -90,8 +90,10 @@ pub struct Voxelized {
 }
 
 /// Runs `plan` on `mesh` (named `name` in messages) on the grid its request
-/// fits to `bounds`. Runs on the current rayon pool.
-pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dyn Progress>) -> Result<Voxelized> {
+/// fits to `bounds`. Runs on the current rayon pool. Once `stop` is
+/// requested the work left is skipped and the result is
+/// [`JobError::Interrupted`].
+pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dyn Progress>, stop: Option<&Stop>) -> Result<Voxelized> {
     let mut warnings = Vec::new();
     let is_line = plan.is_line();
     if !is_line && mesh.triangles.is_empty() {
@@ -123,16 +125,21 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
     } else {
         plan.surface_method
     };
-    let mut opts = Options { progress, ..Options::default() };
-    if let (Some(_), None) = (tile, &plan.solid) {
-        // A tiled surface holds its non-empty bricks: refused before any
-        // work when they would not fit, and reserved at once otherwise.
-        let mut e = crate::memory::tiled_estimate(mesh, &grid);
+    let mut opts = Options { progress, stop, ..Options::default() };
+    if tile.is_some() {
+        // A tiled surface (or sparse solid) holds its non-empty bricks:
+        // refused before any work when they would not fit, and reserved at
+        // once otherwise.
+        let mut e = match &plan.solid {
+            None => crate::memory::tiled_estimate(mesh, &grid),
+            Some(sp) => crate::memory::sparse_solid_estimate(mesh, &grid, sp.method == crate::plan::SolidMethod::Flood),
+        };
         e.bytes += e.bricks * plan.request.writer_bytes_per_brick;
         if e.bytes > budget {
             let [x, y, z] = grid.dims();
             return Err(JobError::failed(format!(
-                "{name}: the surface on the {x}x{y}x{z} grid needs about {} (up to {} bricks of 8x8x8 voxels), more than the {} this run may use; raise --max-memory or lower the resolution",
+                "{name}: the {} on the {x}x{y}x{z} grid needs about {} (up to {} bricks of 8x8x8 voxels), more than the {} this run may use; raise --max-memory or lower the resolution",
+                if plan.solid.is_some() { "solid" } else { "surface" },
                 crate::memory::bytes(e.bytes),
                 e.bricks,
                 crate::memory::bytes(budget)
@@ -196,6 +203,9 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
         };
         (v, r, surface_method.name(), Value::Null)
     };
+    if stop.is_some_and(Stop::requested) {
+        return Err(JobError::Interrupted);
+    }
     let voxelize_s = t.elapsed().as_secs_f64();
     let p = report.prepare;
     if report.voxels == 0 {

@@ -4,7 +4,7 @@
 use serde_json::{json, Value};
 use topovox::grid::dense::DenseBits;
 use topovox::grid::sparse::SparseBricks;
-use topovox::voxelize::{self, fill, solid, winding, Options};
+use topovox::voxelize::{self, fill, solid, winding, Options, Stop};
 use topovox::{GridSpec, MeshRef};
 
 use crate::error::{JobError, Result};
@@ -37,6 +37,8 @@ fn gpu_parity(_mesh: MeshRef<'_>, _grid: &GridSpec) -> Result<(DenseBits, solid:
 
 /// Makes the solid `plan` asks for; `name` names the mesh in warnings.
 pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opts: &Options<'_>) -> Result<Outcome> {
+    let never = Stop::new();
+    let stop = opts.stop.unwrap_or(&never);
     let mut warnings = Vec::new();
     let (mut bits, method, mut facts) = if plan.method == SolidMethod::Flood {
         let surface = plan.surface.unwrap_or(voxelize::Mode::Cover);
@@ -64,19 +66,19 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
                 if !watertight {
                     warnings.push(format!("{}: ray parity may streak through holes", open()));
                 }
-                let (b, r) = solid::parity_snapped(&snapped, dims);
+                let (b, r) = solid::parity_snapped(&snapped, dims, stop);
                 (b, r, "parity")
             }
             SolidMethod::Auto if watertight => {
-                let (b, r) = solid::parity_snapped(&snapped, dims);
+                let (b, r) = solid::parity_snapped(&snapped, dims, stop);
                 (b, r, "parity")
             }
             SolidMethod::Winding if watertight => {
-                let (b, r) = solid::winding_closed_snapped(&snapped, dims);
+                let (b, r) = solid::winding_closed_snapped(&snapped, dims, stop);
                 (b, r, "winding")
             }
             SolidMethod::Auto | SolidMethod::Winding => {
-                let (b, r) = winding::winding_snapped(&snapped, dims);
+                let (b, r) = winding::winding_snapped(&snapped, dims, stop);
                 gwn = Some(json!({"boundary_cycles": r.cycles, "cap_triangles": r.cap_triangles, "evaluated_voxels": r.evaluated}));
                 (b, r.solid, "winding")
             }
@@ -153,10 +155,12 @@ pub fn run_sparse(
             "{name}: this solid (reference or gpu) has no sparse path yet; parity, the winding numbers and flood fills do"
         )));
     }
+    let never = Stop::new();
+    let stop = opts.stop.unwrap_or(&never);
     if plan.method == SolidMethod::Flood {
         let surface = plan.surface.unwrap_or(voxelize::Mode::Cover);
         let (shell, _) = voxelize::tiled::tiled(surface, mesh, grid, tile, opts).map_err(|e| JobError::invalid(e.to_string()))?;
-        let (bits, rep) = fill::flood_fill_sparse(&shell);
+        let (bits, rep) = fill::flood_fill_sparse(&shell, stop);
         drop(shell);
         let mut warnings = Vec::new();
         if rep.enclosed == 0 {
@@ -181,20 +185,20 @@ pub fn run_sparse(
             if !inspect.watertight() {
                 warnings.push(format!("{open}: ray parity may streak through holes"));
             }
-            let (b, r) = solid::parity_sparse(&snapped, dims);
+            let (b, r) = solid::parity_sparse(&snapped, dims, stop);
             (b, r, "parity")
         }
         _ if !inspect.watertight() => {
-            let (b, r) = winding::winding_sparse(&snapped, dims);
+            let (b, r) = winding::winding_sparse(&snapped, dims, stop);
             gwn = Some(json!({"boundary_cycles": r.cycles, "cap_triangles": r.cap_triangles, "evaluated_voxels": r.evaluated}));
             (b, r.solid, "winding")
         }
         SolidMethod::Winding => {
-            let (b, r) = solid::winding_closed_sparse(&snapped, dims);
+            let (b, r) = solid::winding_closed_sparse(&snapped, dims, stop);
             (b, r, "winding")
         }
         _ => {
-            let (b, r) = solid::parity_sparse(&snapped, dims);
+            let (b, r) = solid::parity_sparse(&snapped, dims, stop);
             (b, r, "parity")
         }
     };

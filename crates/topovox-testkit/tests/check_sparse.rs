@@ -8,7 +8,7 @@ use proptest::prelude::*;
 use topovox::grid::sparse::SparseBricks;
 use topovox::topology::inside::{snap_all, Parity};
 use topovox::topology::{certify, certify_sparse};
-use topovox::voxelize::{self, Mode, Options};
+use topovox::voxelize::{self, Mode, Options, Stop};
 use topovox::{DenseBits, GridSpec, Mesh, VoxelSource};
 use topovox_testkit::{random_rotation, rng, rotated, shared_mesh};
 
@@ -115,7 +115,7 @@ fn sparse_solids_with_full_runs() {
         let mesh = shared_mesh(name);
         let grid = GridSpec::from_resolution(&mesh.as_ref().bounds(), res).unwrap();
         let snapped = snap_all(mesh.as_ref(), &grid).unwrap();
-        let (solid, _) = voxelize::solid::parity_sparse(&snapped, grid.dims());
+        let (solid, _) = voxelize::solid::parity_sparse(&snapped, grid.dims(), &Stop::new());
         assert!(solid.full_bricks() > 0, "{name}: no full bricks to test");
         same(&solid.to_dense(), &solid, Some((&mesh, &grid)), &format!("{name} solid"));
         same(&solid.to_dense(), &solid, None, &format!("{name} solid, no mesh"));

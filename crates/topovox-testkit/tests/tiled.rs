@@ -5,7 +5,7 @@
 //! (`agree_mode` also runs tiles of 8, 24 and 64 against every reference.)
 
 use glam::DVec3;
-use topovox::voxelize::{self, tiled::tiled, Mode, Options};
+use topovox::voxelize::{self, tiled::tiled, Mode, Options, Stop};
 use topovox::GridSpec;
 use topovox_testkit::{random_rotation, rng, rotated, shared_mesh, SHARED_MESHES};
 
@@ -159,9 +159,12 @@ fn sparse_solids_equal_dense_ones() {
         let snapped = snap_all(mesh.as_ref(), grid).unwrap();
         for winding in [false, true] {
             let ((d, dr), (s, sr)) = if winding {
-                (solid::winding_closed_snapped(&snapped, grid.dims()), solid::winding_closed_sparse(&snapped, grid.dims()))
+                (
+                    solid::winding_closed_snapped(&snapped, grid.dims(), &Stop::new()),
+                    solid::winding_closed_sparse(&snapped, grid.dims(), &Stop::new()),
+                )
             } else {
-                (solid::parity_snapped(&snapped, grid.dims()), solid::parity_sparse(&snapped, grid.dims()))
+                (solid::parity_snapped(&snapped, grid.dims(), &Stop::new()), solid::parity_sparse(&snapped, grid.dims(), &Stop::new()))
             };
             assert_eq!(dr, sr, "{what} (winding {winding}): reports differ");
             if let Some(v) = d.first_difference(&s.to_dense()) {
@@ -185,8 +188,10 @@ fn sparse_solids_equal_dense_ones() {
     // (both go through the same rows' spans), straight and rotated.
     let gwn = |mesh: &topovox::Mesh, grid: &GridSpec, what: &str| {
         let snapped = snap_all(mesh.as_ref(), grid).unwrap();
-        let ((d, dr), (s, sr)) =
-            (voxelize::winding::winding_snapped(&snapped, grid.dims()), voxelize::winding::winding_sparse(&snapped, grid.dims()));
+        let ((d, dr), (s, sr)) = (
+            voxelize::winding::winding_snapped(&snapped, grid.dims(), &Stop::new()),
+            voxelize::winding::winding_sparse(&snapped, grid.dims(), &Stop::new()),
+        );
         assert_eq!(dr, sr, "{what} (generalized winding): reports differ");
         assert!(dr.cycles > 0 && dr.evaluated > 0, "{what}: no caps to test");
         if let Some(v) = d.first_difference(&s.to_dense()) {
@@ -218,7 +223,7 @@ fn sparse_solid_interiors_are_full_runs() {
     use topovox::topology::inside::snap_all;
     let b = topovox_testkit::box_mesh(DVec3::splat(3.5), DVec3::splat(996.5));
     let grid = GridSpec::new(DVec3::ZERO, 1.0, [1000, 1000, 1000]).unwrap();
-    let (s, _) = topovox::voxelize::solid::parity_sparse(&snap_all(b.as_ref(), &grid).unwrap(), grid.dims());
+    let (s, _) = topovox::voxelize::solid::parity_sparse(&snap_all(b.as_ref(), &grid).unwrap(), grid.dims(), &Stop::new());
     assert_eq!(s.count(), 993u64.pow(3));
     assert!(s.memory_bytes() < 64 << 20, "{} bytes", s.memory_bytes());
     assert!(s.full_bricks() > 100u64.pow(3));
@@ -237,7 +242,7 @@ fn sparse_flood_fill_equals_dense() {
         let shell = voxelize::fast(mode, mesh.as_ref(), grid, &Options::default()).0;
         let (d, dr) = fill::flood_fill(&shell.to_dense());
         let (sparse, _) = tiled(mode, mesh.as_ref(), grid, 64, &Options::default()).unwrap();
-        let (s, sr) = fill::flood_fill_sparse(&sparse);
+        let (s, sr) = fill::flood_fill_sparse(&sparse, &Stop::new());
         assert_eq!(dr, sr, "{what}: reports differ");
         if let Some(v) = d.first_difference(&s.to_dense()) {
             panic!("{what}: differs at {v:?} (dense {})", d.get(v[0], v[1], v[2]));

@@ -83,7 +83,7 @@ pub fn run(a: &BatchArgs) -> Result<()> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let bar = Bar(pb);
-    let summary = pool.install(|| batch::run(&items, &a.output, &opts, &bar))?;
+    let summary = pool.install(|| batch::run(&items, &a.output, &opts, &bar, None))?;
     bar.0.finish_and_clear();
     let total = summary.done + summary.skipped + summary.failed;
     if a.json {

@@ -27,6 +27,8 @@ pub fn writer_options(e: &ExportArgs) -> Result<WriteOptions> {
         blocks,
         up: up(e),
         mesh: topovox_io::voxel_mesh::MeshOptions { watertight: e.watertight.as_deref() != Some("off"), triangulate: e.triangulate },
+        // Ctrl-C ends the process (see main.rs), removing its temporaries.
+        stop: None,
     })
 }
 

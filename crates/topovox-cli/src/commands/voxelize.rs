@@ -55,7 +55,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     topovox_job::output::check_fits(format, &fitted, plan.request.max_memory)?;
     bar.phase(if plan.surface_method == topovox_job::SurfaceMethod::Reference { "voxelizing (reference, serial)" } else { "voxelizing" });
     let name = a.mesh.display().to_string();
-    let v = pool.install(|| topovox_job::voxelize(&plan, loaded.mesh.as_ref(), &name, Some(&bar)))?;
+    let v = pool.install(|| topovox_job::voxelize(&plan, loaded.mesh.as_ref(), &name, Some(&bar), None))?;
     for w in &v.warnings {
         eprintln!("topovox: warning: {w}");
     }

@@ -123,16 +123,22 @@ pub fn run_triangles<K: Kernel<LatticeTriangle>>(
             let mut slabs = bits.slabs_mut(layers);
             let mut slab = slabs.pop().expect("one slab holds the whole grid");
             let mut deferred = Deferred::off();
-            for tri in &mesh.triangles[part * n / parts..(part + 1) * n / parts] {
-                // Inlined: as a call (`triangle` calls it from two places),
-                // its first loads of `lo` and `hi` stalled on the stores
-                // just made (store forwarding).
-                snapped.triangle(
-                    tri,
-                    &mut st,
-                    #[inline(always)]
-                    |t, lo, hi| run_unless_full(kernel, t, lo, hi, &mut slab, &mut deferred),
-                );
+            // In chunks, so a requested stop is seen within one chunk.
+            for chunk in mesh.triangles[part * n / parts..(part + 1) * n / parts].chunks(STOP_CHUNK) {
+                if opts.stopped() {
+                    break;
+                }
+                for tri in chunk {
+                    // Inlined: as a call (`triangle` calls it from two
+                    // places), its first loads of `lo` and `hi` stalled on
+                    // the stores just made (store forwarding).
+                    snapped.triangle(
+                        tri,
+                        &mut st,
+                        #[inline(always)]
+                        |t, lo, hi| run_unless_full(kernel, t, lo, hi, &mut slab, &mut deferred),
+                    );
+                }
             }
             kernel.finish(&mut deferred, &mut slab);
             let pool = slab.into_pool();
@@ -148,6 +154,10 @@ pub fn run_triangles<K: Kernel<LatticeTriangle>>(
     let (bits, voxels) = BrickBits::union_canonical(&grids);
     (bits, Report { prepare, voxels })
 }
+
+/// Triangles the triangle-parallel driver runs between two looks at
+/// [`Options::stop`].
+const STOP_CHUNK: usize = 4096;
 
 /// Voxels in the inclusive box `[lo, hi]` (not empty).
 #[inline(always)]
@@ -606,7 +616,8 @@ fn slabs_over<P, K: Kernel<P>, I: Items<P>>(kernel: &K, items: &I, dims: [u32; 3
             || Deferred::new(opts.defer_limit),
             |deferred, (s, mut slab)| {
                 let mut st = PrepareStats::default();
-                for &idx in binned.iter().flat_map(|b| &b.0[s]) {
+                let work = if opts.stopped() { &[][..] } else { &binned[..] };
+                for &idx in work.iter().flat_map(|b| &b.0[s]) {
                     items.each(idx as usize, &mut st, |p, mut lo, mut hi| {
                         lo[2] = lo[2].max(slab.k0 as i64);
                         hi[2] = hi[2].min(slab.k1 as i64 - 1);

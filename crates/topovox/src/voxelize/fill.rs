@@ -25,6 +25,7 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 
 use super::solid::{bricks_of_spans, from_brick_rows, push_span, BrickRow};
+use super::Stop;
 use crate::grid::bricks::{Brick, BRICK};
 use crate::grid::dense::DenseBits;
 use crate::grid::sparse::SparseBricks;
@@ -78,8 +79,9 @@ pub fn flood_fill(shell: &DenseBits) -> (DenseBits, FloodReport) {
 /// components), components touching the grid's boundary are marked
 /// outside, and a second pass emits the shell plus the enclosed runs
 /// brick row by brick row, enclosed interiors as runs of full bricks. The
-/// same voxels and report as [`flood_fill`].
-pub fn flood_fill_sparse(shell: &SparseBricks) -> (SparseBricks, FloodReport) {
+/// same voxels and report as [`flood_fill`]. Planes and layers are skipped
+/// once `stop` is requested.
+pub fn flood_fill_sparse(shell: &SparseBricks, stop: &Stop) -> (SparseBricks, FloodReport) {
     let dims = shell.dims();
     let [nx, ny, nz] = dims;
     let bz = nz.div_ceil(BRICK);
@@ -99,7 +101,7 @@ pub fn flood_fill_sparse(shell: &SparseBricks) -> (SparseBricks, FloodReport) {
     let mut comps = StreamedComponents::new(Connectivity::Six);
     let mut outside: Vec<bool> = Vec::new();
     let mut bases = Vec::with_capacity(nz as usize);
-    for layer in 0..bz {
+    for layer in (0..bz).take_while(|_| !stop.requested()) {
         let bricks = bricks_of(layer.saturating_sub(1)..layer + 1);
         for k in layer * BRICK..((layer + 1) * BRICK).min(nz) {
             let (_, unset) = window(&bricks, k);
@@ -130,6 +132,7 @@ pub fn flood_fill_sparse(shell: &SparseBricks) -> (SparseBricks, FloodReport) {
     let by = ny.div_ceil(BRICK);
     let layers: Vec<(Vec<BrickRow>, u64)> = (0..bz)
         .into_par_iter()
+        .filter(|_| !stop.requested())
         .map(|layer| {
             let bricks = bricks_of(layer.saturating_sub(1)..layer + 1);
             let mut spans: Vec<[Vec<(u32, u32)>; 64]> = (0..by).map(|_| std::array::from_fn(|_| Vec::new())).collect();

@@ -179,6 +179,32 @@ pub trait Progress: Sync {
     fn advance(&self, n: u64);
 }
 
+/// A request to stop long work early: a front end (Python on Ctrl-C)
+/// requests it from another thread, and the work checks it between slabs,
+/// tiles, triangle chunks and brick rows, skipping what is left. Work that
+/// was stopped returns an incomplete result: whoever requested the stop
+/// must discard it (`topovox-job` turns it into an `Interrupted` error).
+#[derive(Debug, Default)]
+pub struct Stop(std::sync::atomic::AtomicBool);
+
+impl Stop {
+    /// Not requested yet.
+    pub fn new() -> Stop {
+        Stop::default()
+    }
+
+    /// Asks the work to stop.
+    pub fn request(&self) {
+        self.0.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// Whether a stop was requested.
+    #[inline]
+    pub fn requested(&self) -> bool {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+}
+
 /// How the fast `cover` path walks a triangle's voxels. Every choice gives
 /// the same voxels; the choice exists so tests can pin each traversal and
 /// benchmarks can compare them.
@@ -200,6 +226,9 @@ pub enum Traversal {
 pub struct Options<'a> {
     /// Progress sink. Default: none.
     pub progress: Option<&'a dyn Progress>,
+    /// Checked between slabs, tiles and triangle chunks (see [`Stop`]).
+    /// Default: none (the work runs to the end).
+    pub stop: Option<&'a Stop>,
     /// Layers per z-slab in the parallel driver; `0` (default) picks one
     /// from the grid and the thread count. The result does not depend on it.
     pub slab_height: u32,
@@ -218,6 +247,14 @@ pub struct Options<'a> {
     /// default: unknown), reserved up front so its result is never grown
     /// by doubling. The result does not depend on it.
     pub brick_capacity: usize,
+}
+
+impl Options<'_> {
+    /// Whether the caller asked the work to stop (see [`Stop`]).
+    #[inline]
+    pub fn stopped(&self) -> bool {
+        self.stop.is_some_and(Stop::requested)
+    }
 }
 
 /// What a voxelization did.

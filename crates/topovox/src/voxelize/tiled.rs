@@ -222,6 +222,9 @@ fn by_tiles<P: Primitive, E>(
     let mut local: Vec<P> = Vec::new();
     let mut voxels = 0;
     for (s, &start) in starts.iter().enumerate() {
+        if opts.stopped() {
+            break;
+        }
         let end = starts.get(s + 1).copied().unwrap_or(pairs.len());
         let id = pairs[start].0;
         let t = [id % tdims[0], (id / tdims[0]) % tdims[1], id / (tdims[0] * tdims[1])];

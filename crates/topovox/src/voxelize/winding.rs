@@ -40,7 +40,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
-use super::solid::{brick_rows_of, bricks_of_spans, by_brick_rows_in, push_span, SolidReport};
+use super::solid::{brick_rows_of, bricks_of_spans, by_bands, push_span, SolidReport, BAND_PLANES};
+use super::Stop;
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::{orient, P3};
@@ -67,6 +68,8 @@ pub struct WindingReport {
 /// Edge (voxels) of the blocks the far-field refinement starts from (a
 /// power of two: blocks halve down to single voxels).
 const TOP: u32 = 64;
+/// The edge of the pieces [`Plan::needed_in`] hands to the threads.
+const PIECE: u32 = 16;
 /// Cycles whose bound at a voxel is below this are neglected there.
 const NEGLECT: f64 = 1e-3;
 
@@ -438,7 +441,18 @@ fn blocks_near_caps(caps: &[Cap], dims: [u32; 3]) -> Vec<[u32; 3]> {
     blocks
 }
 
+/// Refines the block at `min` of edge `size` down to voxels (see
+/// [`Plan::needed_in`]), its spans to `out`.
 fn refine(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut Vec<Span>) {
+    let mut todo = vec![(min, size)];
+    while let Some((min, size)) = todo.pop() {
+        refine_step(caps, min, size, dims, out, &mut todo);
+    }
+}
+
+/// One step of [`refine`]: the block's spans to `out` when it is settled
+/// (or a voxel), else its eight children to `children`.
+fn refine_step(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut Vec<Span>, children: &mut Vec<([u32; 3], u32)>) {
     if (0..3).any(|a| min[a] >= dims[a]) {
         return;
     }
@@ -468,7 +482,7 @@ fn refine(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut Vec<
     }
     let spread = spread + 1e-3;
     if size > 1 && spread >= 0.49 {
-        return split(caps, min, size, dims, out);
+        return split(min, size, children);
     }
     let mut scratch = Vec::new();
     let w: f64 = used.iter().map(|c| c.winding(ql, &mut scratch)).sum();
@@ -481,7 +495,7 @@ fn refine(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut Vec<
     // Settled if [w − spread, w + spread] holds no half-integer.
     let (lo, hi) = (w - spread, w + spread);
     if (hi - 0.5).floor() >= (lo - 0.5).ceil() {
-        return split(caps, min, size, dims, out);
+        return split(min, size, children);
     }
     let m = w.round() as i64;
     if m != 0 {
@@ -494,12 +508,12 @@ fn refine(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut Vec<
     }
 }
 
-fn split(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut Vec<Span>) {
+fn split(min: [u32; 3], size: u32, children: &mut Vec<([u32; 3], u32)>) {
     let h = size / 2;
     for dk in [0, h] {
         for dj in [0, h] {
             for di in [0, h] {
-                refine(caps, [min[0] + di, min[1] + dj, min[2] + dk], h, dims, out);
+                children.push(([min[0] + di, min[1] + dj, min[2] + dk], h));
             }
         }
     }
@@ -507,111 +521,144 @@ fn split(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut Vec<S
 
 /// Solid by the generalized winding number (see the module documentation).
 pub fn winding(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<(DenseBits, WindingReport), ClassifyError> {
-    Ok(winding_snapped(&snap_all(mesh, grid)?, grid.dims()))
+    Ok(winding_snapped(&snap_all(mesh, grid)?, grid.dims(), &Stop::new()))
 }
 
-/// [`winding`] on an already snapped mesh.
-pub fn winding_snapped(snapped: &Snapped, dims: [u32; 3]) -> (DenseBits, WindingReport) {
+/// [`winding`] on an already snapped mesh; the work left is skipped once
+/// `stop` is requested.
+pub fn winding_snapped(snapped: &Snapped, dims: [u32; 3], stop: &Stop) -> (DenseBits, WindingReport) {
     let plan = Plan::new(snapped, dims);
+    let hits = row_crossings(&plan.closed, dims);
+    let needed = plan.needed_in(0..dims[2], stop);
     let mut bits = DenseBits::new(dims);
-    bits.par_rows_mut().enumerate().for_each_init(Vec::new, |spans, (r, row)| {
+    bits.par_rows_mut().enumerate().filter(|_| !stop.requested()).for_each_init(Vec::new, |spans, (r, row)| {
         spans.clear();
-        plan.row(r, spans);
+        let r = r as u32;
+        let h0 = hits.partition_point(|h| h.0 < r);
+        plan.row(&hits[h0..h0 + hits[h0..].partition_point(|h| h.0 == r)], &needed, r, spans);
         for &(f, t) in spans.iter() {
             DenseBits::fill_row(row, f, t);
         }
     });
     let voxels = bits.count();
-    (bits, plan.report(snapped, voxels))
+    (bits, plan.report(snapped, voxels, evaluated(&needed)))
 }
 
 /// [`winding_snapped`] without a dense grid, for grids past memory: the
 /// same rows' inside spans, turned brick row by brick row into sparse
 /// bricks with the interior as runs of full bricks. The same voxels.
-pub fn winding_sparse(snapped: &Snapped, dims: [u32; 3]) -> (SparseBricks, WindingReport) {
+pub fn winding_sparse(snapped: &Snapped, dims: [u32; 3], stop: &Stop) -> (SparseBricks, WindingReport) {
     let plan = Plan::new(snapped, dims);
-    let out = by_brick_rows_in(dims, plan.brick_rows(), |bj, bk| {
+    // The spans that need the caps, band by band (blocks are TOP planes
+    // high, bands a whole number of blocks), so that at most one band's
+    // are held.
+    let mut evaluated_voxels = 0;
+    let needed_in = |planes: std::ops::Range<u32>| {
+        let needed = plan.needed_in(planes, stop);
+        evaluated_voxels += evaluated(&needed);
+        let rows = brick_rows_of(needed.iter().map(|s| s.row), dims);
+        (needed, rows)
+    };
+    let out = by_bands(&plan.closed, dims, stop, needed_in, |band, needed, bj, bk| {
         let mut spans: [Vec<(u32, u32)>; 64] = std::array::from_fn(|_| Vec::new());
         for dk in 0..BRICK.min(dims[2] - bk * BRICK) {
             for dj in 0..BRICK.min(dims[1] - bj * BRICK) {
-                let r = (bk * BRICK + dk) as usize * dims[1] as usize + (bj * BRICK + dj) as usize;
-                plan.row(r, &mut spans[(dk * BRICK + dj) as usize]);
+                let (j, k) = (bj * BRICK + dj, bk * BRICK + dk);
+                plan.row(band.row(j, k), needed, k * dims[1] + j, &mut spans[(dk * BRICK + dj) as usize]);
             }
         }
         bricks_of_spans(&spans, dims, bj, bk)
     });
     let voxels = out.count();
-    (out, plan.report(snapped, voxels))
+    (out, plan.report(snapped, voxels, evaluated_voxels))
 }
 
-/// What both storages need: the crossings of mesh + caps per row and the
-/// spans whose decision needs the caps.
+/// The voxels among `needed` where the caps' winding number is evaluated.
+fn evaluated(needed: &[Span]) -> u64 {
+    needed.iter().filter(|s| matches!(s.rule, Rule::Exact(_))).count() as u64
+}
+
+const _: () = assert!(BAND_PLANES % TOP == 0, "a block of TOP planes lies in one band");
+
+/// What both storages need: the mesh closed by its caps (whose rays'
+/// crossings give `J`), the caps, and the blocks near them, where spans
+/// may need the caps to decide ([`Plan::needed_in`]).
 struct Plan {
     dims: [u32; 3],
     cycles: u64,
-    cap_triangles: u64,
-    /// Crossings of mesh + caps, sorted by row.
-    hits: Vec<(u32, u32, i8)>,
-    /// Spans whose decision needs the caps, sorted by row.
-    needed: Vec<Span>,
+    /// The mesh's triangles and the caps'.
+    closed: Vec<LatticeTriangle>,
+    caps: Vec<Cap>,
+    /// Blocks of TOP³ voxels near a cap, sorted by `z`.
+    blocks: Vec<[u32; 3]>,
 }
 
 impl Plan {
     fn new(snapped: &Snapped, dims: [u32; 3]) -> Plan {
         let cycles = boundary_cycles(&snapped.net_edges);
         let caps = caps(&cycles);
-        // Zero-area triangles cross no ray (`row_crossings` skips them).
-        let hits = if caps.is_empty() {
-            row_crossings(&snapped.triangles, dims)
-        } else {
-            let mut closed = snapped.triangles.clone();
-            for c in &caps {
-                closed.extend(c.tris.iter().map(|&v| LatticeTriangle { v }));
+        let mut closed = snapped.triangles.clone();
+        for c in &caps {
+            closed.extend(c.tris.iter().map(|&v| LatticeTriangle { v }));
+        }
+        let mut blocks = if caps.is_empty() { Vec::new() } else { blocks_near_caps(&caps, dims) };
+        blocks.sort_unstable_by_key(|b| (b[2], b[1], b[0]));
+        Plan { dims, cycles: cycles.len() as u64, closed, caps, blocks }
+    }
+
+    /// The spans of the planes `planes` (whole blocks) whose decision needs
+    /// `w_cap`, sorted by row: octree refinement from the blocks of TOP³
+    /// voxels there. A block is settled (inside iff J ≠ 0) when |w_cap|
+    /// stays below 1/2 over it, by each cap's sphere bound or by w_cap at
+    /// its centre plus a Lipschitz bound; otherwise its eight children are
+    /// refined, down to single voxels, where w_cap at the centre is the
+    /// value used. With the rows of a crossing (of `closed`) the rows of
+    /// these spans are all that can hold inside voxels: elsewhere `J = 0`
+    /// and the caps are settled below ½ (outside). Blocks left once `stop`
+    /// is requested are skipped.
+    fn needed_in(&self, planes: std::ops::Range<u32>, stop: &Stop) -> Vec<Span> {
+        let b0 = self.blocks.partition_point(|b| b[2] * TOP < planes.start);
+        let b1 = self.blocks.partition_point(|b| b[2] * TOP < planes.end);
+        // The top levels here, so that the pieces left (PIECE³ voxels at
+        // most, cheap and many) balance across the threads even where a
+        // band holds few blocks.
+        let mut needed = Vec::new();
+        let mut pieces: Vec<([u32; 3], u32)> = self.blocks[b0..b1].iter().map(|b| (b.map(|x| x * TOP), TOP)).collect();
+        while pieces.iter().any(|p| p.1 > PIECE) {
+            let mut next = Vec::with_capacity(pieces.len() * 8);
+            for (min, size) in pieces {
+                if size > PIECE {
+                    refine_step(&self.caps, min, size, self.dims, &mut needed, &mut next);
+                } else {
+                    next.push((min, size));
+                }
             }
-            row_crossings(&closed, dims)
-        };
-        // Voxels whose decision needs w_cap: octree refinement from blocks
-        // of TOP³ voxels. A block is settled (inside iff J ≠ 0) when
-        // |w_cap| stays below 1/2 over it, by each cap's sphere bound or by
-        // w_cap at its centre plus a Lipschitz bound; otherwise its eight
-        // children are refined, down to single voxels, where w_cap at the
-        // centre is the value used.
-        let blocks = blocks_near_caps(&caps, dims);
-        let mut needed: Vec<Span> = if caps.is_empty() {
-            Vec::new()
-        } else {
-            blocks
-                .par_iter()
-                .flat_map_iter(|&b| {
-                    let mut out = Vec::new();
-                    refine(&caps, b.map(|x| x * TOP), TOP, dims, &mut out);
-                    out
-                })
-                .collect()
-        };
+            pieces = next;
+        }
+        let rest: Vec<Span> = pieces
+            .par_iter()
+            .filter(|_| !stop.requested())
+            .flat_map_iter(|&(min, size)| {
+                let mut out = Vec::new();
+                refine(&self.caps, min, size, self.dims, &mut out);
+                out
+            })
+            .collect();
+        needed.extend(rest);
         needed.par_sort_unstable_by_key(|s| (s.row, s.i0));
-        let cap_triangles = caps.iter().map(|c| c.tris.len() as u64).sum();
-        Plan { dims, cycles: cycles.len() as u64, cap_triangles, hits, needed }
+        needed
     }
 
-    /// The brick rows `(bk, bj)` that can hold inside voxels, sorted: those
-    /// of a crossing or a span that needs the caps (elsewhere `J = 0` and
-    /// the caps are settled below ½: outside).
-    fn brick_rows(&self) -> Vec<(u32, u32)> {
-        brick_rows_of(self.hits.iter().map(|h| h.0).chain(self.needed.iter().map(|s| s.row)), self.dims)
-    }
-
-    /// Appends the inside spans of row `r` (`k·ny + j`) to `out`, in
-    /// order, maximal (adjacent spans joined).
-    fn row(&self, r: usize, out: &mut Vec<(u32, u32)>) {
+    /// Appends the inside spans of row `r` (`k·ny + j`), whose crossings
+    /// are `row_hits` (sorted by `i0`) and whose spans that need the caps
+    /// are among `needed` (sorted by row), to `out`, in order, maximal
+    /// (adjacent spans joined).
+    fn row(&self, row_hits: &[(u32, u32, i8)], needed: &[Span], r: u32, out: &mut Vec<(u32, u32)>) {
         let nx = self.dims[0];
-        // Both sorted by row: each row's part found by binary search (a
-        // per-row table would follow the grid, not the surface).
-        let r = r as u32;
-        let h0 = self.hits.partition_point(|h| h.0 < r);
-        let row_hits = &self.hits[h0..h0 + self.hits[h0..].partition_point(|h| h.0 == r)];
-        let n0 = self.needed.partition_point(|s| s.row < r);
-        let spans = &self.needed[n0..n0 + self.needed[n0..].partition_point(|s| s.row == r)];
+        // Sorted by row: the row's spans found by binary search (a per-row
+        // table would follow the grid, not the surface).
+        let n0 = needed.partition_point(|s| s.row < r);
+        let spans = &needed[n0..n0 + needed[n0..].partition_point(|s| s.row == r)];
         let (mut ptr, mut sp) = (0, 0);
         let mut w = 0i64;
         let mut i = 0u32;
@@ -644,11 +691,11 @@ impl Plan {
         }
     }
 
-    fn report(&self, snapped: &Snapped, voxels: u64) -> WindingReport {
-        let evaluated = self.needed.iter().filter(|s| matches!(s.rule, Rule::Exact(_))).count() as u64;
+    fn report(&self, snapped: &Snapped, voxels: u64, evaluated: u64) -> WindingReport {
+        let cap_triangles = self.caps.iter().map(|c| c.tris.len() as u64).sum();
         let mut solid = super::solid::inspect(snapped);
         solid.voxels = voxels;
-        WindingReport { solid, cycles: self.cycles, cap_triangles: self.cap_triangles, evaluated }
+        WindingReport { solid, cycles: self.cycles, cap_triangles, evaluated }
     }
 }
 
