@@ -122,6 +122,39 @@ fn sparse_solids_with_full_runs() {
     }
 }
 
+/// Windows far wider than their voxels look bricks up in a hash map
+/// rather than a table of the whole window (800 MB for a few voxels in a
+/// 65536² window): the same report as the voxels moved to a small grid,
+/// mesh moved with them.
+#[test]
+fn few_voxels_in_a_wide_grid() {
+    // In voxel units on a fixed lattice of 2^-20, so that moving by whole
+    // voxels is exact.
+    let mut mesh = shared_mesh("cow.obj");
+    let fit = GridSpec::from_resolution(&mesh.as_ref().bounds(), 60).unwrap();
+    let q = (1u64 << 20) as f64;
+    mesh.positions.iter_mut().for_each(|p| *p = (((*p - fit.origin()) / fit.voxel_size() + 1.0) * q).round() / q);
+    let small = GridSpec::new(glam::DVec3::ZERO, 1.0, fit.dims().map(|d| d as u64 + 2)).unwrap();
+    let wide = GridSpec::new(glam::DVec3::ZERO, 1.0, [8192, 8192, small.dims()[2] as u64]).unwrap();
+    let mut moved = mesh.clone();
+    moved.positions.iter_mut().for_each(|p| *p += glam::DVec3::new(2000.0, 3000.0, 0.0));
+    for (mode, name) in [(Mode::Cover, "cover"), (Mode::Sep6, "sep6")] {
+        let near = voxelize::tiled::tiled(mode, mesh.as_ref(), &small, 64, &Options::default()).unwrap().0;
+        let far = voxelize::tiled::tiled(mode, moved.as_ref(), &wide, 512, &Options::default()).unwrap().0;
+        assert_eq!(far.count(), near.count(), "{name}");
+        let a = certify_sparse(&near, Some((mesh.as_ref(), &small)), 2).unwrap();
+        let mut b = certify_sparse(&far, Some((moved.as_ref(), &wide)), 2).unwrap();
+        // Witnesses are voxels: moved back.
+        if let Some(sep) = b.mesh.as_mut().and_then(|m| m.separation.as_mut()) {
+            for w in [&mut sep.witness_6, &mut sep.witness_26].into_iter().flatten() {
+                w.iter_mut().for_each(|v| *v = [v[0] - 2000, v[1] - 3000, v[2]]);
+            }
+        }
+        assert_eq!(a, b, "{name}");
+        assert_eq!(certify_sparse(&near, None, 3).unwrap(), certify_sparse(&far, None, 3).unwrap(), "{name}, no mesh");
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
     #[test]

@@ -272,4 +272,34 @@ fn sparse_flood_fill_equals_dense() {
     }
     let grid = GridSpec::new(DVec3::ZERO, 1.0, [45, 33, 53]).unwrap();
     assert!(check(Mode::Cover, &nested, &grid, "nested boxes").enclosed > 0);
+    // Shells far from the grid's faces (the fill runs on their box grown by
+    // a brick), one touching a face, and one in the middle of a partial
+    // last brick.
+    let big = GridSpec::new(DVec3::ZERO, 1.0, [150, 141, 133]).unwrap();
+    for (at, what) in [(DVec3::new(60.0, 70.0, 50.0), "in the middle"), (DVec3::new(0.2, 90.5, 100.0), "at the x = 0 face")] {
+        let mut moved = nested.clone();
+        moved.positions.iter_mut().for_each(|p| *p += at);
+        assert!(check(Mode::Cover, &moved, &big, &format!("nested boxes {what}")).enclosed > 0);
+    }
+    let cow = rotated(&shared_mesh("cow.obj"), random_rotation(&mut r));
+    let grid = GridSpec::from_resolution(&cow.as_ref().bounds(), 60).unwrap();
+    let wide = GridSpec::new(grid.origin() - DVec3::splat(grid.voxel_size() * 37.0), grid.voxel_size(), grid.dims().map(|d| d as u64 + 80))
+        .unwrap();
+    check(Mode::Cover, &cow, &wide, "rotated cow with room around it");
+}
+
+/// A small closed shell in a 65536³ grid fills in the time and memory of
+/// its own box (it walked every plane of the grid before).
+#[test]
+fn a_sparse_flood_fill_follows_the_shell_not_the_grid() {
+    use topovox::voxelize::fill;
+    let b = topovox_testkit::box_mesh(DVec3::new(30000.5, 40000.5, 50000.5), DVec3::new(30040.5, 40030.5, 50020.5));
+    let grid = GridSpec::new(DVec3::ZERO, 1.0, [65536; 3]).unwrap();
+    let (shell, _) = tiled(Mode::Cover, b.as_ref(), &grid, 512, &Options::default()).unwrap();
+    let (s, rep) = fill::flood_fill_sparse(&shell, &Stop::new());
+    // Voxel centres strictly inside the box: 40 x 30 x 20 of them, the
+    // shell the ones the faces pass through.
+    assert_eq!(s.count(), 41 * 31 * 21);
+    assert_eq!(rep.enclosed, 39 * 29 * 19);
+    assert!(s.get(30020, 40015, 50010) && !s.get(30041, 40015, 50010));
 }

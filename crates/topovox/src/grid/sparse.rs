@@ -330,6 +330,37 @@ impl SparseBricks {
         self.keys.get(first).is_some_and(|k| keys.contains(k)) || self.full.get(first_run).is_some_and(|(k, _)| keys.contains(k))
     }
 
+    /// The box `(lo, hi)` (inclusive, in bricks) of every stored brick
+    /// and full run; `None` when there are none.
+    pub fn brick_bounds(&self) -> Option<([u32; 3], [u32; 3])> {
+        let mut bounds: Option<([u32; 3], [u32; 3])> = None;
+        self.for_each_brick_run(|b, _, n| {
+            let last = [b[0] + n - 1, b[1], b[2]];
+            let (lo, hi) = bounds.get_or_insert((b, last));
+            for a in 0..3 {
+                lo[a] = lo[a].min(b[a]);
+                hi[a] = hi[a].max(last[a]);
+            }
+        });
+        bounds
+    }
+
+    /// The same bricks and full runs moved by `by` bricks into a grid of
+    /// `dims` (a window of this one, or a grid it is a window of): every
+    /// one must land inside it, and voxels past `dims` must be clear.
+    pub fn moved(&self, by: [i64; 3], dims: [u32; 3]) -> SparseBricks {
+        let (mut bricks, mut runs) = (Vec::new(), Vec::new());
+        self.for_each_brick_run(|b, bits, n| {
+            let to: [u32; 3] = std::array::from_fn(|a| u32::try_from(b[a] as i64 + by[a]).expect("a brick moved outside the grid"));
+            if *bits == FULL {
+                runs.push((to, n));
+            } else {
+                bricks.push((to, *bits));
+            }
+        });
+        SparseBricks::from_parts(dims, bricks, runs)
+    }
+
     /// The same voxels, dense.
     pub fn to_dense(&self) -> DenseBits {
         let mut d = DenseBits::new(self.dims);

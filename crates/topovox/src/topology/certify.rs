@@ -40,6 +40,7 @@
 use std::ops::Range;
 
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 use super::inside::{snap_all, ClassifyError, Parity};
 use super::runs::{Connectivity, Runs, StreamedComponents};
@@ -249,31 +250,57 @@ impl WindowBits for DenseBits {
 /// Brick layers of a sparse grid, indexed for random access
 /// ([`BrickBits`]) and listed in key order (for runs and sums).
 struct BrickWindow {
-    bits: BrickBits,
+    dims: [u32; 3],
+    index: WindowIndex,
     /// The window's bricks (window brick coordinates), sorted by `(bk, bj, bi)`.
     list: Vec<([u32; 3], Brick)>,
 }
+
+/// How [`BrickWindow::get`] finds a brick: a whole-window table (4 bytes
+/// per brick of the window: fast) where it is small beside the bricks, a
+/// hash map of the bricks where it is not (a few voxels in a 65536²-wide
+/// window would need 800 MB of table).
+enum WindowIndex {
+    Table(BrickBits),
+    Map(FxHashMap<[u32; 3], u32>),
+}
+
+/// Window bricks per stored brick up to which [`WindowIndex::Table`] is used.
+const TABLE_PER_BRICK: u64 = 64;
 
 impl BrickWindow {
     fn new(src: &SparseBricks, layers: Range<u32>, dims: [u32; 3]) -> BrickWindow {
         let mut list = Vec::new();
         src.for_each_brick_in_layers(layers.clone(), |b, bits| list.push(([b[0], b[1], b[2] - layers.start], *bits)));
-        let mut bits = BrickBits::new(dims);
-        for (b, brick) in &list {
-            bits.insert_brick(*b, *brick);
-        }
-        BrickWindow { bits, list }
+        let table: u64 = dims.iter().map(|&d| u64::from(d.div_ceil(BRICK))).product();
+        let index = if table <= TABLE_PER_BRICK * list.len() as u64 + (1 << 20) {
+            let mut bits = BrickBits::new(dims);
+            for (b, brick) in &list {
+                bits.insert_brick(*b, *brick);
+            }
+            WindowIndex::Table(bits)
+        } else {
+            WindowIndex::Map(list.iter().enumerate().map(|(n, (b, _))| (*b, n as u32)).collect())
+        };
+        BrickWindow { dims, index, list }
     }
 }
 
 impl WindowBits for BrickWindow {
     fn dims(&self) -> [u32; 3] {
-        self.bits.dims()
+        self.dims
     }
 
     #[inline]
     fn get(&self, i: u32, j: u32, k: u32) -> bool {
-        self.bits.get(i, j, k)
+        match &self.index {
+            WindowIndex::Table(bits) => bits.get(i, j, k),
+            WindowIndex::Map(map) => {
+                assert!(i < self.dims[0] && j < self.dims[1] && k < self.dims[2], "voxel out of range");
+                map.get(&[i / BRICK, j / BRICK, k / BRICK])
+                    .is_some_and(|&n| (self.list[n as usize].1[(k % BRICK) as usize] >> ((j % BRICK) * BRICK + i % BRICK)) & 1 == 1)
+            }
+        }
     }
 
     fn runs(&self, planes: Range<u32>) -> Runs {

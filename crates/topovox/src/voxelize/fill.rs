@@ -81,7 +81,32 @@ pub fn flood_fill(shell: &DenseBits) -> (DenseBits, FloodReport) {
 /// brick row by brick row, enclosed interiors as runs of full bricks. The
 /// same voxels and report as [`flood_fill`]. Planes and layers are skipped
 /// once `stop` is requested.
+///
+/// Every unset voxel outside the box of the shell's bricks reaches the
+/// grid's boundary in a straight line (along an axis on which it lies past
+/// the box), so the fill runs on that box grown by a brick on each side
+/// (clamped to the grid), whose faces are then outside or the grid's own:
+/// its time and memory follow the shell, not the grid (a small shell in a
+/// 65536³ grid walked 65536 planes of 65536 rows).
 pub fn flood_fill_sparse(shell: &SparseBricks, stop: &Stop) -> (SparseBricks, FloodReport) {
+    let dims = shell.dims();
+    let Some((lo, hi)) = shell.brick_bounds() else {
+        return (SparseBricks::new(dims), FloodReport { shell: 0, enclosed: 0 });
+    };
+    let bdims = dims.map(|d| d.div_ceil(BRICK));
+    let lo = lo.map(|b| b.saturating_sub(1));
+    let hi: [u32; 3] = std::array::from_fn(|a| (hi[a] + 1).min(bdims[a] - 1));
+    if lo == [0; 3] && hi.iter().zip(&bdims).all(|(h, b)| h + 1 == *b) {
+        return flood_fill_window(shell, stop);
+    }
+    let window: [u32; 3] = std::array::from_fn(|a| ((hi[a] + 1) * BRICK).min(dims[a]) - lo[a] * BRICK);
+    let by = lo.map(|b| b as i64);
+    let (filled, rep) = flood_fill_window(&shell.moved(by.map(|b| -b), window), stop);
+    (filled.moved(by, dims), rep)
+}
+
+/// [`flood_fill_sparse`] on the whole of `shell`'s grid.
+fn flood_fill_window(shell: &SparseBricks, stop: &Stop) -> (SparseBricks, FloodReport) {
     let dims = shell.dims();
     let [nx, ny, nz] = dims;
     let bz = nz.div_ceil(BRICK);
