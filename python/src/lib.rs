@@ -878,7 +878,7 @@ fn batch<'py>(
     }
     let stop = Arc::new(Stop::new());
     let summary = interruptible(py, &stop, || -> Result<topovox_job::batch::Summary, JobError> {
-        let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref())?;
+        let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir)?;
         let ext = opts.format.name().replace("npy-bool", "npy");
         let items = topovox_job::batch::plan_items(&files, &out_dir, &ext)?;
         let pool =
@@ -904,7 +904,7 @@ fn batch_plan<'py>(
 ) -> PyResult<BatchListing<'py>> {
     let empty = PyDict::new(py);
     let (opts, _) = batch_options(options.unwrap_or(&empty), format)?;
-    let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref()).map_err(py_err)?;
+    let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir).map_err(py_err)?;
     let ext = opts.format.name().replace("npy-bool", "npy");
     let items = topovox_job::batch::plan_items(&files, &out_dir, &ext).map_err(py_err)?;
     std::fs::create_dir_all(&out_dir).map_err(|e| io_err(topovox_io::IoError::new(&out_dir, topovox_io::ErrorKind::Write(e))))?;

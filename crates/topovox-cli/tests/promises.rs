@@ -76,6 +76,58 @@ fn names_that_are_not_utf8_keep_their_own_manifest_lines() {
     assert_eq!((second["done"].as_u64(), second["skipped"].as_u64()), (Some(0), Some(2)), "{second}");
 }
 
+/// Issue 45, items 2 and 3: any spelling of the output folder or the
+/// inputs resumes a batch, and a batch never reads the outputs in its own
+/// output folder (which once made a second run voxelize its `.ply`
+/// outputs, and `.obj` outputs nest one level deeper per run).
+#[test]
+fn batches_resume_under_any_spelling_and_never_read_their_outputs() {
+    let d = folder("spelling");
+    let ds = d.join("ds");
+    std::fs::create_dir_all(&ds).unwrap();
+    for n in 0..3 {
+        std::fs::copy(repo("examples/meshes/box.obj"), ds.join(format!("m{n}.obj"))).unwrap();
+    }
+    let batch = |cwd: &Path, input: &str, out: &str, format: &str| {
+        let o = Command::new(env!("CARGO_BIN_EXE_topovox"))
+            .current_dir(cwd)
+            .args(["batch", input, "-o", out, "--format", format, "--resolution", "8", "--json"])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (v["done"].as_u64().unwrap(), v["skipped"].as_u64().unwrap())
+    };
+    let abs = std::fs::canonicalize(&d).unwrap();
+    assert_eq!(batch(&d, "ds", "r1", "npy"), (3, 0));
+    assert_eq!(batch(&d, "./ds", "./r1", "npy"), (0, 3));
+    assert_eq!(batch(&ds, "../ds", s(&abs.join("r1")), "npy"), (0, 3));
+    assert_eq!(batch(&d, s(&abs.join("ds")), "r1/../r1", "npy"), (0, 3));
+    let lines = std::fs::read_to_string(d.join("r1/manifest.jsonl")).unwrap();
+    assert_eq!(lines.lines().count(), 3, "{lines}");
+    // Outputs inside the input folder: never read back.
+    for format in ["ply", "obj"] {
+        let out = format!("ds/vox-{format}");
+        assert_eq!(batch(&d, "ds", &out, format), (3, 0));
+        assert_eq!(batch(&d, "ds", &out, format), (0, 3));
+        let nested: Vec<String> = walk(&d.join(&out));
+        assert!(nested.iter().all(|p| !p.contains("vox-")), "{format}: {nested:?}");
+    }
+}
+
+/// The paths below `dir`, relative to it.
+fn walk(dir: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if e.file_type().unwrap().is_dir() {
+            out.extend(walk(&e.path()).into_iter().map(|p| format!("{name}/{p}")));
+        }
+        out.push(name);
+    }
+    out
+}
+
 #[test]
 fn ctrl_c_ends_a_run_at_once_with_130_and_leaves_nothing() {
     let d = folder("interrupt");

@@ -75,8 +75,12 @@ pub struct Item {
 
 /// Expands `inputs` (files and folders) into mesh files, sorted within
 /// each folder; `glob` (e.g. `**/*.obj`) filters the files found in
-/// folders, relative to that folder. Files named directly are kept.
-pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>) -> Result<Vec<PathBuf>> {
+/// folders, relative to that folder. Files named directly are kept. The
+/// output folder `out_dir` is never searched, and no file a manifest found
+/// on the way lists as a batch's output is taken: a batch does not read
+/// what it (or another batch) wrote.
+pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path) -> Result<Vec<PathBuf>> {
+    let outputs = std::fs::canonicalize(out_dir).ok();
     let matcher = match glob {
         Some(g) => Some(
             globset::GlobBuilder::new(g)
@@ -94,12 +98,23 @@ pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>) -> Result<Vec<Path
             out.push(input.clone());
             continue;
         }
-        for entry in walkdir::WalkDir::new(input).follow_links(true).sort_by_file_name() {
+        let not_outputs = |e: &walkdir::DirEntry| {
+            !e.file_type().is_dir() || outputs.as_ref().is_none_or(|o| std::fs::canonicalize(e.path()).ok().as_ref() != Some(o))
+        };
+        let mut written: std::collections::HashSet<String> = std::collections::HashSet::new();
+        for entry in walkdir::WalkDir::new(input).follow_links(true).sort_by_file_name().into_iter().filter_entry(not_outputs) {
             let entry = entry.map_err(|e| JobError::failed(format!("{}: cannot list: {e}", input.display())))?;
+            if entry.file_type().is_dir() {
+                // Folders come before what they hold.
+                written.extend(outputs_listed_in(&entry.path().join(MANIFEST)));
+            }
             if !entry.file_type().is_file() {
                 continue;
             }
             let path = entry.path();
+            if !written.is_empty() && written.contains(&file_key(path)) {
+                continue;
+            }
             let keep = match &matcher {
                 Some(m) => path.strip_prefix(input).is_ok_and(|rel| m.is_match(rel)),
                 None => {
@@ -115,6 +130,17 @@ pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>) -> Result<Vec<Path
         return Err(JobError::invalid("no input meshes found (give mesh files, or folders holding them; see --glob)"));
     }
     Ok(out)
+}
+
+/// The keys of the outputs a manifest at `path` lists (none if there is
+/// no such file, or it is not a manifest).
+fn outputs_listed_in(path: &Path) -> Vec<String> {
+    let Ok(text) = std::fs::read_to_string(path) else { return Vec::new() };
+    text.lines()
+        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
+        .filter(|v| v["input"].is_string() && v["options"].is_object())
+        .filter_map(|v| recorded_key(&v, "output"))
+        .collect()
 }
 
 /// The folder every input lies in (the deepest common one).
@@ -199,11 +225,24 @@ fn record_raw_path(record: &mut Value, name: &str, p: &Path) {
     }
 }
 
-/// The key of a record's path `name` (see [`path_key`]).
+/// The manifest's key of a file: [`path_key`] of its canonical path, so
+/// every spelling of it (`out`, `./out`, `/abs/out`, `../ds/a.obj`, a
+/// link), from any front end (CLI, Python, Dask, Ray), has one key. A file
+/// that does not exist keys by its absolute path.
+pub fn file_key(p: &Path) -> String {
+    path_key(&std::fs::canonicalize(p).unwrap_or_else(|_| absolute(p)))
+}
+
+/// The key of a record's path `name`: its `NAME_key` ([`file_key`] when
+/// written), else (a line of an earlier version) the key of the path as
+/// recorded (see [`path_key`]), made canonical where it still names a file.
 fn recorded_key(v: &Value, name: &str) -> Option<String> {
+    if let Some(k) = v[format!("{name}_key")].as_str() {
+        return Some(k.to_string());
+    }
     match v[format!("{name}_raw")].as_str() {
         Some(raw) => Some(format!("\0{raw}")),
-        None => v[name].as_str().map(String::from),
+        None => v[name].as_str().map(|p| file_key(Path::new(p))),
     }
 }
 
@@ -248,8 +287,8 @@ impl Manifest {
     /// Whether `item` was done with these options and its output is still
     /// there, complete (the recorded size).
     pub fn is_done(&self, item: &Item, fingerprint: &Value) -> bool {
-        let Some(v) = self.done.get(&path_key(&item.input)) else { return false };
-        let same = v["options"] == *fingerprint && recorded_key(v, "output") == Some(path_key(&item.output));
+        let Some(v) = self.done.get(&file_key(&item.input)) else { return false };
+        let same = v["options"] == *fingerprint && recorded_key(v, "output") == Some(file_key(&item.output));
         let size = std::fs::metadata(&item.output).map(|m| m.len()).ok();
         same && size.is_some() && v["output_bytes"].as_u64() == size
     }
@@ -278,6 +317,7 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
     });
     record_raw_path(&mut record, "input", &item.input);
     record_raw_path(&mut record, "output", &item.output);
+    record["input_key"] = json!(file_key(&item.input));
     let result = (|| -> Result<Value> {
         if let Some(dir) = item.output.parent() {
             std::fs::create_dir_all(dir).map_err(|e| JobError::Io(topovox_io::IoError::new(dir, topovox_io::ErrorKind::Write(e))))?;
@@ -320,6 +360,7 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
             }
             record["status"] = json!("done");
             record["output_bytes"] = json!(std::fs::metadata(&item.output).map(|m| m.len()).ok());
+            record["output_key"] = json!(file_key(&item.output));
             record["error"] = Value::Null;
         }
         Err(JobError::Interrupted) => {

@@ -70,7 +70,7 @@ pub fn run(a: &BatchArgs) -> Result<()> {
         fingerprint,
     };
     let pool = crate::thread_pool_for(a.jobs, "--jobs")?;
-    let files = batch::collect_inputs(&a.inputs, a.glob.as_deref())?;
+    let files = batch::collect_inputs(&a.inputs, a.glob.as_deref(), &a.output)?;
     let ext = format.name().replace("npy-bool", "npy");
     let items = batch::plan_items(&files, &a.output, &ext)?;
 
