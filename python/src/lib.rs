@@ -877,16 +877,19 @@ fn batch<'py>(
         topovox_job::check_threads(n, "jobs").map_err(py_err)?;
     }
     let stop = Arc::new(Stop::new());
-    let summary = interruptible(py, &stop, || -> Result<topovox_job::batch::Summary, JobError> {
-        let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir)?;
+    let (summary, warnings) = interruptible(py, &stop, || -> Result<(topovox_job::batch::Summary, Vec<String>), JobError> {
+        let (files, warnings) = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir)?;
         let ext = opts.format.name().replace("npy-bool", "npy");
         let items = topovox_job::batch::plan_items(&files, &out_dir, &ext)?;
         let pool =
             topovox_job::pool_for(jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)), "jobs")?;
-        pool.install(|| topovox_job::batch::run(&items, &out_dir, &opts, &topovox_job::batch::Silent, Some(&stop)))
+        let summary = pool.install(|| topovox_job::batch::run(&items, &out_dir, &opts, &topovox_job::batch::Silent, Some(&stop)))?;
+        Ok((summary, warnings))
     })?
     .map_err(py_err)?;
-    to_py(py, &summary.to_json())
+    let mut v = summary.to_json();
+    v["warnings"] = serde_json::json!(warnings);
+    to_py(py, &v)
 }
 
 /// The batch plan without running it: `[(input, output), ...]` and the
@@ -904,7 +907,7 @@ fn batch_plan<'py>(
 ) -> PyResult<BatchListing<'py>> {
     let empty = PyDict::new(py);
     let (opts, _) = batch_options(options.unwrap_or(&empty), format)?;
-    let files = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir).map_err(py_err)?;
+    let (files, _) = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir).map_err(py_err)?;
     let ext = opts.format.name().replace("npy-bool", "npy");
     let items = topovox_job::batch::plan_items(&files, &out_dir, &ext).map_err(py_err)?;
     std::fs::create_dir_all(&out_dir).map_err(|e| io_err(topovox_io::IoError::new(&out_dir, topovox_io::ErrorKind::Write(e))))?;

@@ -118,7 +118,7 @@ def test_bad_arrays_are_value_errors(vertices, faces, message):
     [
         ({"mode": "nope"}, "unknown mode"),
         ({"method": "magic"}, "unknown method"),
-        ({"resolution": 0}, "resolution must be between"),
+        ({"resolution": 0}, "resolution must be at least 1"),
         ({"resolution": 64, "voxel_size": 0.1}, "either --resolution or --voxel-size"),
         ({"origin": (0, 0, 0)}, "explicit grid needs all"),
         ({"voxel_size": -1.0}, "voxel size must be a positive"),
@@ -246,7 +246,7 @@ def test_save_refuses_unknown_formats_and_missing_folders(tmp_path, meshes):
     g = topovox.voxelize(topovox.load_mesh(meshes / "cow.obj"), resolution=16)
     with pytest.raises(ValueError, match="cannot tell the output format"):
         g.save(tmp_path / "x.unknown")
-    with pytest.raises(ValueError, match="does not exist"):
+    with pytest.raises(FileNotFoundError, match="does not exist"):
         g.save(tmp_path / "no" / "x.npy")
 
 

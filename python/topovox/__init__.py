@@ -187,13 +187,13 @@ def voxelize(
     return _topovox.voxelize(
         mesh,
         mode=mode,
-        resolution=None if resolution is None else _count(resolution, "resolution"),
+        resolution=None if resolution is None else _count(resolution, "resolution", least=1),
         voxel_size=None if voxel_size is None else float(voxel_size),
         origin=None if origin is None else [float(x) for x in origin],
-        dims=None if dims is None else [_count(d, "dims") for d in dims],
+        dims=None if dims is None else [_count(d, "dims", least=1) for d in dims],
         pad=_count(pad, "pad") if pad else None,
         method=method,
-        threads=None if threads is None else _count(threads, "threads"),
+        threads=None if threads is None else _count(threads, "threads", least=1),
         attributes=bool(attributes),
         colour_rule=colour_rule,
         normals=bool(normals),
@@ -207,9 +207,11 @@ def voxelize(
     )
 
 
-def _count(x: Any, name: str) -> int:
-    if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or x < 0:
-        raise ValueError(f"{name} must be a non-negative integer; got {x!r}")
+def _count(x: Any, name: str, least: int = 0) -> int:
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)):
+        raise ValueError(f"{name} must be an integer; got {x!r}")
+    if x < least:
+        raise ValueError(f"{name} must be at least {least}; got {x!r}")
     return int(x)
 
 
@@ -221,8 +223,10 @@ def _options(options: dict) -> dict:
         if k in ("origin",):
             v = [float(x) for x in v]
         elif k in ("dims",):
-            v = [_count(d, "dims") for d in v]
-        elif k in ("resolution", "pad", "threads", "jobs", "hollow", "seed"):
+            v = [_count(d, "dims", least=1) for d in v]
+        elif k in ("resolution", "threads", "jobs"):
+            v = _count(v, k, least=1)
+        elif k in ("pad", "hollow", "seed"):
             v = _count(v, k)
         elif k == "voxel_size":
             v = float(v)
@@ -253,9 +257,11 @@ def batch(
     ``attributes=True`` for every attribute grid in ``.vdb`` outputs;
     ``jobs`` meshes run at once (default: all cores).
 
-    Returns the summary: ``{"done", "skipped", "failed", "total_s", "manifest"}``.
+    Returns the summary: ``{"done", "skipped", "failed", "total_s", "manifest",
+    "warnings"}`` (warnings: links skipped because they loop).
     """
-    if isinstance(paths, (str, os.PathLike)):
+    if isinstance(paths, (str, bytes, os.PathLike)):
         paths = [paths]
     opts = _options(dict(options, jobs=jobs))
-    return _topovox.batch([os.fspath(p) for p in paths], os.fspath(out_dir), format=format, glob=glob, options=opts)
+    # fsdecode: str and bytes paths alike (names that are not UTF-8 survive).
+    return _topovox.batch([os.fsdecode(p) for p in paths], os.fsdecode(out_dir), format=format, glob=glob, options=opts)

@@ -38,11 +38,11 @@ def plan(
     fingerprint. For an fsspec URL ``out_dir`` the outputs are named under
     it; the plan (and what is done) is read from a local mirror of its
     manifest."""
-    if isinstance(paths, (str, os.PathLike)):
+    if isinstance(paths, (str, bytes, os.PathLike)):
         paths = [paths]
     proto, rest = split_protocol(out_dir)
     local_out = rest if proto is None else _remote_manifest_mirror(out_dir)
-    listed, fingerprint = _topovox.batch_plan([os.fspath(p) for p in paths], local_out, format=format, glob=glob, options=options)
+    listed, fingerprint = _topovox.batch_plan([os.fsdecode(p) for p in paths], local_out, format=format, glob=glob, options=options)
     todo = []
     for inp, out, done in listed:
         if done:

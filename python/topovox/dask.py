@@ -40,7 +40,7 @@ def voxelize_paths(
     supplies the parallelism."""
     import dask.bag as db
 
-    out_dir = os.fspath(out_dir)
+    out_dir = os.fsdecode(out_dir)
     opts = _paths.options_dict(options)
     todo, _ = _paths.plan(paths, out_dir, format, glob, opts)
     if not todo:

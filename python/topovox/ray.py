@@ -34,7 +34,7 @@ def voxelize_paths(
     Ray must be initialised (``ray.init``)."""
     import ray
 
-    out_dir = os.fspath(out_dir)
+    out_dir = os.fsdecode(out_dir)
     opts = _paths.options_dict(options)
     todo, _ = _paths.plan(paths, out_dir, format, glob, opts)
 

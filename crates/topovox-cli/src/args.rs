@@ -169,21 +169,21 @@ pub struct VoxelizeArgs {
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Voxelization mode.
-    #[arg(long, value_enum, default_value = "cover")]
+    #[arg(long, value_enum, ignore_case = true, default_value = "cover")]
     pub mode: Mode,
     /// Method.
-    #[arg(long, value_enum, default_value = "auto")]
+    #[arg(long, value_enum, ignore_case = true, default_value = "auto")]
     pub method: Method,
     /// `bubble`: the seed of its random points (same seed, same voxels; default 0).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Solid modes: the surface mode of `solid+surface` and of the
     /// `--fill flood` shell (default cover).
-    #[arg(long, value_enum, value_name = "MODE")]
+    #[arg(long, value_enum, ignore_case = true, value_name = "MODE")]
     pub surface: Option<Mode>,
     /// Solid modes: `flood` fills everything a surface shell encloses
     /// (everything not reachable from the grid boundary through unset voxels).
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, ignore_case = true)]
     pub fill: Option<Fill>,
     /// Solid modes: keep only the voxels touching the outside through a face
     /// (6) or also an edge or corner (26).
@@ -196,7 +196,7 @@ pub struct VoxelizeArgs {
     /// With --method gpu: `compute` (default), `raster` (the rasterizer path, same voxels), or
     /// `msaa-approx` (rasterizer with 4x MSAA instead of conservative coverage: approximate, misses
     /// voxels; the summary says how many).
-    #[arg(long, value_enum, default_value = "compute", value_name = "PATH")]
+    #[arg(long, value_enum, ignore_case = true, default_value = "compute", value_name = "PATH")]
     pub gpu_path: GpuPathArg,
     /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, or obj / glb for a mesh of the voxels (default: from the extension).
     #[arg(long, value_name = "FORMAT")]
@@ -223,7 +223,7 @@ pub struct VoxelizeArgs {
 #[derive(Args, Debug, Clone, Default)]
 pub struct ExportArgs {
     /// How the colours of the surface inside a voxel combine: `dominant` (the colour covering the most area; never a new colour) or `blend` (area-weighted mean in linear light).
-    #[arg(long, value_enum, default_value = "dominant", value_name = "RULE")]
+    #[arg(long, value_enum, ignore_case = true, default_value = "dominant", value_name = "RULE")]
     pub colour_rule: ColourRule,
     /// .vti: also store each voxel's average surface normal.
     #[arg(long)]
@@ -316,12 +316,12 @@ pub struct RenderArgs {
     #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
     pub up: Option<String>,
     /// For a mesh: the surface mode to voxelize with.
-    #[arg(long, value_enum, default_value = "cover")]
+    #[arg(long, value_enum, ignore_case = true, default_value = "cover")]
     pub mode: Mode,
     #[command(flatten)]
     pub grid: GridArgs,
     /// For a mesh: how surface colours combine in a voxel (dominant or blend).
-    #[arg(long, value_enum, default_value = "dominant", value_name = "RULE")]
+    #[arg(long, value_enum, ignore_case = true, default_value = "dominant", value_name = "RULE")]
     pub colour_rule: ColourRule,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
@@ -441,7 +441,7 @@ pub struct ViewArgs {
     pub voxels: Option<PathBuf>,
     /// Also voxelize the mesh with this surface mode (and the grid
     /// options) and draw the voxels beside it.
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, ignore_case = true)]
     pub mode: Option<Mode>,
     #[command(flatten)]
     pub grid: GridArgs,
@@ -573,7 +573,7 @@ pub struct BenchArgs {
     /// alternation with the measured paths, the brute-force loop a short C
     /// program would be (every voxel of each triangle's bounding box, the
     /// f64 triangle/box test, one thread), and adds a "vs brute" column.
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, ignore_case = true)]
     pub baseline: Option<Baseline>,
     /// Split every triangle into four this many times before measuring
     /// (e.g. 2 turns the 69k-triangle bunny into 1.1M triangles).
@@ -636,6 +636,9 @@ pub struct ConvertArgs {
     /// Print one JSON object on stdout instead of the summary line.
     #[arg(long)]
     pub json: bool,
+    /// No summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 #[derive(Args, Debug)]
@@ -661,19 +664,19 @@ pub struct BatchArgs {
     #[arg(long, default_value = "npy", value_name = "FORMAT")]
     pub format: String,
     /// Voxelization mode.
-    #[arg(long, value_enum, default_value = "cover")]
+    #[arg(long, value_enum, ignore_case = true, default_value = "cover")]
     pub mode: Mode,
     /// Method.
-    #[arg(long, value_enum, default_value = "auto")]
+    #[arg(long, value_enum, ignore_case = true, default_value = "auto")]
     pub method: Method,
     /// `bubble`: the seed of its random points (same seed, same voxels; default 0).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Solid modes: the surface mode of `solid+surface` and of the `--fill flood` shell.
-    #[arg(long, value_enum, value_name = "MODE")]
+    #[arg(long, value_enum, ignore_case = true, value_name = "MODE")]
     pub surface: Option<Mode>,
     /// Solid modes: `flood` fills everything a surface shell encloses.
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, ignore_case = true)]
     pub fill: Option<Fill>,
     /// Solid modes: keep only the voxels touching the outside through a face (6) or also an edge or corner (26).
     #[arg(long, value_name = "6|26", value_parser = clap::builder::PossibleValuesParser::new(["6", "26"]))]
@@ -683,7 +686,7 @@ pub struct BatchArgs {
     #[command(flatten)]
     pub memory: MemoryArgs,
     /// With --method gpu: compute, raster or msaa-approx.
-    #[arg(long, value_enum, default_value = "compute", value_name = "PATH")]
+    #[arg(long, value_enum, ignore_case = true, default_value = "compute", value_name = "PATH")]
     pub gpu_path: GpuPathArg,
     #[command(flatten)]
     pub export: ExportArgs,
@@ -719,7 +722,7 @@ pub struct RasterArgs {
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Rasterization mode.
-    #[arg(long, value_enum, default_value = "curve8")]
+    #[arg(long, value_enum, ignore_case = true, default_value = "curve8")]
     pub mode: RasterModeArg,
     /// Fit the grid so the longest side of the drawing spans N pixels (default 128).
     #[arg(long, value_name = "N")]

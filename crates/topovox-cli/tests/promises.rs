@@ -115,6 +115,29 @@ fn batches_resume_under_any_spelling_and_never_read_their_outputs() {
     }
 }
 
+/// Issue 45, item 5: names in any case, `convert --quiet`, no rate of
+/// nothing when every mesh was skipped, a looping link skipped with a
+/// warning rather than refusing the batch.
+#[test]
+fn small_inconsistencies_users_met() {
+    let d = folder("inconsistent");
+    let ds = d.join("ds");
+    std::fs::create_dir_all(ds.join("sub")).unwrap();
+    std::fs::copy(repo("examples/meshes/box.obj"), ds.join("box.obj")).unwrap();
+    std::os::unix::fs::symlink(&ds, ds.join("sub/loop")).unwrap();
+    let out = d.join("out");
+    let run = || topovox(&["batch", s(&ds), "-o", s(&out), "--resolution", "8", "--mode", "COVER"]);
+    let first = run();
+    assert!(first.status.success(), "{}", String::from_utf8_lossy(&first.stderr));
+    let err = String::from_utf8_lossy(&first.stderr);
+    assert!(err.contains("warning") && err.contains("loop"), "{err}");
+    let again = String::from_utf8_lossy(&run().stdout).into_owned();
+    assert!(again.contains("1 skipped") && !again.contains("meshes/s"), "{again}");
+    let npy = out.join("box.npy");
+    let o = topovox(&["convert", s(&npy), s(&d.join("box.vdb")), "--quiet"]);
+    assert!(o.status.success() && o.stdout.is_empty() && o.stderr.is_empty(), "{o:?}");
+}
+
 /// The paths below `dir`, relative to it.
 fn walk(dir: &Path) -> Vec<String> {
     let mut out = Vec::new();

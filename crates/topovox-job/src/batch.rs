@@ -78,8 +78,9 @@ pub struct Item {
 /// folders, relative to that folder. Files named directly are kept. The
 /// output folder `out_dir` is never searched, and no file a manifest found
 /// on the way lists as a batch's output is taken: a batch does not read
-/// what it (or another batch) wrote.
-pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path) -> Result<Vec<PathBuf>> {
+/// what it (or another batch) wrote. A link that loops back to a folder
+/// above it is skipped with a warning (the second value).
+pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path) -> Result<(Vec<PathBuf>, Vec<String>)> {
     let outputs = std::fs::canonicalize(out_dir).ok();
     let matcher = match glob {
         Some(g) => Some(
@@ -92,6 +93,7 @@ pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path) ->
         None => None,
     };
     let mut out = Vec::new();
+    let mut warnings = Vec::new();
     for input in inputs {
         let meta = std::fs::metadata(input).map_err(|e| JobError::Io(topovox_io::IoError::new(input, topovox_io::ErrorKind::Read(e))))?;
         if !meta.is_dir() {
@@ -103,7 +105,14 @@ pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path) ->
         };
         let mut written: std::collections::HashSet<String> = std::collections::HashSet::new();
         for entry in walkdir::WalkDir::new(input).follow_links(true).sort_by_file_name().into_iter().filter_entry(not_outputs) {
-            let entry = entry.map_err(|e| JobError::failed(format!("{}: cannot list: {e}", input.display())))?;
+            let entry = match entry {
+                Err(e) if e.loop_ancestor().is_some() => {
+                    let link = e.path().map_or_else(|| input.display().to_string(), |p| p.display().to_string());
+                    warnings.push(format!("{link}: skipped: a link back to a folder that holds it"));
+                    continue;
+                }
+                r => r.map_err(|e| JobError::failed(format!("{}: cannot list: {e}", input.display())))?,
+            };
             if entry.file_type().is_dir() {
                 // Folders come before what they hold.
                 written.extend(outputs_listed_in(&entry.path().join(MANIFEST)));
@@ -129,7 +138,7 @@ pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path) ->
     if out.is_empty() {
         return Err(JobError::invalid("no input meshes found (give mesh files, or folders holding them; see --glob)"));
     }
-    Ok(out)
+    Ok((out, warnings))
 }
 
 /// The keys of the outputs a manifest at `path` lists (none if there is

@@ -144,12 +144,16 @@ pub fn check_output_path(out: &Path) -> Result<()> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
+    // File errors, of the kinds the OS gives (Python: FileNotFoundError,
+    // IsADirectoryError), not bad arguments.
+    let cannot =
+        |kind, why: String| JobError::Io(topovox_io::IoError::new(out, topovox_io::ErrorKind::Write(std::io::Error::new(kind, why))));
     if !dir.is_dir() {
-        return Err(JobError::invalid(format!("{}: cannot write: directory {} does not exist", out.display(), dir.display())));
+        return Err(cannot(std::io::ErrorKind::NotFound, format!("directory {} does not exist", dir.display())));
     }
     let zarr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("zarr"));
     if out.is_dir() && !(zarr && out.join("zarr.json").is_file()) {
-        return Err(JobError::invalid(format!("{}: cannot write: it is a directory", out.display())));
+        return Err(cannot(std::io::ErrorKind::IsADirectory, "it is a directory".into()));
     }
     Ok(())
 }

@@ -78,7 +78,7 @@ impl Mode {
 
     /// The mode called `name`.
     pub fn parse(name: &str) -> Result<Mode> {
-        match Mode::ALL.into_iter().find(|m| m.name() == name) {
+        match Mode::ALL.into_iter().find(|m| m.name().eq_ignore_ascii_case(name)) {
             Some(m) => Ok(m),
             None => invalid!("unknown mode {name:?} (expected one of: {})", Mode::ALL.map(Mode::name).join(", ")),
         }
@@ -154,7 +154,7 @@ impl Method {
 
     /// The method called `name`.
     pub fn parse(name: &str) -> Result<Method> {
-        match Method::ALL.into_iter().find(|m| m.name() == name) {
+        match Method::ALL.into_iter().find(|m| m.name().eq_ignore_ascii_case(name)) {
             Some(m) => Ok(m),
             None => invalid!("unknown method {name:?} (expected one of: {})", Method::ALL.map(Method::name).join(", ")),
         }

@@ -128,7 +128,7 @@ fn a_stopped_batch_records_only_finished_meshes_and_resumes() {
         read: Default::default(),
         fingerprint: json!({"test": "stop"}),
     };
-    let files = batch::collect_inputs(&[inputs], None, &out).unwrap();
+    let (files, _) = batch::collect_inputs(&[inputs], None, &out).unwrap();
     let items: Vec<Item> = batch::plan_items(&files, &out, "npy").unwrap();
     let stop = Arc::new(Stop::new());
     let one = topovox_job::pool(1).unwrap();

@@ -70,7 +70,10 @@ pub fn run(a: &BatchArgs) -> Result<()> {
         fingerprint,
     };
     let pool = crate::thread_pool_for(a.jobs, "--jobs")?;
-    let files = batch::collect_inputs(&a.inputs, a.glob.as_deref(), &a.output)?;
+    let (files, warnings) = batch::collect_inputs(&a.inputs, a.glob.as_deref(), &a.output)?;
+    for w in &warnings {
+        eprintln!("topovox: warning: {w}");
+    }
     let ext = format.name().replace("npy-bool", "npy");
     let items = batch::plan_items(&files, &a.output, &ext)?;
 
@@ -94,12 +97,13 @@ pub fn run(a: &BatchArgs) -> Result<()> {
         crate::print_stdout(&v.to_string())?;
     } else if !a.quiet {
         crate::print_stdout(&format!(
-            "batch: {} done, {} skipped (already done), {} failed, of {total} meshes in {:.2} s ({:.1} meshes/s) -> {} (manifest {})",
+            "batch: {} done, {} skipped (already done), {} failed, of {total} meshes in {:.2} s{} -> {} (manifest {})",
             summary.done,
             summary.skipped,
             summary.failed,
             summary.total_s,
-            summary.done as f64 / summary.total_s.max(1e-9),
+            // A rate only of meshes voxelized now (none when all were skipped).
+            if summary.done > 0 { format!(" ({:.1} meshes/s)", summary.done as f64 / summary.total_s.max(1e-9)) } else { String::new() },
             a.output.display(),
             summary.manifest.display()
         ))?;

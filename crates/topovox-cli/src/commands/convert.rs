@@ -91,6 +91,9 @@ fn finish(
             "origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size(), "grid_from": source, "export": facts, "sparse": sparse});
         return crate::print_stdout(&v.to_string());
     }
+    if a.quiet {
+        return Ok(());
+    }
     let what = match (facts.get("quads"), facts.get("vertices")) {
         (Some(q), Some(v)) => format!(" as {q} greedy quads, {v} vertices"),
         _ => String::new(),
