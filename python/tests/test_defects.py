@@ -47,3 +47,37 @@ def test_batch_takes_a_bytes_path_and_skips_a_looping_link(tmp_path):
     s = topovox.batch(os.fsencode(ds), tmp_path / "out", resolution=8)
     assert (s["done"], s["failed"]) == (2, 0), s
     assert len(s["warnings"]) == 1 and "loop" in s["warnings"][0], s
+
+
+def test_dask_and_ray_are_reachable_after_import_topovox_without_loading_them():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, topovox\n"
+        "assert 'dask' not in sys.modules and 'ray' not in sys.modules\n"
+        "assert callable(topovox.dask.voxelize_paths) and callable(topovox.ray.voxelize_paths)\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_the_readme_dataset_script_runs_as_written(tmp_path):
+    """python/README.md's "Whole datasets" script, saved and run as a file
+    beside a `meshes/` folder (Dask and Ray start worker processes)."""
+    import re
+    import shutil
+    import subprocess
+    import sys
+
+    text = (REPO / "python" / "README.md").read_text(encoding="utf-8")
+    scripts = [b for b in re.findall(r"^```python\n(.*?)^```$", text, flags=re.S | re.M) if "__main__" in b]
+    assert len(scripts) == 1, "python/README.md should hold one dataset script"
+    (tmp_path / "meshes").mkdir()
+    for name in ("box.obj", "cow.obj"):
+        shutil.copy(REPO / "examples" / "meshes" / name, tmp_path / "meshes" / name)
+    (tmp_path / "voxelize_all.py").write_text(scripts[0], encoding="utf-8")
+    r = subprocess.run([sys.executable, "voxelize_all.py"], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert "2 meshes on Dask" in r.stdout and "2 meshes on Ray" in r.stdout, r.stdout
+    for out in ("voxels", "voxels-dask", "voxels-ray"):
+        assert sorted(p.name for p in (tmp_path / out).glob("*.npy")) == ["box.npy", "cow.npy"]

@@ -73,6 +73,18 @@ FORMATS = ("npy", "npy-bool", "npz", "binvox", "vox", "txt", "schem", "vti", "pl
 
 MeshLike = Union[Mesh, Any]
 
+#: The submodules ``import topovox`` makes reachable on first use, without
+#: importing Dask or Ray before then.
+_LAZY = ("dask", "ray")
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 def _as_float_points(a: Any, name: str) -> np.ndarray:
     """float64/float32 arrays pass through untouched (the native side copies
