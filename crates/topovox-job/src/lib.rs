@@ -57,29 +57,21 @@ pub fn check_threads(threads: usize, what: &str) -> Result<()> {
     Ok(())
 }
 
-/// A rayon pool of `threads` workers, made once per count and kept (jobs
-/// that ask for a thread count run on it); `threads` is checked by
-/// [`check_threads`].
-pub fn pool(threads: usize) -> Result<std::sync::Arc<rayon::ThreadPool>> {
+/// A rayon pool of `threads` workers, of this call's own (`threads` is
+/// checked by [`check_threads`]). Never shared: calls from different
+/// threads (Python threads, a batch's meshes, Dask tasks) that each ask
+/// for one thread run side by side, where one kept pool per count made
+/// them queue on its single worker. Starting threads costs tens of
+/// microseconds each; they end when the pool is dropped.
+pub fn pool(threads: usize) -> Result<rayon::ThreadPool> {
     pool_for(threads, "threads")
 }
 
 /// [`pool`], the count named `what` in errors.
-pub fn pool_for(threads: usize, what: &str) -> Result<std::sync::Arc<rayon::ThreadPool>> {
-    use std::collections::HashMap;
-    use std::sync::{Arc, Mutex, OnceLock};
-    static POOLS: OnceLock<Mutex<HashMap<usize, Arc<rayon::ThreadPool>>>> = OnceLock::new();
+pub fn pool_for(threads: usize, what: &str) -> Result<rayon::ThreadPool> {
     check_threads(threads, what)?;
-    let mut pools = POOLS.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
-    if let Some(p) = pools.get(&threads) {
-        return Ok(p.clone());
-    }
-    let p = Arc::new(
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| JobError::failed(format!("cannot start {threads} threads: {e}")))?,
-    );
-    pools.insert(threads, p.clone());
-    Ok(p)
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| JobError::failed(format!("cannot start {threads} threads: {e}")))
 }
