@@ -1,8 +1,9 @@
 //! PLY, ASCII and binary (both endiannesses), through the `ply-rs-bw` crate.
 //!
-//! Reads element `vertex` (properties `x`, `y`, `z`, any numeric type) and
-//! element `face` (list property `vertex_indices` or `vertex_index`);
-//! polygons are fan-triangulated.
+//! Reads element `vertex` (properties `x`, `y`, `z`, any numeric type),
+//! element `face` (list property `vertex_indices` or `vertex_index`;
+//! polygons are fan-triangulated) and element `tristrips` (the same list,
+//! triangle strips, `-1` starting a new strip; common in older scans).
 
 use std::io::Cursor;
 
@@ -75,12 +76,43 @@ pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
             fan(&idx, &mut triangles);
         }
     }
+    if let Some(strips) = payload.get("tristrips") {
+        for (n, s) in strips.iter().enumerate() {
+            let idx = s
+                .get("vertex_indices")
+                .or_else(|| s.get("vertex_index"))
+                .and_then(list)
+                .ok_or_else(|| ErrorKind::malformed("PLY", format!("tristrips {n} has no 'vertex_indices' list")))?;
+            for strip in idx.split(|&v| v == -1) {
+                unstrip(strip, &mut triangles);
+            }
+        }
+    }
+    if payload.get("face").is_none() && payload.get("tristrips").is_none() {
+        let names: Vec<&str> = header.elements.keys().map(String::as_str).collect();
+        return Err(ErrorKind::malformed(
+            "PLY",
+            format!("no 'face' or 'tristrips' element to read triangles from (it has: {})", names.join(", ")),
+        ));
+    }
     if !colours.is_empty() {
         colours.resize(positions.len(), [255; 3]);
     }
     let mut loaded = finish(positions, triangles, Vec::new())?;
     loaded.appearance.vertex_colour = colours;
     Ok(loaded)
+}
+
+/// The triangles of one triangle strip, every other one turned so all
+/// keep the strip's orientation; the degenerate ones that join strips
+/// (a vertex repeated) are left out.
+fn unstrip(strip: &[i64], out: &mut Vec<[i64; 3]>) {
+    for (n, w) in strip.windows(3).enumerate() {
+        let t = if n % 2 == 0 { [w[0], w[1], w[2]] } else { [w[1], w[0], w[2]] };
+        if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+            out.push(t);
+        }
+    }
 }
 
 /// Refuses a header whose element counts cannot fit in the bytes after it:

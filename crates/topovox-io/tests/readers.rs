@@ -116,6 +116,52 @@ fn ply_ascii_and_binary_with_polygons() {
     }
 }
 
+/// Issue 45, item 6: a PLY of triangle strips (`tristrips`, `-1` starting
+/// a strip, as older scans store them) reads as the triangles of the same
+/// surface listed as faces, each strip's turned triangles oriented alike,
+/// the degenerate ones that join strips left out.
+#[test]
+fn ply_triangle_strips_read_as_their_triangles() {
+    let verts: String = (0..8).map(|v| format!("{} {} {}\n", v & 1, (v >> 1) & 1, (v >> 2) & 1)).collect();
+    // The cube's faces as counter-clockwise quads seen from outside.
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let header = |el: &str, n: usize| {
+        format!("ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\nelement {el} {n}\nproperty list uchar int vertex_indices\nend_header\n{verts}")
+    };
+    let faces = header("face", 6) + &quads.iter().map(|q| format!("4 {} {} {} {}\n", q[0], q[1], q[2], q[3])).collect::<String>();
+    // A quad a b c d as the strip a b d c; three faces in one strip list
+    // joined by a repeated vertex (degenerate triangles), three by -1.
+    let strip = |q: &[i64; 4]| vec![q[0], q[1], q[3], q[2]];
+    let mut first: Vec<i64> = strip(&quads[0]);
+    for q in &quads[1..3] {
+        first.extend([*first.last().unwrap(), q[0], q[0]]);
+        // Keep the parity of the next strip's first triangle even.
+        if first.len() % 2 == 1 {
+            first.push(q[0]);
+        }
+        first.extend(strip(q));
+    }
+    let mut second: Vec<i64> = Vec::new();
+    for q in &quads[3..] {
+        second.extend(strip(q));
+        second.push(-1);
+    }
+    let list = |v: &[i64]| format!("{} {}\n", v.len(), v.iter().map(i64::to_string).collect::<Vec<_>>().join(" "));
+    let strips = header("tristrips", 2) + &list(&first) + &list(&second);
+    // The same closed, outward surface (the quads' diagonals may differ):
+    // 12 triangles, every edge used once each way, volume +1.
+    for (name, text) in [("faces.ply", faces), ("strips.ply", strips)] {
+        let m = read_mesh(&write(name, text.as_bytes())).unwrap_or_else(|e| panic!("{e}"));
+        let t = &m.mesh.triangles;
+        assert_eq!(t.len(), 12, "{name}");
+        let edges: std::collections::HashSet<(u32, u32)> = t.iter().flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]).collect();
+        assert!(edges.len() == 36 && edges.iter().all(|&(a, b)| edges.contains(&(b, a))), "{name}: not closed and consistent");
+        let p = &m.mesh.positions;
+        let volume: f64 = t.iter().map(|t| p[t[0] as usize].dot(p[t[1] as usize].cross(p[t[2] as usize])) / 6.0).sum();
+        assert!((volume - 1.0).abs() < 1e-12, "{name}: volume {volume}");
+    }
+}
+
 /// A glTF document with one triangle (mesh 0) instanced by a parent node
 /// (translation 10,0,0) and its child (scale 2): the triangle appears twice.
 fn gltf_json(uri: Option<&str>, byte_len: usize) -> String {
