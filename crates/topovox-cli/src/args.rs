@@ -329,6 +329,9 @@ pub struct RenderArgs {
     /// Print one JSON object on stdout instead of the summary line.
     #[arg(long)]
     pub json: bool,
+    /// No summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
     #[command(flatten)]
     pub gpu: GpuRenderArgs,
 }
@@ -487,6 +490,9 @@ pub struct ViewArgs {
     /// Print one JSON object on stdout when the window closes.
     #[arg(long)]
     pub json: bool,
+    /// No summary line when the window closes.
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 #[derive(Args, Debug)]

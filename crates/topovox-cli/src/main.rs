@@ -21,6 +21,9 @@ fn main() -> ExitCode {
             eprintln!("topovox: internal error (please report): {info}");
         }
     }));
+    // Before any thread starts (it may set an environment variable).
+    #[cfg(feature = "gpu")]
+    topovox_gpu::quiet_without_display();
     let cli = Cli::parse();
     remove_temporaries_on_interrupt();
     let result = match &cli.command {

@@ -815,6 +815,40 @@ fn gpu_available(out: &Output) -> bool {
     false
 }
 
+/// Issue 45, item 9: on a machine without a display (no
+/// `XDG_RUNTIME_DIR`), GPU runs that succeed print nothing on stderr (a
+/// Vulkan layer probing for Wayland printed "error:" lines), and `render`
+/// takes `--quiet`.
+#[test]
+fn gpu_runs_without_a_display_are_quiet() {
+    let cow = shared("cow.obj");
+    let headless = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_topovox"))
+            .args(args)
+            .env_remove("XDG_RUNTIME_DIR")
+            .env_remove("WAYLAND_DISPLAY")
+            .env_remove("DISPLAY")
+            .output()
+            .expect("run topovox")
+    };
+    let runs: [&[&str]; 2] = [
+        &["voxelize", &cow, "-o", &tmp("quiet-gpu.npy"), "--method", "gpu", "--resolution", "48", "--quiet"],
+        &["render", &cow, "--gpu", "-o", &tmp("quiet-gpu.png"), "--size", "64x48", "--quiet"],
+    ];
+    for args in runs {
+        let out = headless(args);
+        if !out.status.success() && !gpu_available(&out) {
+            return;
+        }
+        assert!(
+            out.stderr.is_empty() && out.stdout.is_empty(),
+            "{args:?}: {}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
+
 #[test]
 fn the_gpu_renderer_draws_the_cornell_box_and_reports_its_frame() {
     let obj = tmp("cornell.obj");

@@ -208,10 +208,39 @@ impl SolidPipelines {
     }
 }
 
+/// The instance for headless work: Vulkan, Metal and DX12 (`WGPU_BACKEND`
+/// chooses others). Not OpenGL: its EGL setup probes for a Wayland display
+/// and, on a headless machine without `XDG_RUNTIME_DIR`, prints "error:"
+/// lines on stderr of runs that succeed; no compute path uses it.
+pub fn headless() -> wgpu::InstanceDescriptor {
+    quiet_without_display();
+    wgpu::InstanceDescriptor { backends: wgpu::Backends::PRIMARY, ..wgpu::InstanceDescriptor::new_without_display_handle() }.with_env()
+}
+
+/// On a machine without a display (no `WAYLAND_DISPLAY`, `DISPLAY` or
+/// valid `XDG_RUNTIME_DIR`), turns off Mesa's Vulkan device-selection
+/// layer (`NODEVICE_SELECT=1`) unless the user chose a device with it
+/// (`MESA_VK_DEVICE_SELECT`): while devices are enumerated it looks for a
+/// Wayland display and prints "error: XDG_RUNTIME_DIR is invalid" on
+/// stderr of runs that succeed. It only orders devices by the display's,
+/// which a machine without one does not have. Once per process; the CLI
+/// calls it first thing, while it has one thread.
+pub fn quiet_without_display() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let set = |v: &str| std::env::var_os(v).is_some_and(|x| !x.is_empty());
+        let runtime_dir = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+        let display = set("WAYLAND_DISPLAY") || set("DISPLAY") || runtime_dir;
+        if !display && !set("MESA_VK_DEVICE_SELECT") && !set("NODEVICE_SELECT") {
+            std::env::set_var("NODEVICE_SELECT", "1");
+        }
+    });
+}
+
 /// The default adapter (high performance preferred), if it has what the
 /// exact path needs.
 fn adapter() -> Result<wgpu::Adapter, GpuError> {
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let instance = wgpu::Instance::new(headless());
     let adapter =
         pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,

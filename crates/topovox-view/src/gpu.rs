@@ -384,7 +384,12 @@ fn shader(parts: &[&str]) -> String {
 impl Renderer {
     /// Opens the default adapter (high performance preferred).
     pub fn new() -> Result<Renderer, ViewError> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        // Vulkan, Metal and DX12 (`WGPU_BACKEND` chooses others): OpenGL's
+        // EGL setup probes for a Wayland display and, headless without
+        // `XDG_RUNTIME_DIR`, prints "error:" lines for runs that succeed.
+        let backends = wgpu::Backends::PRIMARY;
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor { backends, ..wgpu::InstanceDescriptor::new_without_display_handle() }.with_env());
         Renderer::open(&instance, None)
     }
 

@@ -191,6 +191,9 @@ fn summary(a: &RenderArgs, img: &Image, what: &str, bits: &dyn VoxelSource, t0: 
             "dims": bits.dims(), "voxels": bits.count(), "covered_pixels": img.covered, "total_s": total_s});
         return crate::print_stdout(&v.to_string());
     }
+    if a.quiet {
+        return Ok(());
+    }
     crate::print_stdout(&format!(
         "render: {}x{} picture of {} voxels ({}, grid {:?}) in {:.2} s -> {}",
         img.width,

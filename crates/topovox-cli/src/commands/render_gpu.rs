@@ -209,6 +209,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if a.json {
         return crate::print_stdout(&stats.to_string());
     }
+    if a.quiet {
+        return Ok(());
+    }
     crate::print_stdout(&format!(
         "render --gpu: {} frame(s) {}x{} of {} triangles ({}), first: {} of {} clusters drawn, {} lights, {:.1} ms -> {}",
         stats["frames"].as_array().map_or(0, Vec::len),

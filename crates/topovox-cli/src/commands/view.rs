@@ -102,5 +102,8 @@ pub fn run(a: &ViewArgs) -> Result<()> {
             "screenshot": a.screenshot, "screenshot_size": shot.map(|(w, h)| [w, h]), "points": report.points.len(), "save_points": a.save_points});
         return crate::print_stdout(&v.to_string());
     }
+    if a.quiet {
+        return Ok(());
+    }
     crate::print_stdout(&format!("view: {} frames on {}; last camera --camera {camera}", report.frames, report.adapter))
 }
