@@ -80,19 +80,19 @@ pub fn scanline_lattice(mode: Mode, tris: &[LatticeTriangle], dims: [u32; 3], op
 }
 
 /// Whether the scanline path is expected to beat the triangle-box fast path
-/// for `mode` on this mesh and grid (what `--method auto` asks), from the
-/// measurements in BENCHMARKS.md: on triangles of a voxel or two it is
-/// slower (per-row setup with little to amortise it); from a few voxels on
-/// `cover` and `sep26` are as fast or faster, and on large faces several
-/// times faster (runs replace per-voxel work); `sep6`'s single-projection
-/// fast path stays ahead until faces are very large. So: the median
+/// by a wide margin (20 % or more) for `mode` on this mesh and grid (what
+/// `--method auto` asks), from the measurements in BENCHMARKS.md on two
+/// machines: with triangles of up to a hundred voxels the two are within
+/// −23 %…+16 % of each other, the sign changing with the machine and the
+/// mesh, so the fast path is kept; on faces of hundreds of voxels
+/// `cover`'s runs replace per-voxel work (a box at 512: 2.1× faster).
+/// `sep26` and `sep6` never gained 20 % (a box: −6 % and +11 %; the
+/// teapot at 4096: −75 % and +1 %). So: `cover` only, when the median
 /// triangle extent (over a deterministic sample of up to 4096 triangles)
-/// must reach [`PREFER_EXTENT_VOXELS`] for `cover` and `sep26`, and
-/// [`PREFER_EXTENT_VOXELS_SEP6`] for `sep6`.
+/// reaches [`PREFER_EXTENT_VOXELS`].
 pub fn prefers(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec) -> bool {
     let threshold = match mode {
-        Mode::Cover | Mode::Sep26 => PREFER_EXTENT_VOXELS,
-        Mode::Sep6 => PREFER_EXTENT_VOXELS_SEP6,
+        Mode::Cover => PREFER_EXTENT_VOXELS,
         _ => return false,
     };
     if mesh.triangles.is_empty() {
@@ -118,11 +118,8 @@ pub fn prefers(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec) -> bool {
 }
 
 /// Median triangle extent (voxels) from which `auto` takes the scanline
-/// path for `cover` and `sep26`.
-pub const PREFER_EXTENT_VOXELS: f64 = 4.0;
-
-/// The same for `sep6`.
-pub const PREFER_EXTENT_VOXELS_SEP6: f64 = 64.0;
+/// path for `cover`.
+pub const PREFER_EXTENT_VOXELS: f64 = 128.0;
 
 struct ScanKernel {
     mode: Mode,
