@@ -11,7 +11,7 @@
 //! - The GIL is released while meshes load, voxelize, carry colours, write
 //!   and check (`Python::detach`).
 //! - Ctrl-C stops `voxelize`, `VoxelGrid.save` and `batch` within about a
-//!   second, with `KeyboardInterrupt` and no output ([`interruptible`]).
+//!   second, with `KeyboardInterrupt` and no output (see `interruptible`).
 //! - Errors are Python exceptions with the CLI's one-line messages:
 //!   `ValueError` for bad arguments and bad arrays, `OSError` subclasses
 //!   for files (`FileNotFoundError`, `PermissionError`, or
