@@ -573,19 +573,7 @@ type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>, Option<Vec<[u8; 3]>>);
 /// Greedy quads of the voxels (coloured when the grid has colours), with
 /// their T-junctions split (watertight), as world-space triangles.
 fn greedy_triangles(g: &GridData) -> Triangles {
-    use topovox::attributes::quantize;
-    use topovox::export::greedy::{greedy_quads, greedy_quads_by_class};
-    let dense = g.voxels.to_dense();
-    let coloured = g.attrs.as_ref().and_then(|a| a.colour.as_ref().map(|c| (a, c)));
-    let (palette, quads) = match coloured {
-        Some((a, colours)) => {
-            let palette = quantize::palette(colours, 255);
-            let index = quantize::map_to_palette(colours, &palette);
-            let class = move |i: u32, j: u32, k: u32| a.slot(i, j, k).map(|s| index[s] as u32 + 1).unwrap_or(0);
-            (Some(palette), greedy_quads_by_class(&dense, &class))
-        }
-        None => (None, greedy_quads(&dense)),
-    };
+    let (palette, quads) = topovox_job::output::palette_quads(&g.voxels.to_dense(), g.attrs.as_ref());
     let (o, s) = (g.grid.origin(), g.grid.voxel_size() / 2.0);
     let mut index: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::with_capacity(quads.len() * 2);
     let mut verts = Vec::with_capacity(quads.len() * 2);

@@ -31,6 +31,12 @@ fn refused(out: &Output) -> String {
     err
 }
 
+/// The JSON a successful run printed (its stderr when it failed).
+fn succeeded(out: &Output) -> serde_json::Value {
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 fn repo(rel: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..").join(rel)
 }
@@ -67,8 +73,7 @@ fn names_that_are_not_utf8_keep_their_own_manifest_lines() {
     let out = d.join("out");
     let run = || {
         let o = topovox(&["batch", s(&inputs), "-o", s(&out), "--resolution", "8", "--json"]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
+        succeeded(&o)
     };
     let first = run();
     assert_eq!(first["done"], 2, "{first}");
@@ -94,8 +99,7 @@ fn batches_resume_under_any_spelling_and_never_read_their_outputs() {
             .args(["batch", input, "-o", out, "--format", format, "--resolution", "8", "--json"])
             .output()
             .unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let v = succeeded(&o);
         (v["done"].as_u64().unwrap(), v["skipped"].as_u64().unwrap())
     };
     let abs = std::fs::canonicalize(&d).unwrap();
@@ -198,8 +202,7 @@ fn small_files_claiming_huge_grids_are_refused_or_read_from_what_they_store() {
     )
     .unwrap();
     let o = topovox(&["check", s(&z), "--json"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let v = succeeded(&o);
     assert_eq!(v["voxels"], 0, "{v}");
 }
 
@@ -246,8 +249,7 @@ fn max_memory_is_kept_or_the_run_is_refused_before_work() {
     assert!(!out.exists());
     // Enough: the peak stays within the bound.
     let o = run("256M");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let v = succeeded(&o);
     let peak = v["peak_memory_bytes"].as_u64().unwrap();
     assert!(peak <= 256 << 20, "peak {peak} bytes over the 256 MiB bound");
 }
@@ -266,8 +268,7 @@ fn max_memory_is_kept_by_solids_of_open_meshes_or_refused_before_work() {
     assert!(e.contains("the solid on the") && e.contains("needs about"), "{e}");
     assert!(!out.exists());
     let o = run("96M");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let v = succeeded(&o);
     assert_eq!(v["method"], "winding", "{v}");
     let peak = v["peak_memory_bytes"].as_u64().unwrap();
     assert!(peak <= 96 << 20, "peak {peak} bytes over the 96 MiB bound");

@@ -66,26 +66,12 @@ pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
         positions.push(DVec3::from(c));
     }
     let mut triangles = Vec::new();
-    if let Some(faces) = payload.get("face") {
-        for (n, f) in faces.iter().enumerate() {
-            let idx = f
-                .get("vertex_indices")
-                .or_else(|| f.get("vertex_index"))
-                .and_then(list)
-                .ok_or_else(|| ErrorKind::malformed("PLY", format!("face {n} has no 'vertex_indices' list")))?;
-            fan(&idx, &mut triangles);
-        }
+    for idx in index_lists(&payload, "face")? {
+        fan(&idx, &mut triangles);
     }
-    if let Some(strips) = payload.get("tristrips") {
-        for (n, s) in strips.iter().enumerate() {
-            let idx = s
-                .get("vertex_indices")
-                .or_else(|| s.get("vertex_index"))
-                .and_then(list)
-                .ok_or_else(|| ErrorKind::malformed("PLY", format!("tristrips {n} has no 'vertex_indices' list")))?;
-            for strip in idx.split(|&v| v == -1) {
-                unstrip(strip, &mut triangles);
-            }
+    for idx in index_lists(&payload, "tristrips")? {
+        for strip in idx.split(|&v| v == -1) {
+            unstrip(strip, &mut triangles);
         }
     }
     if payload.get("face").is_none() && payload.get("tristrips").is_none() {
@@ -101,6 +87,22 @@ pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
     let mut loaded = finish(positions, triangles, Vec::new())?;
     loaded.appearance.vertex_colour = colours;
     Ok(loaded)
+}
+
+/// The `vertex_indices` (or `vertex_index`) lists of every entry of
+/// `element` (none when the file has no such element).
+fn index_lists(payload: &ply_rs_bw::ply::Payload<DefaultElement>, element: &str) -> Result<Vec<Vec<i64>>, ErrorKind> {
+    let Some(entries) = payload.get(element) else { return Ok(Vec::new()) };
+    entries
+        .iter()
+        .enumerate()
+        .map(|(n, e)| {
+            e.get("vertex_indices")
+                .or_else(|| e.get("vertex_index"))
+                .and_then(list)
+                .ok_or_else(|| ErrorKind::malformed("PLY", format!("{element} {n} has no 'vertex_indices' list")))
+        })
+        .collect()
 }
 
 /// The triangles of one triangle strip, every other one turned so all

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde_json::{json, Value};
 use topovox::attributes::{quantize, VoxelAttributes};
-use topovox::export::greedy::greedy_quads_by_class;
+use topovox::export::greedy::{greedy_quads_by_class, Quad};
 use topovox::{DenseBits, GridSpec, VoxelSource};
 use topovox_io::{VoxelFormat, WriteOptions};
 
@@ -158,6 +158,21 @@ pub fn check_output_path(out: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The greedy quads of `dense`, one class per palette entry when `attrs`
+/// has colours (up to 255, quantized), with that palette: what a mesh of
+/// the voxels is drawn from (`.obj`, `.glb`, Python's `greedy_mesh`).
+pub fn palette_quads(dense: &DenseBits, attrs: Option<&VoxelAttributes>) -> (Option<Vec<[u8; 3]>>, Vec<Quad>) {
+    match attrs.and_then(|a| a.colour.as_ref().map(|c| (a, c))) {
+        Some((a, colours)) => {
+            let palette = quantize::palette(colours, 255);
+            let index = quantize::map_to_palette(colours, &palette);
+            let class = move |i: u32, j: u32, k: u32| a.slot(i, j, k).map(|s| index[s] as u32 + 1).unwrap_or(0);
+            (Some(palette), greedy_quads_by_class(dense, &class))
+        }
+        None => (None, topovox::export::greedy::greedy_quads(dense)),
+    }
+}
+
 /// Writes `bits` (with `attrs`) to `out` as `target`; returns facts for
 /// the summaries. A dense format (or a mesh of the voxels) for a grid that
 /// cannot be held densely is refused before anything is written
@@ -173,49 +188,32 @@ pub fn write(
     opts: &WriteOptions,
 ) -> Result<Value> {
     let stopped = || opts.stop.as_ref().is_some_and(|s| s.requested());
-    match write_unless_stopped(out, target, bits, grid, attrs, opts, &stopped) {
+    let written = (|| -> Result<Value> {
+        check_fits(target, grid, None)?;
+        match target {
+            Output::Voxels(f) => {
+                topovox_io::write_voxels_with(out, f, bits, grid, attrs, opts)?;
+                Ok(json!({"colours": attrs.and_then(|a| a.colour.as_ref()).is_some() && f.has_colour()}))
+            }
+            Output::Mesh(kind) => {
+                let mut dense = DenseBits::new(bits.dims());
+                bits.for_each_set(&mut |i, j, k| dense.set(i, j, k));
+                let (palette, quads) = palette_quads(&dense, attrs);
+                if stopped() {
+                    return Err(JobError::Interrupted);
+                }
+                let vertices = match kind {
+                    MeshKind::Obj => topovox_io::voxel_mesh::write_quads_obj(out, &quads, grid, palette.as_deref(), &opts.mesh)?,
+                    MeshKind::Glb => topovox_io::voxel_mesh::write_quads_glb(out, &quads, grid, palette.as_deref(), &opts.mesh)?,
+                };
+                Ok(json!({"quads": quads.len(), "vertices": vertices, "colours": palette.as_ref().map(|p| p.len()),
+                "watertight": opts.mesh.watertight, "triangulated": opts.mesh.triangulate}))
+            }
+        }
+    })();
+    // A write that failed because the stop was requested is an interruption.
+    match written {
         Err(_) if stopped() => Err(JobError::Interrupted),
         r => r,
-    }
-}
-
-fn write_unless_stopped(
-    out: &Path,
-    target: Output,
-    bits: &dyn VoxelSource,
-    grid: &GridSpec,
-    attrs: Option<&VoxelAttributes>,
-    opts: &WriteOptions,
-    stopped: &dyn Fn() -> bool,
-) -> Result<Value> {
-    check_fits(target, grid, None)?;
-    match target {
-        Output::Voxels(f) => {
-            topovox_io::write_voxels_with(out, f, bits, grid, attrs, opts)?;
-            Ok(json!({"colours": attrs.and_then(|a| a.colour.as_ref()).is_some() && f.has_colour()}))
-        }
-        Output::Mesh(kind) => {
-            let mut dense = DenseBits::new(bits.dims());
-            bits.for_each_set(&mut |i, j, k| dense.set(i, j, k));
-            let coloured = attrs.and_then(|a| a.colour.as_ref().map(|c| (a, c)));
-            let (palette, quads) = match coloured {
-                Some((a, colours)) => {
-                    let palette = quantize::palette(colours, 255);
-                    let index = quantize::map_to_palette(colours, &palette);
-                    let class = move |i: u32, j: u32, k: u32| a.slot(i, j, k).map(|s| index[s] as u32 + 1).unwrap_or(0);
-                    (Some(palette), greedy_quads_by_class(&dense, &class))
-                }
-                None => (None, topovox::export::greedy::greedy_quads(&dense)),
-            };
-            if stopped() {
-                return Err(JobError::Interrupted);
-            }
-            let vertices = match kind {
-                MeshKind::Obj => topovox_io::voxel_mesh::write_quads_obj(out, &quads, grid, palette.as_deref(), &opts.mesh)?,
-                MeshKind::Glb => topovox_io::voxel_mesh::write_quads_glb(out, &quads, grid, palette.as_deref(), &opts.mesh)?,
-            };
-            Ok(json!({"quads": quads.len(), "vertices": vertices, "colours": palette.as_ref().map(|p| p.len()),
-                "watertight": opts.mesh.watertight, "triangulated": opts.mesh.triangulate}))
-        }
     }
 }

@@ -7,6 +7,8 @@
 use std::sync::mpsc;
 use std::time::Duration;
 
+mod common;
+
 #[test]
 fn one_thread_calls_from_two_threads_run_at_once() {
     let (to_b, from_a) = mpsc::channel::<()>();
@@ -30,22 +32,8 @@ fn one_thread_calls_from_two_threads_run_at_once() {
 /// alone.
 #[test]
 fn concurrent_voxelizations_give_the_same_voxels() {
-    let cow = topovox_io::read_mesh(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/meshes/cow.obj")).unwrap();
-    let grid = topovox_job::GridOptions { resolution: Some(64), ..Default::default() };
-    let plan = topovox_job::Plan::new(topovox_job::Request {
-        mode: topovox_job::Mode::parse("sep26").unwrap(),
-        method: topovox_job::Method::Auto,
-        grid: topovox_job::GridRequest::new(&grid).unwrap(),
-        surface: None,
-        fill: None,
-        hollow: None,
-        gpu_path: topovox_job::GpuPath::Compute,
-        seed: 0,
-        tile: None,
-        max_memory: None,
-        writer_bytes_per_brick: 0,
-    })
-    .unwrap();
+    let cow = topovox_io::read_mesh(&common::repo("examples/meshes/cow.obj")).unwrap();
+    let plan = common::plan("sep26", 64, None);
     let run = || {
         topovox_job::pool(1)
             .unwrap()

@@ -6,16 +6,15 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use common::{plan, repo};
 use serde_json::{json, Value};
 use topovox::voxelize::Stop;
 use topovox_io::{VoxelFormat, WriteOptions};
 use topovox_job::batch::{self, BatchOptions, BatchProgress, Item};
 use topovox_job::output::{MeshKind, Output};
-use topovox_job::{GridOptions, GridRequest, JobError, Method, Mode, Plan, Request};
+use topovox_job::JobError;
 
-fn repo(p: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(p)
-}
+mod common;
 
 fn folder(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("topovox-job-stop-{}-{name}", std::process::id()));
@@ -28,24 +27,6 @@ fn names(d: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(d).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
     v.sort();
     v
-}
-
-fn plan(mode: &str, resolution: u64, tile: Option<u32>) -> Plan {
-    let grid = GridOptions { resolution: Some(resolution), ..GridOptions::default() };
-    Plan::new(Request {
-        mode: Mode::parse(mode).unwrap(),
-        method: Method::Auto,
-        grid: GridRequest::new(&grid).unwrap(),
-        surface: None,
-        fill: None,
-        hollow: None,
-        gpu_path: topovox_job::GpuPath::Compute,
-        seed: 0,
-        tile,
-        max_memory: None,
-        writer_bytes_per_brick: 0,
-    })
-    .unwrap()
 }
 
 fn requested() -> Arc<Stop> {
