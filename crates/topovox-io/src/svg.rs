@@ -11,6 +11,17 @@
 //! `px` are refused with an error naming them (never drawn wrongly);
 //! `<text>` and `<image>` are skipped with a warning.
 //!
+//! **Painting.** Each element is one shape for `raster --mode fill`, filled
+//! as SVG paints it: its `fill` (a presentation attribute or a `style`
+//! declaration, the declaration winning; inherited from the enclosing
+//! groups; black, so filled, by default) and its `fill-rule` (`nonzero` by
+//! default, or `evenodd`) decide; a `<path>`'s subpaths are filled together,
+//! each closed. `fill="none"` leaves the element unfilled: `fill` ignores
+//! it, and the curve modes (`curve4`, `curve8`, `diamond`) draw it like
+//! every other element, whatever its `fill` and `stroke`. Stroke widths are
+//! not drawn (a curve is the outline itself), and `<style>` sheets are not
+//! applied (a warning says so when one sets `fill`).
+//!
 //! Coordinates: SVG user units are the plane's coordinates (`x → i`,
 //! `y → j`, no flip). **Flattening:** curves are split until every chord
 //! lies within the tolerance of the curve (`tolerance`, in user units;
@@ -18,7 +29,7 @@
 //! resolution topovox allows).
 
 use glam::DVec2;
-use topovox::raster::Outline;
+use topovox::raster::{FillRule, Outline};
 
 use crate::error::ErrorKind;
 
@@ -33,7 +44,9 @@ pub struct SvgOptions {
 /// Outlines read from an SVG, and warnings.
 #[derive(Clone, Debug, Default)]
 pub struct LoadedSvg {
-    /// Polylines (closed by `Z`, `<polygon>`, `<rect>`, circles, ellipses).
+    /// Polylines (closed by `Z`, `<polygon>`, `<rect>`, circles, ellipses),
+    /// each with its element's fill rule (`None`: `fill="none"`) and the
+    /// element's number as its shape.
     pub outlines: Vec<Outline>,
     /// Skipped elements.
     pub warnings: Vec<String>,
@@ -46,6 +59,56 @@ enum Piece {
     Line(DVec2),
     Cubic(DVec2, DVec2, DVec2),
     Close,
+}
+
+/// One element's path and how it is filled.
+struct Element {
+    pieces: Vec<Piece>,
+    fill: Option<FillRule>,
+}
+
+/// The fill properties an element inherits and passes on.
+#[derive(Clone, Copy)]
+struct Painting {
+    filled: bool,
+    rule: FillRule,
+}
+
+impl Painting {
+    /// SVG's initial values: filled (black), nonzero.
+    const INITIAL: Painting = Painting { filled: true, rule: FillRule::NonZero };
+
+    /// The node's own painting: its presentation attributes, then its
+    /// `style` declarations, over what it inherits. Values a browser would
+    /// ignore (unparsable) are ignored here too.
+    fn of(self, node: roxmltree::Node<'_, '_>) -> Painting {
+        let attributes = ["fill", "fill-rule"].into_iter().filter_map(|n| node.attribute(n).map(|v| (n, v)));
+        let style = node.attribute("style").unwrap_or("").split(';').filter_map(|d| d.split_once(':'));
+        let mut out = self;
+        for (name, value) in attributes.chain(style) {
+            let value = value.trim().trim_end_matches("!important").trim();
+            match name.trim() {
+                "fill" => match svgtypes::Paint::from_str(value) {
+                    Ok(svgtypes::Paint::None) => out.filled = false,
+                    Ok(svgtypes::Paint::Inherit) => out.filled = self.filled,
+                    Ok(_) => out.filled = true,
+                    Err(_) => {}
+                },
+                "fill-rule" => match value {
+                    "nonzero" => out.rule = FillRule::NonZero,
+                    "evenodd" => out.rule = FillRule::EvenOdd,
+                    "inherit" => out.rule = self.rule,
+                    _ => {}
+                },
+                _ => {}
+            }
+        }
+        out
+    }
+
+    fn fill(self) -> Option<FillRule> {
+        self.filled.then_some(self.rule)
+    }
 }
 
 #[derive(Clone, Copy)]
@@ -71,12 +134,12 @@ impl Affine {
 pub fn read(bytes: &[u8], opts: &SvgOptions) -> Result<LoadedSvg, ErrorKind> {
     let text = std::str::from_utf8(bytes).map_err(|e| ErrorKind::malformed("SVG", format!("not UTF-8 ({e})")))?;
     let doc = roxmltree::Document::parse(text).map_err(|e| ErrorKind::malformed("SVG", e))?;
-    let mut paths: Vec<Vec<Piece>> = Vec::new();
+    let mut paths: Vec<Element> = Vec::new();
     let mut warnings = Vec::new();
-    walk(doc.root_element(), Affine::ID, &mut paths, &mut warnings)?;
+    walk(doc.root_element(), (Affine::ID, Painting::INITIAL), &mut paths, &mut warnings)?;
     // The drawing's extent (end and control points) sets the default tolerance.
     let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-    for p in paths.iter().flatten() {
+    for p in paths.iter().flat_map(|e| &e.pieces) {
         let pts: &[DVec2] = match p {
             Piece::Move(a) | Piece::Line(a) => std::slice::from_ref(a),
             Piece::Cubic(a, b, c) => &[*a, *b, *c][..],
@@ -96,7 +159,8 @@ pub fn read(bytes: &[u8], opts: &SvgOptions) -> Result<LoadedSvg, ErrorKind> {
     };
     let mut outlines = Vec::new();
     let mut total = 0usize;
-    for pieces in paths {
+    for (shape, Element { pieces, fill }) in paths.into_iter().enumerate() {
+        let first = outlines.len();
         let mut cur = Outline::default();
         let mut at = DVec2::ZERO;
         let mut start = DVec2::ZERO;
@@ -148,6 +212,9 @@ pub fn read(bytes: &[u8], opts: &SvgOptions) -> Result<LoadedSvg, ErrorKind> {
             }
         }
         push(&mut cur, &mut outlines);
+        for o in &mut outlines[first..] {
+            (o.fill, o.shape) = (fill, shape.min(u32::MAX as usize) as u32);
+        }
     }
     if outlines.iter().all(|o| o.points.is_empty()) {
         return Err(ErrorKind::malformed("SVG", "no path, polyline, polygon, line, rect, circle or ellipse with at least two points"));
@@ -220,14 +287,26 @@ fn number(node: roxmltree::Node<'_, '_>, name: &str, default: f64) -> Result<f64
     }
 }
 
-fn walk(node: roxmltree::Node<'_, '_>, parent: Affine, out: &mut Vec<Vec<Piece>>, warnings: &mut Vec<String>) -> Result<(), ErrorKind> {
+/// Reads the drawn elements under `node`, with the transform and painting
+/// its parent passes on.
+fn walk(
+    node: roxmltree::Node<'_, '_>,
+    (parent, painting): (Affine, Painting),
+    elements: &mut Vec<Element>,
+    warnings: &mut Vec<String>,
+) -> Result<(), ErrorKind> {
     if !node.is_element() {
         return Ok(());
     }
     let name = node.tag_name().name();
+    if name == "style" && node.text().is_some_and(|t| t.contains("fill")) {
+        warnings.push("a <style> sheet sets fill; style sheets are not applied (use fill= or style= on the elements)".into());
+    }
     if matches!(name, "defs" | "clipPath" | "mask" | "marker" | "pattern" | "symbol" | "metadata" | "title" | "desc" | "style") {
         return Ok(());
     }
+    let painting = painting.of(node);
+    let mut out = Vec::new();
     let local = match node.attribute("transform") {
         Some(t) => {
             let ts: svgtypes::Transform = t.parse().map_err(|e| ErrorKind::malformed("SVG", format!("<{name}> transform={t:?}: {e}")))?;
@@ -320,8 +399,9 @@ fn walk(node: roxmltree::Node<'_, '_>, parent: Affine, out: &mut Vec<Vec<Piece>>
         "text" | "image" | "foreignObject" => warnings.push(format!("<{name}> is not an outline; skipped")),
         _ => {}
     }
+    elements.extend(out.into_iter().map(|pieces| Element { pieces, fill: painting.fill() }));
     for child in node.children() {
-        walk(child, m, out, warnings)?;
+        walk(child, (m, painting), elements, warnings)?;
     }
     Ok(())
 }
@@ -376,6 +456,26 @@ mod tests {
         }
         let arc = outlines(r#"<svg><path d="M 0 0 A 5 5 0 0 1 10 0"/></svg>"#);
         assert!(arc[0].points.len() > 8);
+    }
+
+    #[test]
+    fn fill_and_fill_rule_are_read_inherited_and_overridden() {
+        let o = outlines(
+            r#"<svg><style>.a { fill: red }</style>
+            <polygon points="0,0 1,0 0,1"/>
+            <g fill="none" style="fill-rule: evenodd">
+              <polyline points="0,0 5,5 9,0"/>
+              <path d="M0 0 h4 v4 z M1 1 h2 v2 z" fill="blue"/>
+              <rect width="2" height="2" style="stroke: black; fill : #00f !important" fill="none"/>
+              <circle r="2" fill="inherit" style="fill-rule:nonzero"/>
+              <line x2="3" fill="bogus(" />
+            </g></svg>"#,
+        );
+        let fills: Vec<_> = o.iter().map(|o| (o.fill, o.shape)).collect();
+        let (nz, eo) = (Some(FillRule::NonZero), Some(FillRule::EvenOdd));
+        assert_eq!(fills, [(nz, 0), (None, 1), (eo, 2), (eo, 2), (eo, 3), (None, 4), (None, 5)]);
+        let w = read(br#"<svg><style>path { fill: none }</style><path d="M0 0 L1 1"/></svg>"#, &SvgOptions::default()).unwrap();
+        assert!(w.warnings.iter().any(|w| w.contains("style sheets are not applied")), "{:?}", w.warnings);
     }
 
     #[test]

@@ -47,7 +47,7 @@ fn star(c: DVec2, r0: f64, r1: f64, n: usize, angle: f64) -> Outline {
             c + DVec2::new(a.cos(), a.sin()) * if k % 2 == 0 { r0 } else { r1 }
         })
         .collect();
-    Outline { points, closed: true }
+    Outline::new(points, true)
 }
 
 fn certify_closed(o: &Outline, g: &Grid2, what: &str) {
@@ -98,10 +98,9 @@ fn shapes_on_pixel_corners_and_midpoints_hit_every_tie() {
     // Edges along grid lines and through pixel centres, vertices on corners
     // and midpoints: the tie rule decides every one.
     for (lo, hi) in [(4.0, 20.0), (4.5, 20.5), (4.0, 20.5), (3.25, 19.75)] {
-        let sq = Outline { points: vec![DVec2::splat(lo), DVec2::new(hi, lo), DVec2::splat(hi), DVec2::new(lo, hi)], closed: true };
+        let sq = Outline::new(vec![DVec2::splat(lo), DVec2::new(hi, lo), DVec2::splat(hi), DVec2::new(lo, hi)], true);
         certify_closed(&sq, &grid(24), &format!("square {lo}-{hi}"));
-        let diamond =
-            Outline { points: vec![DVec2::new(12.0, lo), DVec2::new(hi, 12.0), DVec2::new(12.0, hi), DVec2::new(lo, 12.0)], closed: true };
+        let diamond = Outline::new(vec![DVec2::new(12.0, lo), DVec2::new(hi, 12.0), DVec2::new(12.0, hi), DVec2::new(lo, 12.0)], true);
         certify_closed(&diamond, &grid(24), &format!("diamond {lo}-{hi}"));
     }
 }
@@ -119,7 +118,7 @@ fn a_fan_covers_each_pixel_centre_exactly_once() {
         let mut sum = vec![0u32; 32 * 32];
         let hub = if r.random_bool(0.5) { c } else { c.round() };
         for k in 0..poly.points.len() {
-            let t = Outline { points: vec![hub, poly.points[k], poly.points[(k + 1) % poly.points.len()]], closed: true };
+            let t = Outline::new(vec![hub, poly.points[k], poly.points[(k + 1) % poly.points.len()]], true);
             let (px, _) = raster::fast(RasterMode::Fill, std::slice::from_ref(&t), &g);
             let (rf, _) = raster::reference(RasterMode::Fill, std::slice::from_ref(&t), &g);
             assert_eq!(px.first_difference(&rf), None);
@@ -146,7 +145,7 @@ fn thin_quads_behave_like_curves() {
         let a = DVec2::new(r.random_range(2.0..30.0), r.random_range(2.0..30.0));
         let b = DVec2::new(r.random_range(2.0..30.0), r.random_range(2.0..30.0));
         let n = (b - a).perp().normalize_or_zero() * 0.01;
-        let quad = Outline { points: vec![a, b, b + n, a + n], closed: true };
+        let quad = Outline::new(vec![a, b, b + n, a + n], true);
         for (m, px) in agree(std::slice::from_ref(&quad), &grid(32)).unwrap() {
             if m != RasterMode::Fill {
                 assert_eq!(components(&px, guarantee(m).0), 1, "{m:?} {a} {b}");
@@ -166,13 +165,76 @@ proptest! {
     /// reference for every mode, and each curve is connected.
     #[test]
     fn random_polylines(pts in prop::collection::vec((coord(), coord()), 2..7), closed in any::<bool>()) {
-        let o = Outline { points: pts.iter().map(|&(x, y)| DVec2::new(x + 1.0, y + 1.0)).collect(), closed };
+        let o = Outline::new(pts.iter().map(|&(x, y)| DVec2::new(x + 1.0, y + 1.0)).collect(), closed);
         let g = grid(19);
         let pix = agree(std::slice::from_ref(&o), &g).map_err(TestCaseError::fail)?;
         for (m, px) in pix {
             if m != RasterMode::Fill && px.count() > 0 {
                 prop_assert_eq!(components(&px, guarantee(m).0), 1, "{:?}", m);
             }
+        }
+    }
+}
+
+#[test]
+fn fill_rules_and_unfilled_outlines_follow_svg_painting() {
+    // A pentagram {5/2}: its centre winds twice, so nonzero fills it and
+    // evenodd leaves a pentagon hole; the arms are filled by both.
+    let c = DVec2::splat(16.0);
+    let pts: Vec<DVec2> = (0..5)
+        .map(|k| {
+            let a = 0.3 + k as f64 * 4.0 * std::f64::consts::PI / 5.0;
+            c + DVec2::new(a.cos(), a.sin()) * 14.0
+        })
+        .collect();
+    let g = grid(32);
+    let mut star = Outline::new(pts.clone(), true);
+    let nonzero = agree(std::slice::from_ref(&star), &g).unwrap().pop().unwrap().1;
+    star.fill = Some(raster::FillRule::EvenOdd);
+    let evenodd = agree(std::slice::from_ref(&star), &g).unwrap().pop().unwrap().1;
+    assert!(nonzero.get(16, 16) && !evenodd.get(16, 16));
+    let arm = (c + (pts[0] - c) * 0.8).floor();
+    assert!(nonzero.get(arm.x as i64, arm.y as i64) && evenodd.get(arm.x as i64, arm.y as i64));
+    assert!(evenodd.count() < nonzero.count());
+    // An unfilled open spiral: no pixel of `fill`, every pixel of a curve.
+    let spiral: Vec<DVec2> =
+        (0..60).map(|k| c + DVec2::new((k as f64 * 0.4).cos(), (k as f64 * 0.4).sin()) * (2.0 + k as f64 * 0.2)).collect();
+    let stroke = Outline { fill: None, shape: 1, ..Outline::new(spiral, false) };
+    let (f, rep) = raster::fast(RasterMode::Fill, std::slice::from_ref(&stroke), &g);
+    assert_eq!((f.count(), rep.segments), (0, 0));
+    assert_eq!(raster::drawn(RasterMode::Fill, std::slice::from_ref(&stroke)), 0);
+    let (curve, _) = raster::fast(RasterMode::Curve8, std::slice::from_ref(&stroke), &g);
+    assert!(curve.count() > 40);
+}
+
+fn painted() -> impl Strategy<Value = Outline> {
+    let fill = prop_oneof![Just(None), Just(Some(raster::FillRule::NonZero)), Just(Some(raster::FillRule::EvenOdd))];
+    (prop::collection::vec((coord(), coord()), 2..7), any::<bool>(), fill, 0u32..3).prop_map(|(pts, closed, fill, shape)| Outline {
+        fill,
+        shape,
+        ..Outline::new(pts.iter().map(|&(x, y)| DVec2::new(x + 1.0, y + 1.0)).collect(), closed)
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 150, ..ProptestConfig::default() })]
+
+    /// Random painted outlines in up to three shapes: fast = reference for
+    /// every mode; `fill` is the union of its shapes filled alone, and the
+    /// curve modes draw every outline, filled or not.
+    #[test]
+    fn shapes_fill_alone_and_unite(outlines in prop::collection::vec(painted(), 1..5)) {
+        let g = grid(19);
+        let pix = agree(&outlines, &g).map_err(TestCaseError::fail)?;
+        for (m, px) in pix {
+            let mut union = Pixels::new(g.dims());
+            for o in &outlines {
+                let same: Vec<Outline> =
+                    outlines.iter().filter(|p| p.shape == o.shape && p.fill == o.fill).cloned().collect();
+                let alone: Vec<Outline> = if m == RasterMode::Fill { same } else { vec![Outline { fill: None, ..o.clone() }] };
+                union.union_with(&raster::fast(m, &alone, &g).0);
+            }
+            prop_assert_eq!(px.first_difference(&union), None, "{:?}", m);
         }
     }
 }

@@ -59,14 +59,17 @@ pub fn run(a: &RasterArgs) -> Result<()> {
     topovox_io::pixels::write_pixels(&a.output, &px)?;
     let dims = grid.dims();
     let o = grid.origin();
+    // `fill` leaves out the outlines the SVG does not fill.
+    let drawn = raster::drawn(mode, &svg.outlines);
+    let unfilled = svg.outlines.len() - drawn;
     if a.json {
         let v = json!({"mode": mode.name(), "method": a.method, "origin": [o.x, o.y], "pixel_size": grid.pixel_size(), "dims": dims,
-            "pixels": rep.pixels, "outlines": svg.outlines.len(), "segments": rep.segments, "degenerate_segments": rep.degenerate,
+            "pixels": rep.pixels, "outlines": drawn, "unfilled_outlines_left_out": unfilled, "segments": rep.segments, "degenerate_segments": rep.degenerate,
             "skipped_segments": rep.skipped, "raster_s": raster_s, "total_s": t0.elapsed().as_secs_f64(), "output": a.output});
         return crate::print_stdout(&v.to_string());
     }
     crate::print_stdout(&format!(
-        "{}: {} pixels set on a {}x{} grid (origin {}, {}; pixel size {}) from {} outlines in {:.1} ms -> {}",
+        "{}: {} pixels set on a {}x{} grid (origin {}, {}; pixel size {}) from {} outlines{} in {:.1} ms -> {}",
         mode.name(),
         rep.pixels,
         dims[0],
@@ -74,7 +77,8 @@ pub fn run(a: &RasterArgs) -> Result<()> {
         o.x,
         o.y,
         grid.pixel_size(),
-        svg.outlines.len(),
+        drawn,
+        if unfilled > 0 { format!(" ({unfilled} unfilled left out)") } else { String::new() },
         raster_s * 1e3,
         a.output.display()
     ))

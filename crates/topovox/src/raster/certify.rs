@@ -60,7 +60,7 @@ pub fn components(px: &Pixels, adj: Adjacency) -> usize {
 /// Inside (nonzero winding at the displaced centre) per pixel, for the
 /// outlines taken as closed.
 pub fn inside(outlines: &[Outline], grid: &Grid2) -> Vec<bool> {
-    let closed: Vec<Outline> = outlines.iter().map(|o| Outline { points: o.points.clone(), closed: true }).collect();
+    let closed: Vec<Outline> = outlines.iter().map(Outline::closed).collect();
     let (edges, _) = super::snap_segments(&closed, grid);
     let [nx, ny] = grid.dims().map(|d| d as i64);
     let h = crate::geom::fixed::ONE / 2;

@@ -9,11 +9,14 @@
 //!
 //! - [`Grid2`]: pixel `(i, j)` is the closed square `[origin + (i, j)·s,
 //!   origin + (i+1, j+1)·s]`, as voxels are in 3D.
-//! - [`Outline`]: a polyline, closed or not, in plane coordinates.
+//! - [`Outline`]: a polyline, closed or not, in plane coordinates, with how
+//!   `fill` paints it (a [`FillRule`], or not at all) and the shape it
+//!   belongs to (one SVG element's subpaths are filled together).
 //! - [`curve`]: `curve4`, `curve8`, `diamond` — a pixel is set iff an
-//!   outline's segment meets its target; [`fill`]: `fill` — a pixel is set
-//!   iff its displaced centre is inside the outlines by the nonzero winding
-//!   rule. Each has a brute-force reference in a `reference` module.
+//!   outline's segment meets its target, filled or not; [`fill`]: `fill` — a
+//!   pixel is set iff its displaced centre is inside some filled shape by
+//!   that shape's fill rule. Each has a brute-force reference in a
+//!   `reference` module.
 //! - [`certify`]: 4- and 8-connectivity and separation of pixel sets.
 //!
 //! Coordinates are snapped to `1/4096` pixel ([`crate::geom::fixed::snap`]);
@@ -131,21 +134,77 @@ impl Grid2 {
     }
 }
 
-/// A polyline in plane coordinates; `closed` joins the last point to the first.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// SVG's fill rules: which winding numbers are inside.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum FillRule {
+    /// Inside where the winding number is not zero (SVG's default).
+    NonZero,
+    /// Inside where the winding number is odd.
+    EvenOdd,
+}
+
+impl FillRule {
+    /// Is a point of winding number `w` inside?
+    #[inline]
+    pub fn inside(self, w: i32) -> bool {
+        match self {
+            FillRule::NonZero => w != 0,
+            FillRule::EvenOdd => w & 1 != 0,
+        }
+    }
+}
+
+/// A polyline in plane coordinates; `closed` joins the last point to the
+/// first.
+///
+/// For `fill`, the outlines sharing a `shape` number and a fill rule form
+/// one shape, filled together (an SVG `<path>`'s subpaths, each closed);
+/// the shapes are filled one by one and their pixels united, as SVG paints
+/// elements. An outline whose `fill` is `None` is not filled: only the
+/// curve modes draw it. [`Outline::new`] gives nonzero fill in shape 0.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Outline {
     /// The points.
     pub points: Vec<DVec2>,
     /// Whether the last point joins the first.
     pub closed: bool,
+    /// How `fill` paints it; `None`: not filled.
+    pub fill: Option<FillRule>,
+    /// The shape it belongs to for `fill`.
+    pub shape: u32,
+}
+
+impl Default for Outline {
+    fn default() -> Outline {
+        Outline::new(Vec::new(), false)
+    }
 }
 
 impl Outline {
+    /// A filled (nonzero) outline of shape 0.
+    pub fn new(points: Vec<DVec2>, closed: bool) -> Outline {
+        Outline { points, closed, fill: Some(FillRule::NonZero), shape: 0 }
+    }
+
     /// Its segments, the closing one included.
     pub fn segments(&self) -> impl Iterator<Item = (DVec2, DVec2)> + '_ {
         let n = self.points.len();
         let m = if self.closed && n > 2 { n } else { n.saturating_sub(1) };
         (0..m).map(move |i| (self.points[i], self.points[(i + 1) % n]))
+    }
+
+    /// The same points, closed.
+    pub fn closed(&self) -> Outline {
+        Outline { closed: true, ..self.clone() }
+    }
+}
+
+/// How many outlines a mode draws: every outline for the curve modes, the
+/// filled ones for `fill`.
+pub fn drawn(mode: RasterMode, outlines: &[Outline]) -> usize {
+    match mode {
+        RasterMode::Fill => outlines.iter().filter(|o| o.fill.is_some()).count(),
+        _ => outlines.len(),
     }
 }
 
@@ -255,7 +314,7 @@ pub enum RasterMode {
     Curve8,
     /// The diamond (Fig. 7d): the rule graphics APIs use for lines.
     Diamond,
-    /// Filled outlines, nonzero winding at the displaced pixel centre.
+    /// Filled shapes, each by its fill rule at the displaced pixel centre.
     Fill,
 }
 
