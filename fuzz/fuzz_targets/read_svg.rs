@@ -4,6 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
+use topovox::choice::Choice;
 use topovox::glam::DVec2;
 use topovox::raster::{self, Grid2, RasterMode};
 
@@ -16,7 +17,7 @@ fuzz_target!(
     if svg.outlines.iter().map(|o| o.points.len()).sum::<usize>() > 2000 {
         return;
     }
-    for m in RasterMode::ALL {
+    for &m in RasterMode::ALL {
         let (f, _) = raster::fast(m, &svg.outlines, &grid);
         let (r, _) = raster::reference(m, &svg.outlines, &grid);
         assert_eq!(f.first_difference(&r), None, "{m:?}");

@@ -28,14 +28,13 @@ use pyo3::exceptions::{
     PyFileNotFoundError, PyIsADirectoryError, PyKeyboardInterrupt, PyOSError, PyPermissionError, PyRuntimeError, PyValueError,
 };
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyBool, PyDict, PyFloat, PyList, PyString};
 use serde_json::Value;
-use topovox::attributes::carry::CarryOptions;
 use topovox::attributes::{ColourRule, VoxelAttributes, NO_MATERIAL};
 use topovox::voxelize::Stop;
 use topovox::{GridSpec, VoxelSource};
 use topovox_io::LoadedMesh;
-use topovox_job::{GridOptions, GridRequest, JobError, Voxels};
+use topovox_job::{JobError, JobOptions, OptionValue, Voxels};
 
 pyo3::create_exception!(_topovox, FileFormatError, PyOSError, "A file's content does not follow its format (the message names the file).");
 
@@ -465,15 +464,9 @@ impl VoxelGrid {
     ) -> PyResult<()> {
         let target = topovox_job::output::output_format(format.as_deref(), &path).map_err(py_err)?;
         topovox_job::output::check_output_path(&path).map_err(py_err)?;
-        let blocks = block_palette.as_deref().map(topovox_io::schem::BlockPalette::read).transpose().map_err(io_err)?;
+        let job = JobOptions { dither, block_palette, up: up_of(up)?, watertight, triangulate, ..JobOptions::default() };
         let stop = Arc::new(Stop::new());
-        let opts = topovox_io::WriteOptions {
-            dither,
-            blocks,
-            up: up_of(up)?,
-            mesh: topovox_io::voxel_mesh::MeshOptions { watertight, triangulate },
-            stop: Some(stop.clone()),
-        };
+        let opts = topovox_io::WriteOptions { stop: Some(stop.clone()), ..job.write_options().map_err(py_err)? };
         let inner = &self.inner;
         interruptible(py, &stop, || topovox_job::output::write(&path, target, &inner.voxels, &inner.grid, inner.attrs.as_ref(), &opts))?
             .map_err(py_err)?;
@@ -602,95 +595,93 @@ fn greedy_triangles(g: &GridData) -> Triangles {
     (verts, faces, colours)
 }
 
-fn grid_options(
-    resolution: Option<u64>,
-    voxel_size: Option<f64>,
-    origin: Option<Vec<f64>>,
-    dims: Option<Vec<u64>>,
-    pad: Option<u32>,
-) -> GridOptions {
-    GridOptions { resolution, voxel_size, origin, dims, pad }
-}
-
-/// The voxelization options of `voxelize` and `batch`, validated.
-#[allow(clippy::too_many_arguments)]
-fn plan_of(
-    mode: &str,
-    method: &str,
-    grid: &GridOptions,
-    surface: Option<&str>,
-    fill: Option<&str>,
-    hollow: Option<u32>,
-    gpu_path: &str,
-    seed: u64,
-    tile: Option<u32>,
-    max_memory: Option<&str>,
-) -> Result<topovox_job::Plan, JobError> {
-    let request = topovox_job::Request {
-        mode: topovox_job::Mode::parse(mode)?,
-        method: topovox_job::Method::parse(method)?,
-        grid: GridRequest::new(grid)?,
-        surface: surface.map(topovox_job::Mode::parse).transpose()?,
-        fill: match fill {
-            None => None,
-            Some("flood") => Some(topovox_job::Fill::Flood),
-            Some(f) => return Err(JobError::invalid(format!("unknown fill {f:?} (expected \"flood\")"))),
-        },
-        hollow,
-        gpu_path: match gpu_path {
-            "compute" => topovox_job::GpuPath::Compute,
-            "raster" => topovox_job::GpuPath::Raster,
-            "msaa-approx" => topovox_job::GpuPath::MsaaApprox,
-            p => return Err(JobError::invalid(format!("unknown gpu_path {p:?} (expected compute, raster or msaa-approx)"))),
-        },
-        seed,
-        tile,
-        max_memory: max_memory.map(topovox_job::parse_size).transpose()?,
-        writer_bytes_per_brick: 0,
-    };
-    topovox_job::Plan::new(request)
-}
-
-fn colour_rule(rule: &str) -> Result<ColourRule, JobError> {
-    match rule {
-        "dominant" => Ok(ColourRule::Dominant),
-        "blend" => Ok(ColourRule::Blend),
-        r => Err(JobError::invalid(format!("unknown colour_rule {r:?} (expected dominant or blend)"))),
+/// A Python keyword's value as a job option's value.
+fn option_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<OptionValue> {
+    if v.is_instance_of::<PyBool>() || v.get_type().name()?.to_cow()? == "bool_" {
+        return Ok(OptionValue::Bool(v.extract()?));
     }
+    if v.is_instance_of::<PyString>() {
+        return Ok(OptionValue::Text(v.extract()?));
+    }
+    if !v.is_instance_of::<PyFloat>() {
+        if let Ok(i) = v.extract::<i64>() {
+            return Ok(OptionValue::Int(i));
+        }
+    }
+    if let Ok(f) = v.extract::<f64>() {
+        return Ok(OptionValue::Float(f));
+    }
+    if let Ok(p) = v.extract::<PathBuf>() {
+        return Ok(OptionValue::Text(p.to_string_lossy().into_owned()));
+    }
+    if let Ok(n) = v.extract::<Vec<f64>>() {
+        return Ok(OptionValue::Numbers(n));
+    }
+    Err(value_err(format!("{key} does not take {}", v.repr()?)))
+}
+
+/// The job options of keyword arguments (`None` keeps a default; the
+/// names in `skip` are the caller's own), checked by the job crate.
+fn job_options(options: Option<&Bound<'_, PyDict>>, skip: &[&str]) -> PyResult<JobOptions> {
+    let mut o = JobOptions::default();
+    for (k, v) in options.into_iter().flat_map(|d| d.iter()) {
+        let k: String = k.extract()?;
+        if !v.is_none() && !skip.contains(&k.as_str()) {
+            o.set(&k, &option_value(&k, &v)?).map_err(py_err)?;
+        }
+    }
+    Ok(o)
+}
+
+/// Every option `voxelize` and `batch` take: `[(name, help, example)]`
+/// (from the job crate's one list; the tests check both take each).
+#[pyfunction]
+fn options<'py>(py: Python<'py>) -> PyResult<Vec<(&'static str, &'static str, Bound<'py, PyAny>)>> {
+    use topovox_job::options::Example as E;
+    topovox_job::KEYWORDS
+        .iter()
+        .map(|k| {
+            let example = match k.example {
+                E::Bool(b) => b.into_pyobject(py)?.to_owned().into_any(),
+                E::Int(i) => i.into_pyobject(py)?.into_any(),
+                E::Float(f) => f.into_pyobject(py)?.into_any(),
+                E::Text(t) => t.into_pyobject(py)?.into_any(),
+                E::Numbers(n) => PyList::new(py, n)?.into_any(),
+            };
+            Ok((k.name, k.help, example))
+        })
+        .collect()
+}
+
+/// Every name of every named choice: `{"mode": [...], "method": [...], ...}`.
+#[pyfunction]
+fn choices(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    use topovox_job::Choice;
+    fn names<T: Choice>() -> Vec<&'static str> {
+        T::names()
+    }
+    let d = PyDict::new(py);
+    d.set_item("mode", names::<topovox_job::Mode>())?;
+    d.set_item("method", names::<topovox_job::Method>())?;
+    d.set_item("fill", names::<topovox_job::Fill>())?;
+    d.set_item("hollow", names::<topovox_job::Hollow>())?;
+    d.set_item("gpu_path", names::<topovox_job::GpuPath>())?;
+    d.set_item("colour_rule", names::<ColourRule>())?;
+    d.set_item("up", names::<topovox_job::Up>())?;
+    d.set_item("format", topovox_job::output::Output::names().split(", ").collect::<Vec<_>>())?;
+    Ok(d)
 }
 
 /// The native voxelize: see `topovox.voxelize` for the documentation.
 #[pyfunction]
-#[pyo3(signature = (mesh, *, mode="cover", resolution=None, voxel_size=None, origin=None, dims=None, pad=None, method="auto", threads=None,
-    attributes=false, colour_rule="dominant", normals=false, surface=None, fill=None, hollow=None, gpu_path="compute", seed=0,
-    tile=None, max_memory=None))]
-#[allow(clippy::too_many_arguments)]
-fn voxelize(
-    py: Python<'_>,
-    mesh: &Mesh,
-    mode: &str,
-    resolution: Option<u64>,
-    voxel_size: Option<f64>,
-    origin: Option<Vec<f64>>,
-    dims: Option<Vec<u64>>,
-    pad: Option<u32>,
-    method: &str,
-    threads: Option<usize>,
-    attributes: bool,
-    colour_rule: &str,
-    normals: bool,
-    surface: Option<&str>,
-    fill: Option<&str>,
-    hollow: Option<u32>,
-    gpu_path: &str,
-    seed: u64,
-    tile: Option<u32>,
-    max_memory: Option<&str>,
-) -> PyResult<VoxelGrid> {
-    let grid = grid_options(resolution, voxel_size, origin, dims, pad);
-    let plan = plan_of(mode, method, &grid, surface, fill, hollow, gpu_path, seed, tile, max_memory).map_err(py_err)?;
-    let carry = CarryOptions { rule: self::colour_rule(colour_rule).map_err(py_err)?, normals };
-    let pool = threads.map(topovox_job::pool).transpose().map_err(py_err)?;
+#[pyo3(signature = (mesh, options=None))]
+fn voxelize(py: Python<'_>, mesh: &Mesh, options: Option<&Bound<'_, PyDict>>) -> PyResult<VoxelGrid> {
+    let opts = job_options(options, &[])?;
+    let plan = opts.plan().map_err(py_err)?;
+    let carry = opts.carry();
+    // Attributes are carried when any is asked for (normals are one).
+    let attributes = opts.attributes || opts.normals;
+    let pool = opts.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
     let inner = &mesh.inner;
     let name = mesh.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into());
     let stop = Stop::new();
@@ -717,8 +708,8 @@ fn voxelize(
 }
 
 /// `x`, `y` or `z` as an up axis.
-fn up_of(up: &str) -> PyResult<topovox_io::orient::Up> {
-    topovox_io::orient::Up::from_name(up).ok_or_else(|| value_err(format!("up must be \"x\", \"y\" or \"z\"; got {up:?}")))
+fn up_of(up: &str) -> PyResult<topovox_job::Up> {
+    <topovox_job::Up as topovox_job::Choice>::parse(up).map_err(|e| value_err(format!("up: {e}")))
 }
 
 /// load_voxels(path, origin=None, voxel_size=None, up="y", allow_external_paths=False) -> VoxelGrid
@@ -748,103 +739,18 @@ fn load_voxels(
     Ok(VoxelGrid { inner: Arc::new(GridData { voxels: Voxels::Dense(loaded.bits), grid, attrs: loaded.attributes, facts }) })
 }
 
-/// The options of a batch, validated, and its fingerprint.
-#[allow(clippy::too_many_arguments)]
-fn batch_options(options: &Bound<'_, PyDict>, format: &str) -> PyResult<(topovox_job::batch::BatchOptions, Option<usize>)> {
-    let get_str = |k: &str| -> PyResult<Option<String>> { options.get_item(k)?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose() };
-    let get_u64 = |k: &str| -> PyResult<Option<u64>> { options.get_item(k)?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose() };
-    let known = [
-        "mode",
-        "method",
-        "resolution",
-        "voxel_size",
-        "origin",
-        "dims",
-        "pad",
-        "surface",
-        "fill",
-        "hollow",
-        "gpu_path",
-        "colour_rule",
-        "normals",
-        "attributes",
-        "dither",
-        "threads",
-        "jobs",
-    ];
-    for k in options.keys() {
-        let k: String = k.extract()?;
-        if !known.contains(&k.as_str()) {
-            return Err(value_err(format!("unknown batch option {k:?} (expected one of: {})", known.join(", "))));
-        }
-    }
-    let grid = grid_options(
-        get_u64("resolution")?,
-        options.get_item("voxel_size")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?,
-        options.get_item("origin")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?,
-        options.get_item("dims")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?,
-        get_u64("pad")?.map(|p| p as u32),
-    );
-    let mode = get_str("mode")?.unwrap_or_else(|| "cover".into());
-    let method = get_str("method")?.unwrap_or_else(|| "auto".into());
-    let gpu_path = get_str("gpu_path")?.unwrap_or_else(|| "compute".into());
-    let rule = get_str("colour_rule")?.unwrap_or_else(|| "dominant".into());
-    let normals: bool = options.get_item("normals")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
-    let attributes: bool = options.get_item("attributes")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
-    let dither: bool = options.get_item("dither")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
-    let watertight: bool = options.get_item("watertight")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(true);
-    let triangulate: bool = options.get_item("triangulate")?.filter(|v| !v.is_none()).map(|v| v.extract()).transpose()?.unwrap_or(false);
-    let up = get_str("up")?.unwrap_or_else(|| "y".into());
-    let up_axis = up_of(&up)?;
-    let (surface, fill) = (get_str("surface")?, get_str("fill")?);
-    let hollow = get_u64("hollow")?.map(|h| h as u32);
-    let seed = get_u64("seed")?.unwrap_or(0);
-    let plan = plan_of(&mode, &method, &grid, surface.as_deref(), fill.as_deref(), hollow, &gpu_path, seed, None, None).map_err(py_err)?;
+/// The options of a batch, validated (with its fingerprint), and `jobs`.
+fn batch_options(options: Option<&Bound<'_, PyDict>>, format: &str) -> PyResult<(topovox_job::batch::BatchOptions, Option<usize>)> {
     let target = topovox_job::output::Output::from_name(format)
         .ok_or_else(|| value_err(format!("unknown format {format:?} (expected one of: {})", topovox_job::output::Output::names())))?;
-    let threads = get_u64("threads")?.map(|t| t as usize);
-    let jobs = get_u64("jobs")?.map(|t| t as usize);
-    let fingerprint = topovox_job::batch::fingerprint(&topovox_job::batch::FingerprintParts {
-        mode: &mode,
-        method: &method,
-        grid: &grid,
-        surface: surface.as_deref(),
-        fill: fill.as_deref(),
-        hollow,
-        gpu_path: &gpu_path,
-        format: target.name(),
-        colour_rule: &rule,
-        normals,
-        attributes,
-        dither,
-        up: up_axis.name(),
-        watertight,
-        triangulate,
-        seed,
-    });
-    let opts = topovox_job::batch::BatchOptions {
-        plan,
-        format: target,
-        carry: CarryOptions { rule: self::colour_rule(&rule).map_err(py_err)?, normals: normals || attributes },
-        attributes,
-        write: topovox_io::WriteOptions {
-            dither,
-            blocks: None,
-            up: up_axis,
-            mesh: topovox_io::voxel_mesh::MeshOptions { watertight, triangulate },
-            stop: None,
+    let jobs = match options.map(|d| d.get_item("jobs")).transpose()?.flatten().filter(|v| !v.is_none()) {
+        Some(v) => match option_value("jobs", &v)? {
+            OptionValue::Int(n) if n >= 1 => Some(n as usize),
+            _ => return Err(value_err(format!("jobs must be an integer of at least 1; got {}", v.repr()?))),
         },
-        threads,
-        read: topovox_io::ReadOptions {
-            allow_external_paths: options
-                .get_item("allow_external_paths")?
-                .filter(|v| !v.is_none())
-                .map(|v| v.extract())
-                .transpose()?
-                .unwrap_or(false),
-        },
-        fingerprint,
+        None => None,
     };
+    let opts = job_options(options, &["jobs"])?.batch(target).map_err(py_err)?;
     Ok((opts, jobs))
 }
 
@@ -859,8 +765,7 @@ fn batch<'py>(
     glob: Option<String>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let empty = PyDict::new(py);
-    let (opts, jobs) = batch_options(options.unwrap_or(&empty), format)?;
+    let (opts, jobs) = batch_options(options, format)?;
     if let Some(n) = jobs {
         topovox_job::check_threads(n, "jobs").map_err(py_err)?;
     }
@@ -893,8 +798,7 @@ fn batch_plan<'py>(
     glob: Option<String>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<BatchListing<'py>> {
-    let empty = PyDict::new(py);
-    let (opts, _) = batch_options(options.unwrap_or(&empty), format)?;
+    let (opts, _) = batch_options(options, format)?;
     let (files, _) = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir).map_err(py_err)?;
     let ext = opts.format.name().replace("npy-bool", "npy");
     let items = topovox_job::batch::plan_items(&files, &out_dir, &ext).map_err(py_err)?;
@@ -918,8 +822,7 @@ fn process_one<'py>(
     format: &str,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let empty = PyDict::new(py);
-    let (mut opts, _) = batch_options(options.unwrap_or(&empty), format)?;
+    let (mut opts, _) = batch_options(options, format)?;
     opts.threads = opts.threads.or(Some(1));
     let item = topovox_job::batch::Item { input, output };
     // One mesh, run by a Dask or Ray worker (which interrupts its tasks its own way).
@@ -955,5 +858,7 @@ fn _topovox(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(batch_plan, m)?)?;
     m.add_function(wrap_pyfunction!(process_one, m)?)?;
     m.add_function(wrap_pyfunction!(append_manifest, m)?)?;
+    m.add_function(wrap_pyfunction!(options, m)?)?;
+    m.add_function(wrap_pyfunction!(choices, m)?)?;
     Ok(())
 }

@@ -97,7 +97,7 @@ def test_batch_errors(tmp_path, dataset, meshes):
     (clash / "m.stl").write_bytes(b"solid x\nendsolid x\n")
     with pytest.raises(ValueError, match="would both be written to"):
         topovox.batch(clash, tmp_path / "o2")
-    with pytest.raises(ValueError, match="unknown batch option"):
+    with pytest.raises(ValueError, match="unknown option \"resolutoin\""):
         topovox.batch(dataset, tmp_path / "o3", resolutoin=3)
     with pytest.raises(FileNotFoundError):
         topovox.batch(tmp_path / "missing", tmp_path / "o4")

@@ -124,9 +124,9 @@ def test_bad_arrays_are_value_errors(vertices, faces, message):
         ({"voxel_size": -1.0}, "voxel size must be a positive"),
         ({"mode": "sep6", "method": "parity"}, "applies only to --mode solid"),
         ({"mode": "cover", "hollow": 6}, "apply to --mode solid"),
-        ({"mode": "solid", "hollow": 7}, "--hollow takes 6 or 26"),
+        ({"mode": "solid", "hollow": 7}, "unknown hollow connectivity \"7\" \\(expected one of: 6, 26\\)"),
         ({"threads": 0}, "threads must be at least 1"),
-        ({"colour_rule": "mean"}, "unknown colour_rule"),
+        ({"colour_rule": "mean"}, "unknown colour rule \"mean\""),
     ],
 )
 def test_bad_options_are_value_errors_with_the_cli_message(meshes, kwargs, message):

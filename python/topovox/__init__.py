@@ -62,14 +62,19 @@ __all__ = [
     "MODES",
     "METHODS",
     "FORMATS",
+    "OPTIONS",
 ]
 
+# The names come from the one list the command line uses too.
+_CHOICES = _topovox.choices()
 #: Every mode, as ``voxelize(mode=...)`` takes it.
-MODES = ("cover", "sep26", "sep6", "ss6", "tunnel18", "tunnel26", "bubble", "diagonal", "solid", "solid+surface", "line6", "line26", "pos")
+MODES = tuple(_CHOICES["mode"])
 #: Every method, as ``voxelize(method=...)`` takes it.
-METHODS = ("auto", "reference", "fast", "scanline", "gpu", "parity", "winding")
+METHODS = tuple(_CHOICES["method"])
 #: Every output format ``VoxelGrid.save`` and ``batch`` write.
-FORMATS = ("npy", "npy-bool", "npz", "binvox", "vox", "txt", "schem", "vti", "ply", "vdb", "zarr", "obj", "glb")
+FORMATS = tuple(_CHOICES["format"])
+#: Every option :func:`voxelize` and :func:`batch` take, with its help.
+OPTIONS = {name: help for name, help, _example in _topovox.options()}
 
 MeshLike = Union[Mesh, Any]
 
@@ -149,6 +154,13 @@ def voxelize(
     seed: int = 0,
     tile: Optional[int] = None,
     max_memory: Optional[Union[int, str]] = None,
+    up: str = "y",
+    dither: bool = False,
+    watertight: bool = True,
+    triangulate: bool = False,
+    block_palette: Optional[Union[str, os.PathLike]] = None,
+    allow_external_paths: bool = False,
+    color_rule: Optional[str] = None,
 ) -> VoxelGrid:
     """Voxelizes a mesh; returns a :class:`VoxelGrid`.
 
@@ -168,10 +180,12 @@ def voxelize(
         method: one of :data:`METHODS`. ``auto`` picks the fastest path that
             gives the mode's exact voxels; every method gives the same voxels.
         threads: worker threads (default: all cores).
-        attributes: also carry colours, material ids, coverage (and
-            ``normals=True``: normals) from the mesh into the voxels.
+        attributes: also carry colours, material ids, coverage and
+            normals from the mesh into the voxels (as ``--attributes`` does
+            on the command line); ``normals=True`` carries them too.
         colour_rule: ``dominant`` (the colour covering the most area) or
-            ``blend`` (area-weighted mean in linear light).
+            ``blend`` (area-weighted mean in linear light); ``color_rule``
+            is the same option.
         surface: solid modes: the surface of ``solid+surface`` and of a
             flood fill's shell (cover, sep26, sep6 or ss6).
         fill: solid modes: ``"flood"`` fills what a surface shell encloses.
@@ -187,6 +201,12 @@ def voxelize(
             ``"8G"`` (default: nine tenths of what is available). Tiled
             grids are sparse: use :meth:`VoxelGrid.indices` or
             ``save("x.vdb")`` / ``save("x.zarr")`` rather than ``occupancy``.
+        up, dither, watertight, triangulate, block_palette: the writers'
+            options, as :meth:`VoxelGrid.save` and :func:`batch` take them
+            (accepted here so that every front end takes every option;
+            :meth:`VoxelGrid.save` is where they apply).
+        allow_external_paths: accepted for the same reason (meshes given
+            here are already read).
 
     The GIL is released while voxelizing, so threads voxelize in parallel.
 
@@ -196,53 +216,21 @@ def voxelize(
         RuntimeError: the job could not run (no GPU, not enough memory).
     """
     mesh = as_mesh(mesh_or_vertices, faces)
-    return _topovox.voxelize(
-        mesh,
-        mode=mode,
-        resolution=None if resolution is None else _count(resolution, "resolution", least=1),
-        voxel_size=None if voxel_size is None else float(voxel_size),
-        origin=None if origin is None else [float(x) for x in origin],
-        dims=None if dims is None else [_count(d, "dims", least=1) for d in dims],
-        pad=_count(pad, "pad") if pad else None,
-        method=method,
-        threads=None if threads is None else _count(threads, "threads", least=1),
-        attributes=bool(attributes),
-        colour_rule=colour_rule,
-        normals=bool(normals),
-        surface=surface,
-        fill=fill,
-        hollow=None if hollow is None else _count(hollow, "hollow"),
-        gpu_path=gpu_path,
-        seed=_count(seed, "seed"),
-        tile=None if tile is None else _count(tile, "tile"),
-        max_memory=None if max_memory is None else str(max_memory),
-    )
-
-
-def _count(x: Any, name: str, least: int = 0) -> int:
-    if isinstance(x, bool) or not isinstance(x, (int, np.integer)):
-        raise ValueError(f"{name} must be an integer; got {x!r}")
-    if x < least:
-        raise ValueError(f"{name} must be at least {least}; got {x!r}")
-    return int(x)
+    options = dict(locals())
+    for k in ("mesh_or_vertices", "faces", "mesh"):
+        options.pop(k)
+    return _topovox.voxelize(mesh, _options(options))
 
 
 def _options(options: dict) -> dict:
-    out = {}
-    for k, v in options.items():
-        if v is None:
-            continue
-        if k in ("origin",):
-            v = [float(x) for x in v]
-        elif k in ("dims",):
-            v = [_count(d, "dims", least=1) for d in v]
-        elif k in ("resolution", "threads", "jobs"):
-            v = _count(v, k, least=1)
-        elif k in ("pad", "hollow", "seed"):
-            v = _count(v, k)
-        elif k == "voxel_size":
-            v = float(v)
-        out[k] = v
+    """Keyword options as the native side takes them: ``None`` left out,
+    ``color_rule`` spelled ``colour_rule``, paths as strings. Every value is
+    checked there, by the job crate, with the command line's rules."""
+    out = {k: v for k, v in options.items() if v is not None}
+    if "color_rule" in out:
+        out["colour_rule"] = out.pop("color_rule")
+    if "block_palette" in out:
+        out["block_palette"] = os.fsdecode(out["block_palette"])
     return out
 
 
@@ -264,10 +252,11 @@ def batch(
     meshes already done with the same options are skipped, so an
     interrupted batch resumes; a bad mesh is recorded and the batch goes on.
 
-    ``options`` are :func:`voxelize`'s (mode, resolution, method, …) plus
-    ``colour_rule``, ``normals`` and ``dither`` for coloured formats and
-    ``attributes=True`` for every attribute grid in ``.vdb`` outputs;
-    ``jobs`` meshes run at once (default: all cores).
+    ``options`` are every option :func:`voxelize` takes (:data:`OPTIONS`:
+    mode, resolution, method, seed, tile, max_memory, the writers' up,
+    dither, watertight, triangulate, …; ``attributes=True`` writes every
+    attribute grid into ``.vdb`` and ``.zarr`` outputs); ``jobs`` meshes run
+    at once (default: all cores).
 
     Returns the summary: ``{"done", "skipped", "failed", "total_s", "manifest",
     "warnings"}`` (warnings: links skipped because they loop).

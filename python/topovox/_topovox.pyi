@@ -78,28 +78,9 @@ def load_voxels(
     up: str = "y",
     allow_external_paths: bool = False,
 ) -> VoxelGrid: ...
-def voxelize(
-    mesh: Mesh,
-    *,
-    mode: str = "cover",
-    resolution: Optional[int] = None,
-    voxel_size: Optional[float] = None,
-    origin: Optional[Sequence[float]] = None,
-    dims: Optional[Sequence[int]] = None,
-    pad: Optional[int] = None,
-    method: str = "auto",
-    threads: Optional[int] = None,
-    attributes: bool = False,
-    colour_rule: str = "dominant",
-    normals: bool = False,
-    surface: Optional[str] = None,
-    fill: Optional[str] = None,
-    hollow: Optional[int] = None,
-    gpu_path: str = "compute",
-    seed: int = 0,
-    tile: Optional[int] = None,
-    max_memory: Optional[str] = None,
-) -> VoxelGrid: ...
+def voxelize(mesh: Mesh, options: Optional[Dict[str, Any]] = None) -> VoxelGrid: ...
+def options() -> List[Tuple[str, str, Any]]: ...
+def choices() -> Dict[str, List[str]]: ...
 def batch(inputs: Sequence[str], out_dir: str, format: str = "npy", glob: Optional[str] = None, options: Optional[Dict[str, Any]] = None) -> Dict[str, Any]: ...
 def batch_plan(
     inputs: Sequence[str], out_dir: str, format: str = "npy", glob: Optional[str] = None, options: Optional[Dict[str, Any]] = None

@@ -2,7 +2,14 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
+use topovox::raster::{RasterMethod, RasterMode};
+use topovox_job::{ColourRule, Fill, GpuPath, Hollow, Method, Mode, Switch, Up};
+
+use topovox::render::raycast::View;
+
+use crate::choice::choice;
+use crate::values::{self, CameraSpec, Size};
 
 /// topovox: voxelize triangle meshes with guaranteed topology.
 #[derive(Parser, Debug)]
@@ -53,69 +60,12 @@ pub enum Command {
     Raster(RasterArgs),
 }
 
-/// Voxelization modes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Mode {
-    /// Conservative surface: every voxel whose closed box meets a triangle.
-    Cover,
-    /// Laine's minimal 26-separating surface (space-diagonal target).
-    Sep26,
-    /// Laine's thin 6-separating surface (3D crosshair target).
-    Sep6,
-    /// Schwarz–Seidel 6-separating surface.
-    Ss6,
-    /// Solid: voxels whose centre is inside.
-    Solid,
-    /// Solid united with a surface mode (--surface), so thin parts never vanish.
-    #[value(name = "solid+surface")]
-    SolidSurface,
-    /// 6-connected polyline voxelization.
-    Line6,
-    /// 26-connected polyline voxelization.
-    Line26,
-    /// Projected optimal scanline, as published.
-    Pos,
-    /// 18-tunnel-free surface: targets from the centre to face centres and edge midpoints.
-    Tunnel18,
-    /// 26-tunnel-free surface: also from the centre to the corners.
-    Tunnel26,
-    /// Randomized 6-separating surface: the crosshair's joins at random points (--seed).
-    Bubble,
-    /// 6-separating surface from one alternating body diagonal per voxel.
-    Diagonal,
-}
-
-/// Extra baselines of `topovox bench`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Baseline {
-    /// The brute-force loop: bounding box × f64 triangle/box test, one thread.
-    Brute,
-}
-
-/// Solid filling strategies other than the inside test.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Fill {
-    /// Everything not reachable from the grid boundary through unset voxels of a surface shell.
-    Flood,
-}
-
-/// Voxelization methods.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Method {
-    /// The fastest correct method for the mode.
-    Auto,
-    /// The slow brute-force reference implementation of the mode.
-    Reference,
-    /// The triangle/box fast path (Schwarz & Seidel 2010), parallel.
-    Fast,
-    /// Projected optimal scanline fast path.
-    Scanline,
-    /// GPU (wgpu).
-    Gpu,
-    /// Solid by ray parity.
-    Parity,
-    /// Solid by generalized winding number.
-    Winding,
+topovox::choice! {
+    /// Extra baselines of `topovox bench`.
+    pub enum Baseline: "baseline" {
+        /// The brute-force loop: bounding box × f64 triangle/box test, one thread.
+        Brute = "brute",
+    }
 }
 
 /// How the grid is chosen.
@@ -144,8 +94,8 @@ pub struct MemoryArgs {
     /// Memory the run may use, e.g. 8G or 512M (default: nine tenths of
     /// what is available). Surface and line modes on grids that do not fit densely
     /// run tile by tile into sparse storage; write those to .vdb, .txt or .ply.
-    #[arg(long, value_name = "SIZE")]
-    pub max_memory: Option<String>,
+    #[arg(long, value_name = "SIZE", value_parser = values::memory)]
+    pub max_memory: Option<u64>,
     /// Run the surface or line mode tile by tile with tiles of N voxels (a multiple
     /// of 8; default: only when the grid does not fit in --max-memory, with
     /// tiles of 512). Same voxels either way.
@@ -153,42 +103,36 @@ pub struct MemoryArgs {
     pub tile: Option<u32>,
 }
 
+/// The options of a voxelization job, shared by `voxelize` and `batch`
+/// (turned into the job's [`topovox_job::JobOptions`] in `plan.rs`).
 #[derive(Args, Debug)]
-pub struct VoxelizeArgs {
-    /// Input mesh (.obj, .stl, .ply, .gltf, .glb).
-    pub mesh: PathBuf,
+pub struct JobArgs {
     /// Read files the model names (OBJ material libraries and textures,
     /// glTF buffers and images) even outside its folder: absolute paths,
     /// `../`, links leading out. Off by default.
     #[arg(long)]
     pub allow_external_paths: bool,
-    /// Output file: .npy, .npz, .binvox, .vox, .txt, .schem, .vti, .ply,
-    /// .vdb, .zarr (voxels), or .obj / .glb (a mesh of the voxels); the format comes from the
-    /// extension unless --format is given. `-` writes to standard output
-    /// (with --format).
-    #[arg(short, long, value_name = "OUT")]
-    pub output: PathBuf,
     /// Voxelization mode.
-    #[arg(long, value_enum, ignore_case = true, default_value = "cover")]
+    #[arg(long, value_parser = choice::<Mode>(), default_value = "cover")]
     pub mode: Mode,
     /// Method.
-    #[arg(long, value_enum, ignore_case = true, default_value = "auto")]
+    #[arg(long, value_parser = choice::<Method>(), default_value = "auto")]
     pub method: Method,
     /// `bubble`: the seed of its random points (same seed, same voxels; default 0).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Solid modes: the surface mode of `solid+surface` and of the
     /// `--fill flood` shell (default cover).
-    #[arg(long, value_enum, ignore_case = true, value_name = "MODE")]
+    #[arg(long, value_parser = choice::<Mode>(), value_name = "MODE")]
     pub surface: Option<Mode>,
     /// Solid modes: `flood` fills everything a surface shell encloses
     /// (everything not reachable from the grid boundary through unset voxels).
-    #[arg(long, value_enum, ignore_case = true)]
+    #[arg(long, value_parser = choice::<Fill>())]
     pub fill: Option<Fill>,
     /// Solid modes: keep only the voxels touching the outside through a face
     /// (6) or also an edge or corner (26).
-    #[arg(long, value_name = "6|26", value_parser = clap::builder::PossibleValuesParser::new(["6", "26"]))]
-    pub hollow: Option<String>,
+    #[arg(long, value_name = "6|26", value_parser = choice::<Hollow>())]
+    pub hollow: Option<Hollow>,
     #[command(flatten)]
     pub grid: GridArgs,
     #[command(flatten)]
@@ -196,8 +140,24 @@ pub struct VoxelizeArgs {
     /// With --method gpu: `compute` (default), `raster` (the rasterizer path, same voxels), or
     /// `msaa-approx` (rasterizer with 4x MSAA instead of conservative coverage: approximate, misses
     /// voxels; the summary says how many).
-    #[arg(long, value_enum, ignore_case = true, default_value = "compute", value_name = "PATH")]
-    pub gpu_path: GpuPathArg,
+    #[arg(long, value_parser = choice::<GpuPath>(), default_value = "compute", value_name = "PATH")]
+    pub gpu_path: GpuPath,
+    #[command(flatten)]
+    pub export: ExportArgs,
+}
+
+#[derive(Args, Debug)]
+pub struct VoxelizeArgs {
+    /// Input mesh (.obj, .stl, .ply, .gltf, .glb).
+    pub mesh: PathBuf,
+    /// Output file: .npy, .npz, .binvox, .vox, .txt, .schem, .vti, .ply,
+    /// .vdb, .zarr (voxels), or .obj / .glb (a mesh of the voxels); the format comes from the
+    /// extension unless --format is given. `-` writes to standard output
+    /// (with --format).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub job: JobArgs,
     /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, or obj / glb for a mesh of the voxels (default: from the extension).
     #[arg(long, value_name = "FORMAT")]
     pub format: Option<String>,
@@ -206,8 +166,6 @@ pub struct VoxelizeArgs {
     pub preview: Option<PathBuf>,
     #[command(flatten)]
     pub picture: PictureArgs,
-    #[command(flatten)]
-    pub export: ExportArgs,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
@@ -223,7 +181,7 @@ pub struct VoxelizeArgs {
 #[derive(Args, Debug, Clone, Default)]
 pub struct ExportArgs {
     /// How the colours of the surface inside a voxel combine: `dominant` (the colour covering the most area; never a new colour) or `blend` (area-weighted mean in linear light).
-    #[arg(long, value_enum, ignore_case = true, default_value = "dominant", value_name = "RULE")]
+    #[arg(long, visible_alias = "color-rule", value_parser = choice::<ColourRule>(), default_value = "dominant", value_name = "RULE")]
     pub colour_rule: ColourRule,
     /// .vti: also store each voxel's average surface normal.
     #[arg(long)]
@@ -247,50 +205,28 @@ pub struct ExportArgs {
     /// .schem are rotated (never mirrored) so the model stands upright in
     /// MagicaVoxel (z-up) and Minecraft (y-up), and --preview draws it up.
     /// Default: y, as for most OBJ, glTF, PLY and STL models.
-    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
-    pub up: Option<String>,
+    #[arg(long, value_name = "x|y|z", value_parser = choice::<Up>())]
+    pub up: Option<Up>,
     /// .obj and .glb meshes of the voxels: `on` (default) splits the greedy
     /// quads at T-junctions so every edge is shared (watertight, for 3D
     /// printing and booleans); `off` keeps the plain quads.
-    #[arg(long, value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
-    pub watertight: Option<String>,
+    #[arg(long, value_name = "on|off", value_parser = choice::<Switch>())]
+    pub watertight: Option<Switch>,
     /// .obj meshes of the voxels: triangles only (quads split in two); for
     /// readers that take only triangles, such as Open3D.
     #[arg(long)]
     pub triangulate: bool,
 }
 
-/// `--gpu-path`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum GpuPathArg {
-    /// Compute shaders, one workgroup per triangle.
-    #[default]
-    Compute,
-    /// The rasterizer: dominant-axis projection, conservative coverage, exact tests per fragment.
-    Raster,
-    /// The rasterizer with 4x MSAA: approximate.
-    MsaaApprox,
-}
-
-/// `--colour-rule`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum ColourRule {
-    /// The colour covering the most area.
-    #[default]
-    Dominant,
-    /// The area-weighted mean, in linear light.
-    Blend,
-}
-
 /// How a picture is taken.
 #[derive(Args, Debug, Clone)]
 pub struct PictureArgs {
     /// Camera: iso, x, y, z (from that axis's positive side), or AZIMUTH,ELEVATION in degrees.
-    #[arg(long, default_value = "iso", value_name = "VIEW")]
-    pub view: String,
+    #[arg(long, default_value = "iso", value_name = "VIEW", allow_hyphen_values = true, value_parser = values::view)]
+    pub view: View,
     /// Picture size in pixels, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1024x768", value_name = "WxH")]
-    pub size: String,
+    #[arg(long, default_value = "1024x768", value_name = "WxH", value_parser = values::size)]
+    pub size: Size,
     /// Draw the outline of the source mesh's silhouette over the voxels (mesh inputs and --preview).
     #[arg(long)]
     pub outline: bool,
@@ -313,15 +249,15 @@ pub struct RenderArgs {
     /// The axis drawn pointing up: x, y or z (default y: OBJ and glTF
     /// models are usually y-up). For .vox and .schem inputs, also the axis
     /// they were written with (`--up` of voxelize), unless they record it.
-    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
-    pub up: Option<String>,
+    #[arg(long, value_name = "x|y|z", value_parser = choice::<Up>())]
+    pub up: Option<Up>,
     /// For a mesh: the surface mode to voxelize with.
-    #[arg(long, value_enum, ignore_case = true, default_value = "cover")]
+    #[arg(long, value_parser = choice::<Mode>(), default_value = "cover")]
     pub mode: Mode,
     #[command(flatten)]
     pub grid: GridArgs,
     /// For a mesh: how surface colours combine in a voxel (dominant or blend).
-    #[arg(long, value_enum, ignore_case = true, default_value = "dominant", value_name = "RULE")]
+    #[arg(long, visible_alias = "color-rule", value_parser = choice::<ColourRule>(), default_value = "dominant", value_name = "RULE")]
     pub colour_rule: ColourRule,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
@@ -345,24 +281,23 @@ pub struct GpuRenderArgs {
     pub gpu: bool,
     /// --gpu: camera eye, target and vertical field of view in degrees
     /// (default: the whole scene from above-front-right, 45°).
-    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
-    pub camera: Option<String>,
+    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]", allow_hyphen_values = true, value_parser = values::camera)]
+    pub camera: Option<CameraSpec>,
     /// --gpu: cluster culling: none, frustum, occlusion (frustum, then
     /// Hi-Z occlusion against the depth of the frustum survivors), or
     /// occlusion-two-pass (the depth of the previous frame's clusters).
-    #[arg(long, default_value = "occlusion", value_name = "none|frustum|occlusion|occlusion-two-pass",
-          value_parser = clap::builder::PossibleValuesParser::new(["none", "frustum", "occlusion", "occlusion-two-pass"]))]
-    pub culling: String,
+    #[arg(long, default_value = "occlusion", value_parser = choice::<topovox::render::Culling>())]
+    pub culling: topovox::render::Culling,
     /// --gpu: a depth-only pass before shading.
-    #[arg(long, default_value = "off", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
-    pub prepass: String,
+    #[arg(long, default_value = "off", value_name = "on|off", value_parser = choice::<Switch>())]
+    pub prepass: Switch,
     /// --gpu: colour surfaces by their light-grid cell's list length (blue:
     /// no light, red: the longest list) instead of shading them.
-    #[arg(long, default_value = "off", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
-    pub light_grid: String,
+    #[arg(long, default_value = "off", value_name = "on|off", value_parser = choice::<Switch>())]
+    pub light_grid: Switch,
     /// --gpu: linear to sRGB on output.
-    #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
-    pub gamma: String,
+    #[arg(long, default_value = "on", value_name = "on|off", value_parser = choice::<Switch>())]
+    pub gamma: Switch,
     /// --gpu: a camera path, one camera per line as for --camera (`#`
     /// starts a comment); frame N is written to OUT with `-NNNN` before
     /// the extension.
@@ -382,11 +317,11 @@ pub struct GpuRenderArgs {
     pub points: Option<PathBuf>,
     /// --gpu: draw every cluster's box over the picture, green where the
     /// cluster was drawn, red where culling dropped it.
-    #[arg(long, default_value = "off", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
-    pub boxes: String,
+    #[arg(long, default_value = "off", value_name = "on|off", value_parser = choice::<Switch>())]
+    pub boxes: Switch,
     /// --gpu: draw the scene's triangles (off: only the --points cloud).
-    #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
-    pub mesh: String,
+    #[arg(long, default_value = "on", value_name = "on|off", value_parser = choice::<Switch>())]
+    pub mesh: Switch,
 }
 
 /// `topovox spray`: rays from a camera into a scene, hits as a point cloud.
@@ -408,21 +343,21 @@ pub struct SprayArgs {
     #[arg(long, default_value_t = 16, value_name = "K")]
     pub light_samples: u32,
     /// Shadow rays towards the light samples.
-    #[arg(long, default_value = "on", value_name = "on|off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
-    pub shadows: String,
+    #[arg(long, default_value = "on", value_name = "on|off", value_parser = choice::<Switch>())]
+    pub shadows: Switch,
     /// Seed of the random rays and samples (the cloud is the same for a seed, whatever the thread count).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Camera eye, target and vertical field of view in degrees (default:
     /// the whole scene from above-front-right, 45°, as render --gpu).
-    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
-    pub camera: Option<String>,
+    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]", allow_hyphen_values = true, value_parser = values::camera)]
+    pub camera: Option<CameraSpec>,
     /// The camera's picture, WIDTHxHEIGHT: rays fill its aspect.
-    #[arg(long, default_value = "1280x720", value_name = "WxH")]
-    pub size: String,
+    #[arg(long, default_value = "1280x720", value_name = "WxH", value_parser = values::size)]
+    pub size: Size,
     /// The axis pointing up: x, y or z (default y).
-    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
-    pub up: Option<String>,
+    #[arg(long, value_name = "x|y|z", value_parser = choice::<Up>())]
+    pub up: Option<Up>,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
@@ -444,31 +379,31 @@ pub struct ViewArgs {
     pub voxels: Option<PathBuf>,
     /// Also voxelize the mesh with this surface mode (and the grid
     /// options) and draw the voxels beside it.
-    #[arg(long, value_enum, ignore_case = true)]
+    #[arg(long, value_parser = choice::<Mode>())]
     pub mode: Option<Mode>,
     #[command(flatten)]
     pub grid: GridArgs,
     /// Voxels beside the mesh (side) or in its place (overlay).
-    #[arg(long, default_value = "side", value_parser = clap::builder::PossibleValuesParser::new(["side", "overlay"]))]
-    pub layout: String,
+    #[arg(long, default_value = "side", value_parser = choice::<Layout>())]
+    pub layout: Layout,
     /// Window size in pixels, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_name = "WxH")]
-    pub size: String,
+    #[arg(long, default_value = "1280x720", value_name = "WxH", value_parser = values::size)]
+    pub size: Size,
     /// The axis pointing up: x, y or z (default y).
-    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
-    pub up: Option<String>,
+    #[arg(long, value_name = "x|y|z", value_parser = choice::<Up>())]
+    pub up: Option<Up>,
     /// Starting camera: eye, target, vertical field of view in degrees.
-    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]")]
-    pub camera: Option<String>,
+    #[arg(long, value_name = "EX,EY,EZ,TX,TY,TZ[,FOV]", allow_hyphen_values = true, value_parser = values::camera)]
+    pub camera: Option<CameraSpec>,
     /// Starting culling: none, frustum, occlusion or occlusion-two-pass (key C cycles).
-    #[arg(long, default_value = "occlusion", value_parser = clap::builder::PossibleValuesParser::new(["none", "frustum", "occlusion", "occlusion-two-pass"]))]
-    pub culling: String,
+    #[arg(long, default_value = "occlusion", value_parser = choice::<topovox::render::Culling>())]
+    pub culling: topovox::render::Culling,
     /// Starting Z-prepass (key Z toggles).
-    #[arg(long, default_value = "off", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
-    pub prepass: String,
+    #[arg(long, default_value = "off", value_name = "on|off", value_parser = choice::<Switch>())]
+    pub prepass: Switch,
     /// Starting gamma correction (key G toggles).
-    #[arg(long, default_value = "on", value_parser = clap::builder::PossibleValuesParser::new(["on", "off"]))]
-    pub gamma: String,
+    #[arg(long, default_value = "on", value_name = "on|off", value_parser = choice::<Switch>())]
+    pub gamma: Switch,
     /// Scripted run: close after N frames (with --screenshot, save the last).
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
@@ -495,12 +430,36 @@ pub struct ViewArgs {
     pub quiet: bool,
 }
 
+topovox::choice! {
+    /// The bundled scenes of `topovox scene`.
+    pub enum SceneName: "scene" {
+        /// The Cornell box.
+        Cornell = "cornell",
+        /// A city of about a million triangles with 169 emissive street
+        /// lamps and cut-out foliage.
+        City = "city",
+        /// Three quads, the front one cut out in a checkerboard: the alpha
+        /// test's scene.
+        CutOuts = "cut-outs",
+    }
+}
+
+topovox::choice! {
+    /// Where `view` draws the voxels.
+    pub enum Layout: "layout" {
+        /// Beside the mesh.
+        Side = "side",
+        /// In the mesh's place.
+        Overlay = "overlay",
+    }
+}
+
 #[derive(Args, Debug)]
 pub struct SceneArgs {
     /// Which scene: cornell, city, or cut-outs (three quads, the front one
     /// cut out in a checkerboard: the alpha test's scene).
-    #[arg(value_parser = clap::builder::PossibleValuesParser::new(["cornell", "city", "cut-outs"]))]
-    pub name: String,
+    #[arg(value_parser = choice::<SceneName>())]
+    pub name: SceneName,
     /// Output OBJ; its MTL is written beside it with the same stem.
     #[arg(short, long, value_name = "OBJ")]
     pub output: PathBuf,
@@ -526,8 +485,8 @@ pub struct CheckArgs {
     pub grid: GridArgs,
     /// .vox and .schem files: the up axis they were written with (`--up` of
     /// voxelize; default y), when the file does not record it.
-    #[arg(long, value_name = "x|y|z", value_parser = clap::builder::PossibleValuesParser::new(["x", "y", "z"]))]
-    pub up: Option<String>,
+    #[arg(long, value_name = "x|y|z", value_parser = choice::<Up>())]
+    pub up: Option<Up>,
     /// Check without a dense grid, window by window (.vdb, .zarr and .npz
     /// only; chosen by itself when the grid does not fit in memory densely).
     /// Same report.
@@ -564,7 +523,7 @@ pub struct BenchArgs {
     #[arg(long, value_delimiter = ',', default_value = "128,256,512,1024")]
     pub resolutions: Vec<u64>,
     /// Modes to measure (surface and line modes).
-    #[arg(long, value_delimiter = ',', default_value = "cover")]
+    #[arg(long, value_delimiter = ',', value_parser = choice::<Mode>(), default_value = "cover")]
     pub modes: Vec<Mode>,
     /// Thread counts to measure.
     #[arg(long, value_delimiter = ',', default_value = "1,2")]
@@ -579,7 +538,7 @@ pub struct BenchArgs {
     /// alternation with the measured paths, the brute-force loop a short C
     /// program would be (every voxel of each triangle's bounding box, the
     /// f64 triangle/box test, one thread), and adds a "vs brute" column.
-    #[arg(long, value_enum, ignore_case = true)]
+    #[arg(long, value_parser = choice::<Baseline>())]
     pub baseline: Option<Baseline>,
     /// Split every triangle into four this many times before measuring
     /// (e.g. 2 turns the 69k-triangle bunny into 1.1M triangles).
@@ -605,10 +564,10 @@ pub struct GapsArgs {
     #[arg(required = true)]
     pub meshes: Vec<PathBuf>,
     /// The mode under test.
-    #[arg(long, default_value = "pos")]
+    #[arg(long, value_parser = choice::<Mode>(), default_value = "pos")]
     pub mode: Mode,
     /// Modes it is compared against (voxels they set that it lacks).
-    #[arg(long, value_delimiter = ',', default_value = "sep6,cover")]
+    #[arg(long, value_delimiter = ',', value_parser = choice::<Mode>(), default_value = "sep6,cover")]
     pub against: Vec<Mode>,
     /// Resolutions (longest side in voxels).
     #[arg(long, value_delimiter = ',', default_value = "128,256,512,1024")]
@@ -649,11 +608,6 @@ pub struct ConvertArgs {
 
 #[derive(Args, Debug)]
 pub struct BatchArgs {
-    /// Read files the model names (OBJ material libraries and textures,
-    /// glTF buffers and images) even outside its folder: absolute paths,
-    /// `../`, links leading out. Off by default.
-    #[arg(long)]
-    pub allow_external_paths: bool,
     /// Input meshes, or folders searched (recursively) for them.
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
@@ -669,33 +623,8 @@ pub struct BatchArgs {
     /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, obj or glb.
     #[arg(long, default_value = "npy", value_name = "FORMAT")]
     pub format: String,
-    /// Voxelization mode.
-    #[arg(long, value_enum, ignore_case = true, default_value = "cover")]
-    pub mode: Mode,
-    /// Method.
-    #[arg(long, value_enum, ignore_case = true, default_value = "auto")]
-    pub method: Method,
-    /// `bubble`: the seed of its random points (same seed, same voxels; default 0).
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
-    /// Solid modes: the surface mode of `solid+surface` and of the `--fill flood` shell.
-    #[arg(long, value_enum, ignore_case = true, value_name = "MODE")]
-    pub surface: Option<Mode>,
-    /// Solid modes: `flood` fills everything a surface shell encloses.
-    #[arg(long, value_enum, ignore_case = true)]
-    pub fill: Option<Fill>,
-    /// Solid modes: keep only the voxels touching the outside through a face (6) or also an edge or corner (26).
-    #[arg(long, value_name = "6|26", value_parser = clap::builder::PossibleValuesParser::new(["6", "26"]))]
-    pub hollow: Option<String>,
     #[command(flatten)]
-    pub grid: GridArgs,
-    #[command(flatten)]
-    pub memory: MemoryArgs,
-    /// With --method gpu: compute, raster or msaa-approx.
-    #[arg(long, value_enum, ignore_case = true, default_value = "compute", value_name = "PATH")]
-    pub gpu_path: GpuPathArg,
-    #[command(flatten)]
-    pub export: ExportArgs,
+    pub job: JobArgs,
     /// Meshes processed at once (default: all cores); each is voxelized on the same threads.
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
@@ -707,19 +636,6 @@ pub struct BatchArgs {
     pub quiet: bool,
 }
 
-/// 2D rasterization modes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum RasterModeArg {
-    /// 4-connected, 8-separating curves (the two pixel diagonals).
-    Curve4,
-    /// 8-connected, 4-separating curves (the crosshair).
-    Curve8,
-    /// The diamond target: the rule graphics APIs use for lines.
-    Diamond,
-    /// Filled outlines, nonzero winding at the pixel centre.
-    Fill,
-}
-
 #[derive(Args, Debug)]
 pub struct RasterArgs {
     /// Input SVG: <path>, <polyline>, <polygon>, <line>, <rect>, <circle>, <ellipse>.
@@ -728,8 +644,8 @@ pub struct RasterArgs {
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Rasterization mode.
-    #[arg(long, value_enum, ignore_case = true, default_value = "curve8")]
-    pub mode: RasterModeArg,
+    #[arg(long, value_parser = choice::<RasterMode>(), default_value = "curve8")]
+    pub mode: RasterMode,
     /// Fit the grid so the longest side of the drawing spans N pixels (default 128).
     #[arg(long, value_name = "N")]
     pub resolution: Option<u64>,
@@ -747,9 +663,83 @@ pub struct RasterArgs {
     #[arg(long, value_name = "T")]
     pub tolerance: Option<f64>,
     /// `fast` (default) or `reference` (brute force from the definition; the same pixels).
-    #[arg(long, default_value = "fast", value_parser = clap::builder::PossibleValuesParser::new(["fast", "reference"]))]
-    pub method: String,
+    #[arg(long, default_value = "fast", value_parser = choice::<RasterMethod>())]
+    pub method: RasterMethod,
     /// Print one JSON object on stdout instead of the summary line.
     #[arg(long)]
     pub json: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+    use topovox::render::Culling;
+
+    use super::*;
+
+    fn parse(args: &[&str]) -> Command {
+        Cli::try_parse_from(std::iter::once("topovox").chain(args.iter().copied())).unwrap_or_else(|e| panic!("{args:?}: {e}")).command
+    }
+
+    #[test]
+    fn flags_parse_into_their_types_in_any_case() {
+        let Command::Voxelize(v) = parse(&[
+            "voxelize",
+            "m.obj",
+            "-o",
+            "o.npy",
+            "--mode",
+            "Solid",
+            "--method",
+            "WINDING",
+            "--hollow",
+            "26",
+            "--fill",
+            "flood",
+            "--color-rule",
+            "blend",
+            "--up",
+            "Z",
+            "--watertight",
+            "OFF",
+            "--gpu-path",
+            "msaa-approx",
+            "--max-memory",
+            "64M",
+        ]) else {
+            panic!("not voxelize")
+        };
+        let j = &v.job;
+        assert_eq!((j.mode, j.method, j.hollow, j.fill), (Mode::Solid, Method::Winding, Some(Hollow::TwentySix), Some(Fill::Flood)));
+        assert_eq!((j.export.colour_rule, j.export.up, j.export.watertight), (ColourRule::Blend, Some(Up::Z), Some(Switch::Off)));
+        assert_eq!((j.gpu_path, j.memory.max_memory), (GpuPath::MsaaApprox, Some(64 << 20)));
+        let Command::Render(r) =
+            parse(&["render", "s.obj", "-o", "a.png", "--gpu", "--camera", "-5,2,3,0,0,0", "--culling", "Frustum", "--gamma", "off"])
+        else {
+            panic!("not render")
+        };
+        assert_eq!((r.gpu.culling, r.gpu.gamma), (Culling::Frustum, Switch::Off));
+        assert_eq!(r.gpu.camera.unwrap().eye, glam::Vec3::new(-5.0, 2.0, 3.0));
+        let Command::Raster(r) = parse(&["raster", "a.svg", "-o", "a.png", "--mode", "FILL", "--method", "reference"]) else {
+            panic!("not raster")
+        };
+        assert_eq!((r.mode, r.method), (RasterMode::Fill, RasterMethod::Reference));
+        let Command::Render(r) = parse(&["render", "v.npy", "-o", "a.png", "--view=-30,20", "--size", "64x48"]) else { panic!() };
+        assert_eq!((r.picture.view, r.picture.size.width), (View::Angles(-30.0, 20.0), 64));
+    }
+
+    #[test]
+    fn bad_values_are_refused_by_the_flag() {
+        for args in [
+            &["voxelize", "m.obj", "-o", "o.npy", "--mode", "cube"][..],
+            &["voxelize", "m.obj", "-o", "o.npy", "--hollow", "7"],
+            &["render", "s.obj", "-o", "a.png", "--up", "w"],
+            &["render", "s.obj", "-o", "a.png", "--gpu", "--gamma", "maybe"],
+            &["render", "s.obj", "-o", "a.png", "--gpu", "--camera", "1,2,3"],
+            &["spray", "s.obj", "-o", "a.ply", "--size", "0x5"],
+            &["voxelize", "m.obj", "-o", "o.npy", "--max-memory", "lots"],
+        ] {
+            assert!(Cli::try_parse_from(std::iter::once("topovox").chain(args.iter().copied())).is_err(), "{args:?}");
+        }
+    }
 }

@@ -1,14 +1,17 @@
 //! The `topovox` command-line tool: arguments → plan → `commands/*`.
 
 mod args;
+mod choice;
 mod commands;
 mod plan;
 mod progress;
+mod values;
 
 use std::io::Write;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
+use clap::error::{ContextKind, ContextValue, ErrorKind};
 use clap::Parser;
 
 use args::{Cli, Command};
@@ -24,7 +27,10 @@ fn main() -> ExitCode {
     // Before any thread starts (it may set an environment variable).
     #[cfg(feature = "gpu")]
     topovox_gpu::quiet_without_display();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return usage_error(e),
+    };
     remove_temporaries_on_interrupt();
     let result = match &cli.command {
         Command::Voxelize(a) => commands::voxelize::run(a),
@@ -57,6 +63,34 @@ fn main() -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+/// A command line clap refused, in one line (help and the version are
+/// printed whole): a flag's own parser names the flag and the problem; a
+/// wrong choice lists the right ones. Exit status 2, as clap's.
+fn usage_error(e: clap::Error) -> ExitCode {
+    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand) {
+        e.exit();
+    }
+    let rendered = e.render().to_string();
+    let first = rendered.lines().next().unwrap_or("invalid arguments").trim_start_matches("error: ");
+    let source = std::error::Error::source(&e).map(ToString::to_string);
+    let mut line = match (e.kind(), source) {
+        (ErrorKind::ValueValidation, Some(why)) => match e.get(ContextKind::InvalidValue) {
+            Some(ContextValue::String(v)) => format!("{why} (got {v:?})"),
+            _ => why,
+        },
+        (ErrorKind::MissingRequiredArgument, _) => match e.get(ContextKind::InvalidArg) {
+            Some(ContextValue::Strings(args)) => format!("missing {}", args.join(", ")),
+            _ => first.trim_end_matches(':').to_string(),
+        },
+        _ => first.trim_end_matches(':').to_string(),
+    };
+    if let Some(ContextValue::Strings(valid)) = e.get(ContextKind::ValidValue) {
+        line += &format!(" (expected one of: {})", valid.join(", "));
+    }
+    eprintln!("topovox: error: {line}; see --help");
+    ExitCode::from(2)
 }
 
 /// On Ctrl-C (SIGINT) or SIGTERM, removes the temporaries of the outputs

@@ -1007,6 +1007,10 @@ fn gpu_renderer_options_give_one_line_errors() {
         assert!(e.contains(says), "{args:?}: {e}");
     }
     assert!(!std::path::Path::new(&png).exists());
+    // A camera with negative coordinates, written as a new user would.
+    let out = topovox(&["render", obj.as_str(), "--gpu", "--camera", "-5,2,3,0,0,0", "-o", png.as_str(), "--size", "32x24"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
 }
 
 #[test]

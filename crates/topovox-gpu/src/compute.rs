@@ -21,21 +21,7 @@ const LIMIT_COVER: i64 = 1 << 19;
 /// differences of coordinates (≤ 2R) three at a time: 3·2·(2^19)³ < 2^63.
 const LIMIT_TARGETS: i64 = 1 << 18;
 
-/// How the GPU visits each triangle's voxel columns.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum GpuPath {
-    /// Compute shaders: one workgroup per triangle (default).
-    #[default]
-    Compute,
-    /// The rasterizer: dominant-axis projection, conservative coverage
-    /// (hardware where the adapter has it, else triangles expanded in the
-    /// vertex shader), exact tests per fragment. Same voxels as `Compute`.
-    Raster,
-    /// The rasterizer with 4× MSAA and no conservative coverage:
-    /// **approximate** — it misses voxels whose pixel no sample of the
-    /// projected triangle covers (never sets a wrong one).
-    RasterMsaa,
-}
+pub use topovox::voxelize::GpuPath;
 
 /// The surface modes the GPU path runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -129,7 +115,7 @@ impl Gpu {
     }
 
     /// `mode` of `mesh` on `grid` by `path` (see [`GpuPath`]; all but
-    /// [`GpuPath::RasterMsaa`] give the reference's voxels).
+    /// [`GpuPath::MsaaApprox`] give the reference's voxels).
     pub fn voxelize_with(
         &self,
         mode: GpuMode,
@@ -188,7 +174,7 @@ impl Gpu {
         let side = dims.iter().copied().max().unwrap_or(1);
         let target = match path {
             GpuPath::Compute => None,
-            GpuPath::Raster | GpuPath::RasterMsaa => Some(self.raster_target(side, path == GpuPath::RasterMsaa)?),
+            GpuPath::Raster | GpuPath::MsaaApprox => Some(self.raster_target(side, path == GpuPath::MsaaApprox)?),
         };
         let expand = if path == GpuPath::Raster && !self.raster.hardware_conservative { 16 } else { 0 };
         let max_batch = (self.max_slab_bytes / std::mem::size_of::<GpuTri>() as u64).clamp(1, 1 << 22) as usize;
@@ -235,7 +221,7 @@ impl Gpu {
                             occlusion_query_set: None,
                             multiview_mask: None,
                         });
-                        pass.set_pipeline(if path == GpuPath::RasterMsaa { &self.raster.msaa } else { &self.raster.conservative });
+                        pass.set_pipeline(if path == GpuPath::MsaaApprox { &self.raster.msaa } else { &self.raster.conservative });
                         pass.set_bind_group(0, &bind, &[]);
                         let per = if expand != 0 { 6 } else { 3 };
                         pass.draw(0..per * batch.len() as u32, 0..1);

@@ -166,7 +166,7 @@ fn the_rasterizer_path_equals_the_reference_and_msaa_only_misses() {
             if let Some(v) = bits.to_dense().first_difference(&want) {
                 panic!("{name}, {mode:?}, rasterizer: differs from the reference at {v:?} ({} vs {})", bits.count(), want.count());
             }
-            let (msaa, _) = g.voxelize_with(gm, GpuPath::RasterMsaa, mesh.as_ref(), &grid).unwrap();
+            let (msaa, _) = g.voxelize_with(gm, GpuPath::MsaaApprox, mesh.as_ref(), &grid).unwrap();
             let msaa = msaa.to_dense();
             let mut extra = 0;
             let mut missed = 0;

@@ -11,36 +11,22 @@
 //! | `y` (default: most OBJ and glTF models) | `(i, nz−1−k, j)` | `(i, j, k)` |
 //! | `z` | `(i, j, k)` | `(i, k, ny−1−j)` |
 
-/// The axis of the voxel data that points up.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Up {
-    /// `+x` is up.
-    X,
-    /// `+y` is up (OBJ and glTF convention; the default).
-    #[default]
-    Y,
-    /// `+z` is up.
-    Z,
+topovox::choice! {
+    /// The axis of the voxel data that points up.
+    pub enum Up: "up axis" default Y {
+        /// `+x` is up.
+        X = "x",
+        /// `+y` is up (OBJ and glTF convention; the default).
+        Y = "y",
+        /// `+z` is up.
+        Z = "z",
+    }
 }
 
 impl Up {
-    /// `x`, `y` or `z`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Up::X => "x",
-            Up::Y => "y",
-            Up::Z => "z",
-        }
-    }
-
-    /// The axis called `name` (`x`, `y`, `z`), if any.
+    /// The axis called `name` (`x`, `y`, `z`, any case), if any.
     pub fn from_name(name: &str) -> Option<Up> {
-        match name {
-            "x" | "X" => Some(Up::X),
-            "y" | "Y" => Some(Up::Y),
-            "z" | "Z" => Some(Up::Z),
-            _ => None,
-        }
+        topovox::choice::Choice::parse(name).ok()
     }
 }
 

@@ -255,7 +255,7 @@ pub fn write(
         height: height as u16 as i16,
         length: length as u16 as i16,
         offset: IntArray::new(vec![0, 0, 0]),
-        metadata: Some(Metadata { we_offset_x: 0, we_offset_y: 0, we_offset_z: 0, topovox_up: Some(up.name().to_string()) }),
+        metadata: Some(Metadata { we_offset_x: 0, we_offset_y: 0, we_offset_z: 0, topovox_up: Some(up.to_string()) }),
         palette_max: palette.len() as i32,
         palette,
         block_data: ByteArray::new(data),

@@ -29,6 +29,7 @@
 //! resolution topovox allows).
 
 use glam::DVec2;
+use topovox::choice::Choice;
 use topovox::raster::{FillRule, Outline};
 
 use crate::error::ErrorKind;
@@ -94,12 +95,8 @@ impl Painting {
                     Ok(_) => out.filled = true,
                     Err(_) => {}
                 },
-                "fill-rule" => match value {
-                    "nonzero" => out.rule = FillRule::NonZero,
-                    "evenodd" => out.rule = FillRule::EvenOdd,
-                    "inherit" => out.rule = self.rule,
-                    _ => {}
-                },
+                "fill-rule" if value == "inherit" => out.rule = self.rule,
+                "fill-rule" => out.rule = FillRule::parse(value).unwrap_or(out.rule),
                 _ => {}
             }
         }

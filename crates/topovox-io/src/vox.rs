@@ -69,7 +69,7 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, attrs: Option<&VoxelAttr
     }
     let single = blocks.len() == 1 && dims.iter().all(|&d| d <= BLOCK);
     let mut models = Vec::with_capacity(blocks.len());
-    let root = Dict::from_iter([("_topovox_up".to_string(), up.name().to_string())]);
+    let root = Dict::from_iter([("_topovox_up".to_string(), up.to_string())]);
     let mut scenes = vec![
         SceneNode::Transform { attributes: root, frames: vec![Frame::new(Dict::new())], child: 1, layer_id: u32::MAX },
         SceneNode::Group { attributes: Dict::new(), children: Vec::new() },

@@ -40,3 +40,9 @@ pub type Result<T> = std::result::Result<T, JobError>;
 macro_rules! invalid {
     ($($t:tt)*) => { return Err($crate::JobError::Invalid(format!($($t)*))) };
 }
+
+impl From<topovox::choice::UnknownChoice> for JobError {
+    fn from(e: topovox::choice::UnknownChoice) -> JobError {
+        JobError::Invalid(e.to_string())
+    }
+}

@@ -24,19 +24,24 @@ mod solid;
 
 pub mod batch;
 pub mod check;
+pub mod options;
 pub mod output;
 
 pub use error::{JobError, Result};
 pub use grid::{GridOptions, GridRequest};
 pub use memory::{available_memory, budget, bytes, check_memory, dense_fits, parse_size, peak_memory};
+pub use options::{JobOptions, OptionValue, KEYWORDS};
 pub use plan::{
-    auto_method, gpu_has, resolve_method, Fill, GpuPath, Method, Mode, Plan, Request, SolidMethod, SolidPlan, SurfaceMethod,
+    auto_method, gpu_has, resolve_method, Fill, GpuPath, Hollow, Method, Mode, Plan, Request, SolidMethod, SolidPlan, SurfaceMethod,
     GPU_AUTO_MIN_SIDE,
 };
 pub use run::{
     attributes, attributes_for, check_attributes_carried, every_attribute, voxelize, Voxelized, Voxels, ATTRIBUTE_BYTES_PER_VOXEL,
 };
 pub use solid::Outcome as SolidOutcome;
+pub use topovox::attributes::ColourRule;
+pub use topovox::choice::{Choice, Switch, UnknownChoice};
+pub use topovox_io::orient::Up;
 
 /// The most worker threads any front end starts (`--threads`, `--jobs`,
 /// `threads=`, `jobs=`): far more than cores only costs memory and time

@@ -1,6 +1,7 @@
 //! Modes, methods and solid options by the names users give them, and the
 //! validated plan of a job: which core mode and which path will run.
 
+use topovox::choice::Choice;
 use topovox::topology::runs::Connectivity;
 use topovox::GridSpec;
 
@@ -8,80 +9,47 @@ use crate::error::{JobError, Result};
 use crate::grid::GridRequest;
 use crate::invalid;
 
-/// A voxelization mode as the CLI and the Python package name it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Mode {
-    /// Conservative surface.
-    Cover,
-    /// Laine's 26-separating surface.
-    Sep26,
-    /// Laine's thin 6-separating surface.
-    Sep6,
-    /// Schwarz–Seidel 6-separating surface.
-    Ss6,
-    /// Voxels whose centre is inside.
-    Solid,
-    /// The solid united with a surface mode.
-    SolidSurface,
-    /// 6-connected polylines.
-    Line6,
-    /// 26-connected polylines.
-    Line26,
-    /// The published projected optimal scanline algorithm.
-    Pos,
-    /// 18-tunnel-free surface.
-    Tunnel18,
-    /// 26-tunnel-free surface.
-    Tunnel26,
-    /// Randomized 6-separating surface (seeded).
-    Bubble,
-    /// Alternating single-diagonal 6-separating surface.
-    Diagonal,
+topovox::choice! {
+    /// A voxelization mode as the CLI and the Python package name it.
+    pub enum Mode: "mode" default Cover {
+        /// Conservative surface: every voxel whose closed box meets a triangle.
+        Cover = "cover",
+        /// Laine's minimal 26-separating surface (space-diagonal target).
+        Sep26 = "sep26",
+        /// Laine's thin 6-separating surface (3D crosshair target).
+        Sep6 = "sep6",
+        /// Schwarz–Seidel 6-separating surface.
+        Ss6 = "ss6",
+        /// 18-tunnel-free surface: targets from the centre to face centres and edge midpoints.
+        Tunnel18 = "tunnel18",
+        /// 26-tunnel-free surface: also from the centre to the corners.
+        Tunnel26 = "tunnel26",
+        /// Randomized 6-separating surface: the crosshair's joins at random points (seed).
+        Bubble = "bubble",
+        /// 6-separating surface from one alternating body diagonal per voxel.
+        Diagonal = "diagonal",
+        /// Solid: voxels whose centre is inside.
+        Solid = "solid",
+        /// Solid united with a surface mode (surface), so thin parts never vanish.
+        SolidSurface = "solid+surface",
+        /// 6-connected polyline voxelization.
+        Line6 = "line6",
+        /// 26-connected polyline voxelization.
+        Line26 = "line26",
+        /// Projected optimal scanline, as published.
+        Pos = "pos",
+    }
 }
 
 impl Mode {
-    /// Every mode, in documentation order.
-    pub const ALL: [Mode; 13] = [
-        Mode::Cover,
-        Mode::Sep26,
-        Mode::Sep6,
-        Mode::Ss6,
-        Mode::Tunnel18,
-        Mode::Tunnel26,
-        Mode::Bubble,
-        Mode::Diagonal,
-        Mode::Solid,
-        Mode::SolidSurface,
-        Mode::Line6,
-        Mode::Line26,
-        Mode::Pos,
-    ];
-
     /// The user-facing name.
     pub fn name(self) -> &'static str {
-        match self {
-            Mode::Cover => "cover",
-            Mode::Sep26 => "sep26",
-            Mode::Sep6 => "sep6",
-            Mode::Ss6 => "ss6",
-            Mode::Solid => "solid",
-            Mode::SolidSurface => "solid+surface",
-            Mode::Line6 => "line6",
-            Mode::Line26 => "line26",
-            Mode::Pos => "pos",
-            Mode::Tunnel18 => "tunnel18",
-            Mode::Tunnel26 => "tunnel26",
-            Mode::Bubble => "bubble",
-            Mode::Diagonal => "diagonal",
-        }
+        Choice::name(self)
     }
 
-    /// The mode called `name`.
+    /// The mode called `name`, in any case.
     pub fn parse(name: &str) -> Result<Mode> {
-        match Mode::ALL.into_iter().find(|m| m.name().eq_ignore_ascii_case(name)) {
-            Some(m) => Ok(m),
-            None => invalid!("unknown mode {name:?} (expected one of: {})", Mode::ALL.map(Mode::name).join(", ")),
-        }
+        Ok(Choice::parse(name)?)
     }
 
     /// Whether this is a solid mode.
@@ -114,75 +82,39 @@ impl Mode {
     }
 }
 
-/// A method as users name it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Method {
-    /// The fastest correct method for the mode.
-    #[default]
-    Auto,
-    /// The brute-force reference.
-    Reference,
-    /// The triangle-box fast path.
-    Fast,
-    /// The exact scanline path.
-    Scanline,
-    /// The GPU.
-    Gpu,
-    /// Solid by ray parity.
-    Parity,
-    /// Solid by the generalized winding number.
-    Winding,
+topovox::choice! {
+    /// A method as users name it.
+    pub enum Method: "method" default Auto {
+        /// The fastest correct method for the mode.
+        Auto = "auto",
+        /// The slow brute-force reference implementation of the mode.
+        Reference = "reference",
+        /// The triangle/box fast path (Schwarz & Seidel 2010), parallel.
+        Fast = "fast",
+        /// Projected optimal scanline fast path.
+        Scanline = "scanline",
+        /// GPU (wgpu).
+        Gpu = "gpu",
+        /// Solid by ray parity.
+        Parity = "parity",
+        /// Solid by generalized winding number.
+        Winding = "winding",
+    }
 }
 
 impl Method {
-    /// Every method.
-    pub const ALL: [Method; 7] =
-        [Method::Auto, Method::Reference, Method::Fast, Method::Scanline, Method::Gpu, Method::Parity, Method::Winding];
-
     /// The user-facing name.
     pub fn name(self) -> &'static str {
-        match self {
-            Method::Auto => "auto",
-            Method::Reference => "reference",
-            Method::Fast => "fast",
-            Method::Scanline => "scanline",
-            Method::Gpu => "gpu",
-            Method::Parity => "parity",
-            Method::Winding => "winding",
-        }
+        Choice::name(self)
     }
 
-    /// The method called `name`.
+    /// The method called `name`, in any case.
     pub fn parse(name: &str) -> Result<Method> {
-        match Method::ALL.into_iter().find(|m| m.name().eq_ignore_ascii_case(name)) {
-            Some(m) => Ok(m),
-            None => invalid!("unknown method {name:?} (expected one of: {})", Method::ALL.map(Method::name).join(", ")),
-        }
+        Ok(Choice::parse(name)?)
     }
 }
 
-/// The GPU path of `method gpu`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum GpuPath {
-    /// Compute shaders.
-    #[default]
-    Compute,
-    /// The rasterizer, exact.
-    Raster,
-    /// The rasterizer with 4x MSAA: approximate.
-    MsaaApprox,
-}
-
-impl GpuPath {
-    /// The name `--gpu-path` takes and the summary reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            GpuPath::Compute => "compute",
-            GpuPath::Raster => "raster",
-            GpuPath::MsaaApprox => "msaa-approx",
-        }
-    }
-}
+pub use topovox::voxelize::GpuPath;
 
 /// The surface/line paths a method can name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -318,11 +250,23 @@ pub struct SolidPlan {
     pub hollow: Option<Connectivity>,
 }
 
-/// Solid filling strategies other than the inside test.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Fill {
-    /// Everything a surface shell encloses.
-    Flood,
+topovox::choice! {
+    /// Solid filling strategies other than the inside test.
+    pub enum Fill: "fill" {
+        /// Everything not reachable from the grid boundary through unset
+        /// voxels of a surface shell.
+        Flood = "flood",
+    }
+}
+
+topovox::choice! {
+    /// Which voxels a hollowed solid keeps: those touching the outside.
+    pub enum Hollow: "hollow connectivity" {
+        /// Through a face.
+        Six = "6",
+        /// Through a face, an edge or a corner.
+        TwentySix = "26",
+    }
 }
 
 /// Everything a voxelization job is asked to do, before the mesh is read.
@@ -338,8 +282,8 @@ pub struct Request {
     pub surface: Option<Mode>,
     /// Solid modes: fill by flood instead of the inside test.
     pub fill: Option<Fill>,
-    /// Solid modes: keep only the skin (6 or 26).
-    pub hollow: Option<u32>,
+    /// Solid modes: keep only the skin.
+    pub hollow: Option<Hollow>,
     /// `method gpu`: which GPU path.
     pub gpu_path: GpuPath,
     /// `bubble`: the seed of its random points.
@@ -444,11 +388,9 @@ fn solid_plan(a: &Request) -> Result<Option<SolidPlan>> {
         (None, m) => invalid!("--method {} does not apply to solid modes (use auto, parity, winding or reference)", m.name()),
     };
     let surface = (a.mode == Mode::SolidSurface || method == SolidMethod::Flood).then_some(surface_mode);
-    let hollow = match a.hollow {
-        None => None,
-        Some(6) => Some(Connectivity::Six),
-        Some(26) => Some(Connectivity::TwentySix),
-        Some(n) => invalid!("--hollow takes 6 or 26, not {n}"),
-    };
+    let hollow = a.hollow.map(|h| match h {
+        Hollow::Six => Connectivity::Six,
+        Hollow::TwentySix => Connectivity::TwentySix,
+    });
     Ok(Some(SolidPlan { method, surface, hollow }))
 }

@@ -347,16 +347,10 @@ fn gpu_failed(e: topovox_gpu::GpuError) -> JobError {
 
 /// The GPU, and the mode and path a `--method gpu` run asks of it.
 #[cfg(feature = "gpu")]
-fn gpu_setup(mode: voxelize::Mode, path: GpuPath) -> Result<(topovox_gpu::Gpu, topovox_gpu::GpuMode, topovox_gpu::GpuPath)> {
-    use topovox_gpu::GpuPath as P;
+fn gpu_setup(mode: voxelize::Mode, path: GpuPath) -> Result<(topovox_gpu::Gpu, topovox_gpu::GpuMode, GpuPath)> {
     let gm = topovox_gpu::GpuMode::of(mode)
         .ok_or_else(|| JobError::invalid(format!("--method gpu: {} on the GPU is not built yet", mode.name())))?;
-    let gp = match path {
-        GpuPath::Compute => P::Compute,
-        GpuPath::Raster => P::Raster,
-        GpuPath::MsaaApprox => P::RasterMsaa,
-    };
-    Ok((topovox_gpu::Gpu::new().map_err(gpu_failed)?, gm, gp))
+    Ok((topovox_gpu::Gpu::new().map_err(gpu_failed)?, gm, path))
 }
 
 /// A surface mode on the GPU: the voxels, the report, facts, warnings.
@@ -373,7 +367,7 @@ fn gpu_voxelize(
     let (bits, r) = gpu.voxelize_with(gm, gp, mesh, grid).map_err(fail)?;
     let mut warnings = Vec::new();
     // The approximation says what it misses: the exact voxels by the compute path.
-    let missed = if gp == P::RasterMsaa {
+    let missed = if gp == P::MsaaApprox {
         let (exact, _) = gpu.voxelize(gm, mesh, grid).map_err(fail)?;
         let mut missed = 0u64;
         exact.for_each_set(|i, j, k| missed += !bits.get(i, j, k) as u64);
@@ -384,7 +378,7 @@ fn gpu_voxelize(
     };
     let t = r.timings;
     let facts = json!({
-        "path": path.name(),
+        "path": path.to_string(),
         "hardware_conservative": gpu.hardware_conservative(),
         "missed_voxels": missed,
         "adapter": gpu.adapter(),
@@ -430,7 +424,7 @@ fn gpu_tiled(
     .map_err(|e| JobError::invalid(e.to_string()))?
     .map_err(gpu_failed)?;
     let facts = json!({
-        "path": path.name(),
+        "path": path.to_string(),
         "hardware_conservative": gpu.hardware_conservative(),
         "adapter": gpu.adapter(),
         "software": gpu.is_software(),

@@ -5,6 +5,7 @@
 use glam::DVec2;
 use proptest::prelude::*;
 use rand::Rng;
+use topovox::choice::Choice;
 use topovox::raster::certify::{components, inside, separation_witness, Adjacency};
 use topovox::raster::{self, Grid2, Outline, Pixels, RasterMode};
 use topovox_testkit::rng;

@@ -27,42 +27,7 @@ use crate::scene::{Scene, Vertex};
 use crate::spray::SprayPoint;
 use crate::ViewError;
 
-/// Which clusters are drawn.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Culling {
-    /// Every cluster.
-    None,
-    /// Clusters whose box meets the view frustum (compute pass).
-    Frustum,
-    /// Frustum survivors not hidden behind the depth of all frustum
-    /// survivors, tested against a Hi-Z pyramid ([`crate::hiz`]).
-    Occlusion,
-    /// The two-pass variant: the depth pass draws only the clusters the
-    /// previous frame drew (all of them on the first frame), so it is
-    /// cheaper; the pyramid of that partial depth is farther than the
-    /// final one, so the test stays a bound and the picture the same.
-    OcclusionTwoPass,
-}
-
-impl Culling {
-    /// Every setting, in the order the viewer's key cycles them.
-    pub const ALL: [Culling; 4] = [Culling::None, Culling::Frustum, Culling::Occlusion, Culling::OcclusionTwoPass];
-
-    /// The command-line name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Culling::None => "none",
-            Culling::Frustum => "frustum",
-            Culling::Occlusion => "occlusion",
-            Culling::OcclusionTwoPass => "occlusion-two-pass",
-        }
-    }
-
-    /// The setting of a command-line name.
-    pub fn from_name(name: &str) -> Option<Culling> {
-        Culling::ALL.into_iter().find(|c| c.name() == name)
-    }
-}
+pub use topovox::render::Culling;
 
 /// What one frame is.
 #[derive(Clone, Copy, Debug, PartialEq)]

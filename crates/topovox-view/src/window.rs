@@ -22,6 +22,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use glam::Vec3;
+use topovox::choice::Choice;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};

@@ -38,6 +38,7 @@
 pub use glam;
 
 pub mod attributes;
+pub mod choice;
 pub mod export;
 pub mod geom;
 pub mod grid;

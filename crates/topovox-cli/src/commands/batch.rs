@@ -3,10 +3,9 @@
 use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde_json::Value;
-use topovox::attributes::carry::CarryOptions;
-use topovox_job::batch::{self, BatchOptions, BatchProgress, FingerprintParts};
+use topovox_job::batch::{self, BatchProgress};
 
-use crate::args::{BatchArgs, Fill};
+use crate::args::BatchArgs;
 
 /// The bar: meshes done of all, meshes per second, time to go.
 struct Bar(ProgressBar);
@@ -27,48 +26,10 @@ impl BatchProgress for Bar {
 }
 
 pub fn run(a: &BatchArgs) -> Result<()> {
-    let mut plan =
-        crate::plan::plan_from(a.mode, a.method, &a.grid, a.surface, a.fill, a.hollow.as_deref(), a.gpu_path, a.seed, &a.memory)?;
     let Some(format) = topovox_job::output::Output::from_name(&a.format) else {
         bail!("unknown --format {:?} (expected one of: {})", a.format, topovox_job::output::Output::names());
     };
-    plan.request.writer_bytes_per_brick = topovox_job::output::writer_bytes_per_brick(format);
-    let write = crate::commands::export::writer_options(&a.export)?;
-    let colour_rule = format!("{:?}", a.export.colour_rule).to_lowercase();
-    let gpu_path = crate::plan::gpu_path_name(a.gpu_path).0;
-    let fingerprint = batch::fingerprint(&FingerprintParts {
-        mode: crate::plan::mode_name(a.mode),
-        method: topovox_job::Method::from(a.method).name(),
-        grid: &crate::plan::grid_options(&a.grid),
-        surface: a.surface.map(crate::plan::mode_name),
-        fill: a.fill.map(|f| match f {
-            Fill::Flood => "flood",
-        }),
-        hollow: a.hollow.as_deref().and_then(|h| h.parse().ok()),
-        gpu_path,
-        format: format.name(),
-        colour_rule: &colour_rule,
-        normals: a.export.normals,
-        attributes: a.export.attributes,
-        dither: a.export.dither,
-        up: crate::commands::export::up(&a.export).name(),
-        watertight: a.export.watertight.as_deref() != Some("off"),
-        triangulate: a.export.triangulate,
-        seed: a.seed,
-    });
-    let opts = BatchOptions {
-        plan,
-        format,
-        carry: CarryOptions {
-            rule: crate::commands::export::colour_rule(a.export.colour_rule),
-            normals: a.export.normals || a.export.attributes,
-        },
-        attributes: a.export.attributes,
-        write,
-        threads: None,
-        read: topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
-        fingerprint,
-    };
+    let opts = crate::plan::job_options(&a.job, None)?.batch(format)?;
     let pool = crate::thread_pool_for(a.jobs, "--jobs")?;
     let (files, warnings) = batch::collect_inputs(&a.inputs, a.glob.as_deref(), &a.output)?;
     for w in &warnings {

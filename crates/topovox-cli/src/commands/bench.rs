@@ -57,9 +57,9 @@ impl Engine {
     /// measures parity and the generalized winding number (two groups);
     /// modes with a scanline path measure it beside the fast path, in one
     /// group whose engines are timed in alternation.
-    fn new(m: crate::args::Mode) -> Result<Vec<Vec<Engine>>> {
+    fn new(m: topovox_job::Mode) -> Result<Vec<Vec<Engine>>> {
         Ok(match m {
-            crate::args::Mode::Solid => vec![vec![Engine::SolidParity], vec![Engine::SolidWinding]],
+            topovox_job::Mode::Solid => vec![vec![Engine::SolidParity], vec![Engine::SolidWinding]],
             m => {
                 let core = crate::plan::core_mode(m)?;
                 let mut v = vec![Engine::Surface(core)];

@@ -10,7 +10,7 @@ use crate::args::CheckArgs;
 pub fn run(a: &CheckArgs) -> Result<()> {
     let t0 = Instant::now();
     let pool = crate::thread_pool(a.threads)?;
-    let up = a.up.as_deref().and_then(topovox_io::orient::Up::from_name).unwrap_or_default();
+    let up = a.up.unwrap_or_default();
     let sparse_format = topovox_io::VoxelFormat::from_path(&a.voxels).is_some_and(topovox_io::VoxelFormat::reads_sparsely);
     if a.sparse && !sparse_format {
         bail!("{}: --sparse reads only .vdb, .zarr and .npz files", a.voxels.display());

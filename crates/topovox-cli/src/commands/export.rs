@@ -3,39 +3,10 @@
 
 use std::path::Path;
 
-use anyhow::Result;
-use topovox_io::orient::Up;
-use topovox_io::schem::BlockPalette;
-use topovox_io::WriteOptions;
 use topovox_job::output::{MeshKind, Output};
+use topovox_job::ColourRule;
 
-use crate::args::{ColourRule, ExportArgs};
-
-/// The core's colour rule for `--colour-rule`.
-pub fn colour_rule(r: ColourRule) -> topovox::attributes::ColourRule {
-    match r {
-        ColourRule::Dominant => topovox::attributes::ColourRule::Dominant,
-        ColourRule::Blend => topovox::attributes::ColourRule::Blend,
-    }
-}
-
-/// Checks the export options that name files (before any work is done).
-pub fn writer_options(e: &ExportArgs) -> Result<WriteOptions> {
-    let blocks = e.block_palette.as_deref().map(BlockPalette::read).transpose()?;
-    Ok(WriteOptions {
-        dither: e.dither,
-        blocks,
-        up: up(e),
-        mesh: topovox_io::voxel_mesh::MeshOptions { watertight: e.watertight.as_deref() != Some("off"), triangulate: e.triangulate },
-        // Ctrl-C ends the process (see main.rs), removing its temporaries.
-        stop: None,
-    })
-}
-
-/// `--up` (default y).
-pub fn up(e: &ExportArgs) -> Up {
-    e.up.as_deref().and_then(Up::from_name).unwrap_or_default()
-}
+use crate::args::ExportArgs;
 
 /// Warns, before any work, about export options that do nothing for this
 /// output (`from_mesh`: the voxels come from a mesh, so colours can be

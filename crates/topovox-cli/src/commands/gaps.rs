@@ -8,7 +8,7 @@ use topovox::voxelize::{self, Options};
 use topovox::{DenseBits, GridSpec};
 
 use crate::args::GapsArgs;
-use crate::plan::{core_mode, mode_name};
+use crate::plan::core_mode;
 
 /// Voxels set in `a` and not in `b` (same dims).
 fn and_not(a: &DenseBits, b: &DenseBits) -> u64 {
@@ -20,11 +20,11 @@ pub fn run(a: &GapsArgs) -> Result<()> {
     let against = a.against.iter().map(|&m| core_mode(m)).collect::<Result<Vec<_>>>()?;
     let mut table = String::new();
     if !a.json {
-        table += &format!("| mesh | closed | resolution | {} voxels |", mode_name(a.mode));
+        table += &format!("| mesh | closed | resolution | {} voxels |", a.mode.name());
         for &m in &a.against {
-            table += &format!(" missing vs {} |", mode_name(m));
+            table += &format!(" missing vs {} |", m.name());
         }
-        table += &format!(" outside {} | 6-separating | 6-tunnels |\n", mode_name(a.against[a.against.len() - 1]));
+        table += &format!(" outside {} | 6-separating | 6-tunnels |\n", a.against[a.against.len() - 1].name());
         table += &"|---".repeat(7 + a.against.len());
         table += "|\n";
     }
@@ -44,9 +44,9 @@ pub fn run(a: &GapsArgs) -> Result<()> {
             let facts = report.mesh.context("certify returned no mesh facts")?;
             let separating = facts.separation.as_ref().map(|s| s.witness_6.is_none());
             if a.json {
-                let v = json!({"mesh": name, "closed": facts.closed, "resolution": res, "dims": grid.dims(), "mode": mode_name(a.mode),
+                let v = json!({"mesh": name, "closed": facts.closed, "resolution": res, "dims": grid.dims(), "mode": a.mode.name(),
                     "voxels": report.voxels,
-                    "missing": a.against.iter().zip(&missing).map(|(m, n)| (mode_name(*m).to_string(), json!(n))).collect::<serde_json::Map<_, _>>(),
+                    "missing": a.against.iter().zip(&missing).map(|(m, n)| (m.name().to_string(), json!(n))).collect::<serde_json::Map<_, _>>(),
                     "outside": outside, "separating_6": separating, "tunnels_6": facts.tunnels_6});
                 crate::print_stdout(&v.to_string())?;
                 continue;

@@ -5,19 +5,15 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use serde_json::json;
+use topovox::choice::Choice;
 use topovox::glam::DVec2;
-use topovox::raster::{self, Grid2, RasterMode};
+use topovox::raster::{self, Grid2};
 
-use crate::args::{RasterArgs, RasterModeArg};
+use crate::args::RasterArgs;
 
 pub fn run(a: &RasterArgs) -> Result<()> {
     let t0 = Instant::now();
-    let mode = match a.mode {
-        RasterModeArg::Curve4 => RasterMode::Curve4,
-        RasterModeArg::Curve8 => RasterMode::Curve8,
-        RasterModeArg::Diamond => RasterMode::Diamond,
-        RasterModeArg::Fill => RasterMode::Fill,
-    };
+    let mode = a.mode;
     let ext = a.output.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase());
     if !matches!(ext.as_deref(), Some("png" | "npy")) {
         bail!("{}: raster writes .png or .npy", a.output.display());
@@ -50,8 +46,7 @@ pub fn run(a: &RasterArgs) -> Result<()> {
     }
     .context("invalid grid")?;
     let t = Instant::now();
-    let (px, rep) =
-        if a.method == "reference" { raster::reference(mode, &svg.outlines, &grid) } else { raster::fast(mode, &svg.outlines, &grid) };
+    let (px, rep) = raster::run(a.method, mode, &svg.outlines, &grid);
     let raster_s = t.elapsed().as_secs_f64();
     if rep.skipped > 0 {
         eprintln!("topovox: warning: {}: {} segments too far from the grid or not finite were skipped", a.input.display(), rep.skipped);
@@ -63,7 +58,7 @@ pub fn run(a: &RasterArgs) -> Result<()> {
     let drawn = raster::drawn(mode, &svg.outlines);
     let unfilled = svg.outlines.len() - drawn;
     if a.json {
-        let v = json!({"mode": mode.name(), "method": a.method, "origin": [o.x, o.y], "pixel_size": grid.pixel_size(), "dims": dims,
+        let v = json!({"mode": mode.name(), "method": a.method.name(), "origin": [o.x, o.y], "pixel_size": grid.pixel_size(), "dims": dims,
             "pixels": rep.pixels, "outlines": drawn, "unfilled_outlines_left_out": unfilled, "segments": rep.segments, "degenerate_segments": rep.degenerate,
             "skipped_segments": rep.skipped, "raster_s": raster_s, "total_s": t0.elapsed().as_secs_f64(), "output": a.output});
         return crate::print_stdout(&v.to_string());

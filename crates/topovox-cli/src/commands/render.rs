@@ -10,54 +10,25 @@ use topovox::attributes::carry::{carry, CarryOptions};
 use topovox::attributes::VoxelAttributes;
 use topovox::glam::DVec3;
 use topovox::grid::sparse::SparseBricks;
-use topovox::render::raycast::{render_grid, render_with, Image, RenderGrid, RenderOptions, View};
+use topovox::render::raycast::{render_grid, render_with, Image, RenderGrid, RenderOptions};
 use topovox::voxelize::{self, Options};
 use topovox::{BrickBits, VoxelSource};
+use topovox_io::orient::Up;
 
 use crate::args::{PictureArgs, RenderArgs};
 use crate::plan;
 
-/// Largest picture side and pixel count accepted.
-const MAX_SIDE: u32 = 16_384;
-const MAX_PIXELS: u64 = 64 << 20;
-
-/// Validates the picture options.
-pub fn options(p: &PictureArgs, up: Option<&str>) -> Result<RenderOptions> {
-    let view = match p.view.as_str() {
-        "iso" => View::Iso,
-        "x" => View::Axis(0),
-        "y" => View::Axis(1),
-        "z" => View::Axis(2),
-        other => {
-            let parts: Vec<&str> = other.split(',').collect();
-            let angles: Option<Vec<f64>> = parts.iter().map(|s| s.trim().parse::<f64>().ok().filter(|v| v.is_finite())).collect();
-            match angles.as_deref() {
-                Some([az, el]) => View::Angles(*az, *el),
-                _ => bail!("--view takes iso, x, y, z or AZIMUTH,ELEVATION in degrees, not {other:?}"),
-            }
-        }
-    };
-    let (width, height) = parse_size(&p.size)?;
-    let up = up_axis(up);
-    Ok(RenderOptions { width, height, view, up, ..RenderOptions::default() })
-}
-
-/// Parses `--size WIDTHxHEIGHT` within the picture limits.
-pub fn parse_size(text: &str) -> Result<(u32, u32)> {
-    let size: Option<(u32, u32)> = text.split_once(['x', 'X']).and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
-    let Some((width, height)) = size else { bail!("--size takes WIDTHxHEIGHT in pixels, e.g. 1024x768, not {text:?}") };
-    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE || width as u64 * height as u64 > MAX_PIXELS {
-        bail!("--size {width}x{height}: each side must be 1..={MAX_SIDE} and the picture at most {MAX_PIXELS} pixels");
-    }
-    Ok((width, height))
+/// The picture options.
+pub fn options(p: &PictureArgs, up: Option<Up>) -> Result<RenderOptions> {
+    Ok(RenderOptions { width: p.size.width, height: p.size.height, view: p.view, up: up_axis(up), ..RenderOptions::default() })
 }
 
 /// The `--up` axis's index (default y).
-pub fn up_axis(up: Option<&str>) -> usize {
-    match up {
-        Some("x") => 0,
-        Some("z") => 2,
-        _ => 1,
+pub fn up_axis(up: Option<Up>) -> usize {
+    match up.unwrap_or_default() {
+        Up::X => 0,
+        Up::Y => 1,
+        Up::Z => 2,
     }
 }
 
@@ -125,15 +96,15 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         || g.frames.is_some()
         || g.repeat != 1
         || g.stats_json.is_some()
-        || g.culling != "occlusion"
-        || g.prepass != "off"
-        || g.gamma != "on"
-        || g.light_grid != "off"
+        || g.culling != topovox::render::Culling::Occlusion
+        || g.prepass.on()
+        || !g.gamma.on()
+        || g.light_grid.on()
     {
         bail!("--camera, --frames, --repeat, --culling, --prepass, --gamma, --light-grid and --stats-json belong to the GPU renderer; add --gpu");
     }
     let t0 = Instant::now();
-    let o = options(&a.picture, a.up.as_deref())?;
+    let o = options(&a.picture, a.up)?;
     check_png_path(&a.output)?;
     let pool = crate::thread_pool(a.threads)?;
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.input))?;
@@ -142,7 +113,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             bail!("--outline draws the source mesh's silhouette; it needs a mesh input (or voxelize --preview)");
         }
         // .vox and .schem are rotated back so the --up axis is up again.
-        let up = a.up.as_deref().and_then(topovox_io::orient::Up::from_name).unwrap_or_default();
+        let up = a.up.unwrap_or_default();
         use topovox_io::VoxelFormat as F;
         match topovox_io::read_voxels_opts(&a.input, up, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths }) {
             Ok(loaded) => (Box::new(loaded.bits), "voxel file", loaded.attributes, None),
@@ -162,7 +133,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             Err(e) => return Err(e.into()),
         }
     } else {
-        let (mode, _) = topovox_job::resolve_method(a.mode.into(), topovox_job::Method::Fast)
+        let (mode, _) = topovox_job::resolve_method(a.mode, topovox_job::Method::Fast)
             .context("render voxelizes meshes with a surface or line mode; voxelize solids to a file first")?;
         let loaded = topovox_io::read_mesh_with(&a.input, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
         topovox_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
@@ -173,7 +144,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         }
         let (b, _) = pool.install(|| voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &Options::default()));
         let colours = loaded.appearance.has_colour().then(|| {
-            let opts = CarryOptions { rule: crate::commands::export::colour_rule(a.colour_rule), normals: false };
+            let opts = CarryOptions { rule: a.colour_rule, normals: false };
             pool.install(|| carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &b, &opts))
         });
         let outline = a.picture.outline.then(|| outline_triangles(loaded.mesh.as_ref(), &grid));

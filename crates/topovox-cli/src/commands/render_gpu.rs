@@ -7,18 +7,19 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde_json::json;
 use topovox::glam::Vec3;
-use topovox_view::{Camera, Culling, FrameOptions, FrameStats, Renderer, Scene};
+use topovox_view::{Camera, FrameOptions, FrameStats, Renderer, Scene};
 
 use crate::args::RenderArgs;
 use crate::commands::render::{check_png_path, options};
+use crate::values::CameraSpec;
 
 /// Voxel quads' material: light grey, rough.
 const VOXEL_COLOUR: [f32; 3] = [0.72, 0.72, 0.70];
 
 /// Adds a voxel file's greedy quads, placed where the file says (else
 /// voxel `(i, j, k)` at `(i, j, k)`), moved by `offset`.
-pub(crate) fn add_voxel_file(scene: &mut Scene, path: &Path, up: Option<&str>, offset: Vec3) -> Result<()> {
-    let upname = up.and_then(topovox_io::orient::Up::from_name).unwrap_or_default();
+pub(crate) fn add_voxel_file(scene: &mut Scene, path: &Path, up: Option<topovox_io::orient::Up>, offset: Vec3) -> Result<()> {
+    let upname = up.unwrap_or_default();
     let loaded = topovox_io::read_voxels_with(path, upname)?;
     let (origin, size) = loaded.placement.map(|(o, s)| (o.as_vec3(), s as f32)).unwrap_or((Vec3::ZERO, 1.0));
     add_voxels(scene, &loaded.bits, origin + offset, size);
@@ -35,7 +36,12 @@ pub(crate) fn add_voxels(scene: &mut Scene, bits: &topovox::grid::dense::DenseBi
 /// Loads a mesh with its materials, or a voxel file's greedy quads, as a
 /// scene; the kind loaded ("mesh" or "voxel file"). None of `outputs` may
 /// be a file the mesh reads.
-pub(crate) fn load_scene(input: &Path, up: Option<&str>, allow_external_paths: bool, outputs: &[PathBuf]) -> Result<(Scene, &'static str)> {
+pub(crate) fn load_scene(
+    input: &Path,
+    up: Option<topovox_io::orient::Up>,
+    allow_external_paths: bool,
+    outputs: &[PathBuf],
+) -> Result<(Scene, &'static str)> {
     let mut scene = Scene::default();
     if topovox_io::is_voxel_file(input) {
         add_voxel_file(&mut scene, input, up, Vec3::ZERO)?;
@@ -61,20 +67,9 @@ pub(crate) fn read_points(path: &Path) -> Result<Vec<topovox_view::spray::SprayP
 }
 
 /// Parses `EX,EY,EZ,TX,TY,TZ[,FOV]`.
-pub(crate) fn parse_camera(s: &str, up: Vec3) -> Result<Camera> {
-    let v: Option<Vec<f32>> = s.split(',').map(|x| x.trim().parse::<f32>().ok().filter(|v| v.is_finite())).collect();
-    let Some(v) = v.filter(|v| v.len() == 6 || v.len() == 7) else {
-        bail!("--camera takes EX,EY,EZ,TX,TY,TZ[,FOV]: an eye, a target and a vertical field of view in degrees, not {s:?}")
-    };
-    let (eye, target) = (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]));
-    let fov_deg = v.get(6).copied().unwrap_or(45.0);
-    if !(fov_deg > 0.5 && fov_deg < 179.0) {
-        bail!("--camera: the field of view must be between 0.5 and 179 degrees, not {fov_deg}");
-    }
-    if (eye - target).length() <= f32::EPSILON * eye.abs().max(target.abs()).max_element().max(1.0) {
-        bail!("--camera: the eye and the target must differ");
-    }
-    Ok(Camera { eye, target, up, fov_deg })
+/// The renderer's camera of `--camera`, with the `--up` direction.
+pub(crate) fn camera(c: CameraSpec, up: Vec3) -> Camera {
+    Camera { eye: c.eye, target: c.target, up, fov_deg: c.fov_deg }
 }
 
 pub fn run(a: &RenderArgs) -> Result<()> {
@@ -82,10 +77,10 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     if a.picture.outline {
         bail!("--outline belongs to the CPU ray caster; leave out --gpu");
     }
-    if a.picture.view != "iso" {
+    if a.picture.view != topovox::render::raycast::View::Iso {
         bail!("--gpu places its camera with --camera EX,EY,EZ,TX,TY,TZ[,FOV], not --view");
     }
-    let o = options(&a.picture, a.up.as_deref())?;
+    let o = options(&a.picture, a.up)?;
     if g.repeat == 0 || g.repeat > 1000 {
         bail!("--repeat must be 1..=1000, not {}", g.repeat);
     }
@@ -105,7 +100,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     up[o.up] = 1.0;
 
     let t0 = std::time::Instant::now();
-    let (scene, kind) = load_scene(&a.input, a.up.as_deref(), a.allow_external_paths, &outputs)?;
+    let (scene, kind) = load_scene(&a.input, a.up, a.allow_external_paths, &outputs)?;
     let load_s = t0.elapsed().as_secs_f64();
     let bounds = scene.bounds().with_context(|| format!("{}: nothing to draw (no triangle with area)", a.input.display()))?;
     let points = match &g.points {
@@ -113,7 +108,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         None => Vec::new(),
     };
     let cameras: Vec<Camera> = match (&g.camera, &g.frames) {
-        (Some(s), _) => vec![parse_camera(s, up)?],
+        (Some(c), _) => vec![camera(*c, up)],
         (None, Some(path)) => read_camera_path(path, up)?,
         (None, None) => vec![Camera::framing(bounds.0, bounds.1, o.up)],
     };
@@ -127,7 +122,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let mut uploaded = renderer.upload(&scene)?;
     renderer.add_points(&mut uploaded, &points)?;
     let upload_s = t1.elapsed().as_secs_f64();
-    let culling = Culling::from_name(&g.culling).expect("clap checked the name");
+    let culling = g.culling;
     let mut frames = Vec::with_capacity(cameras.len());
     for (camera, out) in cameras.iter().zip(&outputs_png) {
         let opts = FrameOptions {
@@ -135,12 +130,12 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             height: o.height,
             camera: *camera,
             culling,
-            prepass: g.prepass == "on",
-            gamma: g.gamma == "on",
-            light_grid_view: g.light_grid == "on",
+            prepass: g.prepass.on(),
+            gamma: g.gamma.on(),
+            light_grid_view: g.light_grid.on(),
             read_hiz: false,
-            mesh: g.mesh == "on",
-            boxes: g.boxes == "on",
+            mesh: g.mesh.on(),
+            boxes: g.boxes.on(),
         };
         // Every run's statistics, the last run's picture.
         let mut frame = renderer.render(&uploaded, &opts)?;
@@ -183,9 +178,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         "width": o.width,
         "height": o.height,
         "camera": first["camera"],
-        "culling": g.culling,
-        "prepass": g.prepass == "on",
-        "gamma": g.gamma == "on",
+        "culling": g.culling.to_string(),
+        "prepass": g.prepass.on(),
+        "gamma": g.gamma.on(),
         "clusters": uploaded.clusters.len(),
         "clusters_after_frustum": first["clusters_after_frustum"],
         "clusters_after_occlusion": first["clusters_after_occlusion"],
@@ -248,7 +243,8 @@ fn read_camera_path(path: &Path, up: Vec3) -> Result<Vec<Camera>> {
         if line.is_empty() {
             continue;
         }
-        cams.push(parse_camera(line, up).with_context(|| format!("{} line {}", path.display(), n + 1))?);
+        let spec = crate::values::camera(line).map_err(|e| anyhow::anyhow!("{} line {}: {e}", path.display(), n + 1))?;
+        cams.push(camera(spec, up));
         if cams.len() > 10_000 {
             bail!("{}: more than 10000 cameras", path.display());
         }

@@ -2,14 +2,13 @@
 
 use anyhow::{bail, Result};
 
-use crate::args::SceneArgs;
+use crate::args::{SceneArgs, SceneName};
 
 pub fn run(a: &SceneArgs) -> Result<()> {
-    let (mesh, app) = match a.name.as_str() {
-        "cornell" => topovox_view::scenes::cornell(),
-        "city" => topovox_view::scenes::city(),
-        "cut-outs" => topovox_view::scenes::cut_outs(),
-        other => bail!("unknown scene {other:?} (known: cornell, city, cut-outs)"),
+    let (mesh, app) = match a.name {
+        SceneName::Cornell => topovox_view::scenes::cornell(),
+        SceneName::City => topovox_view::scenes::city(),
+        SceneName::CutOuts => topovox_view::scenes::cut_outs(),
     };
     if a.output.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("obj")) != Some(true) {
         bail!("{}: scenes are written as OBJ; give a .obj file name", a.output.display());

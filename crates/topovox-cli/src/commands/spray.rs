@@ -13,8 +13,8 @@ use topovox_view::spray::{write_ply, SprayOptions, Tracer};
 use topovox_view::Camera;
 
 use crate::args::SprayArgs;
-use crate::commands::render::{parse_size, up_axis};
-use crate::commands::render_gpu::{load_scene, parse_camera};
+use crate::commands::render::up_axis;
+use crate::commands::render_gpu::{camera, load_scene};
 
 /// The most rays one run casts: every hit is a 64-byte point held until
 /// the PLY is written, so 2^26 rays need at most 4 GiB.
@@ -39,22 +39,22 @@ pub fn run(a: &SprayArgs) -> Result<()> {
     if a.light_samples > MAX_SAMPLES {
         bail!("--light-samples must be 0..={MAX_SAMPLES}, not {}", a.light_samples);
     }
-    let (width, height) = parse_size(&a.size)?;
+    let (width, height) = (a.size.width, a.size.height);
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.input))?;
     let pool = crate::thread_pool(a.threads)?;
-    let upi = up_axis(a.up.as_deref());
+    let upi = up_axis(a.up);
     let mut up = Vec3::ZERO;
     up[upi] = 1.0;
 
     let t0 = Instant::now();
-    let (scene, kind) = load_scene(&a.input, a.up.as_deref(), a.allow_external_paths, std::slice::from_ref(&a.output))?;
+    let (scene, kind) = load_scene(&a.input, a.up, a.allow_external_paths, std::slice::from_ref(&a.output))?;
     let (lo, hi) = scene.bounds().with_context(|| format!("{}: nothing to spray at (no triangle with area)", a.input.display()))?;
     let camera = match &a.camera {
-        Some(s) => parse_camera(s, up)?,
+        Some(c) => camera(*c, up),
         None => Camera::framing(lo, hi, upi),
     };
     let load_s = t0.elapsed().as_secs_f64();
-    let opts = SprayOptions { rays: a.rays, light_samples: a.light_samples, seed: a.seed, shadows: a.shadows == "on" };
+    let opts = SprayOptions { rays: a.rays, light_samples: a.light_samples, seed: a.seed, shadows: a.shadows.on() };
     let t1 = Instant::now();
     let tracer = pool.install(|| Tracer::new(&scene))?;
     let bvh_s = t1.elapsed().as_secs_f64();

@@ -6,15 +6,15 @@ use serde_json::json;
 use topovox::glam::Vec3;
 use topovox::voxelize::{self, Options};
 use topovox_view::window::{run as run_window, ViewOptions};
-use topovox_view::{Culling, Scene};
+use topovox_view::Scene;
 
 use crate::args::ViewArgs;
-use crate::commands::render::{check_png_path, parse_size, up_axis};
-use crate::commands::render_gpu::{add_voxel_file, add_voxels, parse_camera, read_points};
+use crate::commands::render::{check_png_path, up_axis};
+use crate::commands::render_gpu::{add_voxel_file, add_voxels, camera, read_points};
 use crate::plan;
 
 pub fn run(a: &ViewArgs) -> Result<()> {
-    let (width, height) = parse_size(&a.size)?;
+    let (width, height) = (a.size.width, a.size.height);
     if let Some(p) = &a.screenshot {
         check_png_path(p)?;
         topovox_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.input))?;
@@ -26,7 +26,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     if a.frames == Some(0) {
         bail!("--frames must be at least 1");
     }
-    let up_axis = up_axis(a.up.as_deref());
+    let up_axis = up_axis(a.up);
     let mut up = Vec3::ZERO;
     up[up_axis] = 1.0;
     let mut scene = Scene::default();
@@ -34,7 +34,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         if a.mode.is_some() || a.voxels.is_some() {
             bail!("--mode and --voxels draw voxels beside a mesh; {} is already a voxel file", a.input.display());
         }
-        add_voxel_file(&mut scene, &a.input, a.up.as_deref(), Vec3::ZERO)?;
+        add_voxel_file(&mut scene, &a.input, a.up, Vec3::ZERO)?;
     } else {
         let loaded = topovox_io::read_mesh_with(&a.input, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
         if let Some(p) = &a.screenshot {
@@ -47,14 +47,14 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         let (lo, hi) = scene.bounds().with_context(|| format!("{}: nothing to draw (no triangle with area)", a.input.display()))?;
         // Beside: shifted along the first horizontal axis by the mesh's extent and a gap.
         let mut offset = Vec3::ZERO;
-        if a.layout == "side" {
+        if a.layout == crate::args::Layout::Side {
             let h = (up_axis + 1) % 3;
             offset[h] = (hi[h] - lo[h]) * 1.15;
         }
         if let Some(v) = &a.voxels {
-            add_voxel_file(&mut scene, v, a.up.as_deref(), offset)?;
+            add_voxel_file(&mut scene, v, a.up, offset)?;
         } else if let Some(mode) = a.mode {
-            let (mode, _) = topovox_job::resolve_method(mode.into(), topovox_job::Method::Fast)
+            let (mode, _) = topovox_job::resolve_method(mode, topovox_job::Method::Fast)
                 .context("view voxelizes with a surface or line mode; voxelize solids to a file and pass --voxels")?;
             let grid = plan::grid_request(&a.grid)?.fit(&loaded.report.bounds)?;
             plan::check_memory(&grid)?;
@@ -62,8 +62,8 @@ pub fn run(a: &ViewArgs) -> Result<()> {
             add_voxels(&mut scene, &bits.to_dense(), grid.origin().as_vec3() + offset, grid.voxel_size() as f32);
         }
     }
-    let culling = Culling::from_name(&a.culling).expect("clap checked the name");
-    let camera = a.camera.as_deref().map(|s| parse_camera(s, up)).transpose()?;
+    let culling = a.culling;
+    let camera = a.camera.map(|c| camera(c, up));
     if a.spray_rays == 0 || a.spray_rays > 1 << 24 {
         bail!("--spray-rays must be 1..={}, not {}", 1 << 24, a.spray_rays);
     }
@@ -80,8 +80,8 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         camera,
         up: up_axis,
         culling,
-        prepass: a.prepass == "on",
-        gamma: a.gamma == "on",
+        prepass: a.prepass.on(),
+        gamma: a.gamma.on(),
         frames: a.frames,
         spray_rays: a.spray_rays,
         spray_degrees: a.spray_degrees,

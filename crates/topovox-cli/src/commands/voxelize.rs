@@ -4,8 +4,8 @@ use std::time::Instant;
 
 use anyhow::Result;
 use serde_json::json;
-use topovox::attributes::carry::CarryOptions;
 use topovox_job::output::{check_output_path, output_format};
+use topovox_job::Choice;
 
 use crate::args::VoxelizeArgs;
 use crate::plan;
@@ -14,7 +14,8 @@ use crate::progress::Bar;
 pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let t_total = Instant::now();
     // Validate everything that does not need the mesh first.
-    let mut plan = plan::voxelize_plan(a)?;
+    let opts = plan::job_options(&a.job, a.threads)?;
+    let mut plan = opts.plan()?;
     let format = output_format(a.format.as_deref(), &a.output)?;
     plan.request.writer_bytes_per_brick = topovox_job::output::writer_bytes_per_brick(format);
     check_output_path(&a.output)?;
@@ -23,14 +24,14 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     if let Some(p) = &a.preview {
         topovox_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.mesh))?;
     }
-    let write_opts = crate::commands::export::writer_options(&a.export)?;
+    let write_opts = opts.write_options()?;
     if !a.quiet && !a.json {
-        crate::commands::export::warn_unused(&a.export, format, &a.output, true, a.preview.is_some());
+        crate::commands::export::warn_unused(&a.job.export, format, &a.output, true, a.preview.is_some());
     }
     let preview = match &a.preview {
         Some(p) => {
             crate::commands::render::check_png_path(p)?;
-            Some((p, crate::commands::render::options(&a.picture, a.export.up.as_deref())?))
+            Some((p, crate::commands::render::options(&a.picture, a.job.export.up)?))
         }
         None => None,
     };
@@ -40,7 +41,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let bar = Bar::new(a.quiet || a.json);
     bar.phase("loading mesh");
     let t_load = Instant::now();
-    let loaded = topovox_io::read_mesh_with(&a.mesh, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
+    let loaded = topovox_io::read_mesh_with(&a.mesh, &opts.read_options())?;
     let load_s = t_load.elapsed().as_secs_f64();
     // Nor any file the mesh led to (its .mtl, textures, buffers).
     topovox_job::output::refuse_overwriting(&a.output, format, &loaded.sources)?;
@@ -64,7 +65,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     // Attributes: colours for the formats that store them (and the preview),
     // every array (coverage, material, normal) for .vti, and for .vdb and
     // .zarr with --attributes; tiled grids too, while they fit in memory.
-    let every = topovox_job::every_attribute(format, a.export.attributes);
+    let every = topovox_job::every_attribute(format, opts.attributes);
     let app = &loaded.appearance;
     let want_colour = app.has_colour() && (format.has_colour() || preview.is_some());
     let t_attr = Instant::now();
@@ -73,11 +74,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     }
     let attrs = (want_colour || every).then(|| {
         bar.phase("carrying colours into voxels");
-        let opts = CarryOptions {
-            rule: crate::commands::export::colour_rule(a.export.colour_rule),
-            normals: a.export.normals || a.export.attributes,
-        };
-        pool.install(|| topovox_job::attributes(&plan, loaded.mesh.as_ref(), app, &v, &opts))
+        pool.install(|| topovox_job::attributes(&plan, loaded.mesh.as_ref(), app, &v, &opts.carry()))
     });
     let attrs = attrs.flatten();
     let attributes_s = t_attr.elapsed().as_secs_f64();
@@ -114,7 +111,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
             "attributes_s": attributes_s,
             "attributes": attrs.as_ref().map(|t| json!({
                 "colour": t.colour.is_some(),
-                "colour_rule": format!("{:?}", a.export.colour_rule).to_lowercase(),
+                "colour_rule": opts.colour_rule.name(),
                 "material": t.material.is_some(),
                 "normal": t.normal.is_some(),
                 "coverage": t.coverage.is_some(),
@@ -148,7 +145,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
             to_stdout,
             &format!(
                 "{}: {} voxels set on grid {}x{}x{} (origin {}, {}, {}; voxel size {}) by {} in {:.1} ms; total {:.2} s -> {}",
-                plan::mode_name(a.mode),
+                a.job.mode.name(),
                 v.report.voxels,
                 dims[0],
                 dims[1],

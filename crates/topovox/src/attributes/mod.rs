@@ -143,15 +143,15 @@ impl Appearance {
     }
 }
 
-/// How a voxel's colour is made from the colours of the surface inside it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum ColourRule {
-    /// The colour covering the most area inside the voxel: always a colour
-    /// of the texture (or material, or vertex), never a new one.
-    #[default]
-    Dominant,
-    /// The area-weighted mean in linear light.
-    Blend,
+crate::choice! {
+    /// How a voxel's colour is made from the colours of the surface inside it.
+    pub enum ColourRule: "colour rule" default Dominant {
+        /// The colour covering the most area inside the voxel: always a
+        /// colour of the texture (or material, or vertex), never a new one.
+        Dominant = "dominant",
+        /// The area-weighted mean in linear light.
+        Blend = "blend",
+    }
 }
 
 /// Per-voxel attributes of a voxel set, aligned with its set voxels in

@@ -134,13 +134,14 @@ impl Grid2 {
     }
 }
 
-/// SVG's fill rules: which winding numbers are inside.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum FillRule {
-    /// Inside where the winding number is not zero (SVG's default).
-    NonZero,
-    /// Inside where the winding number is odd.
-    EvenOdd,
+crate::choice! {
+    /// SVG's fill rules (`fill-rule`): which winding numbers are inside.
+    pub enum FillRule: "fill rule" default NonZero {
+        /// Inside where the winding number is not zero (SVG's default).
+        NonZero = "nonzero",
+        /// Inside where the winding number is odd.
+        EvenOdd = "evenodd",
+    }
 }
 
 impl FillRule {
@@ -305,31 +306,35 @@ impl Pixels {
     }
 }
 
-/// A 2D rasterization mode.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum RasterMode {
-    /// 4-connected, 8-separating curves: the two pixel diagonals (Fig. 5c).
-    Curve4,
-    /// 8-connected, 4-separating curves: the crosshair (Fig. 7c).
-    Curve8,
-    /// The diamond (Fig. 7d): the rule graphics APIs use for lines.
-    Diamond,
-    /// Filled shapes, each by its fill rule at the displaced pixel centre.
-    Fill,
+crate::choice! {
+    /// A 2D rasterization mode.
+    pub enum RasterMode: "raster mode" default Curve8 {
+        /// 4-connected, 8-separating curves: the two pixel diagonals (Fig. 5c).
+        Curve4 = "curve4",
+        /// 8-connected, 4-separating curves: the crosshair (Fig. 7c).
+        Curve8 = "curve8",
+        /// The diamond (Fig. 7d): the rule graphics APIs use for lines.
+        Diamond = "diamond",
+        /// Filled shapes, each by its fill rule at the displaced pixel centre.
+        Fill = "fill",
+    }
 }
 
-impl RasterMode {
-    /// Every mode.
-    pub const ALL: [RasterMode; 4] = [RasterMode::Curve4, RasterMode::Curve8, RasterMode::Diamond, RasterMode::Fill];
+crate::choice! {
+    /// Which path rasterizes: the same pixels either way.
+    pub enum RasterMethod: "raster method" default Fast {
+        /// The fast path.
+        Fast = "fast",
+        /// Brute force from the definition.
+        Reference = "reference",
+    }
+}
 
-    /// The CLI name.
-    pub fn name(self) -> &'static str {
-        match self {
-            RasterMode::Curve4 => "curve4",
-            RasterMode::Curve8 => "curve8",
-            RasterMode::Diamond => "diamond",
-            RasterMode::Fill => "fill",
-        }
+/// Rasterizes with the chosen method.
+pub fn run(method: RasterMethod, mode: RasterMode, outlines: &[Outline], grid: &Grid2) -> (Pixels, RasterReport) {
+    match method {
+        RasterMethod::Fast => fast(mode, outlines, grid),
+        RasterMethod::Reference => reference(mode, outlines, grid),
     }
 }
 

@@ -72,6 +72,21 @@ pub(crate) fn brute_force_triangles(
     (bits, Report { prepare: prepare_stats, voxels })
 }
 
+crate::choice! {
+    /// The paths of `method gpu`. They run in the `topovox-gpu` crate; they
+    /// are named here so that every crate above the core shares one list.
+    pub enum GpuPath: "GPU path" default Compute {
+        /// Compute shaders, one workgroup per triangle.
+        Compute = "compute",
+        /// The rasterizer: dominant-axis projection, conservative coverage,
+        /// exact tests per fragment (the same voxels as compute).
+        Raster = "raster",
+        /// The rasterizer with 4x MSAA instead of conservative coverage:
+        /// approximate, misses voxels (never sets a wrong one).
+        MsaaApprox = "msaa-approx",
+    }
+}
+
 /// A surface or 1D voxelization mode (the solid modes live elsewhere).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Mode {

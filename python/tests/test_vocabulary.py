@@ -1,0 +1,50 @@
+"""One vocabulary: every option `voxelize` takes is generated from the job
+crate's one list, and every front end (voxelize, batch, Dask, Ray through
+the same native calls) takes each of them."""
+
+import inspect
+import json
+
+import pytest
+
+import topovox
+from topovox import _topovox
+
+OPTIONS = _topovox.options()
+# Options that only mean something beside others.
+COMPANIONS = {
+    "surface": {"mode": "solid+surface"},
+    "fill": {"mode": "solid"},
+    "hollow": {"mode": "solid"},
+    "origin": {"voxel_size": 0.25, "dims": [8, 8, 8]},
+    "dims": {"voxel_size": 0.25, "origin": [-1.0, -1.0, -1.0]},
+    "voxel_size": {},
+}
+
+
+def test_the_python_signature_is_the_list():
+    params = set(inspect.signature(topovox.voxelize).parameters) - {"mesh_or_vertices", "faces", "color_rule"}
+    assert params == {name for name, _, _ in OPTIONS}
+    assert set(topovox.OPTIONS) == params
+    assert topovox.MODES[0] == "cover" and "solid+surface" in topovox.MODES
+
+
+@pytest.mark.parametrize("name,example", [(n, e) for n, _, e in OPTIONS])
+def test_every_option_is_taken_by_voxelize_and_by_batch(name, example, meshes, tmp_path):
+    kw = dict(COMPANIONS.get(name, {}), **{name: example})
+    if "voxel_size" not in kw and "resolution" not in kw:
+        kw["resolution"] = 12
+    mesh = topovox.load_mesh(meshes / "cow.obj")
+    grid = topovox.voxelize(mesh, **kw)
+    assert grid.count > 0
+    summary = topovox.batch(meshes / "cow.obj", tmp_path / "out", **kw)
+    assert (summary["done"], summary["failed"]) == (1, 0), summary
+    line = json.loads((tmp_path / "out" / "manifest.jsonl").read_text().splitlines()[-1])
+    assert line["status"] == "done"
+
+
+def test_american_spelling_and_any_case():
+    v, f = [[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]
+    a = topovox.voxelize(v, f, resolution=8, mode="SEP6", color_rule="blend")
+    b = topovox.voxelize(v, f, resolution=8, mode="sep6", colour_rule="blend")
+    assert (a.occupancy == b.occupancy).all()
