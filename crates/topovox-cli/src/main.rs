@@ -3,14 +3,18 @@
 mod args;
 mod choice;
 mod commands;
+mod console;
+mod export;
+mod pictures;
 mod plan;
+mod pool;
 mod progress;
+#[cfg(feature = "gpu")]
+mod scene_input;
 mod values;
 
-use std::io::Write;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
 use clap::error::{ContextKind, ContextValue, ErrorKind};
 use clap::Parser;
 
@@ -111,25 +115,4 @@ fn remove_temporaries_on_interrupt() {
 
 fn is_broken_pipe(e: &anyhow::Error) -> bool {
     e.chain().any(|c| c.downcast_ref::<std::io::Error>().is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe))
-}
-
-/// Prints a line on stdout; a closed pipe surfaces as an error that `main` ignores.
-pub(crate) fn print_stdout(s: &str) -> Result<()> {
-    let mut out = std::io::stdout().lock();
-    writeln!(out, "{s}")?;
-    out.flush()?;
-    Ok(())
-}
-
-/// A rayon pool with `threads` workers (default: all cores).
-pub(crate) fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
-    thread_pool_for(threads, "--threads")
-}
-
-/// [`thread_pool`], the count named `what` (`--jobs`) in errors.
-pub(crate) fn thread_pool_for(threads: Option<usize>, what: &str) -> Result<rayon::ThreadPool> {
-    if let Some(n) = threads {
-        topovox_job::check_threads(n, what)?;
-    }
-    rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start worker threads")
 }

@@ -250,6 +250,16 @@ pub struct SolidPlan {
     pub hollow: Option<Connectivity>,
 }
 
+impl SolidPlan {
+    /// Whether it has a sparse path (for grids past memory): parity, the
+    /// winding numbers (closed and generalized) and flood fills, alone or
+    /// with a surface, hollowed or not; not the brute-force reference or
+    /// the GPU.
+    pub fn has_sparse_path(&self) -> bool {
+        matches!(self.method, SolidMethod::Auto | SolidMethod::Parity | SolidMethod::Winding | SolidMethod::Flood)
+    }
+}
+
 topovox::choice! {
     /// Solid filling strategies other than the inside test.
     pub enum Fill: "fill" {
@@ -341,7 +351,7 @@ impl Plan {
                 return Err(JobError::invalid(format!("--tile {t}: must be a multiple of 8 from 8 to 1048576")));
             }
             if let Some(sp) = &solid {
-                if !crate::solid::has_sparse_path(sp) {
+                if !sp.has_sparse_path() {
                     return Err(JobError::invalid(
                         "--tile: the reference and gpu solids do not run tiled yet (parity, winding and flood fills do, hollowed or not)",
                     ));

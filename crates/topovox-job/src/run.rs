@@ -12,7 +12,7 @@ use topovox::voxelize::{self, Options, Progress, Report, Stop};
 use topovox::{DenseBits, GridSpec, MeshRef, VoxelSource};
 
 use crate::error::{JobError, Result};
-use crate::plan::{GpuPath, Plan, SurfaceMethod};
+use crate::plan::{GpuPath, Plan, SolidPlan, SurfaceMethod};
 
 /// A voxel set in whichever storage the path produced.
 #[derive(Clone, Debug)]
@@ -234,7 +234,7 @@ fn tile_for(plan: &Plan, grid: &GridSpec, budget: u64) -> Option<u32> {
         plan.request.method,
         crate::plan::Method::Auto | crate::plan::Method::Fast | crate::plan::Method::Scanline | crate::plan::Method::Gpu
     );
-    let sparse_solid = plan.solid.as_ref().is_some_and(crate::solid::has_sparse_path);
+    let sparse_solid = plan.solid.as_ref().is_some_and(SolidPlan::has_sparse_path);
     let tileable = if plan.solid.is_some() { sparse_solid } else { fast };
     if !tileable {
         return None;

@@ -118,13 +118,6 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
     Ok(Outcome { bits, method, facts, warnings })
 }
 
-/// Whether `plan` has a sparse path (for grids past memory): parity, the
-/// winding numbers (closed and generalized) and flood fills, alone or with
-/// a surface, hollowed or not; not the brute-force reference or the GPU.
-pub fn has_sparse_path(plan: &SolidPlan) -> bool {
-    matches!(plan.method, SolidMethod::Auto | SolidMethod::Parity | SolidMethod::Winding | SolidMethod::Flood)
-}
-
 /// A sparse solid and what was done to get it (see [`run_sparse`]).
 pub struct SparseOutcome {
     /// The voxels: sparse bricks, the interior as runs of full bricks.
@@ -150,7 +143,7 @@ pub fn run_sparse(
     tile: u32,
     opts: &Options<'_>,
 ) -> Result<SparseOutcome> {
-    if !has_sparse_path(plan) {
+    if !plan.has_sparse_path() {
         return Err(JobError::invalid(format!(
             "{name}: this solid (reference or gpu) has no sparse path yet; parity, the winding numbers and flood fills do"
         )));

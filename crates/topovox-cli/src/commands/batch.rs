@@ -30,7 +30,7 @@ pub fn run(a: &BatchArgs) -> Result<()> {
         bail!("unknown --format {:?} (expected one of: {})", a.format, topovox_job::output::Output::names());
     };
     let opts = crate::plan::job_options(&a.job, None)?.batch(format)?;
-    let pool = crate::thread_pool_for(a.jobs, "--jobs")?;
+    let pool = crate::pool::thread_pool_for(a.jobs, "--jobs")?;
     let (files, warnings) = batch::collect_inputs(&a.inputs, a.glob.as_deref(), &a.output)?;
     for w in &warnings {
         eprintln!("topovox: warning: {w}");
@@ -55,9 +55,9 @@ pub fn run(a: &BatchArgs) -> Result<()> {
         v["total"] = total.into();
         v["jobs"] = pool.current_num_threads().into();
         v["meshes_per_s"] = (summary.done as f64 / summary.total_s.max(1e-9)).into();
-        crate::print_stdout(&v.to_string())?;
+        crate::console::print_stdout(&v.to_string())?;
     } else if !a.quiet {
-        crate::print_stdout(&format!(
+        crate::console::print_stdout(&format!(
             "batch: {} done, {} skipped (already done), {} failed, of {total} meshes in {:.2} s{} -> {} (manifest {})",
             summary.done,
             summary.skipped,

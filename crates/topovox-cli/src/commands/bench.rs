@@ -169,7 +169,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         });
 
         for (n_threads, &threads) in a.threads.iter().enumerate() {
-            let pool = crate::thread_pool(Some(threads))?;
+            let pool = crate::pool::thread_pool(Some(threads))?;
             for &res in &a.resolutions {
                 let grid = GridSpec::from_resolution(&bounds, res).context("invalid grid")?;
                 crate::plan::check_memory(&grid)?;
@@ -245,7 +245,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             let v = json!({"mode": r.mode, "method": r.method, "threads": r.threads, "resolution": r.resolution, "dims": r.dims, "voxels": r.voxels,
                 "voxelize_median_s": r.voxelize_s, "with_loading_median_s": r.with_loading_s, "repeats": a.repeats,
                 "brute_median_s": brute_s.get(&r.resolution)});
-            crate::print_stdout(&v.to_string())?;
+            crate::console::print_stdout(&v.to_string())?;
         }
         return Ok(());
     }
@@ -299,7 +299,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
             vs_brute
         );
     }
-    crate::print_stdout(out.trim_end())
+    crate::console::print_stdout(out.trim_end())
 }
 
 /// `--attributes`: per thread count and resolution, the medians of
@@ -325,7 +325,7 @@ fn attributes(a: &BenchArgs, loaded: &topovox_io::LoadedMesh) -> Result<()> {
     );
     let mut json_rows = Vec::new();
     for &threads in &a.threads {
-        let pool = crate::thread_pool(Some(threads))?;
+        let pool = crate::pool::thread_pool(Some(threads))?;
         for &res in &a.resolutions {
             let grid = GridSpec::from_resolution(&loaded.report.bounds, res).context("invalid grid")?;
             crate::plan::check_memory(&grid)?;
@@ -375,11 +375,11 @@ fn attributes(a: &BenchArgs, loaded: &topovox_io::LoadedMesh) -> Result<()> {
     let _ = std::fs::remove_dir_all(&dir);
     if a.json {
         for r in json_rows {
-            crate::print_stdout(&r.to_string())?;
+            crate::console::print_stdout(&r.to_string())?;
         }
         return Ok(());
     }
-    crate::print_stdout(out.trim_end())
+    crate::console::print_stdout(out.trim_end())
 }
 
 /// `--gpu`: `cover` by the GPU compute path against the CPU fast path
@@ -434,11 +434,11 @@ fn gpu(a: &BenchArgs, loaded: &topovox_io::LoadedMesh) -> Result<()> {
     }
     if a.json {
         for r in json_rows {
-            crate::print_stdout(&r.to_string())?;
+            crate::console::print_stdout(&r.to_string())?;
         }
         return Ok(());
     }
-    crate::print_stdout(out.trim_end())
+    crate::console::print_stdout(out.trim_end())
 }
 
 #[cfg(not(feature = "gpu"))]

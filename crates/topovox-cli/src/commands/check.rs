@@ -9,7 +9,7 @@ use crate::args::CheckArgs;
 
 pub fn run(a: &CheckArgs) -> Result<()> {
     let t0 = Instant::now();
-    let pool = crate::thread_pool(a.threads)?;
+    let pool = crate::pool::thread_pool(a.threads)?;
     let up = a.up.unwrap_or_default();
     let sparse_format = topovox_io::VoxelFormat::from_path(&a.voxels).is_some_and(topovox_io::VoxelFormat::reads_sparsely);
     if a.sparse && !sparse_format {
@@ -70,9 +70,9 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     })?;
     v["check_s"] = json!(t0.elapsed().as_secs_f64());
     if a.json {
-        return crate::print_stdout(&v.to_string());
+        return crate::console::print_stdout(&v.to_string());
     }
-    crate::print_stdout(&text(&v, a))
+    crate::console::print_stdout(&text(&v, a))
 }
 
 /// The voxels, read densely or (past memory, or with `--sparse`) as bricks.

@@ -17,7 +17,7 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
     use topovox_io::VoxelFormat as F;
     let input_format = F::from_path(&a.input);
     let input_has_up = matches!(input_format, Some(F::Vox | F::Schem));
-    crate::commands::export::warn_unused(&a.export, format, &a.output, false, input_has_up);
+    crate::export::warn_unused(&a.export, format, &a.output, false, input_has_up);
     // The up axis is the data's: .vox and .schem files are read back with it too.
     let loaded =
         match topovox_io::read_voxels_opts(&a.input, job.up, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths }) {
@@ -88,7 +88,7 @@ fn finish(
         let o = grid.origin();
         let v = json!({"input": a.input, "output": a.output, "format": format.name(), "dims": dims, "voxels": voxels,
             "origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size(), "grid_from": source, "export": facts, "sparse": sparse});
-        return crate::print_stdout(&v.to_string());
+        return crate::console::print_stdout(&v.to_string());
     }
     if a.quiet {
         return Ok(());
@@ -97,7 +97,7 @@ fn finish(
         (Some(q), Some(v)) => format!(" as {q} greedy quads, {v} vertices"),
         _ => String::new(),
     };
-    crate::print_stdout(&format!(
+    crate::console::print_stdout(&format!(
         "convert: {voxels} voxels on a {}x{}x{} grid (placement from the {source}){what} -> {}",
         dims[0],
         dims[1],

@@ -48,7 +48,7 @@ pub fn run(a: &GapsArgs) -> Result<()> {
                     "voxels": report.voxels,
                     "missing": a.against.iter().zip(&missing).map(|(m, n)| (m.name().to_string(), json!(n))).collect::<serde_json::Map<_, _>>(),
                     "outside": outside, "separating_6": separating, "tunnels_6": facts.tunnels_6});
-                crate::print_stdout(&v.to_string())?;
+                crate::console::print_stdout(&v.to_string())?;
                 continue;
             }
             table += &format!("| {name} | {} | {res} | {} |", if facts.closed { "yes" } else { "no" }, report.voxels);
@@ -67,5 +67,5 @@ pub fn run(a: &GapsArgs) -> Result<()> {
     if a.json {
         return Ok(());
     }
-    crate::print_stdout(table.trim_end())
+    crate::console::print_stdout(table.trim_end())
 }

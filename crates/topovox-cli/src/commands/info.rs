@@ -34,13 +34,13 @@ pub fn run(a: &InfoArgs) -> Result<()> {
                 "vertex_colours": !app.vertex_colour.is_empty(),
             },
         });
-        crate::print_stdout(&v.to_string())?;
+        crate::console::print_stdout(&v.to_string())?;
     } else {
         for w in &loaded.warnings {
             eprintln!("topovox: warning: {}: {w}", a.mesh.display());
         }
         let e = r.bounds.extent();
-        crate::print_stdout(&format!(
+        crate::console::print_stdout(&format!(
             "{}\n  vertices:   {}\n  triangles:  {}\n  degenerate: {} (skipped when voxelizing)\n  bounds:     [{}, {}, {}] .. [{}, {}, {}]\n  extent:     {} x {} x {}",
             a.mesh.display(),
             r.vertices,
@@ -57,7 +57,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
             e.z
         ))?;
         let colour = if app.has_colour() { "carried into voxels" } else { "none" };
-        crate::print_stdout(&format!(
+        crate::console::print_stdout(&format!(
             "  colour:     {colour} ({} materials, {} textures, {with_uv} triangles with UVs, vertex colours: {})",
             app.materials.len(),
             app.textures.len(),

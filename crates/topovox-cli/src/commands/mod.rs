@@ -5,13 +5,10 @@ pub mod bench;
 mod brute;
 pub mod check;
 pub mod convert;
-pub mod export;
 pub mod gaps;
 pub mod info;
 pub mod raster;
 pub mod render;
-#[cfg(feature = "gpu")]
-pub mod render_gpu;
 #[cfg(feature = "gpu")]
 pub mod scene;
 #[cfg(feature = "gpu")]

@@ -61,9 +61,9 @@ pub fn run(a: &RasterArgs) -> Result<()> {
         let v = json!({"mode": mode.name(), "method": a.method.name(), "origin": [o.x, o.y], "pixel_size": grid.pixel_size(), "dims": dims,
             "pixels": rep.pixels, "outlines": drawn, "unfilled_outlines_left_out": unfilled, "segments": rep.segments, "degenerate_segments": rep.degenerate,
             "skipped_segments": rep.skipped, "raster_s": raster_s, "total_s": t0.elapsed().as_secs_f64(), "output": a.output});
-        return crate::print_stdout(&v.to_string());
+        return crate::console::print_stdout(&v.to_string());
     }
-    crate::print_stdout(&format!(
+    crate::console::print_stdout(&format!(
         "{}: {} pixels set on a {}x{} grid (origin {}, {}; pixel size {}) from {} outlines{} in {:.1} ms -> {}",
         mode.name(),
         rep.pixels,

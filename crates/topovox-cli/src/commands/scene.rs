@@ -29,7 +29,7 @@ pub fn run(a: &SceneArgs) -> Result<()> {
     let staged_obj = topovox_io::atomic::stage(&a.output, |w| w.write_all(obj.as_bytes()))?;
     staged_mtl.commit()?;
     staged_obj.commit()?;
-    crate::print_stdout(&format!(
+    crate::console::print_stdout(&format!(
         "scene {}: {} triangles, {} materials, {} textures -> {} and {}",
         a.name,
         mesh.triangles.len(),

@@ -3,7 +3,6 @@
 //! written as PLY for `render --gpu --points`, `view --points` and other
 //! point-cloud tools.
 
-use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
@@ -13,23 +12,14 @@ use topovox_view::spray::{write_ply, SprayOptions, Tracer};
 use topovox_view::Camera;
 
 use crate::args::SprayArgs;
-use crate::commands::render::up_axis;
-use crate::commands::render_gpu::{camera, load_scene};
+use crate::pictures::up_axis;
+use crate::scene_input::{camera, check_cloud_path, load_scene};
 
 /// The most rays one run casts: every hit is a 64-byte point held until
 /// the PLY is written, so 2^26 rays need at most 4 GiB.
 const MAX_RAYS: usize = 1 << 26;
 /// The most light samples per point.
 const MAX_SAMPLES: u32 = 4096;
-
-/// Checks that a spray cloud may be written to `path`: a `.ply` name in a
-/// folder that exists.
-pub(crate) fn check_cloud_path(path: &Path) -> Result<()> {
-    if path.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("ply")) != Some(true) {
-        bail!("{}: spray clouds are written as PLY; give a .ply file name", path.display());
-    }
-    Ok(topovox_job::output::check_output_path(path)?)
-}
 
 pub fn run(a: &SprayArgs) -> Result<()> {
     check_cloud_path(&a.output)?;
@@ -41,7 +31,7 @@ pub fn run(a: &SprayArgs) -> Result<()> {
     }
     let (width, height) = (a.size.width, a.size.height);
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.input))?;
-    let pool = crate::thread_pool(a.threads)?;
+    let pool = crate::pool::thread_pool(a.threads)?;
     let upi = up_axis(a.up);
     let mut up = Vec3::ZERO;
     up[upi] = 1.0;
@@ -82,9 +72,9 @@ pub fn run(a: &SprayArgs) -> Result<()> {
         "rays_per_s": a.rays as f64 / spray_s.max(1e-9),
     });
     if a.json {
-        return crate::print_stdout(&summary.to_string());
+        return crate::console::print_stdout(&summary.to_string());
     }
-    crate::print_stdout(&format!(
+    crate::console::print_stdout(&format!(
         "spray: {} rays, {} points ({} missed), {} light samples each from {} emissive triangles, BVH {:.2} s, rays {:.2} s -> {}",
         a.rays,
         points.len(),

@@ -9,9 +9,9 @@ use topovox_view::window::{run as run_window, ViewOptions};
 use topovox_view::Scene;
 
 use crate::args::ViewArgs;
-use crate::commands::render::{check_png_path, up_axis};
-use crate::commands::render_gpu::{add_voxel_file, add_voxels, camera, read_points};
+use crate::pictures::{check_png_path, up_axis};
 use crate::plan;
+use crate::scene_input::{add_voxel_file, add_voxels, camera, read_points};
 
 pub fn run(a: &ViewArgs) -> Result<()> {
     let (width, height) = (a.size.width, a.size.height);
@@ -20,7 +20,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         topovox_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.input))?;
     }
     if let Some(p) = &a.save_points {
-        crate::commands::spray::check_cloud_path(p)?;
+        crate::scene_input::check_cloud_path(p)?;
         topovox_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.input))?;
     }
     if a.frames == Some(0) {
@@ -100,10 +100,10 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     if a.json {
         let v = json!({"input": a.input, "frames": report.frames, "adapter": report.adapter, "camera": camera,
             "screenshot": a.screenshot, "screenshot_size": shot.map(|(w, h)| [w, h]), "points": report.points.len(), "save_points": a.save_points});
-        return crate::print_stdout(&v.to_string());
+        return crate::console::print_stdout(&v.to_string());
     }
     if a.quiet {
         return Ok(());
     }
-    crate::print_stdout(&format!("view: {} frames on {}; last camera --camera {camera}", report.frames, report.adapter))
+    crate::console::print_stdout(&format!("view: {} frames on {}; last camera --camera {camera}", report.frames, report.adapter))
 }

@@ -26,16 +26,16 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     }
     let write_opts = opts.write_options()?;
     if !a.quiet && !a.json {
-        crate::commands::export::warn_unused(&a.job.export, format, &a.output, true, a.preview.is_some());
+        crate::export::warn_unused(&a.job.export, format, &a.output, true, a.preview.is_some());
     }
     let preview = match &a.preview {
         Some(p) => {
-            crate::commands::render::check_png_path(p)?;
-            Some((p, crate::commands::render::options(&a.picture, a.job.export.up)?))
+            crate::pictures::check_png_path(p)?;
+            Some((p, crate::pictures::options(&a.picture, a.job.export.up)?))
         }
         None => None,
     };
-    let pool = crate::thread_pool(a.threads)?;
+    let pool = crate::pool::thread_pool(a.threads)?;
     let threads = pool.current_num_threads();
 
     let bar = Bar::new(a.quiet || a.json);
@@ -88,12 +88,12 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let write_s = t_write.elapsed().as_secs_f64();
     if let Some((path, o)) = &preview {
         bar.phase("rendering the preview");
-        let outline = a.picture.outline.then(|| crate::commands::render::outline_triangles(loaded.mesh.as_ref(), &grid));
+        let outline = a.picture.outline.then(|| crate::pictures::outline_triangles(loaded.mesh.as_ref(), &grid));
         match &v.voxels {
             topovox_job::Voxels::Sparse(sparse) => {
-                pool.install(|| crate::commands::render::picture_sparse(sparse, path, o, attrs.as_ref(), outline.as_deref()))?
+                pool.install(|| crate::pictures::picture_sparse(sparse, path, o, attrs.as_ref(), outline.as_deref()))?
             }
-            voxels => pool.install(|| crate::commands::render::picture(voxels, path, o, attrs.as_ref(), outline.as_deref()))?,
+            voxels => pool.install(|| crate::pictures::picture(voxels, path, o, attrs.as_ref(), outline.as_deref()))?,
         };
     }
     bar.finish();
@@ -170,6 +170,6 @@ fn summary(voxels_on_stdout: bool, line: &str) -> Result<()> {
         eprintln!("{line}");
         Ok(())
     } else {
-        crate::print_stdout(line)
+        crate::console::print_stdout(line)
     }
 }

@@ -1,93 +1,26 @@
 //! `topovox render`: a PNG picture of a voxel file or of a mesh's voxels,
 //! and the picture behind `voxelize --preview`.
 
-use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use serde_json::json;
 use topovox::attributes::carry::{carry, CarryOptions};
-use topovox::attributes::VoxelAttributes;
-use topovox::glam::DVec3;
-use topovox::grid::sparse::SparseBricks;
-use topovox::render::raycast::{render_grid, render_with, Image, RenderGrid, RenderOptions};
+use topovox::render::raycast::Image;
 use topovox::voxelize::{self, Options};
-use topovox::{BrickBits, VoxelSource};
-use topovox_io::orient::Up;
+use topovox::VoxelSource;
 
-use crate::args::{PictureArgs, RenderArgs};
+use crate::args::RenderArgs;
+use crate::pictures::{check_png_path, options, outline_triangles, picture, picture_sparse};
 use crate::plan;
 
-/// The picture options.
-pub fn options(p: &PictureArgs, up: Option<Up>) -> Result<RenderOptions> {
-    Ok(RenderOptions { width: p.size.width, height: p.size.height, view: p.view, up: up_axis(up), ..RenderOptions::default() })
-}
-
-/// The `--up` axis's index (default y).
-pub fn up_axis(up: Option<Up>) -> usize {
-    match up.unwrap_or_default() {
-        Up::X => 0,
-        Up::Y => 1,
-        Up::Z => 2,
-    }
-}
-
-/// A mesh's triangles in grid units, for the silhouette outline.
-pub fn outline_triangles(mesh: topovox::MeshRef<'_>, grid: &topovox::GridSpec) -> Vec<[DVec3; 3]> {
-    mesh.triangles
-        .iter()
-        .filter_map(|t| {
-            let p = [0, 1, 2].map(|c| mesh.positions.get(t[c] as usize).map(|&p| grid.to_grid_units(p)));
-            Some([p[0]?, p[1]?, p[2]?])
-        })
-        .collect()
-}
-
-/// Renders `bits` (coloured by `colours` where present, with the outline of
-/// `outline`'s triangles) and writes the PNG atomically.
-pub fn picture(
-    bits: &dyn VoxelSource,
-    path: &Path,
-    o: &RenderOptions,
-    colours: Option<&VoxelAttributes>,
-    outline: Option<&[[DVec3; 3]]>,
-) -> Result<Image> {
-    let bricks = BrickBits::from_source(bits);
-    let img = render_with(&bricks, o, colours, outline);
-    topovox_io::write_png(path, img.width, img.height, &img.rgb)?;
-    Ok(img)
-}
-
-/// [`picture`] of a grid held as sparse bricks (past memory), without a
-/// dense grid or brick index: the ray caster indexes 64³-voxel blocks.
-pub fn picture_sparse(
-    bits: &SparseBricks,
-    path: &Path,
-    o: &RenderOptions,
-    colours: Option<&VoxelAttributes>,
-    outline: Option<&[[DVec3; 3]]>,
-) -> Result<Image> {
-    let Some(grid) = RenderGrid::from_sparse(bits) else {
-        let [x, y, z] = bits.dims();
-        bail!("grid {x}x{y}x{z} is too large to render: its index of 64^3-voxel blocks would pass 1 GiB");
-    };
-    let img = render_grid(&grid, o, colours, outline);
-    topovox_io::write_png(path, img.width, img.height, &img.rgb)?;
-    Ok(img)
-}
-
-/// Refuses an output that is not a `.png` or whose folder does not exist.
-pub fn check_png_path(path: &Path) -> Result<()> {
-    if path.extension().and_then(|e| e.to_str()).map(|e| e.eq_ignore_ascii_case("png")) != Some(true) {
-        bail!("{}: pictures are written as PNG; give a .png file name", path.display());
-    }
-    Ok(topovox_job::output::check_output_path(path)?)
-}
+#[cfg(feature = "gpu")]
+mod gpu;
 
 pub fn run(a: &RenderArgs) -> Result<()> {
     if a.gpu.gpu {
         #[cfg(feature = "gpu")]
-        return crate::commands::render_gpu::run(a);
+        return gpu::run(a);
         #[cfg(not(feature = "gpu"))]
         bail!("--gpu: this topovox was built without the gpu feature");
     }
@@ -106,7 +39,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let t0 = Instant::now();
     let o = options(&a.picture, a.up)?;
     check_png_path(&a.output)?;
-    let pool = crate::thread_pool(a.threads)?;
+    let pool = crate::pool::thread_pool(a.threads)?;
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.input))?;
     let (bits, what, colours, outline): (Box<dyn VoxelSource + Send>, &str, _, _) = if topovox_io::is_voxel_file(&a.input) {
         if a.picture.outline {
@@ -160,12 +93,12 @@ fn summary(a: &RenderArgs, img: &Image, what: &str, bits: &dyn VoxelSource, t0: 
     if a.json {
         let v = json!({"input": a.input, "kind": what, "output": a.output, "width": img.width, "height": img.height,
             "dims": bits.dims(), "voxels": bits.count(), "covered_pixels": img.covered, "total_s": total_s});
-        return crate::print_stdout(&v.to_string());
+        return crate::console::print_stdout(&v.to_string());
     }
     if a.quiet {
         return Ok(());
     }
-    crate::print_stdout(&format!(
+    crate::console::print_stdout(&format!(
         "render: {}x{} picture of {} voxels ({}, grid {:?}) in {:.2} s -> {}",
         img.width,
         img.height,

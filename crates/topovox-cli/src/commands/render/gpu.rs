@@ -7,70 +7,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde_json::json;
 use topovox::glam::Vec3;
-use topovox_view::{Camera, FrameOptions, FrameStats, Renderer, Scene};
+use topovox_view::{Camera, FrameOptions, FrameStats, Renderer};
 
 use crate::args::RenderArgs;
-use crate::commands::render::{check_png_path, options};
-use crate::values::CameraSpec;
-
-/// Voxel quads' material: light grey, rough.
-const VOXEL_COLOUR: [f32; 3] = [0.72, 0.72, 0.70];
-
-/// Adds a voxel file's greedy quads, placed where the file says (else
-/// voxel `(i, j, k)` at `(i, j, k)`), moved by `offset`.
-pub(crate) fn add_voxel_file(scene: &mut Scene, path: &Path, up: Option<topovox_io::orient::Up>, offset: Vec3) -> Result<()> {
-    let upname = up.unwrap_or_default();
-    let loaded = topovox_io::read_voxels_with(path, upname)?;
-    let (origin, size) = loaded.placement.map(|(o, s)| (o.as_vec3(), s as f32)).unwrap_or((Vec3::ZERO, 1.0));
-    add_voxels(scene, &loaded.bits, origin + offset, size);
-    Ok(())
-}
-
-/// Adds voxels as greedy quads of one clay material.
-pub(crate) fn add_voxels(scene: &mut Scene, bits: &topovox::grid::dense::DenseBits, origin: Vec3, size: f32) {
-    let quads = topovox::export::greedy::greedy_quads(bits);
-    let m = scene.add_material(topovox_view::scene::ShadeMaterial::new(VOXEL_COLOUR, [0.0; 3], 0.7));
-    scene.add_quads(&quads, origin, size, m);
-}
-
-/// Loads a mesh with its materials, or a voxel file's greedy quads, as a
-/// scene; the kind loaded ("mesh" or "voxel file"). None of `outputs` may
-/// be a file the mesh reads.
-pub(crate) fn load_scene(
-    input: &Path,
-    up: Option<topovox_io::orient::Up>,
-    allow_external_paths: bool,
-    outputs: &[PathBuf],
-) -> Result<(Scene, &'static str)> {
-    let mut scene = Scene::default();
-    if topovox_io::is_voxel_file(input) {
-        add_voxel_file(&mut scene, input, up, Vec3::ZERO)?;
-        return Ok((scene, "voxel file"));
-    }
-    let loaded = topovox_io::read_mesh_with(input, &topovox_io::ReadOptions { allow_external_paths })?;
-    for out in outputs {
-        topovox_io::atomic::refuse_overwriting_inputs(out, &loaded.sources)?;
-    }
-    for w in &loaded.warnings {
-        eprintln!("topovox: warning: {}: {w}", input.display());
-    }
-    scene.add_mesh(loaded.mesh.as_ref(), &loaded.appearance);
-    Ok((scene, "mesh"))
-}
-
-/// Reads a spray cloud (`topovox spray`'s PLY).
-pub(crate) fn read_points(path: &Path) -> Result<Vec<topovox_view::spray::SprayPoint>> {
-    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    topovox_io::fenced(|| topovox_view::spray::read_ply(&bytes))
-        .unwrap_or_else(|msg| Err(format!("the PLY parser crashed on it ({msg})")))
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
-}
-
-/// Parses `EX,EY,EZ,TX,TY,TZ[,FOV]`.
-/// The renderer's camera of `--camera`, with the `--up` direction.
-pub(crate) fn camera(c: CameraSpec, up: Vec3) -> Camera {
-    Camera { eye: c.eye, target: c.target, up, fov_deg: c.fov_deg }
-}
+use crate::pictures::{check_png_path, options};
+use crate::scene_input::{camera, load_scene, read_points};
 
 pub fn run(a: &RenderArgs) -> Result<()> {
     let g = &a.gpu;
@@ -202,12 +143,12 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         topovox_io::atomic::write_atomically(p, |w| w.write_all(text.as_bytes()))?;
     }
     if a.json {
-        return crate::print_stdout(&stats.to_string());
+        return crate::console::print_stdout(&stats.to_string());
     }
     if a.quiet {
         return Ok(());
     }
-    crate::print_stdout(&format!(
+    crate::console::print_stdout(&format!(
         "render --gpu: {} frame(s) {}x{} of {} triangles ({}), first: {} of {} clusters drawn, {} lights, {:.1} ms -> {}",
         stats["frames"].as_array().map_or(0, Vec::len),
         o.width,
