@@ -1,8 +1,14 @@
-//! Geometry: bounding boxes, the fixed-point lattice, lattice triangles and
-//! polygon clipping.
+//! Geometry, and the lattice floor every algorithm stands on: the
+//! fixed-point lattice ([`fixed`]), mesh preparation onto it ([`lattice`]:
+//! `prepare`), the tie rule ([`perturb`]), the triangle setup of the exact
+//! target tests ([`setup`]) and exact floor/ceiling division ([`divide`]).
+//! Algorithm files (`voxelize/`) and certificates (`topology/`) import
+//! from here; nothing here imports from them.
 
 pub mod aabb;
 pub mod clip;
+pub mod divide;
 pub mod fixed;
 pub mod lattice;
 pub mod perturb;
+pub mod setup;

@@ -8,25 +8,14 @@
 
 use rayon::prelude::*;
 
+pub use super::brick::{set_in_brick, Brick, BRICK};
 use super::dense::DenseBits;
 use super::VoxelSource;
 
-/// Edge length of a brick in voxels.
-pub const BRICK: u32 = 8;
 const SHIFT: u32 = 3;
-
-/// One brick: word `z & 7`, bit `(y & 7) * 8 + (x & 7)`.
-pub type Brick = [u64; 8];
 
 /// Smallest brick index [`BrickBits::new`] zeroes in parallel.
 const PAR_ZERO_MIN: usize = 1 << 20;
-
-/// Sets voxel `(i, j, k)` in its brick `b` (only the coordinates' low
-/// three bits count: whole-grid and brick-local coordinates alike).
-#[inline(always)]
-pub fn set_in_brick(b: &mut Brick, i: u32, j: u32, k: u32) {
-    b[(k & 7) as usize] |= 1u64 << (((j & 7) << 3) | (i & 7));
-}
 
 /// The offset `(di, dj, dk)` from a 2×2×2 block's first voxel of bit `o`
 /// (`di + 2·dj + 4·dk`) of a block mask ([`SlabView::block2_set`]).

@@ -215,7 +215,7 @@ impl super::VoxelSource for DenseBits {
 
     /// Brick by brick from the words: each brick's 64 row bytes are read
     /// directly (a row's byte `bi` holds voxels `8·bi .. 8·bi + 7`).
-    fn for_each_brick(&self, f: &mut dyn FnMut([u32; 3], &super::bricks::Brick)) {
+    fn for_each_brick(&self, f: &mut dyn FnMut([u32; 3], &super::brick::Brick)) {
         let [nx, ny, nz] = self.dims;
         let wpr = self.words_per_row;
         let byte = |j: u32, k: u32, bi: u32| -> u64 {

@@ -1,5 +1,6 @@
 //! Grids: the specification (where voxels are) and storage (which are set).
 
+pub mod brick;
 pub mod bricks;
 pub mod dense;
 pub mod sparse;
@@ -27,12 +28,12 @@ pub trait VoxelSource: Sync {
 
     /// Calls `f([bi, bj, bk], bits)` for every 8×8×8 brick holding a set
     /// voxel, in order of `bk`, then `bj`, then `bi` (bit layout of
-    /// [`bricks::Brick`]). The sparse storages hand out their bricks; the
+    /// [`brick::Brick`]). The sparse storages hand out their bricks; the
     /// default gathers them from [`VoxelSource::for_each_set`].
-    fn for_each_brick(&self, f: &mut dyn FnMut([u32; 3], &bricks::Brick)) {
-        let mut map: std::collections::BTreeMap<[u32; 3], bricks::Brick> = std::collections::BTreeMap::new();
+    fn for_each_brick(&self, f: &mut dyn FnMut([u32; 3], &brick::Brick)) {
+        let mut map: std::collections::BTreeMap<[u32; 3], brick::Brick> = std::collections::BTreeMap::new();
         self.for_each_set(&mut |i, j, k| {
-            bricks::set_in_brick(map.entry([k / 8, j / 8, i / 8]).or_insert([0; 8]), i, j, k);
+            brick::set_in_brick(map.entry([k / 8, j / 8, i / 8]).or_insert([0; 8]), i, j, k);
         });
         for (kji, b) in &map {
             f([kji[2], kji[1], kji[0]], b);
@@ -43,7 +44,7 @@ pub trait VoxelSource: Sync {
     /// bricks along `bi` may come as one call `f(first brick, full, n)`
     /// (sparse solids keep their interiors as such runs; sparse writers
     /// store them as constant tiles). Other bricks come with `n = 1`.
-    fn for_each_brick_run(&self, f: &mut dyn FnMut([u32; 3], &bricks::Brick, u32)) {
+    fn for_each_brick_run(&self, f: &mut dyn FnMut([u32; 3], &brick::Brick, u32)) {
         self.for_each_brick(&mut |b, bits| f(b, bits, 1))
     }
 }

@@ -46,12 +46,12 @@ use super::inside::{snap_all, ClassifyError, Parity};
 use super::runs::{Connectivity, Runs, StreamedComponents};
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::LatticeTriangle;
+use crate::geom::setup::{fits_i64, TriSetup};
 use crate::grid::bricks::{Brick, BrickBits, BRICK};
 use crate::grid::dense::DenseBits;
 use crate::grid::sparse::SparseBricks;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
-use crate::voxelize::targets::{fits_i64, TriSetup};
 
 /// Everything `topovox check` reports.
 #[derive(Clone, Debug, PartialEq)]
@@ -676,7 +676,7 @@ fn columns_of<T: crate::geom::fixed::PlaneInt>(
     st: &mut ColumnStats,
 ) {
     let Some((mut lo, mut hi)) = t.voxel_bounds(dims) else { return };
-    let (u, v, w) = crate::voxelize::targets::dominant_axes(t);
+    let (u, v, w) = crate::geom::setup::dominant_axes(t);
     if w != 2 {
         lo[2] = lo[2].max(owned.start);
         hi[2] = hi[2].min(owned.end - 1);

@@ -20,9 +20,9 @@
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
-use super::super::voxelize::targets::TriSetup;
 use crate::geom::fixed::{snap, PlaneInt, DIRECT_LIMIT_VOXELS, ONE};
 use crate::geom::lattice::LatticeTriangle;
+use crate::geom::setup::TriSetup;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
 
@@ -320,7 +320,7 @@ fn crossings(t: &LatticeTriangle, dims: [u32; 3], planes: &std::ops::Range<u32>,
         // No row's centre line within reach (most small triangles).
         return;
     }
-    if crate::voxelize::targets::fits_i64(t) {
+    if crate::geom::setup::fits_i64(t) {
         crossings_in::<i64>(t, n, dims, planes.start, rj, rk, out);
     } else {
         crossings_in::<i128>(t, n, dims, planes.start, rj, rk, out);

@@ -46,11 +46,12 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, FilterUnset, Kernel};
-use super::targets::{dot, fits_i64, is_tiny, TriSetup};
+use super::targets::is_tiny;
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::{segment_meets_triangle, P3};
+use crate::geom::setup::{dot, fits_i64, TriSetup};
 use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;

@@ -31,11 +31,12 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, Filter, Kernel};
-use super::targets::{diagonal_lines, fits_i64, is_tiny, LazyTargets, DIAGONALS, DIAGONAL_SET};
+use super::targets::{diagonal_lines, is_tiny, LazyTargets, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::{segment_meets_triangle, P3};
+use crate::geom::setup::fits_i64;
 use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;

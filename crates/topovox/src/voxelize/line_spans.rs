@@ -37,12 +37,13 @@
 //! for one about a voxel wide the walkers' divisions cost more than
 //! testing its handful of lines one by one, which the modes do instead.
 
-use super::cover::{div_floor, Walker};
+use super::cover::Walker;
 use super::driver::Sink;
-use super::targets::{dot, TriSetup};
+use crate::geom::divide::div_floor;
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::{cross, LatticeTriangle};
 use crate::geom::perturb::bias;
+use crate::geom::setup::{dot, TriSetup};
 
 /// `log2(ONE)`: the straddling segment's index is a floor division by `ONE`.
 const ONE_SHIFT: u32 = ONE.trailing_zeros();
@@ -57,7 +58,7 @@ pub(crate) struct SpanSetup<'t> {
 }
 
 impl<'t> SpanSetup<'t> {
-    /// For an `i64` triangle ([`super::targets::fits_i64`]).
+    /// For an `i64` triangle ([`crate::geom::setup::fits_i64`]).
     #[inline(always)]
     pub fn new(tri: &'t LatticeTriangle) -> Self {
         let s = TriSetup::<i64>::new(tri);
@@ -248,7 +249,8 @@ impl SpanSetup<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::voxelize::targets::{fits_i64, sep26_hit, sep6_hit};
+    use crate::geom::setup::fits_i64;
+    use crate::voxelize::targets::{sep26_hit, sep6_hit};
     use std::collections::BTreeSet;
 
     /// The voxels a family emits, as a set.

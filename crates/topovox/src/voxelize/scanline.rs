@@ -47,13 +47,15 @@
 //! thread count. **Reference:** the modes' brute-force references; the
 //! tests compare voxel for voxel.
 
-use super::cover::{cover_triangle_runs, div_floor, edges_2d, run, set};
+use super::cover::{cover_triangle_runs, edges_2d, run, set};
 use super::driver::{run_mesh, run_slabs, Filter, Kernel, Sink};
-use super::targets::{fits_i64, DirSetup, TriSetup, CROSSHAIR, DIAGONALS};
+use super::targets::{CROSSHAIR, DIAGONALS};
 use super::{Mode, Options, Report};
+use crate::geom::divide::div_floor;
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::P3;
+use crate::geom::setup::{fits_i64, DirSetup, TriSetup};
 use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;

@@ -31,11 +31,12 @@
 
 use super::cover::{PlaneRange, Setup as CoverSetup};
 use super::driver::{buffered, run_mesh, run_slabs, Deferred, Kernel};
-use super::targets::{diagonal_lines, dominant_axes, fits_i64, is_tiny, LazyTargets, PixelTest, TriSetup, DIAGONALS, DIAGONAL_SET};
+use super::targets::{diagonal_lines, is_tiny, LazyTargets, PixelTest, DIAGONALS, DIAGONAL_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::P3;
+use crate::geom::setup::{dominant_axes, fits_i64, TriSetup};
 use crate::grid::bricks::{BoxBricks, BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;

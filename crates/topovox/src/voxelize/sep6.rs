@@ -32,10 +32,11 @@
 //! generic `i128` predicate for every voxel of each triangle's bounding box.
 
 use super::driver::{run_mesh, run_slabs, Kernel};
-use super::targets::{all_one_side, dominant_axes, edge_side, fits_i64, is_tiny, PixelTest, TriSetup, CROSSHAIR_SET};
+use super::targets::{is_tiny, PixelTest, CROSSHAIR_SET};
 use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
+use crate::geom::setup::{all_one_side, dominant_axes, edge_side, fits_i64, TriSetup};
 use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;

@@ -36,11 +36,12 @@
 
 use super::cover::cover_triangle;
 use super::driver::{run_mesh, FilterUnset, Kernel};
-use super::targets::{dominant_axes, fits_i64, is_tiny, PixelTest, TriSetup};
+use super::targets::{is_tiny, PixelTest};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::bias;
+use crate::geom::setup::{dominant_axes, fits_i64, TriSetup};
 use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;

@@ -38,11 +38,12 @@
 
 use super::cover::cover_triangle;
 use super::driver::{box_volume, run_mesh, FilterUnset, Kernel};
-use super::targets::{fits_i64, forms_reached, PairedTargets, TargetSet};
+use super::targets::{forms_reached, PairedTargets, TargetSet};
 use super::{Options, Report, Traversal};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::{segment_meets_triangle, P3};
+use crate::geom::setup::fits_i64;
 use crate::grid::bricks::{BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
