@@ -176,24 +176,24 @@ impl Gpu {
             GpuPath::Compute => None,
             GpuPath::Raster | GpuPath::MsaaApprox => Some(self.raster_target(side, path == GpuPath::MsaaApprox)?),
         };
-        let expand = if path == GpuPath::Raster && !self.raster.hardware_conservative { 16 } else { 0 };
+        let expand = if path == GpuPath::Raster && !self.raster.hardware_conservative { crate::params::QUADS } else { 0 };
         let max_batch = (self.max_slab_bytes / std::mem::size_of::<GpuTri>() as u64).clamp(1, 1 << 22) as usize;
         let mut bits = BrickBits::new(dims);
         for (k0, nk) in slabs.layers(dims[2]) {
             let t_up = Instant::now();
             let slab = in_slab(&on_gpu, k0, nk);
-            let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("slab") });
+            let mut encoder = self.dev.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("slab") });
             encoder.clear_buffer(out, 0, None);
             let mut keep = Vec::new();
             let mut passes = 0u32;
             for batch in slab.chunks(max_batch) {
-                let tri_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                let tri_buf = self.dev.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("triangles"),
                     contents: bytemuck::cast_slice(batch),
                     usage: wgpu::BufferUsages::STORAGE,
                 });
                 let par_buf = self.params(dims, &slabs, (k0, nk), batch.len() as u32, mode.code() | expand, side);
-                let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                let bind = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("cover"),
                     layout: &self.layout,
                     entries: &[

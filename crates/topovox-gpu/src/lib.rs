@@ -39,13 +39,14 @@
 //! triangles.
 
 mod compute;
+pub mod device;
+mod params;
 mod slabs;
 mod solid;
 
 pub use compute::{CoverReport, GpuMode, GpuPath, Timings};
+pub use device::Device;
 pub use solid::SolidGpuReport;
-
-use std::sync::{Arc, Mutex};
 
 use thiserror::Error;
 
@@ -74,15 +75,8 @@ pub enum GpuError {
     Unsupported(String),
 }
 
-/// A shader's source: `common.wgsl` followed by `parts`.
-fn shader(parts: &[&str]) -> String {
-    let mut s = include_str!("shaders/common.wgsl").to_string();
-    for p in parts {
-        s.push('\n');
-        s.push_str(p);
-    }
-    s
-}
+/// The definitions every voxelization shader starts with.
+const COMMON: &str = include_str!("shaders/common.wgsl");
 
 /// The rasterizer path's pipelines: conservative (hardware, or expansion
 /// in the vertex shader) and 4× MSAA.
@@ -96,10 +90,9 @@ pub(crate) struct RasterPipelines {
 pub(crate) const MSAA_SAMPLES: u32 = 4;
 
 impl RasterPipelines {
-    fn new(device: &wgpu::Device, layout: &wgpu::PipelineLayout, hardware_conservative: bool) -> RasterPipelines {
-        let source = shader(&[include_str!("shaders/cover.wgsl"), include_str!("shaders/raster.wgsl")]);
-        let module = device
-            .create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("raster"), source: wgpu::ShaderSource::Wgsl(source.into()) });
+    fn new(dev: &Device, layout: &wgpu::PipelineLayout, hardware_conservative: bool) -> RasterPipelines {
+        let module = dev.shader("raster", &[COMMON, include_str!("shaders/cover.wgsl"), include_str!("shaders/raster.wgsl")]);
+        let device = &dev.device;
         let pipeline = |conservative: bool, samples: u32| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("raster"),
@@ -141,7 +134,7 @@ impl Gpu {
                 self.max_texture_side
             )));
         }
-        let tex = self.device.create_texture(&wgpu::TextureDescriptor {
+        let tex = self.dev.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("raster target"),
             size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: 1 },
             mip_level_count: 1,
@@ -169,11 +162,9 @@ pub(crate) struct SolidPipelines {
 }
 
 impl SolidPipelines {
-    fn new(device: &wgpu::Device) -> SolidPipelines {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("solid"),
-            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/solid.wgsl")]).into()),
-        });
+    fn new(dev: &Device) -> SolidPipelines {
+        let module = dev.shader("solid", &[COMMON, include_str!("shaders/solid.wgsl")]);
+        let device = &dev.device;
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -237,20 +228,13 @@ pub fn quiet_without_display() {
     });
 }
 
+/// What the exact path cannot do without.
+const REQUIRED: &[(wgpu::Features, &str)] = &[(wgpu::Features::SHADER_INT64, "64-bit integers in shaders (SHADER_INT64)")];
+
 /// The default adapter (high performance preferred), if it has what the
 /// exact path needs.
 fn adapter() -> Result<wgpu::Adapter, GpuError> {
-    let instance = wgpu::Instance::new(headless());
-    let adapter =
-        pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            ..Default::default()
-        }))
-        .map_err(|_| GpuError::NoAdapter)?;
-    if !adapter.features().contains(wgpu::Features::SHADER_INT64) {
-        return Err(GpuError::MissingFeature { adapter: adapter.get_info().name, what: "64-bit integers in shaders (SHADER_INT64)" });
-    }
-    Ok(adapter)
+    device::adapter(&wgpu::Instance::new(headless()), None, REQUIRED)
 }
 
 /// Is the adapter [`Gpu::new`] would open a hardware one (not lavapipe or
@@ -280,9 +264,7 @@ fn hardware_plausible() -> bool {
 
 /// An open GPU device with the voxelization pipelines.
 pub struct Gpu {
-    device: wgpu::Device,
-    queue: wgpu::Queue,
-    info: wgpu::AdapterInfo,
+    dev: Device,
     cover: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     solid: SolidPipelines,
@@ -293,52 +275,25 @@ pub struct Gpu {
     timestamps: bool,
     /// Largest storage buffer the output slab may use, in bytes.
     max_slab_bytes: u64,
-    /// The first error the device reported outside a call's own checks
-    /// (validation, out of memory, device lost), turned into a
-    /// [`GpuError`] at the next check instead of a panic.
-    errors: Arc<Mutex<Option<String>>>,
 }
 
 impl Gpu {
     /// Opens the default adapter (high performance preferred) with the
     /// features the exact path needs.
     pub fn new() -> Result<Gpu, GpuError> {
-        let adapter = adapter()?;
-        let info = adapter.get_info();
-        let limits = adapter.limits();
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("topovox"),
-            required_features: wgpu::Features::SHADER_INT64
-                | (adapter.features() & (wgpu::Features::CONSERVATIVE_RASTERIZATION | wgpu::Features::TIMESTAMP_QUERY)),
-            required_limits: wgpu::Limits {
-                max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
-                max_buffer_size: limits.max_buffer_size,
-                max_texture_dimension_2d: limits.max_texture_dimension_2d,
-                ..wgpu::Limits::downlevel_defaults()
+        let dev = Device::open(
+            &wgpu::Instance::new(headless()),
+            &device::DeviceOptions {
+                label: "topovox",
+                surface: None,
+                required: REQUIRED,
+                optional: wgpu::Features::CONSERVATIVE_RASTERIZATION | wgpu::Features::TIMESTAMP_QUERY,
             },
-            experimental_features: wgpu::ExperimentalFeatures::disabled(),
-            memory_hints: wgpu::MemoryHints::Performance,
-            trace: wgpu::Trace::Off,
-        }))
-        .map_err(|e| GpuError::Device(e.to_string()))?;
-        let errors: Arc<Mutex<Option<String>>> = Arc::default();
-        let sink = errors.clone();
-        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-            if let Ok(mut slot) = sink.lock() {
-                slot.get_or_insert_with(|| e.to_string().lines().next().unwrap_or("unknown error").to_string());
-            }
-        }));
-        let sink = errors.clone();
-        device.set_device_lost_callback(move |reason, msg| {
-            if let Ok(mut slot) = sink.lock() {
-                slot.get_or_insert_with(|| format!("device lost ({reason:?}): {msg}"));
-            }
-        });
+        )?;
+        let limits = &dev.limits;
         let max_slab_bytes = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size).min(1 << 30);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("cover"),
-            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/cover.wgsl")]).into()),
-        });
+        let module = dev.shader("cover", &[COMMON, include_str!("shaders/cover.wgsl")]);
+        let device = &dev.device;
         // The rasterizer shares this layout: triangles and parameters are
         // read in the vertex and fragment stages, bits written in fragments.
         let all = wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
@@ -382,32 +337,28 @@ impl Gpu {
             compilation_options: Default::default(),
             cache: None,
         });
-        let solid = SolidPipelines::new(&device);
-        let hardware_conservative = adapter.features().contains(wgpu::Features::CONSERVATIVE_RASTERIZATION);
-        let raster = RasterPipelines::new(&device, &pl, hardware_conservative);
+        let solid = SolidPipelines::new(&dev);
+        let hardware_conservative = dev.features.contains(wgpu::Features::CONSERVATIVE_RASTERIZATION);
+        let raster = RasterPipelines::new(&dev, &pl, hardware_conservative);
         let max_texture_side = limits.max_texture_dimension_2d;
-        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let gpu = Gpu { device, queue, info, cover, layout, solid, raster, max_texture_side, timestamps, max_slab_bytes, errors };
-        gpu.check()?;
-        Ok(gpu)
+        let timestamps = dev.features.contains(wgpu::Features::TIMESTAMP_QUERY);
+        dev.check()?;
+        Ok(Gpu { dev, cover, layout, solid, raster, max_texture_side, timestamps, max_slab_bytes })
     }
 
     /// The first error the device reported since the last check, if any.
     pub(crate) fn check(&self) -> Result<(), GpuError> {
-        match self.errors.lock().ok().and_then(|mut e| e.take()) {
-            Some(msg) => Err(GpuError::Device(msg)),
-            None => Ok(()),
-        }
+        self.dev.check()
     }
 
     /// The adapter's name and backend, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan)".
     pub fn adapter(&self) -> String {
-        format!("{} ({:?})", self.info.name, self.info.backend)
+        self.dev.adapter_name()
     }
 
     /// True for software adapters (lavapipe, WARP): correct, not fast (see also [`hardware_adapter`]).
     pub fn is_software(&self) -> bool {
-        self.info.device_type == wgpu::DeviceType::Cpu
+        self.dev.info.device_type == wgpu::DeviceType::Cpu
     }
 
     /// Caps the output slab size (tests use it to force many slabs).

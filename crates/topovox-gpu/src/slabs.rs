@@ -6,6 +6,8 @@ use std::time::Instant;
 
 use wgpu::util::DeviceExt;
 
+use crate::device::mapped;
+use crate::params::Params;
 use crate::{Gpu, GpuError};
 
 /// The grid cut into z-slabs of 32-bit words (bit `i % 32` of word
@@ -84,12 +86,12 @@ impl crate::Timings {
 }
 
 impl Gpu {
-    /// The uniform parameters of one pass (`Params` in `common.wgsl`).
+    /// The uniform parameters of one pass ([`Params`]).
     pub(crate) fn params(&self, dims: [u32; 3], s: &Slabs, (k0, nk): (u32, u32), count: u32, mode: u32, side: u32) -> wgpu::Buffer {
-        let params: [u32; 12] = [dims[0], dims[1], dims[2], k0, nk, s.words_per_row as u32, count, mode, side, 0, 0, 0];
-        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let params = Params { dims, k0, nk, words_per_row: s.words_per_row as u32, count, mode, side, pad: [0; 3] };
+        self.dev.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("params"),
-            contents: bytemuck::cast_slice(&params),
+            contents: bytemuck::bytes_of(&params),
             usage: wgpu::BufferUsages::UNIFORM,
         })
     }
@@ -126,25 +128,25 @@ impl Gpu {
         let nk_max = ((self.max_slab_bytes / layer_bytes) as u32).clamp(1, dims[2]);
         let size = layer_bytes * nk_max as u64;
         let buffer = |label, usage| {
-            self.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+            self.dev.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
         let out = buffer("slab bits", wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST);
         let staging = buffer("slab readback", wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
         let queries = self.timestamps.then(|| {
             let bytes = 16 * TIMED_PASSES as u64;
             Queries {
-                set: self.device.create_query_set(&wgpu::QuerySetDescriptor {
+                set: self.dev.device.create_query_set(&wgpu::QuerySetDescriptor {
                     label: Some("pass timestamps"),
                     ty: wgpu::QueryType::Timestamp,
                     count: 2 * TIMED_PASSES,
                 }),
-                resolve: self.device.create_buffer(&wgpu::BufferDescriptor {
+                resolve: self.dev.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("timestamps"),
                     size: bytes,
                     usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                     mapped_at_creation: false,
                 }),
-                read: self.device.create_buffer(&wgpu::BufferDescriptor {
+                read: self.dev.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("timestamps readback"),
                     size: bytes,
                     usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
@@ -177,40 +179,21 @@ impl Gpu {
             encoder.copy_buffer_to_buffer(&q.resolve, 0, &q.read, 0, 16 * passes as u64);
         }
         let t_run = Instant::now();
-        self.queue.submit([encoder.finish()]);
+        self.dev.queue.submit([encoder.finish()]);
         let slice = s.staging.slice(0..used);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        let stamps = timed.map(|q| {
-            let ts = q.read.slice(0..16 * passes as u64);
-            let (ttx, trx) = std::sync::mpsc::channel();
-            ts.map_async(wgpu::MapMode::Read, move |r| {
-                let _ = ttx.send(r);
-            });
-            (q, ts, trx)
-        });
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Device(e.to_string()))?;
-        self.check()?;
-        rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+        let stamps = timed.map(|q| (q, q.read.slice(0..16 * passes as u64)));
+        let mut slices = vec![slice];
+        slices.extend(stamps.map(|(_, ts)| ts));
+        self.dev.map_all(&slices)?;
         let run_s = t_run.elapsed().as_secs_f64();
         let mut gpu_s = None;
-        if let Some((q, ts, trx)) = stamps {
-            trx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
-            {
-                let view = ts.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-                let t: &[u64] = bytemuck::cast_slice(&view);
-                let ticks: u64 = t.chunks_exact(2).map(|p| p[1].saturating_sub(p[0])).sum();
-                // Some drivers (lavapipe) offer the feature but write zeros: no time, not zero time.
-                gpu_s = (ticks > 0).then(|| ticks as f64 * self.queue.get_timestamp_period() as f64 * 1e-9);
-            }
+        if let Some((q, ts)) = stamps {
+            gpu_s = self.dev.timestamp_seconds(bytemuck::cast_slice(&mapped(ts)?));
             q.read.unmap();
         }
         let t_read = Instant::now();
         {
-            let view = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-            read(bytemuck::cast_slice(&view));
+            read(bytemuck::cast_slice(&mapped(slice)?));
         }
         s.staging.unmap();
         Ok((run_s, t_read.elapsed().as_secs_f64(), gpu_s))

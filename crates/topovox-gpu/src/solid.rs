@@ -86,7 +86,7 @@ impl Gpu {
                     [local_row * words_per_row as u32 + i0 / 32, 1u32 << (i0 % 32)]
                 })
                 .collect();
-            let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("solid slab") });
+            let mut encoder = self.dev.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("solid slab") });
             encoder.clear_buffer(out, 0, None);
             let empty_tris = [STri { a: [0; 4], b: [0; 4], c: [0; 4] }];
             let mut keep = Vec::new();
@@ -97,18 +97,18 @@ impl Gpu {
                                  flips: &[[u32; 2]],
                                  count: u32,
                                  groups: u32| {
-                let list_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                let list_buf = self.dev.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("cpu flips"),
                     contents: bytemuck::cast_slice(if flips.is_empty() { &[[0u32; 2]][..] } else { flips }),
                     usage: wgpu::BufferUsages::STORAGE,
                 });
-                let tri_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                let tri_buf = self.dev.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("solid triangles"),
                     contents: bytemuck::cast_slice(if tris.is_empty() { &empty_tris[..] } else { tris }),
                     usage: wgpu::BufferUsages::STORAGE,
                 });
                 let par_buf = self.params(dims, &slabs, (k0, nk), count, 0, 0);
-                let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                let bind = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("solid"),
                     layout: &self.solid.layout,
                     entries: &[

@@ -12,7 +12,6 @@
 //! compaction, which atomics would make order-dependent; it is not used
 //! (the statistics name the call that ran).
 
-use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use bytemuck::{Pod, Zeroable};
@@ -26,6 +25,8 @@ use crate::partition::{Cluster, Partition};
 use crate::scene::{Scene, Vertex};
 use crate::spray::SprayPoint;
 use crate::ViewError;
+use topovox_gpu::device::{Device, DeviceOptions};
+use topovox_gpu::GpuError;
 
 pub use topovox::render::Culling;
 
@@ -295,10 +296,8 @@ pub struct GpuScene {
 
 /// An open device with the frame's pipelines.
 pub struct Renderer {
-    pub(crate) adapter: wgpu::Adapter,
-    pub(crate) device: wgpu::Device,
-    queue: wgpu::Queue,
-    info: wgpu::AdapterInfo,
+    /// The device, shared layer of `topovox-gpu`.
+    pub(crate) dev: Device,
     cull: wgpu::ComputePipeline,
     occlude: wgpu::ComputePipeline,
     hiz_copy: wgpu::ComputePipeline,
@@ -324,7 +323,6 @@ pub struct Renderer {
     font: wgpu::TextureView,
     timestamps: bool,
     max_side: u32,
-    errors: Arc<Mutex<Option<String>>>,
 }
 
 const COLOUR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -337,61 +335,26 @@ pub const MAX_TEXTURE_BYTES: u64 = 512 << 20;
 /// Background, written as is (not gamma corrected).
 const BACKGROUND: wgpu::Color = wgpu::Color { r: 0.10, g: 0.10, b: 0.12, a: 1.0 };
 
-fn shader(parts: &[&str]) -> String {
-    let mut s = include_str!("shaders/frame.wgsl").to_string();
-    for p in parts {
-        s.push('\n');
-        s.push_str(p);
-    }
-    s
-}
+/// The definitions the frame's shaders start with.
+const FRAME: &str = include_str!("shaders/frame.wgsl");
 
 impl Renderer {
     /// Opens the default adapter (high performance preferred).
     pub fn new() -> Result<Renderer, ViewError> {
-        // Vulkan, Metal and DX12 (`WGPU_BACKEND` chooses others): OpenGL's
-        // EGL setup probes for a Wayland display and, headless without
-        // `XDG_RUNTIME_DIR`, prints "error:" lines for runs that succeed.
-        let backends = wgpu::Backends::PRIMARY;
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor { backends, ..wgpu::InstanceDescriptor::new_without_display_handle() }.with_env());
-        Renderer::open(&instance, None)
+        Renderer::open(&wgpu::Instance::new(topovox_gpu::headless()), None)
     }
 
     /// Opens an adapter of `instance` (one that can present to `surface`,
     /// when given).
     pub fn open(instance: &wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Renderer, ViewError> {
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            compatible_surface: surface,
-            ..Default::default()
-        }))
-        .map_err(|_| ViewError::NoAdapter)?;
-        let info = adapter.get_info();
-        let limits = adapter.limits();
-        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("topovox view"),
-            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
-            required_limits: wgpu::Limits {
-                max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
-                max_buffer_size: limits.max_buffer_size,
-                max_texture_dimension_2d: limits.max_texture_dimension_2d,
-                max_texture_array_layers: limits.max_texture_array_layers,
-                ..wgpu::Limits::downlevel_defaults()
-            },
-            experimental_features: wgpu::ExperimentalFeatures::disabled(),
-            memory_hints: wgpu::MemoryHints::Performance,
-            trace: wgpu::Trace::Off,
-        }))
-        .map_err(|e| ViewError::Device(e.to_string()))?;
-        let errors: Arc<Mutex<Option<String>>> = Arc::default();
-        let sink = errors.clone();
-        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-            if let Ok(mut slot) = sink.lock() {
-                slot.get_or_insert_with(|| e.to_string().lines().next().unwrap_or("unknown error").to_string());
-            }
-        }));
+        let dev = Device::open(
+            instance,
+            &DeviceOptions { label: "topovox view", surface, required: &[], optional: wgpu::Features::TIMESTAMP_QUERY },
+        )?;
+        let timestamps = dev.features.contains(wgpu::Features::TIMESTAMP_QUERY);
+        let limits = dev.limits.clone();
+        let device = &dev.device;
+        let queue = &dev.queue;
 
         let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry {
             binding,
@@ -439,10 +402,7 @@ impl Renderer {
         let pipeline_layout = |layouts: &[Option<&wgpu::BindGroupLayout>]| {
             device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: None, bind_group_layouts: layouts, immediate_size: 0 })
         };
-        let cull_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("cull"),
-            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/cull.wgsl")]).into()),
-        });
+        let cull_module = dev.shader("cull", &[FRAME, include_str!("shaders/cull.wgsl")]);
         let compute = |label, layouts: &[Option<&wgpu::BindGroupLayout>], module, entry| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(label),
@@ -481,10 +441,7 @@ impl Renderer {
                 },
             ],
         });
-        let hiz_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("hiz"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("shaders/hiz.wgsl").into()),
-        });
+        let hiz_module = dev.shader("hiz", &[include_str!("shaders/hiz.wgsl")]);
         let hiz_copy = compute("hiz copy", &[Some(&hiz_layout)], &hiz_module, "copy_depth");
         let grid_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("light grid"),
@@ -496,18 +453,12 @@ impl Renderer {
                 entry(4, S::COMPUTE, Storage { read_only: false }),
             ],
         });
-        let grid_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("light grid"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("shaders/grid.wgsl").into()),
-        });
+        let grid_module = dev.shader("light grid", &[include_str!("shaders/grid.wgsl")]);
         let grid_count = compute("light grid count", &[Some(&grid_layout)], &grid_module, "count");
         let grid_scan = compute("light grid scan", &[Some(&grid_layout)], &grid_module, "scan");
         let grid_fill = compute("light grid fill", &[Some(&grid_layout)], &grid_module, "fill");
         let hiz_reduce = compute("hiz reduce", &[Some(&hiz_layout)], &hiz_module, "reduce");
-        let shade_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("shade"),
-            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/shade.wgsl"), include_str!("shaders/points.wgsl")]).into()),
-        });
+        let shade_module = dev.shader("shade", &[FRAME, include_str!("shaders/shade.wgsl"), include_str!("shaders/points.wgsl")]);
         let shade_pl = pipeline_layout(&[Some(&shade_layout)]);
         let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x3, 3 => Float32x2];
         let colour_target = [Some(wgpu::ColorTargetState { format: COLOUR, blend: None, write_mask: wgpu::ColorWrites::ALL })];
@@ -520,7 +471,7 @@ impl Renderer {
         // cut-out texels neither hide nor occlude anything.
         let draw = |label, colour: bool, write: bool, compare| {
             render_pipeline(
-                &device,
+                device,
                 PipelineParts {
                     label,
                     layout: &shade_pl,
@@ -535,7 +486,7 @@ impl Renderer {
         };
         let point_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x3, 4 => Float32x3];
         let points = render_pipeline(
-            &device,
+            device,
             PipelineParts {
                 label: "spray points",
                 layout: &shade_pl,
@@ -551,7 +502,7 @@ impl Renderer {
                 targets: &colour_target,
             },
         );
-        let boxes = adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE).then(|| {
+        let boxes = dev.adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE).then(|| {
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("cluster boxes"),
                 entries: &[
@@ -560,12 +511,9 @@ impl Renderer {
                     entry(2, S::VERTEX, Storage { read_only: true }),
                 ],
             });
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("cluster boxes"),
-                source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/boxes.wgsl")]).into()),
-            });
+            let module = dev.shader("cluster boxes", &[FRAME, include_str!("shaders/boxes.wgsl")]);
             let pipeline = render_pipeline(
-                &device,
+                device,
                 PipelineParts {
                     label: "cluster boxes",
                     layout: &pipeline_layout(&[Some(&layout)]),
@@ -595,13 +543,10 @@ impl Renderer {
                 },
             ],
         });
-        let text_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("overlay text"),
-            source: wgpu::ShaderSource::Wgsl(shader(&[include_str!("shaders/text.wgsl")]).into()),
-        });
+        let text_module = dev.shader("overlay text", &[FRAME, include_str!("shaders/text.wgsl")]);
         let glyph_attributes = wgpu::vertex_attr_array![0 => Float32x2, 1 => Uint32];
         let text = render_pipeline(
-            &device,
+            device,
             PipelineParts {
                 label: "overlay text",
                 layout: &pipeline_layout(&[Some(&text_layout)]),
@@ -617,16 +562,13 @@ impl Renderer {
                 targets: &colour_target,
             },
         );
-        let font = font_atlas(&device, &queue);
+        let font = font_atlas(device, queue);
         let prepass = draw("prepass", false, true, wgpu::CompareFunction::Less);
         let shade = draw("shade", true, true, wgpu::CompareFunction::Less);
         let shade_equal = draw("shade after prepass", true, false, wgpu::CompareFunction::Equal);
         let shade_lequal = draw("shade over a partial prepass", true, true, wgpu::CompareFunction::LessEqual);
         let r = Renderer {
-            adapter,
-            device,
-            queue,
-            info,
+            dev,
             cull,
             occlude,
             hiz_copy,
@@ -650,7 +592,6 @@ impl Renderer {
             font,
             timestamps,
             max_side: limits.max_texture_dimension_2d,
-            errors,
         };
         r.check()?;
         Ok(r)
@@ -658,7 +599,7 @@ impl Renderer {
 
     /// Shows a window's surface texture.
     pub fn present_texture(&self, texture: wgpu::SurfaceTexture) {
-        self.queue.present(texture);
+        self.dev.queue.present(texture);
     }
 
     /// The largest picture side the adapter takes.
@@ -668,14 +609,11 @@ impl Renderer {
 
     /// The adapter's name and backend.
     pub fn adapter(&self) -> String {
-        format!("{} ({:?})", self.info.name, self.info.backend)
+        self.dev.adapter_name()
     }
 
     fn check(&self) -> Result<(), ViewError> {
-        match self.errors.lock().ok().and_then(|mut e| e.take()) {
-            Some(e) => Err(ViewError::Device(e)),
-            None => Ok(()),
-        }
+        Ok(self.dev.check()?)
     }
 
     /// Partitions the scene, builds its lights and light grid, and uploads it.
@@ -684,7 +622,7 @@ impl Renderer {
         let part = Partition::new(scene);
         let (lights, report) = lights(scene);
         let t_grid = Instant::now();
-        let light_buf = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let light_buf = self.dev.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("lights"),
             contents: bytemuck::cast_slice(&nonempty(&lights)),
             usage: wgpu::BufferUsages::STORAGE,
@@ -692,7 +630,7 @@ impl Renderer {
         let (grid, ranges, light_indices) = self.light_grid(scene, &light_buf, lights.len() as u32)?;
         let grid_ms = t_grid.elapsed().as_secs_f64() * 1e3;
         let init = |label, contents: &[u8], usage| {
-            self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+            self.dev.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
         use wgpu::BufferUsages as U;
         let vertices = init("vertices", bytemuck::cast_slice(&scene.vertices), U::VERTEX);
@@ -704,7 +642,7 @@ impl Renderer {
         let commands = init("commands", bytemuck::cast_slice(&commands_init), U::STORAGE | U::INDIRECT | U::COPY_DST | U::COPY_SRC);
         let counters = init("counters", &[0u8; 16], U::STORAGE | U::COPY_DST | U::COPY_SRC);
         let prev_commands = init("previous commands", bytemuck::cast_slice(&commands_init), U::INDIRECT | U::COPY_DST);
-        let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
+        let uniform = self.dev.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame"),
             size: std::mem::size_of::<FrameUniform>() as u64,
             usage: U::UNIFORM | U::COPY_DST,
@@ -714,7 +652,7 @@ impl Renderer {
         let textures = self.texture_array(&scene.textures)?;
         let texture_view = textures
             .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
-        let sampler = self.device.create_sampler(&wgpu::SamplerDescriptor {
+        let sampler = self.dev.device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("textures"),
             address_mode_u: wgpu::AddressMode::Repeat,
             address_mode_v: wgpu::AddressMode::Repeat,
@@ -725,11 +663,11 @@ impl Renderer {
         let group = |layout, entries: &[(u32, &wgpu::Buffer)]| {
             let entries: Vec<wgpu::BindGroupEntry> =
                 entries.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
-            self.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout, entries: &entries })
+            self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout, entries: &entries })
         };
         let cull_group = group(&self.cull_layout, &[(0, &uniform), (1, &boxes), (2, &commands), (3, &counters)]);
         let boxes_group = self.boxes.as_ref().map(|(_, layout)| group(layout, &[(0, &uniform), (1, &boxes), (2, &commands)]));
-        let text_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let text_group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("overlay text"),
             layout: &self.text_layout,
             entries: &[
@@ -742,7 +680,7 @@ impl Renderer {
             buffers.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
         entries.push(wgpu::BindGroupEntry { binding: 8, resource: wgpu::BindingResource::TextureView(&texture_view) });
         entries.push(wgpu::BindGroupEntry { binding: 9, resource: wgpu::BindingResource::Sampler(&sampler) });
-        let shade_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let shade_group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shade"),
             layout: &self.shade_layout,
             entries: &entries,
@@ -780,15 +718,15 @@ impl Renderer {
     /// [`MAX_TEXTURE_BYTES`]. One white texel when there is none.
     fn texture_array(&self, textures: &[topovox::attributes::Texture]) -> Result<wgpu::Texture, ViewError> {
         let layers = textures.len().max(1) as u32;
-        let max_layers = self.device.limits().max_texture_array_layers;
+        let max_layers = self.dev.device.limits().max_texture_array_layers;
         if layers > max_layers {
-            return Err(ViewError::Device(format!("{layers} textures: this adapter takes at most {max_layers} in one array")));
+            return Err(ViewError::device(format!("{layers} textures: this adapter takes at most {max_layers} in one array")));
         }
         let mut side = textures.iter().map(|t| t.width.max(t.height)).max().unwrap_or(1).clamp(1, MAX_TEXTURE_SIDE.min(self.max_side));
         while side > 1 && u64::from(side) * u64::from(side) * 4 * u64::from(layers) > MAX_TEXTURE_BYTES {
             side /= 2;
         }
-        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
+        let texture = self.dev.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("textures"),
             size: wgpu::Extent3d { width: side, height: side, depth_or_array_layers: layers },
             mip_level_count: 1,
@@ -806,11 +744,11 @@ impl Renderer {
                 Some(t) => match image::RgbaImage::from_raw(t.width, t.height, t.rgba.clone()) {
                     Some(img) => image::imageops::resize(&img, side, side, image::imageops::FilterType::Triangle).into_raw(),
                     None => {
-                        return Err(ViewError::Device(format!("texture {}: {} bytes for {}x{}", t.name, t.rgba.len(), t.width, t.height)))
+                        return Err(ViewError::device(format!("texture {}: {} bytes for {}x{}", t.name, t.rgba.len(), t.width, t.height)))
                     }
                 },
             };
-            self.queue.write_texture(
+            self.dev.queue.write_texture(
                 wgpu::TexelCopyTextureInfo {
                     texture: &texture,
                     mip_level: 0,
@@ -834,28 +772,28 @@ impl Renderer {
         }
         let stride = std::mem::size_of::<SprayPoint>() as u64;
         let count = u64::from(s.point_count) + points.len() as u64;
-        let max = self.device.limits().max_buffer_size / stride;
+        let max = self.dev.device.limits().max_buffer_size / stride;
         if count > max.min(u64::from(u32::MAX)) {
-            return Err(ViewError::Device(format!("{count} spray points exceed this adapter's largest buffer ({max} points)")));
+            return Err(ViewError::device(format!("{count} spray points exceed this adapter's largest buffer ({max} points)")));
         }
         let capacity = s.points.as_ref().map_or(0, |b| b.size() / stride);
         if count > capacity {
             let size = count.max(2 * capacity).max(1024).min(max) * stride;
-            let grown = self.device.create_buffer(&wgpu::BufferDescriptor {
+            let grown = self.dev.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("spray points"),
                 size,
                 usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
             if let Some(old) = &s.points {
-                let mut enc = self.device.create_command_encoder(&Default::default());
+                let mut enc = self.dev.device.create_command_encoder(&Default::default());
                 enc.copy_buffer_to_buffer(old, 0, &grown, 0, u64::from(s.point_count) * stride);
-                self.queue.submit([enc.finish()]);
+                self.dev.queue.submit([enc.finish()]);
             }
             s.points = Some(grown);
         }
         let buffer = s.points.as_ref().expect("grown above");
-        self.queue.write_buffer(buffer, u64::from(s.point_count) * stride, bytemuck::cast_slice(points));
+        self.dev.queue.write_buffer(buffer, u64::from(s.point_count) * stride, bytemuck::cast_slice(points));
         s.point_count = count as u32;
         self.check()
     }
@@ -876,7 +814,7 @@ impl Renderer {
             })
             .collect();
         s.overlay = (!glyphs.is_empty()).then(|| {
-            let buffer = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            let buffer = self.dev.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("overlay glyphs"),
                 contents: bytemuck::cast_slice(&glyphs),
                 usage: wgpu::BufferUsages::VERTEX,
@@ -905,11 +843,8 @@ impl Renderer {
 
     /// A pipeline copying frames onto textures of `format`.
     pub fn blit(&self, format: wgpu::TextureFormat) -> Blit {
-        let module = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("blit"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("shaders/blit.wgsl").into()),
-        });
-        let layout = self.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let module = self.dev.shader("blit", &[include_str!("shaders/blit.wgsl")]);
+        let layout = self.dev.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("blit"),
             entries: &[wgpu::BindGroupLayoutEntry {
                 binding: 0,
@@ -922,12 +857,12 @@ impl Renderer {
                 count: None,
             }],
         });
-        let pl = self.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        let pl = self.dev.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: None,
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = self.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let pipeline = self.dev.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("blit"),
             layout: Some(&pl),
             vertex: wgpu::VertexState { module: &module, entry_point: Some("vs"), compilation_options: Default::default(), buffers: &[] },
@@ -951,7 +886,7 @@ impl Renderer {
             return Err(ViewError::Size { width: o.width, height: o.height, max: self.max_side });
         }
         if o.boxes && self.boxes.is_none() {
-            return Err(ViewError::Device(
+            return Err(ViewError::device(
                 "the cluster-box wireframe needs vertex shaders that read storage buffers, which this adapter lacks".into(),
             ));
         }
@@ -971,12 +906,16 @@ impl Renderer {
             grid_cell: s.grid.cell.extend(s.grid_max as f32).to_array(),
             params: [n, u32::from(o.culling != Culling::None), flags, o.width | (o.height << 16)],
         };
-        self.queue.write_buffer(&s.uniform, 0, bytemuck::bytes_of(&u));
-        self.queue.write_buffer(&s.commands, 0, bytemuck::cast_slice(&s.commands_init));
-        self.queue.write_buffer(&s.counters, 0, &[0u8; 16]);
+        self.dev.queue.write_buffer(&s.uniform, 0, bytemuck::bytes_of(&u));
+        self.dev.queue.write_buffer(&s.commands, 0, bytemuck::cast_slice(&s.commands_init));
+        self.dev.queue.write_buffer(&s.counters, 0, &[0u8; 16]);
 
         let queries = self.timestamps.then(|| {
-            self.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("pass times"), ty: wgpu::QueryType::Timestamp, count: 8 })
+            self.dev.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("pass times"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 8,
+            })
         });
         let stamp = |i: u32| {
             queries.as_ref().map(|q| wgpu::RenderPassTimestampWrites {
@@ -985,7 +924,7 @@ impl Renderer {
                 end_of_pass_write_index: Some(2 * i + 1),
             })
         };
-        let mut enc = self.device.create_command_encoder(&Default::default());
+        let mut enc = self.dev.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("cull"),
@@ -1000,7 +939,7 @@ impl Renderer {
             pass.dispatch_workgroups(n.div_ceil(64).max(1), 1, 1);
         }
         let texture = |format, usage| {
-            self.device.create_texture(&wgpu::TextureDescriptor {
+            self.dev.device.create_texture(&wgpu::TextureDescriptor {
                 label: None,
                 size: wgpu::Extent3d { width: o.width, height: o.height, depth_or_array_layers: 1 },
                 mip_level_count: 1,
@@ -1113,7 +1052,7 @@ impl Renderer {
         enc.copy_buffer_to_buffer(&s.commands, 0, &s.prev_commands, 0, 20 * n.max(1) as u64);
         let row = aligned_row(o.width);
         let readback = |label, size| {
-            self.device.create_buffer(&wgpu::BufferDescriptor {
+            self.dev.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
                 size,
                 usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
@@ -1123,7 +1062,7 @@ impl Renderer {
         let pixels = present.is_none().then(|| readback("picture", row as u64 * o.height as u64));
         match (present, &pixels) {
             (Some((blit, target)), _) => {
-                let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                let group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: None,
                     layout: &blit.layout,
                     entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&cview) }],
@@ -1170,7 +1109,7 @@ impl Renderer {
         let counts = readback("counters", 16);
         enc.copy_buffer_to_buffer(&s.counters, 0, &counts, 0, 16);
         let times = queries.as_ref().map(|q| {
-            let resolve = self.device.create_buffer(&wgpu::BufferDescriptor {
+            let resolve = self.dev.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("timestamps"),
                 size: 64,
                 usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
@@ -1181,27 +1120,27 @@ impl Renderer {
             enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, 64);
             read
         });
-        self.queue.submit([enc.finish()]);
+        self.dev.queue.submit([enc.finish()]);
         let mapped: Vec<&wgpu::Buffer> = [pixels.as_ref(), Some(&cmds), Some(&counts), times.as_ref()]
             .into_iter()
             .flatten()
             .chain(hiz_read.iter().flat_map(|(bufs, _)| bufs.iter()))
             .collect();
-        self.map_all(&mapped)?;
+        self.dev.map_all(&mapped.iter().map(|b| b.slice(..)).collect::<Vec<_>>())?;
         let mut rgba = Vec::with_capacity(4 * o.width as usize * o.height as usize);
         if let Some(pixels) = &pixels {
-            let data = pixels.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
+            let data = pixels.slice(..).get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
             for y in 0..o.height as usize {
                 rgba.extend_from_slice(&data[y * row as usize..y * row as usize + 4 * o.width as usize]);
             }
         }
         let kept: Vec<bool> = {
-            let data = cmds.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
+            let data = cmds.slice(..).get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
             let words: &[u32] = bytemuck::cast_slice(&data);
             (0..n as usize).map(|c| words[5 * c + 1] != 0).collect()
         };
         let [after, drawn, after_occ, drawn_occ] = {
-            let data = counts.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
+            let data = counts.slice(..).get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
             let w: &[u32] = bytemuck::cast_slice(&data);
             [w[0], w[1], w[2], w[3]]
         };
@@ -1209,7 +1148,7 @@ impl Renderer {
             Some((bufs, sizes)) => {
                 let mut levels = Vec::with_capacity(bufs.len());
                 for (b, [w, h]) in bufs.iter().zip(&sizes) {
-                    let data = b.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
+                    let data = b.slice(..).get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
                     let row = aligned_row(*w) as usize;
                     let mut level = Vec::with_capacity((*w * *h) as usize);
                     for y in 0..*h as usize {
@@ -1223,9 +1162,9 @@ impl Renderer {
         };
         let gpu = match times {
             Some(t) => {
-                let data = t.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?;
+                let data = t.slice(..).get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
                 let w: &[u64] = bytemuck::cast_slice(&data);
-                let period = self.queue.get_timestamp_period() as f64 * 1e-6;
+                let period = self.dev.queue.get_timestamp_period() as f64 * 1e-6;
                 let span = |i: usize| w[2 * i + 1].saturating_sub(w[2 * i]) as f64 * period;
                 Some(PassTimes {
                     cull_ms: span(0),
@@ -1268,7 +1207,7 @@ impl Renderer {
         queries: Option<&wgpu::QuerySet>,
     ) -> (wgpu::Texture, Vec<[u32; 2]>) {
         let ([w0, h0], count) = pyramid_size(o.width, o.height);
-        let tex = self.device.create_texture(&wgpu::TextureDescriptor {
+        let tex = self.dev.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("hi-z"),
             size: wgpu::Extent3d { width: w0, height: h0, depth_or_array_layers: 1 },
             mip_level_count: count,
@@ -1295,7 +1234,7 @@ impl Renderer {
                     &dummy
                 }
             };
-            let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            let group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: None,
                 layout: &self.hiz_layout,
                 entries: &[
@@ -1318,7 +1257,7 @@ impl Renderer {
             pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
         }
         let all = tex.create_view(&Default::default());
-        let read_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let read_group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
             layout: &self.hiz_read_layout,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&all) }],
@@ -1348,19 +1287,19 @@ impl Renderer {
         let (lo, cell, unit) = grid_frame(scene);
         let cells = (GRID * GRID * GRID) as u64;
         let u = GridUniform { lo: lo.extend(0.0).to_array(), cell: cell.extend(0.0).to_array(), counts: [count, 0, 0, 0] };
-        let uniform = self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let uniform = self.dev.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("light grid"),
             contents: bytemuck::bytes_of(&u),
             usage: U::UNIFORM,
         });
         let buffer = |label, size: u64, usage| {
-            self.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+            self.dev.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
         let ranges = buffer("light ranges", 8 * cells, U::STORAGE | U::COPY_SRC);
         let total = buffer("light total", 4, U::STORAGE | U::COPY_SRC);
         let placeholder = buffer("no light indices yet", 4, U::STORAGE);
         let group = |indices: &wgpu::Buffer| {
-            self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: None,
                 layout: &self.grid_layout,
                 entries: &[
@@ -1373,7 +1312,7 @@ impl Renderer {
             })
         };
         let groups = (cells as u32).div_ceil(64);
-        let mut enc = self.device.create_command_encoder(&Default::default());
+        let mut enc = self.dev.device.create_command_encoder(&Default::default());
         {
             let g = group(&placeholder);
             let mut pass = enc.begin_compute_pass(&Default::default());
@@ -1386,7 +1325,7 @@ impl Renderer {
         let total_read = self.read_buffers(enc, &[(&total, 4)])?;
         let n = u32::from_le_bytes(total_read[0][..4].try_into().expect("4 bytes")) as u64;
         let indices = buffer("light indices", 4 * n.max(1), U::STORAGE | U::COPY_SRC);
-        let mut enc = self.device.create_command_encoder(&Default::default());
+        let mut enc = self.dev.device.create_command_encoder(&Default::default());
         {
             let g = group(&indices);
             let mut pass = enc.begin_compute_pass(&Default::default());
@@ -1402,49 +1341,14 @@ impl Renderer {
 
     /// Submits `enc` after copying each buffer's first bytes to a readback
     /// buffer, waits, and returns the bytes.
-    fn read_buffers(&self, mut enc: wgpu::CommandEncoder, bufs: &[(&wgpu::Buffer, u64)]) -> Result<Vec<Vec<u8>>, ViewError> {
-        let reads: Vec<wgpu::Buffer> = bufs
-            .iter()
-            .map(|(b, size)| {
-                let r = self.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("readback"),
-                    size: *size,
-                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                });
-                enc.copy_buffer_to_buffer(b, 0, &r, 0, *size);
-                r
-            })
-            .collect();
-        self.queue.submit([enc.finish()]);
-        self.map_all(&reads.iter().collect::<Vec<_>>())?;
-        reads.iter().map(|b| Ok(b.slice(..).get_mapped_range().map_err(|e| ViewError::Readback(e.to_string()))?.to_vec())).collect()
-    }
-
-    /// Maps every buffer for reading and waits until all are (after the
-    /// submitted work that fills them).
-    fn map_all(&self, bufs: &[&wgpu::Buffer]) -> Result<(), ViewError> {
-        let rx: Vec<_> = bufs
-            .iter()
-            .map(|b| {
-                let (tx, rx) = std::sync::mpsc::channel();
-                b.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-                    let _ = tx.send(r);
-                });
-                rx
-            })
-            .collect();
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| ViewError::Device(e.to_string()))?;
-        self.check()?;
-        for rx in rx {
-            rx.recv().map_err(|e| ViewError::Readback(e.to_string()))?.map_err(|e| ViewError::Readback(e.to_string()))?;
-        }
-        Ok(())
+    fn read_buffers(&self, enc: wgpu::CommandEncoder, bufs: &[(&wgpu::Buffer, u64)]) -> Result<Vec<Vec<u8>>, ViewError> {
+        Ok(self.dev.read_buffers(enc, bufs)?)
     }
 
     /// A 1×1 float texture view, bound where a pass reads no source level.
     fn dummy_float(&self) -> wgpu::TextureView {
-        self.device
+        self.dev
+            .device
             .create_texture(&wgpu::TextureDescriptor {
                 label: Some("unused"),
                 size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
@@ -1466,7 +1370,7 @@ impl Renderer {
             .enumerate()
             .map(|(l, &[w, h])| {
                 let row = aligned_row(w);
-                let buf = self.device.create_buffer(&wgpu::BufferDescriptor {
+                let buf = self.dev.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("hi-z level readback"),
                     size: row as u64 * h as u64,
                     usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,

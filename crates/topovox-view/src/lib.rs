@@ -50,15 +50,10 @@ use thiserror::Error;
 /// Why a frame could not be rendered.
 #[derive(Debug, Error)]
 pub enum ViewError {
-    /// No adapter (no Vulkan/Metal/DX12 driver).
-    #[error("no GPU adapter found (install a Vulkan driver; on Linux without a GPU, Mesa's lavapipe: apt install mesa-vulkan-drivers)")]
-    NoAdapter,
-    /// The device could not be created, or reported an error.
-    #[error("GPU device: {0}")]
-    Device(String),
-    /// The picture could not be read back.
-    #[error("GPU readback failed: {0}")]
-    Readback(String),
+    /// The device layer (`topovox_gpu::device`): no adapter, a device
+    /// error, a failed readback.
+    #[error(transparent)]
+    Gpu(#[from] topovox_gpu::GpuError),
     /// Nothing to draw.
     #[error("the scene has no drawable triangles")]
     EmptyScene,
@@ -75,4 +70,11 @@ pub enum ViewError {
         /// The adapter's largest texture side.
         max: u32,
     },
+}
+
+impl ViewError {
+    /// A device error with this message.
+    pub fn device(msg: String) -> ViewError {
+        ViewError::Gpu(topovox_gpu::GpuError::Device(msg))
+    }
 }

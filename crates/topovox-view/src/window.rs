@@ -211,7 +211,7 @@ impl App {
         let renderer = Renderer::open(&instance, Some(&surface))?;
         let size = window.inner_size();
         let mut config = surface
-            .get_default_config(&renderer.adapter, size.width.max(1), size.height.max(1))
+            .get_default_config(&renderer.dev.adapter, size.width.max(1), size.height.max(1))
             .ok_or_else(|| ViewError::Window("the adapter cannot present to this window".into()))?;
         // The frame is already gamma-corrected (or not, as asked): present
         // it through a non-sRGB view so the bytes are shown as they are.
@@ -220,7 +220,7 @@ impl App {
             config.view_formats = vec![view_format];
         }
         config.present_mode = wgpu::PresentMode::AutoVsync;
-        surface.configure(&renderer.device, &config);
+        surface.configure(&renderer.dev.device, &config);
         let mut uploaded = renderer.upload(&self.scene)?;
         renderer.add_points(&mut uploaded, &self.points)?;
         let blit = renderer.blit(view_format);
@@ -250,7 +250,7 @@ impl App {
         let texture = match a.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                a.surface.configure(&a.renderer.device, &a.config);
+                a.surface.configure(&a.renderer.dev.device, &a.config);
                 return;
             }
             _ => return,
@@ -381,7 +381,7 @@ impl ApplicationHandler for App {
                 if let Some(a) = &mut self.active {
                     a.config.width = size.width.clamp(1, a.renderer.max_side());
                     a.config.height = size.height.clamp(1, a.renderer.max_side());
-                    a.surface.configure(&a.renderer.device, &a.config);
+                    a.surface.configure(&a.renderer.dev.device, &a.config);
                 }
             }
             WindowEvent::RedrawRequested => self.draw(event_loop),

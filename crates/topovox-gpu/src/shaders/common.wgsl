@@ -10,13 +10,15 @@ struct Params {
     nk: u32,
     words_per_row: u32,
     count: u32,
-    // 0 cover, 1 sep26, 2 sep6 (bit 4: the rasterizer draws bounding rectangles).
+    // 0 cover, 1 sep26, 2 sep6 (bits 0-1); QUADS (16): the rasterizer
+    // draws bounding rectangles. The Rust twin is params.rs (a test checks
+    // the two agree).
     mode: u32,
     // The rasterizer's viewport side N.
-    pad_n: u32,
+    side: u32,
+    pad0: u32,
     pad1: u32,
     pad2: u32,
-    pad3: u32,
 };
 
 fn cross64(p: vec3<i64>, q: vec3<i64>) -> vec3<i64> {

@@ -58,7 +58,7 @@ fn vs(@builtin(vertex_index) vi: u32) -> VOut {
     } else {
         at = projected(t, s)[corner];
     }
-    let side = f32(params.pad_n);
+    let side = f32(params.side);
     out.pos = vec4<f32>(at.x / side * 2.0 - 1.0, 1.0 - at.y / side * 2.0, 0.5, 1.0);
     return out;
 }
