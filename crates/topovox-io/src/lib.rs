@@ -30,6 +30,7 @@ pub mod points;
 pub mod polyline;
 mod resources;
 pub mod schem;
+pub mod spray_cloud;
 pub mod stl;
 pub mod svg;
 pub mod text;

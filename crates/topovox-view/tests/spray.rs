@@ -3,7 +3,8 @@
 //! term converges to the integral it estimates, and the PLY round-trips.
 
 use glam::Vec3;
-use topovox_view::spray::{read_ply, write_ply, SprayOptions, SprayPoint, Tracer};
+use topovox_io::spray_cloud::{read_ply, write_ply, SprayPoint};
+use topovox_view::spray::{SprayOptions, Tracer};
 use topovox_view::{scenes, Camera, Scene};
 
 fn cornell() -> Scene {

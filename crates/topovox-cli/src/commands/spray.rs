@@ -8,7 +8,8 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use serde_json::json;
 use topovox::glam::Vec3;
-use topovox_view::spray::{write_ply, SprayOptions, Tracer};
+use topovox_io::spray_cloud::write_ply;
+use topovox_view::spray::{SprayOptions, Tracer};
 use topovox_view::Camera;
 
 use crate::args::SprayArgs;

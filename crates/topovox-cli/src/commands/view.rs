@@ -88,7 +88,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
     };
     let report = run_window(scene, points, opts)?;
     if let Some(p) = &a.save_points {
-        topovox_io::atomic::write_atomically(p, |w| topovox_view::spray::write_ply(w, &report.points))?;
+        topovox_io::atomic::write_atomically(p, |w| topovox_io::spray_cloud::write_ply(w, &report.points))?;
     }
     let mut shot = None;
     if let (Some(p), Some(f)) = (&a.screenshot, &report.screenshot) {
