@@ -19,7 +19,7 @@
 //!   failures while running (no GPU, not enough memory).
 
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2, Array3};
@@ -39,9 +39,30 @@ use topovox_job::{JobError, JobOptions, OptionValue, Voxels};
 pyo3::create_exception!(_topovox, FileFormatError, PyOSError, "A file's content does not follow its format (the message names the file).");
 
 /// A [`JobError`] as the Python exception the package documents.
+/// A message in Python's terms: the command line's `--voxel-size` is the
+/// keyword `voxel_size`.
+fn python_terms(msg: &str) -> String {
+    let mut out = String::with_capacity(msg.len());
+    let mut rest = msg;
+    while let Some(at) = rest.find("--") {
+        out.push_str(&rest[..at]);
+        let flag = &rest[at + 2..];
+        let end = flag.find(|c: char| !(c.is_ascii_alphanumeric() || c == '-')).unwrap_or(flag.len());
+        if end > 0 && flag.as_bytes()[0].is_ascii_lowercase() {
+            out.push_str(&flag[..end].replace('-', "_"));
+        } else {
+            out.push_str("--");
+            out.push_str(&flag[..end]);
+        }
+        rest = &flag[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
 fn py_err(e: JobError) -> PyErr {
     match e {
-        JobError::Invalid(m) => PyValueError::new_err(m),
+        JobError::Invalid(m) => PyValueError::new_err(python_terms(&m)),
         JobError::Failed(m) => PyRuntimeError::new_err(m),
         JobError::Io(io) => io_err(io),
         JobError::Interrupted => PyKeyboardInterrupt::new_err("interrupted"),
@@ -161,6 +182,27 @@ fn indices_from<const K: usize>(name: &str, a: &Bound<'_, PyAny>) -> PyResult<Ve
     Err(shape_or_dtype(name, a, &format!("(n, {K}) int64, int32, uint32 or uint64")))
 }
 
+/// Face colours as materials: one plain material per distinct colour.
+fn face_materials(app: &mut topovox::attributes::Appearance, colours: &[[u8; 3]]) {
+    let mut index: std::collections::HashMap<[u8; 3], u32> = std::collections::HashMap::new();
+    for c in colours {
+        let next = app.materials.len() as u32;
+        let id = *index.entry(*c).or_insert_with(|| {
+            app.materials.push(topovox::attributes::Material {
+                name: format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2]),
+                factor: c.map(|x| topovox::attributes::colour::to_linear(x) as f32),
+                texture: None,
+                emission: [0.0; 3],
+                roughness: topovox::attributes::DEFAULT_ROUGHNESS,
+                alpha_cutoff: None,
+                alpha_texture: None,
+            });
+            next
+        });
+        app.triangle_material.push(id);
+    }
+}
+
 /// A shape as Python prints it: `(3, 2)`, `(5,)`.
 fn shape(s: &[usize]) -> String {
     match s {
@@ -178,20 +220,34 @@ fn shape_or_dtype(name: &str, a: &Bound<'_, PyAny>, want: &str) -> PyErr {
 
 #[pymethods]
 impl Mesh {
-    /// Mesh(vertices, faces, segments=None): a mesh from arrays, validated
-    /// like a file (finite coordinates, indices in range).
+    /// Mesh(vertices, faces, segments=None, vertex_colours=None,
+    /// face_colours=None): a mesh from arrays, validated like a file
+    /// (finite coordinates, indices in range); colours are `(n, 3)` uint8
+    /// sRGB, one per vertex or per face (`topovox.as_mesh` converts
+    /// floats, RGBA and trimesh/Open3D colours).
     #[new]
-    #[pyo3(signature = (vertices, faces=None, segments=None))]
-    fn new(
-        py: Python<'_>,
-        vertices: &Bound<'_, PyAny>,
-        faces: Option<&Bound<'_, PyAny>>,
-        segments: Option<&Bound<'_, PyAny>>,
+    #[pyo3(signature = (vertices, faces=None, segments=None, vertex_colours=None, face_colours=None))]
+    fn new<'py>(
+        py: Python<'py>,
+        vertices: &Bound<'py, PyAny>,
+        faces: Option<&Bound<'py, PyAny>>,
+        segments: Option<&Bound<'py, PyAny>>,
+        vertex_colours: Option<&Bound<'py, PyAny>>,
+        face_colours: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Mesh> {
         let positions = points_from("vertices", vertices)?;
         let triangles = faces.map(|f| indices_from::<3>("faces", f)).transpose()?.unwrap_or_default();
         let segs = segments.map(|s| indices_from::<2>("segments", s)).transpose()?.unwrap_or_default();
-        let loaded = py.detach(|| topovox_io::validate_mesh(positions, triangles, segs)).map_err(|k| value_err(k.to_string()))?;
+        let (nv, nf) = (positions.len(), triangles.len());
+        let vc = vertex_colours.map(|c| rows_of::<u8, 3>("vertex_colours", &as_array(py, c, "uint8")?, nv)).transpose()?;
+        let fc = face_colours.map(|c| rows_of::<u8, 3>("face_colours", &as_array(py, c, "uint8")?, nf)).transpose()?;
+        let mut loaded = py.detach(|| topovox_io::validate_mesh(positions, triangles, segs)).map_err(|k| value_err(k.to_string()))?;
+        if let Some(vc) = vc {
+            loaded.appearance.vertex_colour = vc;
+        }
+        if let Some(fc) = fc {
+            face_materials(&mut loaded.appearance, &fc);
+        }
         Ok(Mesh { inner: Arc::new(loaded), path: None })
     }
 
@@ -300,6 +356,10 @@ struct GridData {
     grid: GridSpec,
     attrs: Option<VoxelAttributes>,
     facts: Value,
+    /// The dense array, made on first use (read-only: every caller shares it).
+    dense: OnceLock<Py<PyArray3<bool>>>,
+    /// The set voxels in C order with their attribute slots, made on first use.
+    order: OnceLock<Vec<([u32; 3], usize)>>,
 }
 
 /// A JSON value as Python objects.
@@ -331,17 +391,24 @@ fn to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
 }
 
 impl GridData {
+    fn new(voxels: Voxels, grid: GridSpec, attrs: Option<VoxelAttributes>, facts: Value) -> GridData {
+        GridData { voxels, grid, attrs, facts, dense: OnceLock::new(), order: OnceLock::new() }
+    }
+
     /// Set voxels in the order of `numpy.argwhere(occupancy)` (i, then j,
-    /// then k), each with its slot in key order (the attributes' order).
-    fn ordered(&self) -> Vec<([u32; 3], usize)> {
-        let mut v = Vec::with_capacity(self.voxels.count() as usize);
-        let mut slot = 0usize;
-        self.voxels.for_each_set(&mut |i, j, k| {
-            v.push(([i, j, k], slot));
-            slot += 1;
-        });
-        v.sort_unstable_by_key(|e| e.0);
-        v
+    /// then k), each with its slot in key order (the attributes' order);
+    /// sorted once.
+    fn ordered(&self) -> &[([u32; 3], usize)] {
+        self.order.get_or_init(|| {
+            let mut v = Vec::with_capacity(self.voxels.count() as usize);
+            let mut slot = 0usize;
+            self.voxels.for_each_set(&mut |i, j, k| {
+                v.push(([i, j, k], slot));
+                slot += 1;
+            });
+            v.sort_unstable_by_key(|e| e.0);
+            v
+        })
     }
 }
 
@@ -373,8 +440,15 @@ impl VoxelGrid {
         self.inner.voxels.count()
     }
 
+    /// `len(grid)`: the first axis, as NumPy's (`grid.count` counts the set voxels).
     fn __len__(&self) -> usize {
-        self.inner.voxels.count() as usize
+        self.inner.grid.dims()[0] as usize
+    }
+
+    /// `(nx, ny, nz)`, as NumPy's `shape`.
+    #[getter]
+    fn shape(&self) -> (u32, u32, u32) {
+        self.dims()
     }
 
     /// What made it: mode, method, grid, counts, times, solid and GPU facts.
@@ -383,14 +457,18 @@ impl VoxelGrid {
         to_py(py, &self.inner.facts)
     }
 
-    /// Dense occupancy, `(nx, ny, nz)` bool, element `[i, j, k]` = voxel `(i, j, k)`.
+    /// Dense occupancy, `(nx, ny, nz)` bool, element `[i, j, k]` = voxel
+    /// `(i, j, k)`: made once and shared, so read-only (`.copy()` to edit).
     #[getter]
     fn occupancy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<bool>>> {
+        if let Some(a) = self.inner.dense.get() {
+            return Ok(a.bind(py).clone());
+        }
         let [nx, ny, nz] = self.inner.grid.dims().map(|d| d as usize);
         let bytes = nx.checked_mul(ny).and_then(|n| n.checked_mul(nz)).ok_or_else(|| value_err("grid too large to densify"))?;
         if topovox_job::available_memory().is_some_and(|m| bytes as u64 > m / 2) {
             return Err(PyRuntimeError::new_err(format!(
-                "a dense {nx}x{ny}x{nz} occupancy needs {}; use .indices() for the set voxels",
+                "a dense {nx}x{ny}x{nz} occupancy needs {}; use .coords() for the set voxels",
                 topovox_job::bytes(bytes as u64)
             )));
         }
@@ -400,15 +478,44 @@ impl VoxelGrid {
             inner.voxels.for_each_set(&mut |i, j, k| a[(i as usize * ny + j as usize) * nz + k as usize] = true);
             a
         });
-        let arr = Array3::from_shape_vec((nx, ny, nz), dense).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
-        Ok(arr.into_pyarray(py))
+        let arr = Array3::from_shape_vec((nx, ny, nz), dense).map_err(|e| PyRuntimeError::new_err(e.to_string()))?.into_pyarray(py);
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("write", false)?;
+        arr.call_method("setflags", (), Some(&kwargs))?;
+        Ok(self.inner.dense.get_or_init(|| arr.clone().unbind()).bind(py).clone())
+    }
+
+    /// to_dense() -> (nx, ny, nz) bool: [`occupancy`](VoxelGrid.occupancy).
+    fn to_dense<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<bool>>> {
+        self.occupancy(py)
+    }
+
+    /// `numpy.asarray(grid)`: the dense occupancy (a copy when `dtype`
+    /// differs or `copy=True`).
+    #[pyo3(signature = (dtype=None, copy=None))]
+    fn __array__<'py>(&self, py: Python<'py>, dtype: Option<&Bound<'py, PyAny>>, copy: Option<bool>) -> PyResult<Bound<'py, PyAny>> {
+        let a = self.occupancy(py)?.into_any();
+        match (dtype, copy) {
+            (Some(d), _) => a.call_method1("astype", (d,)),
+            (None, Some(true)) => a.call_method0("copy"),
+            _ => Ok(a),
+        }
+    }
+
+    /// coords() -> (n, 3) int32: the set voxels sorted in C order (as
+    /// `numpy.argwhere(occupancy)`), aligned with `colours`, `normals`,
+    /// `coverage` and `materials`; sparse, for grids of any size.
+    fn coords<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i32>> {
+        let inner = self.inner.clone();
+        let v = py.detach(move || inner.ordered().iter().map(|e| e.0).collect::<Vec<_>>());
+        Array2::from_shape_fn((v.len(), 3), |(n, c)| v[n][c] as i32).into_pyarray(py)
     }
 
     /// indices() -> (k, 3) int64: the set voxels, in the order of
     /// `numpy.argwhere(occupancy)`; sparse, for grids too big to densify.
     fn indices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
         let inner = self.inner.clone();
-        let v = py.detach(move || inner.ordered());
+        let v = py.detach(move || inner.ordered().to_vec());
         Array2::from_shape_fn((v.len(), 3), |(n, c)| v[n].0[c] as i64).into_pyarray(py)
     }
 
@@ -478,9 +585,13 @@ impl VoxelGrid {
     /// thinness, tunnels). A tiled grid (past memory) is checked window by
     /// window without a dense copy (`sparse` is true in the report).
     #[pyo3(signature = (mesh=None))]
-    fn check<'py>(&self, py: Python<'py>, mesh: Option<&Mesh>) -> PyResult<Bound<'py, PyAny>> {
+    fn check<'py>(&self, py: Python<'py>, mesh: Option<&Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyAny>> {
         let inner = self.inner.clone();
-        let m = mesh.map(|m| m.inner.clone());
+        // Any mesh `voxelize` takes (trimesh, Open3D, arrays, a path).
+        let m = match mesh {
+            Some(m) => Some(py.import("topovox")?.getattr("as_mesh")?.call1((m,))?.cast_into::<Mesh>()?.get().inner.clone()),
+            None => None,
+        };
         let v = py
             .detach(move || {
                 let mesh = m.as_ref().map(|m| (m.mesh.as_ref(), &inner.grid, "grid"));
@@ -527,13 +638,29 @@ impl VoxelGrid {
         Ok((v, f, c))
     }
 
-    /// to_trimesh() -> trimesh.Trimesh: the mesh of the voxels (boundary
-    /// faces merged into greedy quads, two triangles each), coloured per
-    /// face when the grid carries colours. Needs `trimesh`.
+    /// to_trimesh() -> trimesh.voxel.VoxelGrid: the voxels with their
+    /// placement (voxel `(i, j, k)`'s centre at `transform @ (i, j, k, 1)`).
+    /// Needs `trimesh`.
     fn to_trimesh<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let trimesh = py.import("trimesh").map_err(|e| {
-            pyo3::exceptions::PyImportError::new_err(format!("VoxelGrid.to_trimesh needs trimesh (pip install trimesh): {e}"))
-        })?;
+        let trimesh = import_trimesh(py, "to_trimesh")?;
+        let (o, s) = (self.inner.grid.origin(), self.inner.grid.voxel_size());
+        let t = Array2::from_shape_fn((4, 4), |(r, c)| match (r, c) {
+            (r, c) if r == c && r < 3 => s,
+            (3, 3) => 1.0,
+            (r, 3) => o[r] + 0.5 * s,
+            _ => 0.0,
+        });
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("transform", t.into_pyarray(py))?;
+        let dense = self.occupancy(py)?.call_method0("copy")?;
+        trimesh.getattr("voxel")?.getattr("VoxelGrid")?.call((dense,), Some(&kwargs))
+    }
+
+    /// to_trimesh_mesh() -> trimesh.Trimesh: the mesh of the voxels
+    /// (boundary faces merged into greedy quads, watertight), coloured per
+    /// face when the grid carries colours. Needs `trimesh`.
+    fn to_trimesh_mesh<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let trimesh = import_trimesh(py, "to_trimesh_mesh")?;
         let (v, f, c) = self.greedy_mesh(py)?;
         let kwargs = PyDict::new(py);
         kwargs.set_item("vertices", v)?;
@@ -548,11 +675,166 @@ impl VoxelGrid {
         trimesh.getattr("Trimesh")?.call((), Some(&kwargs))
     }
 
+    /// VoxelGrid.from_coords(coords, dims, origin=(0, 0, 0), voxel_size=1.0,
+    /// colours=None, materials=None, normals=None, coverage=None): a grid
+    /// whose set voxels are the rows of `coords` ((n, 3) integers inside
+    /// `dims`, each once), with attributes aligned with those rows.
+    #[staticmethod]
+    #[pyo3(signature = (coords, dims, origin=None, voxel_size=1.0, colours=None, materials=None, normals=None, coverage=None, facts=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn from_coords<'py>(
+        py: Python<'py>,
+        coords: &Bound<'py, PyAny>,
+        dims: (u64, u64, u64),
+        origin: Option<(f64, f64, f64)>,
+        voxel_size: f64,
+        colours: Option<&Bound<'py, PyAny>>,
+        materials: Option<&Bound<'py, PyAny>>,
+        normals: Option<&Bound<'py, PyAny>>,
+        coverage: Option<&Bound<'py, PyAny>>,
+        facts: Option<String>,
+    ) -> PyResult<VoxelGrid> {
+        let o = origin.unwrap_or_default();
+        let grid = GridSpec::new(DVec3::new(o.0, o.1, o.2), voxel_size, [dims.0, dims.1, dims.2])
+            .map_err(|e| value_err(format!("invalid grid: {e}")))?;
+        let ijk = indices_from::<3>("coords", &as_array(py, coords, "int64")?)?;
+        let order = sorted_coords(&ijk, grid.dims())?;
+        let n = ijk.len();
+        let attr = |a: Option<&Bound<'py, PyAny>>, dtype: &str| a.map(|a| as_array(py, a, dtype)).transpose();
+        let (colours, materials, normals, coverage) =
+            (attr(colours, "uint8")?, attr(materials, "int64")?, attr(normals, "float32")?, attr(coverage, "float32")?);
+        let attrs = if colours.is_some() || materials.is_some() || normals.is_some() || coverage.is_some() {
+            fn perm<T: Copy>(v: Vec<T>, order: &[(u64, usize)]) -> Vec<T> {
+                order.iter().map(|&(_, r)| v[r]).collect()
+            }
+            Some(VoxelAttributes {
+                dims: grid.dims(),
+                keys: order.iter().map(|e| e.0).collect(),
+                colour: colours.map(|c| rows_of::<u8, 3>("colours", &c, n)).transpose()?.map(|c| perm(c, &order)),
+                material: materials
+                    .map(|m| rows_of::<i64, 1>("materials", &m, n))
+                    .transpose()?
+                    .map(|m| perm(m, &order).into_iter().map(|[x]| u32::try_from(x).unwrap_or(NO_MATERIAL)).collect()),
+                normal: normals.map(|c| rows_of::<f32, 3>("normals", &c, n)).transpose()?.map(|c| perm(c, &order)),
+                coverage: coverage
+                    .map(|c| rows_of::<f32, 1>("coverage", &c, n))
+                    .transpose()?
+                    .map(|c| perm(c, &order).into_iter().map(|[x]| x).collect()),
+            })
+        } else {
+            None
+        };
+        let voxels = voxels_at(grid.dims(), order.iter().map(|&(_, r)| ijk[r].map(|c| c as u32)));
+        let facts = match facts {
+            Some(f) => serde_json::from_str(&f).map_err(|e| value_err(format!("facts: not JSON ({e})")))?,
+            None => serde_json::json!({"source": "coords", "voxels": n}),
+        };
+        Ok(VoxelGrid { inner: Arc::new(GridData::new(voxels, grid, attrs, facts)) })
+    }
+
+    /// VoxelGrid.from_dense(array, origin=(0, 0, 0), voxel_size=1.0): a
+    /// grid whose set voxels are the non-zero elements of a 3-D array
+    /// (`[i, j, k]` = voxel `(i, j, k)`).
+    #[staticmethod]
+    #[pyo3(signature = (array, origin=None, voxel_size=1.0))]
+    fn from_dense(py: Python<'_>, array: &Bound<'_, PyAny>, origin: Option<(f64, f64, f64)>, voxel_size: f64) -> PyResult<VoxelGrid> {
+        let np = py.import("numpy")?;
+        let a = np.call_method1("asarray", (array,))?;
+        let shape: Vec<u64> = a.getattr("shape")?.extract()?;
+        let [nx, ny, nz] = shape[..] else {
+            return Err(value_err(format!(
+                "from_dense takes a 3-D array; got shape {}",
+                self::shape(&shape.iter().map(|&d| d as usize).collect::<Vec<_>>())
+            )));
+        };
+        let coords = np.call_method1("argwhere", (a,))?;
+        VoxelGrid::from_coords(py, &coords, (nx, ny, nz), origin, voxel_size, None, None, None, None, None)
+    }
+
+    /// Pickling and `copy.deepcopy`: the grid, its set voxels and attributes.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let ctor = py.import("topovox._topovox")?.getattr("VoxelGrid")?.getattr("from_coords")?;
+        let g = &self.inner.grid;
+        let args = (
+            self.coords(py),
+            self.dims(),
+            self.origin(),
+            g.voxel_size(),
+            self.colours(py),
+            self.materials(py),
+            self.normals(py),
+            self.coverage(py),
+            self.inner.facts.to_string(),
+        );
+        Ok((ctor, args.into_pyobject(py)?.into_any()))
+    }
+
     fn __repr__(&self) -> String {
         let [x, y, z] = self.inner.grid.dims();
         let mode = self.inner.facts.get("mode").and_then(Value::as_str).map(|m| format!(" {m}")).unwrap_or_default();
         format!("<topovox.VoxelGrid{mode} {x}x{y}x{z}, {} voxels, voxel size {}>", self.inner.voxels.count(), self.inner.grid.voxel_size())
     }
+}
+
+/// `a` as a NumPy array of `dtype` (converted by NumPy, which says what it cannot convert).
+fn as_array<'py>(py: Python<'py>, a: &Bound<'py, PyAny>, dtype: &str) -> PyResult<Bound<'py, PyAny>> {
+    let np = py.import("numpy")?;
+    let arr = np.call_method1("asarray", (a, dtype))?;
+    // One attribute per voxel may come as a flat array: make it a column.
+    if arr.getattr("ndim")?.extract::<usize>()? == 1 {
+        return arr.call_method1("reshape", ((-1i64, 1i64),));
+    }
+    Ok(arr)
+}
+
+/// The rows of an `(n, K)` array of `T`, checked to number `n`.
+fn rows_of<T: numpy::Element + Copy, const K: usize>(name: &str, a: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<[T; K]>> {
+    let arr = a.extract::<PyReadonlyArray2<'_, T>>().map_err(|_| value_err(format!("{name} must be an (n, {K}) array")))?;
+    let v = arr.as_array();
+    if v.nrows() != n || v.ncols() != K {
+        return Err(value_err(format!("{name} must have shape ({n}, {K}), one row per voxel; got {}", shape(v.shape()))));
+    }
+    Ok(v.rows().into_iter().map(|r| std::array::from_fn(|c| r[c])).collect())
+}
+
+/// Each voxel's key (`i + nx·(j + ny·k)`) with its row, sorted by key;
+/// refuses voxels outside the grid and voxels given twice.
+fn sorted_coords(ijk: &[[i64; 3]], dims: [u32; 3]) -> PyResult<Vec<(u64, usize)>> {
+    let [nx, ny, _] = dims.map(u64::from);
+    let mut keyed = Vec::with_capacity(ijk.len());
+    for (row, c) in ijk.iter().enumerate() {
+        if (0..3).any(|a| c[a] < 0 || c[a] >= dims[a] as i64) {
+            return Err(value_err(format!("coords row {row} {c:?} lies outside the grid {dims:?}")));
+        }
+        keyed.push((c[0] as u64 + nx * (c[1] as u64 + ny * c[2] as u64), row));
+    }
+    keyed.sort_unstable();
+    if let Some(w) = keyed.windows(2).find(|w| w[0].0 == w[1].0) {
+        return Err(value_err(format!("coords rows {} and {} are the same voxel {:?}", w[0].1, w[1].1, ijk[w[0].1])));
+    }
+    Ok(keyed)
+}
+
+/// Voxels with the given set voxels: dense bits for grids up to 2^31
+/// voxels, sparse bricks past that.
+fn voxels_at(dims: [u32; 3], set: impl Iterator<Item = [u32; 3]>) -> Voxels {
+    if dims.iter().map(|&d| d as u64).product::<u64>() <= 1 << 31 {
+        let mut d = topovox::DenseBits::new(dims);
+        set.for_each(|[i, j, k]| d.set(i, j, k));
+        return Voxels::Dense(d);
+    }
+    let bricks = set.map(|[i, j, k]| {
+        let mut b = [0u64; 8];
+        topovox::grid::brick::set_in_brick(&mut b, i, j, k);
+        ([i / 8, j / 8, k / 8], b)
+    });
+    Voxels::Sparse(topovox::grid::sparse::SparseBricks::from_bricks(dims, bricks))
+}
+
+/// `trimesh`, or an ImportError saying which method needs it.
+fn import_trimesh<'py>(py: Python<'py>, what: &str) -> PyResult<Bound<'py, PyModule>> {
+    py.import("trimesh")
+        .map_err(|e| pyo3::exceptions::PyImportError::new_err(format!("VoxelGrid.{what} needs trimesh (pip install trimesh): {e}")))
 }
 
 /// Vertices, faces and optional face colours of a mesh of the voxels.
@@ -696,7 +978,7 @@ fn voxelize(py: Python<'_>, mesh: &Mesh, options: Option<&Bound<'_, PyDict>>) ->
             };
             let mut facts = v.facts(&plan);
             facts["warnings"] = serde_json::json!(v.warnings);
-            Ok(GridData { voxels: v.voxels, grid: v.grid, attrs, facts })
+            Ok(GridData::new(v.voxels, v.grid, attrs, facts))
         };
         match pool {
             Some(p) => p.install(run),
@@ -736,7 +1018,7 @@ fn load_voxels(
     let s = voxel_size.or(loaded.placement.map(|p| p.1)).unwrap_or(1.0);
     let grid = GridSpec::new(o, s, dims.map(u64::from)).map_err(|e| value_err(format!("invalid grid: {e}")))?;
     let facts = serde_json::json!({"input": path.display().to_string(), "voxels": loaded.bits.count(), "placement_from_file": loaded.placement.is_some()});
-    Ok(VoxelGrid { inner: Arc::new(GridData { voxels: Voxels::Dense(loaded.bits), grid, attrs: loaded.attributes, facts }) })
+    Ok(VoxelGrid { inner: Arc::new(GridData::new(Voxels::Dense(loaded.bits), grid, loaded.attributes, facts)) })
 }
 
 /// The options of a batch, validated (with its fingerprint), and `jobs`.

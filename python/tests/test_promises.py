@@ -55,7 +55,7 @@ def test_grids_that_cannot_be_dense_are_refused_before_any_write(tmp_path):
             g.save(tmp_path / name)
     assert os.listdir(tmp_path) == []
     with pytest.raises(RuntimeError, match="dense storage"):
-        g.to_trimesh()
+        g.to_trimesh_mesh()
     g.save(tmp_path / "x.vdb")  # sparse formats still work
     assert (tmp_path / "x.vdb").stat().st_size > 0
 

@@ -119,17 +119,17 @@ def test_bad_arrays_are_value_errors(vertices, faces, message):
         ({"mode": "nope"}, "unknown mode"),
         ({"method": "magic"}, "unknown method"),
         ({"resolution": 0}, "resolution must be at least 1"),
-        ({"resolution": 64, "voxel_size": 0.1}, "either --resolution or --voxel-size"),
+        ({"resolution": 64, "voxel_size": 0.1}, "either resolution or voxel_size"),
         ({"origin": (0, 0, 0)}, "explicit grid needs all"),
         ({"voxel_size": -1.0}, "voxel size must be a positive"),
-        ({"mode": "sep6", "method": "parity"}, "applies only to --mode solid"),
-        ({"mode": "cover", "hollow": 6}, "apply to --mode solid"),
+        ({"mode": "sep6", "method": "parity"}, "applies only to mode solid"),
+        ({"mode": "cover", "hollow": 6}, "apply to mode solid"),
         ({"mode": "solid", "hollow": 7}, "unknown hollow connectivity \"7\" \\(expected one of: 6, 26\\)"),
         ({"threads": 0}, "threads must be at least 1"),
         ({"colour_rule": "mean"}, "unknown colour rule \"mean\""),
     ],
 )
-def test_bad_options_are_value_errors_with_the_cli_message(meshes, kwargs, message):
+def test_bad_options_are_value_errors_in_python_terms(meshes, kwargs, message):
     m = topovox.load_mesh(meshes / "cow.obj")
     with pytest.raises(ValueError, match=message):
         topovox.voxelize(m, **kwargs)
@@ -175,7 +175,7 @@ def test_grid_properties_indices_and_helpers(meshes):
     assert occ.dtype == np.bool_ and occ.shape == g.dims
     idx = g.indices()
     assert idx.dtype == np.int64 and np.array_equal(idx, np.argwhere(occ))
-    assert len(g) == g.count == len(idx)
+    assert len(g) == g.dims[0] and g.count == len(idx)
     centres = g.index_to_world(idx)
     assert np.array_equal(g.world_to_index(centres), idx)
     o, s = np.array(g.origin), g.voxel_size
@@ -279,11 +279,11 @@ def test_trimesh_in_and_out(meshes):
     ours = topovox.load_mesh(meshes / "cow.obj")
     assert np.array_equal(topovox.voxelize(tm, resolution=48).occupancy, topovox.voxelize(ours, resolution=48).occupancy)
     g = topovox.voxelize(ours, mode="solid", resolution=32)
-    out = g.to_trimesh()
+    out = g.to_trimesh_mesh()
     assert isinstance(out, trimesh.Trimesh)
     # The quads bound exactly the set voxels: the enclosed volume is theirs.
     assert abs(out.volume - g.count * g.voxel_size**3) < 1e-9 * max(1.0, g.count * g.voxel_size**3)
-    coloured = topovox.voxelize(topovox.load_mesh(meshes / "spot-textured.obj"), resolution=24, attributes=True).to_trimesh()
+    coloured = topovox.voxelize(topovox.load_mesh(meshes / "spot-textured.obj"), resolution=24, attributes=True).to_trimesh_mesh()
     assert coloured.visual.face_colors.shape[1] == 4
 
 

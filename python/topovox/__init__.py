@@ -57,6 +57,7 @@ __all__ = [
     "FileFormatError",
     "load_mesh",
     "load_voxels",
+    "as_mesh",
     "voxelize",
     "batch",
     "MODES",
@@ -114,22 +115,97 @@ def _as_index_array(a: Any, name: str) -> np.ndarray:
     return arr.astype(np.int64)
 
 
-def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray], faces: Optional[Any] = None) -> Mesh:
-    """A :class:`Mesh` from a topovox mesh, anything with ``.vertices`` and
-    ``.faces`` (a ``trimesh.Trimesh``), or a vertex array and ``faces``.
-    Arrays are copied once, into the voxelizer's own storage."""
-    if isinstance(mesh_or_vertices, Mesh):
+def _colours(c: Any) -> Optional[np.ndarray]:
+    """(n, 3) uint8 sRGB from uint8 or float (0..1) colours, RGB or RGBA."""
+    if c is None:
+        return None
+    arr = np.asarray(c)
+    if arr.ndim != 2 or arr.shape[1] < 3:
+        raise ValueError(f"colours must have shape (n, 3) or (n, 4); got {arr.shape}")
+    arr = arr[:, :3]
+    if arr.dtype.kind == "f":
+        return np.clip(np.round(arr * 255.0), 0, 255).astype(np.uint8)
+    return arr.astype(np.uint8)
+
+
+def _trimesh_colours(mesh: Any) -> Tuple[Optional[np.ndarray], Optional[np.ndarray]]:
+    """A trimesh mesh's (vertex, face) colours: its colour visuals as they
+    are; a texture sampled at the vertices' UVs (trimesh's ``to_color``)."""
+    visual = getattr(mesh, "visual", None)
+    kind = getattr(visual, "kind", None)
+    if kind == "texture":
+        try:
+            visual = visual.to_color()
+            kind = visual.kind
+        except Exception:  # a texture trimesh cannot sample: no colours
+            return None, None
+    if kind == "vertex":
+        return _colours(visual.vertex_colors), None
+    if kind == "face":
+        return None, _colours(visual.face_colors)
+    return None, None
+
+
+def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike], faces: Optional[Any] = None) -> Mesh:
+    """A :class:`Mesh` from whatever holds a triangle mesh.
+
+    Parameters
+    ----------
+    mesh_or_vertices
+        A :class:`Mesh`; a path (read by :func:`load_mesh`); a
+        ``trimesh.Trimesh`` (``vertices`` and ``faces``, with its vertex or
+        face colours, a texture sampled at the vertices) or ``trimesh.Scene``
+        (its geometry, concatenated); an Open3D ``TriangleMesh``
+        (``vertices`` and ``triangles``, with its vertex colours); a
+        ``(vertices, faces)`` pair; or an ``(n, 3)`` vertex array with
+        ``faces``.
+    faces
+        ``(m, 3)`` integer vertex indices, when vertices are given.
+
+    Returns
+    -------
+    Mesh
+        The mesh; arrays are copied once, into the voxelizer's own storage.
+
+    Raises
+    ------
+    ValueError
+        Nothing here is a mesh, or its arrays are malformed.
+    OSError
+        A path that cannot be read.
+
+    Examples
+    --------
+    >>> m = topovox.as_mesh(np.eye(3), [[0, 1, 2]])
+    """
+    m = mesh_or_vertices
+    if isinstance(m, Mesh):
         if faces is not None:
             raise ValueError("faces is given twice: by the Mesh and by faces=")
-        return mesh_or_vertices
-    if faces is None and hasattr(mesh_or_vertices, "vertices") and hasattr(mesh_or_vertices, "faces"):
-        return Mesh(
-            _as_float_points(mesh_or_vertices.vertices, "vertices"),
-            _as_index_array(mesh_or_vertices.faces, "faces"),
-        )
+        return m
     if faces is None:
-        raise ValueError("give a topovox.Mesh, an object with .vertices and .faces, or vertices and faces arrays")
-    return Mesh(_as_float_points(mesh_or_vertices, "vertices"), _as_index_array(faces, "faces"))
+        if isinstance(m, (str, os.PathLike)):
+            return load_mesh(os.fspath(m))
+        if isinstance(m, tuple) and len(m) == 2:
+            return as_mesh(m[0], m[1])
+        if isinstance(getattr(m, "geometry", None), dict):  # a trimesh.Scene (what trimesh.load("x.glb") returns)
+            m = m.to_geometry() if hasattr(m, "to_geometry") else m.dump(concatenate=True)
+        if hasattr(m, "vertices") and hasattr(m, "faces"):
+            vc, fc = _trimesh_colours(m)
+            return Mesh(_as_float_points(m.vertices, "vertices"), _as_index_array(m.faces, "faces"), vertex_colours=vc, face_colours=fc)
+        if hasattr(m, "vertices") and hasattr(m, "triangles"):
+            has = getattr(m, "has_vertex_colors", None)
+            vc = _colours(np.asarray(m.vertex_colors)) if callable(has) and has() else None
+            return Mesh(
+                _as_float_points(np.asarray(m.vertices), "vertices"),
+                _as_index_array(np.asarray(m.triangles), "triangles"),
+                vertex_colours=vc,
+            )
+        raise ValueError(
+            "give a topovox.Mesh, a path, a trimesh mesh or scene, an Open3D TriangleMesh, "
+            f"a (vertices, faces) pair, or vertices and faces arrays; got {type(m).__name__}"
+        )
+    return Mesh(_as_float_points(m, "vertices"), _as_index_array(faces, "faces"))
 
 
 def voxelize(

@@ -53,9 +53,9 @@ use crate::camera::Camera;
 use crate::lights::{area_units, frame, merge_key};
 use crate::scene::{Scene, ShadeMaterial};
 use crate::ViewError;
-pub use topovox_io::spray_cloud::SprayPoint;
 use topovox::attributes::colour::to_linear;
 use topovox::attributes::Texture;
+pub use topovox_io::spray_cloud::SprayPoint;
 
 /// Rays per random stream.
 pub const BLOCK: usize = 4096;
