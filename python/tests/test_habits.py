@@ -104,3 +104,16 @@ def test_trimesh_meshes_scenes_colours_and_voxel_grids():
     centres = vg.points
     assert np.allclose(np.sort(centres, axis=0), np.sort(g.index_to_world(g.coords()), axis=0))
     assert isinstance(g.to_trimesh_mesh(), trimesh.Trimesh)
+
+
+def test_a_centred_cube_as_datasets_use(meshes):
+    g = topovox.voxelize(topovox.load_mesh(meshes / "cow.obj"), resolution=32, fit="cube", pad=2)
+    assert g.shape == (32, 32, 32)
+    occ = g.occupancy
+    # The longest axis spans voxels 2..29 (cover also sets the voxels its
+    # ends touch, 1 and 30); the outer pad stays empty on every side.
+    assert not occ[0].any() and not occ[-1].any() and not occ[:, 0].any() and not occ[:, :, -1].any()
+    assert occ[2].any() and occ[-3].any()
+    # Centred: the other axes' empty margins differ by at most one voxel.
+    ys = np.nonzero(occ.any(axis=(0, 2)))[0]
+    assert abs(ys[0] - (31 - ys[-1])) <= 1

@@ -218,6 +218,7 @@ def voxelize(
     origin: Optional[Sequence[float]] = None,
     dims: Optional[Sequence[int]] = None,
     pad: int = 0,
+    fit: str = "box",
     method: str = "auto",
     threads: Optional[int] = None,
     attributes: bool = False,
@@ -253,6 +254,10 @@ def voxelize(
         origin, dims: with ``voxel_size``, an explicit grid; triangles
             outside it are clipped, never wrapped.
         pad: empty voxels added on every side of a fitted grid.
+        fit: ``"box"`` (the grid starts at the bounding box's corner) or
+            ``"cube"``: ``resolution**3`` voxels centred on the bounding box,
+            its longest side spanning ``resolution - 2 * pad`` voxels (the
+            ShapeNet/ModelNet convention).
         method: one of :data:`METHODS`. ``auto`` picks the fastest path that
             gives the mode's exact voxels; every method gives the same voxels.
         threads: worker threads (default: all cores).

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
 use topovox::raster::{RasterMethod, RasterMode};
-use topovox_job::{ColourRule, Fill, GpuPath, Hollow, Method, Mode, Switch, Up};
+use topovox_job::{ColourRule, Fill, Fit, GpuPath, Hollow, Method, Mode, Switch, Up};
 
 use topovox::render::raycast::View;
 
@@ -86,6 +86,11 @@ pub struct GridArgs {
     /// Empty voxels added on every side of a fitted grid (default 0).
     #[arg(long, value_name = "P")]
     pub pad: Option<u32>,
+    /// How the grid is fitted to the mesh: `box` (default: origin at the
+    /// bounding box's corner) or `cube` (N³ voxels centred on it, the mesh's
+    /// longest side spanning N − 2·pad: the ShapeNet/ModelNet convention).
+    #[arg(long, value_parser = choice::<Fit>())]
+    pub fit: Option<Fit>,
 }
 
 /// Grids past memory: the tiled path and the memory it may use.

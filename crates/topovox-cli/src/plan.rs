@@ -14,7 +14,14 @@ pub fn check_memory(grid: &topovox::GridSpec) -> topovox_job::Result<()> {
 
 /// The grid options as the job takes them.
 pub fn grid_options(g: &GridArgs) -> GridOptions {
-    GridOptions { resolution: g.resolution, voxel_size: g.voxel_size, origin: g.origin.clone(), dims: g.dims.clone(), pad: g.pad }
+    GridOptions {
+        resolution: g.resolution,
+        voxel_size: g.voxel_size,
+        origin: g.origin.clone(),
+        dims: g.dims.clone(),
+        pad: g.pad,
+        fit: g.fit,
+    }
 }
 
 /// Checks that the grid options form one of the three documented ways.

@@ -8,12 +8,26 @@ use topovox::{Aabb, GridSpec};
 use crate::error::{JobError, Result};
 use crate::invalid;
 
+topovox::choice! {
+    /// How a grid is fitted to the mesh.
+    pub enum Fit: "fit" default Box {
+        /// To the bounding box: origin at its low corner, the longest side
+        /// spanning the resolution (other sides as many voxels as they need).
+        Box = "box",
+        /// A cube of N³ voxels centred on the bounding box, its longest side
+        /// spanning N − 2·pad voxels (the ShapeNet/ModelNet convention).
+        Cube = "cube",
+    }
+}
+
 /// The grid request, validated but not yet fitted to a mesh.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GridRequest {
     kind: GridKind,
     /// Voxels of margin on every side of a fitted grid.
     pad: u32,
+    /// Bounding box or centred cube.
+    fit: Fit,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -39,12 +53,19 @@ pub struct GridOptions {
     pub dims: Option<Vec<u64>>,
     /// Empty voxels on every side of a fitted grid.
     pub pad: Option<u32>,
+    /// How the grid is fitted (default: to the bounding box).
+    pub fit: Option<Fit>,
 }
 
 impl GridOptions {
     /// Whether any grid option was given.
     pub fn any(&self) -> bool {
         self.resolution.is_some() || self.voxel_size.is_some() || self.origin.is_some() || self.dims.is_some() || self.pad.is_some()
+    }
+
+    /// A cube fit asked for.
+    pub fn cube(&self) -> bool {
+        self.fit == Some(Fit::Cube)
     }
 }
 
@@ -54,20 +75,45 @@ impl GridRequest {
     pub fn new(g: &GridOptions) -> Result<GridRequest> {
         let kind = GridKind::new(g)?;
         let pad = g.pad.unwrap_or(0);
-        if pad > 0 && matches!(kind, GridKind::Explicit { .. }) {
-            invalid!("--pad applies to fitted grids (--resolution or --voxel-size), not to an explicit --origin/--dims grid");
+        let fit = g.fit.unwrap_or_default();
+        if (pad > 0 || fit == Fit::Cube) && matches!(kind, GridKind::Explicit { .. }) {
+            invalid!("--pad and --fit apply to fitted grids (--resolution or --voxel-size), not to an explicit --origin/--dims grid");
         }
-        Ok(GridRequest { kind, pad })
+        if let (Fit::Cube, GridKind::Resolution(n)) = (fit, &kind) {
+            if *n <= 2 * pad as u64 {
+                invalid!("--fit cube --resolution {n} --pad {pad}: the resolution must exceed twice the pad");
+            }
+        }
+        Ok(GridRequest { kind, pad, fit })
     }
 
     /// The grid for a mesh with these bounds.
     pub fn fit(&self, bounds: &Aabb) -> Result<GridSpec> {
+        if self.fit == Fit::Cube {
+            return self.cube(bounds);
+        }
         let g = self.kind.fit(bounds)?;
         if self.pad == 0 {
             return Ok(g);
         }
         let (p, s) = (self.pad as f64, g.voxel_size());
         GridSpec::new(g.origin() - DVec3::splat(p * s), s, g.dims().map(|d| d as u64 + 2 * self.pad as u64))
+            .map_err(|e| JobError::invalid(format!("invalid grid: {e}")))
+    }
+
+    /// The centred cube: N³ voxels (`--resolution N`, the mesh's longest
+    /// side spanning N − 2·pad), or as many as `--voxel-size` needs for the
+    /// longest side plus the pad on both ends.
+    fn cube(&self, bounds: &Aabb) -> Result<GridSpec> {
+        let box_grid = match self.kind {
+            GridKind::Resolution(n) => GridKind::Resolution(n - 2 * self.pad as u64),
+            ref k => k.clone(),
+        }
+        .fit(bounds)?;
+        let s = box_grid.voxel_size();
+        let side = box_grid.dims().into_iter().max().unwrap_or(1) as u64 + 2 * self.pad as u64;
+        let centre = (bounds.min + bounds.max) * 0.5;
+        GridSpec::new(centre - DVec3::splat(side as f64 * s * 0.5), s, [side; 3])
             .map_err(|e| JobError::invalid(format!("invalid grid: {e}")))
     }
 
@@ -122,5 +168,44 @@ impl GridKind {
             GridKind::Explicit { origin, voxel_size, dims } => GridSpec::new(origin, voxel_size, dims),
         };
         g.map_err(|e| JobError::invalid(format!("invalid grid: {e}")))
+    }
+}
+
+#[cfg(test)]
+mod cube_tests {
+    use super::*;
+
+    fn request(resolution: Option<u64>, voxel_size: Option<f64>, pad: u32) -> GridRequest {
+        GridRequest::new(&GridOptions { resolution, voxel_size, pad: Some(pad), fit: Some(Fit::Cube), ..GridOptions::default() }).unwrap()
+    }
+
+    #[test]
+    fn a_cube_is_centred_on_the_box_and_holds_it_inside_the_pad() {
+        let b = Aabb { min: DVec3::new(-1.0, 2.0, 0.5), max: DVec3::new(3.0, 2.5, 1.5) };
+        for (r, v, pad) in [(Some(32), None, 0), (Some(64), None, 3), (None, Some(0.3), 2), (Some(7), None, 3)] {
+            let g = request(r, v, pad).fit(&b).unwrap();
+            let [nx, ny, nz] = g.dims();
+            assert!(nx == ny && ny == nz, "{:?}", g.dims());
+            if let Some(n) = r {
+                assert_eq!(nx as u64, n);
+                // The longest side spans exactly N − 2·pad voxels.
+                assert!(((b.max.x - b.min.x) / g.voxel_size() - (n - 2 * pad as u64) as f64).abs() < 1e-9);
+            }
+            let (lo, hi) = (g.origin(), g.origin() + DVec3::splat(nx as f64 * g.voxel_size()));
+            assert!(((lo + hi) * 0.5 - (b.min + b.max) * 0.5).length() < 1e-9);
+            let margin = pad as f64 * g.voxel_size() - 1e-9;
+            assert!((b.min - lo).min_element() >= margin && (hi - b.max).min_element() >= margin, "{r:?} {v:?} {pad}");
+        }
+        assert!(
+            GridRequest::new(&GridOptions { resolution: Some(4), pad: Some(2), fit: Some(Fit::Cube), ..GridOptions::default() }).is_err()
+        );
+        let explicit = GridOptions {
+            origin: Some(vec![0.0; 3]),
+            voxel_size: Some(1.0),
+            dims: Some(vec![2; 3]),
+            fit: Some(Fit::Cube),
+            ..GridOptions::default()
+        };
+        assert!(GridRequest::new(&explicit).is_err());
     }
 }

@@ -28,7 +28,7 @@ pub mod options;
 pub mod output;
 
 pub use error::{JobError, Result};
-pub use grid::{GridOptions, GridRequest};
+pub use grid::{Fit, GridOptions, GridRequest};
 pub use memory::{available_memory, budget, bytes, check_memory, dense_fits, parse_size, peak_memory};
 pub use options::{JobOptions, OptionValue, KEYWORDS};
 pub use plan::{

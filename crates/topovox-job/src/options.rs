@@ -163,6 +163,7 @@ keywords! {
     "origin": Example::Numbers(&[-1.0, -1.0, -1.0]), "an explicit grid's origin (with voxel_size and dims)";
     "dims": Example::Numbers(&[8.0, 8.0, 8.0]), "an explicit grid's dims (with origin and voxel_size)";
     "pad": Example::Int(1), "empty voxels on every side of a fitted grid";
+    "fit": Example::Text("cube"), "box: to the bounding box; cube: N³ voxels centred on it (ShapeNet's convention)";
     "surface": Example::Text("sep26"), "solid modes: the surface of solid+surface and of a flood fill's shell";
     "fill": Example::Text("flood"), "solid modes: flood fills what a surface shell encloses";
     "hollow": Example::Int(6), "solid modes: keep the voxels 6- or 26-adjacent to the outside";
@@ -264,6 +265,7 @@ impl JobOptions {
             "pad" => {
                 self.grid.pad = Some(u32::try_from(int(key, v, 0)?).map_err(|_| JobError::invalid("pad is too large"))?).filter(|&p| p > 0)
             }
+            "fit" => self.grid.fit = Some(chosen(key, v)?),
             "surface" => self.surface = Some(chosen(key, v)?),
             "fill" => self.fill = Some(chosen(key, v)?),
             "hollow" => self.hollow = Some(chosen(key, v)?),
@@ -364,6 +366,9 @@ impl JobOptions {
         }
         if let Some(t) = self.tile {
             v["tile"] = json!(t);
+        }
+        if g.cube() {
+            v["fit"] = json!("cube");
         }
         v
     }
