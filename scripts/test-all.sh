@@ -18,7 +18,7 @@ if [ ! -x target/venv/bin/python ]; then
 fi
 VPY=target/venv/bin/python
 "$VPY" -m pip install --quiet --disable-pip-version-check --upgrade pip
-"$VPY" -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" numpy pytest trimesh "dask[bag]" distributed ray fsspec
+"$VPY" -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" numpy pytest trimesh "dask[bag]" distributed ray fsspec mypy
 rm -rf target/dist
 "$VPY" -m maturin build --release --manifest-path python/Cargo.toml --out target/dist
 "$VPY" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps target/dist/topovox-*.whl
@@ -27,3 +27,7 @@ echo "== pytest"
 # Run from the repository root so `import topovox` finds the installed
 # package, not the sources in python/topovox.
 TOPOVOX_BIN="$PWD/target/release/topovox" "$VPY" -m pytest -q python/tests
+
+echo "== types: the stubs match the native module (stubtest); the package and its examples pass mypy --strict"
+(root="$PWD"; cd /tmp && "$root/$VPY" -m mypy.stubtest --ignore-disjoint-bases topovox._topovox)
+(cd python && "../$VPY" -m mypy --strict topovox examples)

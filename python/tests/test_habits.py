@@ -3,7 +3,10 @@ paths and pairs; grids as NumPy arrays (shape, len, __array__, to_dense,
 coords); grids from arrays and coordinates; pickling; trimesh voxel grids."""
 
 import copy
+import pathlib
 import pickle
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -117,3 +120,10 @@ def test_a_centred_cube_as_datasets_use(meshes):
     # Centred: the other axes' empty margins differ by at most one voxel.
     ys = np.nonzero(occ.any(axis=(0, 2)))[0]
     assert abs(ys[0] - (31 - ys[-1])) <= 1
+
+
+def test_the_typed_quick_start_runs(meshes):
+    script = pathlib.Path(__file__).parents[1] / "examples" / "quickstart.py"
+    r = subprocess.run([sys.executable, str(script), str(meshes / "cow.obj")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert "6-separating True" in r.stdout

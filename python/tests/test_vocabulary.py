@@ -48,3 +48,18 @@ def test_american_spelling_and_any_case():
     a = topovox.voxelize(v, f, resolution=8, mode="SEP6", color_rule="blend")
     b = topovox.voxelize(v, f, resolution=8, mode="sep6", colour_rule="blend")
     assert (a.occupancy == b.occupancy).all()
+
+
+def test_the_typing_names_are_the_native_lists():
+    from typing import get_args
+
+    c = _topovox.choices()
+    for alias, key in [
+        (topovox.ModeName, "mode"),
+        (topovox.MethodName, "method"),
+        (topovox.FillName, "fill"),
+        (topovox.GpuPathName, "gpu_path"),
+        (topovox.ColourRuleName, "colour_rule"),
+        (topovox.UpName, "up"),
+    ]:
+        assert list(get_args(alias)) == c[key], key

@@ -42,7 +42,7 @@ command line's.
 from __future__ import annotations
 
 import os
-from typing import Any, Iterable, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Iterable, Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -74,6 +74,15 @@ MODES = tuple(_CHOICES["mode"])
 METHODS = tuple(_CHOICES["method"])
 #: Every output format ``VoxelGrid.save`` and ``batch`` write.
 FORMATS = tuple(_CHOICES["format"])
+#: The option names as types checkers see them (names are also taken in
+#: any case at run time); the tests check each against the native list.
+ModeName = Literal["cover", "sep26", "sep6", "ss6", "tunnel18", "tunnel26", "bubble", "diagonal", "solid", "solid+surface", "line6", "line26", "pos"]
+MethodName = Literal["auto", "reference", "fast", "scanline", "gpu", "parity", "winding"]
+FillName = Literal["flood"]
+GpuPathName = Literal["compute", "raster", "msaa-approx"]
+ColourRuleName = Literal["dominant", "blend"]
+UpName = Literal["x", "y", "z"]
+FitName = Literal["box", "cube"]
 #: Every option :func:`voxelize` and :func:`batch` take, with its help.
 OPTIONS = {name: help for name, help, _example in _topovox.options()}
 
@@ -131,8 +140,10 @@ def _colours(c: Any) -> Optional[np.ndarray]:
 def _trimesh_colours(mesh: Any) -> Tuple[Optional[np.ndarray], Optional[np.ndarray]]:
     """A trimesh mesh's (vertex, face) colours: its colour visuals as they
     are; a texture sampled at the vertices' UVs (trimesh's ``to_color``)."""
-    visual = getattr(mesh, "visual", None)
+    visual: Any = getattr(mesh, "visual", None)
     kind = getattr(visual, "kind", None)
+    if visual is None:
+        return None, None
     if kind == "texture":
         try:
             visual = visual.to_color()
@@ -146,7 +157,7 @@ def _trimesh_colours(mesh: Any) -> Tuple[Optional[np.ndarray], Optional[np.ndarr
     return None, None
 
 
-def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike], faces: Optional[Any] = None) -> Mesh:
+def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]], faces: Optional[Any] = None) -> Mesh:
     """A :class:`Mesh` from whatever holds a triangle mesh.
 
     Parameters
@@ -178,7 +189,7 @@ def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike], fac
     --------
     >>> m = topovox.as_mesh(np.eye(3), [[0, 1, 2]])
     """
-    m = mesh_or_vertices
+    m: Any = mesh_or_vertices
     if isinstance(m, Mesh):
         if faces is not None:
             raise ValueError("faces is given twice: by the Mesh and by faces=")
@@ -212,32 +223,32 @@ def voxelize(
     mesh_or_vertices: Union[MeshLike, np.ndarray],
     faces: Optional[Any] = None,
     *,
-    mode: str = "cover",
+    mode: ModeName = "cover",
     resolution: Optional[int] = None,
     voxel_size: Optional[float] = None,
     origin: Optional[Sequence[float]] = None,
     dims: Optional[Sequence[int]] = None,
     pad: int = 0,
-    fit: str = "box",
-    method: str = "auto",
+    fit: FitName = "box",
+    method: MethodName = "auto",
     threads: Optional[int] = None,
     attributes: bool = False,
-    colour_rule: str = "dominant",
+    colour_rule: ColourRuleName = "dominant",
     normals: bool = False,
-    surface: Optional[str] = None,
-    fill: Optional[str] = None,
+    surface: Optional[ModeName] = None,
+    fill: Optional[FillName] = None,
     hollow: Optional[int] = None,
-    gpu_path: str = "compute",
+    gpu_path: GpuPathName = "compute",
     seed: int = 0,
     tile: Optional[int] = None,
     max_memory: Optional[Union[int, str]] = None,
-    up: str = "y",
+    up: UpName = "y",
     dither: bool = False,
     watertight: bool = True,
     triangulate: bool = False,
-    block_palette: Optional[Union[str, os.PathLike]] = None,
+    block_palette: Optional[Union[str, os.PathLike[str]]] = None,
     allow_external_paths: bool = False,
-    color_rule: Optional[str] = None,
+    color_rule: Optional[ColourRuleName] = None,
 ) -> VoxelGrid:
     """Voxelizes a mesh; returns a :class:`VoxelGrid`.
 
@@ -303,7 +314,7 @@ def voxelize(
     return _topovox.voxelize(mesh, _options(options))
 
 
-def _options(options: dict) -> dict:
+def _options(options: Dict[str, Any]) -> Dict[str, Any]:
     """Keyword options as the native side takes them: ``None`` left out,
     ``color_rule`` spelled ``colour_rule``, paths as strings. Every value is
     checked there, by the job crate, with the command line's rules."""
@@ -316,14 +327,14 @@ def _options(options: dict) -> dict:
 
 
 def batch(
-    paths: Union[str, os.PathLike, Iterable[Union[str, os.PathLike]]],
-    out_dir: Union[str, os.PathLike],
+    paths: Union[str, os.PathLike[str], Iterable[Union[str, os.PathLike[str]]]],
+    out_dir: Union[str, os.PathLike[str]],
     *,
     format: str = "npy",
     glob: Optional[str] = None,
     jobs: Optional[int] = None,
     **options: Any,
-) -> dict:
+) -> Dict[str, Any]:
     """Voxelizes every mesh of ``paths`` (files, or folders walked for
     meshes; ``glob`` such as ``"**/*.obj"`` filters them) into ``out_dir``,
     as ``topovox batch`` does: one output per input, named after the input's

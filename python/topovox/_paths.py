@@ -11,7 +11,7 @@ from typing import Any, Dict, Iterable, List, Optional, Tuple, Union
 
 from . import _topovox
 
-PathLike = Union[str, os.PathLike]
+PathLike = Union[str, os.PathLike[str]]
 
 
 def split_protocol(path: str) -> Tuple[Optional[str], str]:
@@ -56,7 +56,7 @@ def plan(
 def _remote_manifest_mirror(out_dir: str) -> str:
     """A local folder holding a copy of the remote manifest (and nothing
     else), so the native planner can tell what is done."""
-    import fsspec
+    import fsspec  # type: ignore[import-untyped]
 
     local = tempfile.mkdtemp(prefix="topovox-manifest-")
     fs, root = fsspec.core.url_to_fs(out_dir)

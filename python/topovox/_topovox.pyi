@@ -1,27 +1,29 @@
 """Type stubs of the native module (topovox._topovox)."""
 
 from os import PathLike
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+__all__ = ["__version__", "FileFormatError", "Mesh", "VoxelGrid", "load_mesh", "voxelize", "load_voxels", "batch", "batch_plan", "process_one", "append_manifest", "options", "choices"]
 
 class FileFormatError(OSError):
     """A file's content does not follow its format (the message names the file)."""
 
+@final
 class Mesh:
     """A triangle mesh (and polylines), read from a file or built from arrays."""
 
-    def __init__(
-        self,
+    def __new__(
+        cls,
         vertices: npt.ArrayLike,
         faces: Optional[npt.ArrayLike] = None,
         segments: Optional[npt.ArrayLike] = None,
         vertex_colours: Optional[npt.ArrayLike] = None,
         face_colours: Optional[npt.ArrayLike] = None,
-    ) -> None: ...
+    ) -> Mesh: ...
     @property
     def vertices(self) -> npt.NDArray[np.float64]: ...
     @property
@@ -43,6 +45,7 @@ class Mesh:
     @property
     def bounds(self) -> npt.NDArray[np.float64]: ...
 
+@final
 class VoxelGrid:
     """A voxel grid: where the voxels are, which are set, and what they carry."""
 
@@ -88,7 +91,14 @@ class VoxelGrid:
     @property
     def coverage(self) -> Optional[npt.NDArray[np.float32]]: ...
     def save(
-        self, path: Union[str, PathLike[str]], format: Optional[str] = None, dither: bool = False, block_palette: Optional[Union[str, PathLike[str]]] = None
+        self,
+        path: Union[str, PathLike[str]],
+        format: Optional[str] = None,
+        dither: bool = False,
+        block_palette: Optional[Union[str, PathLike[str]]] = None,
+        up: str = "y",
+        watertight: bool = True,
+        triangulate: bool = False,
     ) -> None: ...
     def check(self, mesh: Any = None) -> Dict[str, Any]: ...
     def world_to_index(self, points: npt.ArrayLike) -> npt.NDArray[np.int64]: ...

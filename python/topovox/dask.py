@@ -23,14 +23,14 @@ from . import _paths
 
 
 def voxelize_paths(
-    paths: Union[str, os.PathLike, Iterable[Union[str, os.PathLike]]],
-    out_dir: Union[str, os.PathLike],
+    paths: Union[str, os.PathLike[str], Iterable[Union[str, os.PathLike[str]]]],
+    out_dir: Union[str, os.PathLike[str]],
     *,
     format: str = "npy",
     glob: Optional[str] = None,
     npartitions: Optional[int] = None,
     **options: Any,
-):
+) -> Any:
     """A ``dask.bag.Bag`` with one task per mesh still to do (meshes the
     manifest records as done with the same options are left out). Computing
     it voxelizes each mesh (``options`` as :func:`topovox.voxelize` takes
@@ -44,6 +44,6 @@ def voxelize_paths(
     opts = _paths.options_dict(options)
     todo, _ = _paths.plan(paths, out_dir, format, glob, opts)
     if not todo:
-        return db.from_sequence([], npartitions=1)
-    bag = db.from_sequence(todo, npartitions=npartitions or len(todo))
+        return db.from_sequence([], npartitions=1)  # type: ignore[no-untyped-call]
+    bag = db.from_sequence(todo, npartitions=npartitions or len(todo))  # type: ignore[no-untyped-call]
     return bag.map(lambda pair: _paths.process(pair[0], pair[1], out_dir, format, opts))

@@ -20,8 +20,8 @@ from . import _paths
 
 
 def voxelize_paths(
-    paths: Union[str, os.PathLike, Iterable[Union[str, os.PathLike]]],
-    out_dir: Union[str, os.PathLike],
+    paths: Union[str, os.PathLike[str], Iterable[Union[str, os.PathLike[str]]]],
+    out_dir: Union[str, os.PathLike[str]],
     *,
     format: str = "npy",
     glob: Optional[str] = None,
@@ -49,7 +49,7 @@ def voxelize_paths(
             return _topovox.process_one(inp, out, format=format, options=opts)
         import tempfile
 
-        import fsspec
+        import fsspec  # type: ignore[import-untyped]
 
         with tempfile.TemporaryDirectory(prefix="topovox-") as tmp:
             local = os.path.join(tmp, os.path.basename(out))
@@ -59,7 +59,8 @@ def voxelize_paths(
                 fs.makedirs(os.path.dirname(path), exist_ok=True)
                 fs.put_file(local, path)
             record["output"] = out
-            return json.loads(json.dumps(record))
+            out_record: Dict[str, Any] = json.loads(json.dumps(record))
+            return out_record
 
     pending = [one.remote(i, o) for i, o in todo]
     records = []
