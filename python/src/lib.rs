@@ -337,6 +337,30 @@ impl Mesh {
 }
 
 /// load_mesh(path, allow_external_paths=False) -> Mesh
+///
+/// Reads a mesh file: OBJ (with its MTL and textures), STL, PLY, glTF/GLB,
+/// or `.lines` polylines.
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+///     The file.
+/// allow_external_paths : bool
+///     Read files the model names (material libraries, textures, buffers)
+///     even outside its folder. Off by default.
+///
+/// Returns
+/// -------
+/// Mesh
+///
+/// Raises
+/// ------
+/// FileNotFoundError, PermissionError, FileFormatError
+///     The file cannot be read, or its content is malformed.
+///
+/// Examples
+/// --------
+/// >>> mesh = topovox.load_mesh("bunny.obj")
 #[pyfunction]
 #[pyo3(signature = (path, allow_external_paths=false))]
 fn load_mesh(py: Python<'_>, path: PathBuf, allow_external_paths: bool) -> PyResult<Mesh> {
@@ -485,7 +509,23 @@ impl VoxelGrid {
         Ok(self.inner.dense.get_or_init(|| arr.clone().unbind()).bind(py).clone())
     }
 
-    /// to_dense() -> (nx, ny, nz) bool: [`occupancy`](VoxelGrid.occupancy).
+    /// to_dense() -> numpy.ndarray
+    ///
+    /// The dense occupancy (`occupancy`), made once and shared, so read-only.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     `(nx, ny, nz)` bool, element `[i, j, k]` = voxel `(i, j, k)`.
+    ///
+    /// Raises
+    /// ------
+    /// RuntimeError
+    ///     The dense array would not fit in memory (use `coords()`).
+    ///
+    /// Examples
+    /// --------
+    /// >>> occ = grid.to_dense().copy()
     fn to_dense<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<bool>>> {
         self.occupancy(py)
     }
@@ -502,17 +542,39 @@ impl VoxelGrid {
         }
     }
 
-    /// coords() -> (n, 3) int32: the set voxels sorted in C order (as
-    /// `numpy.argwhere(occupancy)`), aligned with `colours`, `normals`,
-    /// `coverage` and `materials`; sparse, for grids of any size.
+    /// coords() -> numpy.ndarray
+    ///
+    /// The set voxels sorted in C order (as `numpy.argwhere(occupancy)`),
+    /// aligned with `colours`, `normals`, `coverage` and `materials`; sparse,
+    /// for grids of any size, made once.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     `(n, 3)` int32.
+    ///
+    /// Examples
+    /// --------
+    /// >>> xyz = grid.index_to_world(grid.coords())
     fn coords<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i32>> {
         let inner = self.inner.clone();
         let v = py.detach(move || inner.ordered().iter().map(|e| e.0).collect::<Vec<_>>());
         Array2::from_shape_fn((v.len(), 3), |(n, c)| v[n][c] as i32).into_pyarray(py)
     }
 
-    /// indices() -> (k, 3) int64: the set voxels, in the order of
-    /// `numpy.argwhere(occupancy)`; sparse, for grids too big to densify.
+    /// indices() -> numpy.ndarray
+    ///
+    /// The set voxels in C order (as `numpy.argwhere(occupancy)`), aligned with
+    /// the attributes; for grids of any size.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     `(n, 3)` int64.
+    ///
+    /// Examples
+    /// --------
+    /// >>> ijk = grid.indices()
     fn indices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
         let inner = self.inner.clone();
         let v = py.detach(move || inner.ordered().to_vec());
@@ -551,11 +613,36 @@ impl VoxelGrid {
         Some(order.iter().map(|o| c[o.1]).collect::<Array1<f32>>().into_pyarray(py))
     }
 
-    /// save(path, format=None, dither=False, block_palette=None, up="y",
-    /// watertight=True, triangulate=False): writes any format the CLI
-    /// writes (by extension or `format`), atomically; `up` is the data's up
-    /// axis for .vox and .schem, `watertight` and `triangulate` shape .obj
-    /// and .glb meshes of the voxels.
+    /// save(path, format=None, dither=False, block_palette=None, up="y", watertight=True, triangulate=False)
+    ///
+    /// Writes the grid in any format the CLI writes, atomically (a temporary
+    /// file renamed into place).
+    ///
+    /// Parameters
+    /// ----------
+    /// path : str or os.PathLike
+    ///     The output; the format comes from the extension unless `format` is given.
+    /// format : str, optional
+    ///     One of `topovox.FORMATS`.
+    /// dither : bool
+    ///     `.vox`: dither colours onto the palette.
+    /// block_palette : str or os.PathLike, optional
+    ///     `.schem`: a colour -> block table.
+    /// up : {"x", "y", "z"}
+    ///     `.vox` and `.schem`: the data's up axis.
+    /// watertight, triangulate : bool
+    ///     `.obj` and `.glb`: split T-junctions; triangles only.
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     A format that cannot hold this grid (too large to be dense, unknown).
+    /// FileNotFoundError, IsADirectoryError, PermissionError
+    ///     The output's folder is missing, or the path is a folder.
+    ///
+    /// Examples
+    /// --------
+    /// >>> grid.save("bunny.vdb")
     #[pyo3(signature = (path, format=None, dither=false, block_palette=None, up="y", watertight=true, triangulate=false))]
     #[allow(clippy::too_many_arguments)]
     fn save(
@@ -580,10 +667,25 @@ impl VoxelGrid {
         Ok(())
     }
 
-    /// check(mesh=None) -> dict: the `topovox check` report (components,
-    /// thick voxels; with the mesh: closedness, separation with witnesses,
-    /// thinness, tunnels). A tiled grid (past memory) is checked window by
-    /// window without a dense copy (`sparse` is true in the report).
+    /// check(mesh=None) -> dict
+    ///
+    /// The `topovox check` report: components, thick voxels; with the mesh
+    /// (anything `voxelize` takes): closedness, separation with witnesses,
+    /// thinness, tunnels. A grid past memory is checked window by window.
+    ///
+    /// Parameters
+    /// ----------
+    /// mesh : optional
+    ///     The source mesh.
+    ///
+    /// Returns
+    /// -------
+    /// dict
+    ///     The report (`separating_6`, `components_26`, `tunnels_6`, ...).
+    ///
+    /// Examples
+    /// --------
+    /// >>> grid.check(mesh)["separating_6"]
     #[pyo3(signature = (mesh=None))]
     fn check<'py>(&self, py: Python<'py>, mesh: Option<&Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyAny>> {
         let inner = self.inner.clone();
@@ -607,15 +709,47 @@ impl VoxelGrid {
         to_py(py, &v)
     }
 
-    /// world_to_index(points) -> (n, 3) int64: the voxel holding each point
-    /// (`floor((p - origin) / voxel_size)`; may lie outside the grid).
+    /// world_to_index(points) -> numpy.ndarray
+    ///
+    /// The voxel holding each point: `floor((p - origin) / voxel_size)` (may lie
+    /// outside the grid).
+    ///
+    /// Parameters
+    /// ----------
+    /// points : array_like
+    ///     `(n, 3)` float.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     `(n, 3)` int64.
+    ///
+    /// Examples
+    /// --------
+    /// >>> grid.world_to_index([[0.0, 0.0, 0.0]])
     fn world_to_index<'py>(&self, py: Python<'py>, points: &Bound<'_, PyAny>) -> PyResult<Bound<'py, PyArray2<i64>>> {
         let p = points_from("points", points)?;
         let g = self.inner.grid;
         Ok(Array2::from_shape_fn((p.len(), 3), |(n, c)| g.to_grid_units(p[n])[c].floor() as i64).into_pyarray(py))
     }
 
-    /// index_to_world(indices) -> (n, 3) float64: the centre of each voxel.
+    /// index_to_world(indices) -> numpy.ndarray
+    ///
+    /// The centre of each voxel.
+    ///
+    /// Parameters
+    /// ----------
+    /// indices : array_like
+    ///     `(n, 3)` integers.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     `(n, 3)` float64.
+    ///
+    /// Examples
+    /// --------
+    /// >>> centres = grid.index_to_world(grid.coords())
     fn index_to_world<'py>(&self, py: Python<'py>, indices: &Bound<'_, PyAny>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let ijk = indices_from::<3>("indices", indices)?;
         let g = self.inner.grid;
@@ -623,10 +757,25 @@ impl VoxelGrid {
         Ok(Array2::from_shape_fn((ijk.len(), 3), |(n, c)| o[c] + (ijk[n][c] as f64 + 0.5) * s).into_pyarray(py))
     }
 
-    /// The mesh of the voxels (boundary faces merged into greedy quads,
-    /// T-junctions split so it is watertight, as triangles with shared
-    /// vertices): `(vertices (n, 3) float64, faces (m, 3) int64,
-    /// face_colours (m, 3) uint8 or None)`.
+    /// greedy_mesh() -> (vertices, faces, face_colours)
+    ///
+    /// The mesh of the voxels: boundary faces merged into greedy quads,
+    /// T-junctions split so it is watertight, as triangles with shared vertices.
+    ///
+    /// Returns
+    /// -------
+    /// tuple
+    ///     `vertices (n, 3) float64, faces (m, 3) int64, face_colours (m, 3)
+    ///     uint8 or None`.
+    ///
+    /// Raises
+    /// ------
+    /// RuntimeError
+    ///     The grid does not fit densely in memory.
+    ///
+    /// Examples
+    /// --------
+    /// >>> v, f, c = grid.greedy_mesh()
     fn greedy_mesh<'py>(&self, py: Python<'py>) -> PyResult<MeshArrays<'py>> {
         let g = &self.inner.grid;
         topovox_job::check_memory(g, topovox_job::budget(None), "a mesh of the voxels").map_err(py_err)?;
@@ -638,9 +787,23 @@ impl VoxelGrid {
         Ok((v, f, c))
     }
 
-    /// to_trimesh() -> trimesh.voxel.VoxelGrid: the voxels with their
-    /// placement (voxel `(i, j, k)`'s centre at `transform @ (i, j, k, 1)`).
-    /// Needs `trimesh`.
+    /// to_trimesh() -> trimesh.voxel.VoxelGrid
+    ///
+    /// The voxels as trimesh holds them, placed where they are (voxel
+    /// `(i, j, k)`'s centre at `transform @ (i, j, k, 1)`).
+    ///
+    /// Returns
+    /// -------
+    /// trimesh.voxel.VoxelGrid
+    ///
+    /// Raises
+    /// ------
+    /// ImportError
+    ///     trimesh is not installed.
+    ///
+    /// Examples
+    /// --------
+    /// >>> grid.to_trimesh().points
     fn to_trimesh<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let trimesh = import_trimesh(py, "to_trimesh")?;
         let (o, s) = (self.inner.grid.origin(), self.inner.grid.voxel_size());
@@ -656,9 +819,23 @@ impl VoxelGrid {
         trimesh.getattr("voxel")?.getattr("VoxelGrid")?.call((dense,), Some(&kwargs))
     }
 
-    /// to_trimesh_mesh() -> trimesh.Trimesh: the mesh of the voxels
-    /// (boundary faces merged into greedy quads, watertight), coloured per
-    /// face when the grid carries colours. Needs `trimesh`.
+    /// to_trimesh_mesh() -> trimesh.Trimesh
+    ///
+    /// The mesh of the voxels (`greedy_mesh()`), coloured per face when the grid
+    /// carries colours.
+    ///
+    /// Returns
+    /// -------
+    /// trimesh.Trimesh
+    ///
+    /// Raises
+    /// ------
+    /// ImportError
+    ///     trimesh is not installed.
+    ///
+    /// Examples
+    /// --------
+    /// >>> grid.to_trimesh_mesh().export("voxels.stl")
     fn to_trimesh_mesh<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let trimesh = import_trimesh(py, "to_trimesh_mesh")?;
         let (v, f, c) = self.greedy_mesh(py)?;
@@ -675,10 +852,36 @@ impl VoxelGrid {
         trimesh.getattr("Trimesh")?.call((), Some(&kwargs))
     }
 
-    /// VoxelGrid.from_coords(coords, dims, origin=(0, 0, 0), voxel_size=1.0,
-    /// colours=None, materials=None, normals=None, coverage=None): a grid
-    /// whose set voxels are the rows of `coords` ((n, 3) integers inside
-    /// `dims`, each once), with attributes aligned with those rows.
+    /// VoxelGrid.from_coords(coords, dims, origin=(0, 0, 0), voxel_size=1.0, colours=None, materials=None, normals=None, coverage=None)
+    ///
+    /// A grid whose set voxels are the rows of `coords`, with attributes aligned
+    /// with those rows (any row order).
+    ///
+    /// Parameters
+    /// ----------
+    /// coords : array_like
+    ///     `(n, 3)` integers inside `dims`, each voxel once.
+    /// dims : tuple of int
+    ///     `(nx, ny, nz)`.
+    /// origin : tuple of float, optional
+    ///     The grid's low corner.
+    /// voxel_size : float
+    ///     A voxel's edge.
+    /// colours, materials, normals, coverage : array_like, optional
+    ///     `(n, 3)` uint8, `(n,)` int (-1: none), `(n, 3)` float, `(n,)` float.
+    ///
+    /// Returns
+    /// -------
+    /// VoxelGrid
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     A voxel outside the grid or given twice, or arrays of the wrong shape.
+    ///
+    /// Examples
+    /// --------
+    /// >>> g = topovox.VoxelGrid.from_coords([[0, 0, 0], [1, 2, 3]], (4, 4, 4))
     #[staticmethod]
     #[pyo3(signature = (coords, dims, origin=None, voxel_size=1.0, colours=None, materials=None, normals=None, coverage=None, facts=None))]
     #[allow(clippy::too_many_arguments)]
@@ -732,9 +935,31 @@ impl VoxelGrid {
         Ok(VoxelGrid { inner: Arc::new(GridData::new(voxels, grid, attrs, facts)) })
     }
 
-    /// VoxelGrid.from_dense(array, origin=(0, 0, 0), voxel_size=1.0): a
-    /// grid whose set voxels are the non-zero elements of a 3-D array
-    /// (`[i, j, k]` = voxel `(i, j, k)`).
+    /// VoxelGrid.from_dense(array, origin=(0, 0, 0), voxel_size=1.0)
+    ///
+    /// A grid whose set voxels are the non-zero elements of a 3-D array.
+    ///
+    /// Parameters
+    /// ----------
+    /// array : array_like
+    ///     `(nx, ny, nz)`, element `[i, j, k]` = voxel `(i, j, k)`.
+    /// origin : tuple of float, optional
+    ///     The grid's low corner.
+    /// voxel_size : float
+    ///     A voxel's edge.
+    ///
+    /// Returns
+    /// -------
+    /// VoxelGrid
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     The array is not 3-D.
+    ///
+    /// Examples
+    /// --------
+    /// >>> g = topovox.VoxelGrid.from_dense(np.ones((2, 2, 2), bool))
     #[staticmethod]
     #[pyo3(signature = (array, origin=None, voxel_size=1.0))]
     fn from_dense(py: Python<'_>, array: &Bound<'_, PyAny>, origin: Option<(f64, f64, f64)>, voxel_size: f64) -> PyResult<VoxelGrid> {
@@ -995,6 +1220,33 @@ fn up_of(up: &str) -> PyResult<topovox_job::Up> {
 }
 
 /// load_voxels(path, origin=None, voxel_size=None, up="y", allow_external_paths=False) -> VoxelGrid
+///
+/// Reads any voxel file topovox writes, with its placement where the file
+/// records it.
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+///     The file (.npy, .npz, .binvox, .vox, .txt, .schem, .vti, .ply, .vdb, .zarr).
+/// origin, voxel_size
+///     The placement, when the file does not record it (default 0 and 1).
+/// up : {"x", "y", "z"}
+///     The up axis `.vox` and `.schem` files were written with.
+/// allow_external_paths : bool
+///     Follow links out of a `.zarr` folder.
+///
+/// Returns
+/// -------
+/// VoxelGrid
+///
+/// Raises
+/// ------
+/// FileNotFoundError, FileFormatError
+///     The file cannot be read, or its content is malformed.
+///
+/// Examples
+/// --------
+/// >>> grid = topovox.load_voxels("bunny.vdb")
 #[pyfunction]
 #[pyo3(signature = (path, origin=None, voxel_size=None, up="y", allow_external_paths=false))]
 fn load_voxels(

@@ -63,3 +63,29 @@ def test_the_typing_names_are_the_native_lists():
         (topovox.UpName, "up"),
     ]:
         assert list(get_args(alias)) == c[key], key
+
+
+def _public_functions():
+    import topovox.dask
+    import topovox.ray
+
+    for name in topovox.__all__:
+        f = getattr(topovox, name)
+        if callable(f) and not isinstance(f, type):
+            yield f"topovox.{name}", f
+    for cls in (topovox.VoxelGrid,):
+        for name, f in vars(cls).items():
+            if not name.startswith("_") and callable(f) or isinstance(f, staticmethod):
+                yield f"{cls.__name__}.{name}", getattr(cls, name)
+    yield "topovox.dask.voxelize_paths", topovox.dask.voxelize_paths
+    yield "topovox.ray.voxelize_paths", topovox.ray.voxelize_paths
+
+
+@pytest.mark.parametrize("name,f", list(_public_functions()))
+def test_every_public_function_has_a_numpy_style_docstring(name, f):
+    doc = f.__doc__ or ""
+    for section in ("Returns\n", "Examples\n"):
+        if section == "Returns\n" and name.endswith(".save"):
+            continue
+        assert section in doc, f"{name}: no {section.strip()} section"
+    assert "Parameters\n" in doc or "()" in doc.splitlines()[0] or name.endswith(("coords", "indices", "to_dense", "greedy_mesh", "to_trimesh", "to_trimesh_mesh")), name

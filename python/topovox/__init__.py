@@ -250,62 +250,95 @@ def voxelize(
     allow_external_paths: bool = False,
     color_rule: Optional[ColourRuleName] = None,
 ) -> VoxelGrid:
-    """Voxelizes a mesh; returns a :class:`VoxelGrid`.
+    """Voxelizes a mesh with a stated topological guarantee.
 
-    Args:
-        mesh_or_vertices: a :class:`Mesh` (``load_mesh``), anything with
-            ``.vertices`` and ``.faces`` (a ``trimesh.Trimesh``), or an
-            ``(n, 3)`` vertex array (float64 or float32; other dtypes are
-            converted) with ``faces``.
-        faces: ``(m, 3)`` integer vertex indices, when vertices are given.
-        mode: one of :data:`MODES` (see the module documentation).
-        resolution: the longest side of the bounding box spans this many
-            voxels (default 128 when no grid option is given).
-        voxel_size: the voxel edge; alone, the grid is fitted to the mesh.
-        origin, dims: with ``voxel_size``, an explicit grid; triangles
-            outside it are clipped, never wrapped.
-        pad: empty voxels added on every side of a fitted grid.
-        fit: ``"box"`` (the grid starts at the bounding box's corner) or
-            ``"cube"``: ``resolution**3`` voxels centred on the bounding box,
-            its longest side spanning ``resolution - 2 * pad`` voxels (the
-            ShapeNet/ModelNet convention).
-        method: one of :data:`METHODS`. ``auto`` picks the fastest path that
-            gives the mode's exact voxels; every method gives the same voxels.
-        threads: worker threads (default: all cores).
-        attributes: also carry colours, material ids, coverage and
-            normals from the mesh into the voxels (as ``--attributes`` does
-            on the command line); ``normals=True`` carries them too.
-        colour_rule: ``dominant`` (the colour covering the most area) or
-            ``blend`` (area-weighted mean in linear light); ``color_rule``
-            is the same option.
-        surface: solid modes: the surface of ``solid+surface`` and of a
-            flood fill's shell (cover, sep26, sep6 or ss6).
-        fill: solid modes: ``"flood"`` fills what a surface shell encloses.
-        hollow: solid modes: keep the voxels 6- or 26-adjacent to the outside.
-        gpu_path: with ``method="gpu"``: ``compute``, ``raster`` or
-            ``msaa-approx``.
-        seed: ``bubble``: the seed of the random target points (same seed,
-            same voxels).
-        tile: run the surface or line mode tile by tile with tiles of this many
-            voxels (a multiple of 8); same voxels. By default only grids
-            that do not fit in ``max_memory`` run tiled.
-        max_memory: memory the run may use, bytes or a string such as
-            ``"8G"`` (default: nine tenths of what is available). Tiled
-            grids are sparse: use :meth:`VoxelGrid.indices` or
-            ``save("x.vdb")`` / ``save("x.zarr")`` rather than ``occupancy``.
-        up, dither, watertight, triangulate, block_palette: the writers'
-            options, as :meth:`VoxelGrid.save` and :func:`batch` take them
-            (accepted here so that every front end takes every option;
-            :meth:`VoxelGrid.save` is where they apply).
-        allow_external_paths: accepted for the same reason (meshes given
-            here are already read).
+    Parameters
+    ----------
+    mesh_or_vertices : Mesh, path, trimesh or Open3D mesh, or array_like
+        Anything :func:`as_mesh` takes, or an ``(n, 3)`` vertex array
+        (float64 or float32; other dtypes are converted) with ``faces``.
+    faces : array_like, optional
+        ``(m, 3)`` integer vertex indices, when vertices are given.
+    mode : str
+        One of :data:`MODES` (see the module documentation).
+    resolution : int, optional
+        The longest side of the bounding box spans this many voxels
+        (default 128 when no grid option is given).
+    voxel_size : float, optional
+        The voxel edge; alone, the grid is fitted to the mesh.
+    origin, dims : sequence, optional
+        With ``voxel_size``, an explicit grid; triangles outside it are
+        clipped, never wrapped.
+    pad : int
+        Empty voxels added on every side of a fitted grid.
+    fit : {"box", "cube"}
+        ``"box"``: the grid starts at the bounding box's corner; ``"cube"``:
+        ``resolution**3`` voxels centred on the bounding box, its longest
+        side spanning ``resolution - 2 * pad`` voxels (the ShapeNet/ModelNet
+        convention).
+    method : str
+        One of :data:`METHODS`. ``auto`` picks the fastest path that gives
+        the mode's exact voxels; every method gives the same voxels.
+    threads : int, optional
+        Worker threads (default: all cores).
+    attributes : bool
+        Also carry colours, material ids, coverage and normals from the
+        mesh into the voxels (as ``--attributes`` does on the command
+        line); ``normals=True`` carries them too.
+    colour_rule : {"dominant", "blend"}
+        The colour covering the most area, or the area-weighted mean in
+        linear light; ``color_rule`` is the same option.
+    surface : str, optional
+        Solid modes: the surface of ``solid+surface`` and of a flood fill's
+        shell (cover, sep26, sep6 or ss6).
+    fill : {"flood"}, optional
+        Solid modes: fill what a surface shell encloses.
+    hollow : {6, 26}, optional
+        Solid modes: keep the voxels 6- or 26-adjacent to the outside.
+    gpu_path : {"compute", "raster", "msaa-approx"}
+        With ``method="gpu"``.
+    seed : int
+        ``bubble``: the seed of the random target points (same seed, same
+        voxels).
+    tile : int, optional
+        Run the surface or line mode tile by tile with tiles of this many
+        voxels (a multiple of 8); same voxels. By default only grids that
+        do not fit in ``max_memory`` run tiled.
+    max_memory : int or str, optional
+        Memory the run may use, bytes or a size such as ``"8G"`` (default:
+        nine tenths of what is available). Tiled grids are sparse: use
+        :meth:`VoxelGrid.coords` or ``save("x.vdb")`` rather than
+        ``occupancy``.
+    up, dither, watertight, triangulate, block_palette
+        The writers' options, as :meth:`VoxelGrid.save` and :func:`batch`
+        take them (accepted here so that every front end takes every
+        option; :meth:`VoxelGrid.save` is where they apply).
+    allow_external_paths : bool
+        Read files a mesh given by path names outside its folder.
 
+    Returns
+    -------
+    VoxelGrid
+        The voxels, the grid and what the run did (``facts``).
+
+    Raises
+    ------
+    ValueError
+        Bad arguments or arrays (wrong shape, NaN, indices out of range),
+        with the command line's message in Python's terms.
+    RuntimeError
+        The job could not run (no GPU, not enough memory).
+    KeyboardInterrupt
+        Ctrl-C: the run stops within a fraction of a second.
+
+    Notes
+    -----
     The GIL is released while voxelizing, so threads voxelize in parallel.
 
-    Raises:
-        ValueError: bad arguments or arrays (wrong shape, NaN, indices out
-            of range), the CLI's message.
-        RuntimeError: the job could not run (no GPU, not enough memory).
+    Examples
+    --------
+    >>> grid = topovox.voxelize("bunny.obj", mode="sep6", resolution=64)
+    >>> occupancy = np.asarray(grid)
     """
     mesh = as_mesh(mesh_or_vertices, faces)
     options = dict(locals())
@@ -335,23 +368,50 @@ def batch(
     jobs: Optional[int] = None,
     **options: Any,
 ) -> Dict[str, Any]:
-    """Voxelizes every mesh of ``paths`` (files, or folders walked for
-    meshes; ``glob`` such as ``"**/*.obj"`` filters them) into ``out_dir``,
-    as ``topovox batch`` does: one output per input, named after the input's
-    path below the inputs' common folder with the format's extension; a
-    manifest ``out_dir/manifest.jsonl`` (one JSON line per mesh: input,
-    output, status, options, grid, voxels, times, error) written as it goes;
-    meshes already done with the same options are skipped, so an
-    interrupted batch resumes; a bad mesh is recorded and the batch goes on.
+    """Voxelizes whole datasets, resumably, as ``topovox batch`` does.
 
-    ``options`` are every option :func:`voxelize` takes (:data:`OPTIONS`:
-    mode, resolution, method, seed, tile, max_memory, the writers' up,
-    dither, watertight, triangulate, …; ``attributes=True`` writes every
-    attribute grid into ``.vdb`` and ``.zarr`` outputs); ``jobs`` meshes run
-    at once (default: all cores).
+    One output per input, named after the input's path below the inputs'
+    common folder with the format's extension; a manifest
+    ``out_dir/manifest.jsonl`` (one JSON line per mesh: input, output,
+    status, options, grid, voxels, times, error) written as it goes; meshes
+    already done with the same options are skipped, so an interrupted batch
+    resumes (from any front end); a bad mesh is recorded and the batch goes
+    on. The output folder and files a manifest lists as outputs are never
+    read as inputs.
 
-    Returns the summary: ``{"done", "skipped", "failed", "total_s", "manifest",
-    "warnings"}`` (warnings: links skipped because they loop).
+    Parameters
+    ----------
+    paths : path or iterable of paths
+        Files, or folders walked for meshes.
+    out_dir : path
+        The output folder.
+    format : str
+        One of :data:`FORMATS`.
+    glob : str, optional
+        Which files of the folders to take, such as ``"**/*.obj"``.
+    jobs : int, optional
+        Meshes run at once (default: all cores).
+    **options
+        Every option :func:`voxelize` takes (:data:`OPTIONS`);
+        ``attributes=True`` writes every attribute grid into ``.vdb`` and
+        ``.zarr`` outputs.
+
+    Returns
+    -------
+    dict
+        ``{"done", "skipped", "failed", "total_s", "manifest", "warnings"}``
+        (warnings: links skipped because they loop).
+
+    Raises
+    ------
+    ValueError
+        Bad options, or two inputs that would share an output.
+    FileNotFoundError
+        An input that does not exist.
+
+    Examples
+    --------
+    >>> topovox.batch("meshes/", "voxels/", resolution=64, fit="cube")
     """
     if isinstance(paths, (str, bytes, os.PathLike)):
         paths = [paths]

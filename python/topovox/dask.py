@@ -31,13 +31,42 @@ def voxelize_paths(
     npartitions: Optional[int] = None,
     **options: Any,
 ) -> Any:
-    """A ``dask.bag.Bag`` with one task per mesh still to do (meshes the
-    manifest records as done with the same options are left out). Computing
-    it voxelizes each mesh (``options`` as :func:`topovox.voxelize` takes
-    them, plus ``colour_rule``, ``normals``, ``dither``), writes its output
-    and appends its manifest line; its elements are the manifest records.
-    Each task voxelizes on one thread (``threads=`` to change): the cluster
-    supplies the parallelism."""
+    """A Dask bag with one task per mesh still to do, as :func:`topovox.batch` would run.
+
+    Meshes the manifest records as done with the same options are left out.
+    Computing the bag voxelizes each mesh, writes its output and appends its
+    manifest line. Each task voxelizes on one thread (``threads=`` to
+    change): the cluster supplies the parallelism.
+
+    Parameters
+    ----------
+    paths : path or iterable of paths
+        Files, or folders walked for meshes.
+    out_dir : path or str
+        The output folder, or an fsspec URL.
+    format : str
+        One of :data:`topovox.FORMATS`.
+    glob : str, optional
+        Which files of the folders to take.
+    npartitions : int, optional
+        Partitions of the bag (default: one per mesh).
+    **options
+        Every option :func:`topovox.voxelize` takes.
+
+    Returns
+    -------
+    dask.bag.Bag
+        Its elements are the manifest records.
+
+    Raises
+    ------
+    ValueError
+        Bad options.
+
+    Examples
+    --------
+    >>> records = topovox.dask.voxelize_paths(["meshes/"], "out/", resolution=64).compute()
+    """
     import dask.bag as db
 
     out_dir = os.fsdecode(out_dir)

@@ -28,10 +28,38 @@ def voxelize_paths(
     num_cpus: float = 1,
     **options: Any,
 ) -> List[Dict[str, Any]]:
-    """Runs one Ray task per mesh still to do (``options`` as
-    :func:`topovox.voxelize` takes them, plus ``colour_rule``, ``normals``,
-    ``dither``); returns the manifest records, in the order tasks finished.
-    Ray must be initialised (``ray.init``)."""
+    """Runs one Ray task per mesh still to do, as :func:`topovox.batch` would.
+
+    Parameters
+    ----------
+    paths : path or iterable of paths
+        Files, or folders walked for meshes.
+    out_dir : path or str
+        The output folder, or an fsspec URL (outputs are uploaded by each task).
+    format : str
+        One of :data:`topovox.FORMATS`.
+    glob : str, optional
+        Which files of the folders to take.
+    num_cpus : float
+        CPUs each task asks Ray for.
+    **options
+        Every option :func:`topovox.voxelize` takes.
+
+    Returns
+    -------
+    list of dict
+        The manifest records, in the order tasks finished.
+
+    Raises
+    ------
+    ValueError
+        Bad options.
+
+    Examples
+    --------
+    >>> ray.init()
+    >>> records = topovox.ray.voxelize_paths(["meshes/"], "out/", resolution=64)
+    """
     import ray
 
     out_dir = os.fsdecode(out_dir)
