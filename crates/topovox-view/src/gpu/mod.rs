@@ -22,11 +22,13 @@ use crate::camera::{frustum_box, Camera};
 use crate::hiz::{pyramid_size, Pyramid};
 use crate::lights::{grid_frame, lights, LightGrid, LightReport, GRID};
 use crate::partition::{Cluster, Partition};
-use crate::scene::{Scene, Vertex};
+use crate::scene::Scene;
 use crate::spray::SprayPoint;
 use crate::ViewError;
 use topovox_gpu::device::{Device, DeviceOptions};
 use topovox_gpu::GpuError;
+
+mod pipelines;
 
 pub use topovox::render::Culling;
 
@@ -161,51 +163,6 @@ struct FrameUniform {
     params: [u32; 4],
 }
 
-/// What the frame's render pipelines differ in.
-struct PipelineParts<'a> {
-    label: &'a str,
-    layout: &'a wgpu::PipelineLayout,
-    module: &'a wgpu::ShaderModule,
-    /// Vertex and fragment entry points.
-    entry: (&'a str, &'a str),
-    buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
-    topology: wgpu::PrimitiveTopology,
-    /// Depth write and test against [`DEPTH`], or no depth attachment.
-    depth: Option<(bool, wgpu::CompareFunction)>,
-    targets: &'a [Option<wgpu::ColorTargetState>],
-}
-
-/// A render pipeline of the frame: no face culling, no blending.
-fn render_pipeline(device: &wgpu::Device, p: PipelineParts<'_>) -> wgpu::RenderPipeline {
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(p.label),
-        layout: Some(p.layout),
-        vertex: wgpu::VertexState {
-            module: p.module,
-            entry_point: Some(p.entry.0),
-            compilation_options: Default::default(),
-            buffers: p.buffers,
-        },
-        primitive: wgpu::PrimitiveState { topology: p.topology, cull_mode: None, ..Default::default() },
-        depth_stencil: p.depth.map(|(write, compare)| wgpu::DepthStencilState {
-            format: DEPTH,
-            depth_write_enabled: Some(write),
-            depth_compare: Some(compare),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: p.module,
-            entry_point: Some(p.entry.1),
-            compilation_options: Default::default(),
-            targets: p.targets,
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
-}
-
 /// Pixels between the picture's corner and the overlay text.
 pub const OVERLAY_MARGIN: f32 = 4.0;
 /// Overlay glyphs are 8×8 font texels drawn this many pixels wide.
@@ -298,36 +255,16 @@ pub struct GpuScene {
 pub struct Renderer {
     /// The device, shared layer of `topovox-gpu`.
     pub(crate) dev: Device,
-    cull: wgpu::ComputePipeline,
-    occlude: wgpu::ComputePipeline,
-    hiz_copy: wgpu::ComputePipeline,
-    hiz_reduce: wgpu::ComputePipeline,
-    hiz_layout: wgpu::BindGroupLayout,
-    hiz_read_layout: wgpu::BindGroupLayout,
-    grid_count: wgpu::ComputePipeline,
-    grid_scan: wgpu::ComputePipeline,
-    grid_fill: wgpu::ComputePipeline,
-    grid_layout: wgpu::BindGroupLayout,
-    cull_layout: wgpu::BindGroupLayout,
-    shade_layout: wgpu::BindGroupLayout,
-    prepass: wgpu::RenderPipeline,
-    shade: wgpu::RenderPipeline,
-    shade_equal: wgpu::RenderPipeline,
-    shade_lequal: wgpu::RenderPipeline,
-    points: wgpu::RenderPipeline,
-    /// The cluster-box wireframe, where vertex shaders may read storage
-    /// buffers (a downlevel capability every desktop driver has).
-    boxes: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
-    text: wgpu::RenderPipeline,
-    text_layout: wgpu::BindGroupLayout,
+    /// The frame's pipelines and layouts.
+    p: pipelines::Pipelines,
     font: wgpu::TextureView,
     timestamps: bool,
     max_side: u32,
 }
 
-const COLOUR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-const HIZ: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+pub(crate) const COLOUR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+pub(crate) const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+pub(crate) const HIZ: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 /// The largest side of the texture array's layers.
 pub const MAX_TEXTURE_SIDE: u32 = 2048;
 /// The most bytes the texture array takes.
@@ -336,7 +273,7 @@ pub const MAX_TEXTURE_BYTES: u64 = 512 << 20;
 const BACKGROUND: wgpu::Color = wgpu::Color { r: 0.10, g: 0.10, b: 0.12, a: 1.0 };
 
 /// The definitions the frame's shaders start with.
-const FRAME: &str = include_str!("shaders/frame.wgsl");
+const FRAME: &str = include_str!("../shaders/frame.wgsl");
 
 impl Renderer {
     /// Opens the default adapter (high performance preferred).
@@ -351,247 +288,12 @@ impl Renderer {
             instance,
             &DeviceOptions { label: "topovox view", surface, required: &[], optional: wgpu::Features::TIMESTAMP_QUERY },
         )?;
-        let timestamps = dev.features.contains(wgpu::Features::TIMESTAMP_QUERY);
-        let limits = dev.limits.clone();
-        let device = &dev.device;
-        let queue = &dev.queue;
-
-        let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-            count: None,
-        };
-        use wgpu::BufferBindingType::{Storage, Uniform};
-        use wgpu::ShaderStages as S;
-        let cull_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("cull"),
-            entries: &[
-                entry(0, S::COMPUTE, Uniform),
-                entry(1, S::COMPUTE, Storage { read_only: true }),
-                entry(2, S::COMPUTE, Storage { read_only: false }),
-                entry(3, S::COMPUTE, Storage { read_only: false }),
-            ],
-        });
-        let shade_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shade"),
-            entries: &[
-                entry(0, S::VERTEX | S::FRAGMENT, Uniform),
-                entry(4, S::FRAGMENT, Storage { read_only: true }),
-                entry(5, S::FRAGMENT, Storage { read_only: true }),
-                entry(6, S::FRAGMENT, Storage { read_only: true }),
-                entry(7, S::FRAGMENT, Storage { read_only: true }),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 8,
-                    visibility: S::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 9,
-                    visibility: S::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
-        let pipeline_layout = |layouts: &[Option<&wgpu::BindGroupLayout>]| {
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: None, bind_group_layouts: layouts, immediate_size: 0 })
-        };
-        let cull_module = dev.shader("cull", &[FRAME, include_str!("shaders/cull.wgsl")]);
-        let compute = |label, layouts: &[Option<&wgpu::BindGroupLayout>], module, entry| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pipeline_layout(layouts)),
-                module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let cull = compute("cull", &[Some(&cull_layout)], &cull_module, "cull");
-        let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: S::COMPUTE,
-            ty: wgpu::BindingType::Texture { sample_type, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false },
-            count: None,
-        };
-        let float = wgpu::TextureSampleType::Float { filterable: false };
-        let hiz_read_layout =
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("hiz read"), entries: &[texture(0, float)] });
-        let occlude = compute("occlude", &[Some(&cull_layout), Some(&hiz_read_layout)], &cull_module, "occlude");
-        let hiz_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("hiz build"),
-            entries: &[
-                texture(0, wgpu::TextureSampleType::Depth),
-                texture(1, float),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: S::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: HIZ,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let hiz_module = dev.shader("hiz", &[include_str!("shaders/hiz.wgsl")]);
-        let hiz_copy = compute("hiz copy", &[Some(&hiz_layout)], &hiz_module, "copy_depth");
-        let grid_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("light grid"),
-            entries: &[
-                entry(0, S::COMPUTE, Uniform),
-                entry(1, S::COMPUTE, Storage { read_only: true }),
-                entry(2, S::COMPUTE, Storage { read_only: false }),
-                entry(3, S::COMPUTE, Storage { read_only: false }),
-                entry(4, S::COMPUTE, Storage { read_only: false }),
-            ],
-        });
-        let grid_module = dev.shader("light grid", &[include_str!("shaders/grid.wgsl")]);
-        let grid_count = compute("light grid count", &[Some(&grid_layout)], &grid_module, "count");
-        let grid_scan = compute("light grid scan", &[Some(&grid_layout)], &grid_module, "scan");
-        let grid_fill = compute("light grid fill", &[Some(&grid_layout)], &grid_module, "fill");
-        let hiz_reduce = compute("hiz reduce", &[Some(&hiz_layout)], &hiz_module, "reduce");
-        let shade_module = dev.shader("shade", &[FRAME, include_str!("shaders/shade.wgsl"), include_str!("shaders/points.wgsl")]);
-        let shade_pl = pipeline_layout(&[Some(&shade_layout)]);
-        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x3, 3 => Float32x2];
-        let colour_target = [Some(wgpu::ColorTargetState { format: COLOUR, blend: None, write_mask: wgpu::ColorWrites::ALL })];
-        let vertex_layout = [Some(wgpu::VertexBufferLayout {
-            array_stride: std::mem::size_of::<Vertex>() as u64,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &attributes,
-        })];
-        // The depth-only passes run the alpha test too (fs_depth), so
-        // cut-out texels neither hide nor occlude anything.
-        let draw = |label, colour: bool, write: bool, compare| {
-            render_pipeline(
-                device,
-                PipelineParts {
-                    label,
-                    layout: &shade_pl,
-                    module: &shade_module,
-                    entry: ("vs", if colour { "fs" } else { "fs_depth" }),
-                    buffers: &vertex_layout,
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    depth: Some((write, compare)),
-                    targets: if colour { &colour_target } else { &[] },
-                },
-            )
-        };
-        let point_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x3, 4 => Float32x3];
-        let points = render_pipeline(
-            device,
-            PipelineParts {
-                label: "spray points",
-                layout: &shade_pl,
-                module: &shade_module,
-                entry: ("vs_point", "fs_point"),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<SprayPoint>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &point_attributes,
-                })],
-                topology: wgpu::PrimitiveTopology::PointList,
-                depth: Some((true, wgpu::CompareFunction::LessEqual)),
-                targets: &colour_target,
-            },
-        );
-        let boxes = dev.adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE).then(|| {
-            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("cluster boxes"),
-                entries: &[
-                    entry(0, S::VERTEX, Uniform),
-                    entry(1, S::VERTEX, Storage { read_only: true }),
-                    entry(2, S::VERTEX, Storage { read_only: true }),
-                ],
-            });
-            let module = dev.shader("cluster boxes", &[FRAME, include_str!("shaders/boxes.wgsl")]);
-            let pipeline = render_pipeline(
-                device,
-                PipelineParts {
-                    label: "cluster boxes",
-                    layout: &pipeline_layout(&[Some(&layout)]),
-                    module: &module,
-                    entry: ("vs_box", "fs_box"),
-                    buffers: &[],
-                    topology: wgpu::PrimitiveTopology::LineList,
-                    depth: None,
-                    targets: &colour_target,
-                },
-            );
-            (pipeline, layout)
-        });
-        let text_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("overlay text"),
-            entries: &[
-                entry(0, S::VERTEX | S::FRAGMENT, Uniform),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: S::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: float,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let text_module = dev.shader("overlay text", &[FRAME, include_str!("shaders/text.wgsl")]);
-        let glyph_attributes = wgpu::vertex_attr_array![0 => Float32x2, 1 => Uint32];
-        let text = render_pipeline(
-            device,
-            PipelineParts {
-                label: "overlay text",
-                layout: &pipeline_layout(&[Some(&text_layout)]),
-                module: &text_module,
-                entry: ("vs_text", "fs_text"),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<Glyph>() as u64,
-                    step_mode: wgpu::VertexStepMode::Instance,
-                    attributes: &glyph_attributes,
-                })],
-                topology: wgpu::PrimitiveTopology::TriangleStrip,
-                depth: None,
-                targets: &colour_target,
-            },
-        );
-        let font = font_atlas(device, queue);
-        let prepass = draw("prepass", false, true, wgpu::CompareFunction::Less);
-        let shade = draw("shade", true, true, wgpu::CompareFunction::Less);
-        let shade_equal = draw("shade after prepass", true, false, wgpu::CompareFunction::Equal);
-        let shade_lequal = draw("shade over a partial prepass", true, true, wgpu::CompareFunction::LessEqual);
         let r = Renderer {
+            p: pipelines::Pipelines::new(&dev),
+            font: font_atlas(&dev.device, &dev.queue),
+            timestamps: dev.features.contains(wgpu::Features::TIMESTAMP_QUERY),
+            max_side: dev.limits.max_texture_dimension_2d,
             dev,
-            cull,
-            occlude,
-            hiz_copy,
-            hiz_reduce,
-            hiz_layout,
-            hiz_read_layout,
-            grid_count,
-            grid_scan,
-            grid_fill,
-            grid_layout,
-            cull_layout,
-            shade_layout,
-            prepass,
-            shade,
-            shade_equal,
-            shade_lequal,
-            points,
-            boxes,
-            text,
-            text_layout,
-            font,
-            timestamps,
-            max_side: limits.max_texture_dimension_2d,
         };
         r.check()?;
         Ok(r)
@@ -665,11 +367,11 @@ impl Renderer {
                 entries.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
             self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout, entries: &entries })
         };
-        let cull_group = group(&self.cull_layout, &[(0, &uniform), (1, &boxes), (2, &commands), (3, &counters)]);
-        let boxes_group = self.boxes.as_ref().map(|(_, layout)| group(layout, &[(0, &uniform), (1, &boxes), (2, &commands)]));
+        let cull_group = group(&self.p.layouts.cull, &[(0, &uniform), (1, &boxes), (2, &commands), (3, &counters)]);
+        let boxes_group = self.p.boxes.as_ref().map(|(_, layout)| group(layout, &[(0, &uniform), (1, &boxes), (2, &commands)]));
         let text_group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("overlay text"),
-            layout: &self.text_layout,
+            layout: &self.p.layouts.text,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&self.font) },
@@ -682,7 +384,7 @@ impl Renderer {
         entries.push(wgpu::BindGroupEntry { binding: 9, resource: wgpu::BindingResource::Sampler(&sampler) });
         let shade_group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shade"),
-            layout: &self.shade_layout,
+            layout: &self.p.layouts.shade,
             entries: &entries,
         });
         self.check()?;
@@ -843,7 +545,7 @@ impl Renderer {
 
     /// A pipeline copying frames onto textures of `format`.
     pub fn blit(&self, format: wgpu::TextureFormat) -> Blit {
-        let module = self.dev.shader("blit", &[include_str!("shaders/blit.wgsl")]);
+        let module = self.dev.shader("blit", &[include_str!("../shaders/blit.wgsl")]);
         let layout = self.dev.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("blit"),
             entries: &[wgpu::BindGroupLayoutEntry {
@@ -885,7 +587,7 @@ impl Renderer {
         if o.width == 0 || o.height == 0 || o.width > self.max_side || o.height > self.max_side {
             return Err(ViewError::Size { width: o.width, height: o.height, max: self.max_side });
         }
-        if o.boxes && self.boxes.is_none() {
+        if o.boxes && self.p.boxes.is_none() {
             return Err(ViewError::device(
                 "the cluster-box wireframe needs vertex shaders that read storage buffers, which this adapter lacks".into(),
             ));
@@ -934,7 +636,7 @@ impl Renderer {
                     end_of_pass_write_index: Some(1),
                 }),
             });
-            pass.set_pipeline(&self.cull);
+            pass.set_pipeline(&self.p.cull);
             pass.set_bind_group(0, &s.cull_group, &[]);
             pass.dispatch_workgroups(n.div_ceil(64).max(1), 1, 1);
         }
@@ -977,7 +679,7 @@ impl Renderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.prepass);
+            pass.set_pipeline(&self.p.prepass);
             draw_all(&mut pass, if two_pass { &s.prev_commands } else { &s.commands });
         }
         let hiz = occlusion.then(|| self.occlusion_passes(&mut enc, s, &depth, o, queries.as_ref()));
@@ -1005,21 +707,21 @@ impl Renderer {
             // After a two-pass depth pass the depth holds only the previous
             // frame's clusters: shade over it with a less-or-equal test.
             pass.set_pipeline(match (o.prepass, two_pass) {
-                (false, _) => &self.shade,
-                (true, false) => &self.shade_equal,
-                (true, true) => &self.shade_lequal,
+                (false, _) => &self.p.shade,
+                (true, false) => &self.p.shade_equal,
+                (true, true) => &self.p.shade_lequal,
             });
             if o.mesh {
                 draw_all(&mut pass, &s.commands);
             }
             if let (Some(points), true) = (&s.points, s.point_count > 0) {
-                pass.set_pipeline(&self.points);
+                pass.set_pipeline(&self.p.points);
                 pass.set_bind_group(0, &s.shade_group, &[]);
                 pass.set_vertex_buffer(0, points.slice(..));
                 pass.draw(0..s.point_count, 0..1);
             }
         }
-        let boxes = match (o.boxes && n > 0, &self.boxes, &s.boxes_group) {
+        let boxes = match (o.boxes && n > 0, &self.p.boxes, &s.boxes_group) {
             (true, Some((pipeline, _)), Some(group)) => Some((pipeline, group)),
             _ => None,
         };
@@ -1043,7 +745,7 @@ impl Renderer {
                 pass.draw(0..24, 0..n);
             }
             if let Some((glyphs, count)) = &s.overlay {
-                pass.set_pipeline(&self.text);
+                pass.set_pipeline(&self.p.text);
                 pass.set_bind_group(0, &s.text_group, &[]);
                 pass.set_vertex_buffer(0, glyphs.slice(..));
                 pass.draw(0..4, 0..*count);
@@ -1236,7 +938,7 @@ impl Renderer {
             };
             let group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: None,
-                layout: &self.hiz_layout,
+                layout: &self.p.layouts.hiz,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_view) },
                     wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(src_view) },
@@ -1251,7 +953,7 @@ impl Renderer {
                     end_of_pass_write_index: None,
                 }),
             });
-            pass.set_pipeline(if l == 0 { &self.hiz_copy } else { &self.hiz_reduce });
+            pass.set_pipeline(if l == 0 { &self.p.hiz_copy } else { &self.p.hiz_reduce });
             pass.set_bind_group(0, &group, &[]);
             let [w, h] = sizes[l as usize];
             pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
@@ -1259,7 +961,7 @@ impl Renderer {
         let all = tex.create_view(&Default::default());
         let read_group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
-            layout: &self.hiz_read_layout,
+            layout: &self.p.layouts.hiz_read,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&all) }],
         });
         let n = s.clusters.len() as u32;
@@ -1271,7 +973,7 @@ impl Renderer {
                 end_of_pass_write_index: Some(7),
             }),
         });
-        pass.set_pipeline(&self.occlude);
+        pass.set_pipeline(&self.p.occlude);
         pass.set_bind_group(0, &s.cull_group, &[]);
         pass.set_bind_group(1, &read_group, &[]);
         pass.dispatch_workgroups(n.div_ceil(64).max(1), 1, 1);
@@ -1301,7 +1003,7 @@ impl Renderer {
         let group = |indices: &wgpu::Buffer| {
             self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: None,
-                layout: &self.grid_layout,
+                layout: &self.p.layouts.grid,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: lights.as_entire_binding() },
@@ -1317,9 +1019,9 @@ impl Renderer {
             let g = group(&placeholder);
             let mut pass = enc.begin_compute_pass(&Default::default());
             pass.set_bind_group(0, &g, &[]);
-            pass.set_pipeline(&self.grid_count);
+            pass.set_pipeline(&self.p.grid_count);
             pass.dispatch_workgroups(groups, 1, 1);
-            pass.set_pipeline(&self.grid_scan);
+            pass.set_pipeline(&self.p.grid_scan);
             pass.dispatch_workgroups(1, 1, 1);
         }
         let total_read = self.read_buffers(enc, &[(&total, 4)])?;
@@ -1330,7 +1032,7 @@ impl Renderer {
             let g = group(&indices);
             let mut pass = enc.begin_compute_pass(&Default::default());
             pass.set_bind_group(0, &g, &[]);
-            pass.set_pipeline(&self.grid_fill);
+            pass.set_pipeline(&self.p.grid_fill);
             pass.dispatch_workgroups(groups, 1, 1);
         }
         let read = self.read_buffers(enc, &[(&ranges, 8 * cells), (&indices, 4 * n.max(1))])?;
