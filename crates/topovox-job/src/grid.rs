@@ -76,8 +76,13 @@ impl GridRequest {
         let kind = GridKind::new(g)?;
         let pad = g.pad.unwrap_or(0);
         let fit = g.fit.unwrap_or_default();
-        if (pad > 0 || fit == Fit::Cube) && matches!(kind, GridKind::Explicit { .. }) {
-            invalid!("--pad and --fit apply to fitted grids (--resolution or --voxel-size), not to an explicit --origin/--dims grid");
+        if matches!(kind, GridKind::Explicit { .. }) {
+            if pad > 0 {
+                invalid!("--pad applies to fitted grids (--resolution or --voxel-size), not to an explicit --origin/--dims grid");
+            }
+            if fit == Fit::Cube {
+                invalid!("--fit cube applies to fitted grids (--resolution or --voxel-size), not to an explicit --origin/--dims grid");
+            }
         }
         if let (Fit::Cube, GridKind::Resolution(n)) = (fit, &kind) {
             if *n <= 2 * pad as u64 {

@@ -18,17 +18,18 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-use crate::camera::{frustum_box, Camera};
-use crate::hiz::{pyramid_size, Pyramid};
+use crate::camera::Camera;
+use crate::hiz::Pyramid;
 use crate::lights::{grid_frame, lights, LightGrid, LightReport, GRID};
 use crate::partition::{Cluster, Partition};
 use crate::scene::Scene;
 use crate::spray::SprayPoint;
 use crate::ViewError;
 use topovox_gpu::device::{Device, DeviceOptions};
-use topovox_gpu::GpuError;
 
+mod passes;
 mod pipelines;
+mod readback;
 
 pub use topovox::render::Culling;
 
@@ -351,17 +352,6 @@ impl Renderer {
             mapped_at_creation: false,
         });
         let materials = init("materials", bytemuck::cast_slice(&nonempty(&scene.materials)), U::STORAGE);
-        let textures = self.texture_array(&scene.textures)?;
-        let texture_view = textures
-            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
-        let sampler = self.dev.device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("textures"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
         let group = |layout, entries: &[(u32, &wgpu::Buffer)]| {
             let entries: Vec<wgpu::BindGroupEntry> =
                 entries.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
@@ -377,16 +367,7 @@ impl Renderer {
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&self.font) },
             ],
         });
-        let buffers = [(0, &uniform), (4, &materials), (5, &light_buf), (6, &ranges), (7, &light_indices)];
-        let mut entries: Vec<wgpu::BindGroupEntry> =
-            buffers.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
-        entries.push(wgpu::BindGroupEntry { binding: 8, resource: wgpu::BindingResource::TextureView(&texture_view) });
-        entries.push(wgpu::BindGroupEntry { binding: 9, resource: wgpu::BindingResource::Sampler(&sampler) });
-        let shade_group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shade"),
-            layout: &self.p.layouts.shade,
-            entries: &entries,
-        });
+        let shade_group = self.shade_group(scene, [(0, &uniform), (4, &materials), (5, &light_buf), (6, &ranges), (7, &light_indices)])?;
         self.check()?;
         Ok(GpuScene {
             vertices,
@@ -411,6 +392,31 @@ impl Renderer {
             points: None,
             point_count: 0,
         })
+    }
+
+    /// The shading pass's group: its buffers, the scene's texture array
+    /// and its sampler.
+    fn shade_group(&self, scene: &Scene, buffers: [(u32, &wgpu::Buffer); 5]) -> Result<wgpu::BindGroup, ViewError> {
+        let textures = self.texture_array(&scene.textures)?;
+        let texture_view = textures
+            .create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::D2Array), ..Default::default() });
+        let sampler = self.dev.device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("textures"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let mut entries: Vec<wgpu::BindGroupEntry> =
+            buffers.iter().map(|(binding, b)| wgpu::BindGroupEntry { binding: *binding, resource: b.as_entire_binding() }).collect();
+        entries.push(wgpu::BindGroupEntry { binding: 8, resource: wgpu::BindingResource::TextureView(&texture_view) });
+        entries.push(wgpu::BindGroupEntry { binding: 9, resource: wgpu::BindingResource::Sampler(&sampler) });
+        Ok(self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shade"),
+            layout: &self.p.layouts.shade,
+            entries: &entries,
+        }))
     }
 
     /// The scene's textures as one array of sRGB layers (sampled as
@@ -593,25 +599,7 @@ impl Renderer {
             ));
         }
         let t0 = Instant::now();
-        let (lo, hi) = s.bounds;
-        let (near, far) = o.camera.depth_range(lo, hi);
-        let view_proj = o.camera.view_proj(o.width as f32 / o.height as f32, near, far);
-        let (f_lo, f_hi) = frustum_box(view_proj);
-        let n = s.clusters.len() as u32;
-        let flags = u32::from(o.gamma) | if s.lights.lights == 0 { 2 } else { 0 } | if o.light_grid_view { 4 } else { 0 };
-        let u = FrameUniform {
-            view_proj: view_proj.to_cols_array_2d(),
-            eye: o.camera.eye.extend((o.camera.target - o.camera.eye).length()).to_array(),
-            f_lo: f_lo.extend(0.0).to_array(),
-            f_hi: f_hi.extend(0.0).to_array(),
-            grid_lo: s.grid.lo.extend(s.grid.unit).to_array(),
-            grid_cell: s.grid.cell.extend(s.grid_max as f32).to_array(),
-            params: [n, u32::from(o.culling != Culling::None), flags, o.width | (o.height << 16)],
-        };
-        self.dev.queue.write_buffer(&s.uniform, 0, bytemuck::bytes_of(&u));
-        self.dev.queue.write_buffer(&s.commands, 0, bytemuck::cast_slice(&s.commands_init));
-        self.dev.queue.write_buffer(&s.counters, 0, &[0u8; 16]);
-
+        self.write_uniforms(s, o);
         let queries = self.timestamps.then(|| {
             self.dev.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("pass times"),
@@ -619,366 +607,23 @@ impl Renderer {
                 count: 8,
             })
         });
-        let stamp = |i: u32| {
-            queries.as_ref().map(|q| wgpu::RenderPassTimestampWrites {
-                query_set: q,
-                beginning_of_pass_write_index: Some(2 * i),
-                end_of_pass_write_index: Some(2 * i + 1),
-            })
-        };
+        let q = queries.as_ref();
         let mut enc = self.dev.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("cull"),
-                timestamp_writes: queries.as_ref().map(|q| wgpu::ComputePassTimestampWrites {
-                    query_set: q,
-                    beginning_of_pass_write_index: Some(0),
-                    end_of_pass_write_index: Some(1),
-                }),
-            });
-            pass.set_pipeline(&self.p.cull);
-            pass.set_bind_group(0, &s.cull_group, &[]);
-            pass.dispatch_workgroups(n.div_ceil(64).max(1), 1, 1);
+        self.cull_pass(&mut enc, s, q);
+        let t = passes::Targets::new(&self.dev.device, o);
+        if o.prepass || passes::occlusion(o) {
+            self.depth_pass(&mut enc, s, o, &t, q);
         }
-        let texture = |format, usage| {
-            self.dev.device.create_texture(&wgpu::TextureDescriptor {
-                label: None,
-                size: wgpu::Extent3d { width: o.width, height: o.height, depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let colour =
-            texture(COLOUR, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING);
-        let occlusion = matches!(o.culling, Culling::Occlusion | Culling::OcclusionTwoPass);
-        let two_pass = o.culling == Culling::OcclusionTwoPass;
-        let depth = texture(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING);
-        let (cview, dview) = (colour.create_view(&Default::default()), depth.create_view(&Default::default()));
-        let draw_all = |pass: &mut wgpu::RenderPass<'_>, commands: &wgpu::Buffer| {
-            pass.set_bind_group(0, &s.shade_group, &[]);
-            pass.set_vertex_buffer(0, s.vertices.slice(..));
-            pass.set_index_buffer(s.indices.slice(..), wgpu::IndexFormat::Uint32);
-            if n > 0 {
-                pass.multi_draw_indexed_indirect(commands, 0, n);
-            }
-        };
-        if o.prepass || occlusion {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("depth pass"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &dview,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: stamp(1),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.p.prepass);
-            draw_all(&mut pass, if two_pass { &s.prev_commands } else { &s.commands });
+        let hiz = passes::occlusion(o).then(|| self.occlusion_passes(&mut enc, s, &t.depth, o, q));
+        self.shade_pass(&mut enc, s, o, &t, q);
+        self.overlay_pass(&mut enc, s, o, &t);
+        enc.copy_buffer_to_buffer(&s.commands, 0, &s.prev_commands, 0, 20 * (s.clusters.len() as u64).max(1));
+        if let Some((blit, target)) = present {
+            self.blit_pass(&mut enc, &t, blit, target);
         }
-        let hiz = occlusion.then(|| self.occlusion_passes(&mut enc, s, &depth, o, queries.as_ref()));
-        {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shade"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &cview,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(BACKGROUND), store: wgpu::StoreOp::Store },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &dview,
-                    depth_ops: Some(wgpu::Operations {
-                        load: if o.prepass { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(1.0) },
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: stamp(2),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            // After a two-pass depth pass the depth holds only the previous
-            // frame's clusters: shade over it with a less-or-equal test.
-            pass.set_pipeline(match (o.prepass, two_pass) {
-                (false, _) => &self.p.shade,
-                (true, false) => &self.p.shade_equal,
-                (true, true) => &self.p.shade_lequal,
-            });
-            if o.mesh {
-                draw_all(&mut pass, &s.commands);
-            }
-            if let (Some(points), true) = (&s.points, s.point_count > 0) {
-                pass.set_pipeline(&self.p.points);
-                pass.set_bind_group(0, &s.shade_group, &[]);
-                pass.set_vertex_buffer(0, points.slice(..));
-                pass.draw(0..s.point_count, 0..1);
-            }
-        }
-        let boxes = match (o.boxes && n > 0, &self.p.boxes, &s.boxes_group) {
-            (true, Some((pipeline, _)), Some(group)) => Some((pipeline, group)),
-            _ => None,
-        };
-        if boxes.is_some() || s.overlay.is_some() {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("cluster boxes and text"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &cview,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            if let Some((pipeline, group)) = boxes {
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, group, &[]);
-                pass.draw(0..24, 0..n);
-            }
-            if let Some((glyphs, count)) = &s.overlay {
-                pass.set_pipeline(&self.p.text);
-                pass.set_bind_group(0, &s.text_group, &[]);
-                pass.set_vertex_buffer(0, glyphs.slice(..));
-                pass.draw(0..4, 0..*count);
-            }
-        }
-        enc.copy_buffer_to_buffer(&s.commands, 0, &s.prev_commands, 0, 20 * n.max(1) as u64);
-        let row = aligned_row(o.width);
-        let readback = |label, size| {
-            self.dev.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
-        let pixels = present.is_none().then(|| readback("picture", row as u64 * o.height as u64));
-        match (present, &pixels) {
-            (Some((blit, target)), _) => {
-                let group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: None,
-                    layout: &blit.layout,
-                    entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&cview) }],
-                });
-                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("blit"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: target,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(BACKGROUND), store: wgpu::StoreOp::Store },
-                    })],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&blit.pipeline);
-                pass.set_bind_group(0, &group, &[]);
-                pass.draw(0..3, 0..1);
-            }
-            (None, Some(pixels)) => enc.copy_texture_to_buffer(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &colour,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::TexelCopyBufferInfo {
-                    buffer: pixels,
-                    layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(o.height) },
-                },
-                wgpu::Extent3d { width: o.width, height: o.height, depth_or_array_layers: 1 },
-            ),
-            (None, None) => unreachable!("frames not presented are read back"),
-        }
-        let hiz_read = match (&hiz, o.read_hiz) {
-            (Some(h), true) => Some(self.copy_levels(&mut enc, h)),
-            _ => None,
-        };
-        let cmd_bytes = 20 * n.max(1) as u64;
-        let cmds = readback("commands", cmd_bytes);
-        enc.copy_buffer_to_buffer(&s.commands, 0, &cmds, 0, cmd_bytes);
-        let counts = readback("counters", 16);
-        enc.copy_buffer_to_buffer(&s.counters, 0, &counts, 0, 16);
-        let times = queries.as_ref().map(|q| {
-            let resolve = self.dev.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timestamps"),
-                size: 64,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            let read = readback("timestamps readback", 64);
-            enc.resolve_query_set(q, 0..8, &resolve, 0);
-            enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, 64);
-            read
-        });
+        let reads = self.readbacks(&mut enc, (s, o, &t), present.is_none(), hiz.as_ref(), q);
         self.dev.queue.submit([enc.finish()]);
-        let mapped: Vec<&wgpu::Buffer> = [pixels.as_ref(), Some(&cmds), Some(&counts), times.as_ref()]
-            .into_iter()
-            .flatten()
-            .chain(hiz_read.iter().flat_map(|(bufs, _)| bufs.iter()))
-            .collect();
-        self.dev.map_all(&mapped.iter().map(|b| b.slice(..)).collect::<Vec<_>>())?;
-        let mut rgba = Vec::with_capacity(4 * o.width as usize * o.height as usize);
-        if let Some(pixels) = &pixels {
-            let data = pixels.slice(..).get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-            for y in 0..o.height as usize {
-                rgba.extend_from_slice(&data[y * row as usize..y * row as usize + 4 * o.width as usize]);
-            }
-        }
-        let kept: Vec<bool> = {
-            let data = cmds.slice(..).get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-            let words: &[u32] = bytemuck::cast_slice(&data);
-            (0..n as usize).map(|c| words[5 * c + 1] != 0).collect()
-        };
-        let [after, drawn, after_occ, drawn_occ] = {
-            let data = counts.slice(..).get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-            let w: &[u32] = bytemuck::cast_slice(&data);
-            [w[0], w[1], w[2], w[3]]
-        };
-        let hiz = match hiz_read {
-            Some((bufs, sizes)) => {
-                let mut levels = Vec::with_capacity(bufs.len());
-                for (b, [w, h]) in bufs.iter().zip(&sizes) {
-                    let data = b.slice(..).get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-                    let row = aligned_row(*w) as usize;
-                    let mut level = Vec::with_capacity((*w * *h) as usize);
-                    for y in 0..*h as usize {
-                        level.extend_from_slice(bytemuck::cast_slice::<u8, f32>(&data[y * row..y * row + 4 * *w as usize]));
-                    }
-                    levels.push(level);
-                }
-                Some(Pyramid { sizes, levels, picture: [o.width, o.height] })
-            }
-            None => None,
-        };
-        let gpu = match times {
-            Some(t) => {
-                let data = t.slice(..).get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
-                let w: &[u64] = bytemuck::cast_slice(&data);
-                let period = self.dev.queue.get_timestamp_period() as f64 * 1e-6;
-                let span = |i: usize| w[2 * i + 1].saturating_sub(w[2 * i]) as f64 * period;
-                Some(PassTimes {
-                    cull_ms: span(0),
-                    depth_ms: if o.prepass || occlusion { span(1) } else { 0.0 },
-                    shade_ms: span(2),
-                    hiz_ms: if occlusion { span(3) } else { 0.0 },
-                })
-            }
-            None => None,
-        };
-        let stats = FrameStats {
-            clusters: n,
-            clusters_after_frustum: after,
-            clusters_after_occlusion: occlusion.then_some(after_occ),
-            triangles: s.triangles,
-            triangles_drawn: if !o.mesh {
-                0
-            } else if occlusion {
-                u64::from(drawn_occ)
-            } else {
-                u64::from(drawn)
-            },
-            points_drawn: u64::from(s.point_count),
-            multi_draw: "multi_draw_indexed_indirect",
-            cpu_ms: t0.elapsed().as_secs_f64() * 1e3,
-            gpu,
-        };
-        Ok(Frame { width: o.width, height: o.height, rgba, kept, hiz, stats })
-    }
-
-    /// Builds the Hi-Z pyramid from the depth pass and runs the occlusion
-    /// test over the frustum survivors; returns the pyramid texture and
-    /// its level sizes.
-    fn occlusion_passes(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        s: &GpuScene,
-        depth: &wgpu::Texture,
-        o: &FrameOptions,
-        queries: Option<&wgpu::QuerySet>,
-    ) -> (wgpu::Texture, Vec<[u32; 2]>) {
-        let ([w0, h0], count) = pyramid_size(o.width, o.height);
-        let tex = self.dev.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("hi-z"),
-            size: wgpu::Extent3d { width: w0, height: h0, depth_or_array_layers: 1 },
-            mip_level_count: count,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: HIZ,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let level =
-            |l: u32| tex.create_view(&wgpu::TextureViewDescriptor { base_mip_level: l, mip_level_count: Some(1), ..Default::default() });
-        let depth_view = depth.create_view(&wgpu::TextureViewDescriptor { aspect: wgpu::TextureAspect::DepthOnly, ..Default::default() });
-        let sizes: Vec<[u32; 2]> = (0..count).map(|l| [(w0 >> l).max(1), (h0 >> l).max(1)]).collect();
-        for l in 0..count {
-            // Level 0 reads the depth; the source binding is then any
-            // level but the one written (level 1 for level 0: unused).
-            let (src, dst) = (level(if l == 0 { 1.min(count - 1) } else { l - 1 }), level(l));
-            let src = if l == 0 && count == 1 { None } else { Some(src) };
-            let dummy;
-            let src_view = match &src {
-                Some(v) => v,
-                None => {
-                    dummy = self.dummy_float();
-                    &dummy
-                }
-            };
-            let group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: None,
-                layout: &self.p.layouts.hiz,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_view) },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(src_view) },
-                    wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&dst) },
-                ],
-            });
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("hi-z level"),
-                timestamp_writes: queries.filter(|_| l == 0).map(|q| wgpu::ComputePassTimestampWrites {
-                    query_set: q,
-                    beginning_of_pass_write_index: Some(6),
-                    end_of_pass_write_index: None,
-                }),
-            });
-            pass.set_pipeline(if l == 0 { &self.p.hiz_copy } else { &self.p.hiz_reduce });
-            pass.set_bind_group(0, &group, &[]);
-            let [w, h] = sizes[l as usize];
-            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
-        }
-        let all = tex.create_view(&Default::default());
-        let read_group = self.dev.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &self.p.layouts.hiz_read,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&all) }],
-        });
-        let n = s.clusters.len() as u32;
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("occlude"),
-            timestamp_writes: queries.map(|q| wgpu::ComputePassTimestampWrites {
-                query_set: q,
-                beginning_of_pass_write_index: None,
-                end_of_pass_write_index: Some(7),
-            }),
-        });
-        pass.set_pipeline(&self.p.occlude);
-        pass.set_bind_group(0, &s.cull_group, &[]);
-        pass.set_bind_group(1, &read_group, &[]);
-        pass.dispatch_workgroups(n.div_ceil(64).max(1), 1, 1);
-        drop(pass);
-        (tex, sizes)
+        self.read_frame(s, o, reads, t0)
     }
 
     /// Builds the light grid on the GPU (count, scan, fill) and reads it

@@ -108,7 +108,11 @@ impl Layouts {
             ),
             hiz: layout(device, "hiz build", &[texture(0, wgpu::TextureSampleType::Depth), texture(1, FLOAT), hiz_out]),
             hiz_read: layout(device, "hiz read", &[texture(0, FLOAT)]),
-            grid: layout(device, "light grid", &[buffer(0, c, Uniform), buffer(1, c, ro), buffer(2, c, rw), buffer(3, c, rw), buffer(4, c, rw)]),
+            grid: layout(
+                device,
+                "light grid",
+                &[buffer(0, c, Uniform), buffer(1, c, ro), buffer(2, c, rw), buffer(3, c, rw), buffer(4, c, rw)],
+            ),
             text: layout(device, "overlay text", &[buffer(0, S::VERTEX | S::FRAGMENT, Uniform), fragment(1, glyphs)]),
         }
     }
@@ -133,7 +137,12 @@ fn render_pipeline(device: &wgpu::Device, p: PipelineParts<'_>) -> wgpu::RenderP
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(p.label),
         layout: Some(p.layout),
-        vertex: wgpu::VertexState { module: p.module, entry_point: Some(p.entry.0), compilation_options: Default::default(), buffers: p.buffers },
+        vertex: wgpu::VertexState {
+            module: p.module,
+            entry_point: Some(p.entry.0),
+            compilation_options: Default::default(),
+            buffers: p.buffers,
+        },
         primitive: wgpu::PrimitiveState { topology: p.topology, cull_mode: None, ..Default::default() },
         depth_stencil: p.depth.map(|(write, compare)| wgpu::DepthStencilState {
             format: DEPTH,
@@ -159,7 +168,13 @@ fn pipeline_layout(device: &wgpu::Device, layouts: &[&wgpu::BindGroupLayout]) ->
     device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: None, bind_group_layouts: &layouts, immediate_size: 0 })
 }
 
-fn compute(device: &wgpu::Device, label: &str, layouts: &[&wgpu::BindGroupLayout], module: &wgpu::ShaderModule, entry: &str) -> wgpu::ComputePipeline {
+fn compute(
+    device: &wgpu::Device,
+    label: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    module: &wgpu::ShaderModule,
+    entry: &str,
+) -> wgpu::ComputePipeline {
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(label),
         layout: Some(&pipeline_layout(device, layouts)),
@@ -190,7 +205,19 @@ fn draws(dev: &Device, l: &Layouts) -> [wgpu::RenderPipeline; 5] {
     let draw = |label, colour: bool, write: bool, compare| {
         let (entry, targets): (_, &[_]) = if colour { (("vs", "fs"), &COLOUR_TARGET) } else { (("vs", "fs_depth"), &[]) };
         let topology = wgpu::PrimitiveTopology::TriangleList;
-        render_pipeline(device, PipelineParts { label, layout: &layout, module: &module, entry, buffers: &vertices, topology, depth: Some((write, compare)), targets })
+        render_pipeline(
+            device,
+            PipelineParts {
+                label,
+                layout: &layout,
+                module: &module,
+                entry,
+                buffers: &vertices,
+                topology,
+                depth: Some((write, compare)),
+                targets,
+            },
+        )
     };
     let point_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x3, 4 => Float32x3];
     let points = [Some(wgpu::VertexBufferLayout {
