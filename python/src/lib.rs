@@ -182,6 +182,53 @@ fn indices_from<const K: usize>(name: &str, a: &Bound<'_, PyAny>) -> PyResult<Ve
     Err(shape_or_dtype(name, a, &format!("(n, {K}) int64, int32, uint32 or uint64")))
 }
 
+/// An `(h, w, 3|4)` uint8 image as a texture.
+fn texture_from(py: Python<'_>, t: &Bound<'_, PyAny>) -> PyResult<topovox::attributes::Texture> {
+    let arr = py.import("numpy")?.call_method1("asarray", (t, "uint8"))?;
+    let a = arr.extract::<numpy::PyReadonlyArray3<'_, u8>>().map_err(|_| value_err("texture must be an (h, w, 3) or (h, w, 4) image"))?;
+    let v = a.as_array();
+    let (h, w, c) = v.dim();
+    if !(c == 3 || c == 4) || h == 0 || w == 0 || h > 16384 || w > 16384 {
+        return Err(value_err(format!("texture must be an (h, w, 3) or (h, w, 4) image up to 16384 a side; got {}", shape(&[h, w, c]))));
+    }
+    let rgba = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (y, x)))
+        .flat_map(|(y, x)| [v[[y, x, 0]], v[[y, x, 1]], v[[y, x, 2]], if c == 4 { v[[y, x, 3]] } else { 255 }])
+        .collect();
+    Ok(topovox::attributes::Texture {
+        name: "texture".into(),
+        width: w as u32,
+        height: h as u32,
+        rgba,
+        wrap: [topovox::attributes::Wrap::Repeat; 2],
+    })
+}
+
+/// One textured material over every triangle, with per-vertex UVs given
+/// with `v = 0` at the image's bottom row (as trimesh, Open3D and OBJ
+/// store them) turned into per-corner UVs with `v = 0` at the top.
+fn textured_material(
+    app: &mut topovox::attributes::Appearance,
+    triangles: &[[i64; 3]],
+    uv: &[[f32; 2]],
+    texture: topovox::attributes::Texture,
+) {
+    let index = app.textures.len() as u32;
+    app.textures.push(texture);
+    let material = app.materials.len() as u32;
+    app.materials.push(topovox::attributes::Material {
+        name: "texture".into(),
+        factor: [1.0; 3],
+        texture: Some(index),
+        emission: [0.0; 3],
+        roughness: topovox::attributes::DEFAULT_ROUGHNESS,
+        alpha_cutoff: None,
+        alpha_texture: None,
+    });
+    app.triangle_material = vec![material; triangles.len()];
+    app.triangle_uv = triangles.iter().map(|t| t.map(|v| [uv[v as usize][0], 1.0 - uv[v as usize][1]])).collect();
+}
+
 /// Face colours as materials: one plain material per distinct colour.
 fn face_materials(app: &mut topovox::attributes::Appearance, colours: &[[u8; 3]]) {
     let mut index: std::collections::HashMap<[u8; 3], u32> = std::collections::HashMap::new();
@@ -226,7 +273,8 @@ impl Mesh {
     /// sRGB, one per vertex or per face (`topovox.as_mesh` converts
     /// floats, RGBA and trimesh/Open3D colours).
     #[new]
-    #[pyo3(signature = (vertices, faces=None, segments=None, vertex_colours=None, face_colours=None))]
+    #[pyo3(signature = (vertices, faces=None, segments=None, vertex_colours=None, face_colours=None, uvs=None, texture=None))]
+    #[allow(clippy::too_many_arguments)]
     fn new<'py>(
         py: Python<'py>,
         vertices: &Bound<'py, PyAny>,
@@ -234,6 +282,8 @@ impl Mesh {
         segments: Option<&Bound<'py, PyAny>>,
         vertex_colours: Option<&Bound<'py, PyAny>>,
         face_colours: Option<&Bound<'py, PyAny>>,
+        uvs: Option<&Bound<'py, PyAny>>,
+        texture: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Mesh> {
         let positions = points_from("vertices", vertices)?;
         let triangles = faces.map(|f| indices_from::<3>("faces", f)).transpose()?.unwrap_or_default();
@@ -241,12 +291,21 @@ impl Mesh {
         let (nv, nf) = (positions.len(), triangles.len());
         let vc = vertex_colours.map(|c| rows_of::<u8, 3>("vertex_colours", &as_array(py, c, "uint8")?, nv)).transpose()?;
         let fc = face_colours.map(|c| rows_of::<u8, 3>("face_colours", &as_array(py, c, "uint8")?, nf)).transpose()?;
+        let textured = match (uvs, texture) {
+            (Some(u), Some(t)) => Some((rows_of::<f32, 2>("uvs", &as_array(py, u, "float32")?, nv)?, texture_from(py, t)?)),
+            (None, None) => None,
+            _ => return Err(value_err("uvs and texture come together: per-vertex UVs and the image they index")),
+        };
+        let tris_for_uv = triangles.clone();
         let mut loaded = py.detach(|| topovox_io::validate_mesh(positions, triangles, segs)).map_err(|k| value_err(k.to_string()))?;
         if let Some(vc) = vc {
             loaded.appearance.vertex_colour = vc;
         }
         if let Some(fc) = fc {
             face_materials(&mut loaded.appearance, &fc);
+        }
+        if let Some((uv, tex)) = textured {
+            textured_material(&mut loaded.appearance, &tris_for_uv, &uv, tex);
         }
         Ok(Mesh { inner: Arc::new(loaded), path: None })
     }
@@ -270,6 +329,12 @@ impl Mesh {
     fn segments<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i64>> {
         let s = &self.inner.mesh.segments;
         Array2::from_shape_fn((s.len(), 2), |(i, c)| s[i][c] as i64).into_pyarray(py)
+    }
+
+    /// `vertex_colours`, as trimesh and Open3D spell it.
+    #[getter]
+    fn vertex_colors<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<u8>>> {
+        self.vertex_colours(py)
     }
 
     /// Per-vertex sRGB colours, `(n, 3)` uint8, or None.
@@ -445,11 +510,18 @@ impl VoxelGrid {
         (d[0], d[1], d[2])
     }
 
-    /// World position of the grid's low corner.
+    /// World position of the grid's low corner, `(3,)` float64.
     #[getter]
-    fn origin(&self) -> (f64, f64, f64) {
-        let o = self.inner.grid.origin();
-        (o.x, o.y, o.z)
+    fn origin<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from(self.inner.grid.origin().to_array().to_vec()).into_pyarray(py)
+    }
+
+    /// The grid's world box, `(2, 3)` float64: its low and high corners.
+    #[getter]
+    fn bounds<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let g = &self.inner.grid;
+        let (o, s, d) = (g.origin(), g.voxel_size(), g.dims());
+        Array2::from_shape_fn((2, 3), |(r, c)| o[c] + r as f64 * d[c] as f64 * s).into_pyarray(py)
     }
 
     /// Edge length of a voxel.
@@ -579,6 +651,12 @@ impl VoxelGrid {
         let inner = self.inner.clone();
         let v = py.detach(move || inner.ordered().to_vec());
         Array2::from_shape_fn((v.len(), 3), |(n, c)| v[n].0[c] as i64).into_pyarray(py)
+    }
+
+    /// `colours`, as NumPy/trimesh users spell it.
+    #[getter]
+    fn colors<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray2<u8>>> {
+        self.colours(py)
     }
 
     /// Per set voxel sRGB colour, `(k, 3)` uint8, aligned with `indices()`; None without attributes.
@@ -983,7 +1061,10 @@ impl VoxelGrid {
         let args = (
             self.coords(py),
             self.dims(),
-            self.origin(),
+            {
+                let o = g.origin();
+                (o.x, o.y, o.z)
+            },
             g.voxel_size(),
             self.colours(py),
             self.materials(py),

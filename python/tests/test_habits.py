@@ -37,7 +37,8 @@ def test_grids_from_arrays_and_coordinates_round_trip_and_pickle(tmp_path):
     rng = np.random.default_rng(5)
     a = rng.random((7, 5, 6)) > 0.6
     g = topovox.VoxelGrid.from_dense(a, origin=(1.0, 2.0, 3.0), voxel_size=0.5)
-    assert (g.occupancy == a).all() and g.origin == (1.0, 2.0, 3.0) and g.voxel_size == 0.5
+    assert (g.occupancy == a).all() and (g.origin == [1.0, 2.0, 3.0]).all() and g.voxel_size == 0.5
+    assert np.allclose(g.bounds, [[1.0, 2.0, 3.0], [4.5, 4.5, 6.0]])
     coords = np.argwhere(a)[::-1].copy()  # any row order
     colours = (coords * 30).astype(np.uint8)
     h = topovox.VoxelGrid.from_coords(coords, a.shape, colours=colours)
@@ -127,3 +128,20 @@ def test_the_typed_quick_start_runs(meshes):
     r = subprocess.run([sys.executable, str(script), str(meshes / "cow.obj")], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert "6-separating True" in r.stdout
+
+
+def test_a_textured_trimesh_keeps_its_texture(tmp_path):
+    v, f = box()
+    uv = np.array([[0.1, 0.1]] * 8, np.float32)  # every vertex samples the bottom-left texel
+    image = np.zeros((2, 2, 3), np.uint8)
+    image[1, 0] = [0, 0, 255]  # the bottom-left texel (row 1 of 2: v = 0 is the bottom)
+    image[0, :] = [255, 0, 0]
+    m = topovox.Mesh(v, f, uvs=uv, texture=image)
+    assert m.uvs.shape == (12, 3, 2) and np.allclose(m.uvs[0, 0], [0.1, 0.9])
+    g = topovox.voxelize(m, resolution=6, attributes=True)
+    assert (g.colors == [0, 0, 255]).all() and g.colors is not None
+    with pytest.raises(ValueError, match="come together"):
+        topovox.Mesh(v, f, uvs=uv)
+    PIL = pytest.importorskip("PIL.Image")
+    tm = trimesh.Trimesh(v, f, process=False, visual=trimesh.visual.TextureVisuals(uv=uv, image=PIL.fromarray(image)))
+    assert (topovox.voxelize(tm, resolution=6, attributes=True).colors == [0, 0, 255]).all()

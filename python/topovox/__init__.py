@@ -137,24 +137,30 @@ def _colours(c: Any) -> Optional[np.ndarray]:
     return arr.astype(np.uint8)
 
 
-def _trimesh_colours(mesh: Any) -> Tuple[Optional[np.ndarray], Optional[np.ndarray]]:
-    """A trimesh mesh's (vertex, face) colours: its colour visuals as they
-    are; a texture sampled at the vertices' UVs (trimesh's ``to_color``)."""
+def _trimesh_appearance(mesh: Any) -> Dict[str, Any]:
+    """A trimesh mesh's colours as :class:`Mesh` keywords: its texture and
+    per-vertex UVs as they are, or its vertex or face colours."""
     visual: Any = getattr(mesh, "visual", None)
     kind = getattr(visual, "kind", None)
     if visual is None:
-        return None, None
+        return {}
     if kind == "texture":
-        try:
+        material = getattr(visual, "material", None)
+        image = getattr(material, "baseColorTexture", None) or getattr(material, "image", None)
+        uv = getattr(visual, "uv", None)
+        if image is not None and uv is not None:
+            rgba = np.asarray(image.convert("RGBA") if hasattr(image, "convert") else image)
+            return {"uvs": np.asarray(uv, dtype=np.float32), "texture": rgba}
+        try:  # a texture without an image: the colours trimesh samples
             visual = visual.to_color()
             kind = visual.kind
-        except Exception:  # a texture trimesh cannot sample: no colours
-            return None, None
+        except Exception:
+            return {}
     if kind == "vertex":
-        return _colours(visual.vertex_colors), None
+        return {"vertex_colours": _colours(visual.vertex_colors)}
     if kind == "face":
-        return None, _colours(visual.face_colors)
-    return None, None
+        return {"face_colours": _colours(visual.face_colors)}
+    return {}
 
 
 def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]], faces: Optional[Any] = None) -> Mesh:
@@ -164,8 +170,8 @@ def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]]
     ----------
     mesh_or_vertices
         A :class:`Mesh`; a path (read by :func:`load_mesh`); a
-        ``trimesh.Trimesh`` (``vertices`` and ``faces``, with its vertex or
-        face colours, a texture sampled at the vertices) or ``trimesh.Scene``
+        ``trimesh.Trimesh`` (``vertices`` and ``faces``, with its texture and
+        UVs, or its vertex or face colours) or ``trimesh.Scene``
         (its geometry, concatenated); an Open3D ``TriangleMesh``
         (``vertices`` and ``triangles``, with its vertex colours); a
         ``(vertices, faces)`` pair; or an ``(n, 3)`` vertex array with
@@ -202,8 +208,7 @@ def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]]
         if isinstance(getattr(m, "geometry", None), dict):  # a trimesh.Scene (what trimesh.load("x.glb") returns)
             m = m.to_geometry() if hasattr(m, "to_geometry") else m.dump(concatenate=True)
         if hasattr(m, "vertices") and hasattr(m, "faces"):
-            vc, fc = _trimesh_colours(m)
-            return Mesh(_as_float_points(m.vertices, "vertices"), _as_index_array(m.faces, "faces"), vertex_colours=vc, face_colours=fc)
+            return Mesh(_as_float_points(m.vertices, "vertices"), _as_index_array(m.faces, "faces"), **_trimesh_appearance(m))
         if hasattr(m, "vertices") and hasattr(m, "triangles"):
             has = getattr(m, "has_vertex_colors", None)
             vc = _colours(np.asarray(m.vertex_colors)) if callable(has) and has() else None
