@@ -1,9 +1,9 @@
 //! Floor and ceiling division on the lattice, exact, without a hardware
 //! division where the operands allow: an `f64` estimate of the quotient
-//! (a division, or a multiplication by a [`Divisor`]'s reciprocal)
+//! (a division, or a multiplication by a `Divisor`'s reciprocal)
 //! corrected exactly. Every algorithm that turns a plane or edge value into
 //! a voxel index divides here (the shaders of `topovox-gpu` carry the same
-//! correction in WGSL); [`PlaneInt::div_floor`] is the plain `i64`/`i128`
+//! correction in WGSL); `PlaneInt::div_floor` is the plain `i64`/`i128`
 //! one the estimates fall back to.
 
 use crate::geom::fixed::{PlaneInt, ONE};

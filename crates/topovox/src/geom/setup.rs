@@ -1,7 +1,7 @@
 //! The triangle setup of the exact target tests: a lattice triangle's
-//! plane and edges relative to its first vertex ([`TriSetup`]), per target
-//! direction ([`DirSetup`]), and per pivot point ([`PivotCross`]), in `i64`
-//! where the triangle is small enough ([`fits_i64`]) and `i128` otherwise.
+//! plane and edges relative to its first vertex (`TriSetup`), per target
+//! direction (`DirSetup`), and per pivot point (`PivotCross`), in `i64`
+//! where the triangle is small enough (`fits_i64`) and `i128` otherwise.
 //! Every decision is Laine's (2013) test of a displaced target segment
 //! against the triangle, with the tie rule of [`crate::geom::perturb`];
 //! the algorithm files (`voxelize/`) and the certificates (`topology/`)
