@@ -109,6 +109,17 @@ impl Device {
         }
     }
 
+    /// The device writes timestamps around passes (opened with
+    /// `TIMESTAMP_QUERY`).
+    pub fn timestamps(&self) -> bool {
+        self.features.contains(wgpu::Features::TIMESTAMP_QUERY)
+    }
+
+    /// The largest 2D texture side (pictures, the rasterizer's viewport).
+    pub fn max_texture_side(&self) -> u32 {
+        self.limits.max_texture_dimension_2d
+    }
+
     /// The adapter's name and backend, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan)".
     pub fn adapter_name(&self) -> String {
         format!("{} ({:?})", self.info.name, self.info.backend)

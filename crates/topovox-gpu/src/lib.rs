@@ -128,10 +128,10 @@ impl RasterPipelines {
 impl Gpu {
     /// The rasterizer's colour target: `side`², never written.
     pub(crate) fn raster_target(&self, side: u32, msaa: bool) -> Result<wgpu::TextureView, GpuError> {
-        if side > self.max_texture_side {
+        if side > self.dev.max_texture_side() {
             return Err(GpuError::Unsupported(format!(
                 "the rasterizer path on grids over {} voxels on a side (the adapter's largest viewport); use the compute path",
-                self.max_texture_side
+                self.dev.max_texture_side()
             )));
         }
         let tex = self.dev.device.create_texture(&wgpu::TextureDescriptor {
@@ -269,10 +269,6 @@ pub struct Gpu {
     layout: wgpu::BindGroupLayout,
     solid: SolidPipelines,
     raster: RasterPipelines,
-    /// Largest 2D texture side (the rasterizer's viewport).
-    max_texture_side: u32,
-    /// The adapter writes timestamps around passes (GPU time is reported).
-    timestamps: bool,
     /// Largest storage buffer the output slab may use, in bytes.
     max_slab_bytes: u64,
 }
@@ -340,10 +336,8 @@ impl Gpu {
         let solid = SolidPipelines::new(&dev);
         let hardware_conservative = dev.features.contains(wgpu::Features::CONSERVATIVE_RASTERIZATION);
         let raster = RasterPipelines::new(&dev, &pl, hardware_conservative);
-        let max_texture_side = limits.max_texture_dimension_2d;
-        let timestamps = dev.features.contains(wgpu::Features::TIMESTAMP_QUERY);
         dev.check()?;
-        Ok(Gpu { dev, cover, layout, solid, raster, max_texture_side, timestamps, max_slab_bytes })
+        Ok(Gpu { dev, cover, layout, solid, raster, max_slab_bytes })
     }
 
     /// The first error the device reported since the last check, if any.

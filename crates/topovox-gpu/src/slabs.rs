@@ -132,7 +132,7 @@ impl Gpu {
         };
         let out = buffer("slab bits", wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST);
         let staging = buffer("slab readback", wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
-        let queries = self.timestamps.then(|| {
+        let queries = self.dev.timestamps().then(|| {
             let bytes = 16 * TIMED_PASSES as u64;
             Queries {
                 set: self.dev.device.create_query_set(&wgpu::QuerySetDescriptor {

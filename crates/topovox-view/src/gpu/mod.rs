@@ -259,8 +259,6 @@ pub struct Renderer {
     /// The frame's pipelines and layouts.
     p: pipelines::Pipelines,
     font: wgpu::TextureView,
-    timestamps: bool,
-    max_side: u32,
 }
 
 pub(crate) const COLOUR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -289,13 +287,7 @@ impl Renderer {
             instance,
             &DeviceOptions { label: "topovox view", surface, required: &[], optional: wgpu::Features::TIMESTAMP_QUERY },
         )?;
-        let r = Renderer {
-            p: pipelines::Pipelines::new(&dev),
-            font: font_atlas(&dev.device, &dev.queue),
-            timestamps: dev.features.contains(wgpu::Features::TIMESTAMP_QUERY),
-            max_side: dev.limits.max_texture_dimension_2d,
-            dev,
-        };
+        let r = Renderer { p: pipelines::Pipelines::new(&dev), font: font_atlas(&dev.device, &dev.queue), dev };
         r.check()?;
         Ok(r)
     }
@@ -307,7 +299,7 @@ impl Renderer {
 
     /// The largest picture side the adapter takes.
     pub fn max_side(&self) -> u32 {
-        self.max_side
+        self.dev.max_texture_side()
     }
 
     /// The adapter's name and backend.
@@ -430,7 +422,7 @@ impl Renderer {
         if layers > max_layers {
             return Err(ViewError::device(format!("{layers} textures: this adapter takes at most {max_layers} in one array")));
         }
-        let mut side = textures.iter().map(|t| t.width.max(t.height)).max().unwrap_or(1).clamp(1, MAX_TEXTURE_SIDE.min(self.max_side));
+        let mut side = textures.iter().map(|t| t.width.max(t.height)).max().unwrap_or(1).clamp(1, MAX_TEXTURE_SIDE.min(self.max_side()));
         while side > 1 && u64::from(side) * u64::from(side) * 4 * u64::from(layers) > MAX_TEXTURE_BYTES {
             side /= 2;
         }
@@ -590,8 +582,9 @@ impl Renderer {
     }
 
     fn frame(&self, s: &GpuScene, o: &FrameOptions, present: Option<(&Blit, &wgpu::TextureView)>) -> Result<Frame, ViewError> {
-        if o.width == 0 || o.height == 0 || o.width > self.max_side || o.height > self.max_side {
-            return Err(ViewError::Size { width: o.width, height: o.height, max: self.max_side });
+        let max = self.max_side();
+        if o.width == 0 || o.height == 0 || o.width > max || o.height > max {
+            return Err(ViewError::Size { width: o.width, height: o.height, max });
         }
         if o.boxes && self.p.boxes.is_none() {
             return Err(ViewError::device(
@@ -600,7 +593,7 @@ impl Renderer {
         }
         let t0 = Instant::now();
         self.write_uniforms(s, o);
-        let queries = self.timestamps.then(|| {
+        let queries = self.dev.timestamps().then(|| {
             self.dev.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("pass times"),
                 ty: wgpu::QueryType::Timestamp,
