@@ -48,7 +48,10 @@ fn python_terms(msg: &str) -> String {
         out.push_str(&rest[..at]);
         let flag = &rest[at + 2..];
         let end = flag.find(|c: char| !(c.is_ascii_alphanumeric() || c == '-')).unwrap_or(flag.len());
-        if end > 0 && flag.as_bytes()[0].is_ascii_lowercase() {
+        // A flag starts a word ("give --voxel-size"); a "--" inside a word
+        // (a file name such as "a--b.obj") is left as it is.
+        let starts_word = out.chars().last().is_none_or(|c| !(c.is_alphanumeric() || "-_./\\".contains(c)));
+        if end > 0 && flag.as_bytes()[0].is_ascii_lowercase() && starts_word {
             out.push_str(&flag[..end].replace('-', "_"));
         } else {
             out.push_str("--");

@@ -145,3 +145,15 @@ def test_a_textured_trimesh_keeps_its_texture(tmp_path):
     PIL = pytest.importorskip("PIL.Image")
     tm = trimesh.Trimesh(v, f, process=False, visual=trimesh.visual.TextureVisuals(uv=uv, image=PIL.fromarray(image)))
     assert (topovox.voxelize(tm, resolution=6, attributes=True).colors == [0, 0, 255]).all()
+
+
+def test_keywords_replace_flags_but_never_touch_file_names(tmp_path, meshes):
+    import shutil
+
+    d = tmp_path / "x--in"
+    d.mkdir()
+    shutil.copy(meshes / "cow.obj", d / "a--b.obj")
+    (d / "a--b.stl").write_bytes(b"solid x\nendsolid x\n")
+    with pytest.raises(ValueError) as e:
+        topovox.batch(d, tmp_path / "out")
+    assert "a--b" in str(e.value) and "x--in" in str(e.value)
