@@ -810,11 +810,32 @@ fn read_attributes(
             values.at(std::array::from_fn(|a| v[a] as i64 + offset[a]))
         };
         let f = |b: &[u8], n: usize| f32::from_le_bytes(b[4 * n..4 * n + 4].try_into().expect("4 bytes"));
+        // One lookup per voxel, its three components read from it.
         match name {
             ATTR_COLOUR => {
-                attrs.colour = Some(attrs.keys.iter().map(|&k| std::array::from_fn(|n| from_linear(f(&at(k), n) as f64))).collect())
+                attrs.colour = Some(
+                    attrs
+                        .keys
+                        .iter()
+                        .map(|&k| {
+                            let v = at(k);
+                            std::array::from_fn(|n| from_linear(f(&v, n) as f64))
+                        })
+                        .collect(),
+                )
             }
-            ATTR_NORMAL => attrs.normal = Some(attrs.keys.iter().map(|&k| std::array::from_fn(|n| f(&at(k), n))).collect()),
+            ATTR_NORMAL => {
+                attrs.normal = Some(
+                    attrs
+                        .keys
+                        .iter()
+                        .map(|&k| {
+                            let v = at(k);
+                            std::array::from_fn(|n| f(&v, n))
+                        })
+                        .collect(),
+                )
+            }
             ATTR_COVERAGE => attrs.coverage = Some(attrs.keys.iter().map(|&k| f(&at(k), 0)).collect()),
             _ => {
                 let id = |v: f32| if v >= 0.0 && v.fract() == 0.0 && v < NO_MATERIAL as f32 { v as u32 } else { NO_MATERIAL };
