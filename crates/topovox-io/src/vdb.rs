@@ -805,9 +805,10 @@ fn read_attributes(
         let Some(d) = found.iter().find(|d| d.name == name && d.ty == ty) else { continue };
         c.seek(d.pos)?;
         let values = read_values_grid(&mut c, if ty == VEC3_TYPE { 12 } else { 4 }).map_err(|e| in_grid(name, e))?;
-        let at = |key: u64| {
+        let mut read = values.reader();
+        let mut at = |key: u64| {
             let v = attrs.voxel(key);
-            values.at(std::array::from_fn(|a| v[a] as i64 + offset[a]))
+            read(std::array::from_fn(|a| v[a] as i64 + offset[a]))
         };
         let f = |b: &[u8], n: usize| f32::from_le_bytes(b[4 * n..4 * n + 4].try_into().expect("4 bytes"));
         // One lookup per voxel, its three components read from it.
@@ -920,26 +921,57 @@ struct GridValues {
     tiles: std::collections::HashMap<([i64; 3], i64), [u8; 12]>,
 }
 
+/// Where one leaf-sized block of an attribute grid takes its values.
+#[derive(Clone, Copy)]
+enum Block<'a> {
+    Leaf(&'a [u64], &'a [u8]),
+    Constant([u8; 12]),
+}
+
 impl GridValues {
-    /// The value at `p`: its leaf's if it is active there, else an active
-    /// tile's, else zero (the background topovox writes).
-    fn at(&self, p: [i64; 3]) -> [u8; 12] {
-        let mut out = [0u8; 12];
-        if let Some((mask, vals)) = self.leaves.get(&p.map(|c| c & !7)) {
-            let n = ((p[0] & 7) * 64 + (p[1] & 7) * 8 + (p[2] & 7)) as usize;
-            if bit(mask, n) {
-                let below = mask[..n / 64].iter().map(|w| w.count_ones() as usize).sum::<usize>()
-                    + (mask[n / 64] & ((1u64 << (n % 64)) - 1)).count_ones() as usize;
-                out[..self.vs].copy_from_slice(&vals[below * self.vs..(below + 1) * self.vs]);
-            }
-            return out;
+    /// The leaf-sized block at `origin` (a multiple of 8): its leaf, else
+    /// the active tile holding it, else zero (the background topovox writes).
+    fn block(&self, origin: [i64; 3]) -> Block<'_> {
+        if let Some((mask, vals)) = self.leaves.get(&origin) {
+            return Block::Leaf(mask, vals);
         }
         for edge in [1i64 << LEAF, 1 << LOWER, 1 << UPPER] {
-            if let Some(v) = self.tiles.get(&(p.map(|c| c & !(edge - 1)), edge)) {
-                return *v;
+            if let Some(v) = self.tiles.get(&(origin.map(|c| c & !(edge - 1)), edge)) {
+                return Block::Constant(*v);
             }
         }
-        out
+        Block::Constant([0; 12])
+    }
+
+    /// A lookup of values by index coordinate that finds each block once
+    /// per run of voxels in it (voxels come in row order, so a leaf's
+    /// eight voxels along x cost one map lookup, not eight).
+    fn reader(&self) -> impl FnMut([i64; 3]) -> [u8; 12] + '_ {
+        let mut last: Option<([i64; 3], Block<'_>)> = None;
+        move |p| {
+            let origin = p.map(|c| c & !7);
+            let block = match last {
+                Some((o, b)) if o == origin => b,
+                _ => {
+                    let b = self.block(origin);
+                    last = Some((origin, b));
+                    b
+                }
+            };
+            match block {
+                Block::Constant(v) => v,
+                Block::Leaf(mask, vals) => {
+                    let mut out = [0u8; 12];
+                    let n = ((p[0] & 7) * 64 + (p[1] & 7) * 8 + (p[2] & 7)) as usize;
+                    if bit(mask, n) {
+                        let below = mask[..n / 64].iter().map(|w| w.count_ones() as usize).sum::<usize>()
+                            + (mask[n / 64] & ((1u64 << (n % 64)) - 1)).count_ones() as usize;
+                        out[..self.vs].copy_from_slice(&vals[below * self.vs..(below + 1) * self.vs]);
+                    }
+                    out
+                }
+            }
+        }
     }
 }
 
