@@ -36,6 +36,8 @@ use topovox::{GridSpec, VoxelSource};
 use topovox_io::LoadedMesh;
 use topovox_job::{JobError, JobOptions, OptionValue, Voxels};
 
+mod distance;
+
 pyo3::create_exception!(_topovox, FileFormatError, PyOSError, "A file's content does not follow its format (the message names the file).");
 
 /// A [`JobError`] as the Python exception the package documents.
@@ -1469,6 +1471,8 @@ fn _topovox(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FileFormatError", m.py().get_type::<FileFormatError>())?;
     m.add_class::<Mesh>()?;
     m.add_class::<VoxelGrid>()?;
+    m.add_class::<distance::DistanceGrid>()?;
+    m.add_function(wrap_pyfunction!(distance::sdf, m)?)?;
     m.add_function(wrap_pyfunction!(load_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(voxelize, m)?)?;
     m.add_function(wrap_pyfunction!(load_voxels, m)?)?;

@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
 use topovox::raster::{RasterMethod, RasterMode};
+use topovox_job::distance::{DistanceFormat, Sign};
 use topovox_job::{ColourRule, Fill, Fit, GpuPath, Hollow, Method, Mode, Switch, Up};
 
 use topovox::render::raycast::View;
@@ -23,6 +24,10 @@ pub struct Cli {
 pub enum Command {
     /// Voxelize a mesh into a voxel file (.npy, .npz, .vdb, .zarr, .vox, .binvox, .schem, .vti, .ply, .txt) or a mesh of the voxels.
     Voxelize(VoxelizeArgs),
+    /// Distance field of a mesh: the exact distance from each voxel centre to the
+    /// mesh in a narrow band (or on every voxel), negative exactly where
+    /// `voxelize --mode solid` sets voxels; to .vdb (an OpenVDB level set), .npy, .zarr or .vti.
+    Sdf(SdfArgs),
     /// Print a report of a mesh file: vertices, triangles, degenerate triangles, bounds.
     Info(InfoArgs),
     /// Benchmark voxelization (medians over repeats) on a mesh at several resolutions.
@@ -171,6 +176,47 @@ pub struct VoxelizeArgs {
     pub preview: Option<PathBuf>,
     #[command(flatten)]
     pub picture: PictureArgs,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress bar and no summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct SdfArgs {
+    /// Input mesh (.obj, .stl, .ply, .gltf, .glb).
+    pub mesh: PathBuf,
+    /// Output file: .vdb (a float level set named `surface`, the band active), .npy
+    /// (float32, every voxel), .zarr (float32, sharded) or .vti (a `distance` cell array).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub grid: GridArgs,
+    /// Half width of the stored band in voxels: voxels nearer than W voxel sizes to the
+    /// mesh get their distance, the others ±W voxel sizes (OpenVDB's level-set
+    /// background). `all`: every voxel gets its distance.
+    #[arg(long, default_value = "3", value_name = "W|all")]
+    pub band: String,
+    /// Unsigned distances (no inside): for open meshes, polylines and point-like data.
+    #[arg(long)]
+    pub unsigned: bool,
+    /// How inside is decided (the same rule, and the same voxels, as `voxelize --mode solid --method`).
+    #[arg(long, value_parser = choice::<Sign>(), default_value = "auto")]
+    pub sign: Sign,
+    /// Output format: vdb, npy, zarr or vti (default: from the extension).
+    #[arg(long, value_name = "FORMAT", value_parser = choice::<DistanceFormat>())]
+    pub format: Option<DistanceFormat>,
+    /// Memory the run may use, e.g. 8G or 512M (default: nine tenths of what is available).
+    #[arg(long, value_name = "SIZE", value_parser = values::memory)]
+    pub max_memory: Option<u64>,
+    /// Read files the model names even outside its folder. Off by default.
+    #[arg(long)]
+    pub allow_external_paths: bool,
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,

@@ -38,6 +38,7 @@ fn main() -> ExitCode {
     remove_temporaries_on_interrupt();
     let result = match &cli.command {
         Command::Voxelize(a) => commands::voxelize::run(a),
+        Command::Sdf(a) => commands::sdf::run(a),
         Command::Info(a) => commands::info::run(a),
         Command::Bench(a) => commands::bench::run(a),
         Command::Check(a) => commands::check::run(a),

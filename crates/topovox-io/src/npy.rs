@@ -1,7 +1,8 @@
 //! NumPy `.npy` (format version 1.0), written by hand.
 //!
 //! Shape `(nx, ny, nz)`, C order, element `[i, j, k]` = voxel `(i, j, k)`,
-//! dtype `uint8` (`|u1`, 0 or 1) or `bool` (`|b1`). Written directly rather
+//! dtype `uint8` (`|u1`, 0 or 1) or `bool` (`|b1`); distance fields
+//! as `float32` (`<f4`). Written directly rather
 //! than through `npyz`: its per-element writer is far slower for the 10⁹
 //! elements of a 1024³ grid, and the header is a dozen lines. Tests read
 //! the files back with NumPy itself.
@@ -39,6 +40,21 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, dtype: Dtype) -> std::io
         bits.fill_i_planes(i0, count, true, &mut buf);
         w.write_all(&buf[..plane * count as usize])?;
         i0 += count;
+    }
+    Ok(())
+}
+
+/// Writes `values` (C order, `[i][j][k]`) as a float32 `.npy` array
+/// (`<f4`) of shape `dims`: a distance field.
+pub fn write_f32(w: &mut dyn Write, dims: [u32; 3], values: &[f32]) -> std::io::Result<()> {
+    let [nx, ny, nz] = dims;
+    debug_assert_eq!(values.len() as u64, nx as u64 * ny as u64 * nz as u64);
+    w.write_all(&header("<f4", &format!("({nx}, {ny}, {nz})")))?;
+    let mut buf = Vec::with_capacity(1 << 20);
+    for chunk in values.chunks(1 << 18) {
+        buf.clear();
+        chunk.iter().for_each(|v| buf.extend_from_slice(&v.to_le_bytes()));
+        w.write_all(&buf)?;
     }
     Ok(())
 }

@@ -8,7 +8,8 @@
 //! present `colour` (UInt8 × 3, sRGB), `material` (Int32, −1 for none and
 //! for empty cells),
 //! `coverage` (Float32, surface area inside the voxel / s²) and `normal`
-//! (Float32 × 3). Each array is one appended block stream with a UInt64
+//! (Float32 × 3); a distance field is one Float32 cell array
+//! `distance`. Each array is one appended block stream with a UInt64
 //! compression header (VTK's `vtkZLibDataCompressor` layout). Arrays are
 //! built block by block from the set voxels in key order, so memory stays
 //! at one block plus the compressed output.
@@ -175,8 +176,47 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: 
         st.finish(&fill)
     };
     let encoded: Vec<Vec<u8>> = arrays.par_iter().map(encode).collect::<std::io::Result<_>>()?;
-    let o = grid.origin();
-    let s = grid.voxel_size();
+    let mut xml = head(grid, "occupancy");
+    let mut offset = 0usize;
+    for ((name, ty, comps, _, _), e) in arrays.iter().zip(&encoded) {
+        xml.push_str(&format!(
+            "        <DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"appended\" offset=\"{offset}\"/>\n"
+        ));
+        offset += e.len();
+    }
+    xml.push_str(TAIL);
+    w.write_all(xml.as_bytes())?;
+    for e in &encoded {
+        w.write_all(e)?;
+    }
+    w.write_all(b"\n  </AppendedData>\n</VTKFile>\n")
+}
+
+/// Writes a distance field (`values` in C order, `[i][j][k]`) on `grid`
+/// as `.vti`: one Float32 cell array `distance`.
+pub fn write_distance(w: &mut dyn Write, values: &[f32], grid: &GridSpec) -> std::io::Result<()> {
+    let dims = grid.dims();
+    let [nx, ny, nz] = dims.map(|d| d as usize);
+    let mut st = Stream::new((nx * ny * nz) as u64, 4);
+    let mut row = Vec::with_capacity(4 * nx);
+    for k in 0..nz {
+        for j in 0..ny {
+            row.clear();
+            (0..nx).for_each(|i| row.extend_from_slice(&values[(i * ny + j) * nz + k].to_le_bytes()));
+            st.push(&row)?;
+        }
+    }
+    let encoded = st.finish(&[0; 4])?;
+    w.write_all(head(grid, "distance").as_bytes())?;
+    w.write_all(b"        <DataArray type=\"Float32\" Name=\"distance\" NumberOfComponents=\"1\" format=\"appended\" offset=\"0\"/>\n")?;
+    w.write_all(TAIL.as_bytes())?;
+    w.write_all(&encoded)?;
+    w.write_all(b"\n  </AppendedData>\n</VTKFile>\n")
+}
+
+/// The document up to the first cell array, with `scalars` the active one.
+fn head(grid: &GridSpec, scalars: &str) -> String {
+    let (dims, o, s) = (grid.dims(), grid.origin(), grid.voxel_size());
     let mut xml = String::new();
     xml.push_str("<?xml version=\"1.0\"?>\n");
     xml.push_str("<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\">\n");
@@ -186,22 +226,13 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: 
         o.x, o.y, o.z
     ));
     xml.push_str(&format!(
-        "    <Piece Extent=\"{extent}\">\n      <PointData>\n      </PointData>\n      <CellData Scalars=\"occupancy\">\n"
+        "    <Piece Extent=\"{extent}\">\n      <PointData>\n      </PointData>\n      <CellData Scalars=\"{scalars}\">\n"
     ));
-    let mut offset = 0usize;
-    for ((name, ty, comps, _, _), e) in arrays.iter().zip(&encoded) {
-        xml.push_str(&format!(
-            "        <DataArray type=\"{ty}\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"appended\" offset=\"{offset}\"/>\n"
-        ));
-        offset += e.len();
-    }
-    xml.push_str("      </CellData>\n    </Piece>\n  </ImageData>\n  <AppendedData encoding=\"raw\">\n   _");
-    w.write_all(xml.as_bytes())?;
-    for e in &encoded {
-        w.write_all(e)?;
-    }
-    w.write_all(b"\n  </AppendedData>\n</VTKFile>\n")
+    xml
 }
+
+/// The document after the cell arrays, up to the appended data.
+const TAIL: &str = "      </CellData>\n    </Piece>\n  </ImageData>\n  <AppendedData encoding=\"raw\">\n   _";
 
 /// An attribute's value in an XML tag.
 fn attr<'a>(tag: &'a str, name: &str) -> Option<&'a str> {

@@ -49,6 +49,7 @@ use flate2::write::GzEncoder;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use topovox::attributes::{VoxelAttributes, NO_MATERIAL};
+use topovox::distance::field::Field;
 use topovox::grid::bricks::{set_in_brick, Brick};
 use topovox::grid::sparse::SparseBricks;
 use topovox::voxelize::Stop;
@@ -240,6 +241,92 @@ pub fn write(
     fill_all(tmp.path(), bits, grid, extra, stop).map_err(|e| io(path, e))?;
     crate::atomic::check_stop(stop).map_err(|e| io(path, e))?;
     replace(tmp, path).map_err(|e| io(path, e))
+}
+
+/// Writes a distance field on `grid` as a Zarr v3 `float32` array at
+/// `path`, sharded and chunked as the occupancy ([`write`], whose
+/// replacement and stop rules apply), fill value `+background`: chunks
+/// holding no band voxel and nothing inside are not written.
+/// `attributes.topovox.distance` records the background and `signed`.
+pub fn write_distance(path: &Path, field: &Field, grid: &GridSpec, signed: bool, stop: Option<&Stop>) -> Result<(), IoError> {
+    check_replaceable(path)?;
+    crate::atomic::remove_stale_temporaries(path);
+    let tmp = Temporary::create_dir(path).map_err(|e| io(path, e))?;
+    fill_distance(tmp.path(), field, grid, signed, stop).map_err(|e| io(path, e))?;
+    crate::atomic::check_stop(stop).map_err(|e| io(path, e))?;
+    replace(tmp, path).map_err(|e| io(path, e))
+}
+
+fn fill_distance(dir: &Path, field: &Field, grid: &GridSpec, signed: bool, stop: Option<&Stop>) -> std::io::Result<()> {
+    let bg = field.background;
+    let kind = Kind {
+        name: "distance",
+        data_type: "float32",
+        comps: 1,
+        bytes: 4,
+        fill_value: json!(bg as f64),
+        fill: bg.to_le_bytes().to_vec(),
+        put: None,
+    };
+    let mut meta = metadata(grid, &kind);
+    meta["attributes"]["topovox"]["distance"] = json!({"background": bg as f64, "signed": signed});
+    std::fs::create_dir_all(dir)?;
+    std::fs::write(dir.join("zarr.json"), serde_json::to_vec_pretty(&meta).map_err(std::io::Error::other)?)?;
+    // The chunks holding a band voxel or an inside one, by shard.
+    let per = CHUNK / 8;
+    let shard = shard_shape(grid.dims());
+    let inner = shard.map(|s| s / CHUNK);
+    let mut chunks: Vec<[u32; 3]> = field.band.bricks.iter().map(|b| b.at.map(|v| v / per)).collect();
+    if let Some(inside) = &field.inside {
+        inside.source().for_each_brick_run(&mut |b, _, n| {
+            for x in (b[0] / per)..=((b[0] + n - 1) / per) {
+                chunks.push([x, b[1] / per, b[2] / per]);
+            }
+        });
+    }
+    let shard_of = |c: &[u32; 3]| std::array::from_fn::<u32, 3, _>(|a| c[a] / inner[a]);
+    chunks.par_sort_unstable_by_key(|c| (shard_of(c), *c));
+    chunks.dedup();
+    let shards = crate::runs(&chunks, shard_of);
+    shards.par_iter().try_for_each(|r| -> std::io::Result<()> {
+        crate::atomic::check_stop(stop)?;
+        let s = shard_of(&chunks[r.start]);
+        let mut body = Vec::new();
+        let mut index = vec![EMPTY; 2 * (inner[0] * inner[1] * inner[2]) as usize];
+        for c in &chunks[r.clone()] {
+            let n = (((c[0] % inner[0]) * inner[1] + c[1] % inner[1]) * inner[2] + c[2] % inner[2]) as usize;
+            let mut enc = GzEncoder::new(Vec::new(), flate2::Compression::new(1));
+            enc.write_all(&distance_chunk(field, *c))?;
+            let z = enc.finish()?;
+            index[2 * n] = body.len() as u64;
+            index[2 * n + 1] = z.len() as u64;
+            body.extend_from_slice(&z);
+        }
+        body.extend(index.iter().flat_map(|v| v.to_le_bytes()));
+        let d = dir.join("c").join(s[0].to_string()).join(s[1].to_string());
+        std::fs::create_dir_all(&d)?;
+        std::fs::write(d.join(s[2].to_string()), body)
+    })
+}
+
+/// One chunk of a distance field, C order, little-endian float32.
+fn distance_chunk(field: &Field, c: [u32; 3]) -> Vec<u8> {
+    let n = CHUNK as usize;
+    let mut values = vec![field.background; n * n * n];
+    let per = CHUNK / 8;
+    for bk in 0..per {
+        for bj in 0..per {
+            for bi in 0..per {
+                let at = [c[0] * per + bi, c[1] * per + bj, c[2] * per + bk];
+                let (v, _) = field.brick_values(at);
+                for (slot, &x) in v.iter().enumerate() {
+                    let (i, j, k) = (bi as usize * 8 + (slot & 7), bj as usize * 8 + (slot >> 3 & 7), bk as usize * 8 + (slot >> 6));
+                    values[(i * n + j) * n + k] = x;
+                }
+            }
+        }
+    }
+    values.iter().flat_map(|v| v.to_le_bytes()).collect()
 }
 
 /// Refuses to write over `path` unless it does not exist, is an empty

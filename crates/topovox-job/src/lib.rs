@@ -9,6 +9,7 @@
 //! - [`Request`] (mode, method, solid options) → [`Plan`] (validated) →
 //!   [`voxelize`] on a mesh → [`Voxelized`] (voxels, grid, the path that
 //!   ran, facts for summaries);
+//! - [`distance`]: distance fields ([`distance::sdf`]), signed by the solid;
 //! - [`attributes`] carries colours into them; [`output::write`] writes
 //!   any format; [`check::report`] certifies them.
 //!
@@ -24,6 +25,7 @@ mod solid;
 
 pub mod batch;
 pub mod check;
+pub mod distance;
 pub mod options;
 pub mod output;
 

@@ -21,6 +21,8 @@
 //! - Solids ([`voxelize::solid`], [`voxelize::winding`],
 //!   [`voxelize::fill`]): parity, the generalized winding number, flood
 //!   fill of a surface shell, hollowing.
+//! - [`distance`] — distance fields: the exact distance from voxel
+//!   centres to the mesh, in a narrow band or on every voxel.
 //! - [`attributes`] (colours, materials, normals, coverage carried into
 //!   the voxels), [`export`] (greedy quads of the voxels' boundary) and
 //!   [`render`] (CPU ray casting of a grid).
@@ -39,6 +41,7 @@ pub use glam;
 
 pub mod attributes;
 pub mod choice;
+pub mod distance;
 pub mod export;
 pub mod geom;
 pub mod grid;

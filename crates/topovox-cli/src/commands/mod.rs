@@ -11,6 +11,7 @@ pub mod raster;
 pub mod render;
 #[cfg(feature = "gpu")]
 pub mod scene;
+pub mod sdf;
 #[cfg(feature = "gpu")]
 pub mod spray;
 #[cfg(feature = "gpu")]

@@ -30,6 +30,7 @@ use rayon::prelude::*;
 use super::colour::{from_linear, linear_to_rgb, pack, to_linear, unpack};
 use super::{Appearance, ColourRule, Texture, VoxelAttributes, NO_MATERIAL};
 use crate::geom::clip::{clip_to_slab, ClipPoly, CLIPPED_MAX};
+use crate::geom::closest::closest_point;
 use crate::geom::lattice::{prepare_triangle, LatticeTriangle};
 use crate::voxelize::cover::cover_triangle;
 use crate::voxelize::driver::Sink;
@@ -630,44 +631,6 @@ pub mod reference {
 
 fn centroid(poly: &[DVec3]) -> DVec3 {
     poly.iter().copied().sum::<DVec3>() / poly.len() as f64
-}
-
-/// The point of triangle `p` nearest to `q` (C. Ericson, *Real-Time
-/// Collision Detection*, 5.1.5), for touches the f64 clip misses.
-fn closest_point(p: &[DVec3; 3], q: DVec3) -> DVec3 {
-    let (a, b, c) = (p[0], p[1], p[2]);
-    let (ab, ac, ap) = (b - a, c - a, q - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = q - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = q - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = va + vb + vc;
-    if denom == 0.0 {
-        return a;
-    }
-    a + ab * (vb / denom) + ac * (vc / denom)
 }
 
 /// The colour of one triangle at a point: texture × factor × vertex colour.

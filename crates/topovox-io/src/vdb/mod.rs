@@ -57,6 +57,10 @@ use topovox::{GridSpec, VoxelSource};
 use crate::error::ErrorKind;
 use crate::{LoadedVoxels, SparseVoxels};
 
+mod level_set;
+pub use level_set::write_level_set;
+use topovox::distance::field::Field;
+
 const MAGIC: i64 = 0x5644_4220;
 const FILE_VERSION: u32 = 224;
 /// Oldest format read: 222 introduced node-mask compression and the
@@ -182,7 +186,8 @@ fn vec3d(v: [f64; 3]) -> Vec<u8> {
 }
 
 /// The grid's metadata and transform.
-fn put_grid_head(o: &mut dyn Out, name: &str, tree: &Tree, count: u64, grid: &GridSpec) -> std::io::Result<()> {
+fn put_grid_head(o: &mut dyn Out, g: &GridOut<'_>, grid: &GridSpec) -> std::io::Result<()> {
+    let (name, tree, count) = (g.name, g.tree, g.count);
     o.put(&COMPRESS_ACTIVE_MASK.to_le_bytes())?;
     // Bounds of the active voxels: the tiles' boxes, then leaf by leaf: x
     // from the non-zero words, y and z from the bytes and bits of their union.
@@ -207,6 +212,9 @@ fn put_grid_head(o: &mut dyn Out, name: &str, tree: &Tree, count: u64, grid: &Gr
     let s = grid.voxel_size();
     let dims = grid.dims().map(|d| d as i32);
     let mut entries: Vec<(&str, &str, Vec<u8>)> = Vec::new();
+    if let Some(class) = g.class {
+        entries.push(("class", "string", class.as_bytes().to_vec()));
+    }
     if let Some((lo, hi)) = bbox {
         entries.push(("file_bbox_max", "vec3i", vec3i(hi)));
         entries.push(("file_bbox_min", "vec3i", vec3i(lo)));
@@ -226,6 +234,25 @@ fn put_grid_head(o: &mut dyn Out, name: &str, tree: &Tree, count: u64, grid: &Gr
         o.put(&vec3d(v))?;
     }
     Ok(())
+}
+
+/// Full bricks by lower node: key → mask of its 16³ bricks.
+type FullBricks = std::collections::HashMap<(u32, u32, u32, u32), Box<[u64; 64]>>;
+
+/// Marks the run of `n` full bricks from brick `b` along x in `full`,
+/// cut where it crosses lower nodes (16 bricks each).
+fn mark_full(full: &mut FullBricks, b: [u32; 3], n: u32) {
+    let mut x = b[0];
+    while x < b[0] + n {
+        let end = (b[0] + n).min((x / 16 + 1) * 16);
+        let first = Leaf { origin: [x << LEAF, b[1] << LEAF, b[2] << LEAF], mask: [0; 8] }.order();
+        let mask = full.entry((first.0, first.1, first.2, first.3)).or_insert_with(|| Box::new([0; 64]));
+        for xx in x..end {
+            let idx = (((xx & 15) << 8) | (first.4 & 0xff)) as usize;
+            mask[idx / 64] |= 1 << (idx % 64);
+        }
+        x = end;
+    }
 }
 
 /// A lower internal node (128³ voxels): its leaves, and its active tiles
@@ -260,9 +287,8 @@ impl Tree {
     /// tiles of 128³. Without `tiles` (attribute grids, whose voxels each
     /// hold their own value) every brick is a leaf.
     fn of(bits: &dyn VoxelSource, tiles: bool) -> Tree {
-        use rayon::slice::ParallelSliceMut;
         let mut leaves = Vec::new();
-        let mut full: std::collections::HashMap<(u32, u32, u32, u32), Box<[u64; 64]>> = std::collections::HashMap::new();
+        let mut full = FullBricks::new();
         let mut tile_box: Option<([i32; 3], [i32; 3])> = None;
         bits.for_each_brick_run(&mut |b, brick, n| {
             if *brick != FULL {
@@ -282,19 +308,15 @@ impl Tree {
                 bb.0[a] = bb.0[a].min(lo[a]);
                 bb.1[a] = bb.1[a].max(hi[a]);
             }
-            // The run, cut where it crosses lower nodes (16 bricks each).
-            let mut x = b[0];
-            while x < b[0] + n {
-                let end = (b[0] + n).min((x / 16 + 1) * 16);
-                let first = Leaf { origin: [x << LEAF, b[1] << LEAF, b[2] << LEAF], mask: [0; 8] }.order();
-                let mask = full.entry((first.0, first.1, first.2, first.3)).or_insert_with(|| Box::new([0; 64]));
-                for xx in x..end {
-                    let idx = (((xx & 15) << 8) | (first.4 & 0xff)) as usize;
-                    mask[idx / 64] |= 1 << (idx % 64);
-                }
-                x = end;
-            }
+            mark_full(&mut full, b, n);
         });
+        Tree::assemble(leaves, full, tile_box)
+    }
+
+    /// The tree of `leaves` (any order) and the full bricks of lower nodes
+    /// (`full`: lower-node key → mask of its 16³ bricks).
+    fn assemble(mut leaves: Vec<Leaf>, mut full: FullBricks, tile_box: Option<([i32; 3], [i32; 3])>) -> Tree {
+        use rayon::slice::ParallelSliceMut;
         leaves.par_sort_unstable_by_key(Leaf::order);
         // Lower nodes: those of leaves, with their tiles, then tile-only ones.
         let lower_key = |l: &Leaf| {
@@ -337,13 +359,43 @@ fn put_tile_values(o: &mut dyn Out, tiles: &[u64]) -> std::io::Result<()> {
     Ok(())
 }
 
-/// The tree: topology, then buffers. Without `values`, a bool grid
-/// (occupancy); with them, an attribute grid (no tiles, zero background,
-/// each leaf's active values after its mask).
-fn put_tree(o: &mut dyn Out, tree: &Tree, values: Option<&Values<'_>>) -> std::io::Result<()> {
+/// What a tree's nodes hold beyond their topology.
+#[derive(Clone, Copy)]
+enum Buffers<'a> {
+    /// A bool grid: tiles are active `true`, leaves' masks are the values.
+    Occupancy,
+    /// An attribute grid: no tiles, zero background, each leaf's active
+    /// values after its mask.
+    Attribute(&'a Values<'a>),
+    /// A distance field: tiles are inactive `−background` (inside), every
+    /// other inactive value `±background` by its sign ([`level_set`]).
+    LevelSet(&'a Field),
+}
+
+/// An internal node's value mask and values after its child mask: active
+/// tiles (`Occupancy`), or for a level set no active tile and a selection
+/// mask (metadata 3: a set bit is `+background`, a clear one
+/// `−background`), clear where `tiles` are inside.
+fn put_node_values(o: &mut dyn Out, tiles: &[u64], buffers: Buffers<'_>) -> std::io::Result<()> {
+    if let Buffers::LevelSet(_) = buffers {
+        put_words(o, &vec![0; tiles.len()])?;
+        o.put(&[3])?;
+        let outside: Vec<u64> = tiles.iter().map(|w| !w).collect();
+        return put_words(o, &outside);
+    }
+    put_words(o, tiles)?;
+    put_tile_values(o, tiles)
+}
+
+/// The tree: topology, then buffers.
+fn put_tree(o: &mut dyn Out, tree: &Tree, buffers: Buffers<'_>) -> std::io::Result<()> {
     o.put(&1i32.to_le_bytes())?; // buffer count
-    o.put(&[0; 12][..values.map_or(1, |v| v.size)])?; // background: false, or zero
-                                                      // Upper nodes: those of lower nodes and of full lower nodes, in order.
+    match buffers {
+        Buffers::Occupancy => o.put(&[0])?, // background: false
+        Buffers::Attribute(v) => o.put(&[0; 12][..v.size])?,
+        Buffers::LevelSet(f) => o.put(&f.background.to_le_bytes())?,
+    }
+    // Upper nodes: those of lower nodes and of full lower nodes, in order.
     let mut uppers: Vec<(u32, u32, u32)> =
         tree.lowers.iter().map(|l| upper_of(&l.key)).chain(tree.full_lowers.iter().map(upper_of)).collect();
     uppers.sort_unstable();
@@ -364,8 +416,7 @@ fn put_tree(o: &mut dyn Out, tree: &Tree, values: Option<&Values<'_>>) -> std::i
             value[x.3 as usize / 64] |= 1 << (x.3 % 64);
         }
         put_words(o, &child)?;
-        put_words(o, &value)?;
-        put_tile_values(o, &value)?;
+        put_node_values(o, &value, buffers)?;
         for x in &tree.lowers[l..l_end] {
             let mut child = [0u64; 16 * 16 * 16 / 64];
             for leaf in &tree.leaves[x.leaves.clone()] {
@@ -373,43 +424,58 @@ fn put_tree(o: &mut dyn Out, tree: &Tree, values: Option<&Values<'_>>) -> std::i
                 child[n / 64] |= 1 << (n % 64);
             }
             put_words(o, &child)?;
-            put_words(o, &x.tiles[..])?;
-            put_tile_values(o, &x.tiles[..])?;
+            put_node_values(o, &x.tiles[..], buffers)?;
             for leaf in &tree.leaves[x.leaves.clone()] {
                 put_words(o, &leaf.mask)?;
             }
         }
         (l, f) = (l_end, f_end);
     }
-    if let Some(v) = values {
-        for leaf in &tree.leaves {
-            // Value mask, then OpenVDB's compressed values: metadata 0 (every
-            // inactive value is the background), the active values in
-            // index order (`x·64 + y·8 + z`).
-            put_words(o, &leaf.mask)?;
-            let active: u32 = leaf.mask.iter().map(|w| w.count_ones()).sum();
-            o.put_with(1 + active as usize * v.size, &mut |buf| {
-                buf.push(0);
-                for (x, &w) in leaf.mask.iter().enumerate() {
-                    let mut w = w;
-                    while w != 0 {
-                        let b = w.trailing_zeros();
-                        w &= w - 1;
-                        let p = [leaf.origin[0] + x as u32, leaf.origin[1] + (b >> 3), leaf.origin[2] + (b & 7)];
-                        let slot = v.attrs.slot(p[0], p[1], p[2]).ok_or_else(|| {
-                            std::io::Error::other(format!("voxel {p:?} is set but has no attributes (voxels and attributes differ)"))
-                        })?;
-                        (v.put)(slot, buf);
-                    }
-                }
-                Ok(())
-            })?;
+    match buffers {
+        Buffers::Occupancy => put_bool_leaves(o, tree),
+        Buffers::Attribute(v) => put_attribute_leaves(o, tree, v),
+        Buffers::LevelSet(field) => {
+            for leaf in &tree.leaves {
+                put_words(o, &leaf.mask)?;
+                o.put(&level_set::leaf_values(field, leaf))?;
+            }
+            Ok(())
         }
-        return Ok(());
     }
+}
+
+/// Each leaf's active values after its mask (an attribute grid).
+fn put_attribute_leaves(o: &mut dyn Out, tree: &Tree, v: &Values<'_>) -> std::io::Result<()> {
+    for leaf in &tree.leaves {
+        // Value mask, then OpenVDB's compressed values: metadata 0 (every
+        // inactive value is the background), the active values in
+        // index order (`x·64 + y·8 + z`).
+        put_words(o, &leaf.mask)?;
+        let active: u32 = leaf.mask.iter().map(|w| w.count_ones()).sum();
+        o.put_with(1 + active as usize * v.size, &mut |buf| {
+            buf.push(0);
+            for (x, &w) in leaf.mask.iter().enumerate() {
+                let mut w = w;
+                while w != 0 {
+                    let b = w.trailing_zeros();
+                    w &= w - 1;
+                    let p = [leaf.origin[0] + x as u32, leaf.origin[1] + (b >> 3), leaf.origin[2] + (b & 7)];
+                    let slot = v.attrs.slot(p[0], p[1], p[2]).ok_or_else(|| {
+                        std::io::Error::other(format!("voxel {p:?} is set but has no attributes (voxels and attributes differ)"))
+                    })?;
+                    (v.put)(slot, buf);
+                }
+            }
+            Ok(())
+        })?;
+    }
+    Ok(())
+}
+
+/// Each leaf of a bool grid: value mask (active), origin, values.
+fn put_bool_leaves(o: &mut dyn Out, tree: &Tree) -> std::io::Result<()> {
     let mut buf = [0u8; 140];
     for leaf in &tree.leaves {
-        // Value mask (active), origin, values.
         for (n, w) in leaf.mask.iter().enumerate() {
             buf[8 * n..8 * n + 8].copy_from_slice(&w.to_le_bytes());
             buf[76 + 8 * n..84 + 8 * n].copy_from_slice(&w.to_le_bytes());
@@ -482,10 +548,29 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: 
     let count = bits.count();
     let extra = attrs.map(attribute_grids).unwrap_or_default();
     let value_tree = (!extra.is_empty()).then(|| Tree::of(bits, false));
-    let mut grids: Vec<(&str, &str, &Tree, Option<&Values<'_>>)> = vec![(GRID_NAME, GRID_TYPE, &tree, None)];
+    let mut grids: Vec<GridOut<'_>> =
+        vec![GridOut { name: GRID_NAME, ty: GRID_TYPE, class: None, tree: &tree, buffers: Buffers::Occupancy, count }];
     for (name, ty, v) in &extra {
-        grids.push((name, ty, value_tree.as_ref().expect("built when there are attributes"), Some(v)));
+        let tree = value_tree.as_ref().expect("built when there are attributes");
+        grids.push(GridOut { name, ty, class: None, tree, buffers: Buffers::Attribute(v), count });
     }
+    write_grids(w, &grids, grid)
+}
+
+/// One grid to write: name, tree type, class (metadata `class`), tree,
+/// values and active voxel count.
+struct GridOut<'a> {
+    name: &'a str,
+    ty: &'a str,
+    class: Option<&'a str>,
+    tree: &'a Tree,
+    buffers: Buffers<'a>,
+    count: u64,
+}
+
+/// The file: header, then each grid (descriptor, head, tree).
+fn write_grids(w: &mut dyn Write, grids: &[GridOut<'_>], grid: &GridSpec) -> std::io::Result<()> {
+    let count = grids.first().map_or(0, |g| g.count);
     let mut header = Vec::new();
     let mut o = Stream(&mut header);
     let o: &mut dyn Out = &mut o;
@@ -506,26 +591,26 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: 
     let mut at = header.len() as u64;
     let mut o = Stream(w);
     let o: &mut dyn Out = &mut o;
-    for (name, ty, tree, values) in grids {
+    for g in grids {
         let mut desc = Count(0);
-        put_str(&mut desc, name)?;
-        put_str(&mut desc, ty)?;
+        put_str(&mut desc, g.name)?;
+        put_str(&mut desc, g.ty)?;
         put_str(&mut desc, "")?;
         let mut head = Vec::new();
-        put_grid_head(&mut Stream(&mut head), name, tree, count, grid)?;
+        put_grid_head(&mut Stream(&mut head), g, grid)?;
         let mut tree_len = Count(0);
-        put_tree(&mut tree_len, tree, values)?;
+        put_tree(&mut tree_len, g.tree, g.buffers)?;
         let grid_pos = at + desc.0 + 24;
         let block_pos = grid_pos + head.len() as u64;
         let end_pos = block_pos + tree_len.0;
-        put_str(o, name)?;
-        put_str(o, ty)?;
+        put_str(o, g.name)?;
+        put_str(o, g.ty)?;
         put_str(o, "")?;
         for p in [grid_pos, block_pos, end_pos] {
             o.put(&(p as i64).to_le_bytes())?;
         }
         o.put(&head)?;
-        put_tree(o, tree, values)?;
+        put_tree(o, g.tree, g.buffers)?;
         at = end_pos;
     }
     Ok(())

@@ -1,0 +1,91 @@
+//! `topovox sdf MESH -o OUT`: a distance field (see `topovox_job::distance`).
+
+use std::time::Instant;
+
+use anyhow::Result;
+use serde_json::json;
+use topovox_job::distance::{DistanceFormat, SdfRequest, Width};
+use topovox_job::Choice;
+
+use crate::args::SdfArgs;
+use crate::progress::Bar;
+
+pub fn run(a: &SdfArgs) -> Result<()> {
+    let t_total = Instant::now();
+    // Everything that does not need the mesh first.
+    let grid = crate::plan::grid_request(&a.grid)?;
+    let width = Width::parse(&a.band)?;
+    let format = DistanceFormat::of(a.format.map(|f| f.name()), &a.output)?;
+    let req = SdfRequest { grid, width, unsigned: a.unsigned, sign: a.sign, max_memory: a.max_memory, format };
+    topovox_job::output::check_output_path(&a.output)?;
+    topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.mesh))?;
+    let pool = crate::pool::thread_pool(a.threads)?;
+    let threads = pool.current_num_threads();
+
+    let bar = Bar::new(a.quiet || a.json);
+    bar.phase("loading mesh");
+    let t_load = Instant::now();
+    let read = topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths, ..Default::default() };
+    let loaded = topovox_io::read_mesh_with(&a.mesh, &read)?;
+    let load_s = t_load.elapsed().as_secs_f64();
+    topovox_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
+    for w in &loaded.warnings {
+        eprintln!("topovox: warning: {}: {w}", a.mesh.display());
+    }
+    bar.phase("computing distances");
+    let name = a.mesh.display().to_string();
+    let sdf = pool.install(|| topovox_job::distance::sdf(loaded.mesh.as_ref(), &name, &req, None))?;
+    for w in &sdf.warnings {
+        eprintln!("topovox: warning: {w}");
+    }
+    bar.phase("writing");
+    let t_write = Instant::now();
+    pool.install(|| topovox_job::distance::write(&a.output, format, &sdf, None))?;
+    let write_s = t_write.elapsed().as_secs_f64();
+    bar.finish();
+    let total_s = t_total.elapsed().as_secs_f64();
+    let (g, dims) = (sdf.grid, sdf.grid.dims());
+    let o = g.origin();
+    if a.json {
+        let mut j = sdf.facts.clone();
+        let extra = json!({
+            "grid": {"origin": [o.x, o.y, o.z], "voxel_size": g.voxel_size(), "dims": dims},
+            "load_s": load_s,
+            "write_s": write_s,
+            "total_s": total_s,
+            "threads": threads,
+            "input": name,
+            "output": a.output.display().to_string(),
+            "format": format.name(),
+            "mesh": {"vertices": loaded.report.vertices, "triangles": loaded.report.triangles, "segments": loaded.report.segments},
+            "warnings": loaded.warnings,
+        });
+        if let (Some(obj), Some(add)) = (j.as_object_mut(), extra.as_object()) {
+            obj.extend(add.clone());
+        }
+        crate::console::print_stdout(&j.to_string())?;
+    } else if !a.quiet {
+        let kind = if sdf.signed {
+            format!("signed distances (inside by {})", sdf.facts["sign"].as_str().unwrap_or("?"))
+        } else {
+            "unsigned distances".into()
+        };
+        crate::console::print_stdout(&format!(
+            "sdf: {} voxels stored ({}, band {}) on grid {}x{}x{} (origin {}, {}, {}; voxel size {}); distances in {:.1} ms; total {:.2} s -> {}",
+            sdf.field.band.count(),
+            kind,
+            a.band,
+            dims[0],
+            dims[1],
+            dims[2],
+            o.x,
+            o.y,
+            o.z,
+            g.voxel_size(),
+            sdf.facts["distance_s"].as_f64().unwrap_or(0.0) * 1e3,
+            total_s,
+            a.output.display()
+        ))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,125 @@
+//! Every distance path against the brute-force reference, on random
+//! soups with degenerate triangles, segments and points; the paths
+//! against each other bit for bit, at every thread count.
+
+use glam::DVec3;
+
+use super::{band, nearest, reference, DistanceError, Pieces};
+use crate::test_rng::Xorshift;
+use crate::voxelize::Stop;
+use crate::{GridSpec, Mesh};
+
+/// A soup of `n` triangles in `[0, 10]³`: random ones, slivers, triangles
+/// with two equal corners, and a few segments.
+fn soup(rng: &mut Xorshift, n: usize) -> Mesh {
+    let mut m = Mesh::default();
+    let mut point = |rng: &mut Xorshift| DVec3::new(rng.below(10_001) as f64, rng.below(10_001) as f64, rng.below(10_001) as f64) * 1e-3;
+    for t in 0..n {
+        let a = point(rng);
+        let b = if t % 7 == 3 { a } else { a + (point(rng) - DVec3::splat(5.0)) * 0.4 };
+        let c = if t % 5 == 1 { a + (b - a) * 0.5 } else { a + (point(rng) - DVec3::splat(5.0)) * 0.4 };
+        let base = m.positions.len() as u32;
+        m.positions.extend([a, b, c]);
+        m.triangles.push([base, base + 1, base + 2]);
+    }
+    for _ in 0..3 {
+        let base = m.positions.len() as u32;
+        let a = point(rng);
+        m.positions.extend([a, a + DVec3::new(1.5, -0.5, 0.25)]);
+        m.segments.push([base, base + 1]);
+    }
+    m
+}
+
+fn grid(rng: &mut Xorshift) -> GridSpec {
+    let h = 0.35 + rng.below(1000) as f64 * 4e-4;
+    let o = DVec3::new(rng.signed(1000) as f64, rng.signed(1000) as f64, rng.signed(1000) as f64) * 1e-3 - DVec3::splat(0.5);
+    GridSpec::new(o, h, [26 + rng.below(6), 24 + rng.below(6), 28]).unwrap()
+}
+
+/// `|got − want| ≤ 1e-5 voxel + half an f32 step of want`.
+fn close(got: f32, want: f64, h: f64) -> bool {
+    (got as f64 - want).abs() <= 1e-5 * h + want * f32::EPSILON as f64
+}
+
+#[test]
+fn band_and_dense_match_the_reference() {
+    let mut rng = Xorshift(0x5eed_d157);
+    for round in 0..6 {
+        let mesh = soup(&mut rng, 12 + round * 5);
+        let g = grid(&mut rng);
+        let want = reference::distances(mesh.as_ref(), &g).unwrap();
+        let pieces = Pieces::of(mesh.as_ref()).unwrap();
+        let dense = nearest::dense(&pieces, &g, &Stop::new()).unwrap();
+        let [_, ny, nz] = g.dims().map(|d| d as usize);
+        let at = |i: u32, j: u32, k: u32| (i as usize * ny + j as usize) * nz + k as usize;
+        for (n, (&d, &w)) in dense.iter().zip(&want).enumerate() {
+            assert!(close(d, w, g.voxel_size()), "round {round}: voxel {n}: dense {d}, reference {w}");
+        }
+        for width in [1.0, 2.5, 3.0] {
+            let b = band::band(&pieces, &g, width, &Stop::new()).unwrap();
+            let r = width * g.voxel_size();
+            let mut seen = vec![false; want.len()];
+            b.for_each(|i, j, k, d| {
+                let n = at(i, j, k);
+                seen[n] = true;
+                assert_eq!(d.to_bits(), dense[n].to_bits(), "band and dense differ at {:?}", [i, j, k]);
+            });
+            for (n, &w) in want.iter().enumerate() {
+                // Within rounding of the radius either answer is right.
+                if (w - r).abs() > 1e-9 * r {
+                    assert_eq!(seen[n], w < r, "round {round}, width {width}: voxel {n} at {w} (radius {r})");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let mut rng = Xorshift(0xabcd_0123);
+    let mesh = soup(&mut rng, 60);
+    let g = grid(&mut rng);
+    let pieces = Pieces::of(mesh.as_ref()).unwrap();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| (band::band(&pieces, &g, 3.0, &Stop::new()).unwrap(), nearest::dense(&pieces, &g, &Stop::new()).unwrap()))
+    };
+    let (b1, d1) = run(1);
+    for t in [2, 3, 7] {
+        let (b, d) = run(t);
+        assert_eq!(b, b1);
+        assert!(d.iter().zip(&d1).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+}
+
+#[test]
+fn a_stop_returns_nothing() {
+    let mut rng = Xorshift(7);
+    let mesh = soup(&mut rng, 10);
+    let pieces = Pieces::of(mesh.as_ref()).unwrap();
+    let stop = Stop::new();
+    stop.request();
+    let g = grid(&mut rng);
+    assert!(band::band(&pieces, &g, 3.0, &stop).is_none());
+    assert!(nearest::dense(&pieces, &g, &stop).is_none());
+}
+
+#[test]
+fn bad_meshes_are_refused_and_bad_indices_skipped() {
+    let mut m = Mesh { positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y], triangles: vec![[0, 1, 2], [0, 1, 9]], segments: vec![] };
+    assert_eq!(Pieces::of(m.as_ref()).unwrap().skipped, 1);
+    m.positions[1].x = f64::NAN;
+    assert_eq!(Pieces::of(m.as_ref()).unwrap_err(), DistanceError::NonFinite(1));
+    assert_eq!(Pieces::of(Mesh::default().as_ref()).unwrap_err(), DistanceError::Empty);
+}
+
+#[test]
+fn a_flat_triangle_is_its_edges() {
+    // Collinear corners: the distance is to the segment they span.
+    let m = Mesh { positions: vec![DVec3::ZERO, DVec3::X * 4.0, DVec3::X * 2.0], triangles: vec![[0, 1, 2]], segments: vec![] };
+    let p = Pieces::of(m.as_ref()).unwrap();
+    assert!(p.items[0].flat);
+    assert_eq!(p.items[0].distance_squared(DVec3::new(3.0, 1.0, 0.0)), 1.0);
+    assert_eq!(p.items[0].distance_squared(DVec3::new(5.0, 0.0, 0.0)), 1.0);
+}

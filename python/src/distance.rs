@@ -1,0 +1,231 @@
+//! `topovox.sdf` and `DistanceGrid`: distance fields, as `topovox sdf` makes
+//! them (`topovox_job::distance`), with the same grid options as `voxelize`.
+
+use std::path::PathBuf;
+use std::sync::{Arc, OnceLock};
+
+use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use topovox::voxelize::Stop;
+use topovox_job::distance::{DistanceFormat, Sdf, SdfRequest, Sign, Width};
+use topovox_job::{Choice, GridRequest, JobError};
+
+use crate::{interruptible, job_options, py_err, to_py, value_err, Mesh};
+
+/// A distance field: see `topovox.sdf`.
+#[pyclass(module = "topovox._topovox", name = "DistanceGrid", frozen)]
+pub struct DistanceGrid {
+    inner: Arc<Sdf>,
+    /// The dense array, made once.
+    dense: OnceLock<Py<PyArray3<f32>>>,
+}
+
+#[pymethods]
+impl DistanceGrid {
+    /// `(nx, ny, nz)`: voxels along each axis.
+    #[getter]
+    fn shape(&self) -> (u32, u32, u32) {
+        let d = self.inner.grid.dims();
+        (d[0], d[1], d[2])
+    }
+
+    /// World position of the grid's low corner, `(3,)` float64.
+    #[getter]
+    fn origin<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from(self.inner.grid.origin().to_array().to_vec()).into_pyarray(py)
+    }
+
+    /// Edge length of a voxel.
+    #[getter]
+    fn voxel_size(&self) -> f64 {
+        self.inner.grid.voxel_size()
+    }
+
+    /// Whether values are negative inside.
+    #[getter]
+    fn signed(&self) -> bool {
+        self.inner.signed
+    }
+
+    /// The value of the voxels outside the band (`-background` inside):
+    /// the band's half width in world units, or with `band="all"` the
+    /// largest distance.
+    #[getter]
+    fn background(&self) -> f32 {
+        self.inner.field.background
+    }
+
+    /// Number of voxels stored (the band's, or every voxel's).
+    #[getter]
+    fn count(&self) -> u64 {
+        self.inner.field.band.count()
+    }
+
+    /// What made it: band, sign rule, solid facts, counts, times.
+    #[getter]
+    fn facts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_py(py, &self.inner.facts)
+    }
+
+    /// to_dense() -> numpy.ndarray
+    ///
+    /// Every voxel's value, `(nx, ny, nz)` float32, element `[i, j, k]` =
+    /// voxel `(i, j, k)` (outside the band: `±background`); made once and
+    /// shared, so read-only.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///
+    /// Examples
+    /// --------
+    /// >>> d = field.to_dense()
+    fn to_dense<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<f32>>> {
+        if let Some(a) = self.dense.get() {
+            return Ok(a.bind(py).clone());
+        }
+        let [nx, ny, nz] = self.inner.grid.dims().map(|d| d as usize);
+        let bytes = (nx as u64 * ny as u64 * nz as u64).saturating_mul(4);
+        let budget = topovox_job::budget(None);
+        if bytes > budget {
+            return Err(pyo3::exceptions::PyRuntimeError::new_err(format!(
+                "the dense array needs {} (float32 per voxel), more than the {} available; use coords() and values(), or save() to .vdb or .zarr",
+                topovox_job::bytes(bytes),
+                topovox_job::bytes(budget)
+            )));
+        }
+        let inner = self.inner.clone();
+        let values = py.detach(move || inner.field.dense());
+        let a = Array3::from_shape_vec((nx, ny, nz), values).map_err(|e| value_err(e.to_string()))?.into_pyarray(py);
+        a.readwrite().make_nonwriteable();
+        let _ = self.dense.set(a.clone().unbind());
+        Ok(self.dense.get().map(|a| a.bind(py).clone()).unwrap_or(a))
+    }
+
+    /// `numpy.asarray(field)`: the dense values (a copy when `dtype`
+    /// differs or `copy=True`).
+    #[pyo3(signature = (dtype=None, copy=None))]
+    fn __array__<'py>(&self, py: Python<'py>, dtype: Option<&Bound<'py, PyAny>>, copy: Option<bool>) -> PyResult<Bound<'py, PyAny>> {
+        let a = self.to_dense(py)?.into_any();
+        match (dtype, copy) {
+            (Some(d), _) => a.call_method1("astype", (d,)),
+            (None, Some(true)) => a.call_method0("copy"),
+            _ => Ok(a),
+        }
+    }
+
+    /// coords() -> numpy.ndarray
+    ///
+    /// The stored voxels (the band), `(n, 3)` int32 in C order, aligned
+    /// with :meth:`values`; for grids of any size.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///
+    /// Examples
+    /// --------
+    /// >>> ijk, d = field.coords(), field.values()
+    fn coords<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i32>> {
+        let inner = self.inner.clone();
+        let v = py.detach(move || ordered(&inner));
+        Array2::from_shape_fn((v.len(), 3), |(n, c)| v[n].0[c] as i32).into_pyarray(py)
+    }
+
+    /// values() -> numpy.ndarray
+    ///
+    /// The stored voxels' values, `(n,)` float32, aligned with :meth:`coords`.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///
+    /// Examples
+    /// --------
+    /// >>> inside = field.coords()[field.values() < 0]
+    fn values<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
+        let inner = self.inner.clone();
+        let v = py.detach(move || ordered(&inner));
+        Array1::from_iter(v.iter().map(|e| e.1)).into_pyarray(py)
+    }
+
+    /// save(path, format=None) -> None
+    ///
+    /// Writes the field as `topovox sdf` does: `.vdb` (an OpenVDB level set
+    /// named `surface`), `.npy` (float32, every voxel), `.zarr` or `.vti`.
+    ///
+    /// Parameters
+    /// ----------
+    /// path : str or os.PathLike
+    ///     The file (or `.zarr` folder).
+    /// format : {"vdb", "npy", "zarr", "vti"}, optional
+    ///     Default: from the extension.
+    ///
+    /// Examples
+    /// --------
+    /// >>> field.save("bunny.vdb")
+    #[pyo3(signature = (path, format=None))]
+    fn save(&self, py: Python<'_>, path: PathBuf, format: Option<String>) -> PyResult<()> {
+        let format = DistanceFormat::of(format.as_deref(), &path).map_err(py_err)?;
+        topovox_job::output::check_output_path(&path).map_err(py_err)?;
+        let stop = Stop::new();
+        let inner = &self.inner;
+        interruptible(py, &stop, || topovox_job::distance::write(&path, format, inner, Some(&stop)))?.map_err(py_err)
+    }
+
+    fn __repr__(&self) -> String {
+        let [x, y, z] = self.inner.grid.dims();
+        let kind = if self.inner.signed { "signed" } else { "unsigned" };
+        format!(
+            "<topovox.DistanceGrid {kind} {x}x{y}x{z}, {} voxels stored, voxel size {}>",
+            self.inner.field.band.count(),
+            self.inner.grid.voxel_size()
+        )
+    }
+}
+
+/// The stored voxels and values in C order.
+fn ordered(s: &Sdf) -> Vec<([u32; 3], f32)> {
+    let mut v = Vec::with_capacity(s.field.band.count() as usize);
+    s.field.band.for_each(|i, j, k, d| v.push(([i, j, k], d)));
+    v.sort_unstable_by_key(|e| e.0);
+    v
+}
+
+/// The band keyword: a number of voxels, or `"all"`.
+fn width_of(v: &Bound<'_, PyAny>) -> PyResult<Width> {
+    let text = if v.is_instance_of::<PyString>() { v.extract::<String>()? } else { v.str()?.to_string() };
+    Width::parse(&text).map_err(py_err)
+}
+
+/// The native sdf: see `topovox.sdf` for the documentation.
+#[pyfunction]
+#[pyo3(signature = (mesh, options=None))]
+pub fn sdf(py: Python<'_>, mesh: &Mesh, options: Option<&Bound<'_, PyDict>>) -> PyResult<DistanceGrid> {
+    const OWN: [&str; 3] = ["band", "unsigned", "sign"];
+    let opts = job_options(options, &OWN)?;
+    let get = |k: &str| options.and_then(|d| d.get_item(k).ok().flatten()).filter(|v| !v.is_none());
+    let width = get("band").map(|v| width_of(&v)).transpose()?.unwrap_or(Width::Voxels(3.0));
+    let unsigned = get("unsigned").map(|v| v.extract::<bool>()).transpose()?.unwrap_or(false);
+    let sign = match get("sign") {
+        Some(v) => Sign::parse(&v.extract::<String>()?).map_err(|e| value_err(format!("sign: {e}")))?,
+        None => Sign::Auto,
+    };
+    let grid = GridRequest::new(&opts.grid).map_err(py_err)?;
+    let req = SdfRequest { grid, width, unsigned, sign, max_memory: opts.max_memory, format: DistanceFormat::Vdb };
+    let pool = opts.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
+    let inner = &mesh.inner;
+    let name = mesh.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into());
+    let stop = Stop::new();
+    let run = || -> Result<Sdf, JobError> {
+        let go = || topovox_job::distance::sdf(inner.mesh.as_ref(), &name, &req, Some(&stop));
+        match &pool {
+            Some(p) => p.install(go),
+            None => go(),
+        }
+    };
+    let s = interruptible(py, &stop, run)?.map_err(py_err)?;
+    Ok(DistanceGrid { inner: Arc::new(s), dense: OnceLock::new() })
+}
