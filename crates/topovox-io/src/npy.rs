@@ -2,7 +2,8 @@
 //!
 //! Shape `(nx, ny, nz)`, C order, element `[i, j, k]` = voxel `(i, j, k)`,
 //! dtype `uint8` (`|u1`, 0 or 1) or `bool` (`|b1`); distance fields
-//! as `float32` (`<f4`). Written directly rather
+//! as `float32` (`<f4`), read back (with `<f8`) as their inside, the
+//! negative elements. Written directly rather
 //! than through `npyz`: its per-element writer is far slower for the 10⁹
 //! elements of a 1024³ grid, and the header is a dozen lines. Tests read
 //! the files back with NumPy itself.
@@ -69,16 +70,35 @@ pub(crate) fn plane_block(plane: usize) -> u32 {
     b
 }
 
-/// Reads a 3-D `.npy` array of dtype uint8/int8/bool in C order; nonzero = set.
+/// What an element is and which elements are set.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Element {
+    /// uint8, int8 or bool: nonzero is set.
+    Byte,
+    /// float32 or float64, a distance field (`topovox sdf`): negative is set (inside).
+    Float(usize),
+}
+
+impl Element {
+    fn size(self) -> usize {
+        match self {
+            Element::Byte => 1,
+            Element::Float(s) => s,
+        }
+    }
+}
+
+/// Reads a 3-D `.npy` array in C order: uint8/int8/bool (nonzero = set),
+/// or float32/float64, a distance field (negative = set: the inside).
 pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
-    let (dims, data_at) = parse_header(bytes)?;
+    let (dims, data_at, elem) = parse_header(bytes)?;
     let data = &bytes[data_at..];
-    let n = (dims[0] * dims[1] * dims[2]) as usize;
+    let n = (dims[0] * dims[1] * dims[2]) as usize * elem.size();
     if data.len() < n {
         return Err(truncated(data.len(), n));
     }
     let mut bits = crate::dense_grid(dims.map(|d| d as u32))?;
-    fill(&mut bits, &data[..n], 0);
+    fill(&mut bits, &data[..n], 0, elem);
     Ok(LoadedVoxels { bits, placement: None, attributes: None })
 }
 
@@ -113,8 +133,8 @@ pub fn read_stream(r: &mut impl std::io::Read, total: u64) -> Result<LoadedVoxel
     let start = head.len();
     head.resize(start + hlen, 0);
     r.read_exact(&mut head[start..]).map_err(io)?;
-    let (dims, _) = parse_header(&head)?;
-    let n = (dims[0] * dims[1] * dims[2]) as usize;
+    let (dims, _, elem) = parse_header(&head)?;
+    let n = (dims[0] * dims[1] * dims[2]) as usize * elem.size();
     let have = total.saturating_sub(head.len() as u64);
     if have < n as u64 {
         return Err(truncated(have as usize, n));
@@ -123,13 +143,14 @@ pub fn read_stream(r: &mut impl std::io::Read, total: u64) -> Result<LoadedVoxel
     let mut buf = vec![0u8; 1 << 22];
     let mut at = 0usize;
     while at < n {
+        // Whole elements at a time (the buffer is a multiple of 8 bytes).
         let want = buf.len().min(n - at);
-        let got = r.read(&mut buf[..want]).map_err(ErrorKind::Read)?;
-        if got == 0 {
-            return Err(truncated(at, n));
-        }
-        fill(&mut bits, &buf[..got], at);
-        at += got;
+        r.read_exact(&mut buf[..want]).map_err(|e| match e.kind() {
+            std::io::ErrorKind::UnexpectedEof => truncated(at, n),
+            _ => ErrorKind::Read(e),
+        })?;
+        fill(&mut bits, &buf[..want], at, elem);
+        at += want;
     }
     Ok(LoadedVoxels { bits, placement: None, attributes: None })
 }
@@ -157,8 +178,9 @@ pub(crate) fn header_field<'h>(header: &'h str, key: &str) -> Option<&'h str> {
     header[at..].trim_start().strip_prefix(':').map(str::trim_start)
 }
 
-/// Validates the header; returns the shape and where the data starts.
-fn parse_header(bytes: &[u8]) -> Result<([u64; 3], usize), ErrorKind> {
+/// Validates the header; returns the shape, where the data starts and
+/// what an element is.
+fn parse_header(bytes: &[u8]) -> Result<([u64; 3], usize, Element), ErrorKind> {
     let bad = |d: &str| ErrorKind::malformed("npy", d);
     if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
         return Err(bad("missing \\x93NUMPY magic"));
@@ -172,9 +194,14 @@ fn parse_header(bytes: &[u8]) -> Result<([u64; 3], usize), ErrorKind> {
     let header = std::str::from_utf8(header).map_err(|_| bad("header is not text"))?;
     let field = |key: &str| header_field(header, key);
     let descr = field("descr").and_then(|r| r.strip_prefix('\'')).and_then(|r| r.split('\'').next()).ok_or_else(|| bad("no descr"))?;
-    if !matches!(descr, "|u1" | "|b1" | "|i1" | "<u1" | "<i1") {
-        return Err(ErrorKind::Unsupported(format!("npy dtype {descr} (expected uint8 or bool)")));
-    }
+    let elem = match descr {
+        "|u1" | "|b1" | "|i1" | "<u1" | "<i1" => Element::Byte,
+        "<f4" => Element::Float(4),
+        "<f8" => Element::Float(8),
+        _ => {
+            return Err(ErrorKind::Unsupported(format!("npy dtype {descr} (expected uint8 or bool, or a float32/float64 distance field)")))
+        }
+    };
     if field("fortran_order").is_some_and(|r| r.starts_with("True")) {
         return Err(ErrorKind::Unsupported("Fortran-ordered npy arrays".into()));
     }
@@ -192,13 +219,28 @@ fn parse_header(bytes: &[u8]) -> Result<([u64; 3], usize), ErrorKind> {
     if [nx, ny, nz].iter().any(|&d| d == 0 || d > topovox::grid::spec::MAX_DIM as u64) {
         return Err(bad(&format!("shape ({nx}, {ny}, {nz}) out of range")));
     }
-    Ok(([nx, ny, nz], hstart + hlen))
+    Ok(([nx, ny, nz], hstart + hlen, elem))
 }
 
-/// Sets the voxels of the nonzero bytes of `data`, whose first byte is
-/// element `start` of the C-ordered array.
-fn fill(bits: &mut DenseBits, data: &[u8], start: usize) {
+/// Sets the voxels of the set elements of `data` (whole elements), whose
+/// first byte is byte `start` of the C-ordered array.
+fn fill(bits: &mut DenseBits, data: &[u8], start: usize, elem: Element) {
     let [_, ny, nz] = bits.dims().map(|d| d as usize);
+    if let Element::Float(size) = elem {
+        for (e, x) in data.chunks_exact(size).enumerate() {
+            let v = if size == 4 {
+                f32::from_le_bytes(x.try_into().expect("4 bytes")) as f64
+            } else {
+                f64::from_le_bytes(x.try_into().expect("8 bytes"))
+            };
+            if v < 0.0 {
+                let idx = start / size + e;
+                let (k, j, i) = (idx % nz, (idx / nz) % ny, idx / (nz * ny));
+                bits.set(i as u32, j as u32, k as u32);
+            }
+        }
+        return;
+    }
     // Surfaces are sparse: skip zero bytes eight at a time.
     for (c, chunk) in data.chunks(8).enumerate() {
         if chunk.len() == 8 && u64::from_ne_bytes(chunk.try_into().unwrap_or([0; 8])) == 0 {

@@ -244,7 +244,7 @@ pub fn write(
 }
 
 /// Writes a distance field on `grid` as a Zarr v3 `float32` array at
-/// `path`, sharded and chunked as the occupancy ([`write`], whose
+/// `path`, sharded and chunked as the occupancy ([`write`](fn@write), whose
 /// replacement and stop rules apply), fill value `+background`: chunks
 /// holding no band voxel and nothing inside are not written.
 /// `attributes.topovox.distance` records the background and `signed`.
@@ -1016,7 +1016,8 @@ pub fn read_sparse(path: &Path, attributes: bool, opts: &ReadOptions) -> Result<
     };
     let a = array_meta(&dir, &m, 1)?;
     if !matches!(a.data_type.as_str(), "bool" | "uint8") {
-        return Err(IoError::new(&dir, bad(format!("data_type {:?} (topovox reads bool and uint8)", a.data_type))));
+        let hint = if a.data_type == "float32" { "; distance fields are read back from .vdb and .npy, not yet from .zarr" } else { "" };
+        return Err(IoError::new(&dir, bad(format!("data_type {:?} (topovox reads bool and uint8{hint})", a.data_type))));
     }
     if a.shape.iter().any(|&d| d > SparseBricks::MAX_DIM as u64) {
         return Err(IoError::new(&dir, bad(format!("shape {:?} beyond {} voxels per axis", a.shape, SparseBricks::MAX_DIM))));

@@ -25,7 +25,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
     let bar = Bar::new(a.quiet || a.json);
     bar.phase("loading mesh");
     let t_load = Instant::now();
-    let read = topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths, ..Default::default() };
+    let read = topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths };
     let loaded = topovox_io::read_mesh_with(&a.mesh, &read)?;
     let load_s = t_load.elapsed().as_secs_f64();
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
@@ -49,7 +49,9 @@ pub fn run(a: &SdfArgs) -> Result<()> {
     if a.json {
         let mut j = sdf.facts.clone();
         let extra = json!({
-            "grid": {"origin": [o.x, o.y, o.z], "voxel_size": g.voxel_size(), "dims": dims},
+            "origin": [o.x, o.y, o.z],
+            "voxel_size": g.voxel_size(),
+            "dims": dims,
             "load_s": load_s,
             "write_s": write_s,
             "total_s": total_s,

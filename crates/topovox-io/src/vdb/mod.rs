@@ -32,7 +32,10 @@
 //! back with OpenVDB's own reader (`pyopenvdb`) and compares every active
 //! voxel.
 //!
-//! **What is read.** The first bool grid, written uncompressed or with
+//! **What is read.** The first bool grid, or without one the first float
+//! level set (or topovox's unsigned `surface` field) as the voxels inside
+//! it (negative values, active or not; unsigned: within half a voxel
+//! diagonal of the surface), written uncompressed or with
 //! active-mask compression (topovox's own files, and OpenVDB files saved
 //! without zip/blosc), active voxels and active tiles, and beside it the
 //! attribute grids named and typed as above (a set voxel a grid holds no
@@ -58,7 +61,7 @@ use crate::error::ErrorKind;
 use crate::{LoadedVoxels, SparseVoxels};
 
 mod level_set;
-pub use level_set::write_level_set;
+pub use level_set::{write_level_set, LEVEL_SET_NAME};
 use topovox::distance::field::Field;
 
 const MAGIC: i64 = 0x5644_4220;
@@ -731,7 +734,17 @@ fn read_values(c: &mut Cur<'_>, active: &[u64], n: usize, mask_compressed: bool,
     Ok(out)
 }
 
+/// How a distance field's values are read as voxels: its background, and
+/// which values are inside (see [`read_level_set`]).
+#[derive(Clone, Copy)]
+struct Inside<'a> {
+    background: [u8; 4],
+    test: &'a dyn Fn(f32) -> bool,
+}
+
 /// An internal node's topology: masks, compressed tile values, children.
+/// With `inside`, its tiles are those whose value (active or not) is
+/// inside, not the active ones.
 fn read_internal(
     c: &mut Cur<'_>,
     origin: [i64; 3],
@@ -739,21 +752,29 @@ fn read_internal(
     mask_compressed: bool,
     vs: usize,
     found: &mut Found,
+    inside: Option<Inside<'_>>,
 ) -> Result<(), ErrorKind> {
     let dim = log2 - child_log2;
     let n = 1usize << (3 * dim);
     let child = c.words(n / 64)?;
     let value = c.words(n / 64)?;
-    let vals = read_values(c, &value, n, mask_compressed, vs)?;
     let offset = |idx: usize| -> [i64; 3] {
         let off = [(idx >> (2 * dim)) as i64, ((idx >> dim) & ((1 << dim) - 1)) as i64, (idx & ((1 << dim) - 1)) as i64];
         std::array::from_fn(|a| origin[a] + (off[a] << child_log2))
     };
-    for (v, idx) in (0..n).filter(|&i| bit(&value, i)).enumerate() {
-        if !bit(&child, idx) {
-            let mut val = [0u8; 12];
-            val[..vs].copy_from_slice(&vals[v * vs..(v + 1) * vs]);
-            found.tiles.push((offset(idx), 1 << child_log2, val));
+    if let Some(ins) = inside {
+        let all = read_all_values(c, &value, n, mask_compressed, ins.background)?;
+        for idx in (0..n).filter(|&i| !bit(&child, i) && (ins.test)(all[i])) {
+            found.tiles.push((offset(idx), 1 << child_log2, [1; 12]));
+        }
+    } else {
+        let vals = read_values(c, &value, n, mask_compressed, vs)?;
+        for (v, idx) in (0..n).filter(|&i| bit(&value, i)).enumerate() {
+            if !bit(&child, idx) {
+                let mut val = [0u8; 12];
+                val[..vs].copy_from_slice(&vals[v * vs..(v + 1) * vs]);
+                found.tiles.push((offset(idx), 1 << child_log2, val));
+            }
         }
     }
     for idx in (0..n).filter(|&i| bit(&child, i)) {
@@ -762,10 +783,39 @@ fn read_internal(
             c.take(64)?; // the leaf's value mask, read again with its buffer
             found.leaves.push(o);
         } else {
-            read_internal(c, o, (child_log2, LEAF), mask_compressed, vs, found)?;
+            read_internal(c, o, (child_log2, LEAF), mask_compressed, vs, found, inside)?;
         }
     }
     Ok(())
+}
+
+/// Every one of a float node's `n` values as OpenVDB's
+/// `readCompressedValues` restores them: the active ones as stored, the
+/// inactive ones by the metadata byte (0: the background, 1: its negative,
+/// 2/4/5: values stored once, 3–5: a selection mask choosing between two
+/// of them, 6: every value stored).
+fn read_all_values(c: &mut Cur<'_>, active: &[u64], n: usize, mask_compressed: bool, background: [u8; 4]) -> Result<Vec<f32>, ErrorKind> {
+    let bg = f32::from_le_bytes(background);
+    let f = |b: &[u8]| f32::from_le_bytes(b.try_into().expect("4 bytes"));
+    let meta = c.u8()?;
+    if meta > 6 {
+        return Err(bad(format!("unknown node compression metadata {meta}")));
+    }
+    let mut inactive = [if meta == 0 { bg } else { -bg }, bg];
+    if matches!(meta, 2 | 4 | 5) {
+        inactive[0] = f(c.take(4)?);
+    }
+    if meta == 5 {
+        inactive[1] = f(c.take(4)?);
+    }
+    let selection = if matches!(meta, 3..=5) { Some(c.take(n / 8)?) } else { None };
+    let chosen = |i: usize| inactive[selection.is_some_and(|m| m[i / 8] >> (i % 8) & 1 == 1) as usize];
+    if mask_compressed && meta != 6 {
+        let on: usize = active.iter().map(|w| w.count_ones() as usize).sum();
+        let mut stored = c.take(on * 4)?.chunks_exact(4);
+        return Ok((0..n).map(|i| if bit(active, i) { stored.next().map_or(bg, f) } else { chosen(i) }).collect());
+    }
+    Ok(c.take(n * 4)?.chunks_exact(4).map(f).collect())
 }
 
 /// Most voxels the reader fills from active tiles (128 MiB of bits; a
@@ -825,19 +875,30 @@ fn in_grid(name: &str, e: ErrorKind) -> ErrorKind {
     }
 }
 
-/// The first bool grid of a file.
+/// The voxels of a file: its first bool grid; without one, its first
+/// float grid that is a level set or topovox's distance field (`surface`),
+/// read as the voxels inside (negative; unsigned: within half a voxel
+/// diagonal of the surface).
 fn occupancy(bytes: &[u8], found: &[Descriptor]) -> Result<Occupancy, ErrorKind> {
-    let Some(d) = found.iter().find(|d| d.ty == GRID_TYPE) else {
+    let bool_grid = found.iter().find(|d| d.ty == GRID_TYPE);
+    let distance = || {
+        found.iter().filter(|d| d.ty == FLOAT_TYPE).find(|d| {
+            let mut c = Cur { b: bytes, at: 0 };
+            d.name == level_set::LEVEL_SET_NAME
+                || (c.seek(d.pos).is_ok() && read_head(&mut c).is_ok_and(|h| h.meta.iter().any(|m| m.0 == "class" && m.2 == b"level set")))
+        })
+    };
+    let Some((d, is_distance)) = bool_grid.map(|d| (d, false)).or_else(|| distance().map(|d| (d, true))) else {
         let types: Vec<String> = found.iter().map(|d| format!("{} ({})", d.name, d.ty)).collect();
         return Err(bad(if types.is_empty() {
             "no grids".to_string()
         } else {
-            format!("no bool grid (topovox reads {GRID_TYPE}); grids: {}", types.join(", "))
+            format!("no bool grid or level set (topovox reads {GRID_TYPE}, and {FLOAT_TYPE} level sets); grids: {}", types.join(", "))
         }));
     };
     let mut c = Cur { b: bytes, at: 0 };
     c.seek(d.pos)?;
-    read_grid(&mut c).map_err(|e| in_grid(&d.name, e))
+    read_grid(&mut c, is_distance).map_err(|e| in_grid(&d.name, e))
 }
 
 /// The attribute grids topovox reads: name and tree type.
@@ -971,11 +1032,18 @@ fn read_head(c: &mut Cur<'_>) -> Result<Head, ErrorKind> {
 }
 
 /// A tree's root and internal nodes, values `vs` bytes each.
-fn read_topology(c: &mut Cur<'_>, mask_compressed: bool, vs: usize) -> Result<Found, ErrorKind> {
+fn read_topology(
+    c: &mut Cur<'_>,
+    mask_compressed: bool,
+    vs: usize,
+    test: Option<&dyn Fn(f32) -> bool>,
+) -> Result<(Found, [u8; 12]), ErrorKind> {
     if c.i32()? != 1 {
         return Err(bad("multi-buffer trees are not supported"));
     }
-    c.take(vs)?; // background
+    let mut background = [0u8; 12];
+    background[..vs].copy_from_slice(c.take(vs)?);
+    let inside = test.map(|test| Inside { background: background[..4].try_into().expect("4 bytes"), test });
     let (ntiles, nchildren) = (c.u32()? as usize, c.u32()? as usize);
     // Each tile takes 13 + vs bytes, each child at least 12 + 2·4096 + 1.
     if ntiles.saturating_mul(13 + vs).saturating_add(nchildren.saturating_mul(8205)) > c.b.len() - c.at {
@@ -986,15 +1054,21 @@ fn read_topology(c: &mut Cur<'_>, mask_compressed: bool, vs: usize) -> Result<Fo
         let o = c.coord()?;
         let mut val = [0u8; 12];
         val[..vs].copy_from_slice(c.take(vs)?);
-        if c.u8()? != 0 {
+        let active = c.u8()? != 0;
+        // A distance field's root tile counts when inside, active or not.
+        let counts = match inside {
+            Some(ins) => (ins.test)(f32::from_le_bytes(val[..4].try_into().expect("4 bytes"))),
+            None => active,
+        };
+        if counts {
             found.tiles.push((o.map(|v| v as i64), 1 << UPPER, val));
         }
     }
     for _ in 0..nchildren {
         let o = c.coord()?;
-        read_internal(c, o.map(|v| v as i64), (UPPER, LOWER), mask_compressed, vs, &mut found)?;
+        read_internal(c, o.map(|v| v as i64), (UPPER, LOWER), mask_compressed, vs, &mut found, inside)?;
     }
-    Ok(found)
+    Ok((found, background))
 }
 
 /// An attribute grid's active values, looked up by index coordinate.
@@ -1065,7 +1139,7 @@ fn read_values_grid(c: &mut Cur<'_>, vs: usize) -> Result<GridValues, ErrorKind>
     if head.meta.iter().any(|m| m.0 == "is_saved_as_half_float" && m.2.first().is_some_and(|&b| b != 0)) {
         return Err(bad("half-float grids are not supported (topovox writes 32-bit floats)"));
     }
-    let found = read_topology(c, head.mask_compressed, vs)?;
+    let (found, _) = read_topology(c, head.mask_compressed, vs, None)?;
     let mut leaves = std::collections::HashMap::with_capacity(found.leaves.len());
     for o in &found.leaves {
         let active = c.words(8)?;
@@ -1180,15 +1254,12 @@ impl Occupancy {
 /// bytes each: 1 GiB; a 4096³ tile is 262 144 rows).
 const MAX_SPARSE_RUNS: u64 = 1 << 26;
 
-/// The bool grid at the cursor.
-fn read_grid(c: &mut Cur<'_>) -> Result<Occupancy, ErrorKind> {
-    let Head { mask_compressed, meta, translation, scale } = read_head(c)?;
-    let find = |n: &str| meta.iter().find(|m| m.0 == n).map(|m| m.2.clone());
-    // Our own keys (`topovox_dims`, …), or as written before the rename.
-    let get = |n: &str| {
-        find(n).or_else(|| n.strip_prefix("topovox_").and_then(|rest| find(&format!("{}{rest}", crate::former_name::VDB_META_PREFIX))))
-    };
-    let found = read_topology(c, mask_compressed, 1)?;
+/// Tiles and leaves (OpenVDB's mask layout) as a grid's voxels.
+type TreeVoxels = (Vec<([i64; 3], i64)>, Vec<([i64; 3], [u64; 8])>);
+
+/// A bool tree's active tiles and leaves.
+fn read_bool_tree(c: &mut Cur<'_>, mask_compressed: bool) -> Result<TreeVoxels, ErrorKind> {
+    let (found, _) = read_topology(c, mask_compressed, 1, None)?;
     let tiles: Vec<([i64; 3], i64)> = found.tiles.iter().filter(|t| t.2[0] != 0).map(|t| (t.0, t.1)).collect();
     // Masks inline: a heap vector per leaf would more than double the
     // memory of a large file's tree.
@@ -1202,6 +1273,45 @@ fn read_grid(c: &mut Cur<'_>) -> Result<Occupancy, ErrorKind> {
         c.words(8)?; // values: occupancy is activity
         leaves.push((o, active.try_into().expect("8 words")));
     }
+    Ok((tiles, leaves))
+}
+
+/// A float tree (a distance field) as the voxels whose values, active or
+/// not, pass `test`: tiles wholly inside, and per leaf a mask of them.
+fn read_level_set(c: &mut Cur<'_>, mask_compressed: bool, test: &dyn Fn(f32) -> bool) -> Result<TreeVoxels, ErrorKind> {
+    let (found, background) = read_topology(c, mask_compressed, 4, Some(test))?;
+    let tiles = found.tiles.iter().map(|t| (t.0, t.1)).collect();
+    let mut leaves = Vec::with_capacity(found.leaves.len());
+    for o in &found.leaves {
+        let active = c.words(8)?;
+        let values = read_all_values(c, &active, 512, mask_compressed, background[..4].try_into().expect("4 bytes"))?;
+        let mut mask = [0u64; 8];
+        for (n, _) in values.iter().enumerate().filter(|(_, &v)| test(v)) {
+            mask[n / 64] |= 1 << (n % 64);
+        }
+        leaves.push((*o, mask));
+    }
+    Ok((tiles, leaves))
+}
+
+/// The bool grid at the cursor.
+fn read_grid(c: &mut Cur<'_>, distance: bool) -> Result<Occupancy, ErrorKind> {
+    let Head { mask_compressed, meta, translation, scale } = read_head(c)?;
+    let find = |n: &str| meta.iter().find(|m| m.0 == n).map(|m| m.2.clone());
+    // Our own keys (`topovox_dims`, …), or as written before the rename.
+    let get = |n: &str| {
+        find(n).or_else(|| n.strip_prefix("topovox_").and_then(|rest| find(&format!("{}{rest}", crate::former_name::VDB_META_PREFIX))))
+    };
+    let (tiles, leaves) = if distance {
+        // A level set's inside: its negative values; an unsigned field's
+        // voxels within half a voxel diagonal of the surface.
+        let level_set = find("class").is_some_and(|c| c == b"level set");
+        let near = 0.5 * 3f64.sqrt() * scale[0].abs();
+        let test = move |v: f32| if level_set { v < 0.0 } else { (v as f64) <= near };
+        read_level_set(c, mask_compressed, &test)?
+    } else {
+        read_bool_tree(c, mask_compressed)?
+    };
     // The index box of the active voxels.
     let mut lo = [i64::MAX; 3];
     let mut hi = [i64::MIN; 3];
@@ -1320,7 +1430,7 @@ mod tests {
     /// claims 10 M tile voxels; filled one by one that took minutes).
     #[test]
     fn active_tiles_are_filled() {
-        let bytes = include_bytes!("../../../fuzz/seeds/voxels_vdb/tiles_timeout.vdb");
+        let bytes = include_bytes!("../../../../fuzz/seeds/voxels_vdb/tiles_timeout.vdb");
         let v = read(bytes).unwrap();
         let n = v.bits.count();
         assert!(n >= 10_000_000, "{n}");

@@ -140,7 +140,8 @@ pub(crate) fn centre_range(grid: &GridSpec, lo: DVec3, hi: DVec3) -> Option<([u3
     for ax in 0..3 {
         let first = a[ax].ceil().max(0.0);
         let last = b[ax].floor().min(dims[ax] as f64 - 1.0);
-        if !(first <= last) {
+        // Empty, or not a number (never for finite boxes): no voxels.
+        if !matches!(first.partial_cmp(&last), Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)) {
             return None;
         }
         (out.0[ax], out.1[ax]) = (first as u32, last as u32);

@@ -24,7 +24,7 @@
 //! Both give, for every voxel they store, the same f64 minimum over the
 //! same per-piece distances (rounded once to f32), so the two paths agree
 //! bit for bit and neither depends on the thread count. The brute-force
-//! [`reference`] computes the same definition with an independent formula
+//! [`reference`](mod@reference) computes the same definition with an independent formula
 //! (plane projection and edge distances); the tests hold every path within
 //! 1e-5 voxel of it (plus f32 rounding of the stored value).
 //!

@@ -13,7 +13,7 @@ use crate::{GridSpec, Mesh};
 /// with two equal corners, and a few segments.
 fn soup(rng: &mut Xorshift, n: usize) -> Mesh {
     let mut m = Mesh::default();
-    let mut point = |rng: &mut Xorshift| DVec3::new(rng.below(10_001) as f64, rng.below(10_001) as f64, rng.below(10_001) as f64) * 1e-3;
+    let point = |rng: &mut Xorshift| DVec3::new(rng.below(10_001) as f64, rng.below(10_001) as f64, rng.below(10_001) as f64) * 1e-3;
     for t in 0..n {
         let a = point(rng);
         let b = if t % 7 == 3 { a } else { a + (point(rng) - DVec3::splat(5.0)) * 0.4 };
