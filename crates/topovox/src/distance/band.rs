@@ -160,29 +160,29 @@ pub fn band(pieces: &Pieces, grid: &GridSpec, width: f64, stop: &Stop) -> Option
         return None;
     }
     let groups: Vec<(u64, std::ops::Range<usize>)> = runs(&bins);
-    let bricks: Vec<Option<(Brick, Vec<f32>)>> = groups
-        .par_iter()
-        .map(|(k, r)| {
-            if stop.requested() {
-                return None;
-            }
-            let ids = bins[r.clone()].iter().map(|&(_, p)| p as usize);
-            Some(brick(pieces, ids, grid, unkey(*k), radius))
-        })
-        .collect();
-    if stop.requested() {
-        return None;
-    }
     let mut out = Band { dims: grid.dims(), radius, ..Default::default() };
-    for ((k, _), b) in groups.iter().zip(bricks) {
-        let (mask, vals) = b?;
-        if vals.is_empty() {
-            continue;
+    // A few thousand bricks at a time: their values are held twice (each
+    // brick's, then the band's) only that long.
+    for chunk in groups.chunks(1 << 13) {
+        let bricks: Vec<Option<(Brick, Vec<f32>)>> = chunk
+            .par_iter()
+            .map(|(k, r)| {
+                if stop.requested() {
+                    return None;
+                }
+                let ids = bins[r.clone()].iter().map(|&(_, p)| p as usize);
+                Some(brick(pieces, ids, grid, unkey(*k), radius))
+            })
+            .collect();
+        for ((k, _), b) in chunk.iter().zip(bricks) {
+            let (mask, vals) = b?;
+            if !vals.is_empty() {
+                out.bricks.push(BandBrick { at: unkey(*k), mask, first: out.values.len() });
+                out.values.extend_from_slice(&vals);
+            }
         }
-        out.bricks.push(BandBrick { at: unkey(*k), mask, first: out.values.len() });
-        out.values.extend_from_slice(&vals);
     }
-    Some(out)
+    (!stop.requested()).then_some(out)
 }
 
 /// `(brick key, piece)` for every brick a piece's grown box reaches that
