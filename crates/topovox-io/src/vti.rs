@@ -9,7 +9,7 @@
 //! for empty cells),
 //! `coverage` (Float32, surface area inside the voxel / s²) and `normal`
 //! (Float32 × 3); a distance field is one Float32 cell array
-//! `distance`. Each array is one appended block stream with a UInt64
+//! `distance`, read back as its inside (negative cells). Each array is one appended block stream with a UInt64
 //! compression header (VTK's `vtkZLibDataCompressor` layout). Arrays are
 //! built block by block from the set voxels in key order, so memory stays
 //! at one block plus the compressed output.
@@ -312,7 +312,27 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     let occ = arrays.iter().find(|a| a.0 == "occupancy").or(arrays.first()).ok_or_else(|| bad("no cell arrays".into()))?;
     let mut bits = crate::dense_grid(dims)?;
     let (ow, ot) = (occ.3.len() / cells as usize / occ.2, occ.1.clone());
-    let nonzero = |b: &[u8]| if ot.starts_with("Float") { b.iter().any(|&x| x != 0 && x != 0x80) } else { b.iter().any(|&x| x != 0) };
+    // A distance field (`topovox sdf`): its inside, the negative cells; an
+    // unsigned one (no negative cell) the cells within half a voxel
+    // diagonal of the surface.
+    let distance = (occ.0 == "distance" && ot == "Float32" && occ.2 == 1).then(|| {
+        let values: Vec<f32> = occ.3.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes"))).collect();
+        let signed = values.iter().any(|&v| v < 0.0);
+        let near = (0.5 * 3f64.sqrt() * spacing.iter().fold(0f64, |a, &b| a.max(b.abs()))) as f32;
+        move |b: &[u8]| {
+            let v = f32::from_le_bytes(b.try_into().expect("4 bytes"));
+            if signed {
+                v < 0.0
+            } else {
+                v <= near
+            }
+        }
+    });
+    let nonzero = |b: &[u8]| match &distance {
+        Some(inside) => inside(b),
+        None if ot.starts_with("Float") => b.iter().any(|&x| x != 0 && x != 0x80),
+        None => b.iter().any(|&x| x != 0),
+    };
     let mut keys = Vec::new();
     for c in 0..cells as usize {
         if nonzero(&occ.3[c * ow * occ.2..c * ow * occ.2 + ow]) {

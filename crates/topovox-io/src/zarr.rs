@@ -32,6 +32,11 @@
 //! (`int32`, fill -1: none), little-endian; elements off the voxels hold
 //! the fill value.
 //!
+//! Distance fields (`topovox sdf`: one `float32` array, fill value the
+//! background, `attributes.topovox.distance`) are read as their inside:
+//! the negative elements, or for an unsigned field those within half a
+//! voxel diagonal of the surface.
+//!
 //! The reader takes topovox's arrays and groups, and plain (unsharded) ones with the
 //! `bytes` and `gzip` codecs, as the `zarr` package writes them; a shard
 //! index's `crc32c` checksum, where present, is skipped, not verified
@@ -1015,15 +1020,12 @@ pub fn read_sparse(path: &Path, attributes: bool, opts: &ReadOptions) -> Result<
         (path.to_path_buf(), m, None, false)
     };
     let a = array_meta(&dir, &m, 1)?;
-    if !matches!(a.data_type.as_str(), "bool" | "uint8") {
-        let hint = if a.data_type == "float32" { "; distance fields are read back from .vdb and .npy, not yet from .zarr" } else { "" };
-        return Err(IoError::new(&dir, bad(format!("data_type {:?} (topovox reads bool and uint8{hint})", a.data_type))));
-    }
+    let elements = Elements::of(&a).map_err(|k| IoError::new(&dir, k))?;
     if a.shape.iter().any(|&d| d > SparseBricks::MAX_DIM as u64) {
         return Err(IoError::new(&dir, bad(format!("shape {:?} beyond {} voxels per axis", a.shape, SparseBricks::MAX_DIM))));
     }
     let mut bricks = Vec::new();
-    for_each_chunk(&store, &dir, &a, 1, |o, shape, buf| place_bricks(&mut bricks, buf, o, shape, a.shape))?;
+    for_each_chunk(&store, &dir, &a, elements.size(), |o, shape, buf| place_bricks(&mut bricks, &elements.set(buf), o, shape, a.shape))?;
     let placement = read_placement(&a.attributes).or(placement);
     let bits = SparseBricks::from_parts(a.shape.map(|d| d as u32), bricks, Vec::new());
     let attrs = if attributes && attributes_left { read_attributes(&store, path, &bits)? } else { None };
@@ -1066,16 +1068,61 @@ fn place_bricks(out: &mut Vec<([u32; 3], Brick)>, buf: &[u8], origin: [u64; 3], 
     }
 }
 
+/// What an array's elements are and which make a voxel set.
+enum Elements {
+    /// bool or uint8: nonzero.
+    Bytes,
+    /// A float32 distance field (`topovox sdf`): negative (signed), or
+    /// within this distance (unsigned: half a voxel diagonal).
+    Distance(Option<f32>),
+}
+
+impl Elements {
+    fn of(a: &ArrayMeta) -> Result<Elements, ErrorKind> {
+        match a.data_type.as_str() {
+            "bool" | "uint8" => Ok(Elements::Bytes),
+            "float32" => {
+                let ours = &a.attributes["topovox"];
+                let unsigned = ours["distance"]["signed"] == json!(false);
+                let near = ours["voxel_size"].as_f64().filter(|s| s.is_finite() && *s > 0.0).map(|s| (0.5 * 3f64.sqrt() * s) as f32);
+                match (unsigned, near) {
+                    (false, _) => Ok(Elements::Distance(None)),
+                    (true, Some(n)) => Ok(Elements::Distance(Some(n))),
+                    (true, None) => Err(bad("an unsigned distance field without its voxel size")),
+                }
+            }
+            t => Err(bad(format!("data_type {t:?} (topovox reads bool and uint8, and float32 distance fields)"))),
+        }
+    }
+
+    /// Bytes per element.
+    fn size(&self) -> u64 {
+        match self {
+            Elements::Bytes => 1,
+            Elements::Distance(_) => 4,
+        }
+    }
+
+    /// One byte per element of a decoded chunk: nonzero where set.
+    fn set<'b>(&self, buf: &'b [u8]) -> std::borrow::Cow<'b, [u8]> {
+        match self {
+            Elements::Bytes => std::borrow::Cow::Borrowed(buf),
+            Elements::Distance(near) => {
+                let test = |v: f32| near.map_or(v < 0.0, |n| v <= n);
+                buf.chunks_exact(4).map(|x| test(f32::from_le_bytes(x.try_into().expect("4 bytes"))) as u8).collect()
+            }
+        }
+    }
+}
+
 /// The occupancy array `m` at `path`.
 fn read_occupancy(store: &Store, path: &Path, m: &Value) -> Result<LoadedVoxels, IoError> {
     let e = |k| IoError::new(path, k);
     let a = array_meta(path, m, 1)?;
-    if !matches!(a.data_type.as_str(), "bool" | "uint8") {
-        return Err(e(bad(format!("data_type {:?} (topovox reads bool and uint8)", a.data_type))));
-    }
+    let elements = Elements::of(&a).map_err(e)?;
     let dims = a.shape.map(|d| d as u32);
     let mut bits = crate::dense_grid(dims).map_err(e)?;
-    for_each_chunk(store, path, &a, 1, |o, shape, buf| place(&mut bits, buf, o, shape, a.shape))?;
+    for_each_chunk(store, path, &a, elements.size(), |o, shape, buf| place(&mut bits, &elements.set(buf), o, shape, a.shape))?;
     Ok(LoadedVoxels { bits, placement: read_placement(&a.attributes), attributes: None })
 }
 

@@ -188,10 +188,11 @@ proptest! {
     }
 }
 
-/// `convert`, `render` and `check` read a written `.vdb` or `.npy` field
-/// as its inside: exactly the negative voxels (the solid), with the
-/// placement for `.vdb`; an unsigned `.vdb` as the voxels within half a
-/// voxel diagonal of the surface.
+/// `convert`, `render` and `check` read a written field in any format as
+/// its inside: exactly the negative voxels (the solid), with the
+/// placement where the format keeps it; an unsigned field as the voxels
+/// within half a voxel diagonal of the surface (not in `.npy`, which keeps
+/// no voxel size).
 #[test]
 fn written_fields_read_back_as_their_inside() {
     let dir = std::env::temp_dir().join(format!("topovox-sdf-read-{}", std::process::id()));
@@ -207,7 +208,7 @@ fn written_fields_read_back_as_their_inside() {
         let h = s.grid.voxel_size() as f32;
         let want: Vec<bool> = d.iter().map(|&v| if s.signed { v < 0.0 } else { v <= 0.5 * 3f32.sqrt() * h }).collect();
         assert!(want.iter().filter(|&&w| w).count() > 100, "{what}");
-        for format in [DistanceFormat::Vdb, DistanceFormat::Npy] {
+        for format in [DistanceFormat::Vdb, DistanceFormat::Npy, DistanceFormat::Zarr, DistanceFormat::Vti] {
             if format == DistanceFormat::Npy && !s.signed {
                 continue; // .npy records no voxel size: an unsigned field has no inside
             }
@@ -220,9 +221,9 @@ fn written_fields_read_back_as_their_inside() {
                 let (i, j, k) = ((n / (ny * nz)) as u32, (n / nz % ny) as u32, (n % nz) as u32);
                 assert_eq!(back.bits.get(i, j, k), w, "{what} {format}: voxel {:?}", [i, j, k]);
             }
-            if format == DistanceFormat::Vdb {
+            if format != DistanceFormat::Npy {
                 let (o, size) = back.placement.unwrap();
-                assert_eq!((o, size), (s.grid.origin(), s.grid.voxel_size()));
+                assert_eq!((o, size), (s.grid.origin(), s.grid.voxel_size()), "{what} {format}");
             }
         }
     }
