@@ -37,10 +37,17 @@ impl DistanceGrid {
         Array1::from(self.inner.grid.origin().to_array().to_vec()).into_pyarray(py)
     }
 
-    /// Edge length of a voxel.
+    /// Edge length of a voxel: a float for cubes, `(sx, sy, sz)` when the
+    /// grid has a size per axis (see `spacing` for the three always).
     #[getter]
-    fn voxel_size(&self) -> f64 {
-        self.inner.grid.voxel_size()
+    fn voxel_size<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        crate::size_to_py(py, self.inner.grid.size())
+    }
+
+    /// A voxel's edge lengths along x, y, z, `(3,)` float64 (equal for cubes).
+    #[getter]
+    fn spacing<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        numpy::ndarray::Array1::from(self.inner.grid.voxel_size().to_array().to_vec()).into_pyarray(py)
     }
 
     /// Whether values are negative inside.
@@ -181,7 +188,7 @@ impl DistanceGrid {
         format!(
             "<topovox.DistanceGrid {kind} {x}x{y}x{z}, {} voxels stored, voxel size {}>",
             self.inner.field.band.count(),
-            self.inner.grid.voxel_size()
+            self.inner.grid.size()
         )
     }
 }

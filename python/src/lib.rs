@@ -32,7 +32,7 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyList, PyString};
 use serde_json::Value;
 use topovox::attributes::{ColourRule, VoxelAttributes, NO_MATERIAL};
 use topovox::voxelize::Stop;
-use topovox::{GridSpec, VoxelSource};
+use topovox::{GridSpec, VoxelSize, VoxelSource};
 use topovox_io::LoadedMesh;
 use topovox_job::{JobError, JobOptions, OptionValue, Voxels};
 
@@ -526,13 +526,20 @@ impl VoxelGrid {
     fn bounds<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let g = &self.inner.grid;
         let (o, s, d) = (g.origin(), g.voxel_size(), g.dims());
-        Array2::from_shape_fn((2, 3), |(r, c)| o[c] + r as f64 * d[c] as f64 * s).into_pyarray(py)
+        Array2::from_shape_fn((2, 3), |(r, c)| o[c] + r as f64 * d[c] as f64 * s[c]).into_pyarray(py)
     }
 
-    /// Edge length of a voxel.
+    /// Edge length of a voxel: a float for cubes, `(sx, sy, sz)` when the
+    /// grid has a size per axis (see `spacing` for the three always).
     #[getter]
-    fn voxel_size(&self) -> f64 {
-        self.inner.grid.voxel_size()
+    fn voxel_size<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        size_to_py(py, self.inner.grid.size())
+    }
+
+    /// A voxel's edge lengths along x, y, z, `(3,)` float64 (equal for cubes).
+    #[getter]
+    fn spacing<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from(self.inner.grid.voxel_size().to_array().to_vec()).into_pyarray(py)
     }
 
     /// Number of set voxels.
@@ -837,7 +844,7 @@ impl VoxelGrid {
         let ijk = indices_from::<3>("indices", indices)?;
         let g = self.inner.grid;
         let (o, s) = (g.origin(), g.voxel_size());
-        Ok(Array2::from_shape_fn((ijk.len(), 3), |(n, c)| o[c] + (ijk[n][c] as f64 + 0.5) * s).into_pyarray(py))
+        Ok(Array2::from_shape_fn((ijk.len(), 3), |(n, c)| o[c] + (ijk[n][c] as f64 + 0.5) * s[c]).into_pyarray(py))
     }
 
     /// greedy_mesh() -> (vertices, faces, face_colours)
@@ -891,9 +898,9 @@ impl VoxelGrid {
         let trimesh = import_trimesh(py, "to_trimesh")?;
         let (o, s) = (self.inner.grid.origin(), self.inner.grid.voxel_size());
         let t = Array2::from_shape_fn((4, 4), |(r, c)| match (r, c) {
-            (r, c) if r == c && r < 3 => s,
+            (r, c) if r == c && r < 3 => s[r],
             (3, 3) => 1.0,
-            (r, 3) => o[r] + 0.5 * s,
+            (r, 3) => o[r] + 0.5 * s[r],
             _ => 0.0,
         });
         let kwargs = PyDict::new(py);
@@ -948,8 +955,8 @@ impl VoxelGrid {
     ///     `(nx, ny, nz)`.
     /// origin : tuple of float, optional
     ///     The grid's low corner.
-    /// voxel_size : float
-    ///     A voxel's edge.
+    /// voxel_size : float or tuple of float
+    ///     A voxel's edge, or `(sx, sy, sz)` per axis.
     /// colours, materials, normals, coverage : array_like, optional
     ///     `(n, 3)` uint8, `(n,)` int (-1: none), `(n, 3)` float, `(n,)` float.
     ///
@@ -966,14 +973,14 @@ impl VoxelGrid {
     /// --------
     /// >>> g = topovox.VoxelGrid.from_coords([[0, 0, 0], [1, 2, 3]], (4, 4, 4))
     #[staticmethod]
-    #[pyo3(signature = (coords, dims, origin=None, voxel_size=1.0, colours=None, materials=None, normals=None, coverage=None, facts=None))]
+    #[pyo3(signature = (coords, dims, origin=None, voxel_size=SizeArg::Cube(1.0), colours=None, materials=None, normals=None, coverage=None, facts=None))]
     #[allow(clippy::too_many_arguments)]
     fn from_coords<'py>(
         py: Python<'py>,
         coords: &Bound<'py, PyAny>,
         dims: (u64, u64, u64),
         origin: Option<(f64, f64, f64)>,
-        voxel_size: f64,
+        voxel_size: SizeArg,
         colours: Option<&Bound<'py, PyAny>>,
         materials: Option<&Bound<'py, PyAny>>,
         normals: Option<&Bound<'py, PyAny>>,
@@ -981,7 +988,7 @@ impl VoxelGrid {
         facts: Option<String>,
     ) -> PyResult<VoxelGrid> {
         let o = origin.unwrap_or_default();
-        let grid = GridSpec::new(DVec3::new(o.0, o.1, o.2), voxel_size, [dims.0, dims.1, dims.2])
+        let grid = GridSpec::new(DVec3::new(o.0, o.1, o.2), VoxelSize::from(voxel_size), [dims.0, dims.1, dims.2])
             .map_err(|e| value_err(format!("invalid grid: {e}")))?;
         let ijk = indices_from::<3>("coords", &as_array(py, coords, "int64")?)?;
         let order = sorted_coords(&ijk, grid.dims())?;
@@ -1028,8 +1035,8 @@ impl VoxelGrid {
     ///     `(nx, ny, nz)`, element `[i, j, k]` = voxel `(i, j, k)`.
     /// origin : tuple of float, optional
     ///     The grid's low corner.
-    /// voxel_size : float
-    ///     A voxel's edge.
+    /// voxel_size : float or tuple of float
+    ///     A voxel's edge, or `(sx, sy, sz)` per axis.
     ///
     /// Returns
     /// -------
@@ -1044,8 +1051,8 @@ impl VoxelGrid {
     /// --------
     /// >>> g = topovox.VoxelGrid.from_dense(np.ones((2, 2, 2), bool))
     #[staticmethod]
-    #[pyo3(signature = (array, origin=None, voxel_size=1.0))]
-    fn from_dense(py: Python<'_>, array: &Bound<'_, PyAny>, origin: Option<(f64, f64, f64)>, voxel_size: f64) -> PyResult<VoxelGrid> {
+    #[pyo3(signature = (array, origin=None, voxel_size=SizeArg::Cube(1.0)))]
+    fn from_dense(py: Python<'_>, array: &Bound<'_, PyAny>, origin: Option<(f64, f64, f64)>, voxel_size: SizeArg) -> PyResult<VoxelGrid> {
         let np = py.import("numpy")?;
         let a = np.call_method1("asarray", (array,))?;
         let shape: Vec<u64> = a.getattr("shape")?.extract()?;
@@ -1070,7 +1077,7 @@ impl VoxelGrid {
                 let o = g.origin();
                 (o.x, o.y, o.z)
             },
-            g.voxel_size(),
+            size_to_py(py, g.size())?,
             self.colours(py),
             self.materials(py),
             self.normals(py),
@@ -1083,7 +1090,33 @@ impl VoxelGrid {
     fn __repr__(&self) -> String {
         let [x, y, z] = self.inner.grid.dims();
         let mode = self.inner.facts.get("mode").and_then(Value::as_str).map(|m| format!(" {m}")).unwrap_or_default();
-        format!("<topovox.VoxelGrid{mode} {x}x{y}x{z}, {} voxels, voxel size {}>", self.inner.voxels.count(), self.inner.grid.voxel_size())
+        format!("<topovox.VoxelGrid{mode} {x}x{y}x{z}, {} voxels, voxel size {}>", self.inner.voxels.count(), self.inner.grid.size())
+    }
+}
+
+/// A voxel size as Python gives it: one number (cubes) or three (per axis).
+#[derive(FromPyObject, Clone, Copy)]
+pub(crate) enum SizeArg {
+    /// A cube's edge.
+    Cube(f64),
+    /// `(sx, sy, sz)`.
+    Boxes((f64, f64, f64)),
+}
+
+impl From<SizeArg> for VoxelSize {
+    fn from(s: SizeArg) -> VoxelSize {
+        match s {
+            SizeArg::Cube(c) => c.into(),
+            SizeArg::Boxes((x, y, z)) => [x, y, z].into(),
+        }
+    }
+}
+
+/// A voxel size for Python: a float for cubes, `(sx, sy, sz)` for boxes.
+pub(crate) fn size_to_py(py: Python<'_>, s: VoxelSize) -> PyResult<Bound<'_, PyAny>> {
+    match s.cube() {
+        Some(c) => Ok(c.into_pyobject(py)?.into_any()),
+        None => Ok(s.0.to_array().into_pyobject(py)?.into_any()),
     }
 }
 
@@ -1171,7 +1204,7 @@ fn greedy_triangles(g: &GridData) -> Triangles {
             .iter()
             .map(|&c| {
                 *index.entry(c).or_insert_with(|| {
-                    verts.push([o.x + c[0] as f64 * s, o.y + c[1] as f64 * s, o.z + c[2] as f64 * s]);
+                    verts.push([o.x + c[0] as f64 * s.x, o.y + c[1] as f64 * s.y, o.z + c[2] as f64 * s.z]);
                     verts.len() as u32 - 1
                 })
             })
@@ -1339,7 +1372,7 @@ fn load_voxels(
     py: Python<'_>,
     path: PathBuf,
     origin: Option<Vec<f64>>,
-    voxel_size: Option<f64>,
+    voxel_size: Option<SizeArg>,
     up: &str,
     allow_external_paths: bool,
 ) -> PyResult<VoxelGrid> {
@@ -1353,7 +1386,7 @@ fn load_voxels(
         Some(o) => return Err(value_err(format!("origin must have 3 values; got {}", o.len()))),
         None => loaded.placement.map(|p| p.0).unwrap_or(DVec3::ZERO),
     };
-    let s = voxel_size.or(loaded.placement.map(|p| p.1)).unwrap_or(1.0);
+    let s = voxel_size.map(|s| VoxelSize::from(s).0).or(loaded.placement.map(|p| p.1)).unwrap_or(DVec3::ONE);
     let grid = GridSpec::new(o, s, dims.map(u64::from)).map_err(|e| value_err(format!("invalid grid: {e}")))?;
     let facts = serde_json::json!({"input": path.display().to_string(), "voxels": loaded.bits.count(), "placement_from_file": loaded.placement.is_some()});
     Ok(VoxelGrid { inner: Arc::new(GridData::new(Voxels::Dense(loaded.bits), grid, loaded.attributes, facts)) })

@@ -29,8 +29,10 @@ Modes (``mode=``):
 Grids: ``resolution=N`` (the longest side of the bounding box spans N
 voxels; the default is 128), ``voxel_size=S`` (fitted to the bounding box),
 or ``origin=(x, y, z), voxel_size=S, dims=(nx, ny, nz)`` exactly; ``pad=P``
-adds empty voxels around a fitted grid. Voxel ``(i, j, k)`` is the closed
-box ``[origin + (i, j, k) * s, origin + (i + 1, j + 1, k + 1) * s]``.
+adds empty voxels around a fitted grid. ``voxel_size=(sx, sy, sz)`` gives a
+size per axis (boxes: a scan's spacing, a layer height). Voxel ``(i, j, k)``
+is the closed box ``[origin + (i, j, k) * s, origin + (i + 1, j + 1, k + 1) * s]``
+(per axis); every mode's rules hold in index space, where voxels are cubes.
 
 Errors: ``ValueError`` for bad arguments and bad arrays, ``OSError``
 subclasses for files (``FileNotFoundError``, ``PermissionError``,
@@ -86,6 +88,8 @@ ColourRuleName = Literal["dominant", "blend"]
 UpName = Literal["x", "y", "z"]
 FitName = Literal["box", "cube"]
 SignName = Literal["auto", "parity", "winding"]
+#: A voxel size: one edge (cubes) or ``(sx, sy, sz)``.
+VoxelSizeLike = Union[float, Tuple[float, float, float]]
 #: Every option :func:`voxelize` and :func:`batch` take, with its help.
 OPTIONS = {name: help for name, help, _example in _topovox.options()}
 
@@ -233,7 +237,7 @@ def voxelize(
     *,
     mode: ModeName = "cover",
     resolution: Optional[int] = None,
-    voxel_size: Optional[float] = None,
+    voxel_size: Optional[VoxelSizeLike] = None,
     origin: Optional[Sequence[float]] = None,
     dims: Optional[Sequence[int]] = None,
     pad: int = 0,
@@ -272,8 +276,9 @@ def voxelize(
     resolution : int, optional
         The longest side of the bounding box spans this many voxels
         (default 128 when no grid option is given).
-    voxel_size : float, optional
-        The voxel edge; alone, the grid is fitted to the mesh.
+    voxel_size : float or (float, float, float), optional
+        The voxel edge, or ``(sx, sy, sz)`` per axis; alone, the grid is
+        fitted to the mesh.
     origin, dims : sequence, optional
         With ``voxel_size``, an explicit grid; triangles outside it are
         clipped, never wrapped.
@@ -360,7 +365,7 @@ def sdf(
     faces: Optional[Any] = None,
     *,
     resolution: Optional[int] = None,
-    voxel_size: Optional[float] = None,
+    voxel_size: Optional[VoxelSizeLike] = None,
     origin: Optional[Sequence[float]] = None,
     dims: Optional[Sequence[int]] = None,
     pad: int = 0,
@@ -393,8 +398,9 @@ def sdf(
         placement).
     band : float or "all"
         Half width of the stored band in voxels (default 3, as OpenVDB):
-        voxels nearer than ``band * voxel_size`` get their distance, the
-        others ``±band * voxel_size``. ``"all"``: every voxel.
+        voxels nearer than ``band * h`` get their distance, the others
+        ``±band * h``, ``h`` the voxel edge (the largest of the three for
+        boxes). ``"all"``: every voxel.
     unsigned : bool
         No sign: the unsigned distance (open meshes, polylines).
     sign : {"auto", "parity", "winding"}

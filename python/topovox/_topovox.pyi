@@ -60,7 +60,9 @@ class VoxelGrid:
     @property
     def bounds(self) -> npt.NDArray[np.float64]: ...
     @property
-    def voxel_size(self) -> float: ...
+    def voxel_size(self) -> Union[float, Tuple[float, float, float]]: ...
+    @property
+    def spacing(self) -> npt.NDArray[np.float64]: ...
     @property
     def shape(self) -> Tuple[int, int, int]: ...
     @property
@@ -74,7 +76,7 @@ class VoxelGrid:
         coords: npt.ArrayLike,
         dims: Tuple[int, int, int],
         origin: Optional[Tuple[float, float, float]] = None,
-        voxel_size: float = 1.0,
+        voxel_size: Union[float, Tuple[float, float, float]] = ...,
         colours: Optional[npt.ArrayLike] = None,
         materials: Optional[npt.ArrayLike] = None,
         normals: Optional[npt.ArrayLike] = None,
@@ -82,7 +84,11 @@ class VoxelGrid:
         facts: Optional[str] = None,
     ) -> VoxelGrid: ...
     @staticmethod
-    def from_dense(array: npt.ArrayLike, origin: Optional[Tuple[float, float, float]] = None, voxel_size: float = 1.0) -> VoxelGrid: ...
+    def from_dense(
+        array: npt.ArrayLike,
+        origin: Optional[Tuple[float, float, float]] = None,
+        voxel_size: Union[float, Tuple[float, float, float]] = ...,
+    ) -> VoxelGrid: ...
     @property
     def facts(self) -> Dict[str, Any]: ...
     @property
@@ -124,7 +130,9 @@ class DistanceGrid:
     @property
     def origin(self) -> npt.NDArray[np.float64]: ...
     @property
-    def voxel_size(self) -> float: ...
+    def voxel_size(self) -> Union[float, Tuple[float, float, float]]: ...
+    @property
+    def spacing(self) -> npt.NDArray[np.float64]: ...
     @property
     def signed(self) -> bool: ...
     @property
@@ -144,7 +152,7 @@ def load_mesh(path: Union[str, PathLike[str]], allow_external_paths: bool = Fals
 def load_voxels(
     path: Union[str, PathLike[str]],
     origin: Optional[Sequence[float]] = None,
-    voxel_size: Optional[float] = None,
+    voxel_size: Optional[Union[float, Tuple[float, float, float]]] = None,
     up: str = "y",
     allow_external_paths: bool = False,
 ) -> VoxelGrid: ...

@@ -79,9 +79,9 @@ pub struct GridArgs {
     /// Fit the grid so the longest side of the mesh's bounding box spans N voxels (default 128).
     #[arg(long, value_name = "N")]
     pub resolution: Option<u64>,
-    /// Voxel edge length; alone, fits the grid to the mesh's bounding box.
-    #[arg(long, value_name = "S")]
-    pub voxel_size: Option<f64>,
+    /// Voxel edge length, or SX,SY,SZ for a size per axis (boxes); alone, fits the grid to the mesh's bounding box.
+    #[arg(long, value_name = "S|SX,SY,SZ", value_parser = crate::values::voxel_size)]
+    pub voxel_size: Option<topovox::VoxelSize>,
     /// Explicit grid origin (with --voxel-size and --dims).
     #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', allow_hyphen_values = true)]
     pub origin: Option<Vec<f64>>,
@@ -646,9 +646,9 @@ pub struct ConvertArgs {
     /// Grid origin X,Y,Z for formats that record it (binvox, txt), when the input does not carry it (default 0,0,0).
     #[arg(long, value_delimiter = ',', value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub origin: Option<Vec<f64>>,
-    /// Voxel size for formats that record it, when the input does not carry it (default 1).
-    #[arg(long, value_name = "S")]
-    pub voxel_size: Option<f64>,
+    /// Voxel size (S, or SX,SY,SZ per axis) for formats that record it, when the input does not carry it (default 1).
+    #[arg(long, value_name = "S|SX,SY,SZ", value_parser = crate::values::voxel_size)]
+    pub voxel_size: Option<topovox::VoxelSize>,
     /// Print one JSON object on stdout instead of the summary line.
     #[arg(long)]
     pub json: bool,

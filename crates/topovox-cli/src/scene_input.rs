@@ -17,13 +17,13 @@ const VOXEL_COLOUR: [f32; 3] = [0.72, 0.72, 0.70];
 pub fn add_voxel_file(scene: &mut Scene, path: &Path, up: Option<topovox_io::orient::Up>, offset: Vec3) -> Result<()> {
     let upname = up.unwrap_or_default();
     let loaded = topovox_io::read_voxels_with(path, upname)?;
-    let (origin, size) = loaded.placement.map(|(o, s)| (o.as_vec3(), s as f32)).unwrap_or((Vec3::ZERO, 1.0));
+    let (origin, size) = loaded.placement.map(|(o, s)| (o.as_vec3(), s.as_vec3())).unwrap_or((Vec3::ZERO, Vec3::ONE));
     add_voxels(scene, &loaded.bits, origin + offset, size);
     Ok(())
 }
 
 /// Adds voxels as greedy quads of one clay material.
-pub fn add_voxels(scene: &mut Scene, bits: &topovox::grid::dense::DenseBits, origin: Vec3, size: f32) {
+pub fn add_voxels(scene: &mut Scene, bits: &topovox::grid::dense::DenseBits, origin: Vec3, size: Vec3) {
     let quads = topovox::export::greedy::greedy_quads(bits);
     let m = scene.add_material(topovox_view::scene::ShadeMaterial::new(VOXEL_COLOUR, [0.0; 3], 0.7));
     scene.add_quads(&quads, origin, size, m);

@@ -1,5 +1,5 @@
 //! Typed flag values that are not named choices (those are
-//! [`crate::choice`]): picture sizes, views, cameras and memory sizes. Each
+//! [`crate::choice`]): picture sizes, views, cameras, voxel sizes and memory sizes. Each
 //! parses in one function that clap calls (`value_parser`), so a command
 //! receives the value checked, and each has its tests here.
 
@@ -41,6 +41,17 @@ pub fn view(text: &str) -> Result<View, String> {
             _ => return Err("--view takes iso, x, y, z or AZIMUTH,ELEVATION in degrees".into()),
         },
     })
+}
+
+/// A voxel size: `S` (cubes) or `SX,SY,SZ` (`--voxel-size`); the grid
+/// request checks that each is positive and finite.
+pub fn voxel_size(text: &str) -> Result<topovox::VoxelSize, String> {
+    let n: Option<Vec<f64>> = text.split(',').map(|x| x.trim().parse::<f64>().ok()).collect();
+    match n.as_deref() {
+        Some(&[s]) => Ok(s.into()),
+        Some(&[x, y, z]) => Ok([x, y, z].into()),
+        _ => Err("--voxel-size takes S (cubes) or SX,SY,SZ (a size per axis), e.g. 0.7,0.7,2.5".into()),
+    }
 }
 
 /// Comma-separated finite numbers, or `None`.
@@ -92,6 +103,15 @@ mod tests {
         assert_eq!(size(" 3 X 4 "), Ok(Size { width: 3, height: 4 }));
         for bad in ["1024", "0x5", "20000x1", "8192x8193", "axb", "-1x5"] {
             assert!(size(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn voxel_sizes() {
+        assert_eq!(voxel_size("0.5"), Ok(0.5.into()));
+        assert_eq!(voxel_size("0.7, 0.7,2.5"), Ok([0.7, 0.7, 2.5].into()));
+        for bad in ["", "a", "1,2", "1,2,3,4", "1,,2"] {
+            assert!(voxel_size(bad).is_err(), "{bad}");
         }
     }
 

@@ -87,6 +87,29 @@ fn large_triangles_go_to_the_cpu_and_still_agree() {
     check(&g, &rot, &grid, "rotated box at 100");
 }
 
+#[test]
+fn grids_of_boxes_equal_the_reference_on_every_path() {
+    use topovox_gpu::GpuPath;
+    let Some(g) = gpu() else { return };
+    let mut r = rng(43);
+    for name in ["suzanne.obj", "cow.obj", "fandisk.obj"] {
+        let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
+        let grid = topovox_testkit::box_grid(&mesh.as_ref().bounds(), 64, &mut r);
+        let what = format!("rotated {name} on sizes {}", grid.size());
+        check(&g, &mesh, &grid, &what);
+        for mode in MODES {
+            let (want, _) = voxelize::reference(mode, mesh.as_ref(), &grid);
+            let (bits, _) = g.voxelize_with(GpuMode::of(mode).unwrap(), GpuPath::Raster, mesh.as_ref(), &grid).unwrap();
+            if let Some(v) = bits.to_dense().first_difference(&want) {
+                panic!("{what}, {mode:?}, rasterizer: differs from the reference at {v:?}");
+            }
+        }
+        if name != "suzanne.obj" {
+            check_solid(&g, &mesh, &grid, &what);
+        }
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 

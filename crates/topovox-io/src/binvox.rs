@@ -73,14 +73,18 @@ impl Rle<'_> {
 }
 
 /// Writes `bits` on `grid` as binvox.
+/// A grid of boxes is refused (binvox's one `scale` makes cubes).
 pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
+    let Some(s) = grid.cube_size() else {
+        return Err(std::io::Error::other(crate::VoxelFormat::Binvox.refuses(grid.size()).unwrap_or_default()));
+    };
     let [nx, ny, nz] = bits.dims();
     let d = nx.max(ny).max(nz);
     let o = grid.origin();
     writeln!(w, "#binvox 1")?;
     writeln!(w, "dim {d} {d} {d}")?;
     writeln!(w, "translate {} {} {}", o.x, o.y, o.z)?;
-    writeln!(w, "scale {}", grid.voxel_size() * d as f64)?;
+    writeln!(w, "scale {}", s * d as f64)?;
     writeln!(w, "data")?;
     let (nyu, nzu) = (ny as usize, nz as usize);
     let plane = nyu * nzu;
@@ -170,5 +174,5 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if idx != total {
         return Err(bad(format!("data covers {idx} of {total} voxels (truncated?)")));
     }
-    Ok(LoadedVoxels { bits, placement: Some((translate, scale / d as f64)), attributes: None })
+    Ok(LoadedVoxels { bits, placement: Some((translate, DVec3::splat(scale / d as f64))), attributes: None })
 }

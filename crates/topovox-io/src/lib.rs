@@ -229,6 +229,24 @@ impl VoxelFormat {
         }
     }
 
+    /// True when the format only knows cubic voxels (`.binvox`, `.vox`,
+    /// `.schem`): it refuses a grid of boxes.
+    pub fn cubes_only(self) -> bool {
+        matches!(self, VoxelFormat::Binvox | VoxelFormat::Vox | VoxelFormat::Schem)
+    }
+
+    /// The refusal of a grid of boxes by a [cubes-only](Self::cubes_only)
+    /// format, naming the formats that keep a voxel size per axis; `None`
+    /// when the format takes `size`.
+    pub fn refuses(self, size: topovox::VoxelSize) -> Option<String> {
+        (self.cubes_only() && size.cube().is_none()).then(|| {
+            format!(
+                ".{} stores cubic voxels only, and the voxel size {size} is not cubic; write .vti, .vdb, .zarr, .npz, .ply, .txt or .npy, which keep a voxel size per axis",
+                self.name()
+            )
+        })
+    }
+
     /// True when the format stores voxel colours.
     pub fn has_colour(self) -> bool {
         matches!(self, VoxelFormat::Vox | VoxelFormat::Schem | VoxelFormat::Vti | VoxelFormat::Ply)
@@ -272,6 +290,9 @@ pub fn write_voxels_with(
     attrs: Option<&VoxelAttributes>,
     opts: &WriteOptions,
 ) -> Result<(), IoError> {
+    if let Some(why) = format.refuses(grid.size()) {
+        return Err(IoError::new(path, ErrorKind::Unsupported(why)));
+    }
     if format == VoxelFormat::Zarr {
         // A directory: built under a temporary name and renamed (see [`zarr`]).
         if matches!(atomic::target(path), atomic::Target::Stdout | atomic::Target::Special(_)) {
@@ -297,14 +318,33 @@ pub fn write_voxels_with(
     })
 }
 
+/// A voxel size in JSON: one number for cubes (what files and scripts
+/// written before boxes hold), `[sx, sy, sz]` for boxes.
+pub fn size_json(size: topovox::VoxelSize) -> serde_json::Value {
+    match size.cube() {
+        Some(s) => serde_json::json!(s),
+        None => serde_json::json!(size.to_array()),
+    }
+}
+
+/// Reads [`size_json`]'s form back: a positive finite number, or three.
+pub fn size_from_json(v: &serde_json::Value) -> Option<glam::DVec3> {
+    let s = match v {
+        serde_json::Value::Array(a) if a.len() == 3 => glam::DVec3::new(a[0].as_f64()?, a[1].as_f64()?, a[2].as_f64()?),
+        v => glam::DVec3::splat(v.as_f64()?),
+    };
+    (s.is_finite() && s.min_element() > 0.0).then_some(s)
+}
+
 /// A voxel grid read back from a file, with the grid placement when the
 /// format stores it.
 #[derive(Clone, Debug)]
 pub struct LoadedVoxels {
     /// The voxels.
     pub bits: DenseBits,
-    /// Origin and voxel size, when the format carries them (binvox, text, vti, ply).
-    pub placement: Option<(glam::DVec3, f64)>,
+    /// Origin and voxel size per axis, when the format carries them (binvox,
+    /// text, vti, ply, npz, vdb, zarr).
+    pub placement: Option<(glam::DVec3, glam::DVec3)>,
     /// Per-voxel attributes, when the format carries them (colours of
     /// `.vox`, `.schem` and `.ply`; every array of `.vti`).
     pub attributes: Option<VoxelAttributes>,
@@ -366,8 +406,8 @@ pub fn read_voxels_opts(path: &Path, up: orient::Up, opts: &ReadOptions) -> Resu
 pub struct SparseVoxels {
     /// The voxels, as sparse bricks (full regions as runs of full bricks).
     pub bits: topovox::grid::sparse::SparseBricks,
-    /// Origin and voxel size, when the file records them.
-    pub placement: Option<(glam::DVec3, f64)>,
+    /// Origin and voxel size per axis, when the file records them.
+    pub placement: Option<(glam::DVec3, glam::DVec3)>,
     /// The file holds attributes that were not read (not asked for).
     pub attributes_left: bool,
     /// The attributes of the set voxels, when asked for and present.

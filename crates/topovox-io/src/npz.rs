@@ -9,7 +9,7 @@
 //! | `indices` | `int32` | `(k, 3)` | row `n` is the `(i, j, k)` of the `n`-th set voxel, ordered by `k`, then `j`, then `i` |
 //! | `dims` | `int64` | `(3,)` | the grid's `(nx, ny, nz)` |
 //! | `origin` | `float64` | `(3,)` | the world position of voxel `(0, 0, 0)`'s low corner |
-//! | `voxel_size` | `float64` | `()` | the voxel's edge length |
+//! | `voxel_size` | `float64` | `()` or `(3,)` | the voxel's edge length; `(sx, sy, sz)` for boxes |
 //!
 //! A dense grid comes back with `grid = np.zeros(dims, bool);
 //! grid[tuple(indices.T)] = True`. The writer streams: it holds one buffer
@@ -52,7 +52,14 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std:
     member(&mut zip, "dims.npy", header("<i8", "(3,)"), &dims_le)?;
     let origin_le: Vec<u8> = [o.x, o.y, o.z].iter().flat_map(|c| c.to_le_bytes()).collect();
     member(&mut zip, "origin.npy", header("<f8", "(3,)"), &origin_le)?;
-    member(&mut zip, "voxel_size.npy", header("<f8", "()"), &grid.voxel_size().to_le_bytes())?;
+    // One number for cubes (as before boxes), three for boxes.
+    match grid.cube_size() {
+        Some(s) => member(&mut zip, "voxel_size.npy", header("<f8", "()"), &s.to_le_bytes())?,
+        None => {
+            let bytes: Vec<u8> = grid.voxel_size().to_array().iter().flat_map(|v| v.to_le_bytes()).collect();
+            member(&mut zip, "voxel_size.npy", header("<f8", "(3,)"), &bytes)?
+        }
+    }
 
     zip.start_file("indices.npy", large).map_err(std::io::Error::other)?;
     zip.write_all(&header("<i4", &format!("({count}, 3)")))?;
@@ -251,19 +258,20 @@ impl Bricks {
     }
 }
 
-fn read_into<R: Read + Seek>(r: R, total: u64, sparse: bool) -> Result<(Read3, Option<(DVec3, f64)>), ErrorKind> {
+fn read_into<R: Read + Seek>(r: R, total: u64, sparse: bool) -> Result<(Read3, Option<(DVec3, DVec3)>), ErrorKind> {
     let mut zip = zip::ZipArchive::new(r).map_err(|e| ErrorKind::malformed(FORMAT, format!("not a ZIP archive ({e})")))?;
-    let small = |zip: &mut zip::ZipArchive<R>, name: &str, n: usize| -> Result<Option<Vec<f64>>, ErrorKind> {
+    // A small member of `ns[0]` values (or of any other count in `ns`).
+    let small = |zip: &mut zip::ZipArchive<R>, name: &str, ns: &[usize]| -> Result<Option<Vec<f64>>, ErrorKind> {
         let Ok(mut f) = zip.by_name(name) else { return Ok(None) };
         let h = read_header(&mut f, name)?;
-        if h.shape.iter().product::<u64>() != n as u64 {
-            return Err(ErrorKind::malformed(FORMAT, format!("member {name}: shape {:?}, expected {n} values", h.shape)));
-        }
+        let Some(&n) = ns.iter().find(|&&n| h.shape.iter().product::<u64>() == n as u64) else {
+            return Err(ErrorKind::malformed(FORMAT, format!("member {name}: shape {:?}, expected {} values", h.shape, ns[0])));
+        };
         read_numbers(&mut f, &h.descr, n, name).map(Some)
     };
-    let dims = small(&mut zip, "dims.npy", 3)?;
-    let origin = small(&mut zip, "origin.npy", 3)?;
-    let size = small(&mut zip, "voxel_size.npy", 1)?;
+    let dims = small(&mut zip, "dims.npy", &[3])?;
+    let origin = small(&mut zip, "origin.npy", &[3])?;
+    let size = small(&mut zip, "voxel_size.npy", &[1, 3])?;
     let name = "indices.npy";
     let mut f = zip.by_name(name).map_err(|_| ErrorKind::malformed(FORMAT, "no 'indices' array"))?;
     let h = read_header(&mut f, name)?;
@@ -348,8 +356,9 @@ fn read_into<R: Read + Seek>(r: R, total: u64, sparse: bool) -> Result<(Read3, O
         }
     };
     let placement = match (origin, size) {
-        (Some(o), Some(s)) if o.iter().all(|c| c.is_finite()) && s[0].is_finite() && s[0] > 0.0 => {
-            Some((DVec3::new(o[0], o[1], o[2]), s[0]))
+        (Some(o), Some(s)) if o.iter().all(|c| c.is_finite()) && s.iter().all(|&v| v.is_finite() && v > 0.0) => {
+            let s = if s.len() == 3 { DVec3::new(s[0], s[1], s[2]) } else { DVec3::splat(s[0]) };
+            Some((DVec3::new(o[0], o[1], o[2]), s))
         }
         (None, None) => None,
         _ => return Err(ErrorKind::malformed(FORMAT, "origin and voxel_size must both be finite, the size positive")),

@@ -1,7 +1,8 @@
 //! A PLY point cloud of voxel centres (binary little-endian): `x y z` as
 //! float, plus `red green blue` (uchar, sRGB) when the voxels have colours.
 //! A header comment records the grid (`comment topovox grid origin X Y Z
-//! voxel_size S dims NX NY NZ`), which lets topovox read the file back as
+//! voxel_size S dims NX NY NZ`, or `voxel_size SX SY SZ` for a grid of
+//! boxes), which lets topovox read the file back as
 //! voxels; other readers (MeshLab, CloudCompare, Open3D, `plyfile`) see an
 //! ordinary point cloud.
 
@@ -21,9 +22,13 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: 
     let colours = attrs.and_then(|a| a.colour.as_ref().map(|c| (a, c)));
     let o = grid.origin();
     let s = grid.voxel_size();
+    let size = match grid.cube_size() {
+        Some(c) => format!("{c:?}"),
+        None => format!("{:?} {:?} {:?}", s.x, s.y, s.z),
+    };
     let d = grid.dims();
     let mut head = format!(
-        "ply\nformat binary_little_endian 1.0\ncomment voxel centres written by topovox\n{GRID_COMMENT} origin {:?} {:?} {:?} voxel_size {s:?} dims {} {} {}\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n",
+        "ply\nformat binary_little_endian 1.0\ncomment voxel centres written by topovox\n{GRID_COMMENT} origin {:?} {:?} {:?} voxel_size {size} dims {} {} {}\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n",
         o.x,
         o.y,
         o.z,
@@ -40,7 +45,7 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: 
     let mut buf = Vec::with_capacity(1 << 16);
     let mut result = Ok(());
     bits.for_each_set(&mut |i, j, k| {
-        let c = grid.voxel_min([i, j, k]) + DVec3::splat(0.5 * s);
+        let c = grid.voxel_center([i, j, k]);
         for v in [c.x, c.y, c.z] {
             buf.extend_from_slice(&(v as f32).to_le_bytes());
         }
@@ -80,11 +85,19 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         .ok_or_else(|| bad(format!("no '{GRID_COMMENT} …' line: not a topovox voxel point cloud (meshes are read by voxelize)")))?;
     let w: Vec<&str> = line.split_whitespace().collect();
     let num = |i: usize| w.get(i).and_then(|v| v.parse::<f64>().ok()).filter(|v| v.is_finite());
-    let (Some(ox), Some(oy), Some(oz), Some(s), Some(nx), Some(ny), Some(nz)) = (num(4), num(5), num(6), num(8), num(10), num(11), num(12))
+    // `voxel_size` holds one number (cubes) or three (boxes); `dims` follows.
+    let d = w.iter().position(|&v| v == "dims").unwrap_or(9);
+    let size = match d {
+        11 => (num(8), num(9), num(10)),
+        _ => (num(8), num(8), num(8)),
+    };
+    let (Some(ox), Some(oy), Some(oz), (Some(sx), Some(sy), Some(sz)), Some(nx), Some(ny), Some(nz)) =
+        (num(4), num(5), num(6), size, num(d + 1), num(d + 2), num(d + 3))
     else {
         return Err(bad(format!("unreadable grid line {line:?}")));
     };
-    let grid = GridSpec::new(DVec3::new(ox, oy, oz), s, [nx as u64, ny as u64, nz as u64]).map_err(|e| bad(format!("grid: {e}")))?;
+    let grid =
+        GridSpec::new(DVec3::new(ox, oy, oz), [sx, sy, sz], [nx as u64, ny as u64, nz as u64]).map_err(|e| bad(format!("grid: {e}")))?;
     let parser = ply_rs_bw::parser::Parser::<ply_rs_bw::ply::DefaultElement>::new();
     let ply = parser.read_ply(&mut std::io::Cursor::new(bytes)).map_err(|e| bad(e.to_string()))?;
     let verts = ply.payload.get("vertex").ok_or_else(|| bad("no 'vertex' element".into()))?;

@@ -6,6 +6,8 @@
 //! 0 0 0
 //! 3 1 0
 //! ```
+//!
+//! A grid of boxes gives three sizes: `voxel_size 0.7 0.7 2.5`.
 
 use std::io::Write;
 
@@ -19,7 +21,12 @@ use crate::LoadedVoxels;
 pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
     let [nx, ny, nz] = bits.dims();
     let o = grid.origin();
-    writeln!(w, "# topovox voxels dims {nx} {ny} {nz} origin {} {} {} voxel_size {}", o.x, o.y, o.z, grid.voxel_size())?;
+    let s = grid.voxel_size();
+    let size = match grid.cube_size() {
+        Some(c) => c.to_string(),
+        None => format!("{} {} {}", s.x, s.y, s.z),
+    };
+    writeln!(w, "# topovox voxels dims {nx} {ny} {nz} origin {} {} {} voxel_size {size}", o.x, o.y, o.z)?;
     let mut result = Ok(());
     bits.for_each_set(&mut |i, j, k| {
         if result.is_ok() {
@@ -44,7 +51,11 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
                 dims = Some([x as u32, y as u32, z as u32]);
             }
             if let (Some(x), Some(y), Some(z), Some(s)) = (num(5), num(6), num(7), num(9)) {
-                placement = Some((DVec3::new(x, y, z), s));
+                let size = match (num(10), num(11)) {
+                    (Some(sy), Some(sz)) => DVec3::new(s, sy, sz),
+                    _ => DVec3::splat(s),
+                };
+                placement = Some((DVec3::new(x, y, z), size));
             }
             continue;
         }

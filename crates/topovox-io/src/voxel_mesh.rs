@@ -120,7 +120,7 @@ pub fn write_quads_obj(
             writeln!(w, "mtllib {}", m.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default())?;
         }
         for c in &order {
-            writeln!(w, "v {} {} {}", o.x + c[0] as f64 * s, o.y + c[1] as f64 * s, o.z + c[2] as f64 * s)?;
+            writeln!(w, "v {} {} {}", o.x + c[0] as f64 * s.x, o.y + c[1] as f64 * s.y, o.z + c[2] as f64 * s.z)?;
         }
         let mut current = u32::MAX;
         for (class, f) in &faces {
@@ -169,7 +169,7 @@ pub fn write_quads_glb(
         n[q.axis] = if q.positive { 1.0 } else { -1.0 };
         let colour = palette.map(|p| p.get(class.wrapping_sub(1) as usize).copied().unwrap_or([255; 3]).map(|c| to_linear(c) as f32));
         for c in vs {
-            let p = [o.x + c[0] as f64 * s, o.y + c[1] as f64 * s, o.z + c[2] as f64 * s].map(|v| v as f32);
+            let p = [o.x + c[0] as f64 * s.x, o.y + c[1] as f64 * s.y, o.z + c[2] as f64 * s.z].map(|v| v as f32);
             for a in 0..3 {
                 lo[a] = lo[a].min(p[a]);
                 hi[a] = hi[a].max(p[a]);

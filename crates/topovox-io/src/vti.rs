@@ -3,11 +3,12 @@
 //! `flate2`); opens in ParaView and PyVista.
 //!
 //! Voxels are **cells**: `WholeExtent="0 nx 0 ny 0 nz"` (points), `Origin`
-//! = the grid origin, `Spacing` = the voxel size, cell `(i, j, k)` at index
+//! = the grid origin, `Spacing` = the voxel size per axis, cell `(i, j, k)` at index
 //! `i + nx·(j + ny·k)`. Cell arrays: `occupancy` (UInt8, 0/1), and when
 //! present `colour` (UInt8 × 3, sRGB), `material` (Int32, −1 for none and
 //! for empty cells),
-//! `coverage` (Float32, surface area inside the voxel / s²) and `normal`
+//! `coverage` (Float32, the surface area inside the voxel in index space:
+//! / s² for cubes) and `normal`
 //! (Float32 × 3); a distance field is one Float32 cell array
 //! `distance`, read back as its inside (negative cells). Each array is one appended block stream with a UInt64
 //! compression header (VTK's `vtkZLibDataCompressor` layout). Arrays are
@@ -222,8 +223,8 @@ fn head(grid: &GridSpec, scalars: &str) -> String {
     xml.push_str("<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\">\n");
     let extent = format!("0 {} 0 {} 0 {}", dims[0], dims[1], dims[2]);
     xml.push_str(&format!(
-        "  <ImageData WholeExtent=\"{extent}\" Origin=\"{:?} {:?} {:?}\" Spacing=\"{s:?} {s:?} {s:?}\">\n",
-        o.x, o.y, o.z
+        "  <ImageData WholeExtent=\"{extent}\" Origin=\"{:?} {:?} {:?}\" Spacing=\"{:?} {:?} {:?}\">\n",
+        o.x, o.y, o.z, s.x, s.y, s.z
     ));
     xml.push_str(&format!(
         "    <Piece Extent=\"{extent}\">\n      <PointData>\n      </PointData>\n      <CellData Scalars=\"{scalars}\">\n"
@@ -318,7 +319,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     let distance = (occ.0 == "distance" && ot == "Float32" && occ.2 == 1).then(|| {
         let values: Vec<f32> = occ.3.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes"))).collect();
         let signed = values.iter().any(|&v| v < 0.0);
-        let near = (0.5 * 3f64.sqrt() * spacing.iter().fold(0f64, |a, &b| a.max(b.abs()))) as f32;
+        let near = (0.5 * spacing.iter().map(|v| v * v).sum::<f64>().sqrt()) as f32;
         move |b: &[u8]| {
             let v = f32::from_le_bytes(b.try_into().expect("4 bytes"));
             if signed {
@@ -366,8 +367,10 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if let Some(n) = at("normal", "Float32", 3) {
         attrs.normal = Some(attrs.keys.iter().map(|&k| [0, 1, 2].map(|a| f32_at(n, 3 * k as usize + a))).collect());
     }
-    let placement = (spacing[0] == spacing[1] && spacing[1] == spacing[2] && spacing[0] > 0.0)
-        .then(|| (DVec3::new(origin[0], origin[1], origin[2]), spacing[0]));
+    let placement = spacing
+        .iter()
+        .all(|&v| v.is_finite() && v > 0.0)
+        .then(|| (DVec3::new(origin[0], origin[1], origin[2]), DVec3::new(spacing[0], spacing[1], spacing[2])));
     Ok(LoadedVoxels { bits, placement, attributes: Some(attrs) })
 }
 

@@ -14,7 +14,8 @@
 //! `sharding_indexed`: inner chunks of 64³ encoded by `bytes` then `gzip`
 //! (level 1), the index (`bytes`, little-endian) at the end of the shard,
 //! without a checksum. `dimension_names` are `["i", "j", "k"]`, and
-//! `attributes.topovox` holds the grid's `origin` and `voxel_size`. Element
+//! `attributes.topovox` holds the grid's `origin` and `voxel_size` (one
+//! number for cubes, `[sx, sy, sz]` for boxes). Element
 //! `[i, j, k]` is voxel `(i, j, k)` (C order, `k` fastest, as `.npy`).
 //! Chunks holding no set voxel are not written (the index marks them empty
 //! and the fill value stands for them), nor are shards without any, so a
@@ -83,7 +84,7 @@ const EMPTY: u64 = u64::MAX;
 /// The grid placement topovox records in `attributes.topovox`.
 fn placement(grid: &GridSpec) -> Value {
     let o = grid.origin();
-    json!({"topovox": {"origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size()}})
+    json!({"topovox": {"origin": [o.x, o.y, o.z], "voxel_size": crate::size_json(grid.size())}})
 }
 
 /// An array's metadata document: occupancy (`bool`), or an attribute with
@@ -878,12 +879,12 @@ fn decode_chunk_file(
 }
 
 /// The grid placement in `attributes.topovox`, when recorded.
-fn read_placement(attributes: &Value) -> Option<(glam::DVec3, f64)> {
+fn read_placement(attributes: &Value) -> Option<(glam::DVec3, glam::DVec3)> {
     let vk = match &attributes["topovox"] {
         Value::Null => &attributes[crate::former_name::ZARR_ATTRIBUTES],
         v => v,
     };
-    match (vk["origin"].as_array(), vk["voxel_size"].as_f64()) {
+    match (vk["origin"].as_array(), crate::size_from_json(&vk["voxel_size"])) {
         (Some(o), Some(s)) if o.len() == 3 && o.iter().all(|x| x.is_f64() || x.is_i64()) => {
             Some((glam::DVec3::new(o[0].as_f64().unwrap_or(0.0), o[1].as_f64().unwrap_or(0.0), o[2].as_f64().unwrap_or(0.0)), s))
         }
@@ -1084,7 +1085,7 @@ impl Elements {
             "float32" => {
                 let ours = &a.attributes["topovox"];
                 let unsigned = ours["distance"]["signed"] == json!(false);
-                let near = ours["voxel_size"].as_f64().filter(|s| s.is_finite() && *s > 0.0).map(|s| (0.5 * 3f64.sqrt() * s) as f32);
+                let near = crate::size_from_json(&ours["voxel_size"]).map(|s| (0.5 * s.length()) as f32);
                 match (unsigned, near) {
                     (false, _) => Ok(Elements::Distance(None)),
                     (true, Some(n)) => Ok(Elements::Distance(Some(n))),
@@ -1146,7 +1147,7 @@ mod tests {
         write(&out, &d, &grid, None, None).unwrap();
         let back = read(&out, &ReadOptions::default()).unwrap();
         assert_eq!(back.bits, d);
-        assert_eq!(back.placement, Some((grid.origin(), 0.25)));
+        assert_eq!(back.placement, Some((grid.origin(), glam::DVec3::splat(0.25))));
         // One shard (192 × 128 × 64 voxels) holds the whole grid.
         assert!(out.join("c/0/0/0").is_file() && !out.join("c/1").exists());
         // Writing again replaces the array; a non-Zarr directory is refused.
@@ -1261,7 +1262,7 @@ mod tests {
         assert!(out.join("colour/c/0/0/0/0").is_file() && out.join("coverage/c/0/0/0").is_file());
         let back = read(&out, &ReadOptions::default()).unwrap();
         assert_eq!(back.bits, d);
-        assert_eq!(back.placement, Some((grid.origin(), 0.125)));
+        assert_eq!(back.placement, Some((grid.origin(), glam::DVec3::splat(0.125))));
         assert_eq!(back.attributes.as_ref(), Some(&attrs));
         let sparse = read_sparse(&out, false, &ReadOptions::default()).unwrap();
         assert_eq!((sparse.bits.to_dense(), sparse.placement, sparse.attributes_left), (d.clone(), back.placement, true));

@@ -67,7 +67,7 @@ fn vti_round_trips_every_array() {
     write_voxels_with(&p, VoxelFormat::Vti, &b, &grid, Some(&a), &WriteOptions::default()).unwrap();
     let back = read_voxels(&p).unwrap();
     assert!(back.bits.first_difference(&b).is_none());
-    assert_eq!(back.placement, Some((grid.origin(), 0.25)));
+    assert_eq!(back.placement, Some((grid.origin(), glam::DVec3::splat(0.25))));
     assert_eq!(back.attributes.unwrap(), a);
     // Without attributes: occupancy only.
     write_voxels_with(&p, VoxelFormat::Vti, &b, &grid, None, &WriteOptions::default()).unwrap();

@@ -36,7 +36,7 @@ fn reads_as_recorded(name: &str) -> LoadedVoxels {
     assert!(got.bits.count() > 0, "{name}: no voxels");
     assert!(got.bits == want.bits, "{name}: voxels differ");
     // A `.vti` always has a placement: the unit grid where the file had none.
-    let unit = Some((glam::DVec3::ZERO, 1.0));
+    let unit = Some((glam::DVec3::ZERO, glam::DVec3::ONE));
     assert_eq!(got.placement.or(unit), want.placement, "{name}: placement");
     assert_eq!(with_arrays(&got), with_arrays(&want), "{name}: attributes");
     got

@@ -57,7 +57,7 @@ fn binvox_is_a_padded_cube_that_round_trips() {
     assert!(text.starts_with(b"#binvox 1\ndim 9 9 9\ntranslate 1 2 3\nscale 4.5\ndata\n"));
     let back = read_voxels(&p).unwrap();
     assert_eq!(back.bits.dims(), [9, 9, 9]);
-    assert_eq!(back.placement, Some((DVec3::new(1.0, 2.0, 3.0), 0.5)));
+    assert_eq!(back.placement, Some((DVec3::new(1.0, 2.0, 3.0), DVec3::splat(0.5))));
     let mut a = Vec::new();
     bits.for_each_set(|i, j, k| a.push([i, j, k]));
     let mut b = Vec::new();
@@ -187,7 +187,7 @@ fn npz_round_trips_and_refuses_hostile_archives() {
     write_voxels(&p, VoxelFormat::Npz, &bits, &grid).unwrap();
     let back = read_voxels(&p).unwrap();
     assert_eq!(back.bits, bits);
-    assert_eq!(back.placement, Some((DVec3::new(-1.0, 2.0, 0.5), 0.25)));
+    assert_eq!(back.placement, Some((DVec3::new(-1.0, 2.0, 0.5), DVec3::splat(0.25))));
     // Without a dense grid (grids past memory): the same voxels and placement.
     let sparse = topovox_io::read_voxels_sparse(std::path::Path::new(&p), false).unwrap();
     assert_eq!((sparse.bits.to_dense(), sparse.placement), (bits.clone(), back.placement));

@@ -349,7 +349,7 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
             let mut warnings = loaded.warnings.clone();
             warnings.extend(v.warnings.iter().cloned());
             Ok(json!({
-                "grid": {"origin": [o.x, o.y, o.z], "voxel_size": v.grid.voxel_size(), "dims": v.grid.dims()},
+                "grid": {"origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(v.grid.size()), "dims": v.grid.dims()},
                 "voxels": v.report.voxels,
                 "method": v.method,
                 "triangles": loaded.report.triangles,

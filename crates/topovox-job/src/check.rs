@@ -15,7 +15,7 @@ use crate::grid::{GridOptions, GridRequest};
 /// Returns the grid and where it came from (`options`, `file`, `inferred`).
 pub fn check_grid(
     dims: [u32; 3],
-    placement: Option<(glam::DVec3, f64)>,
+    placement: Option<(glam::DVec3, glam::DVec3)>,
     options: &GridOptions,
     bounds: &topovox::Aabb,
     voxels_name: &str,
@@ -111,7 +111,7 @@ fn to_json(report: &CheckReport, dims: [u32; 3], grid: Option<(&GridSpec, &str)>
         }),
         "grid": grid.map(|(g, source)| {
             let o = g.origin();
-            json!({"origin": [o.x, o.y, o.z], "voxel_size": g.voxel_size(), "dims": g.dims(), "source": source})
+            json!({"origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(g.size()), "dims": g.dims(), "source": source})
         }),
     })
 }

@@ -146,7 +146,7 @@ fn band_estimate(pieces: &Pieces, grid: &GridSpec, w: f64) -> u64 {
     let mut pairs = 0.0;
     for p in &pieces.items {
         let [a, b, c] = p.p;
-        area += 0.5 * (b - a).cross(c - a).length() / (h * h);
+        area += 0.5 * ((b - a) / h).cross((c - a) / h).length();
         let ext = (p.hi - p.lo) / h + glam::DVec3::splat(2.0 * w);
         pairs += ext.to_array().iter().map(|e| (e / 8.0).floor() + 2.0).product::<f64>();
     }
@@ -188,7 +188,8 @@ pub fn sdf(mesh: MeshRef<'_>, name: &str, req: &SdfRequest, stop: Option<&Stop>)
     let pieces = Pieces::of(mesh).map_err(|e| distance_error(name, e))?;
     let grid = req.grid.fit(&mesh.bounds())?;
     check_fits(name, req, &pieces, mesh, &grid)?;
-    let h = grid.voxel_size();
+    // The band's unit: the largest voxel edge (see `topovox::distance::band`).
+    let h = grid.voxel_size().max_element();
     let mut warnings = Vec::new();
     let mut facts = json!({"band": req.width.label(), "signed": !req.unsigned, "skipped": pieces.skipped});
     // The sign first: the solid of `--mode solid` with the same method.

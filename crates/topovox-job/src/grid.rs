@@ -3,7 +3,7 @@
 //! is read, fitted to its bounds after.
 
 use glam::DVec3;
-use topovox::{Aabb, GridSpec};
+use topovox::{Aabb, GridSpec, VoxelSize};
 
 use crate::error::{JobError, Result};
 use crate::invalid;
@@ -35,9 +35,9 @@ enum GridKind {
     /// Longest side spans N voxels.
     Resolution(u64),
     /// Fit to the bounding box with this voxel size.
-    VoxelSize(f64),
+    VoxelSize(VoxelSize),
     /// Fully explicit.
-    Explicit { origin: DVec3, voxel_size: f64, dims: [u64; 3] },
+    Explicit { origin: DVec3, voxel_size: VoxelSize, dims: [u64; 3] },
 }
 
 /// The grid options as a user gives them (CLI flags, Python keywords).
@@ -45,8 +45,8 @@ enum GridKind {
 pub struct GridOptions {
     /// Longest side of the mesh's bounding box in voxels.
     pub resolution: Option<u64>,
-    /// Voxel edge length.
-    pub voxel_size: Option<f64>,
+    /// Voxel edge length: one for cubes, or one per axis.
+    pub voxel_size: Option<VoxelSize>,
     /// Explicit origin (with `voxel_size` and `dims`).
     pub origin: Option<Vec<f64>>,
     /// Explicit dims (with `origin` and `voxel_size`).
@@ -102,7 +102,7 @@ impl GridRequest {
             return Ok(g);
         }
         let (p, s) = (self.pad as f64, g.voxel_size());
-        GridSpec::new(g.origin() - DVec3::splat(p * s), s, g.dims().map(|d| d as u64 + 2 * self.pad as u64))
+        GridSpec::new(g.origin() - p * s, g.size(), g.dims().map(|d| d as u64 + 2 * self.pad as u64))
             .map_err(|e| JobError::invalid(format!("invalid grid: {e}")))
     }
 
@@ -118,8 +118,17 @@ impl GridRequest {
         let s = box_grid.voxel_size();
         let side = box_grid.dims().into_iter().max().unwrap_or(1) as u64 + 2 * self.pad as u64;
         let centre = (bounds.min + bounds.max) * 0.5;
-        GridSpec::new(centre - DVec3::splat(side as f64 * s * 0.5), s, [side; 3])
+        GridSpec::new(centre - side as f64 * s * 0.5, box_grid.size(), [side; 3])
             .map_err(|e| JobError::invalid(format!("invalid grid: {e}")))
+    }
+
+    /// The voxel size asked for when it is not cubic (`--resolution` always
+    /// gives cubes): formats that only know cubes refuse it before any work.
+    pub fn boxes(&self) -> Option<VoxelSize> {
+        match self.kind {
+            GridKind::VoxelSize(s) | GridKind::Explicit { voxel_size: s, .. } => s.cube().is_none().then_some(s),
+            GridKind::Resolution(_) => None,
+        }
     }
 
     /// The explicit grid, if the request is one (it needs no mesh).
@@ -157,8 +166,8 @@ impl GridKind {
                 Ok(GridKind::Resolution(n))
             }
             (None, Some(s)) => {
-                if !(s.is_finite() && s > 0.0) {
-                    invalid!("invalid grid: {}", topovox::GridError::BadVoxelSize(s));
+                if let Some(&bad) = s.to_array().iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+                    invalid!("invalid grid: {}", topovox::GridError::BadVoxelSize(bad));
                 }
                 Ok(GridKind::VoxelSize(s))
             }
@@ -167,7 +176,7 @@ impl GridKind {
     }
 
     fn fit(&self, bounds: &Aabb) -> Result<GridSpec> {
-        let g = match *self {
+        let g = match self.clone() {
             GridKind::Resolution(n) => GridSpec::from_resolution(bounds, n),
             GridKind::VoxelSize(s) => GridSpec::from_voxel_size(bounds, s),
             GridKind::Explicit { origin, voxel_size, dims } => GridSpec::new(origin, voxel_size, dims),
@@ -181,6 +190,7 @@ mod cube_tests {
     use super::*;
 
     fn request(resolution: Option<u64>, voxel_size: Option<f64>, pad: u32) -> GridRequest {
+        let voxel_size = voxel_size.map(VoxelSize::from);
         GridRequest::new(&GridOptions { resolution, voxel_size, pad: Some(pad), fit: Some(Fit::Cube), ..GridOptions::default() }).unwrap()
     }
 
@@ -189,16 +199,17 @@ mod cube_tests {
         let b = Aabb { min: DVec3::new(-1.0, 2.0, 0.5), max: DVec3::new(3.0, 2.5, 1.5) };
         for (r, v, pad) in [(Some(32), None, 0), (Some(64), None, 3), (None, Some(0.3), 2), (Some(7), None, 3)] {
             let g = request(r, v, pad).fit(&b).unwrap();
+            let s = g.cube_size().unwrap();
             let [nx, ny, nz] = g.dims();
             assert!(nx == ny && ny == nz, "{:?}", g.dims());
             if let Some(n) = r {
                 assert_eq!(nx as u64, n);
                 // The longest side spans exactly N − 2·pad voxels.
-                assert!(((b.max.x - b.min.x) / g.voxel_size() - (n - 2 * pad as u64) as f64).abs() < 1e-9);
+                assert!(((b.max.x - b.min.x) / s - (n - 2 * pad as u64) as f64).abs() < 1e-9);
             }
-            let (lo, hi) = (g.origin(), g.origin() + DVec3::splat(nx as f64 * g.voxel_size()));
+            let (lo, hi) = (g.origin(), g.origin() + DVec3::splat(nx as f64 * s));
             assert!(((lo + hi) * 0.5 - (b.min + b.max) * 0.5).length() < 1e-9);
-            let margin = pad as f64 * g.voxel_size() - 1e-9;
+            let margin = pad as f64 * s - 1e-9;
             assert!((b.min - lo).min_element() >= margin && (hi - b.max).min_element() >= margin, "{r:?} {v:?} {pad}");
         }
         assert!(
@@ -206,11 +217,26 @@ mod cube_tests {
         );
         let explicit = GridOptions {
             origin: Some(vec![0.0; 3]),
-            voxel_size: Some(1.0),
+            voxel_size: Some(1.0.into()),
             dims: Some(vec![2; 3]),
             fit: Some(Fit::Cube),
             ..GridOptions::default()
         };
         assert!(GridRequest::new(&explicit).is_err());
+    }
+
+    #[test]
+    fn boxes_fit_and_pad_per_axis() {
+        let b = Aabb { min: DVec3::new(0.0, 0.0, 0.0), max: DVec3::new(1.4, 1.4, 5.0) };
+        let o = GridOptions { voxel_size: Some([0.7, 0.7, 2.5].into()), pad: Some(1), ..GridOptions::default() };
+        let r = GridRequest::new(&o).unwrap();
+        assert_eq!(r.boxes(), Some([0.7, 0.7, 2.5].into()));
+        let g = r.fit(&b).unwrap();
+        assert_eq!(g.dims(), [4, 4, 4]);
+        assert_eq!(g.origin(), DVec3::new(-0.7, -0.7, -2.5));
+        let bad = GridOptions { voxel_size: Some([0.7, -1.0, 2.5].into()), ..GridOptions::default() };
+        assert!(GridRequest::new(&bad).unwrap_err().to_string().contains("-1"));
+        let cubes = GridOptions { voxel_size: Some(0.5.into()), ..GridOptions::default() };
+        assert_eq!(GridRequest::new(&cubes).unwrap().boxes(), None);
     }
 }

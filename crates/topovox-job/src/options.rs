@@ -159,7 +159,7 @@ keywords! {
     "mode": Example::Text("sep6"), "the voxelization mode";
     "method": Example::Text("fast"), "the method (every method gives the mode's voxels)";
     "resolution": Example::Int(16), "the longest side of the bounding box spans N voxels";
-    "voxel_size": Example::Float(0.5), "the voxel edge; alone, the grid is fitted to the mesh";
+    "voxel_size": Example::Float(0.5), "the voxel edge, or (sx, sy, sz) per axis; alone, the grid is fitted to the mesh";
     "origin": Example::Numbers(&[-1.0, -1.0, -1.0]), "an explicit grid's origin (with voxel_size and dims)";
     "dims": Example::Numbers(&[8.0, 8.0, 8.0]), "an explicit grid's dims (with origin and voxel_size)";
     "pad": Example::Int(1), "empty voxels on every side of a fitted grid";
@@ -216,6 +216,16 @@ fn number(key: &str, v: &OptionValue) -> Result<f64> {
     }
 }
 
+/// One number (cubes) or three (a size per axis).
+fn voxel_size(key: &str, v: &OptionValue) -> Result<topovox::VoxelSize> {
+    match v {
+        OptionValue::Numbers(n) => Ok(<[f64; 3]>::try_from(numbers(key, v)?).unwrap_or([n[0]; 3]).into()),
+        v => number(key, v)
+            .map(topovox::VoxelSize::from)
+            .map_err(|_| JobError::invalid(format!("{key} must be a number or 3 numbers; got {}", shown(v)))),
+    }
+}
+
 fn numbers(key: &str, v: &OptionValue) -> Result<Vec<f64>> {
     match v {
         OptionValue::Numbers(n) if n.len() == 3 => Ok(n.clone()),
@@ -252,7 +262,7 @@ impl JobOptions {
             "mode" => self.mode = chosen(key, v)?,
             "method" => self.method = chosen(key, v)?,
             "resolution" => self.grid.resolution = Some(int(key, v, 1)?),
-            "voxel_size" => self.grid.voxel_size = Some(number(key, v)?),
+            "voxel_size" => self.grid.voxel_size = Some(voxel_size(key, v)?),
             "origin" => self.grid.origin = Some(numbers(key, v)?),
             "dims" => {
                 let d = numbers(key, v)?;
@@ -343,7 +353,7 @@ impl JobOptions {
             "mode": self.mode.name(),
             "method": self.method.name(),
             "resolution": g.resolution.or((!g.any()).then_some(128)),
-            "voxel_size": g.voxel_size,
+            "voxel_size": g.voxel_size.map(topovox_io::size_json),
             "origin": g.origin,
             "dims": g.dims,
             "pad": g.pad.unwrap_or(0),
@@ -376,6 +386,9 @@ impl JobOptions {
     /// The options of a batch writing `format`.
     pub fn batch(&self, format: Output) -> Result<BatchOptions> {
         let mut plan = self.plan()?;
+        if let Some(why) = plan.request.grid.boxes().and_then(|s| crate::output::refuses(format, s)) {
+            return Err(JobError::invalid(why));
+        }
         plan.request.writer_bytes_per_brick = crate::output::writer_bytes_per_brick(format);
         Ok(BatchOptions {
             plan,

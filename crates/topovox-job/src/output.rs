@@ -98,9 +98,14 @@ pub fn writer_bytes_per_brick(target: Output) -> u64 {
     }
 }
 
-/// Refuses a dense format for a grid that cannot be dense in the memory
-/// the run may use (`max_memory`, else nine tenths of what is available).
+/// Refuses a target that cannot hold `grid`, before any work: a format
+/// that only knows cubes for a grid of boxes, and a dense format for a grid
+/// that cannot be dense in the memory the run may use (`max_memory`, else
+/// nine tenths of what is available).
 pub fn check_fits(target: Output, grid: &GridSpec, max_memory: Option<u64>) -> Result<()> {
+    if let Some(why) = refuses(target, grid.size()) {
+        return Err(JobError::invalid(why));
+    }
     let budget = crate::memory::budget(max_memory);
     if is_sparse(target) || crate::memory::dense_fits(grid, budget) {
         return Ok(());
@@ -112,6 +117,15 @@ pub fn check_fits(target: Output, grid: &GridSpec, max_memory: Option<u64>) -> R
         crate::memory::bytes(budget),
         target.name()
     )))
+}
+
+/// Why `target` cannot store voxels of `size` (a cubes-only format and
+/// boxes); `None` when it can.
+pub fn refuses(target: Output, size: topovox::VoxelSize) -> Option<String> {
+    match target {
+        Output::Voxels(f) => f.refuses(size),
+        Output::Mesh(_) => None,
+    }
 }
 
 /// Every file writing `out` as `target` creates: the output, and for an

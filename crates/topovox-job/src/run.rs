@@ -317,7 +317,7 @@ impl Voxelized {
             "mode": plan.request.mode.name(),
             "method": self.method,
             "origin": [o.x, o.y, o.z],
-            "voxel_size": self.grid.voxel_size(),
+            "voxel_size": topovox_io::size_json(self.grid.size()),
             "dims": self.grid.dims(),
             "voxels": self.report.voxels,
             "voxelize_s": self.voxelize_s,

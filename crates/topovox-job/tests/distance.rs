@@ -11,7 +11,7 @@ use topovox::distance::reference;
 use topovox::Mesh;
 use topovox_job::distance::{sdf, write, DistanceFormat, Sdf, SdfRequest, Sign, Width};
 use topovox_job::{GridOptions, GridRequest, JobError, Method, Mode, Plan, Request};
-use topovox_testkit::{random_rotation, rng, rotated, shared_mesh, soup, sphere};
+use topovox_testkit::{box_grid, random_rotation, rng, rotated, shared_mesh, soup, sphere};
 
 fn request(resolution: u64, width: Width, sign: Sign, unsigned: bool) -> SdfRequest {
     let grid = GridRequest::new(&GridOptions { resolution: Some(resolution), pad: Some(2), ..GridOptions::default() }).unwrap();
@@ -33,7 +33,7 @@ fn assert_exact(mesh: &Mesh, s: &Sdf, what: &str) {
 /// [`assert_exact`] against reference distances `want` of the same grid.
 fn assert_close(want: &[f64], s: &Sdf, what: &str) {
     let got = s.field.dense();
-    let h = s.grid.voxel_size();
+    let h = s.grid.voxel_size().max_element();
     let bg = s.field.background as f64;
     for (n, (&g, &w)) in got.iter().zip(want).enumerate() {
         let g = g.abs() as f64;
@@ -53,7 +53,7 @@ fn assert_sign_is_solid(mesh: &Mesh, s: &Sdf, method: Method, what: &str) -> usi
         method,
         grid: GridRequest::new(&GridOptions {
             origin: Some(s.grid.origin().to_array().to_vec()),
-            voxel_size: Some(s.grid.voxel_size()),
+            voxel_size: Some(s.grid.size()),
             dims: Some(s.grid.dims().map(|d| d as u64).to_vec()),
             ..GridOptions::default()
         })
@@ -103,6 +103,36 @@ fn shared_meshes_match_the_reference_and_the_solid() {
         }
     }
     assert!(inside > 1000, "the signs were tested on {inside} inside voxels only");
+}
+
+/// Grids of boxes: distances in world units from each box's centre, the
+/// band at least `W` voxels deep along every axis, the sign the solid's,
+/// and the written files read back on the same grid.
+#[test]
+fn grids_of_boxes_keep_world_distances_and_the_solid_sign() {
+    let mut r = rng(43);
+    for name in ["suzanne.obj", "cow.obj"] {
+        let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
+        let sizes = box_grid(&mesh.as_ref().bounds(), 40, &mut r).voxel_size().to_array();
+        let grid = GridRequest::new(&GridOptions { voxel_size: Some(sizes.into()), pad: Some(2), ..GridOptions::default() }).unwrap();
+        let what = format!("{name} on sizes {sizes:?}");
+        let req = SdfRequest {
+            grid,
+            width: Width::Voxels(2.0),
+            unsigned: false,
+            sign: Sign::Winding,
+            max_memory: None,
+            format: DistanceFormat::Vdb,
+        };
+        let s = run(&mesh, &req, 2);
+        assert_eq!(s.grid.voxel_size().to_array(), sizes);
+        assert_exact(&mesh, &s, &what);
+        let largest = sizes.iter().fold(0f64, |a, &b| a.max(b));
+        assert_eq!(s.field.background, (2.0 * largest) as f32, "{what}: the band is measured in the largest edge");
+        assert!(assert_sign_is_solid(&mesh, &s, Method::Winding, &what) > 0, "{what}");
+        let all = run(&mesh, &SdfRequest { width: Width::All, ..req }, 2);
+        assert_exact(&mesh, &all, &format!("{what}, all"));
+    }
 }
 
 #[test]
@@ -205,8 +235,8 @@ fn written_fields_read_back_as_their_inside() {
     ] {
         let s = run(&mesh, &req, 2);
         let d = s.field.dense();
-        let h = s.grid.voxel_size() as f32;
-        let want: Vec<bool> = d.iter().map(|&v| if s.signed { v < 0.0 } else { v <= 0.5 * 3f32.sqrt() * h }).collect();
+        let near = (0.5 * s.grid.voxel_size().length()) as f32;
+        let want: Vec<bool> = d.iter().map(|&v| if s.signed { v < 0.0 } else { v <= near }).collect();
         assert!(want.iter().filter(|&&w| w).count() > 100, "{what}");
         for format in [DistanceFormat::Vdb, DistanceFormat::Npy, DistanceFormat::Zarr, DistanceFormat::Vti] {
             if format == DistanceFormat::Npy && !s.signed {

@@ -8,6 +8,7 @@
 
 use glam::DVec3;
 use proptest::prelude::*;
+use rand::Rng;
 use topovox::topology::certify;
 use topovox::voxelize::{self, Mode, Options};
 use topovox::{DenseBits, GridSpec, Mesh};
@@ -88,6 +89,22 @@ fn closed_shared_meshes_randomly_rotated() {
         let dims = (b.extent() / s).ceil().as_u64vec3() + 4;
         let grid = GridSpec::new(b.min - DVec3::splat(2.0 * s), s, dims.to_array()).unwrap();
         surface_guarantees(name, &mesh, &grid);
+    }
+}
+
+/// Grids of boxes (edges up to 1:8): every guarantee holds in index space,
+/// as the certifier checks it there.
+#[test]
+fn closed_shared_meshes_on_grids_of_boxes() {
+    let mut r = rng(0xb0c5);
+    for name in CLOSED {
+        let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
+        let b = mesh.as_ref().bounds();
+        let base = b.extent().max_element() / 40.0;
+        let s = DVec3::new(base * r.random_range(1.0..8.0), base * r.random_range(1.0..8.0), base);
+        let dims = (b.extent() / s).ceil().as_u64vec3() + 4;
+        let grid = GridSpec::new(b.min - 2.0 * s, s, dims.to_array()).unwrap();
+        surface_guarantees(&format!("{name} on sizes {}", grid.size()), &mesh, &grid);
     }
 }
 

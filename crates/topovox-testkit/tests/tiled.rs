@@ -283,8 +283,7 @@ fn sparse_flood_fill_equals_dense() {
     }
     let cow = rotated(&shared_mesh("cow.obj"), random_rotation(&mut r));
     let grid = GridSpec::from_resolution(&cow.as_ref().bounds(), 60).unwrap();
-    let wide = GridSpec::new(grid.origin() - DVec3::splat(grid.voxel_size() * 37.0), grid.voxel_size(), grid.dims().map(|d| d as u64 + 80))
-        .unwrap();
+    let wide = GridSpec::new(grid.origin() - grid.voxel_size() * 37.0, grid.voxel_size(), grid.dims().map(|d| d as u64 + 80)).unwrap();
     check(Mode::Cover, &cow, &wide, "rotated cow with room around it");
 }
 

@@ -160,8 +160,8 @@ impl Scene {
     }
 
     /// Adds a voxel grid's greedy quads, two triangles each, mapping grid
-    /// corner `c` to `origin + c · voxel_size`, all of `material`.
-    pub fn add_quads(&mut self, quads: &[Quad], origin: Vec3, voxel_size: f32, material: u32) {
+    /// corner `c` to `origin + c ∘ voxel_size` (a size per axis), all of `material`.
+    pub fn add_quads(&mut self, quads: &[Quad], origin: Vec3, voxel_size: Vec3, material: u32) {
         for q in quads {
             let c = q.corners().map(|c| origin + Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * voxel_size);
             // Wound so the normal points out of the solid side.

@@ -385,7 +385,7 @@ fn a_voxel_grid_drawn_by_the_gpu_covers_the_pixels_the_cpu_ray_caster_does() {
     let (bits, _) = topovox::voxelize::fast(topovox::voxelize::Mode::Cover, mesh.as_ref(), &grid, &Default::default());
     let mut scene = Scene::default();
     let m = scene.add_material(topovox_view::scene::ShadeMaterial::new([0.7; 3], [0.0; 3], 0.7));
-    scene.add_quads(&topovox::export::greedy::greedy_quads(&bits.to_dense()), Vec3::ZERO, 1.0, m);
+    scene.add_quads(&topovox::export::greedy::greedy_quads(&bits.to_dense()), Vec3::ZERO, Vec3::ONE, m);
     let g = r.upload(&scene).unwrap();
     let d = bits.dims();
     let size = glam::DVec3::new(d[0] as f64, d[1] as f64, d[2] as f64);

@@ -62,6 +62,6 @@ pub struct ReadmeDoctest;
 pub use geom::aabb::Aabb;
 pub use grid::bricks::BrickBits;
 pub use grid::dense::DenseBits;
-pub use grid::spec::{GridError, GridSpec};
+pub use grid::spec::{GridError, GridSpec, VoxelSize};
 pub use grid::VoxelSource;
 pub use mesh::{Mesh, MeshRef};

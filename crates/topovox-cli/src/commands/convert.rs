@@ -75,7 +75,7 @@ fn finish(
     a: &ConvertArgs,
     format: topovox_job::output::Output,
     bits: &dyn topovox::VoxelSource,
-    recorded: Option<(DVec3, f64)>,
+    recorded: Option<(DVec3, DVec3)>,
     attributes: Option<&topovox::attributes::VoxelAttributes>,
     write_opts: &topovox_io::WriteOptions,
     sparse: bool,
@@ -87,7 +87,7 @@ fn finish(
     if a.json {
         let o = grid.origin();
         let v = json!({"input": a.input, "output": a.output, "format": format.name(), "dims": dims, "voxels": voxels,
-            "origin": [o.x, o.y, o.z], "voxel_size": grid.voxel_size(), "grid_from": source, "export": facts, "sparse": sparse});
+            "origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(grid.size()), "grid_from": source, "export": facts, "sparse": sparse});
         return crate::console::print_stdout(&v.to_string());
     }
     if a.quiet {
@@ -107,8 +107,8 @@ fn finish(
 }
 
 /// The grid: what the input records, else the options, else unit voxels at the origin.
-fn placement(a: &ConvertArgs, dims: [u32; 3], recorded: Option<(DVec3, f64)>) -> Result<(GridSpec, &'static str)> {
-    let (origin, size, source) = match (recorded, &a.origin, a.voxel_size) {
+fn placement(a: &ConvertArgs, dims: [u32; 3], recorded: Option<(DVec3, DVec3)>) -> Result<(GridSpec, &'static str)> {
+    let (origin, size, source) = match (recorded, &a.origin, a.voxel_size.map(|s| s.0)) {
         (Some((o, s)), None, None) => (o, s, "input"),
         (placement, o, s) => {
             let origin = match o {
@@ -116,7 +116,7 @@ fn placement(a: &ConvertArgs, dims: [u32; 3], recorded: Option<(DVec3, f64)>) ->
                 Some(_) => bail!("--origin takes three comma-separated values X,Y,Z"),
                 None => placement.map(|p| p.0).unwrap_or(DVec3::ZERO),
             };
-            let size = s.or(placement.map(|p| p.1)).unwrap_or(1.0);
+            let size = s.or(placement.map(|p| p.1)).unwrap_or(DVec3::ONE);
             (origin, size, "options")
         }
     };

@@ -50,7 +50,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
         let mut j = sdf.facts.clone();
         let extra = json!({
             "origin": [o.x, o.y, o.z],
-            "voxel_size": g.voxel_size(),
+            "voxel_size": topovox_io::size_json(g.size()),
             "dims": dims,
             "load_s": load_s,
             "write_s": write_s,
@@ -83,7 +83,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
             o.x,
             o.y,
             o.z,
-            g.voxel_size(),
+            g.size(),
             sdf.facts["distance_s"].as_f64().unwrap_or(0.0) * 1e3,
             total_s,
             a.output.display()

@@ -88,6 +88,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let write_s = t_write.elapsed().as_secs_f64();
     if let Some((path, o)) = &preview {
         bar.phase("rendering the preview");
+        let o = &topovox::render::raycast::RenderOptions { voxel_shape: grid.voxel_size().to_array(), ..*o };
         let outline = a.picture.outline.then(|| crate::pictures::outline_triangles(loaded.mesh.as_ref(), &grid));
         match &v.voxels {
             topovox_job::Voxels::Sparse(sparse) => {
@@ -153,7 +154,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
                 o.x,
                 o.y,
                 o.z,
-                grid.voxel_size(),
+                grid.size(),
                 method,
                 v.voxelize_s * 1e3,
                 total_s,

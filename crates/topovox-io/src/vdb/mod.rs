@@ -6,10 +6,13 @@
 //! leaves). Every set voxel is an active voxel with value `true`; index
 //! coordinate `(i, j, k)` is topovox's voxel `(i, j, k)`. The transform is a
 //! `UniformScaleTranslateMap` taking index `(i, j, k)` to that voxel's
-//! centre: scale = voxel size, translation = grid origin + half a voxel.
+//! centre: scale = voxel size, translation = grid origin + half a voxel; a
+//! grid of boxes gets a `ScaleTranslateMap` with the size per axis (the same
+//! six vectors, which OpenVDB's `voxelSize()` gives back per axis).
 //! Grid metadata: `file_bbox_min`/`file_bbox_max`/`file_voxel_count` (as
 //! OpenVDB writes them), and `topovox_dims`, `topovox_origin`,
-//! `topovox_voxel_size`, which the reader uses to restore the exact grid.
+//! `topovox_voxel_size` (a `double`, a `vec3d` for boxes), which the reader
+//! uses to restore the exact grid.
 //! Full 8³ bricks are active tiles of their 16³ node (value `true`), and
 //! 16³ nodes whose 4096 bricks are all full are active tiles of 128³ in
 //! their 32³ node: a solid's interior costs bits per brick, not voxels.
@@ -226,15 +229,20 @@ fn put_grid_head(o: &mut dyn Out, g: &GridOut<'_>, grid: &GridSpec) -> std::io::
     entries.push(("name", "string", name.as_bytes().to_vec()));
     entries.push(("topovox_dims", "vec3i", vec3i(dims)));
     entries.push(("topovox_origin", "vec3d", vec3d(o_.to_array())));
-    entries.push(("topovox_voxel_size", "double", s.to_le_bytes().to_vec()));
+    entries.push(match grid.cube_size() {
+        Some(c) => ("topovox_voxel_size", "double", c.to_le_bytes().to_vec()),
+        None => ("topovox_voxel_size", "vec3d", vec3d(s.to_array())),
+    });
     o.put(&(entries.len() as u32).to_le_bytes())?;
     for (n, t, v) in &entries {
         put_meta(o, n, t, v)?;
     }
-    put_str(o, "UniformScaleTranslateMap")?;
-    let t = o_ + DVec3::splat(0.5 * s);
-    for v in [[t.x, t.y, t.z], [s; 3], [s; 3], [1.0 / s; 3], [1.0 / (s * s); 3], [0.5 / s; 3]] {
-        o.put(&vec3d(v))?;
+    // OpenVDB's `ScaleTranslateMap::write` order: translation, scale, voxel
+    // size, 1/scale, 1/scale², 1/(2·scale); the uniform map is the same.
+    put_str(o, if grid.cube_size().is_some() { "UniformScaleTranslateMap" } else { "ScaleTranslateMap" })?;
+    let t = o_ + 0.5 * s;
+    for v in [t, s, s, 1.0 / s, 1.0 / (s * s), 0.5 / s] {
+        o.put(&vec3d(v.to_array()))?;
     }
     Ok(())
 }
@@ -494,7 +502,13 @@ fn put_bool_leaves(o: &mut dyn Out, tree: &Tree) -> std::io::Result<()> {
 /// A deterministic UUID-shaped identifier of the contents.
 fn uuid(grid: &GridSpec, count: u64) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for v in grid.dims().iter().map(|&d| d as u64).chain([count, grid.voxel_size().to_bits()]) {
+    let s = grid.voxel_size();
+    // A cube's one size, as before boxes, so cubic files keep their identifier.
+    let sizes = match grid.cube_size() {
+        Some(c) => vec![c.to_bits()],
+        None => vec![s.x.to_bits(), s.y.to_bits(), s.z.to_bits()],
+    };
+    for v in grid.dims().iter().map(|&d| d as u64).chain([count]).chain(sizes) {
         h = (h ^ v).wrapping_mul(0x0100_0000_01b3);
     }
     let g = h.wrapping_mul(0x9e37_79b9_7f4a_7c15);
@@ -1158,7 +1172,7 @@ struct Occupancy {
     tiles: Vec<([i64; 3], i64)>,
     offset: [i64; 3],
     dims: [u32; 3],
-    placement: Option<(DVec3, f64)>,
+    placement: Option<(DVec3, DVec3)>,
 }
 
 impl Occupancy {
@@ -1306,7 +1320,7 @@ fn read_grid(c: &mut Cur<'_>, distance: bool) -> Result<Occupancy, ErrorKind> {
         // A level set's inside: its negative values; an unsigned field's
         // voxels within half a voxel diagonal of the surface.
         let level_set = find("class").is_some_and(|c| c == b"level set");
-        let near = 0.5 * 3f64.sqrt() * scale[0].abs();
+        let near = 0.5 * DVec3::from(scale).length();
         let test = move |v: f32| if level_set { v < 0.0 } else { (v as f64) <= near };
         read_level_set(c, mask_compressed, &test)?
     } else {
@@ -1342,16 +1356,17 @@ fn read_grid(c: &mut Cur<'_>, distance: bool) -> Result<Occupancy, ErrorKind> {
         let d: [f64; 3] = std::array::from_fn(|a| f64::from_le_bytes(v[8 * a..8 * a + 8].try_into().expect("8 bytes")));
         DVec3::from(d)
     });
-    let size_meta = get("topovox_voxel_size").filter(|v| v.len() == 8).map(|v| f64::from_le_bytes(v[..8].try_into().expect("8 bytes")));
-    let uniform = scale[0] == scale[1] && scale[1] == scale[2] && scale[0] > 0.0 && scale[0].is_finite();
+    // A `double` for cubes, a `vec3d` for boxes.
+    let size_meta = get("topovox_voxel_size").and_then(|v| match v.len() {
+        8 => Some(DVec3::splat(f64::from_le_bytes(v[..8].try_into().expect("8 bytes")))),
+        24 => Some(DVec3::from(std::array::from_fn::<f64, 3, _>(|a| f64::from_le_bytes(v[8 * a..8 * a + 8].try_into().expect("8 bytes"))))),
+        _ => None,
+    });
+    let scale = DVec3::from(scale);
     let placement = match (origin_meta, size_meta) {
         (Some(o), Some(s)) if dims_meta.is_some() => Some((o, s)),
-        _ if uniform => {
-            let s = scale[0];
-            Some((
-                DVec3::from(translation) + DVec3::new(offset[0] as f64, offset[1] as f64, offset[2] as f64) * s - DVec3::splat(0.5 * s),
-                s,
-            ))
+        _ if scale.is_finite() && scale.min_element() > 0.0 => {
+            Some((DVec3::from(translation) + DVec3::new(offset[0] as f64, offset[1] as f64, offset[2] as f64) * scale - 0.5 * scale, scale))
         }
         _ => None,
     };
@@ -1376,7 +1391,7 @@ mod tests {
         let back = read(&buf).unwrap();
         assert_eq!(back.bits, d);
         let (o, s) = back.placement.unwrap();
-        assert_eq!((o, s), (grid.origin(), 0.25));
+        assert_eq!((o, s), (grid.origin(), DVec3::splat(0.25)));
         // Every truncation is an error, never a panic.
         for n in (0..buf.len()).step_by(97) {
             assert!(read(&buf[..n]).is_err() && read_sparse(&buf[..n], true).is_err());

@@ -5,7 +5,12 @@
 //! surface mode — all subsets of `cover` — is reached). Each voxel box then
 //! clips the triangle (Sutherland–Hodgman, f64, grid units) and the part
 //! inside is what the voxel gets:
-//! - **coverage**: the clipped polygon's area, in units of the voxel face;
+//! - **coverage**: the clipped polygon's area in index space (each axis in
+//!   units of its voxel edge), so a piece spanning the voxel parallel to a
+//!   face has coverage 1 whichever face it is; on a box grid that is the
+//!   world area divided by the area of the voxel's cross-section in the
+//!   piece's plane direction, `|(sy·sz·nx, sx·sz·ny, sx·sy·nz)|` for its
+//!   index-space unit normal `n` (for cubes, `s²`);
 //! - **colour**: the clipped polygon is sampled on a regular barycentric
 //!   subdivision fine enough to visit every texel it covers (nearest-texel
 //!   lookups, up to 24² samples per fan triangle), each sample weighted by
@@ -14,7 +19,9 @@
 //!   colours of the source; [`ColourRule::Blend`] takes the area-weighted
 //!   mean in linear light;
 //! - **material**: the material with the most area (ties: the smaller id);
-//! - **normal**: the area-weighted mean of the triangles' unit normals.
+//! - **normal**: the coverage-weighted mean of the triangles' world-space
+//!   unit normals (on box grids, the index-space normal times the inverse
+//!   transpose of the world-to-index map).
 //!
 //! A voxel that a triangle only touches (zero area inside) uses that touch
 //! as a point sample, and only when no triangle has area inside it. Voxels
@@ -405,8 +412,14 @@ impl<'a> Ctx<'a> {
         p.iter().all(|q| q.is_finite()).then_some(p)
     }
 
+    /// The world-space unit normal: the index-space normal `n` taken back
+    /// by the inverse transpose of `u = (p - origin) / s`, which is `n / s`.
     fn unit_normal(&self, t: usize) -> DVec3 {
-        self.corners(t).map(|p| (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero()).unwrap_or(DVec3::ZERO)
+        let n = self.corners(t).map(|p| (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero()).unwrap_or(DVec3::ZERO);
+        match self.grid.cube_size() {
+            Some(_) => n,
+            None => (n / self.grid.voxel_size()).normalize_or_zero(),
+        }
     }
 
     /// The contributions of one slab: its binned lattice triangles (indices

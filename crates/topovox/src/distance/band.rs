@@ -150,11 +150,11 @@ pub(crate) fn centre_range(grid: &GridSpec, lo: DVec3, hi: DVec3) -> Option<([u3
 }
 
 /// The narrow band of `pieces` on `grid`: the voxels whose centres lie
-/// nearer than `width` voxels (`width · voxel size` in world units) to the
-/// mesh. `None` when `stop` was requested.
+/// nearer than `width` voxels (`width · h` in world units, `h` the largest
+/// voxel edge, so a box grid's band is at least `width` voxels deep along
+/// every axis) to the mesh. `None` when `stop` was requested.
 pub fn band(pieces: &Pieces, grid: &GridSpec, width: f64, stop: &Stop) -> Option<Band> {
-    let h = grid.voxel_size();
-    let radius = width * h;
+    let radius = width * grid.voxel_size().max_element();
     let bins = bin(pieces, grid, radius);
     if stop.requested() {
         return None;
@@ -190,7 +190,7 @@ pub fn band(pieces: &Pieces, grid: &GridSpec, width: f64, stop: &Stop) -> Option
 fn bin(pieces: &Pieces, grid: &GridSpec, radius: f64) -> Vec<(u64, u32)> {
     let h = grid.voxel_size();
     // A brick's centres lie within this of the brick's centre.
-    let half_diagonal = 3.5 * h * 3f64.sqrt();
+    let half_diagonal = 3.5 * h.length();
     let mut bins: Vec<(u64, u32)> = pieces
         .items
         .par_iter()
@@ -204,7 +204,7 @@ fn bin(pieces: &Pieces, grid: &GridSpec, radius: f64) -> Vec<(u64, u32)> {
                 for bk in blo[2]..=bhi[2] {
                     for bj in blo[1]..=bhi[1] {
                         for bi in blo[0]..=bhi[0] {
-                            let c = grid.voxel_min([bi * 8, bj * 8, bk * 8]) + DVec3::splat(4.0 * h);
+                            let c = grid.voxel_min([bi * 8, bj * 8, bk * 8]) + 4.0 * h;
                             if p.distance_squared(c) <= reach * reach * (1.0 + 1e-9) {
                                 out.push((key([bi, bj, bk]), n as u32));
                             }
@@ -242,11 +242,11 @@ fn brick(pieces: &Pieces, ids: impl Iterator<Item = usize>, grid: &GridSpec, at:
     let size: [usize; 3] = std::array::from_fn(|a| (dims[a] - origin[a]).min(8) as usize);
     // The centres' coordinates, as `GridSpec::voxel_center` computes them.
     let (o, h) = (grid.origin(), grid.voxel_size());
-    let axis = |a: usize| -> [f64; 8] { std::array::from_fn(|x| o[a] + (origin[a] + x as u32) as f64 * h + 0.5 * h) };
+    let axis = |a: usize| -> [f64; 8] { std::array::from_fn(|x| o[a] + (origin[a] + x as u32) as f64 * h[a] + 0.5 * h[a]) };
     let (xs, ys, zs) = (axis(0), axis(1), axis(2));
     // Nearest pieces first: their distances make the box test below turn
     // most farther pieces away before any exact distance is computed.
-    let centre = grid.voxel_min(origin) + DVec3::splat(4.0 * h);
+    let centre = grid.voxel_min(origin) + 4.0 * h;
     let mut ids: Vec<(f64, usize)> = ids.map(|n| (pieces.items[n].distance_squared(centre), n)).collect();
     ids.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let gap = |lo: f64, hi: f64, c: f64| {

@@ -1,4 +1,9 @@
-//! The grid specification: origin, voxel size and dims.
+//! The grid specification: origin, voxel size per axis and dims.
+//!
+//! Voxels are boxes `s = (sx, sy, sz)`; cubes are the case `sx = sy = sz`.
+//! Every algorithm works in *index space*, `u = (p - origin) / s` per axis,
+//! where a voxel is the unit cube `[i, i+1] × [j, j+1] × [k, k+1]`: each
+//! mode's definition, tie rule and guarantee hold there exactly as for cubes.
 
 use glam::DVec3;
 
@@ -11,7 +16,7 @@ pub const MAX_DIM: u32 = 65_536;
 /// Why a grid could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GridError {
-    /// Voxel size zero, negative, NaN or infinite.
+    /// Voxel size zero, negative, NaN or infinite (on some axis).
     #[error("voxel size must be a positive finite number, got {0}")]
     BadVoxelSize(f64),
     /// Origin has a NaN or infinite coordinate.
@@ -21,10 +26,10 @@ pub enum GridError {
     #[error("grid dims must each be between 1 and {MAX_DIM}, got {0:?}")]
     BadDims([u64; 3]),
     /// A voxel size so small that some axis would need more than [`MAX_DIM`] voxels.
-    #[error("voxel size {voxel_size:e} would need {:.3e} x {:.3e} x {:.3e} voxels; at most {MAX_DIM} per axis", needed[0], needed[1], needed[2])]
+    #[error("voxel size {voxel_size} would need {:.3e} x {:.3e} x {:.3e} voxels; at most {MAX_DIM} per axis", needed[0], needed[1], needed[2])]
     VoxelSizeTooSmall {
         /// The voxel size asked for.
-        voxel_size: f64,
+        voxel_size: VoxelSize,
         /// Voxels each axis would need.
         needed: [f64; 3],
     },
@@ -39,29 +44,76 @@ pub enum GridError {
     ZeroExtent,
 }
 
+/// A voxel's edge lengths along x, y and z; one number for cubes.
+///
+/// Built from an `f64` (a cube), a `[f64; 3]` or a [`DVec3`]. Displays as
+/// the one number for cubes and as `sx,sy,sz` otherwise, the form
+/// `--voxel-size` takes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VoxelSize(pub DVec3);
+
+impl VoxelSize {
+    /// The edge length when all three are equal (bit for bit).
+    pub fn cube(self) -> Option<f64> {
+        let s = self.0;
+        (s.x == s.y && s.y == s.z).then_some(s.x)
+    }
+
+    /// The three edge lengths.
+    pub fn to_array(self) -> [f64; 3] {
+        self.0.to_array()
+    }
+}
+
+impl From<f64> for VoxelSize {
+    fn from(s: f64) -> VoxelSize {
+        VoxelSize(DVec3::splat(s))
+    }
+}
+
+impl From<[f64; 3]> for VoxelSize {
+    fn from(s: [f64; 3]) -> VoxelSize {
+        VoxelSize(DVec3::from(s))
+    }
+}
+
+impl From<DVec3> for VoxelSize {
+    fn from(s: DVec3) -> VoxelSize {
+        VoxelSize(s)
+    }
+}
+
+impl std::fmt::Display for VoxelSize {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.cube() {
+            Some(s) => write!(f, "{s}"),
+            None => write!(f, "{},{},{}", self.0.x, self.0.y, self.0.z),
+        }
+    }
+}
+
 /// Where the voxels are.
 ///
 /// Voxel `(i, j, k)` is the **closed** box
-/// `[origin + (i,j,k)·s, origin + (i+1,j+1,k+1)·s]` with `s = voxel_size`,
-/// for `0 <= i < dims[0]` and so on. Neighbouring voxels share their faces.
+/// `[origin + (i,j,k)∘s, origin + (i+1,j+1,k+1)∘s]` with `s = voxel_size`
+/// per axis (`∘` multiplies component by component), for `0 <= i < dims[0]`
+/// and so on. Neighbouring voxels share their faces.
 ///
 /// # Guarantees
 /// Built only through [`GridSpec::new`], [`GridSpec::from_resolution`] or
-/// [`GridSpec::from_voxel_size`]: origin finite, `voxel_size > 0` finite,
-/// `1 <= dims[a] <= MAX_DIM`.
+/// [`GridSpec::from_voxel_size`]: origin finite, each voxel size `> 0`
+/// finite, `1 <= dims[a] <= MAX_DIM`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridSpec {
     origin: DVec3,
-    voxel_size: f64,
+    voxel_size: DVec3,
     dims: [u32; 3],
 }
 
 impl GridSpec {
-    /// An explicit grid.
-    pub fn new(origin: DVec3, voxel_size: f64, dims: [u64; 3]) -> Result<GridSpec, GridError> {
-        if !(voxel_size.is_finite() && voxel_size > 0.0) {
-            return Err(GridError::BadVoxelSize(voxel_size));
-        }
+    /// An explicit grid; `voxel_size` is one number (cubes) or three.
+    pub fn new(origin: DVec3, voxel_size: impl Into<VoxelSize>, dims: [u64; 3]) -> Result<GridSpec, GridError> {
+        let voxel_size = checked_size(voxel_size.into())?;
         if !origin.is_finite() {
             return Err(GridError::BadOrigin(origin.to_array()));
         }
@@ -89,16 +141,15 @@ impl GridSpec {
         GridSpec::new(bounds.min, s, dims)
     }
 
-    /// Fits a grid of voxel size `s` to `bounds`: `origin = bounds.min`,
-    /// `dims = max(1, ceil(extent / s))` on each axis.
-    pub fn from_voxel_size(bounds: &Aabb, s: f64) -> Result<GridSpec, GridError> {
-        if !(s.is_finite() && s > 0.0) {
-            return Err(GridError::BadVoxelSize(s));
-        }
+    /// Fits a grid of voxel size `s` (one number or three) to `bounds`:
+    /// `origin = bounds.min`, `dims = max(1, ceil(extent / s))` on each axis.
+    pub fn from_voxel_size(bounds: &Aabb, s: impl Into<VoxelSize>) -> Result<GridSpec, GridError> {
+        let size = s.into();
+        let s = checked_size(size)?;
         let ext = checked_extent(bounds)?;
-        let needed = ext.to_array().map(|e| (e / s).ceil());
+        let needed = (ext / s).to_array().map(f64::ceil);
         if needed.iter().any(|&d| d > MAX_DIM as f64) {
-            return Err(GridError::VoxelSizeTooSmall { voxel_size: s, needed });
+            return Err(GridError::VoxelSizeTooSmall { voxel_size: size, needed });
         }
         let dims = needed.map(|d| (d as u64).max(1));
         GridSpec::new(bounds.min, s, dims)
@@ -109,9 +160,19 @@ impl GridSpec {
         self.origin
     }
 
-    /// Edge length of a voxel.
-    pub fn voxel_size(&self) -> f64 {
+    /// A voxel's edge lengths along x, y, z.
+    pub fn voxel_size(&self) -> DVec3 {
         self.voxel_size
+    }
+
+    /// The voxel size as given: one number for cubes, three otherwise.
+    pub fn size(&self) -> VoxelSize {
+        VoxelSize(self.voxel_size)
+    }
+
+    /// The edge length when voxels are cubes; `None` for boxes.
+    pub fn cube_size(&self) -> Option<f64> {
+        self.size().cube()
     }
 
     /// Voxels along x, y, z.
@@ -130,7 +191,7 @@ impl GridSpec {
         words_per_row * self.dims[1] as u64 * self.dims[2] as u64 * 8
     }
 
-    /// `(p - origin) / voxel_size`: position in voxel units.
+    /// `(p - origin) / voxel_size` per axis: position in index space.
     #[inline]
     pub fn to_grid_units(&self, p: DVec3) -> DVec3 {
         (p - self.origin) / self.voxel_size
@@ -143,7 +204,25 @@ impl GridSpec {
 
     /// World position of voxel `(i,j,k)`'s centre.
     pub fn voxel_center(&self, ijk: [u32; 3]) -> DVec3 {
-        self.voxel_min(ijk) + DVec3::splat(0.5 * self.voxel_size)
+        self.voxel_min(ijk) + 0.5 * self.voxel_size
+    }
+
+    /// World position of index-space point `u`: `origin + u ∘ voxel_size`.
+    #[inline]
+    pub fn to_world(&self, u: DVec3) -> DVec3 {
+        self.origin + u * self.voxel_size
+    }
+
+    /// This grid's voxels `factor` times as large on every axis (the same origin).
+    pub fn scaled(&self, factor: f64, dims: [u64; 3]) -> Result<GridSpec, GridError> {
+        GridSpec::new(self.origin, self.voxel_size * factor, dims)
+    }
+}
+
+fn checked_size(s: VoxelSize) -> Result<DVec3, GridError> {
+    match s.to_array().into_iter().find(|v| !(v.is_finite() && *v > 0.0)) {
+        Some(bad) => Err(GridError::BadVoxelSize(bad)),
+        None => Ok(s.0),
     }
 }
 
@@ -166,7 +245,7 @@ mod tests {
     fn resolution_fits_longest_side() {
         let g = GridSpec::from_resolution(&bbox([0.0; 3], [2.0, 1.0, 0.5]), 8).unwrap();
         assert_eq!(g.dims(), [8, 4, 2]);
-        assert_eq!(g.voxel_size(), 0.25);
+        assert_eq!(g.cube_size(), Some(0.25));
     }
 
     #[test]
@@ -194,5 +273,19 @@ mod tests {
         assert!(GridSpec::from_resolution(&bbox([1.0; 3], [1.0; 3]), 4).is_err());
         assert!(GridSpec::new(DVec3::ZERO, 1.0, [0, 1, 1]).is_err());
         assert!(GridSpec::new(DVec3::NAN, 1.0, [1, 1, 1]).is_err());
+        assert!(GridSpec::new(DVec3::ZERO, [1.0, 0.0, 1.0], [1, 1, 1]).is_err());
+        assert!(GridSpec::new(DVec3::ZERO, [1.0, 1.0, f64::INFINITY], [1, 1, 1]).is_err());
+        assert!(GridSpec::from_voxel_size(&b, [0.5, 1e-12, 0.5]).is_err());
+    }
+
+    #[test]
+    fn boxes_fit_per_axis() {
+        let g = GridSpec::from_voxel_size(&bbox([0.0; 3], [1.4, 1.4, 5.0]), [0.7, 0.7, 2.5]).unwrap();
+        assert_eq!(g.dims(), [2, 2, 2]);
+        assert_eq!(g.cube_size(), None);
+        assert_eq!(g.to_grid_units(DVec3::new(0.7, 1.4, 2.5)), DVec3::new(1.0, 2.0, 1.0));
+        assert!((g.voxel_center([1, 0, 1]) - DVec3::new(1.05, 0.35, 3.75)).length() < 1e-12);
+        assert_eq!(g.size().to_string(), "0.7,0.7,2.5");
+        assert_eq!(VoxelSize::from(0.5).to_string(), "0.5");
     }
 }

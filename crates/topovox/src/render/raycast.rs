@@ -143,11 +143,14 @@ pub struct RenderOptions {
     pub up: usize,
     /// Linear RGB of the voxels.
     pub colour: [f64; 3],
+    /// A voxel's edge lengths along x, y, z (only their ratios matter), so a
+    /// box grid is drawn in its world proportions; `[1, 1, 1]` for cubes.
+    pub voxel_shape: [f64; 3],
 }
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { width: 1024, height: 768, view: View::Iso, up: 1, colour: [0.62, 0.55, 0.46] }
+        RenderOptions { width: 1024, height: 768, view: View::Iso, up: 1, colour: [0.62, 0.55, 0.46], voxel_shape: [1.0; 3] }
     }
 }
 
@@ -175,7 +178,9 @@ pub struct Hit {
     pub axis: usize,
 }
 
-/// The camera: orthographic, framing the grid's bounding sphere.
+/// The camera: orthographic, framing the grid's bounding sphere. It works
+/// in *shape space* (index space times the voxel shape, the world up to one
+/// factor); rays are handed out, and triangles taken in, in index space.
 struct Camera {
     forward: DVec3,
     right: DVec3,
@@ -183,6 +188,7 @@ struct Camera {
     centre: DVec3,
     radius: f64,
     scale: f64,
+    shape: DVec3,
 }
 
 fn unit(a: usize) -> DVec3 {
@@ -207,18 +213,31 @@ impl Camera {
         let reference_up = if forward.dot(world_up).abs() > 0.999 { front } else { world_up };
         let right = forward.cross(reference_up).normalize();
         let up = right.cross(forward).normalize();
-        let size = DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64);
+        let shape = voxel_shape(o.voxel_shape);
+        let size = DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64) * shape;
         let radius = 0.5 * size.length().max(1.0);
         let scale = 2.0 * radius * 1.02 / o.width.min(o.height).max(1) as f64;
-        Camera { forward, right, up, centre: size * 0.5, radius, scale }
+        Camera { forward, right, up, centre: size * 0.5, radius, scale, shape }
     }
 
-    /// The ray through the centre of pixel `(x, y)` (row 0 at the top).
+    /// The ray through the centre of pixel `(x, y)` (row 0 at the top), in
+    /// index space.
     fn ray(&self, x: u32, y: u32, w: u32, h: u32) -> (DVec3, DVec3) {
         let sx = (x as f64 + 0.5 - w as f64 * 0.5) * self.scale;
         let sy = (h as f64 * 0.5 - y as f64 - 0.5) * self.scale;
         let origin = self.centre + self.right * sx + self.up * sy - self.forward * (self.radius + 1.0);
-        (origin, self.forward)
+        (origin / self.shape, self.forward / self.shape)
+    }
+}
+
+/// The voxel shape scaled so its smallest edge is 1; cubes for a shape
+/// that is not three positive finite numbers.
+fn voxel_shape(s: [f64; 3]) -> DVec3 {
+    let s = DVec3::from(s);
+    if s.is_finite() && s.min_element() > 0.0 {
+        s / s.min_element()
+    } else {
+        DVec3::ONE
     }
 }
 
@@ -268,7 +287,7 @@ pub fn render_grid(grid: &RenderGrid<'_>, o: &RenderOptions, colours: Option<&Vo
 fn silhouette(cam: &Camera, tris: &[[DVec3; 3]], w: u32, h: u32) -> Vec<bool> {
     let mut mask = vec![false; w as usize * h as usize];
     let project = |p: DVec3| {
-        let d = p - cam.centre;
+        let d = p * cam.shape - cam.centre;
         (d.dot(cam.right) / cam.scale + w as f64 * 0.5 - 0.5, h as f64 * 0.5 - 0.5 - d.dot(cam.up) / cam.scale)
     };
     for t in tris {

@@ -37,7 +37,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         bail!("--camera, --frames, --repeat, --culling, --prepass, --gamma, --light-grid and --stats-json belong to the GPU renderer; add --gpu");
     }
     let t0 = Instant::now();
-    let o = options(&a.picture, a.up)?;
+    let mut o = options(&a.picture, a.up)?;
     check_png_path(&a.output)?;
     let pool = crate::pool::thread_pool(a.threads)?;
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.input))?;
@@ -49,7 +49,10 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         let up = a.up.unwrap_or_default();
         use topovox_io::VoxelFormat as F;
         match topovox_io::read_voxels_opts(&a.input, up, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths }) {
-            Ok(loaded) => (Box::new(loaded.bits), "voxel file", loaded.attributes, None),
+            Ok(loaded) => {
+                o.voxel_shape = shape(loaded.placement);
+                (Box::new(loaded.bits), "voxel file", loaded.attributes, None)
+            }
             // A .vdb, .zarr or .npz grid past memory: drawn from its bricks.
             Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && F::from_path(&a.input).is_some_and(F::reads_sparsely) => {
                 let sparse = topovox_io::read_voxels_sparse_opts(
@@ -60,6 +63,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
                 if sparse.attributes_left {
                     eprintln!("topovox: warning: {}: drawn without its colours: the grid does not fit densely", a.input.display());
                 }
+                o.voxel_shape = shape(sparse.placement);
                 let img = pool.install(|| picture_sparse(&sparse.bits, &a.output, &o, None, None))?;
                 return summary(a, &img, "voxel file", &sparse.bits, t0);
             }
@@ -72,6 +76,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         topovox_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
         let grid = plan::grid_request(&a.grid)?.fit(&loaded.report.bounds)?;
         plan::check_memory(&grid)?;
+        o.voxel_shape = grid.voxel_size().to_array();
         for w in &loaded.warnings {
             eprintln!("topovox: warning: {}: {w}", a.input.display());
         }
@@ -85,6 +90,12 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     };
     let img = pool.install(|| picture(bits.as_ref(), &a.output, &o, colours.as_ref(), outline.as_deref()))?;
     summary(a, &img, what, bits.as_ref(), t0)
+}
+
+/// A file's voxel shape (boxes drawn in their proportions); cubes when it
+/// records none.
+fn shape(placement: Option<(topovox::glam::DVec3, topovox::glam::DVec3)>) -> [f64; 3] {
+    placement.map_or([1.0; 3], |p| p.1.to_array())
 }
 
 /// Prints what `render` drew.
