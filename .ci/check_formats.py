@@ -70,6 +70,17 @@ with tempfile.TemporaryDirectory() as d:
     cells = img.GetCellData()
     vocc = vtk_to_numpy(cells.GetArray("occupancy")).reshape(nz, ny, nx).transpose(2, 1, 0)
     check("vti occupancy = npy", np.array_equal(vocc.astype(bool), occ))
+    # A voxel size per axis: VTK's Spacing, and the voxels of the .npy.
+    boxes = voxelize(spot, d / "b.npy", "--voxel-size", "0.02,0.035,0.05", "--mode", "sep6")
+    voxelize(spot, d / "b.vti", "--voxel-size", "0.02,0.035,0.05", "--mode", "sep6")
+    rb = vtk.vtkXMLImageDataReader()
+    rb.SetFileName(str(d / "b.vti"))
+    rb.Update()
+    bimg = rb.GetOutput()
+    bx, by, bz = boxes["dims"]
+    bocc = vtk_to_numpy(bimg.GetCellData().GetArray("occupancy")).reshape(bz, by, bx).transpose(2, 1, 0)
+    check("vti of boxes: VTK's spacing per axis", np.allclose(bimg.GetSpacing(), boxes["voxel_size"]) and boxes["voxel_size"] == [0.02, 0.035, 0.05], bimg.GetSpacing())
+    check("vti of boxes: occupancy = npy", np.array_equal(bocc.astype(bool), np.load(d / "b.npy").astype(bool)))
     vcol = vtk_to_numpy(cells.GetArray("colour")).reshape(nz, ny, nx, 3).transpose(2, 1, 0, 3)
     cov = vtk_to_numpy(cells.GetArray("coverage")).reshape(nz, ny, nx).transpose(2, 1, 0)
     check("vti coverage > 0 only on voxels", bool((cov[~occ] == 0).all()) and float(cov[occ].mean()) > 0.1)

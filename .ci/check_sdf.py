@@ -33,13 +33,21 @@ def sdf(mesh, out, *extra):
     return json.loads(r.stdout)
 
 
-CASES = [("cow.obj", "64", []), ("stanford-bunny.obj", "96", []), ("teapot.obj", "48", ["--sign", "winding"]), ("suzanne.obj", "40", ["--unsigned"])]
+# Each case: mesh, grid options (a resolution, or voxel sizes per axis), extra options.
+CASES = [
+    ("cow.obj", ["--resolution", "64"], []),
+    ("stanford-bunny.obj", ["--resolution", "96"], []),
+    ("teapot.obj", ["--resolution", "48"], ["--sign", "winding"]),
+    ("suzanne.obj", ["--resolution", "40"], ["--unsigned"]),
+    ("cow.obj", ["--voxel-size", "0.05,0.08,0.2"], []),
+]
 
 with tempfile.TemporaryDirectory() as d:
     d = Path(d)
     for mesh, res, extra in CASES:
         m = MESHES / mesh
-        s = sdf(m, d / "f.npy", "--resolution", res, *extra)
+        s = sdf(m, d / "f.npy", *res, *extra)
+        vs = np.broadcast_to(np.array(s["voxel_size"], float), 3)
         a = np.load(d / "f.npy")
         nx, ny, nz = s["dims"]
         bg = np.float32(s["background"])
@@ -48,14 +56,14 @@ with tempfile.TemporaryDirectory() as d:
         if PART == "vdb":
             import pyopenvdb as vdb
 
-            sdf(m, d / "f.vdb", "--resolution", res, *extra)
+            sdf(m, d / "f.vdb", *res, *extra)
             g = vdb.read(str(d / "f.vdb"), "surface")
             cls = "unknown" if "--unsigned" in extra else "level set"
             check(f"{mesh}: class {cls}, background W·h", g.gridClass == cls and np.float32(g.background) == bg, (g.gridClass, g.background))
-            check(f"{mesh}: voxel size", np.allclose(g.transform.voxelSize(), [s["voxel_size"]] * 3, rtol=1e-12))
-            o = np.array(s["origin"]) + 0.5 * s["voxel_size"]
+            check(f"{mesh}: voxel size per axis", np.allclose(g.transform.voxelSize(), vs, rtol=1e-12))
+            o = np.array(s["origin"]) + 0.5 * vs
             w = g.transform.indexToWorld((3, 5, 7))
-            check(f"{mesh}: index (i, j, k) at the voxel's centre", np.allclose(w, o + np.array([3, 5, 7]) * s["voxel_size"], rtol=0, atol=1e-9), w)
+            check(f"{mesh}: index (i, j, k) at the voxel's centre", np.allclose(w, o + np.array([3, 5, 7]) * vs, rtol=0, atol=1e-9), w)
             check(f"{mesh}: active voxels = the band", g.activeVoxelCount() == s["stored_voxels"], (g.activeVoxelCount(), s["stored_voxels"]))
             dense = np.zeros((nx, ny, nz), np.float32)
             g.copyToArray(dense, ijk=(0, 0, 0))
@@ -70,21 +78,22 @@ with tempfile.TemporaryDirectory() as d:
             import zarr
             from vtk.util.numpy_support import vtk_to_numpy
 
-            sdf(m, d / "f.zarr", "--resolution", res, *extra)
+            sdf(m, d / "f.zarr", *res, *extra)
             z = zarr.open_array(str(d / "f.zarr"), mode="r")
             check(f"{mesh}: zarr float32 = the .npy", z.dtype == np.float32 and np.array_equal(z[:], a))
-            sdf(m, d / "f.vti", "--resolution", res, *extra)
+            check(f"{mesh}: zarr attributes record the voxel size", z.attrs["topovox"]["voxel_size"] == s["voxel_size"], dict(z.attrs))
+            sdf(m, d / "f.vti", *res, *extra)
             r = vtk.vtkXMLImageDataReader()
             r.SetFileName(str(d / "f.vti"))
             r.Update()
             img = r.GetOutput()
             v = vtk_to_numpy(img.GetCellData().GetArray("distance")).reshape(nz, ny, nx).transpose(2, 1, 0)
-            check(f"{mesh}: vti 'distance' = the .npy, spacing the voxel size", np.array_equal(v, a) and np.allclose(img.GetSpacing(), [s["voxel_size"]] * 3))
+            check(f"{mesh}: vti 'distance' = the .npy, spacing the voxel size", np.array_equal(v, a) and np.allclose(img.GetSpacing(), vs))
             if "--unsigned" in extra:
                 check(f"{mesh}: unsigned: no negative value", (a >= 0).all())
             else:
                 method = "winding" if "winding" in extra else "auto"
-                ORACLE.voxelize(m, d / "s.npy", "--resolution", res, "--mode", "solid", "--method", method)
+                ORACLE.voxelize(m, d / "s.npy", *res, "--mode", "solid", "--method", method)
                 solid = np.load(d / "s.npy") > 0
                 check(f"{mesh}: d < 0 exactly on voxelize --mode solid's voxels", np.array_equal(a < 0, solid), int((a < 0).sum() - solid.sum()))
     if PART == "arrays":

@@ -85,25 +85,29 @@ def srgb_to_linear(c):
 
 with tempfile.TemporaryDirectory() as d:
     d = Path(d)
-    for mesh, res, extra in [
-        ("cow.obj", 48, []),
-        ("suzanne.obj", 200, ["--mode", "sep6"]),
-        ("stanford-bunny.obj", 300, ["--mode", "sep26", "--tile", "64"]),
-        ("teapot.obj", 257, ["--mode", "bubble", "--seed", "5", "--tile", "128"]),
+    # A grid is a resolution, or voxel sizes per axis (a non-uniform
+    # ScaleTranslateMap that OpenVDB gives back per axis).
+    for mesh, grid, extra in [
+        ("cow.obj", ["--resolution", "48"], []),
+        ("suzanne.obj", ["--resolution", "200"], ["--mode", "sep6"]),
+        ("stanford-bunny.obj", ["--resolution", "300"], ["--mode", "sep26", "--tile", "64"]),
+        ("teapot.obj", ["--resolution", "257"], ["--mode", "bubble", "--seed", "5", "--tile", "128"]),
+        ("cow.obj", ["--voxel-size", "0.05,0.05,0.18"], ["--mode", "sep6"]),
+        ("suzanne.obj", ["--voxel-size", "0.011,0.03,0.008"], ["--tile", "64"]),
     ]:
-        name = f"{mesh} {' '.join([str(res)] + extra)}"
-        s = voxelize(MESHES / mesh, d / "v.vdb", "--resolution", str(res), *extra)
-        voxelize(MESHES / mesh, d / "v.txt", "--resolution", str(res), *[e for e in extra if e not in ("--tile", "64", "128")])
+        name = f"{mesh} {' '.join(grid + extra)}"
+        s = voxelize(MESHES / mesh, d / "v.vdb", *grid, *extra)
+        voxelize(MESHES / mesh, d / "v.txt", *grid, *[e for e in extra if e not in ("--tile", "64", "128")])
         g, got = active(d / "v.vdb")
         want = text_voxels(d / "v.txt")
         check(f"{name}: pyopenvdb reads a BoolGrid", isinstance(g, vdb.BoolGrid), type(g))
         check(f"{name}: every active voxel = the dense run's voxels", got.shape == want.shape and (got == want).all(), (got.shape, want.shape))
         check(f"{name}: activeVoxelCount = topovox's count", g.activeVoxelCount() == s["voxels"], (g.activeVoxelCount(), s["voxels"]))
-        vs = s["voxel_size"]
+        vs = np.broadcast_to(np.array(s["voxel_size"], float), 3)
         o = np.array(s["origin"])
         centre = np.array(g.transform.indexToWorld((3, 4, 5)))
         check(f"{name}: index (3,4,5) -> that voxel's centre", np.allclose(centre, o + (np.array([3, 4, 5]) + 0.5) * vs, rtol=0, atol=1e-9 * max(1, abs(o).max())), centre)
-        check(f"{name}: voxel size", abs(g.transform.voxelSize()[0] - vs) <= 1e-12 * vs)
+        check(f"{name}: voxel size per axis", np.allclose(g.transform.voxelSize(), vs, rtol=1e-12, atol=0), g.transform.voxelSize())
         check(f"{name}: metadata dims", tuple(g.metadata["topovox_dims"]) == tuple(s["dims"]), g.metadata)
         # topovox reads its own file back.
         r = subprocess.run([TOPOVOX, "convert", str(d / "v.vdb"), str(d / "back.txt")], capture_output=True, text=True)

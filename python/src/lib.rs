@@ -988,7 +988,7 @@ impl VoxelGrid {
         facts: Option<String>,
     ) -> PyResult<VoxelGrid> {
         let o = origin.unwrap_or_default();
-        let grid = GridSpec::new(DVec3::new(o.0, o.1, o.2), VoxelSize::from(voxel_size), [dims.0, dims.1, dims.2])
+        let grid = GridSpec::new(DVec3::new(o.0, o.1, o.2), voxel_size.size()?, [dims.0, dims.1, dims.2])
             .map_err(|e| value_err(format!("invalid grid: {e}")))?;
         let ijk = indices_from::<3>("coords", &as_array(py, coords, "int64")?)?;
         let order = sorted_coords(&ijk, grid.dims())?;
@@ -1094,20 +1094,24 @@ impl VoxelGrid {
     }
 }
 
-/// A voxel size as Python gives it: one number (cubes) or three (per axis).
-#[derive(FromPyObject, Clone, Copy)]
+/// A voxel size as Python gives it: one number (cubes) or a sequence of
+/// three (per axis).
+#[derive(FromPyObject, Clone)]
 pub(crate) enum SizeArg {
     /// A cube's edge.
     Cube(f64),
-    /// `(sx, sy, sz)`.
-    Boxes((f64, f64, f64)),
+    /// `(sx, sy, sz)`, checked to be three by [`SizeArg::size`].
+    Boxes(Vec<f64>),
 }
 
-impl From<SizeArg> for VoxelSize {
-    fn from(s: SizeArg) -> VoxelSize {
-        match s {
-            SizeArg::Cube(c) => c.into(),
-            SizeArg::Boxes((x, y, z)) => [x, y, z].into(),
+impl SizeArg {
+    /// The size, or a `ValueError` for a sequence of other than three.
+    pub(crate) fn size(self) -> PyResult<VoxelSize> {
+        match self {
+            SizeArg::Cube(c) => Ok(c.into()),
+            SizeArg::Boxes(v) => <[f64; 3]>::try_from(v.as_slice())
+                .map(VoxelSize::from)
+                .map_err(|_| value_err(format!("voxel_size takes one number or three (sx, sy, sz); got {} values", v.len()))),
         }
     }
 }
@@ -1116,7 +1120,7 @@ impl From<SizeArg> for VoxelSize {
 pub(crate) fn size_to_py(py: Python<'_>, s: VoxelSize) -> PyResult<Bound<'_, PyAny>> {
     match s.cube() {
         Some(c) => Ok(c.into_pyobject(py)?.into_any()),
-        None => Ok(s.0.to_array().into_pyobject(py)?.into_any()),
+        None => Ok((s.0.x, s.0.y, s.0.z).into_pyobject(py)?.into_any()),
     }
 }
 
@@ -1386,7 +1390,7 @@ fn load_voxels(
         Some(o) => return Err(value_err(format!("origin must have 3 values; got {}", o.len()))),
         None => loaded.placement.map(|p| p.0).unwrap_or(DVec3::ZERO),
     };
-    let s = voxel_size.map(|s| VoxelSize::from(s).0).or(loaded.placement.map(|p| p.1)).unwrap_or(DVec3::ONE);
+    let s = voxel_size.map(SizeArg::size).transpose()?.map(|s| s.0).or(loaded.placement.map(|p| p.1)).unwrap_or(DVec3::ONE);
     let grid = GridSpec::new(o, s, dims.map(u64::from)).map_err(|e| value_err(format!("invalid grid: {e}")))?;
     let facts = serde_json::json!({"input": path.display().to_string(), "voxels": loaded.bits.count(), "placement_from_file": loaded.placement.is_some()});
     Ok(VoxelGrid { inner: Arc::new(GridData::new(Voxels::Dense(loaded.bits), grid, loaded.attributes, facts)) })
