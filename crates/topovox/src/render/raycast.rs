@@ -602,6 +602,28 @@ mod tests {
     }
 
     #[test]
+    fn boxes_are_drawn_in_their_proportions() {
+        // One voxel four times as tall (y) as wide, seen along z: the
+        // covered pixels span four times as many rows as columns.
+        let bits = grid([1, 1, 1], &[[0, 0, 0]]);
+        let o = RenderOptions { width: 200, height: 200, view: View::Axis(2), voxel_shape: [0.5, 2.0, 0.5], ..RenderOptions::default() };
+        let img = render(&bits, &o);
+        let bg = img.rgb[..3].to_vec();
+        let (mut rows, mut cols) = (std::collections::BTreeSet::new(), std::collections::BTreeSet::new());
+        for (n, p) in img.rgb.chunks(3).enumerate() {
+            if p != bg.as_slice() {
+                rows.insert(n / 200);
+                cols.insert(n % 200);
+            }
+        }
+        let ratio = rows.len() as f64 / cols.len() as f64;
+        assert!((ratio - 4.0).abs() < 0.2, "{} rows, {} columns", rows.len(), cols.len());
+        // Cubes: square.
+        let cube = render(&bits, &RenderOptions { voxel_shape: [3.0; 3], ..o });
+        assert_eq!(cube, render(&bits, &RenderOptions { voxel_shape: [1.0; 3], ..o }));
+    }
+
+    #[test]
     fn lit_faces_differ_and_the_picture_is_deterministic() {
         let bits = grid([4, 4, 4], &[[1, 1, 1], [2, 1, 1], [1, 2, 1], [1, 1, 2]]);
         let o = RenderOptions { width: 80, height: 60, ..RenderOptions::default() };
