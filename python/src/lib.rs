@@ -1352,7 +1352,8 @@ fn up_of(up: &str) -> PyResult<topovox_job::Up> {
 /// path : str or os.PathLike
 ///     The file (.npy, .npz, .binvox, .vox, .txt, .schem, .vti, .ply, .vdb, .zarr).
 /// origin, voxel_size
-///     The placement, when the file does not record it (default 0 and 1).
+///     The placement, when the file does not record it (default 0 and 1);
+///     `voxel_size` is one number or `(sx, sy, sz)`.
 /// up : {"x", "y", "z"}
 ///     The up axis `.vox` and `.schem` files were written with.
 /// allow_external_paths : bool

@@ -250,3 +250,41 @@ fn npz_round_trips_and_refuses_hostile_archives() {
         assert!(!err.contains('\n'), "{err}");
     }
 }
+
+/// A voxel size per axis: every format that records the spacing gives back
+/// exactly the origin and three sizes it was written with (and the voxels);
+/// the cubes-only formats refuse the grid and write nothing.
+#[test]
+fn grids_of_boxes_round_trip_their_spacing() {
+    let dims = [13, 30, 9];
+    let bits = pattern(dims);
+    let grid = GridSpec::new(DVec3::new(-1.3, 2.0, 0.5), [0.7, 0.7, 2.5], [13, 30, 9]).unwrap();
+    let want = Some((grid.origin(), DVec3::new(0.7, 0.7, 2.5)));
+    for (name, f) in [
+        ("s.txt", VoxelFormat::Text),
+        ("s.ply", VoxelFormat::Ply),
+        ("s.vti", VoxelFormat::Vti),
+        ("s.vdb", VoxelFormat::Vdb),
+        ("s.npz", VoxelFormat::Npz),
+        ("s.zarr", VoxelFormat::Zarr),
+    ] {
+        let p = tmp(name);
+        write_voxels(&p, f, &bits, &grid).unwrap();
+        let back = read_voxels(&p).unwrap();
+        assert_eq!(back.bits, bits, "{name}");
+        assert_eq!(back.placement, want, "{name}");
+        if f.reads_sparsely() {
+            assert_eq!(topovox_io::read_voxels_sparse(&p, false).unwrap().placement, want, "{name} sparse");
+        }
+    }
+    for (name, f) in [("s.binvox", VoxelFormat::Binvox), ("s.vox", VoxelFormat::Vox), ("s.schem", VoxelFormat::Schem)] {
+        let p = tmp(name);
+        let e = write_voxels(&p, f, &bits, &grid).unwrap_err().to_string();
+        assert!(e.contains("cubic") && e.contains(".vti") && !e.contains('\n'), "{name}: {e}");
+        assert!(!p.exists(), "{name}: written");
+    }
+    // Written before boxes: one size means cubes.
+    let cubes = GridSpec::new(DVec3::ZERO, [0.5; 3], dims.map(u64::from)).unwrap();
+    write_voxels(&tmp("c.npz"), VoxelFormat::Npz, &bits, &cubes).unwrap();
+    assert_eq!(read_voxels(&tmp("c.npz")).unwrap().placement, Some((DVec3::ZERO, DVec3::splat(0.5))));
+}
