@@ -20,6 +20,20 @@ pub struct DistanceGrid {
     inner: Arc<Sdf>,
     /// The dense array, made once.
     dense: OnceLock<Py<PyArray3<f32>>>,
+    /// The band in C order, sorted once for `coords` and `values`.
+    order: Arc<OnceLock<Vec<([u32; 3], f32)>>>,
+}
+
+impl DistanceGrid {
+    /// The stored voxels and values in C order, sorted on first use without
+    /// the GIL.
+    fn ordered<'a>(&'a self, py: Python<'_>) -> &'a [([u32; 3], f32)] {
+        let (inner, order) = (self.inner.clone(), self.order.clone());
+        py.detach(move || {
+            order.get_or_init(|| ordered(&inner));
+        });
+        self.order.get().expect("sorted above")
+    }
 }
 
 #[pymethods]
@@ -115,12 +129,7 @@ impl DistanceGrid {
     /// differs or `copy=True`).
     #[pyo3(signature = (dtype=None, copy=None))]
     fn __array__<'py>(&self, py: Python<'py>, dtype: Option<&Bound<'py, PyAny>>, copy: Option<bool>) -> PyResult<Bound<'py, PyAny>> {
-        let a = self.to_dense(py)?.into_any();
-        match (dtype, copy) {
-            (Some(d), _) => a.call_method1("astype", (d,)),
-            (None, Some(true)) => a.call_method0("copy"),
-            _ => Ok(a),
-        }
+        crate::array_protocol(self.to_dense(py)?.into_any(), dtype, copy)
     }
 
     /// coords() -> numpy.ndarray
@@ -136,8 +145,7 @@ impl DistanceGrid {
     /// --------
     /// >>> ijk, d = field.coords(), field.values()
     fn coords<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<i32>> {
-        let inner = self.inner.clone();
-        let v = py.detach(move || ordered(&inner));
+        let v = self.ordered(py);
         Array2::from_shape_fn((v.len(), 3), |(n, c)| v[n].0[c] as i32).into_pyarray(py)
     }
 
@@ -153,8 +161,7 @@ impl DistanceGrid {
     /// --------
     /// >>> inside = field.coords()[field.values() < 0]
     fn values<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
-        let inner = self.inner.clone();
-        let v = py.detach(move || ordered(&inner));
+        let v = self.ordered(py);
         Array1::from_iter(v.iter().map(|e| e.1)).into_pyarray(py)
     }
 
@@ -234,5 +241,5 @@ pub fn sdf(py: Python<'_>, mesh: &Mesh, options: Option<&Bound<'_, PyDict>>) -> 
         }
     };
     let s = interruptible(py, &stop, run)?.map_err(py_err)?;
-    Ok(DistanceGrid { inner: Arc::new(s), dense: OnceLock::new() })
+    Ok(DistanceGrid { inner: Arc::new(s), dense: OnceLock::new(), order: Arc::default() })
 }

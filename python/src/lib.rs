@@ -618,12 +618,7 @@ impl VoxelGrid {
     /// differs or `copy=True`).
     #[pyo3(signature = (dtype=None, copy=None))]
     fn __array__<'py>(&self, py: Python<'py>, dtype: Option<&Bound<'py, PyAny>>, copy: Option<bool>) -> PyResult<Bound<'py, PyAny>> {
-        let a = self.occupancy(py)?.into_any();
-        match (dtype, copy) {
-            (Some(d), _) => a.call_method1("astype", (d,)),
-            (None, Some(true)) => a.call_method0("copy"),
-            _ => Ok(a),
-        }
+        array_protocol(self.occupancy(py)?.into_any(), dtype, copy)
     }
 
     /// coords() -> numpy.ndarray
@@ -1091,6 +1086,20 @@ impl VoxelGrid {
         let [x, y, z] = self.inner.grid.dims();
         let mode = self.inner.facts.get("mode").and_then(Value::as_str).map(|m| format!(" {m}")).unwrap_or_default();
         format!("<topovox.VoxelGrid{mode} {x}x{y}x{z}, {} voxels, voxel size {}>", self.inner.voxels.count(), self.inner.grid.size())
+    }
+}
+
+/// NumPy's `__array__(dtype, copy)` of a cached read-only array `a`:
+/// converted to `dtype`, copied when asked, else `a` itself.
+pub(crate) fn array_protocol<'py>(
+    a: Bound<'py, PyAny>,
+    dtype: Option<&Bound<'py, PyAny>>,
+    copy: Option<bool>,
+) -> PyResult<Bound<'py, PyAny>> {
+    match (dtype, copy) {
+        (Some(d), _) => a.call_method1("astype", (d,)),
+        (None, Some(true)) => a.call_method0("copy"),
+        _ => Ok(a),
     }
 }
 

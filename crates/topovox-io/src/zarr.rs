@@ -284,7 +284,7 @@ fn fill_distance(dir: &Path, field: &Field, grid: &GridSpec, signed: bool, stop:
     let inner = shard.map(|s| s / CHUNK);
     let mut chunks: Vec<[u32; 3]> = field.band.bricks.iter().map(|b| b.at.map(|v| v / per)).collect();
     if let Some(inside) = &field.inside {
-        inside.source().for_each_brick_run(&mut |b, _, n| {
+        topovox::VoxelSource::for_each_brick_run(inside, &mut |b, _, n| {
             for x in (b[0] / per)..=((b[0] + n - 1) / per) {
                 chunks.push([x, b[1] / per, b[2] / per]);
             }

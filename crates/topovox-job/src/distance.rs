@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use serde_json::{json, Value};
 use topovox::distance::band::{band, Band};
-use topovox::distance::field::{Field, Inside};
+use topovox::distance::field::Field;
 use topovox::distance::{nearest, DistanceError, Pieces};
 use topovox::voxelize::{Options, Stop};
 use topovox::{GridSpec, MeshRef};
@@ -212,7 +212,7 @@ pub fn sdf(mesh: MeshRef<'_>, name: &str, req: &SdfRequest, stop: Option<&Stop>)
         facts["sign"] = json!(out.method);
         facts["solid"] = out.facts;
         facts["inside_voxels"] = json!(out.bits.count());
-        Some(Inside::Sparse(out.bits))
+        Some(out.bits)
     };
     facts["sign_s"] = json!(t.elapsed().as_secs_f64());
     let t = Instant::now();

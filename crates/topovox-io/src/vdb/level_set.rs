@@ -50,7 +50,7 @@ fn tree(field: &Field) -> Tree {
     let mut leaf_bricks: Vec<[u32; 3]> = field.band.bricks.iter().map(|b| b.at).collect();
     let mut runs: Vec<([u32; 3], u32)> = Vec::new();
     if let Some(inside) = &field.inside {
-        inside.source().for_each_brick_run(&mut |b, bits, n| {
+        topovox::VoxelSource::for_each_brick_run(inside, &mut |b, bits, n| {
             if *bits == FULL {
                 runs.push((b, n));
             } else {
@@ -82,6 +82,20 @@ fn tree(field: &Field) -> Tree {
         })
         .collect();
     Tree::assemble(leaves, full, None)
+}
+
+/// The length of [`leaf_values`] from the masks alone: the metadata byte,
+/// the selection mask when the inactive voxels are both inside and
+/// outside, and four bytes per active voxel.
+pub(super) fn leaf_values_len(field: &Field, leaf: &Leaf) -> usize {
+    let inside = field.inside.as_ref().map_or([0; 8], |i| to_vdb(&i.brick_bits(leaf.origin.map(|c| c >> LEAF))));
+    let (mut any_in, mut any_out) = (false, false);
+    for (a, i) in leaf.mask.iter().zip(inside) {
+        any_in |= i & !a != 0;
+        any_out |= !i & !a != 0;
+    }
+    let active: u32 = leaf.mask.iter().map(|w| w.count_ones()).sum();
+    1 + if any_in && any_out { 64 } else { 0 } + 4 * active as usize
 }
 
 /// A leaf's compressed values: metadata (0: every inactive voxel outside,

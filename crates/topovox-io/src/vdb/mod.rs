@@ -133,7 +133,11 @@ trait Out {
     fn put_with(&mut self, len: usize, fill: &mut dyn FnMut(&mut Vec<u8>) -> std::io::Result<()>) -> std::io::Result<()> {
         let mut buf = Vec::with_capacity(len);
         fill(&mut buf)?;
-        debug_assert_eq!(buf.len(), len);
+        // The counting pass took `len`: a mismatch would misplace every
+        // later offset, so it is an error, never a corrupt file.
+        if buf.len() != len {
+            return Err(std::io::Error::other(format!("vdb writer: {} bytes where {len} were counted", buf.len())));
+        }
         self.put(&buf)
     }
 }
@@ -448,7 +452,11 @@ fn put_tree(o: &mut dyn Out, tree: &Tree, buffers: Buffers<'_>) -> std::io::Resu
         Buffers::LevelSet(field) => {
             for leaf in &tree.leaves {
                 put_words(o, &leaf.mask)?;
-                o.put(&level_set::leaf_values(field, leaf))?;
+                // Counted from the masks alone: the values are made once, when written.
+                o.put_with(level_set::leaf_values_len(field, leaf), &mut |buf| {
+                    buf.extend_from_slice(&level_set::leaf_values(field, leaf));
+                    Ok(())
+                })?;
             }
             Ok(())
         }

@@ -5,51 +5,10 @@
 
 use rayon::prelude::*;
 
-use super::band::{Band, BandBrick};
+use super::band::Band;
 use crate::grid::brick::Brick;
 use crate::grid::sparse::SparseBricks;
-use crate::{DenseBits, VoxelSource};
-
-/// The voxels inside the mesh, in whichever storage the solid came in.
-#[derive(Clone, Debug)]
-pub enum Inside {
-    /// One bit per voxel.
-    Dense(DenseBits),
-    /// Sparse bricks, interiors as runs of full bricks.
-    Sparse(SparseBricks),
-}
-
-impl Inside {
-    /// The voxels as a [`VoxelSource`].
-    pub fn source(&self) -> &dyn VoxelSource {
-        match self {
-            Inside::Dense(d) => d,
-            Inside::Sparse(s) => s,
-        }
-    }
-
-    /// The bits of brick `at` (layout of [`Brick`]).
-    pub fn brick(&self, at: [u32; 3]) -> Brick {
-        match self {
-            Inside::Sparse(s) => s.brick_bits(at),
-            Inside::Dense(d) => {
-                let mut b: Brick = [0; 8];
-                let dims = d.dims();
-                for z in 0..8 {
-                    for y in 0..8 {
-                        for x in 0..8 {
-                            let v = [at[0] * 8 + x, at[1] * 8 + y, at[2] * 8 + z];
-                            if (0..3).all(|a| v[a] < dims[a]) && d.get(v[0], v[1], v[2]) {
-                                b[z as usize] |= 1 << (y * 8 + x);
-                            }
-                        }
-                    }
-                }
-                b
-            }
-        }
-    }
-}
+use crate::VoxelSource;
 
 /// A distance field: `band` holds the stored voxels (the narrow band, or
 /// every voxel) with signed values; every other voxel holds
@@ -58,8 +17,9 @@ impl Inside {
 pub struct Field {
     /// The stored voxels and their values (negative inside).
     pub band: Band,
-    /// The inside voxels (`None`: unsigned, nothing is inside).
-    pub inside: Option<Inside>,
+    /// The inside voxels, as the sparse solid gives them (`None`: unsigned,
+    /// nothing is inside).
+    pub inside: Option<SparseBricks>,
     /// The value of the voxels outside the band, by its sign.
     pub background: f32,
 }
@@ -79,19 +39,19 @@ pub fn inside_value(d: f32) -> f32 {
 impl Field {
     /// The field from unsigned `band` values: the band voxels `inside`
     /// holds are made negative ([`inside_value`]).
-    pub fn signed(mut band: Band, inside: Option<Inside>, background: f32) -> Field {
+    pub fn signed(mut band: Band, inside: Option<SparseBricks>, background: f32) -> Field {
         if let Some(ins) = &inside {
-            let firsts: Vec<BandBrick> = band.bricks.clone();
-            let ends: Vec<usize> = firsts.iter().skip(1).map(|b| b.first).chain([band.values.len()]).collect();
-            let mut chunks: Vec<&mut [f32]> = Vec::with_capacity(firsts.len());
+            // Each brick's values, split off in place (bricks are in value order).
+            let ends: Vec<usize> = band.bricks.iter().skip(1).map(|b| b.first).chain([band.values.len()]).collect();
+            let mut chunks: Vec<&mut [f32]> = Vec::with_capacity(band.bricks.len());
             let mut rest = band.values.as_mut_slice();
-            for (b, &end) in firsts.iter().zip(&ends) {
+            for (b, &end) in band.bricks.iter().zip(&ends) {
                 let (head, tail) = rest.split_at_mut(end - b.first);
                 chunks.push(head);
                 rest = tail;
             }
-            chunks.into_par_iter().zip(firsts.par_iter()).for_each(|(vals, b)| {
-                let bits = ins.brick(b.at);
+            chunks.into_par_iter().zip(band.bricks.par_iter()).for_each(|(vals, b)| {
+                let bits = ins.brick_bits(b.at);
                 let mut n = 0;
                 for (z, &w) in b.mask.iter().enumerate() {
                     let mut w = w;
@@ -117,7 +77,7 @@ impl Field {
     /// The value of every voxel of brick `at`, in slot order
     /// (`z·64 + y·8 + x`, the bit order of [`Brick`]), and which are stored.
     pub fn brick_values(&self, at: [u32; 3]) -> ([f32; 512], Brick) {
-        let inside = self.inside.as_ref().map_or([0; 8], |i| i.brick(at));
+        let inside = self.inside.as_ref().map_or([0; 8], |i| i.brick_bits(at));
         let mut out = [0f32; 512];
         for (s, v) in out.iter_mut().enumerate() {
             *v = if inside[s >> 6] >> (s & 63) & 1 == 1 { -self.background } else { self.background };
@@ -142,7 +102,7 @@ impl Field {
         let mut out = vec![self.background; nx * ny * nz];
         if let Some(ins) = &self.inside {
             let bg = -self.background;
-            ins.source().for_each_set(&mut |i, j, k| out[(i as usize * ny + j as usize) * nz + k as usize] = bg);
+            ins.for_each_set(&mut |i, j, k| out[(i as usize * ny + j as usize) * nz + k as usize] = bg);
         }
         self.band.for_each(|i, j, k, v| out[(i as usize * ny + j as usize) * nz + k as usize] = v);
         out
