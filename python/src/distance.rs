@@ -14,6 +14,9 @@ use topovox_job::{Choice, GridRequest, JobError};
 
 use crate::{interruptible, job_options, py_err, to_py, value_err, Mesh};
 
+/// The band's voxels and values in C order.
+type Ordered = Vec<([u32; 3], f32)>;
+
 /// A distance field: see `topovox.sdf`.
 #[pyclass(module = "topovox._topovox", name = "DistanceGrid", frozen)]
 pub struct DistanceGrid {
@@ -21,7 +24,7 @@ pub struct DistanceGrid {
     /// The dense array, made once.
     dense: OnceLock<Py<PyArray3<f32>>>,
     /// The band in C order, sorted once for `coords` and `values`.
-    order: Arc<OnceLock<Vec<([u32; 3], f32)>>>,
+    order: Arc<OnceLock<Ordered>>,
 }
 
 impl DistanceGrid {
@@ -201,7 +204,7 @@ impl DistanceGrid {
 }
 
 /// The stored voxels and values in C order.
-fn ordered(s: &Sdf) -> Vec<([u32; 3], f32)> {
+fn ordered(s: &Sdf) -> Ordered {
     let mut v = Vec::with_capacity(s.field.band.count() as usize);
     s.field.band.for_each(|i, j, k, d| v.push(([i, j, k], d)));
     v.sort_unstable_by_key(|e| e.0);
