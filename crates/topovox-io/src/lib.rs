@@ -336,6 +336,13 @@ pub fn size_from_json(v: &serde_json::Value) -> Option<glam::DVec3> {
     (s.is_finite() && s.min_element() > 0.0).then_some(s)
 }
 
+/// Half the diagonal of a voxel of `size`: an unsigned distance field
+/// (`.vdb`, `.vti`, `.zarr`) is read back as the voxels whose value is at
+/// most this, those whose centre lies in reach of a surface crossing them.
+pub(crate) fn half_diagonal(size: glam::DVec3) -> f64 {
+    0.5 * size.length()
+}
+
 /// A voxel grid read back from a file, with the grid placement when the
 /// format stores it.
 #[derive(Clone, Debug)]

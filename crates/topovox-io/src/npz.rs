@@ -52,14 +52,9 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std:
     member(&mut zip, "dims.npy", header("<i8", "(3,)"), &dims_le)?;
     let origin_le: Vec<u8> = [o.x, o.y, o.z].iter().flat_map(|c| c.to_le_bytes()).collect();
     member(&mut zip, "origin.npy", header("<f8", "(3,)"), &origin_le)?;
-    // One number for cubes (as before boxes), three for boxes.
-    match grid.cube_size() {
-        Some(s) => member(&mut zip, "voxel_size.npy", header("<f8", "()"), &s.to_le_bytes())?,
-        None => {
-            let bytes: Vec<u8> = grid.voxel_size().to_array().iter().flat_map(|v| v.to_le_bytes()).collect();
-            member(&mut zip, "voxel_size.npy", header("<f8", "(3,)"), &bytes)?
-        }
-    }
+    let size = grid.size().recorded();
+    let size_le: Vec<u8> = size.iter().flat_map(|v| v.to_le_bytes()).collect();
+    member(&mut zip, "voxel_size.npy", header("<f8", if size.len() == 1 { "()" } else { "(3,)" }), &size_le)?;
 
     zip.start_file("indices.npy", large).map_err(std::io::Error::other)?;
     zip.write_all(&header("<i4", &format!("({count}, 3)")))?;

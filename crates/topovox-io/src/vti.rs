@@ -319,7 +319,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     let distance = (occ.0 == "distance" && ot == "Float32" && occ.2 == 1).then(|| {
         let values: Vec<f32> = occ.3.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().expect("4 bytes"))).collect();
         let signed = values.iter().any(|&v| v < 0.0);
-        let near = (0.5 * spacing.iter().map(|v| v * v).sum::<f64>().sqrt()) as f32;
+        let near = crate::half_diagonal(DVec3::new(spacing[0], spacing[1], spacing[2])) as f32;
         move |b: &[u8]| {
             let v = f32::from_le_bytes(b.try_into().expect("4 bytes"));
             if signed {

@@ -1085,7 +1085,7 @@ impl Elements {
             "float32" => {
                 let ours = &a.attributes["topovox"];
                 let unsigned = ours["distance"]["signed"] == json!(false);
-                let near = crate::size_from_json(&ours["voxel_size"]).map(|s| (0.5 * s.length()) as f32);
+                let near = crate::size_from_json(&ours["voxel_size"]).map(|s| crate::half_diagonal(s) as f32);
                 match (unsigned, near) {
                     (false, _) => Ok(Elements::Distance(None)),
                     (true, Some(n)) => Ok(Elements::Distance(Some(n))),

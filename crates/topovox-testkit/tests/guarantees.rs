@@ -78,16 +78,20 @@ fn closed_shared_meshes_at_several_resolutions() {
     }
 }
 
+/// A grid of voxel size `s` around `mesh` with two empty voxels of margin
+/// on every side: no surface on the grid's faces.
+fn with_margin(mesh: &Mesh, s: DVec3) -> GridSpec {
+    let b = mesh.as_ref().bounds();
+    let dims = (b.extent() / s).ceil().as_u64vec3() + 4;
+    GridSpec::new(b.min - 2.0 * s, s, dims.to_array()).unwrap()
+}
+
 #[test]
 fn closed_shared_meshes_randomly_rotated() {
     let mut r = rng(0x5e9a);
     for name in CLOSED {
         let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
-        // A margin of voxels around the mesh: no surface on the grid's faces.
-        let b = mesh.as_ref().bounds();
-        let s = b.extent().max_element() / 60.0;
-        let dims = (b.extent() / s).ceil().as_u64vec3() + 4;
-        let grid = GridSpec::new(b.min - DVec3::splat(2.0 * s), s, dims.to_array()).unwrap();
+        let grid = with_margin(&mesh, DVec3::splat(mesh.as_ref().bounds().extent().max_element() / 60.0));
         surface_guarantees(name, &mesh, &grid);
     }
 }
@@ -99,11 +103,8 @@ fn closed_shared_meshes_on_grids_of_boxes() {
     let mut r = rng(0xb0c5);
     for name in CLOSED {
         let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
-        let b = mesh.as_ref().bounds();
-        let base = b.extent().max_element() / 40.0;
-        let s = DVec3::new(base * r.random_range(1.0..8.0), base * r.random_range(1.0..8.0), base);
-        let dims = (b.extent() / s).ceil().as_u64vec3() + 4;
-        let grid = GridSpec::new(b.min - 2.0 * s, s, dims.to_array()).unwrap();
+        let base = mesh.as_ref().bounds().extent().max_element() / 40.0;
+        let grid = with_margin(&mesh, DVec3::new(base * r.random_range(1.0..8.0), base * r.random_range(1.0..8.0), base));
         surface_guarantees(&format!("{name} on sizes {}", grid.size()), &mesh, &grid);
     }
 }

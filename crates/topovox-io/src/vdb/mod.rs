@@ -510,12 +510,7 @@ fn put_bool_leaves(o: &mut dyn Out, tree: &Tree) -> std::io::Result<()> {
 /// A deterministic UUID-shaped identifier of the contents.
 fn uuid(grid: &GridSpec, count: u64) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    let s = grid.voxel_size();
-    // A cube's one size, as before boxes, so cubic files keep their identifier.
-    let sizes = match grid.cube_size() {
-        Some(c) => vec![c.to_bits()],
-        None => vec![s.x.to_bits(), s.y.to_bits(), s.z.to_bits()],
-    };
+    let sizes = grid.size().recorded().into_iter().map(f64::to_bits);
     for v in grid.dims().iter().map(|&d| d as u64).chain([count]).chain(sizes) {
         h = (h ^ v).wrapping_mul(0x0100_0000_01b3);
     }
@@ -1328,7 +1323,7 @@ fn read_grid(c: &mut Cur<'_>, distance: bool) -> Result<Occupancy, ErrorKind> {
         // A level set's inside: its negative values; an unsigned field's
         // voxels within half a voxel diagonal of the surface.
         let level_set = find("class").is_some_and(|c| c == b"level set");
-        let near = 0.5 * DVec3::from(scale).length();
+        let near = crate::half_diagonal(DVec3::from(scale));
         let test = move |v: f32| if level_set { v < 0.0 } else { (v as f64) <= near };
         read_level_set(c, mask_compressed, &test)?
     } else {
@@ -1360,14 +1355,14 @@ fn read_grid(c: &mut Cur<'_>, distance: bool) -> Result<Occupancy, ErrorKind> {
         _ if lo[0] == i64::MAX => ([0; 3], [1, 1, 1]),
         _ => (lo, std::array::from_fn(|a| u32::try_from(hi[a] - lo[a] + 1).unwrap_or(u32::MAX))),
     };
-    let origin_meta = get("topovox_origin").filter(|v| v.len() == 24).map(|v| {
-        let d: [f64; 3] = std::array::from_fn(|a| f64::from_le_bytes(v[8 * a..8 * a + 8].try_into().expect("8 bytes")));
-        DVec3::from(d)
-    });
+    let vec3d = |v: Vec<u8>| {
+        DVec3::from(std::array::from_fn::<f64, 3, _>(|a| f64::from_le_bytes(v[8 * a..8 * a + 8].try_into().expect("8 bytes"))))
+    };
+    let origin_meta = get("topovox_origin").filter(|v| v.len() == 24).map(vec3d);
     // A `double` for cubes, a `vec3d` for boxes.
     let size_meta = get("topovox_voxel_size").and_then(|v| match v.len() {
         8 => Some(DVec3::splat(f64::from_le_bytes(v[..8].try_into().expect("8 bytes")))),
-        24 => Some(DVec3::from(std::array::from_fn::<f64, 3, _>(|a| f64::from_le_bytes(v[8 * a..8 * a + 8].try_into().expect("8 bytes"))))),
+        24 => Some(vec3d(v)),
         _ => None,
     });
     let scale = DVec3::from(scale);

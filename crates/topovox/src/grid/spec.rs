@@ -63,6 +63,15 @@ impl VoxelSize {
     pub fn to_array(self) -> [f64; 3] {
         self.0.to_array()
     }
+
+    /// The sizes as files record them: one for cubes (the form written
+    /// before boxes, so cubic files stay as they were), three for boxes.
+    pub fn recorded(self) -> Vec<f64> {
+        match self.cube() {
+            Some(s) => vec![s],
+            None => self.to_array().to_vec(),
+        }
+    }
 }
 
 impl From<f64> for VoxelSize {
@@ -205,17 +214,6 @@ impl GridSpec {
     /// World position of voxel `(i,j,k)`'s centre.
     pub fn voxel_center(&self, ijk: [u32; 3]) -> DVec3 {
         self.voxel_min(ijk) + 0.5 * self.voxel_size
-    }
-
-    /// World position of index-space point `u`: `origin + u ∘ voxel_size`.
-    #[inline]
-    pub fn to_world(&self, u: DVec3) -> DVec3 {
-        self.origin + u * self.voxel_size
-    }
-
-    /// This grid's voxels `factor` times as large on every axis (the same origin).
-    pub fn scaled(&self, factor: f64, dims: [u64; 3]) -> Result<GridSpec, GridError> {
-        GridSpec::new(self.origin, self.voxel_size * factor, dims)
     }
 }
 
