@@ -12,7 +12,12 @@ use topovox::voxelize::Stop;
 use topovox_job::distance::{DistanceFormat, Sdf, SdfRequest, Sign, Width};
 use topovox_job::{Choice, GridRequest, JobError};
 
-use crate::{interruptible, job_options, py_err, to_py, value_err, Mesh};
+use crate::convert::{array_protocol, to_py};
+use crate::errors::{py_err, value_err};
+use crate::interrupt::interruptible;
+use crate::meshes::Mesh;
+use crate::options::job_options;
+use crate::placement;
 
 /// The band's voxels and values in C order.
 type Ordered = Vec<([u32; 3], f32)>;
@@ -41,30 +46,85 @@ impl DistanceGrid {
 
 #[pymethods]
 impl DistanceGrid {
-    /// `(nx, ny, nz)`: voxels along each axis.
+    /// Voxels along x, y, z.
+    #[getter]
+    fn dims(&self) -> (u32, u32, u32) {
+        placement::dims(&self.inner.grid)
+    }
+
+    /// `(nx, ny, nz)`, as NumPy's `shape`.
     #[getter]
     fn shape(&self) -> (u32, u32, u32) {
-        let d = self.inner.grid.dims();
-        (d[0], d[1], d[2])
+        placement::dims(&self.inner.grid)
     }
 
     /// World position of the grid's low corner, `(3,)` float64.
     #[getter]
     fn origin<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        Array1::from(self.inner.grid.origin().to_array().to_vec()).into_pyarray(py)
+        placement::origin(py, &self.inner.grid)
+    }
+
+    /// The grid's world box, `(2, 3)` float64: its low and high corners.
+    #[getter]
+    fn bounds<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        placement::bounds(py, &self.inner.grid)
     }
 
     /// Edge length of a voxel: a float for cubes, `(sx, sy, sz)` when the
     /// grid has a size per axis (see `spacing` for the three always).
     #[getter]
     fn voxel_size<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        crate::size_to_py(py, self.inner.grid.size())
+        placement::voxel_size(py, &self.inner.grid)
     }
 
     /// A voxel's edge lengths along x, y, z, `(3,)` float64 (equal for cubes).
     #[getter]
     fn spacing<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        numpy::ndarray::Array1::from(self.inner.grid.voxel_size().to_array().to_vec()).into_pyarray(py)
+        placement::spacing(py, &self.inner.grid)
+    }
+
+    /// world_to_index(points) -> numpy.ndarray
+    ///
+    /// The voxel holding each point: `floor((p - origin) / voxel_size)` (may lie
+    /// outside the grid).
+    ///
+    /// Parameters
+    /// ----------
+    /// points : array_like
+    ///     `(n, 3)` numbers (an array of any float or integer dtype, a list,
+    ///     a tuple), or one point `(3,)`.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     `(n, 3)` int64; `(3,)` for one point.
+    ///
+    /// Examples
+    /// --------
+    /// >>> field.world_to_index([[0.0, 0.0, 0.0]])
+    fn world_to_index<'py>(&self, py: Python<'py>, points: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        placement::world_to_index(py, &self.inner.grid, points)
+    }
+
+    /// index_to_world(indices) -> numpy.ndarray
+    ///
+    /// The centre of each voxel.
+    ///
+    /// Parameters
+    /// ----------
+    /// indices : array_like
+    ///     `(n, 3)` integers (an array, a list, a tuple), or one voxel `(3,)`.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     `(n, 3)` float64; `(3,)` for one voxel.
+    ///
+    /// Examples
+    /// --------
+    /// >>> centres = field.index_to_world(field.coords())
+    fn index_to_world<'py>(&self, py: Python<'py>, indices: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        placement::index_to_world(py, &self.inner.grid, indices)
     }
 
     /// Whether values are negative inside.
@@ -132,7 +192,7 @@ impl DistanceGrid {
     /// differs or `copy=True`).
     #[pyo3(signature = (dtype=None, copy=None))]
     fn __array__<'py>(&self, py: Python<'py>, dtype: Option<&Bound<'py, PyAny>>, copy: Option<bool>) -> PyResult<Bound<'py, PyAny>> {
-        crate::array_protocol(self.to_dense(py)?.into_any(), dtype, copy)
+        array_protocol(self.to_dense(py)?.into_any(), dtype, copy)
     }
 
     /// coords() -> numpy.ndarray

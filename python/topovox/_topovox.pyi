@@ -74,9 +74,9 @@ class VoxelGrid:
     @staticmethod
     def from_coords(
         coords: npt.ArrayLike,
-        dims: Tuple[int, int, int],
-        origin: Optional[Tuple[float, float, float]] = None,
-        voxel_size: Union[float, Tuple[float, float, float]] = ...,
+        dims: npt.ArrayLike,
+        origin: Optional[npt.ArrayLike] = None,
+        voxel_size: Union[float, Tuple[float, float, float]] = 1.0,
         colours: Optional[npt.ArrayLike] = None,
         materials: Optional[npt.ArrayLike] = None,
         normals: Optional[npt.ArrayLike] = None,
@@ -86,8 +86,8 @@ class VoxelGrid:
     @staticmethod
     def from_dense(
         array: npt.ArrayLike,
-        origin: Optional[Tuple[float, float, float]] = None,
-        voxel_size: Union[float, Tuple[float, float, float]] = ...,
+        origin: Optional[npt.ArrayLike] = None,
+        voxel_size: Union[float, Tuple[float, float, float]] = 1.0,
     ) -> VoxelGrid: ...
     @property
     def facts(self) -> Dict[str, Any]: ...
@@ -126,9 +126,13 @@ class DistanceGrid:
     """A distance field: the exact distance from each voxel centre to a mesh."""
 
     @property
+    def dims(self) -> Tuple[int, int, int]: ...
+    @property
     def shape(self) -> Tuple[int, int, int]: ...
     @property
     def origin(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def bounds(self) -> npt.NDArray[np.float64]: ...
     @property
     def voxel_size(self) -> Union[float, Tuple[float, float, float]]: ...
     @property
@@ -145,6 +149,8 @@ class DistanceGrid:
     def __array__(self, dtype: Any = None, copy: Optional[bool] = None) -> npt.NDArray[Any]: ...
     def coords(self) -> npt.NDArray[np.int32]: ...
     def values(self) -> npt.NDArray[np.float32]: ...
+    def world_to_index(self, points: npt.ArrayLike) -> npt.NDArray[np.int64]: ...
+    def index_to_world(self, indices: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
     def save(self, path: Union[str, PathLike[str]], format: Optional[str] = None) -> None: ...
 
 def sdf(mesh: Mesh, options: Optional[Dict[str, Any]] = None) -> DistanceGrid: ...

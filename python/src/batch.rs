@@ -1,0 +1,127 @@
+//! Folders of meshes: the native `batch` (what `topovox batch` runs), and
+//! the plan, one-mesh step and manifest the Dask and Ray helpers use.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use serde_json::Value;
+use topovox::voxelize::Stop;
+use topovox_job::{JobError, OptionValue};
+
+use crate::convert::to_py;
+use crate::errors::{py_err, value_err};
+use crate::interrupt::interruptible;
+use crate::options::{job_options, option_value};
+
+/// `(input, output, done)` per mesh of a batch, and the options' fingerprint.
+pub(crate) type BatchListing<'py> = (Vec<(String, String, bool)>, Bound<'py, PyAny>);
+
+/// The options of a batch, validated (with its fingerprint), and `jobs`.
+pub(crate) fn batch_options(
+    options: Option<&Bound<'_, PyDict>>,
+    format: &str,
+) -> PyResult<(topovox_job::batch::BatchOptions, Option<usize>)> {
+    let target = topovox_job::output::Output::from_name(format)
+        .ok_or_else(|| value_err(format!("unknown format {format:?} (expected one of: {})", topovox_job::output::Output::names())))?;
+    let jobs = match options.map(|d| d.get_item("jobs")).transpose()?.flatten().filter(|v| !v.is_none()) {
+        Some(v) => match option_value("jobs", &v)? {
+            OptionValue::Int(n) if n >= 1 => Some(n as usize),
+            _ => return Err(value_err(format!("jobs must be an integer of at least 1; got {}", v.repr()?))),
+        },
+        None => None,
+    };
+    let opts = job_options(options, &["jobs"])?.batch(target).map_err(py_err)?;
+    Ok((opts, jobs))
+}
+
+/// The native batch: see `topovox.batch`.
+#[pyfunction]
+#[pyo3(signature = (inputs, out_dir, format="npy", glob=None, options=None))]
+pub(crate) fn batch<'py>(
+    py: Python<'py>,
+    inputs: Vec<PathBuf>,
+    out_dir: PathBuf,
+    format: &str,
+    glob: Option<String>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (opts, jobs) = batch_options(options, format)?;
+    if let Some(n) = jobs {
+        topovox_job::check_threads(n, "jobs").map_err(py_err)?;
+    }
+    let stop = Arc::new(Stop::new());
+    let (summary, warnings) = interruptible(py, &stop, || -> Result<(topovox_job::batch::Summary, Vec<String>), JobError> {
+        let (files, warnings) = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir)?;
+        let ext = opts.format.name().replace("npy-bool", "npy");
+        let items = topovox_job::batch::plan_items(&files, &out_dir, &ext)?;
+        let pool = topovox_job::pool_for(jobs, "jobs")?;
+        let summary = pool.install(|| topovox_job::batch::run(&items, &out_dir, &opts, &topovox_job::batch::Silent, Some(&stop)))?;
+        Ok((summary, warnings))
+    })?
+    .map_err(py_err)?;
+    let mut v = summary.to_json();
+    v["warnings"] = serde_json::json!(warnings);
+    to_py(py, &v)
+}
+
+/// The batch plan without running it: `[(input, output), ...]` and the
+/// options' fingerprint (for the Dask and Ray helpers, which run
+/// [`process_one`] per mesh and write the same manifest).
+#[pyfunction]
+#[pyo3(signature = (inputs, out_dir, format="npy", glob=None, options=None))]
+pub(crate) fn batch_plan<'py>(
+    py: Python<'py>,
+    inputs: Vec<PathBuf>,
+    out_dir: PathBuf,
+    format: &str,
+    glob: Option<String>,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<BatchListing<'py>> {
+    let (opts, _) = batch_options(options, format)?;
+    let (files, _) = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir).map_err(py_err)?;
+    let ext = opts.format.name().replace("npy-bool", "npy");
+    let items = topovox_job::batch::plan_items(&files, &out_dir, &ext).map_err(py_err)?;
+    topovox_job::batch::create_out_dir(&out_dir).map_err(py_err)?;
+    let manifest = topovox_job::batch::Manifest::open(&out_dir).map_err(py_err)?;
+    let listed = items
+        .iter()
+        .map(|i| (i.input.display().to_string(), i.output.display().to_string(), manifest.is_done(i, &opts.fingerprint)))
+        .collect();
+    Ok((listed, to_py(py, &opts.fingerprint)?))
+}
+
+/// One mesh of a batch: voxelizes `input`, writes `output`, returns the
+/// manifest record (a dict; failures are its `error`, never exceptions).
+#[pyfunction]
+#[pyo3(signature = (input, output, format="npy", options=None))]
+pub(crate) fn process_one<'py>(
+    py: Python<'py>,
+    input: PathBuf,
+    output: PathBuf,
+    format: &str,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (mut opts, _) = batch_options(options, format)?;
+    opts.threads = opts.threads.or(Some(1));
+    let item = topovox_job::batch::Item { input, output };
+    // One mesh, run by a Dask or Ray worker (which interrupts its tasks its own way).
+    let record = py.detach(move || topovox_job::batch::process_one(&item, &opts, None));
+    to_py(py, &record)
+}
+
+/// Appends records (dicts or JSON strings) to `out_dir`'s manifest, one
+/// line each.
+#[pyfunction]
+pub(crate) fn append_manifest(py: Python<'_>, out_dir: PathBuf, records: Vec<String>) -> PyResult<()> {
+    py.detach(move || -> Result<(), JobError> {
+        let m = topovox_job::batch::Manifest::open(&out_dir)?;
+        for r in records {
+            let v: Value = serde_json::from_str(&r).map_err(|e| JobError::invalid(format!("manifest record is not JSON: {e}")))?;
+            m.append(&v)?;
+        }
+        Ok(())
+    })
+    .map_err(py_err)
+}

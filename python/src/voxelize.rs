@@ -1,0 +1,49 @@
+//! The native `voxelize`: what `topovox voxelize` runs, on a `Mesh`.
+
+use std::sync::Arc;
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use topovox::voxelize::Stop;
+use topovox_job::JobError;
+
+use crate::errors::py_err;
+use crate::grids::{GridData, VoxelGrid};
+use crate::interrupt::interruptible;
+use crate::meshes::Mesh;
+use crate::options::job_options;
+
+/// The native voxelize: see `topovox.voxelize` for the documentation.
+#[pyfunction]
+#[pyo3(signature = (mesh, options=None))]
+pub(crate) fn voxelize(py: Python<'_>, mesh: &Mesh, options: Option<&Bound<'_, PyDict>>) -> PyResult<VoxelGrid> {
+    let opts = job_options(options, &[])?;
+    let plan = opts.plan().map_err(py_err)?;
+    let carry = opts.carry();
+    // Attributes are carried when any is asked for (normals are one).
+    let attributes = opts.attributes || opts.normals;
+    let pool = opts.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
+    let inner = &mesh.inner;
+    let name = mesh.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into());
+    let stop = Stop::new();
+    let data = interruptible(py, &stop, || {
+        let run = || -> Result<GridData, JobError> {
+            let v = topovox_job::voxelize(&plan, inner.mesh.as_ref(), &name, None, Some(&stop))?;
+            let attrs = if attributes && !plan.is_line() {
+                topovox_job::check_attributes_carried(&plan, &v)?;
+                topovox_job::attributes(&plan, inner.mesh.as_ref(), &inner.appearance, &v, &carry)
+            } else {
+                None
+            };
+            let mut facts = v.facts(&plan);
+            facts["warnings"] = serde_json::json!(v.warnings);
+            Ok(GridData::new(v.voxels, v.grid, attrs, facts))
+        };
+        match pool {
+            Some(p) => p.install(run),
+            None => run(),
+        }
+    })?
+    .map_err(py_err)?;
+    Ok(VoxelGrid { inner: Arc::new(data) })
+}
