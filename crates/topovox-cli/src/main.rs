@@ -7,7 +7,6 @@ mod console;
 mod export;
 mod pictures;
 mod plan;
-mod pool;
 mod progress;
 #[cfg(feature = "gpu")]
 mod scene_input;

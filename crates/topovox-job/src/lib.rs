@@ -71,14 +71,19 @@ pub fn check_threads(threads: usize, what: &str) -> Result<()> {
 /// them queue on its single worker. Starting threads costs tens of
 /// microseconds each; they end when the pool is dropped.
 pub fn pool(threads: usize) -> Result<rayon::ThreadPool> {
-    pool_for(threads, "threads")
+    pool_for(Some(threads), "threads")
 }
 
-/// [`pool`], the count named `what` in errors.
-pub fn pool_for(threads: usize, what: &str) -> Result<rayon::ThreadPool> {
-    check_threads(threads, what)?;
+/// The one pool builder of every front end (`--threads`, `--jobs`,
+/// `threads=`, `jobs=`): `threads` workers, or with `None` one per core
+/// (rayon's default, which `RAYON_NUM_THREADS` overrides); the count is
+/// named `what` in errors.
+pub fn pool_for(threads: Option<usize>, what: &str) -> Result<rayon::ThreadPool> {
+    if let Some(n) = threads {
+        check_threads(n, what)?;
+    }
     rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
+        .num_threads(threads.unwrap_or(0))
         .build()
-        .map_err(|e| JobError::failed(format!("cannot start {threads} threads: {e}")))
+        .map_err(|e| JobError::failed(format!("cannot start {} worker threads: {e}", threads.map_or("the".into(), |n| n.to_string()))))
 }

@@ -30,7 +30,7 @@ pub fn run(a: &BatchArgs) -> Result<()> {
         bail!("unknown --format {:?} (expected one of: {})", a.format, topovox_job::output::Output::names());
     };
     let opts = crate::plan::job_options(&a.job, None)?.batch(format)?;
-    let pool = crate::pool::thread_pool_for(a.jobs, "--jobs")?;
+    let pool = topovox_job::pool_for(a.jobs, "--jobs")?;
     let (files, warnings) = batch::collect_inputs(&a.inputs, a.glob.as_deref(), &a.output)?;
     for w in &warnings {
         eprintln!("topovox: warning: {w}");

@@ -169,7 +169,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         });
 
         for (n_threads, &threads) in a.threads.iter().enumerate() {
-            let pool = crate::pool::thread_pool(Some(threads))?;
+            let pool = topovox_job::pool_for(Some(threads), "--threads")?;
             for &res in &a.resolutions {
                 let grid = GridSpec::from_resolution(&bounds, res).context("invalid grid")?;
                 crate::plan::check_memory(&grid)?;
@@ -325,7 +325,7 @@ fn attributes(a: &BenchArgs, loaded: &topovox_io::LoadedMesh) -> Result<()> {
     );
     let mut json_rows = Vec::new();
     for &threads in &a.threads {
-        let pool = crate::pool::thread_pool(Some(threads))?;
+        let pool = topovox_job::pool_for(Some(threads), "--threads")?;
         for &res in &a.resolutions {
             let grid = GridSpec::from_resolution(&loaded.report.bounds, res).context("invalid grid")?;
             crate::plan::check_memory(&grid)?;

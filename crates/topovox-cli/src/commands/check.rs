@@ -9,7 +9,7 @@ use crate::args::CheckArgs;
 
 pub fn run(a: &CheckArgs) -> Result<()> {
     let t0 = Instant::now();
-    let pool = crate::pool::thread_pool(a.threads)?;
+    let pool = topovox_job::pool_for(a.threads, "--threads")?;
     let up = a.up.unwrap_or_default();
     let sparse_format = topovox_io::VoxelFormat::from_path(&a.voxels).is_some_and(topovox_io::VoxelFormat::reads_sparsely);
     if a.sparse && !sparse_format {

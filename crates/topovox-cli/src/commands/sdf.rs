@@ -19,7 +19,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
     let req = SdfRequest { grid, width, unsigned: a.unsigned, sign: a.sign, max_memory: a.max_memory, format };
     topovox_job::output::check_output_path(&a.output)?;
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.mesh))?;
-    let pool = crate::pool::thread_pool(a.threads)?;
+    let pool = topovox_job::pool_for(a.threads, "--threads")?;
     let threads = pool.current_num_threads();
 
     let bar = Bar::new(a.quiet || a.json);

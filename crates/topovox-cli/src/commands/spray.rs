@@ -32,7 +32,7 @@ pub fn run(a: &SprayArgs) -> Result<()> {
     }
     let (width, height) = (a.size.width, a.size.height);
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.input))?;
-    let pool = crate::pool::thread_pool(a.threads)?;
+    let pool = topovox_job::pool_for(a.threads, "--threads")?;
     let upi = up_axis(a.up);
     let mut up = Vec3::ZERO;
     up[upi] = 1.0;

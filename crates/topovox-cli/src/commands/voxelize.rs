@@ -35,7 +35,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
         }
         None => None,
     };
-    let pool = crate::pool::thread_pool(a.threads)?;
+    let pool = topovox_job::pool_for(a.threads, "--threads")?;
     let threads = pool.current_num_threads();
 
     let bar = Bar::new(a.quiet || a.json);
@@ -78,9 +78,8 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     });
     let attrs = attrs.flatten();
     let attributes_s = t_attr.elapsed().as_secs_f64();
-    if format.has_colour() && !app.has_colour() && !a.quiet && !a.json {
-        eprintln!("topovox: note: {} has no colours (materials, textures or vertex colours); voxels get one colour", a.mesh.display());
-    }
+    // Said in the summary, not on stderr: a successful run is quiet there.
+    let one_colour = format.has_colour() && !app.has_colour();
 
     bar.phase("writing");
     let t_write = Instant::now();
@@ -145,7 +144,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
         summary(
             to_stdout,
             &format!(
-                "{}: {} voxels set on grid {}x{}x{} (origin {}, {}, {}; voxel size {}) by {} in {:.1} ms; total {:.2} s -> {}",
+                "{}: {} voxels set on grid {}x{}x{} (origin {}, {}, {}; voxel size {}) by {} in {:.1} ms; total {:.2} s -> {}{}",
                 a.job.mode.name(),
                 v.report.voxels,
                 dims[0],
@@ -158,7 +157,8 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
                 method,
                 v.voxelize_s * 1e3,
                 total_s,
-                a.output.display()
+                a.output.display(),
+                if one_colour { " (the mesh has no colours: every voxel gets one)" } else { "" }
             ),
         )?;
     }

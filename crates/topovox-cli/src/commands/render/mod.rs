@@ -39,7 +39,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let t0 = Instant::now();
     let mut o = options(&a.picture, a.up)?;
     check_png_path(&a.output)?;
-    let pool = crate::pool::thread_pool(a.threads)?;
+    let pool = topovox_job::pool_for(a.threads, "--threads")?;
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.input))?;
     let (bits, what, colours, outline): (Box<dyn VoxelSource + Send>, &str, _, _) = if topovox_io::is_voxel_file(&a.input) {
         if a.picture.outline {
