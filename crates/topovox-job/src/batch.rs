@@ -111,6 +111,18 @@ pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path) ->
                     warnings.push(format!("{link}: skipped: a link back to a folder that holds it"));
                     continue;
                 }
+                // A link to nothing is one bad input, never the batch's end:
+                // one named like a mesh fails in the batch with its own
+                // manifest record, any other is skipped with a warning.
+                Err(e) if e.path().is_some_and(is_broken_link) => {
+                    let link = e.path().expect("checked above");
+                    if wanted(link, input, matcher.as_ref()) {
+                        out.push(link.to_path_buf());
+                    } else {
+                        warnings.push(format!("{}: skipped: a link to nothing (its target does not exist)", link.display()));
+                    }
+                    continue;
+                }
                 r => r.map_err(|e| JobError::failed(format!("{}: cannot list: {e}", input.display())))?,
             };
             if entry.file_type().is_dir() {
@@ -124,13 +136,7 @@ pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path) ->
             if !written.is_empty() && written.contains(&file_key(path)) {
                 continue;
             }
-            let keep = match &matcher {
-                Some(m) => path.strip_prefix(input).is_ok_and(|rel| m.is_match(rel)),
-                None => {
-                    path.extension().and_then(|e| e.to_str()).is_some_and(|e| MESH_EXTENSIONS.iter().any(|m| m.eq_ignore_ascii_case(e)))
-                }
-            };
-            if keep {
+            if wanted(path, input, matcher.as_ref()) {
                 out.push(path.to_path_buf());
             }
         }
@@ -139,6 +145,20 @@ pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path) ->
         return Err(JobError::invalid("no input meshes found (give mesh files, or folders holding them; see --glob)"));
     }
     Ok((out, warnings))
+}
+
+/// Whether `path`, found under the folder `input`, is an input: it matches
+/// `--glob`, or without one has a mesh file's extension.
+fn wanted(path: &Path, input: &Path, matcher: Option<&globset::GlobMatcher>) -> bool {
+    match matcher {
+        Some(m) => path.strip_prefix(input).is_ok_and(|rel| m.is_match(rel)),
+        None => path.extension().and_then(|e| e.to_str()).is_some_and(|e| MESH_EXTENSIONS.iter().any(|m| m.eq_ignore_ascii_case(e))),
+    }
+}
+
+/// A symbolic link whose target does not exist.
+fn is_broken_link(path: &Path) -> bool {
+    path.symlink_metadata().is_ok_and(|m| m.file_type().is_symlink()) && std::fs::metadata(path).is_err()
 }
 
 /// The keys of the outputs a manifest at `path` lists (none if there is
@@ -424,6 +444,18 @@ impl Summary {
     }
 }
 
+/// Makes the output folder (and those above it). A file standing in its
+/// place is a `NotADirectory` error that says so (Python's
+/// `NotADirectoryError`), not the system's bare "File exists".
+pub fn create_out_dir(out_dir: &Path) -> Result<()> {
+    let io = |e| JobError::Io(topovox_io::IoError::new(out_dir, topovox_io::ErrorKind::Write(e)));
+    if out_dir.exists() && !out_dir.is_dir() {
+        let e = std::io::Error::new(std::io::ErrorKind::NotADirectory, "a file stands there; the output must be a folder");
+        return Err(io(e));
+    }
+    std::fs::create_dir_all(out_dir).map_err(io)
+}
+
 /// Runs a whole batch on the current rayon pool (meshes in parallel, each
 /// voxelized in parallel too, on the same pool). Once `stop` is requested
 /// no mesh is started, those under way give up, none of them is recorded,
@@ -433,7 +465,7 @@ pub fn run(items: &[Item], out_dir: &Path, opts: &BatchOptions, progress: &dyn B
         crate::check_threads(n, "threads")?;
     }
     let t0 = Instant::now();
-    std::fs::create_dir_all(out_dir).map_err(|e| JobError::Io(topovox_io::IoError::new(out_dir, topovox_io::ErrorKind::Write(e))))?;
+    create_out_dir(out_dir)?;
     let manifest = Manifest::open(out_dir)?;
     let todo: Vec<&Item> = items.iter().filter(|i| !manifest.is_done(i, &opts.fingerprint)).collect();
     let skipped = (items.len() - todo.len()) as u64;
