@@ -20,6 +20,11 @@ topovox::choice! {
     }
 }
 
+/// How far a padded grid keeps the mesh from its pad, in voxels: two
+/// lattice units, so that snapping to the lattice (half a unit at most)
+/// leaves every vertex strictly inside the unpadded part.
+pub const PAD_GAP: f64 = 2.0 / topovox::geom::fixed::ONE as f64;
+
 /// The grid request, validated but not yet fitted to a mesh.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GridRequest {
@@ -93,7 +98,15 @@ impl GridRequest {
     }
 
     /// The grid for a mesh with these bounds.
+    ///
+    /// With a pad, the pad's voxels are empty in every mode: the mesh is
+    /// kept [`PAD_GAP`] voxel clear of them on every side (its bounds grow
+    /// by that much before the fit), so no closed voxel box of the margin
+    /// meets it and no tie sends a vertex there. Without a pad the grid is
+    /// the bounding box's, as before.
     pub fn fit(&self, bounds: &Aabb) -> Result<GridSpec> {
+        let clear = self.clear_of_pad(bounds);
+        let bounds = &clear;
         if self.fit == Fit::Cube {
             return self.cube(bounds);
         }
@@ -104,6 +117,26 @@ impl GridRequest {
         let (p, s) = (self.pad as f64, g.voxel_size());
         GridSpec::new(g.origin() - p * s, g.size(), g.dims().map(|d| d as u64 + 2 * self.pad as u64))
             .map_err(|e| JobError::invalid(format!("invalid grid: {e}")))
+    }
+
+    /// `bounds` grown by [`PAD_GAP`] voxel on every side when there is a
+    /// pad. For `--resolution N` the voxel size itself depends on the
+    /// bounds: growing by `e = L·g / (m − 2g)` (L the longest side, m the
+    /// voxels it spans) makes the voxel `s = L / (m − 2g)` and `e = g·s`.
+    fn clear_of_pad(&self, bounds: &Aabb) -> Aabb {
+        if self.pad == 0 || bounds.is_empty() {
+            return *bounds;
+        }
+        let g = PAD_GAP;
+        let e = match &self.kind {
+            GridKind::Resolution(n) => {
+                let m = if self.fit == Fit::Cube { n - 2 * self.pad as u64 } else { *n } as f64;
+                DVec3::splat((bounds.max - bounds.min).max_element() * g / (m - 2.0 * g))
+            }
+            GridKind::VoxelSize(s) => s.0 * g,
+            GridKind::Explicit { .. } => return *bounds,
+        };
+        Aabb { min: bounds.min - e, max: bounds.max + e }
     }
 
     /// The centred cube: N³ voxels (`--resolution N`, the mesh's longest
@@ -204,12 +237,14 @@ mod cube_tests {
             assert!(nx == ny && ny == nz, "{:?}", g.dims());
             if let Some(n) = r {
                 assert_eq!(nx as u64, n);
-                // The longest side spans exactly N − 2·pad voxels.
-                assert!(((b.max.x - b.min.x) / s - (n - 2 * pad as u64) as f64).abs() < 1e-9);
+                // The longest side spans N − 2·pad voxels, less the gap
+                // that keeps it clear of the pad.
+                let gap = if pad > 0 { 2.0 * PAD_GAP } else { 0.0 };
+                assert!(((b.max.x - b.min.x) / s - ((n - 2 * pad as u64) as f64 - gap)).abs() < 1e-9);
             }
             let (lo, hi) = (g.origin(), g.origin() + DVec3::splat(nx as f64 * s));
             assert!(((lo + hi) * 0.5 - (b.min + b.max) * 0.5).length() < 1e-9);
-            let margin = pad as f64 * s - 1e-9;
+            let margin = if pad > 0 { (pad as f64 + PAD_GAP) * s - 1e-12 } else { 0.0 };
             assert!((b.min - lo).min_element() >= margin && (hi - b.max).min_element() >= margin, "{r:?} {v:?} {pad}");
         }
         assert!(
@@ -232,11 +267,46 @@ mod cube_tests {
         let r = GridRequest::new(&o).unwrap();
         assert_eq!(r.boxes(), Some([0.7, 0.7, 2.5].into()));
         let g = r.fit(&b).unwrap();
-        assert_eq!(g.dims(), [4, 4, 4]);
-        assert_eq!(g.origin(), DVec3::new(-0.7, -0.7, -2.5));
+        // Two voxels' worth of mesh a side, clear of the pad: three, plus the pad.
+        assert_eq!(g.dims(), [5, 5, 5]);
+        assert!((g.origin() - DVec3::new(-0.7, -0.7, -2.5) * (1.0 + PAD_GAP)).length() < 1e-12);
+        let unpadded = GridRequest::new(&GridOptions { pad: None, ..o.clone() }).unwrap().fit(&b).unwrap();
+        assert_eq!((unpadded.dims(), unpadded.origin()), ([2, 2, 2], DVec3::ZERO));
         let bad = GridOptions { voxel_size: Some([0.7, -1.0, 2.5].into()), ..GridOptions::default() };
         assert!(GridRequest::new(&bad).unwrap_err().to_string().contains("-1"));
         let cubes = GridOptions { voxel_size: Some(0.5.into()), ..GridOptions::default() };
         assert_eq!(GridRequest::new(&cubes).unwrap().boxes(), None);
+    }
+
+    #[test]
+    fn a_padded_grid_keeps_the_mesh_strictly_inside_its_unpadded_part() {
+        let b = Aabb { min: DVec3::new(0.0, 0.0, 0.0), max: DVec3::new(1.0, 0.5, 0.25) };
+        for fit in [Fit::Box, Fit::Cube] {
+            for (resolution, voxel_size) in [(Some(8), None), (Some(5), None), (None, Some(0.125)), (None, Some(0.25))] {
+                for pad in [1u32, 2] {
+                    let o = GridOptions {
+                        resolution,
+                        voxel_size: voxel_size.map(VoxelSize::from),
+                        pad: Some(pad),
+                        fit: Some(fit),
+                        ..GridOptions::default()
+                    };
+                    let g = GridRequest::new(&o).unwrap().fit(&b).unwrap();
+                    for corner in [b.min, b.max] {
+                        let u = g.to_grid_units(corner);
+                        for a in 0..3 {
+                            let (lo, hi) = (pad as f64, (g.dims()[a] - pad) as f64);
+                            // In lattice units, after snapping: at least one unit inside.
+                            let snapped = (u[a] * 4096.0).round() / 4096.0;
+                            assert!(
+                                snapped > lo && snapped < hi,
+                                "{fit:?} {resolution:?} {voxel_size:?} pad {pad}: {u:?} in {:?}",
+                                g.dims()
+                            );
+                        }
+                    }
+                }
+            }
+        }
     }
 }
