@@ -55,6 +55,8 @@ def uses_gpu(block: str) -> bool:
 def workdir(tmp_path_factory, cli):
     d = tmp_path_factory.mktemp("docs")
     shutil.copytree(REPO / "examples", d / "examples")
+    # As in a checkout after `cargo run`: README's first command writes there.
+    (d / "target").mkdir()
     bindir = d / "bin"
     bindir.mkdir()
     (bindir / "topovox").symlink_to(pathlib.Path(cli).resolve())

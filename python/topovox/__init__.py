@@ -170,6 +170,22 @@ def _trimesh_appearance(mesh: Any) -> Dict[str, Any]:
     return {}
 
 
+def _tensor_array(t: Any) -> np.ndarray:
+    """An Open3D tensor (on any device) as a NumPy array."""
+    return np.asarray(t.cpu().numpy() if hasattr(t, "cpu") else t.numpy())
+
+
+def _from_open3d_tensor(m: Any) -> Mesh:
+    """An ``open3d.t.geometry.TriangleMesh``: ``vertex.positions``,
+    ``triangle.indices`` and, when present, ``vertex.colors``."""
+    v, t = m.vertex, m.triangle
+    if "positions" not in v or "indices" not in t:
+        raise ValueError("an Open3D tensor TriangleMesh needs vertex.positions and triangle.indices")
+    vc = _colours(_tensor_array(v["colors"])) if "colors" in v else None
+    positions = _as_float_points(_tensor_array(v["positions"]), "vertices")
+    return Mesh(positions, _as_index_array(_tensor_array(t["indices"]), "triangles"), vertex_colours=vc)
+
+
 def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]], faces: Optional[Any] = None) -> Mesh:
     """A :class:`Mesh` from whatever holds a triangle mesh.
 
@@ -180,7 +196,9 @@ def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]]
         ``trimesh.Trimesh`` (``vertices`` and ``faces``, with its texture and
         UVs, or its vertex or face colours) or ``trimesh.Scene``
         (its geometry, concatenated); an Open3D ``TriangleMesh``
-        (``vertices`` and ``triangles``, with its vertex colours); a
+        (``vertices`` and ``triangles``, with its vertex colours) or
+        tensor-API ``open3d.t.geometry.TriangleMesh`` (``vertex.positions``,
+        ``triangle.indices``, ``vertex.colors``); a
         ``(vertices, faces)`` pair; or an ``(n, 3)`` vertex array with
         ``faces``.
     faces
@@ -224,6 +242,8 @@ def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]]
                 _as_index_array(np.asarray(m.triangles), "triangles"),
                 vertex_colours=vc,
             )
+        if hasattr(m, "vertex") and hasattr(m, "triangle"):  # open3d.t.geometry.TriangleMesh, the tensor API
+            return _from_open3d_tensor(m)
         raise ValueError(
             "give a topovox.Mesh, a path, a trimesh mesh or scene, an Open3D TriangleMesh, "
             f"a (vertices, faces) pair, or vertices and faces arrays; got {type(m).__name__}"
