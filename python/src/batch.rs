@@ -2,17 +2,19 @@
 //! the plan, one-mesh step and manifest the Dask and Ray helpers use.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde_json::Value;
 use topovox::voxelize::Stop;
+use topovox_job::batch::BatchProgress;
 use topovox_job::{JobError, OptionValue};
 
 use crate::convert::to_py;
 use crate::errors::{py_err, value_err};
-use crate::interrupt::interruptible;
+use crate::interrupt::interruptible_ticking;
 use crate::options::{job_options, option_value};
 
 /// `(input, output, done)` per mesh of a batch, and the options' fingerprint.
@@ -36,9 +38,30 @@ pub(crate) fn batch_options(
     Ok((opts, jobs))
 }
 
-/// The native batch: see `topovox.batch`.
+/// Meshes finished of all (skipped ones count as finished), shared by the
+/// batch's threads and the caller's progress callback.
+#[derive(Default)]
+struct Counts {
+    total: AtomicU64,
+    finished: AtomicU64,
+}
+
+impl BatchProgress for Counts {
+    fn start(&self, total: u64, skipped: u64) {
+        self.total.store(total, Ordering::Relaxed);
+        self.finished.store(skipped, Ordering::Relaxed);
+    }
+
+    fn finished(&self, _record: &Value) {
+        self.finished.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+/// The native batch: see `topovox.batch`. `progress(finished, total)` is
+/// called on the caller's thread as meshes finish (at most every 50 ms)
+/// and once at the end.
 #[pyfunction]
-#[pyo3(signature = (inputs, out_dir, format="npy", glob=None, options=None))]
+#[pyo3(signature = (inputs, out_dir, format="npy", glob=None, options=None, progress=None))]
 pub(crate) fn batch<'py>(
     py: Python<'py>,
     inputs: Vec<PathBuf>,
@@ -46,21 +69,33 @@ pub(crate) fn batch<'py>(
     format: &str,
     glob: Option<String>,
     options: Option<&Bound<'py, PyDict>>,
+    progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (opts, jobs) = batch_options(options, format)?;
     if let Some(n) = jobs {
         topovox_job::check_threads(n, "jobs").map_err(py_err)?;
     }
     let stop = Arc::new(Stop::new());
-    let (summary, warnings) = interruptible(py, &stop, || -> Result<(topovox_job::batch::Summary, Vec<String>), JobError> {
+    let counts = Counts::default();
+    let mut shown = None;
+    let tick = |_: Python<'_>| -> PyResult<()> {
+        let Some(f) = &progress else { return Ok(()) };
+        let now = (counts.finished.load(Ordering::Relaxed), counts.total.load(Ordering::Relaxed));
+        if now.1 > 0 && shown != Some(now) {
+            shown = Some(now);
+            f.call1(now)?;
+        }
+        Ok(())
+    };
+    let work = || -> Result<(topovox_job::batch::Summary, Vec<String>), JobError> {
         let (files, warnings) = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir)?;
         let ext = opts.format.name().replace("npy-bool", "npy");
         let items = topovox_job::batch::plan_items(&files, &out_dir, &ext)?;
         let pool = topovox_job::pool_for(jobs, "jobs")?;
-        let summary = pool.install(|| topovox_job::batch::run(&items, &out_dir, &opts, &topovox_job::batch::Silent, Some(&stop)))?;
+        let summary = pool.install(|| topovox_job::batch::run(&items, &out_dir, &opts, &counts, Some(&stop)))?;
         Ok((summary, warnings))
-    })?
-    .map_err(py_err)?;
+    };
+    let (summary, warnings) = interruptible_ticking(py, &stop, work, tick)?.map_err(py_err)?;
     let mut v = summary.to_json();
     v["warnings"] = serde_json::json!(warnings);
     to_py(py, &v)
@@ -85,6 +120,7 @@ pub(crate) fn batch_plan<'py>(
     let items = topovox_job::batch::plan_items(&files, &out_dir, &ext).map_err(py_err)?;
     topovox_job::batch::create_out_dir(&out_dir).map_err(py_err)?;
     let manifest = topovox_job::batch::Manifest::open(&out_dir).map_err(py_err)?;
+    manifest.refuse_other_options(&items, &opts.fingerprint).map_err(py_err)?;
     let listed = items
         .iter()
         .map(|i| (i.input.display().to_string(), i.output.display().to_string(), manifest.is_done(i, &opts.fingerprint)))

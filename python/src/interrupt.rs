@@ -18,6 +18,18 @@ pub(crate) const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_mi
 /// what the work made is dropped. Outside the main thread Python runs no
 /// signal handlers, and this only runs the work.
 pub(crate) fn interruptible<T: Send>(py: Python<'_>, stop: &Stop, work: impl FnOnce() -> T + Send) -> PyResult<T> {
+    interruptible_ticking(py, stop, work, |_| Ok(()))
+}
+
+/// [`interruptible`], calling `tick` on this thread, with the GIL, at every
+/// poll and once when the work is done (a progress callback). An error
+/// from `tick` stops the work as Ctrl-C does.
+pub(crate) fn interruptible_ticking<T: Send>(
+    py: Python<'_>,
+    stop: &Stop,
+    work: impl FnOnce() -> T + Send,
+    mut tick: impl FnMut(Python<'_>) -> PyResult<()>,
+) -> PyResult<T> {
     use std::sync::mpsc::{self, RecvTimeoutError};
     std::thread::scope(|s| {
         let (done, mut result) = mpsc::sync_channel(1);
@@ -34,7 +46,7 @@ pub(crate) fn interruptible<T: Send>(py: Python<'_>, stop: &Stop, work: impl FnO
             let got;
             (got, result) = py.detach(move || (result.recv_timeout(SIGNAL_POLL), result));
             match got {
-                Ok(r) => return Ok(r),
+                Ok(r) => return tick(py).map(|()| r),
                 // The worker ended without a result: it panicked.
                 Err(RecvTimeoutError::Disconnected) => {
                     return Err(worker.join().map_or_else(
@@ -44,7 +56,7 @@ pub(crate) fn interruptible<T: Send>(py: Python<'_>, stop: &Stop, work: impl FnO
                 }
                 Err(RecvTimeoutError::Timeout) => {}
             }
-            if let Err(e) = py.check_signals() {
+            if let Err(e) = py.check_signals().and_then(|()| tick(py)) {
                 stop.request();
                 // Its result (incomplete, or an Interrupted error) is dropped.
                 let _ = py.detach(|| worker.join());

@@ -69,8 +69,16 @@ def test_python_batch_equals_cli_batch_and_resumes(tmp_path, dataset, cli):
     # The CLI resumes the Python run (same options, same manifest).
     r2 = json.loads(run_cli(cli, "batch", dataset, "-o", py_out, "--resolution", 32, "--mode", "sep6", "--json", check=False).stdout)
     assert r2["skipped"] == 6
-    # Other options redo everything.
-    s3 = topovox.batch(dataset, py_out, resolution=16, mode="sep6")
+    # Other options never replace the outputs without a word: refused,
+    # naming what differs, and nothing is touched (issue 53).
+    before = {p: p.stat().st_mtime_ns for p in py_out.rglob("*.npy")}
+    with pytest.raises(FileExistsError, match="other options \\(resolution 32 → 16\\)"):
+        topovox.batch(dataset, py_out, resolution=16, mode="sep6")
+    assert {p: p.stat().st_mtime_ns for p in py_out.rglob("*.npy")} == before
+    r3 = run_cli(cli, "batch", dataset, "-o", py_out, "--resolution", 16, "--mode", "sep6", check=False)
+    assert r3.returncode == 1 and "other options" in r3.stderr and len(r3.stderr.strip().splitlines()) == 1, r3.stderr
+    # Elsewhere they run.
+    s3 = topovox.batch(dataset, tmp_path / "other", resolution=16, mode="sep6")
     assert s3["done"] == 6
 
 
@@ -95,8 +103,13 @@ def test_batch_errors(tmp_path, dataset, meshes):
     clash.mkdir()
     shutil.copy(meshes / "cow.obj", clash / "m.obj")
     (clash / "m.stl").write_bytes(b"solid x\nendsolid x\n")
+    # Inputs that differ only in their extension get one output each.
+    s = topovox.batch(clash, tmp_path / "o2")
+    assert (s["done"], s["failed"]) == (1, 1), s
+    assert (tmp_path / "o2" / "m.obj.npy").exists() and not (tmp_path / "o2" / "m.npy").exists()
+    assert {r["output"].rsplit("/", 1)[-1] for r in manifest(tmp_path / "o2")} == {"m.obj.npy", "m.stl.npy"}
     with pytest.raises(ValueError, match="would both be written to"):
-        topovox.batch(clash, tmp_path / "o2")
+        topovox.batch([clash / "m.obj", clash / "m.obj"], tmp_path / "o5")
     with pytest.raises(ValueError, match="unknown option \"resolutoin\""):
         topovox.batch(dataset, tmp_path / "o3", resolutoin=3)
     with pytest.raises(FileNotFoundError):
@@ -168,5 +181,7 @@ def test_batch_attributes_into_vdb(tmp_path, meshes, cli):
         assert name in a
     assert manifest(py_out)[0]["options"]["attributes"] is True
     assert "attributes" not in manifest(plain)[0]["options"]
-    # Other options redo the mesh: attributes asked for after a plain run.
-    assert topovox.batch(src, plain, format="vdb", resolution=24, attributes=True)["done"] == 1
+    # Other options never replace it without a word: attributes asked for
+    # after a plain run are refused, naming the option (issue 53).
+    with pytest.raises(FileExistsError, match="attributes unset → true"):
+        topovox.batch(src, plain, format="vdb", resolution=24, attributes=True)

@@ -153,7 +153,6 @@ def test_keywords_replace_flags_but_never_touch_file_names(tmp_path, meshes):
     d = tmp_path / "x--in"
     d.mkdir()
     shutil.copy(meshes / "cow.obj", d / "a--b.obj")
-    (d / "a--b.stl").write_bytes(b"solid x\nendsolid x\n")
     with pytest.raises(ValueError) as e:
-        topovox.batch(d, tmp_path / "out")
+        topovox.batch([d / "a--b.obj", d / "a--b.obj"], tmp_path / "out")
     assert "a--b" in str(e.value) and "x--in" in str(e.value)

@@ -191,16 +191,33 @@ fn absolute(p: &Path) -> PathBuf {
 }
 
 /// Pairs each input with its output under `out_dir`: the input's path
-/// below the common folder of all inputs, with `ext`. Refuses two inputs
-/// with one output, and an output that is an input.
+/// below the common folder of all inputs, with `ext`. Inputs that differ
+/// only in their extension (`a.obj`, `a.stl`) keep it in their outputs'
+/// names (`a.obj.npy`, `a.stl.npy`), so each has its own. Refuses two
+/// inputs with one output still (the same file given twice), and an
+/// output that is an input.
 pub fn plan_items(inputs: &[PathBuf], out_dir: &Path, ext: &str) -> Result<Vec<Item>> {
     let common = common_folder(inputs);
+    let below = |input: &Path| {
+        let abs = absolute(input);
+        abs.strip_prefix(&common).map(Path::to_path_buf).unwrap_or(abs)
+    };
+    let plain = |input: &Path| out_dir.join(below(input)).with_extension(ext);
+    let mut sharing: HashMap<PathBuf, usize> = HashMap::new();
+    for input in inputs {
+        *sharing.entry(plain(input)).or_default() += 1;
+    }
     let mut seen: HashMap<PathBuf, &Path> = HashMap::new();
     let mut items = Vec::with_capacity(inputs.len());
     for input in inputs {
-        let abs = absolute(input);
-        let rel = abs.strip_prefix(&common).unwrap_or(&abs);
-        let output = out_dir.join(rel).with_extension(ext);
+        let mut output = plain(input);
+        if sharing[&output] > 1 {
+            let rel = below(input);
+            let mut name = rel.file_name().map(|n| n.to_os_string()).unwrap_or_default();
+            name.push(".");
+            name.push(ext);
+            output = out_dir.join(rel).with_file_name(name);
+        }
         if let Some(other) = seen.insert(output.clone(), input) {
             return Err(JobError::invalid(format!(
                 "{} and {} would both be written to {}; batch them separately or rename one",
@@ -209,7 +226,7 @@ pub fn plan_items(inputs: &[PathBuf], out_dir: &Path, ext: &str) -> Result<Vec<I
                 output.display()
             )));
         }
-        if absolute(&output) == abs {
+        if absolute(&output) == absolute(input) {
             return Err(JobError::invalid(format!(
                 "{}: the output would overwrite the input; choose another output folder",
                 input.display()
@@ -313,6 +330,26 @@ impl Manifest {
         &self.path
     }
 
+    /// Refuses to let a batch with these options replace an output that an
+    /// earlier batch wrote with other options (a rerun used to overwrite it
+    /// without a word): the error names the output and the options that
+    /// differ. Python raises it as `FileExistsError`.
+    pub fn refuse_other_options(&self, items: &[Item], fingerprint: &Value) -> Result<()> {
+        for item in items {
+            let Some(v) = self.done.get(&file_key(&item.input)) else { continue };
+            if v["options"] == *fingerprint || recorded_key(v, "output") != Some(file_key(&item.output)) || !item.output.exists() {
+                continue;
+            }
+            let why = format!(
+                "written by an earlier batch with other options ({}); give another output folder, or delete the outputs to redo them",
+                option_changes(&v["options"], fingerprint)
+            );
+            let e = std::io::Error::new(std::io::ErrorKind::AlreadyExists, why);
+            return Err(JobError::Io(topovox_io::IoError::new(&item.output, topovox_io::ErrorKind::Write(e))));
+        }
+        Ok(())
+    }
+
     /// Whether `item` was done with these options and its output is still
     /// there, complete (the recorded size).
     pub fn is_done(&self, item: &Item, fingerprint: &Value) -> bool {
@@ -331,6 +368,28 @@ impl Manifest {
             .and_then(|_| f.flush())
             .map_err(|e| JobError::Io(topovox_io::IoError::new(&self.path, topovox_io::ErrorKind::Write(e))))
     }
+}
+
+/// The options two fingerprints give differently, as `name old → new`
+/// (at most four; `unset` where one has none).
+fn option_changes(old: &Value, new: &Value) -> String {
+    let keys: std::collections::BTreeSet<&String> = [old, new].iter().filter_map(|v| v.as_object()).flat_map(|o| o.keys()).collect();
+    let shown = |v: Option<&Value>| match v {
+        None | Some(Value::Null) => "unset".to_string(),
+        Some(Value::String(s)) => s.clone(),
+        Some(v) => v.to_string(),
+    };
+    let changed: Vec<String> = keys
+        .into_iter()
+        .filter(|k| old.get(k.as_str()) != new.get(k.as_str()))
+        .map(|k| format!("{k} {} → {}", shown(old.get(k.as_str())), shown(new.get(k.as_str()))))
+        .collect();
+    let more = changed.len().saturating_sub(4);
+    let mut text = changed.into_iter().take(4).collect::<Vec<_>>().join(", ");
+    if more > 0 {
+        text += &format!(" and {more} more");
+    }
+    text
 }
 
 /// Voxelizes one mesh and writes its output; never fails: a failure is
@@ -467,6 +526,7 @@ pub fn run(items: &[Item], out_dir: &Path, opts: &BatchOptions, progress: &dyn B
     let t0 = Instant::now();
     create_out_dir(out_dir)?;
     let manifest = Manifest::open(out_dir)?;
+    manifest.refuse_other_options(items, &opts.fingerprint)?;
     let todo: Vec<&Item> = items.iter().filter(|i| !manifest.is_done(i, &opts.fingerprint)).collect();
     let skipped = (items.len() - todo.len()) as u64;
     progress.start(items.len() as u64, skipped);
