@@ -252,6 +252,30 @@ impl DistanceGrid {
         interruptible(py, &stop, || topovox_job::distance::write(&path, format, inner, Some(&stop)))?.map_err(py_err)
     }
 
+    /// `a == b`: the same place, sign, background, stored voxels and
+    /// values (bit for bit) and inside voxels; facts are not compared.
+    fn __eq__(&self, py: Python<'_>, other: &Bound<'_, DistanceGrid>) -> bool {
+        let o = other.get();
+        let (a, b) = (&self.inner, &o.inner);
+        if !placement::same_place(&a.grid, &b.grid) || a.signed != b.signed || a.field.background.to_bits() != b.field.background.to_bits()
+        {
+            return false;
+        }
+        let bits = |v: &[([u32; 3], f32)]| v.iter().map(|e| (e.0, e.1.to_bits())).collect::<Vec<_>>();
+        if bits(self.ordered(py)) != bits(o.ordered(py)) {
+            return false;
+        }
+        let (x, y) = (a.clone(), b.clone());
+        py.detach(move || match (&x.field.inside, &y.field.inside) {
+            (Some(p), Some(q)) => placement::same_voxels(p, q),
+            (p, q) => p.is_none() && q.is_none(),
+        })
+    }
+
+    fn __hash__(&self) -> u64 {
+        placement::hash_of(&self.inner.grid, self.inner.field.band.count())
+    }
+
     fn __repr__(&self) -> String {
         let [x, y, z] = self.inner.grid.dims();
         let kind = if self.inner.signed { "signed" } else { "unsigned" };

@@ -641,6 +641,18 @@ impl VoxelGrid {
         Ok((ctor, args.into_pyobject(py)?.into_any()))
     }
 
+    /// `a == b`: the same set voxels at the same place (origin, voxel size,
+    /// dims); attributes and facts are not compared. Grids are immutable,
+    /// so they hash (equal grids alike) and can be set members and keys.
+    fn __eq__(&self, py: Python<'_>, other: &Bound<'_, VoxelGrid>) -> bool {
+        let (a, b) = (self.inner.clone(), other.get().inner.clone());
+        placement::same_place(&a.grid, &b.grid) && py.detach(move || placement::same_voxels(&a.voxels, &b.voxels))
+    }
+
+    fn __hash__(&self) -> u64 {
+        placement::hash_of(&self.inner.grid, self.inner.voxels.count())
+    }
+
     fn __repr__(&self) -> String {
         let [x, y, z] = self.inner.grid.dims();
         let mode = self.inner.facts.get("mode").and_then(Value::as_str).map(|m| format!(" {m}")).unwrap_or_default();

@@ -11,7 +11,7 @@ use glam::DVec3;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
-use topovox::GridSpec;
+use topovox::{GridSpec, VoxelSource};
 
 use crate::convert::{indices_from, points_from, shape, size_to_py};
 use crate::errors::value_err;
@@ -95,4 +95,33 @@ pub(crate) fn index_to_world<'py>(py: Python<'py>, g: &GridSpec, indices: &Bound
     let ijk = indices_from::<3>("indices", &arr)?;
     let (o, s) = (g.origin(), g.voxel_size());
     shaped(Array2::from_shape_fn((ijk.len(), 3), |(n, c)| o[c] + (ijk[n][c] as f64 + 0.5) * s[c]), one, py)
+}
+
+/// The same place: origin, voxel size and dims, exactly (`==` on grids).
+pub(crate) fn same_place(a: &GridSpec, b: &GridSpec) -> bool {
+    a.origin() == b.origin() && a.voxel_size() == b.voxel_size() && a.dims() == b.dims()
+}
+
+/// The same set voxels, whatever holds them (dense bits, sparse bricks):
+/// `for_each_set` visits them in one order for every holder.
+pub(crate) fn same_voxels(a: &dyn VoxelSource, b: &dyn VoxelSource) -> bool {
+    if a.dims() != b.dims() || a.count() != b.count() {
+        return false;
+    }
+    let mut first = Vec::with_capacity(a.count() as usize);
+    a.for_each_set(&mut |i, j, k| first.push([i, j, k]));
+    let (mut n, mut same) = (0usize, true);
+    b.for_each_set(&mut |i, j, k| {
+        same &= first.get(n) == Some(&[i, j, k]);
+        n += 1;
+    });
+    same && n == first.len()
+}
+
+/// A hash that equal grids share: the place and the count.
+pub(crate) fn hash_of(g: &GridSpec, count: u64) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (g.dims(), g.origin().to_array().map(f64::to_bits), g.voxel_size().to_array().map(f64::to_bits), count).hash(&mut h);
+    h.finish()
 }
