@@ -135,3 +135,19 @@ def test_ctrl_c_interrupts_a_long_call_at_once_and_leaves_nothing(tmp_path, call
     assert [n for n in written if n.endswith(".vdb") or ".topovox-" in n] == []
     manifest = tmp_path / "out" / "manifest.jsonl"
     assert not manifest.exists() or manifest.read_text().strip() == ""
+
+
+def test_a_distance_field_too_large_to_be_dense_refuses_dense_files_before_any_work(tmp_path):
+    # Issue 54: DistanceGrid.save to .npy/.vti of such a field aborted the
+    # interpreter ("memory allocation of 274877906944 bytes failed").
+    import numpy as np
+
+    tetra = (np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float), np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]))
+    # A 4096³ grid far from the mesh: an empty band, a field no machine here holds densely.
+    field = topovox.sdf(*tetra, origin=(100, 100, 100), voxel_size=1.0, dims=(4096, 4096, 4096), band=1, unsigned=True)
+    for ext in ("npy", "vti"):
+        with pytest.raises(RuntimeError, match="keep only the band"):
+            field.save(tmp_path / f"x.{ext}")
+        assert not any(tmp_path.iterdir())
+    field.save(tmp_path / "x.vdb")
+    assert (tmp_path / "x.vdb").stat().st_size > 0

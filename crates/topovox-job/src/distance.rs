@@ -237,8 +237,24 @@ pub fn sdf(mesh: MeshRef<'_>, name: &str, req: &SdfRequest, stop: Option<&Stop>)
 
 /// Writes `sdf` to `out` in `format`: to a temporary beside it, renamed
 /// into place (a Zarr folder replaces only a Zarr array topovox wrote).
+///
+/// `.npy` and `.vti` hold every voxel: a field whose dense copy would not
+/// fit in memory is refused before anything is made (Python's
+/// `DistanceGrid.save` reaches here with any field it holds).
 pub fn write(out: &Path, format: DistanceFormat, sdf: &Sdf, stop: Option<&Stop>) -> Result<()> {
     let (field, grid) = (&sdf.field, &sdf.grid);
+    if format.is_dense() {
+        let (need, limit) = (grid.voxel_count().saturating_mul(4), budget(None));
+        if need > limit {
+            let [x, y, z] = grid.dims();
+            return Err(JobError::failed(format!(
+                "{}: a dense {x}x{y}x{z} field needs {} (float32 per voxel), more than the {} available; .vdb and .zarr keep only the band",
+                out.display(),
+                bytes(need),
+                bytes(limit)
+            )));
+        }
+    }
     let io = |e: topovox_io::IoError| JobError::Io(e);
     match format {
         DistanceFormat::Zarr => topovox_io::zarr::write_distance(out, field, grid, sdf.signed, stop).map_err(io),
