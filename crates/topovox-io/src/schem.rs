@@ -267,6 +267,100 @@ pub fn write(
     Ok(())
 }
 
+/// How deeply NBT compounds and lists may nest: fastnbt's deserializer
+/// recurses once per level (skipping unknown tags too), and 467 bytes of
+/// gzip can nest 85,000 compounds (a stack overflow). Schematics nest a
+/// handful deep.
+const MAX_NBT_DEPTH: usize = 512;
+
+/// One open NBT container while [`nbt_depth`] walks the tags.
+enum Open {
+    /// Named tags until TAG_End.
+    Compound,
+    /// `left` more payloads of tag type `of`.
+    List { of: u8, left: u32 },
+}
+
+/// Refuses NBT nesting compounds and lists deeper than `limit`, walked
+/// with an explicit stack (the point is not to recurse). Each step reads
+/// at least one byte, so the walk ends; a truncated or malformed stream
+/// is left for fastnbt to report.
+fn nbt_depth(b: &[u8], limit: usize) -> Result<(), String> {
+    let mut at = 0usize;
+    let take = |at: &mut usize, n: usize| -> Option<usize> {
+        let start = *at;
+        *at = at.checked_add(n).filter(|&e| e <= b.len())?;
+        Some(start)
+    };
+    let int = |at: usize, n: usize| b[at..at + n].iter().fold(0u64, |v, &x| v << 8 | x as u64);
+    // Skips a payload of `tag`, or opens it; None: the stream ended.
+    let mut stack: Vec<Open> = Vec::new();
+    let payload = |tag: u8, at: &mut usize, stack: &mut Vec<Open>| -> Option<()> {
+        let fixed = [0usize, 1, 2, 4, 8, 4, 8];
+        match tag {
+            0..=6 => {
+                take(at, fixed[tag as usize])?;
+            }
+            7 | 11 | 12 => {
+                let n = int(take(at, 4)?, 4) as u32 as i32;
+                take(at, n.max(0) as usize * [1, 4, 8][(tag != 7) as usize + (tag == 12) as usize])?;
+            }
+            8 => {
+                let n = int(take(at, 2)?, 2) as usize;
+                take(at, n)?;
+            }
+            9 => {
+                let of = b[take(at, 1)?];
+                let n = int(take(at, 4)?, 4) as u32 as i32;
+                match of {
+                    0..=6 => {
+                        take(at, n.max(0) as usize * fixed[of as usize])?;
+                    }
+                    _ => stack.push(Open::List { of, left: n.max(0) as u32 }),
+                }
+            }
+            10 => stack.push(Open::Compound),
+            _ => return None,
+        }
+        Some(())
+    };
+    // The root: a named tag.
+    let Some(t) = take(&mut at, 1).map(|i| b[i]) else { return Ok(()) };
+    let named = |at: &mut usize| take(at, 2).and_then(|i| take(at, int(i, 2) as usize));
+    if named(&mut at).and_then(|_| payload(t, &mut at, &mut stack)).is_none() {
+        return Ok(());
+    }
+    while !stack.is_empty() {
+        if stack.len() > limit {
+            return Err(format!("NBT nested more than {limit} deep"));
+        }
+        // The next payload's tag: a list's element type, or a compound's next tag.
+        let list_item = match stack.last_mut() {
+            Some(Open::List { left: 0, .. }) => {
+                stack.pop();
+                continue;
+            }
+            Some(Open::List { of, left }) => {
+                *left -= 1;
+                Some(*of)
+            }
+            _ => None,
+        };
+        let step = match list_item {
+            Some(of) => payload(of, &mut at, &mut stack),
+            None => match take(&mut at, 1).map(|i| b[i]) {
+                Some(0) => stack.pop().map(|_| ()),
+                Some(t) => named(&mut at).and_then(|_| payload(t, &mut at, &mut stack)),
+                None => None,
+            },
+        };
+        if step.is_none() {
+            return Ok(());
+        }
+    }
+    Ok(())
+}
+
 /// Reads a Sponge schematic (version 2 or 3): every non-air block is a
 /// voxel, coloured from the built-in table where the block is in it,
 /// rotated back from Minecraft's y-up by the up axis the file records
@@ -275,6 +369,7 @@ pub fn read(bytes: &[u8], up: Up) -> Result<LoadedVoxels, ErrorKind> {
     let bad = |m: String| ErrorKind::malformed("schem", m);
     let mut nbt = Vec::new();
     flate2::read::GzDecoder::new(bytes).take(1 << 31).read_to_end(&mut nbt).map_err(|e| bad(format!("not gzip-compressed NBT ({e})")))?;
+    nbt_depth(&nbt, MAX_NBT_DEPTH).map_err(bad)?;
     let (w, h, l, palette, data, recorded) = match fastnbt::from_bytes::<V2>(&nbt) {
         Ok(v) => (v.width, v.height, v.length, v.palette, v.block_data, v.metadata.and_then(|m| m.topovox_up)),
         Err(e2) => match fastnbt::from_bytes::<V3Root>(&nbt) {
@@ -331,4 +426,72 @@ pub fn read(bytes: &[u8], up: Up) -> Result<LoadedVoxels, ErrorKind> {
         cell += 1;
     }
     Ok(LoadedVoxels { bits, placement: None, attributes: Some(VoxelAttributes::from_coloured(dims, coloured)) })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gzip(bytes: &[u8]) -> Vec<u8> {
+        let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        std::io::Write::write_all(&mut e, bytes).unwrap();
+        e.finish().unwrap()
+    }
+
+    /// A root compound holding `n` nested compounds, then a list of lists.
+    fn nested(n: usize) -> Vec<u8> {
+        let mut b = vec![10, 0, 9];
+        b.extend_from_slice(b"Schematic");
+        for _ in 0..n {
+            b.extend_from_slice(&[10, 0, 1, b'a']);
+        }
+        b.extend(std::iter::repeat_n(0u8, n + 1));
+        b
+    }
+
+    #[test]
+    fn deep_nesting_is_refused_not_a_stack_overflow() {
+        // Issue 54: 85,000 nested compounds in 467 bytes overflowed the stack.
+        let e = read(&gzip(&nested(85_000)), Up::Y).unwrap_err().to_string();
+        assert!(e.contains("NBT nested more than 512 deep"), "{e}");
+        assert!(gzip(&nested(85_000)).len() < 1000);
+        // Lists nest too: a list of lists of ... compounds.
+        let mut b = vec![10, 0, 1, b's', 9, 0, 1, b'l'];
+        for _ in 0..1000 {
+            b.extend_from_slice(&[9, 0, 0, 0, 1]);
+        }
+        let e = read(&gzip(&b), Up::Y).unwrap_err().to_string();
+        assert!(e.contains("NBT nested more than 512 deep"), "{e}");
+        // Shallow but not a schematic: fastnbt says what is wrong.
+        let e = read(&gzip(&nested(20)), Up::Y).unwrap_err().to_string();
+        assert!(!e.contains("nested") && e.contains("schematic"), "{e}");
+    }
+
+    #[test]
+    fn the_depth_walk_reads_every_tag_kind() {
+        // byte, short, int, long, float, double, byte array, string, list of
+        // ints, int array, long array, then End: depth 1, nothing refused.
+        let mut b = vec![10, 0, 0];
+        for (tag, payload) in [
+            (1u8, vec![7u8]),
+            (2, vec![0, 7]),
+            (3, vec![0, 0, 0, 7]),
+            (4, vec![0; 8]),
+            (5, vec![0; 4]),
+            (6, vec![0; 8]),
+            (7, vec![0, 0, 0, 2, 1, 2]),
+            (8, vec![0, 2, b'h', b'i']),
+            (9, vec![3, 0, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 2]),
+            (11, vec![0, 0, 0, 1, 0, 0, 0, 9]),
+            (12, vec![0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 9]),
+        ] {
+            b.extend_from_slice(&[tag, 0, 1, b'x']);
+            b.extend(payload);
+        }
+        b.push(0);
+        assert_eq!(nbt_depth(&b, 1), Ok(()));
+        // The root compound is a level: `nested(n)` is n + 1 deep.
+        assert_eq!(nbt_depth(&nested(2), 3), Ok(()));
+        assert!(nbt_depth(&nested(3), 3).is_err());
+    }
 }

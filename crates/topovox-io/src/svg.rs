@@ -131,6 +131,7 @@ impl Affine {
 pub fn read(bytes: &[u8], opts: &SvgOptions) -> Result<LoadedSvg, ErrorKind> {
     let text = std::str::from_utf8(bytes).map_err(|e| ErrorKind::malformed("SVG", format!("not UTF-8 ({e})")))?;
     let doc = roxmltree::Document::parse(text).map_err(|e| ErrorKind::malformed("SVG", e))?;
+    check_depth(&doc)?;
     let mut paths: Vec<Element> = Vec::new();
     let mut warnings = Vec::new();
     walk(doc.root_element(), (Affine::ID, Painting::INITIAL), &mut paths, &mut warnings)?;
@@ -284,6 +285,27 @@ fn number(node: roxmltree::Node<'_, '_>, name: &str, default: f64) -> Result<f64
     }
 }
 
+/// How deeply elements may nest: [`walk`] recurses once per level, and a
+/// few kilobytes of SVG can nest thousands of `<g>` (a stack overflow).
+/// Drawings nest a few dozen deep.
+const MAX_DEPTH: usize = 512;
+
+/// Refuses a document nesting elements deeper than [`MAX_DEPTH`], found
+/// without recursion: the open elements of a walk in document order.
+fn check_depth(doc: &roxmltree::Document<'_>) -> Result<(), ErrorKind> {
+    let mut open: Vec<roxmltree::Node<'_, '_>> = Vec::new();
+    for n in doc.descendants().filter(|n| n.is_element()) {
+        while open.last().is_some_and(|&last| Some(last) != n.parent()) {
+            open.pop();
+        }
+        open.push(n);
+        if open.len() > MAX_DEPTH {
+            return Err(ErrorKind::malformed("SVG", format!("elements nested more than {MAX_DEPTH} deep")));
+        }
+    }
+    Ok(())
+}
+
 /// Reads the drawn elements under `node`, with the transform and painting
 /// its parent passes on.
 fn walk(
@@ -428,6 +450,15 @@ mod tests {
         );
         assert_eq!(o[0].points, vec![DVec2::new(10., 0.), DVec2::new(12., 0.), DVec2::new(10., 2.)]);
         assert!(o[0].closed && !o[1].closed);
+    }
+
+    #[test]
+    fn deep_nesting_is_refused_not_a_stack_overflow() {
+        // Issue 54: 9,000 nested <g> (63 KB) overflowed the stack.
+        let deep = |n: usize| format!("<svg>{}<path d=\"M0 0 L1 0 L0 1 Z\"/>{}</svg>", "<g>".repeat(n), "</g>".repeat(n));
+        let e = read(deep(9000).as_bytes(), &SvgOptions::default()).unwrap_err().to_string();
+        assert!(e.contains("nested more than 512 deep"), "{e}");
+        assert_eq!(outlines(&deep(MAX_DEPTH - 2)).len(), 1);
     }
 
     #[test]
