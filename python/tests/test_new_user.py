@@ -207,3 +207,50 @@ def test_pad_is_an_empty_margin_in_every_mode():
                 # or line26's targets; every surface mode sets something.
                 assert occ.any() or mode in ("solid", "line6", "line26"), (mode, grid, pad)
                 assert not _margin(occ, pad).any(), (mode, grid, pad, np.argwhere(_margin(occ, pad))[:4])
+
+
+def test_batch_reports_progress_to_a_callback_and_on_stderr(tmp_path):
+    import pathlib
+    import subprocess
+    import sys
+
+    import pytest
+
+    box = pathlib.Path(__file__).resolve().parents[2] / "examples" / "meshes" / "box.obj"
+    ds = tmp_path / "ds"
+    ds.mkdir()
+    for n in range(5):
+        (ds / f"m{n}.obj").write_bytes(box.read_bytes())
+    seen = []
+    s = topovox.batch(ds, tmp_path / "out", resolution=8, jobs=1, progress=lambda done, total: seen.append((done, total)))
+    assert s["done"] == 5 and seen and seen[-1] == (5, 5), seen
+    assert all(t == 5 for _, t in seen) and [d for d, _ in seen] == sorted(d for d, _ in seen), seen
+    # A rerun: everything skipped counts as finished at once.
+    seen.clear()
+    topovox.batch(ds, tmp_path / "out", resolution=8, progress=lambda done, total: seen.append((done, total)))
+    assert seen == [(5, 5)], seen
+
+    def stop(done, total):
+        raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough"):
+        topovox.batch(ds, tmp_path / "out2", resolution=8, progress=stop)
+    code = f"import topovox; topovox.batch({str(ds)!r}, {str(tmp_path / 'out3')!r}, resolution=8, progress=True)"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0 and "5/5 meshes" in r.stderr, r.stderr
+
+
+def test_grids_compare_by_voxels_and_place_not_identity():
+    import pickle
+
+    mesh = topovox.as_mesh(*TETRA)
+    a, b = topovox.voxelize(mesh, resolution=8), topovox.voxelize(mesh, resolution=8)
+    assert a is not b and a == b and hash(a) == hash(b) and len({a, b}) == 1
+    assert pickle.loads(pickle.dumps(a)) == a
+    assert topovox.VoxelGrid.from_dense(a.to_dense(), origin=a.origin, voxel_size=a.voxel_size) == a
+    assert a != topovox.voxelize(mesh, resolution=8, mode="sep6")
+    moved = topovox.VoxelGrid.from_dense(a.to_dense(), origin=a.origin + 1, voxel_size=a.voxel_size)
+    assert a != moved and a != "a grid" and a != None  # noqa: E711
+    f, g = topovox.sdf(mesh, resolution=8), topovox.sdf(mesh, resolution=8)
+    assert f == g and hash(f) == hash(g)
+    assert f != topovox.sdf(mesh, resolution=8, band=2) and f != topovox.sdf(mesh, resolution=8, unsigned=True)

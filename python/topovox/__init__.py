@@ -44,7 +44,7 @@ command line's.
 from __future__ import annotations
 
 import os
-from typing import Any, Dict, Iterable, Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterable, Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -479,6 +479,7 @@ def batch(
     format: str = "npy",
     glob: Optional[str] = None,
     jobs: Optional[int] = None,
+    progress: Union[None, bool, Callable[[int, int], Any]] = None,
     **options: Any,
 ) -> Dict[str, Any]:
     """Voxelizes whole datasets, resumably, as ``topovox batch`` does.
@@ -504,6 +505,12 @@ def batch(
         Which files of the folders to take, such as ``"**/*.obj"``.
     jobs : int, optional
         Meshes run at once (default: all cores).
+    progress : bool or callable, optional
+        ``True`` shows ``finished/total meshes`` on stderr, as the CLI's
+        bar; a callable is called as ``progress(finished, total)`` on the
+        calling thread as meshes finish (at most every 50 ms, and once at
+        the end; meshes skipped as done count as finished). An exception it
+        raises stops the batch as Ctrl-C does.
     **options
         Every option :func:`voxelize` takes (:data:`OPTIONS`);
         ``attributes=True`` writes every attribute grid into ``.vdb`` and
@@ -518,16 +525,37 @@ def batch(
     Raises
     ------
     ValueError
-        Bad options, or two inputs that would share an output.
+        Bad options, or the same input given twice.
     FileNotFoundError
         An input that does not exist.
+    FileExistsError
+        ``out_dir`` holds outputs an earlier batch wrote with other options
+        (the message names them); nothing is replaced.
+    NotADirectoryError
+        A file stands where ``out_dir`` should be.
 
     Examples
     --------
-    >>> topovox.batch("meshes/", "voxels/", resolution=64, fit="cube")
+    >>> topovox.batch("meshes/", "voxels/", resolution=64, fit="cube", progress=True)
     """
     if isinstance(paths, (str, bytes, os.PathLike)):
         paths = [paths]
     opts = _options(dict(options, jobs=jobs))
     # fsdecode: str and bytes paths alike (names that are not UTF-8 survive).
-    return _topovox.batch([os.fsdecode(p) for p in paths], os.fsdecode(out_dir), format=format, glob=glob, options=opts)
+    report = _stderr_progress() if progress is True else progress or None
+    return _topovox.batch([os.fsdecode(p) for p in paths], os.fsdecode(out_dir), format=format, glob=glob, options=opts, progress=report)
+
+
+def _stderr_progress() -> Callable[[int, int], None]:
+    """``finished/total meshes`` on one line of stderr, as the CLI shows it."""
+    import sys
+    import time
+
+    start = time.monotonic()
+
+    def show(finished: int, total: int) -> None:
+        end = "\n" if finished >= total else ""
+        sys.stderr.write(f"\rtopovox batch: {finished}/{total} meshes ({time.monotonic() - start:.1f} s){end}")
+        sys.stderr.flush()
+
+    return show

@@ -255,19 +255,23 @@ fn polylines_voxelize_connected() {
 }
 
 #[test]
-fn pad_keeps_faces_on_the_high_side_of_a_fitted_grid() {
-    // A cube: on a fitted grid its high faces lie exactly in the grid's
-    // high planes, where the tie rule gives them to the voxels beyond.
+fn pad_leaves_the_margin_empty_even_for_faces_on_grid_planes() {
+    // A cube: on a fitted grid its faces lie exactly in grid planes, where
+    // the tie rule gives the high faces to the voxels beyond. Padded, the
+    // fit keeps it two lattice units clear of the pad on every side.
     let cube = unit_cube_obj("cube.obj");
     let (a, b) = (tmp("cube0.npy"), tmp("cube1.npy"));
     let plain = json(&topovox(&["voxelize", &cube, "-o", &a, "--mode", "sep6", "--resolution", "8", "--json"]));
     let padded = json(&topovox(&["voxelize", &cube, "-o", &b, "--mode", "sep6", "--resolution", "8", "--pad", "1", "--json"]));
     assert_eq!(padded["dims"], serde_json::json!([10, 10, 10]));
-    // The cube spans grid planes 1..9. Displaced by −δ, crosshairs give the
-    // low faces to the first layer inside (the union of three 8×8 faces:
-    // 8³ − 7³ voxels) and the high faces to the first layer outside (three
-    // disjoint 8×8 faces).
-    assert_eq!(padded["voxels"], 8 * 8 * 8 - 7 * 7 * 7 + 3 * 64);
+    // Every face now lies strictly inside the first or last interior layer,
+    // whose crosshairs it crosses: the interior's boundary layer, 8³ − 6³,
+    // and nothing in the pad.
+    assert_eq!(padded["voxels"], 8 * 8 * 8 - 6 * 6 * 6);
+    let npy = std::fs::read(&b).unwrap();
+    let bits = &npy[npy.len() - 1000..];
+    let in_pad = |n: usize| [n / 100, n / 10 % 10, n % 10].iter().any(|&c| c == 0 || c == 9);
+    assert!(bits.iter().enumerate().all(|(n, &v)| v == 0 || !in_pad(n)), "a pad voxel is set");
     // Unpadded, the high faces' voxels lie beyond the grid.
     assert_eq!(plain["voxels"], 8 * 8 * 8 - 7 * 7 * 7);
     let c = json(&topovox(&["check", &b, "--mesh", &cube, "--resolution", "8", "--pad", "1", "--json"]));
@@ -293,11 +297,14 @@ fn solid_modes_say_what_they_did() {
     assert_eq!(run(&["--mode", "solid", "--method", "reference"])["voxels"], 512);
     assert_eq!(run(&["--mode", "solid", "--hollow", "6"])["voxels"], 512 - 216);
     assert_eq!(run(&["--mode", "solid", "--fill", "flood", "--pad", "1"])["method"], "flood");
-    assert!(run(&["--mode", "solid+surface", "--pad", "1"])["voxels"].as_u64().unwrap() > 512);
+    // Padded, the cube's surface voxels lie in its solid's layer: the pad stays empty.
+    assert_eq!(run(&["--mode", "solid+surface", "--pad", "1"])["voxels"], 512);
     // An open mesh: auto takes the generalized winding number, and says so.
     let bunny = shared("stanford-bunny.obj");
     let w = json(&topovox(&["voxelize", &bunny, "-o", &out, "--mode", "solid", "--resolution", "32", "--json"]));
     assert_eq!((w["method"].as_str(), w["solid"]["closed"].as_bool()), (Some("winding"), Some(false)));
+    let ws = json(&topovox(&["voxelize", &bunny, "-o", &out, "--mode", "solid+surface", "--resolution", "32", "--json"]));
+    assert!(ws["voxels"].as_u64() > w["voxels"].as_u64(), "the surface adds voxels to the solid");
     assert!(w["solid"]["generalized_winding"]["boundary_cycles"].as_u64().unwrap() > 0);
     let p = json(&topovox(&["voxelize", &bunny, "-o", &out, "--mode", "solid", "--method", "parity", "--resolution", "32", "--json"]));
     assert_eq!(p["solid"]["closed"], false);
