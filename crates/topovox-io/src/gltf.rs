@@ -6,6 +6,7 @@
 //! is marked default) is read with its node's world transform applied.
 //! Point and line primitives are skipped with a warning.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use glam::{DMat4, DVec3, Mat4};
@@ -36,6 +37,9 @@ pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKin
     let mut out = Builder::default();
     out.materials(&document, &buffers, base_dir, res);
     let scene = document.default_scene().or_else(|| document.scenes().next());
+    if let Some(scene) = &scene {
+        check_instances(scene)?;
+    }
     match scene {
         Some(scene) => {
             for node in scene.nodes() {
@@ -258,6 +262,78 @@ impl Builder {
         }
         Ok(())
     }
+}
+
+/// Vertices and index entries (a bound on triangles) of everything under
+/// a node, meshes counted once per instance.
+#[derive(Clone, Copy, Default)]
+struct Size {
+    vertices: u64,
+    indices: u64,
+    instances: u64,
+}
+
+impl Size {
+    fn add(self, o: Size) -> Size {
+        Size {
+            vertices: self.vertices.saturating_add(o.vertices),
+            indices: self.indices.saturating_add(o.indices),
+            instances: self.instances.saturating_add(o.instances),
+        }
+    }
+
+    /// Bytes the expanded mesh would take: positions (f64), triangles
+    /// (i64), and per triangle a material and three UVs.
+    fn bytes(self) -> u64 {
+        self.vertices.saturating_mul(24).saturating_add((self.indices / 3).saturating_mul(24 + 4 + 24))
+    }
+}
+
+/// Refuses a scene whose nodes share children so often that expanding
+/// every instance would not fit in the memory a read may take: a 9.5 KB
+/// file can place one mesh 10⁹ times. Counted from the accessors' counts,
+/// each node once (memoized), before anything is expanded.
+fn check_instances(scene: &gltf::Scene<'_>) -> Result<(), ErrorKind> {
+    fn mesh_size(mesh: &gltf::Mesh<'_>) -> Size {
+        mesh.primitives().fold(Size { instances: 1, ..Size::default() }, |s, p| {
+            let v = p.get(&gltf::Semantic::Positions).map_or(0, |a| a.count() as u64);
+            let i = p.indices().map_or(v, |a| a.count() as u64);
+            s.add(Size { vertices: v, indices: i, instances: 0 })
+        })
+    }
+    fn size(node: &gltf::Node<'_>, depth: usize, memo: &mut HashMap<usize, Size>) -> Result<Size, ErrorKind> {
+        if depth > 256 {
+            return Err(ErrorKind::malformed("glTF", "node hierarchy deeper than 256 (cycle?)"));
+        }
+        if let Some(&s) = memo.get(&node.index()) {
+            return Ok(s);
+        }
+        let mut s = node.mesh().map(|m| mesh_size(&m)).unwrap_or_default();
+        for child in node.children() {
+            s = s.add(size(&child, depth + 1, memo)?);
+        }
+        memo.insert(node.index(), s);
+        Ok(s)
+    }
+    let mut memo = HashMap::new();
+    let mut total = Size::default();
+    for node in scene.nodes() {
+        total = total.add(size(&node, 0, &mut memo)?);
+    }
+    let limit = crate::read_limit();
+    if total.bytes() > limit {
+        return Err(ErrorKind::malformed(
+            "glTF",
+            format!(
+                "the scene places its meshes {} times: {} vertices, about {} expanded, more than the {} a read may take",
+                total.instances,
+                total.vertices,
+                crate::bytes(total.bytes()),
+                crate::bytes(limit)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Checks that an accessor's elements lie inside its buffer view and the

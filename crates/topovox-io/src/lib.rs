@@ -516,15 +516,26 @@ pub(crate) fn dense_grid(dims: [u32; 3]) -> Result<topovox::DenseBits, ErrorKind
     let need = u64::try_from((dims[0] as u128).div_ceil(64) * 8 * dims[1] as u128 * dims[2] as u128).unwrap_or(u64::MAX);
     let budget = DENSE_READ_BUDGET.load(std::sync::atomic::Ordering::Relaxed);
     // Small grids are never refused: reading /proc per file costs more.
-    // Where the available memory cannot be read, 1 TiB stands for it.
     if need > 64 << 20 || (budget != 0 && need > budget) {
-        let avail = available_memory().unwrap_or(1 << 40) / 10 * 9;
-        let limit = if budget == 0 { avail } else { budget.min(avail) };
+        let limit = read_limit();
         if need > limit {
             return Err(ErrorKind::TooLarge { dims, need: bytes(need), available: bytes(limit) });
         }
     }
     Ok(topovox::DenseBits::new(dims))
+}
+
+/// The memory one read may take: the budget [`set_dense_read_budget`] set
+/// (`--max-memory`), at most nine tenths of the available memory (where
+/// that cannot be read, 1 TiB stands for it).
+pub(crate) fn read_limit() -> u64 {
+    let budget = DENSE_READ_BUDGET.load(std::sync::atomic::Ordering::Relaxed);
+    let avail = available_memory().unwrap_or(1 << 40) / 10 * 9;
+    if budget == 0 {
+        avail
+    } else {
+        budget.min(avail)
+    }
 }
 
 /// Reads an SVG file's outlines (see [`svg`]).

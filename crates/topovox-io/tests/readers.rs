@@ -267,3 +267,34 @@ fn gltf_alpha_modes_become_cutoffs() {
     let cut: Vec<Option<f32>> = m.appearance.materials.iter().map(|m| m.alpha_cutoff).collect();
     assert_eq!(cut, [Some(0.3), Some(0.5), None, None], "the last is glTF's default material");
 }
+
+#[test]
+fn gltf_instancing_past_memory_is_refused_before_expanding() {
+    // Issue 54: root → 1000 × n1 → 1000 × n2 → 1000 × a one-triangle mesh,
+    // 10⁹ instances in about 9.5 KB, grew past 1.5 GB in 4 s.
+    let bin = gltf_bin();
+    write("inst.bin", &bin);
+    let many = |child: usize| format!("[{}]", vec![child.to_string(); 1000].join(","));
+    let json = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}],
+        "nodes": [{{"children": {}}}, {{"children": {}}}, {{"children": {}}}, {{"mesh": 0}}],
+        "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}],
+        "accessors": [
+          {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+          {{"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}}],
+        "bufferViews": [{{"buffer": 0, "byteLength": 36}}, {{"buffer": 0, "byteOffset": 36, "byteLength": 6}}],
+        "buffers": [{{"byteLength": {}, "uri": "inst.bin"}}]}}"#,
+        many(1),
+        many(2),
+        many(3),
+        bin.len()
+    );
+    assert!(json.len() < 16_000);
+    let t = std::time::Instant::now();
+    let e = read_mesh(&write("inst.gltf", json.as_bytes())).unwrap_err().to_string();
+    assert!(e.contains("places its meshes 1000000000 times") && e.contains("more than"), "{e}");
+    assert!(t.elapsed().as_secs() < 5, "counted, not expanded: {:?}", t.elapsed());
+    // A thousand instances are read (and are every one of them).
+    let few = json.replacen(&many(1), "[1]", 1).replacen(&many(2), "[2]", 1);
+    assert_eq!(read_mesh(&write("few.gltf", few.as_bytes())).unwrap().report.triangles, 1000);
+}
