@@ -15,6 +15,13 @@
 //!   by its signal handler ([`remove_live_temporaries`]); those a killed
 //!   process left behind are removed by the next write of the same output
 //!   ([`remove_stale_temporaries`]).
+//! - A folder (a Zarr array) is replaced the same way: built beside it,
+//!   then swapped in with two renames that the signal handler cannot come
+//!   between ([`replace_dir`]); a killed run's old folder is put back by
+//!   the next write ([`recover_replaced`]).
+//! - What an interrupted run promises: the output is as it was, or it is
+//!   the complete new one (when the signal came after the final rename;
+//!   the exit status is still the signal's) — never a part of either.
 
 use std::collections::HashMap;
 use std::fs::File;
@@ -207,12 +214,89 @@ impl Temporary {
         &self.path
     }
 
-    /// Renames it to `to`; on failure it is removed.
+    /// Renames it to `to`; on failure it is removed. The rename happens
+    /// under the registry's lock, which the signal handler holds while it
+    /// removes temporaries: it never removes one mid-rename (it used to
+    /// happen that a folder half removed was renamed into place).
     pub(crate) fn rename_to(self, to: &Path) -> std::io::Result<()> {
+        let mut live = live();
         std::fs::rename(&self.path, to)?;
-        forget_live(&self.path);
+        live.retain(|p| p != &self.path);
+        drop(live);
         std::mem::forget(self);
         Ok(())
+    }
+}
+
+/// What a folder being replaced is renamed to while the new one takes its
+/// place: `.NAME.topovox-old-PID-N`.
+const OLD_MARK: &str = ".topovox-old-";
+
+/// Puts the finished temporary folder `tmp` at `path`, all or nothing: an
+/// existing folder there is moved aside, the new one renamed in, and the
+/// old one removed only then. Both renames happen under the registry's
+/// lock, so the signal handler runs before or after the pair, never
+/// between them. A process killed outright (no handler) between them
+/// leaves the old folder under its aside name: [`recover_replaced`] puts
+/// it back on the next write.
+pub(crate) fn replace_dir(tmp: Temporary, path: &Path) -> std::io::Result<()> {
+    let aside = {
+        let mut live = live();
+        let aside = match std::fs::symlink_metadata(path) {
+            Ok(_) => {
+                let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+                let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+                let aside = path.with_file_name(format!(".{name}{OLD_MARK}{}-{n}", std::process::id()));
+                std::fs::rename(path, &aside)?;
+                Some(aside)
+            }
+            Err(_) => None,
+        };
+        if let Err(e) = std::fs::rename(&tmp.path, path) {
+            if let Some(a) = &aside {
+                let _ = std::fs::rename(a, path);
+            }
+            return Err(e);
+        }
+        live.retain(|p| p != &tmp.path);
+        // From here the handler may remove the old folder: the new one is in place.
+        live.extend(aside.clone());
+        std::mem::forget(tmp);
+        aside
+    };
+    if let Some(a) = aside {
+        remove_path(&a);
+        forget_live(&a);
+    }
+    Ok(())
+}
+
+/// Puts back what a killed run was replacing: a folder `.NAME.topovox-old-
+/// PID-N` beside `output` whose process is gone goes back to `output` when
+/// nothing is there (the run died between its two renames), and is removed
+/// when the new output is in place. Only where a process's end can be told
+/// (Linux's `/proc`).
+pub fn recover_replaced(output: &Path) {
+    let Some(name) = output.file_name().map(|n| n.to_string_lossy().into_owned()) else { return };
+    let dir = match output.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let prefix = format!(".{name}{OLD_MARK}");
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let mut left: Vec<PathBuf> = entries
+        .flatten()
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter(|n| n.strip_prefix(&prefix).and_then(|rest| rest.split('-').next()?.parse::<u32>().ok()).is_some_and(process_is_gone))
+        .map(|n| dir.join(n))
+        .collect();
+    left.sort();
+    for aside in left {
+        if std::fs::symlink_metadata(output).is_err() {
+            let _ = std::fs::rename(&aside, output);
+        } else {
+            remove_path(&aside);
+        }
     }
 }
 

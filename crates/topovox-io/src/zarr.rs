@@ -240,13 +240,14 @@ pub fn write(
     attrs: Option<&VoxelAttributes>,
     stop: Option<&Stop>,
 ) -> Result<(), IoError> {
+    crate::atomic::recover_replaced(path);
     check_replaceable(path)?;
     crate::atomic::remove_stale_temporaries(path);
     let tmp = Temporary::create_dir(path).map_err(|e| io(path, e))?;
     let extra = attrs.map(attribute_arrays).unwrap_or_default();
     fill_all(tmp.path(), bits, grid, extra, stop).map_err(|e| io(path, e))?;
     crate::atomic::check_stop(stop).map_err(|e| io(path, e))?;
-    replace(tmp, path).map_err(|e| io(path, e))
+    crate::atomic::replace_dir(tmp, path).map_err(|e| io(path, e))
 }
 
 /// Writes a distance field on `grid` as a Zarr v3 `float32` array at
@@ -255,12 +256,13 @@ pub fn write(
 /// holding no band voxel and nothing inside are not written.
 /// `attributes.topovox.distance` records the background and `signed`.
 pub fn write_distance(path: &Path, field: &Field, grid: &GridSpec, signed: bool, stop: Option<&Stop>) -> Result<(), IoError> {
+    crate::atomic::recover_replaced(path);
     check_replaceable(path)?;
     crate::atomic::remove_stale_temporaries(path);
     let tmp = Temporary::create_dir(path).map_err(|e| io(path, e))?;
     fill_distance(tmp.path(), field, grid, signed, stop).map_err(|e| io(path, e))?;
     crate::atomic::check_stop(stop).map_err(|e| io(path, e))?;
-    replace(tmp, path).map_err(|e| io(path, e))
+    crate::atomic::replace_dir(tmp, path).map_err(|e| io(path, e))
 }
 
 fn fill_distance(dir: &Path, field: &Field, grid: &GridSpec, signed: bool, stop: Option<&Stop>) -> std::io::Result<()> {
@@ -456,26 +458,6 @@ fn fill(dir: &Path, bits: &dyn VoxelSource, grid: &GridSpec, kinds: &[Kind<'_>],
         std::fs::create_dir_all(&d)?;
         std::fs::write(d.join(file), body)
     })
-}
-
-/// Renames `tmp` to `path`, moving an existing array aside first and
-/// removing it only once the new one is in place.
-fn replace(tmp: Temporary, path: &Path) -> std::io::Result<()> {
-    if std::fs::symlink_metadata(path).is_err() {
-        return tmp.rename_to(path);
-    }
-    let name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
-    let old: PathBuf = path.with_file_name(format!(
-        ".{name}.topovox-old-{}-{}",
-        std::process::id(),
-        std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos()).unwrap_or(0)
-    ));
-    std::fs::rename(path, &old)?;
-    if let Err(e) = tmp.rename_to(path) {
-        let _ = std::fs::rename(&old, path);
-        return Err(e);
-    }
-    std::fs::remove_dir_all(&old)
 }
 
 fn bad(what: impl Into<String>) -> ErrorKind {

@@ -257,3 +257,27 @@ fn temporaries_of_a_killed_run_are_removed_by_the_next_write() {
     assert_eq!(leftovers(&d), vec![mine.file_name().unwrap().to_string_lossy().into_owned()]);
     assert!(d.join(".out.txt.notes").exists());
 }
+
+#[test]
+fn a_killed_runs_hidden_zarr_array_is_put_back_by_the_next_write() {
+    // Issue 54: killed between moving the old array aside and renaming the
+    // new one in, a run left the output missing and the old array hidden.
+    let d = scratch("recover");
+    let dead = std::fs::read_to_string("/proc/sys/kernel/pid_max").map(|s| s.trim().parse::<u64>().unwrap() + 1).unwrap_or(99_999_999);
+    let out = zarr_array(&d, "out", [8, 8, 8]);
+    let aside = d.join(format!(".out.zarr.topovox-old-{dead}-7"));
+    std::fs::rename(&out, &aside).unwrap();
+    // Our own aside folder (a live process) is never touched.
+    let mine = d.join(format!(".out.zarr.topovox-old-{}-1", std::process::id()));
+    std::fs::create_dir(&mine).unwrap();
+    topovox_io::atomic::recover_replaced(&out);
+    assert!(!aside.exists());
+    assert_eq!(read_voxels(&out).unwrap().bits.count(), some_voxels([8, 8, 8]).count());
+    // Left beside a complete new output, the old one is removed; a write
+    // does both first, then replaces the output.
+    std::fs::create_dir(&aside).unwrap();
+    write_voxels(&out, VoxelFormat::Zarr, &some_voxels([9, 9, 9]), &grid([9, 9, 9])).unwrap();
+    assert_eq!(read_voxels(&out).unwrap().bits.dims(), [9, 9, 9]);
+    std::fs::remove_dir(&mine).unwrap();
+    assert_eq!(leftovers(&d), Vec::<String>::new());
+}
