@@ -281,3 +281,20 @@ fn a_killed_runs_hidden_zarr_array_is_put_back_by_the_next_write() {
     std::fs::remove_dir(&mine).unwrap();
     assert_eq!(leftovers(&d), Vec::<String>::new());
 }
+
+#[test]
+fn a_vdb_whose_tiles_cover_more_than_a_billion_voxels_reads_back() {
+    // Issue 54: topovox called its own .vdb malformed when its active
+    // tiles covered more than 2³⁰ voxels (a solid past about 1.07 G voxels).
+    use topovox::grid::sparse::SparseBricks;
+    let n = 1152u32; // 9 lower nodes of 128 a side: all tiles
+    let b = n / 8;
+    let runs: Vec<([u32; 3], u32)> = (0..b).flat_map(|k| (0..b).map(move |j| ([0, j, k], b))).collect();
+    let solid = SparseBricks::from_parts([n; 3], Vec::new(), runs);
+    let d = scratch("tiles");
+    let out = d.join("solid.vdb");
+    write_voxels(&out, VoxelFormat::Vdb, &solid, &grid([n; 3])).unwrap();
+    assert!(std::fs::metadata(&out).unwrap().len() < 1 << 20, "tiles, not leaves");
+    let back = read_voxels(&out).unwrap();
+    assert_eq!((back.bits.dims(), back.bits.count()), ([n; 3], (n as u64).pow(3)));
+}

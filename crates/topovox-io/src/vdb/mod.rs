@@ -835,11 +835,6 @@ fn read_all_values(c: &mut Cur<'_>, active: &[u64], n: usize, mask_compressed: b
     Ok(c.take(n * 4)?.chunks_exact(4).map(f).collect())
 }
 
-/// Most voxels the reader fills from active tiles (128 MiB of bits; a
-/// 200-byte file can claim thousands of 128³ tiles). Tiles are filled a row
-/// of words at a time; files with more tile voxels are refused.
-const MAX_TILE_VOXELS: i64 = 1 << 30;
-
 /// A grid's descriptor: name, tree type, where its head starts.
 struct Descriptor {
     name: String,
@@ -1208,11 +1203,15 @@ impl Occupancy {
         // First: a grid that cannot be dense says so (`TooLarge`; the sparse
         // reader takes such files).
         let mut bits = crate::dense_grid(self.dims)?;
-        let tile_voxels: i64 = self.tiles.iter().fold(0i64, |n, t| n.saturating_add(t.1 * t.1 * t.1));
-        if tile_voxels > MAX_TILE_VOXELS {
-            return Err(bad(format!(
-                "active tiles cover {tile_voxels} voxels, more than topovox reads into a dense grid ({MAX_TILE_VOXELS})"
-            )));
+        // Tiles of one tree never overlap, so together they cover at most
+        // the grid, which fits (checked above): any number of voxels a
+        // solid's interior takes reads back. More means overlapping tiles,
+        // which a 200-byte file can claim by the thousand (each would be
+        // filled again): refused.
+        let grid_voxels = self.dims.iter().map(|&d| d as i64).product::<i64>();
+        let tile_voxels: i64 = self.tiles.iter().fold(0i64, |n, t| n.saturating_add(t.1.saturating_mul(t.1).saturating_mul(t.1)));
+        if tile_voxels > grid_voxels {
+            return Err(bad(format!("active tiles cover {tile_voxels} voxels, more than the grid's {grid_voxels}: they overlap")));
         }
         let mut tiles = Vec::with_capacity(self.tiles.len());
         for (o, e) in &self.tiles {
