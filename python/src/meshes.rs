@@ -228,6 +228,7 @@ impl Mesh {
 /// load_mesh(path, allow_external_paths=False) -> Mesh
 ///
 /// Reads a mesh file: OBJ (with its MTL and textures), STL, PLY, glTF/GLB,
+/// OFF (ModelNet's),
 /// or `.lines` polylines.
 ///
 /// Parameters

@@ -254,3 +254,38 @@ def test_grids_compare_by_voxels_and_place_not_identity():
     f, g = topovox.sdf(mesh, resolution=8), topovox.sdf(mesh, resolution=8)
     assert f == g and hash(f) == hash(g)
     assert f != topovox.sdf(mesh, resolution=8, band=2) and f != topovox.sdf(mesh, resolution=8, unsigned=True)
+
+
+def test_a_rerun_retries_a_failed_mesh_without_piling_up_its_lines(tmp_path, cli):
+    import json
+    import pathlib
+    import subprocess
+
+    box = pathlib.Path(__file__).resolve().parents[2] / "examples" / "meshes" / "box.obj"
+    ds = tmp_path / "ds"
+    ds.mkdir()
+    (ds / "good.obj").write_bytes(box.read_bytes())
+    (ds / "bad.obj").write_text("v 0 0 0\nf 1 2 3\n")
+    lines = lambda: [json.loads(x) for x in (tmp_path / "out" / "manifest.jsonl").read_text().splitlines()]  # noqa: E731
+    for _ in range(3):
+        s = topovox.batch(ds, tmp_path / "out", resolution=8)
+        assert s["failed"] == 1, s
+    subprocess.run([str(cli), "batch", str(ds), "-o", str(tmp_path / "out"), "--resolution", "8"], capture_output=True)
+    assert [r["status"] for r in lines()] in (["done", "failed"], ["failed", "done"]), lines()
+    # Once it reads, the mesh is done and recorded so.
+    (ds / "bad.obj").write_bytes(box.read_bytes())
+    assert topovox.batch(ds, tmp_path / "out", resolution=8)["done"] == 1
+    assert [r["status"] for r in lines()][-1] == "done"
+
+
+def test_modelnet_off_files_are_meshes(tmp_path):
+    v, f = TETRA
+    rows = "\n".join(" ".join(map(str, p)) for p in v)
+    faces = "\n".join("3 " + " ".join(map(str, t)) for t in f)
+    # ModelNet's quirk: the keyword run into the counts.
+    (tmp_path / "t.off").write_text(f"OFF{len(v)} {len(f)} 0\n{rows}\n{faces}\n")
+    m = topovox.load_mesh(tmp_path / "t.off")
+    assert np.array_equal(m.vertices, v) and np.array_equal(m.faces, f)
+    assert topovox.voxelize(tmp_path / "t.off", resolution=8, mode="sep6") == topovox.voxelize(v, f, resolution=8, mode="sep6")
+    s = topovox.batch(tmp_path, tmp_path / "out", resolution=8)
+    assert s["done"] == 1 and (tmp_path / "out" / "t.npy").exists()

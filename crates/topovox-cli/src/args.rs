@@ -158,7 +158,7 @@ pub struct JobArgs {
 
 #[derive(Args, Debug)]
 pub struct VoxelizeArgs {
-    /// Input mesh (.obj, .stl, .ply, .gltf, .glb).
+    /// Input mesh (.obj, .stl, .ply, .gltf, .glb, .off).
     pub mesh: PathBuf,
     /// Output file: .npy, .npz, .binvox, .vox, .txt, .schem, .vti, .ply,
     /// .vdb, .zarr (voxels), or .obj / .glb (a mesh of the voxels); the format comes from the
@@ -189,7 +189,7 @@ pub struct VoxelizeArgs {
 
 #[derive(Args, Debug)]
 pub struct SdfArgs {
-    /// Input mesh (.obj, .stl, .ply, .gltf, .glb).
+    /// Input mesh (.obj, .stl, .ply, .gltf, .glb, .off).
     pub mesh: PathBuf,
     /// Output file: .vdb (a float level set named `surface`, the band active), .npy
     /// (float32, every voxel), .zarr (float32, sharded) or .vti (a `distance` cell array).

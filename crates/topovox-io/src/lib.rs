@@ -22,6 +22,7 @@ pub mod mesh_report;
 pub mod npy;
 pub mod npz;
 pub mod obj;
+pub mod off;
 pub mod orient;
 pub mod pixels;
 pub mod ply;
@@ -63,6 +64,8 @@ pub enum MeshFormat {
     Gltf,
     /// Plain text polylines (`.lines`).
     Polyline,
+    /// Object File Format (`.off`, ModelNet's), text.
+    Off,
 }
 
 impl MeshFormat {
@@ -74,6 +77,7 @@ impl MeshFormat {
             "ply" => Some(MeshFormat::Ply),
             "gltf" | "glb" => Some(MeshFormat::Gltf),
             "lines" => Some(MeshFormat::Polyline),
+            "off" => Some(MeshFormat::Off),
             _ => None,
         }
     }
@@ -90,7 +94,7 @@ pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
 pub fn read_mesh_with(path: &Path, opts: &ReadOptions) -> Result<LoadedMesh, IoError> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     let format = MeshFormat::from_extension(ext).ok_or_else(|| {
-        IoError::new(path, ErrorKind::UnknownFormat { ext: ext.to_string(), expected: "obj, stl, ply, gltf, glb, lines" })
+        IoError::new(path, ErrorKind::UnknownFormat { ext: ext.to_string(), expected: "obj, stl, ply, gltf, glb, off, lines" })
     })?;
     let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
     let base = path.parent().unwrap_or(Path::new("."));
@@ -115,6 +119,7 @@ fn read_with(bytes: &[u8], format: MeshFormat, res: &resources::Resources) -> Re
         MeshFormat::Ply => "PLY",
         MeshFormat::Gltf => "glTF",
         MeshFormat::Polyline => "polyline",
+        MeshFormat::Off => "OFF",
     };
     fence(name, || match format {
         MeshFormat::Obj => obj::read(bytes, res),
@@ -122,6 +127,7 @@ fn read_with(bytes: &[u8], format: MeshFormat, res: &resources::Resources) -> Re
         MeshFormat::Ply => ply::read(bytes),
         MeshFormat::Gltf => gltf::read(bytes, res),
         MeshFormat::Polyline => polyline::read(bytes),
+        MeshFormat::Off => off::read(bytes),
     })
 }
 

@@ -40,7 +40,7 @@ use crate::plan::Plan;
 pub const MANIFEST: &str = "manifest.jsonl";
 
 /// Mesh extensions taken from folders when no glob is given.
-pub const MESH_EXTENSIONS: [&str; 6] = ["obj", "stl", "ply", "gltf", "glb", "lines"];
+pub const MESH_EXTENSIONS: [&str; 7] = ["obj", "stl", "ply", "gltf", "glb", "lines", "off"];
 
 /// What every mesh of a batch gets done to it.
 #[derive(Clone, Debug)]
@@ -298,6 +298,8 @@ pub struct Manifest {
     file: Mutex<std::fs::File>,
     /// The last `done` line per input path.
     done: HashMap<String, Value>,
+    /// Per input path, its last line when that is a failure.
+    failed: Mutex<HashMap<String, Value>>,
 }
 
 impl Manifest {
@@ -307,12 +309,20 @@ impl Manifest {
     pub fn open(out_dir: &Path) -> Result<Manifest> {
         let path = out_dir.join(MANIFEST);
         let io = |e| JobError::Io(topovox_io::IoError::new(&path, topovox_io::ErrorKind::Write(e)));
-        let mut done = HashMap::new();
+        let (mut done, mut failed) = (HashMap::new(), HashMap::new());
         if let Ok(text) = std::fs::read_to_string(&path) {
             for line in text.lines() {
                 let Ok(v) = serde_json::from_str::<Value>(line) else { continue };
-                if let (Some(input), Some("done")) = (recorded_key(&v, "input"), v["status"].as_str()) {
-                    done.insert(input, v.clone());
+                let Some(input) = recorded_key(&v, "input") else { continue };
+                match v["status"].as_str() {
+                    Some("done") => {
+                        failed.remove(&input);
+                        done.insert(input, v);
+                    }
+                    Some("failed") => {
+                        failed.insert(input, v);
+                    }
+                    _ => {}
                 }
             }
             // A torn last line: start the next one on a line of its own.
@@ -322,7 +332,7 @@ impl Manifest {
             }
         }
         let file = std::fs::OpenOptions::new().create(true).append(true).open(&path).map_err(io)?;
-        Ok(Manifest { path: path.clone(), file: Mutex::new(file), done })
+        Ok(Manifest { path: path.clone(), file: Mutex::new(file), done, failed: Mutex::new(failed) })
     }
 
     /// The manifest's path.
@@ -359,8 +369,23 @@ impl Manifest {
         same && size.is_some() && v["output_bytes"].as_u64() == size
     }
 
-    /// Appends one record as one line, with one write.
+    /// Appends one record as one line, with one write. A failure the
+    /// manifest already ends with for that input (same options, same
+    /// error) is not written again: a rerun retries failed meshes, but
+    /// their lines do not pile up.
     pub fn append(&self, record: &Value) -> Result<()> {
+        if let Some(input) = recorded_key(record, "input") {
+            let mut failed = self.failed.lock().unwrap_or_else(|e| e.into_inner());
+            if record["status"] == "failed" {
+                let same = failed.get(&input).is_some_and(|p| p["options"] == record["options"] && p["error"] == record["error"]);
+                if same {
+                    return Ok(());
+                }
+                failed.insert(input, record.clone());
+            } else {
+                failed.remove(&input);
+            }
+        }
         let mut line = record.to_string();
         line.push('\n');
         let mut f = self.file.lock().unwrap_or_else(|e| e.into_inner());
