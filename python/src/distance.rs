@@ -19,6 +19,8 @@ use crate::meshes::Mesh;
 use crate::options::job_options;
 use crate::placement;
 
+mod state;
+
 /// The band's voxels and values in C order.
 type Ordered = Vec<([u32; 3], f32)>;
 
@@ -274,6 +276,20 @@ impl DistanceGrid {
 
     fn __hash__(&self) -> u64 {
         placement::hash_of(&self.inner.grid, self.inner.field.band.count())
+    }
+
+    /// Pickling and `copy.deepcopy` (Dask, Ray, multiprocessing): the
+    /// placement, the band's bricks and values and the inside voxels as
+    /// NumPy arrays, rebuilt by `DistanceGrid._from_state`.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyAny>,))> {
+        let ctor = py.import("topovox._topovox")?.getattr("DistanceGrid")?.getattr("_from_state")?;
+        Ok((ctor, (state::save(py, &self.inner)?,)))
+    }
+
+    /// The grid `__reduce__` described (not for direct use).
+    #[staticmethod]
+    fn _from_state(state: &Bound<'_, PyDict>) -> PyResult<DistanceGrid> {
+        Ok(DistanceGrid { inner: Arc::new(state::load(state)?), dense: OnceLock::new(), order: Arc::default() })
     }
 
     fn __repr__(&self) -> String {

@@ -289,3 +289,23 @@ def test_modelnet_off_files_are_meshes(tmp_path):
     assert topovox.voxelize(tmp_path / "t.off", resolution=8, mode="sep6") == topovox.voxelize(v, f, resolution=8, mode="sep6")
     s = topovox.batch(tmp_path, tmp_path / "out", resolution=8)
     assert s["done"] == 1 and (tmp_path / "out" / "t.npy").exists()
+
+
+def test_distance_grids_pickle_and_deep_copy():
+    import copy
+    import pickle
+
+    import pytest
+
+    mesh = topovox.as_mesh(*TETRA)
+    for kw in (dict(resolution=12), dict(resolution=12, band="all"), dict(resolution=12, unsigned=True), dict(voxel_size=(0.1, 0.05, 0.2), band=2)):
+        f = topovox.sdf(mesh, **kw)
+        g = pickle.loads(pickle.dumps(f))
+        assert g == f and g.facts == f.facts and g.signed == f.signed, kw
+        assert np.array_equal(g.to_dense(), f.to_dense()) and np.array_equal(g.coords(), f.coords())
+        assert copy.deepcopy(f) == f
+    # A damaged state is a ValueError, never a crash.
+    ctor, (state,) = f.__reduce__()
+    state["values"] = state["values"][:-1]
+    with pytest.raises(ValueError, match="not a DistanceGrid state"):
+        ctor(state)
