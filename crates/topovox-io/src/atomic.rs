@@ -17,7 +17,7 @@
 //!   ([`remove_stale_temporaries`]).
 //! - A folder (a Zarr array) is replaced the same way: built beside it,
 //!   then swapped in with two renames that the signal handler cannot come
-//!   between ([`replace_dir`]); a killed run's old folder is put back by
+//!   between (`replace_dir`); a killed run's old folder is put back by
 //!   the next write ([`recover_replaced`]).
 //! - What an interrupted run promises: the output is as it was, or it is
 //!   the complete new one (when the signal came after the final rename;

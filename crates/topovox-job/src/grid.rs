@@ -100,7 +100,7 @@ impl GridRequest {
     /// The grid for a mesh with these bounds.
     ///
     /// With a pad, the pad's voxels are empty in every mode: the mesh is
-    /// kept [`PAD_GAP`] voxel clear of them on every side (its bounds grow
+    /// kept `PAD_GAP` (two lattice units) of a voxel clear of them on every side (its bounds grow
     /// by that much before the fit), so no closed voxel box of the margin
     /// meets it and no tie sends a vertex there. Without a pad the grid is
     /// the bounding box's, as before.
@@ -119,7 +119,7 @@ impl GridRequest {
             .map_err(|e| JobError::invalid(format!("invalid grid: {e}")))
     }
 
-    /// `bounds` grown by [`PAD_GAP`] voxel on every side when there is a
+    /// `bounds` grown by `PAD_GAP` of a voxel on every side when there is a
     /// pad. For `--resolution N` the voxel size itself depends on the
     /// bounds: growing by `e = L·g / (m − 2g)` (L the longest side, m the
     /// voxels it spans) makes the voxel `s = L / (m − 2g)` and `e = g·s`.
