@@ -189,3 +189,66 @@ impl Device {
 pub fn mapped<'a>(slice: wgpu::BufferSlice<'a>) -> Result<wgpu::BufferView, GpuError> {
     slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))
 }
+
+/// The instance for headless work: Vulkan, Metal and DX12 (`WGPU_BACKEND`
+/// chooses others). Not OpenGL: its EGL setup probes for a Wayland display
+/// and, on a headless machine without `XDG_RUNTIME_DIR`, prints "error:"
+/// lines on stderr of runs that succeed; no compute path uses it.
+pub fn headless() -> wgpu::InstanceDescriptor {
+    quiet_without_display();
+    wgpu::InstanceDescriptor { backends: wgpu::Backends::PRIMARY, ..wgpu::InstanceDescriptor::new_without_display_handle() }.with_env()
+}
+
+/// On a machine without a display (no `WAYLAND_DISPLAY`, `DISPLAY` or
+/// valid `XDG_RUNTIME_DIR`), turns off Mesa's Vulkan device-selection
+/// layer (`NODEVICE_SELECT=1`) unless the user chose a device with it
+/// (`MESA_VK_DEVICE_SELECT`): while devices are enumerated it looks for a
+/// Wayland display and prints "error: XDG_RUNTIME_DIR is invalid" on
+/// stderr of runs that succeed. It only orders devices by the display's,
+/// which a machine without one does not have. Once per process; the CLI
+/// calls it first thing, while it has one thread.
+pub fn quiet_without_display() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let set = |v: &str| std::env::var_os(v).is_some_and(|x| !x.is_empty());
+        let runtime_dir = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+        let display = set("WAYLAND_DISPLAY") || set("DISPLAY") || runtime_dir;
+        if !display && !set("MESA_VK_DEVICE_SELECT") && !set("NODEVICE_SELECT") {
+            std::env::set_var("NODEVICE_SELECT", "1");
+        }
+    });
+}
+
+/// What the exact path cannot do without.
+pub(crate) const REQUIRED: &[(wgpu::Features, &str)] = &[(wgpu::Features::SHADER_INT64, "64-bit integers in shaders (SHADER_INT64)")];
+
+/// The default adapter (high performance preferred), if it has what the
+/// exact path needs.
+fn voxelization_adapter() -> Result<wgpu::Adapter, GpuError> {
+    adapter(&wgpu::Instance::new(headless()), None, REQUIRED)
+}
+
+/// Is the adapter [`Gpu::new`](crate::Gpu::new) would open a hardware one (not lavapipe or
+/// WARP)? Asks for the adapter only: no device, no pipelines, so a caller
+/// deciding whether to use the GPU pays little.
+pub fn hardware_adapter() -> Result<bool, GpuError> {
+    if !hardware_plausible() {
+        return Ok(false);
+    }
+    Ok(voxelization_adapter()?.get_info().device_type != wgpu::DeviceType::Cpu)
+}
+
+/// On Linux a hardware GPU is reached through a DRM render node or the
+/// NVIDIA device files; without either there is none to find, and asking
+/// the Vulkan loader would only wake Mesa's software driver and its
+/// device-selection layer, which prints to stderr when no display is set
+/// up (`XDG_RUNTIME_DIR is invalid`). Elsewhere (Metal, DX12), ask.
+fn hardware_plausible() -> bool {
+    if !cfg!(target_os = "linux") {
+        return true;
+    }
+    let any_in = |dir: &str, prefix: &str| {
+        std::fs::read_dir(dir).is_ok_and(|d| d.flatten().any(|e| e.file_name().to_string_lossy().starts_with(prefix)))
+    };
+    any_in("/dev/dri", "renderD") || any_in("/dev", "nvidia")
+}
