@@ -27,7 +27,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
     let mut lines = text.lines().enumerate().map(|(n, l)| (n + 1, l.split('#').next().unwrap_or("").trim())).filter(|(_, l)| !l.is_empty());
     let (n, first) = lines.next().ok_or_else(|| bad("empty file"))?;
     let counts_line = match header(first) {
-        Header::Keyword(rest) if rest.is_empty() => lines.next().ok_or_else(|| bad("no counts after the OFF keyword"))?,
+        Header::Keyword("") => lines.next().ok_or_else(|| bad("no counts after the OFF keyword"))?,
         Header::Keyword(rest) => (n, rest),
         Header::Binary => return Err(ErrorKind::Unsupported("binary OFF (write it as text)".into())),
         Header::Counts => (n, first),
@@ -50,12 +50,10 @@ pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
     }
     let mut triangles = Vec::new();
     let mut warnings = Vec::new();
-    let mut faces = 0u64;
-    for _ in 0..nf {
+    for read in 0..nf {
         let Some((n, l)) = lines.next() else {
-            return Err(bad(format!("declares {nf} faces, the file ends after {faces}")));
+            return Err(bad(format!("declares {nf} faces, the file ends after {read}")));
         };
-        faces += 1;
         face(l, n, &mut triangles, &mut warnings)?;
     }
     if let Some((n, _)) = lines.next() {
