@@ -88,9 +88,7 @@ pub(crate) fn batch<'py>(
         Ok(())
     };
     let work = || -> Result<(topovox_job::batch::Summary, Vec<String>), JobError> {
-        let (files, warnings) = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir)?;
-        let ext = opts.format.name().replace("npy-bool", "npy");
-        let items = topovox_job::batch::plan_items(&files, &out_dir, &ext)?;
+        let (items, warnings) = topovox_job::batch::items(&inputs, glob.as_deref(), &out_dir, opts.format)?;
         let pool = topovox_job::pool_for(jobs, "jobs")?;
         let summary = pool.install(|| topovox_job::batch::run(&items, &out_dir, &opts, &counts, Some(&stop)))?;
         Ok((summary, warnings))
@@ -115,9 +113,7 @@ pub(crate) fn batch_plan<'py>(
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<BatchListing<'py>> {
     let (opts, _) = batch_options(options, format)?;
-    let (files, _) = topovox_job::batch::collect_inputs(&inputs, glob.as_deref(), &out_dir).map_err(py_err)?;
-    let ext = opts.format.name().replace("npy-bool", "npy");
-    let items = topovox_job::batch::plan_items(&files, &out_dir, &ext).map_err(py_err)?;
+    let (items, _) = topovox_job::batch::items(&inputs, glob.as_deref(), &out_dir, opts.format).map_err(py_err)?;
     topovox_job::batch::create_out_dir(&out_dir).map_err(py_err)?;
     let manifest = topovox_job::batch::Manifest::open(&out_dir).map_err(py_err)?;
     manifest.refuse_other_options(&items, &opts.fingerprint).map_err(py_err)?;

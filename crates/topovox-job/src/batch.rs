@@ -190,6 +190,15 @@ fn absolute(p: &Path) -> PathBuf {
     std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf())
 }
 
+/// The items of a batch writing `format` under `out_dir`: the inputs found
+/// ([`collect_inputs`]) paired with their outputs ([`plan_items`]), and
+/// the walk's warnings. What every front end runs before [`run`].
+pub fn items(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path, format: crate::output::Output) -> Result<(Vec<Item>, Vec<String>)> {
+    let (files, warnings) = collect_inputs(inputs, glob, out_dir)?;
+    let ext = format.name().replace("npy-bool", "npy");
+    Ok((plan_items(&files, out_dir, &ext)?, warnings))
+}
+
 /// Pairs each input with its output under `out_dir`: the input's path
 /// below the common folder of all inputs, with `ext`. Inputs that differ
 /// only in their extension (`a.obj`, `a.stl`) keep it in their outputs'

@@ -31,12 +31,10 @@ pub fn run(a: &BatchArgs) -> Result<()> {
     };
     let opts = crate::plan::job_options(&a.job, None)?.batch(format)?;
     let pool = topovox_job::pool_for(a.jobs, "--jobs")?;
-    let (files, warnings) = batch::collect_inputs(&a.inputs, a.glob.as_deref(), &a.output)?;
+    let (items, warnings) = batch::items(&a.inputs, a.glob.as_deref(), &a.output, format)?;
     for w in &warnings {
         eprintln!("topovox: warning: {w}");
     }
-    let ext = format.name().replace("npy-bool", "npy");
-    let items = batch::plan_items(&files, &a.output, &ext)?;
 
     use std::io::IsTerminal;
     let target =
