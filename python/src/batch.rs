@@ -25,8 +25,7 @@ pub(crate) fn batch_options(
     options: Option<&Bound<'_, PyDict>>,
     format: &str,
 ) -> PyResult<(topovox_job::batch::BatchOptions, Option<usize>)> {
-    let target = topovox_job::output::Output::from_name(format)
-        .ok_or_else(|| value_err(format!("unknown format {format:?} (expected one of: {})", topovox_job::output::Output::names())))?;
+    let target = <topovox_job::output::Output as topovox_job::Choice>::parse(format).map_err(|e| value_err(e.to_string()))?;
     let jobs = match options.map(|d| d.get_item("jobs")).transpose()?.flatten().filter(|v| !v.is_none()) {
         Some(v) => match option_value("jobs", &v)? {
             OptionValue::Int(n) if n >= 1 => Some(n as usize),

@@ -16,6 +16,7 @@ use serde_json::Value;
 use topovox::attributes::{VoxelAttributes, NO_MATERIAL};
 use topovox::voxelize::Stop;
 use topovox::{GridSpec, VoxelSource};
+use topovox_job::output::Output;
 use topovox_job::{JobOptions, Voxels};
 
 use crate::convert::{array_protocol, as_array, indices_from, rows_of, shape, size_to_py, to_py, triple_f64, triple_u64, SizeArg};
@@ -295,7 +296,8 @@ impl VoxelGrid {
         watertight: bool,
         triangulate: bool,
     ) -> PyResult<()> {
-        let target = topovox_job::output::output_format(format.as_deref(), &path).map_err(py_err)?;
+        let format = format.map(|f| <Output as topovox_job::Choice>::parse(&f)).transpose().map_err(|e| value_err(e.to_string()))?;
+        let target = topovox_job::output::output_format(format, &path).map_err(py_err)?;
         topovox_job::output::check_output_path(&path).map_err(py_err)?;
         let job = JobOptions { dither, block_palette, up: up_of(up)?, watertight, triangulate, ..JobOptions::default() };
         let stop = Arc::new(Stop::new());

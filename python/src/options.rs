@@ -84,6 +84,6 @@ pub(crate) fn choices(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("gpu_path", names::<topovox_job::GpuPath>())?;
     d.set_item("colour_rule", names::<ColourRule>())?;
     d.set_item("up", names::<topovox_job::Up>())?;
-    d.set_item("format", topovox_job::output::Output::names().split(", ").collect::<Vec<_>>())?;
+    d.set_item("format", names::<topovox_job::output::Output>())?;
     Ok(d)
 }

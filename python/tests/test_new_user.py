@@ -309,3 +309,22 @@ def test_distance_grids_pickle_and_deep_copy():
     state["values"] = state["values"][:-1]
     with pytest.raises(ValueError, match="not a DistanceGrid state"):
         ctor(state)
+
+
+def test_format_is_one_named_choice_everywhere(tmp_path, cli):
+    import subprocess
+
+    import pytest
+
+    assert topovox.FORMATS[:2] == ("npy", "npy-bool") and "glb" in topovox.FORMATS and "obj" in topovox.FORMATS
+    g = topovox.voxelize(*TETRA, resolution=4)
+    g.save(tmp_path / "x.dat", format="NPY")
+    assert (tmp_path / "x.dat").read_bytes()[:6] == b"\x93NUMPY"
+    with pytest.raises(ValueError, match='unknown format "nope" \\(expected one of: npy, npy-bool'):
+        g.save(tmp_path / "y.npy", format="nope")
+    # The CLI lists every format with its help, from the same list.
+    h = subprocess.run([str(cli), "voxelize", "--help"], capture_output=True, text=True).stdout
+    for name in topovox.FORMATS:
+        assert f"  {name}" in h or f" {name}:" in h, (name, h[-2000:])
+    r = subprocess.run([str(cli), "batch", str(tmp_path), "-o", str(tmp_path / "o"), "--format", "nope"], capture_output=True, text=True)
+    assert r.returncode == 2 and "nope" in r.stderr and "npy-bool" in r.stderr, r.stderr

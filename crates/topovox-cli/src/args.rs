@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 use topovox::raster::{RasterMethod, RasterMode};
 use topovox_job::distance::{DistanceFormat, Sign};
+use topovox_job::output::Output;
 use topovox_job::{ColourRule, Fill, Fit, GpuPath, Hollow, Method, Mode, Switch, Up};
 
 use topovox::render::raycast::View;
@@ -168,9 +169,9 @@ pub struct VoxelizeArgs {
     pub output: PathBuf,
     #[command(flatten)]
     pub job: JobArgs,
-    /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, or obj / glb for a mesh of the voxels (default: from the extension).
-    #[arg(long, value_name = "FORMAT")]
-    pub format: Option<String>,
+    /// Output format (default: from the extension).
+    #[arg(long, value_name = "FORMAT", value_parser = choice::<Output>())]
+    pub format: Option<Output>,
     /// Also render the result to this PNG (see `topovox render` for --view, --size, --up, --outline).
     #[arg(long, value_name = "PNG")]
     pub preview: Option<PathBuf>,
@@ -638,9 +639,9 @@ pub struct ConvertArgs {
     pub input: PathBuf,
     /// Output voxel file, or `.obj` / `.glb` for a mesh of the voxels; the format comes from the extension unless --format is given.
     pub output: PathBuf,
-    /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, obj or glb (default: from the extension).
-    #[arg(long, value_name = "FORMAT")]
-    pub format: Option<String>,
+    /// Output format (default: from the extension).
+    #[arg(long, value_name = "FORMAT", value_parser = choice::<Output>())]
+    pub format: Option<Output>,
     #[command(flatten)]
     pub export: ExportArgs,
     /// Grid origin X,Y,Z for formats that record it (binvox, txt), when the input does not carry it (default 0,0,0).
@@ -671,9 +672,9 @@ pub struct BatchArgs {
     /// every mesh extension topovox reads).
     #[arg(long, value_name = "PATTERN")]
     pub glob: Option<String>,
-    /// Output format: npy, npy-bool, npz, binvox, vox, txt, schem, vti, ply, vdb, zarr, obj or glb.
-    #[arg(long, default_value = "npy", value_name = "FORMAT")]
-    pub format: String,
+    /// Output format.
+    #[arg(long, default_value = "npy", value_name = "FORMAT", value_parser = choice::<Output>())]
+    pub format: Output,
     #[command(flatten)]
     pub job: JobArgs,
     /// Meshes processed at once (default: all cores); each is voxelized on the same threads.

@@ -11,6 +11,7 @@ use topovox::{DenseBits, GridSpec, VoxelSource};
 use topovox_io::{VoxelFormat, WriteOptions};
 
 use crate::error::{JobError, Result};
+use topovox::choice::Choice;
 
 /// What an output file holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,16 +60,57 @@ impl Output {
 
     /// Every output format name, for messages.
     pub fn names() -> String {
-        format!("{}, obj, glb", VoxelFormat::NAMES)
+        <Output as Choice>::names().join(", ")
+    }
+}
+
+/// `--format` and Python's `format=` are this choice: clap lists each
+/// format with its line of help, Python's `topovox.FORMATS` is its names.
+impl Choice for Output {
+    const WHAT: &'static str = "format";
+    const ALL: &'static [Output] = &[
+        Output::Voxels(VoxelFormat::Npy),
+        Output::Voxels(VoxelFormat::NpyBool),
+        Output::Voxels(VoxelFormat::Npz),
+        Output::Voxels(VoxelFormat::Binvox),
+        Output::Voxels(VoxelFormat::Vox),
+        Output::Voxels(VoxelFormat::Text),
+        Output::Voxels(VoxelFormat::Schem),
+        Output::Voxels(VoxelFormat::Vti),
+        Output::Voxels(VoxelFormat::Ply),
+        Output::Voxels(VoxelFormat::Vdb),
+        Output::Voxels(VoxelFormat::Zarr),
+        Output::Mesh(MeshKind::Obj),
+        Output::Mesh(MeshKind::Glb),
+    ];
+
+    fn name(self) -> &'static str {
+        Output::name(self)
+    }
+
+    fn help(self) -> &'static str {
+        match self {
+            Output::Voxels(VoxelFormat::Npy) => "NumPy array, uint8, (nx, ny, nz)",
+            Output::Voxels(VoxelFormat::NpyBool) => "NumPy array, bool, (nx, ny, nz)",
+            Output::Voxels(VoxelFormat::Npz) => "NumPy archive: the set voxels' indices and the grid (any size)",
+            Output::Voxels(VoxelFormat::Binvox) => "binvox (cubes only)",
+            Output::Voxels(VoxelFormat::Vox) => "MagicaVoxel, with colours (cubes only)",
+            Output::Voxels(VoxelFormat::Text) => "text, one `i j k` line per set voxel",
+            Output::Voxels(VoxelFormat::Schem) => "Minecraft Sponge schematic, with blocks by colour (cubes only)",
+            Output::Voxels(VoxelFormat::Vti) => "VTK ImageData, with attribute arrays",
+            Output::Voxels(VoxelFormat::Ply) => "PLY point cloud of voxel centres, with colours",
+            Output::Voxels(VoxelFormat::Vdb) => "OpenVDB bool grid (sparse; --attributes adds attribute grids)",
+            Output::Voxels(VoxelFormat::Zarr) => "Zarr v3 array, sharded (sparse; --attributes makes a group)",
+            Output::Mesh(MeshKind::Obj) => "Wavefront OBJ mesh of the voxels (+ MTL with colours)",
+            Output::Mesh(MeshKind::Glb) => "binary glTF mesh of the voxels",
+        }
     }
 }
 
 /// The output format: `format` if given, else the extension of `output`.
-pub fn output_format(format: Option<&str>, output: &Path) -> Result<Output> {
+pub fn output_format(format: Option<Output>, output: &Path) -> Result<Output> {
     match format {
-        Some(f) => {
-            Output::from_name(f).ok_or_else(|| JobError::invalid(format!("unknown --format {f:?} (expected one of: {})", Output::names())))
-        }
+        Some(f) => Ok(f),
         None => output.extension().and_then(|e| e.to_str()).and_then(Output::from_name).ok_or_else(|| {
             JobError::invalid(format!(
                 "{}: cannot tell the output format from the extension (use one of: {}, or --format)",

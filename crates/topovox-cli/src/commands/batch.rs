@@ -26,9 +26,7 @@ impl BatchProgress for Bar {
 }
 
 pub fn run(a: &BatchArgs) -> Result<()> {
-    let Some(format) = topovox_job::output::Output::from_name(&a.format) else {
-        bail!("unknown --format {:?} (expected one of: {})", a.format, topovox_job::output::Output::names());
-    };
+    let format = a.format;
     let opts = crate::plan::job_options(&a.job, None)?.batch(format)?;
     let pool = topovox_job::pool_for(a.jobs, "--jobs")?;
     let (items, warnings) = batch::items(&a.inputs, a.glob.as_deref(), &a.output, format)?;

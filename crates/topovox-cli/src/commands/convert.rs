@@ -8,7 +8,7 @@ use topovox::GridSpec;
 use crate::args::ConvertArgs;
 
 pub fn run(a: &ConvertArgs) -> Result<()> {
-    let format = topovox_job::output::output_format(a.format.as_deref(), &a.output)?;
+    let format = topovox_job::output::output_format(a.format, &a.output)?;
     topovox_job::output::check_output_path(&a.output)?;
     topovox_job::output::refuse_overwriting(&a.output, format, std::slice::from_ref(&a.input))?;
     let mut job = topovox_job::JobOptions::default();

@@ -16,7 +16,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     // Validate everything that does not need the mesh first.
     let opts = plan::job_options(&a.job, a.threads)?;
     let mut plan = opts.plan()?;
-    let format = output_format(a.format.as_deref(), &a.output)?;
+    let format = output_format(a.format, &a.output)?;
     plan.request.writer_bytes_per_brick = topovox_job::output::writer_bytes_per_brick(format);
     check_output_path(&a.output)?;
     // Nothing is read or written before we know no output is an input.
