@@ -201,8 +201,8 @@ pub struct SdfArgs {
     /// Half width of the stored band in voxels: voxels nearer than W voxel sizes to the
     /// mesh get their distance, the others ±W voxel sizes (OpenVDB's level-set
     /// background). `all`: every voxel gets its distance.
-    #[arg(long, default_value = "3", value_name = "W|all", allow_hyphen_values = true)]
-    pub band: String,
+    #[arg(long, default_value = "3", value_name = "W|all", allow_hyphen_values = true, value_parser = values::band)]
+    pub band: topovox_job::distance::Width,
     /// Unsigned distances (no inside): for open meshes, polylines and point-like data.
     #[arg(long)]
     pub unsigned: bool,

@@ -93,6 +93,13 @@ pub fn memory(text: &str) -> Result<u64, String> {
     topovox_job::parse_size(text).map_err(|e| e.to_string())
 }
 
+/// `--band W|all`: a distance field's half width.
+pub fn band(text: &str) -> Result<topovox_job::distance::Width, String> {
+    use topovox_job::distance::Width;
+    // clap adds what was given.
+    Width::parse(text).map_err(|_| format!("band: expected {}", Width::EXPECTED))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

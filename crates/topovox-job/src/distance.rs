@@ -77,7 +77,20 @@ pub enum Width {
     All,
 }
 
+/// As the user writes it: `3`, `2.5`, `all`.
+impl std::fmt::Display for Width {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Width::Voxels(w) => write!(f, "{w}"),
+            Width::All => f.write_str("all"),
+        }
+    }
+}
+
 impl Width {
+    /// What a band may be, for messages.
+    pub const EXPECTED: &'static str = "a number of voxels above 0 (at most 1e6) or `all`";
+
     /// `all`, or a positive number of voxels.
     pub fn parse(s: &str) -> Result<Width> {
         if s.trim().eq_ignore_ascii_case("all") {
@@ -85,7 +98,7 @@ impl Width {
         }
         match s.trim().parse::<f64>() {
             Ok(w) if w.is_finite() && w > 0.0 && w <= 1e6 => Ok(Width::Voxels(w)),
-            _ => Err(JobError::invalid(format!("band: expected a number of voxels above 0 (at most 1e6) or `all`, got {s:?}"))),
+            _ => Err(JobError::invalid(format!("band: expected {}, got {s:?}", Width::EXPECTED))),
         }
     }
 
@@ -207,7 +220,8 @@ pub fn sdf(mesh: MeshRef<'_>, name: &str, req: &SdfRequest, stop: Option<&Stop>)
         };
         let plan = SolidPlan { method, surface: None, hollow: None };
         let opts = Options { stop: Some(stop), ..Default::default() };
-        let out = crate::solid::run_sparse(&plan, mesh, name, &grid, 512, &opts)?;
+        // No surface is united, so the tile size is never used.
+        let out = crate::solid::run_sparse(&plan, mesh, name, &grid, topovox::voxelize::tiled::DEFAULT_TILE, &opts)?;
         if stop.requested() {
             return Err(stopped());
         }

@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use serde_json::json;
-use topovox_job::distance::{DistanceFormat, SdfRequest, Width};
+use topovox_job::distance::{DistanceFormat, SdfRequest};
 use topovox_job::Choice;
 
 use crate::args::SdfArgs;
@@ -14,7 +14,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
     let t_total = Instant::now();
     // Everything that does not need the mesh first.
     let grid = crate::plan::grid_request(&a.grid)?;
-    let width = Width::parse(&a.band)?;
+    let width = a.band;
     let format = DistanceFormat::of(a.format.map(|f| f.name()), &a.output)?;
     let req = SdfRequest { grid, width, unsigned: a.unsigned, sign: a.sign, max_memory: a.max_memory, format };
     topovox_job::output::check_output_path(&a.output)?;
