@@ -245,7 +245,7 @@ impl VoxelGrid {
         Some(Array2::from_shape_fn((order.len(), 3), |(n, k)| nrm[order[n].1][k]).into_pyarray(py))
     }
 
-    /// Per set voxel surface area inside it / voxel_size², `(k,)` float32, aligned with `indices()`; None without.
+    /// Per set voxel surface area inside it, in index space (a piece spanning the voxel parallel to a face: 1; cubes: area / s²), `(k,)` float32, aligned with `indices()`; None without.
     #[getter]
     fn coverage<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f32>>> {
         let c = self.inner.attrs.as_ref()?.coverage.as_ref()?;

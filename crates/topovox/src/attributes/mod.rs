@@ -169,7 +169,8 @@ pub struct VoxelAttributes {
     pub material: Option<Vec<u32>>,
     /// Area-weighted mean unit normal per voxel (zero where the surface inside cancels).
     pub normal: Option<Vec<[f32; 3]>>,
-    /// Surface area inside the voxel as a fraction of the voxel size squared.
+    /// Surface area inside the voxel, measured in index space: a piece
+    /// spanning the voxel parallel to any face has 1 (for cubes, area / s²).
     pub coverage: Option<Vec<f32>>,
 }
 

@@ -3,7 +3,8 @@
 //! §5.1.2 (segment) and §5.1.5 (triangle, by Voronoi regions).
 //!
 //! Used by the attribute carrier (where a voxel touches a triangle the
-//! clip missed) and by the distance fields ([`crate::distance`]).
+//! clip missed). The distance fields measure with their own code
+//! (`distance/nearest.rs`).
 
 use glam::DVec3;
 
