@@ -4,8 +4,10 @@
 A module depends on another when its code names it through `crate::…` or
 `super::…` (a module naming one of its own ancestors does not count, and
 `#[cfg(test)] mod tests` blocks are left out). Prints every circle (a
-strongly connected set of modules) and exits 1 if there is one. CI runs it
-over every crate: `python3 scripts/import-circles.py crates/*/src python/src`.
+strongly connected set of modules) and exits 1 if there is one. With
+`--floors ROOT...` it also checks those crates' floors (top-level modules)
+for circles. CI runs it over every crate, and the core's floors:
+`python3 scripts/import-circles.py crates/*/src python/src --floors crates/topovox/src`.
 """
 
 import os
@@ -73,9 +75,36 @@ def circles(edges):
     return out
 
 
-found = False
-for root in sys.argv[1:]:
-    for c in circles(dependencies(root)):
-        found = True
-        print(f"{root}: import circle: " + " <-> ".join("::".join(m) or "(crate root)" for m in c))
-sys.exit(1 if found else 0)
+def floors(edges):
+    """The graph of a crate's floors: each module stands for its first path
+    segment (a top-level module: `geom`, `grid`, `voxelize`, ...)."""
+    out = {}
+    for m, targets in edges.items():
+        if not m:
+            continue
+        out.setdefault((m[0],), set())
+        for t in targets:
+            if t and t[0] != m[0]:
+                out[(m[0],)].add((t[0],))
+                out.setdefault((t[0],), set())
+    return out
+
+
+def main(argv):
+    """`ROOT...` checks modules; `--floors ROOT...` after them checks the
+    top-level modules of those crates too (no arrow runs back up a floor)."""
+    split = argv.index("--floors") if "--floors" in argv else len(argv)
+    found = False
+    for root in argv[:split]:
+        for c in circles(dependencies(root)):
+            found = True
+            print(f"{root}: import circle: " + " <-> ".join("::".join(m) or "(crate root)" for m in c))
+    for root in argv[split + 1 :]:
+        for c in circles(floors(dependencies(root))):
+            found = True
+            print(f"{root}: floors in a circle: " + " <-> ".join("::".join(m) for m in c))
+    return 1 if found else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

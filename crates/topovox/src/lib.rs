@@ -39,6 +39,7 @@
 
 pub use glam;
 
+pub mod aabb;
 pub mod attributes;
 pub mod choice;
 pub mod distance;
@@ -48,6 +49,7 @@ pub mod grid;
 pub mod mesh;
 pub mod raster;
 pub mod render;
+pub mod stop;
 pub mod topology;
 pub mod voxelize;
 
@@ -59,7 +61,7 @@ mod test_rng;
 #[cfg(doctest)]
 pub struct ReadmeDoctest;
 
-pub use geom::aabb::Aabb;
+pub use aabb::Aabb;
 pub use grid::bricks::BrickBits;
 pub use grid::dense::DenseBits;
 pub use grid::spec::{GridError, GridSpec, VoxelSize};

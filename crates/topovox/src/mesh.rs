@@ -2,7 +2,7 @@
 
 use glam::DVec3;
 
-use crate::geom::aabb::Aabb;
+use crate::aabb::Aabb;
 
 /// An indexed triangle mesh.
 #[derive(Clone, Debug, Default, PartialEq)]

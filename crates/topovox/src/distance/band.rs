@@ -28,7 +28,7 @@ use rayon::prelude::*;
 
 use super::Pieces;
 use crate::grid::brick::{set_in_brick, Brick};
-use crate::voxelize::Stop;
+use crate::stop::Stop;
 use crate::GridSpec;
 
 /// One brick of the band: its brick coordinates, which of its voxels are

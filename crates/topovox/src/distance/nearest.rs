@@ -21,7 +21,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::{box_distance_squared, Piece, Pieces};
-use crate::voxelize::Stop;
+use crate::stop::Stop;
 use crate::GridSpec;
 
 const LEAF: usize = 4;

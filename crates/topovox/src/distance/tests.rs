@@ -5,8 +5,8 @@
 use glam::DVec3;
 
 use super::{band, nearest, reference, DistanceError, Pieces};
+use crate::stop::Stop;
 use crate::test_rng::Xorshift;
-use crate::voxelize::Stop;
 use crate::{GridSpec, Mesh};
 
 /// A soup of `n` triangles in `[0, 10]³`: random ones, slivers, triangles

@@ -6,7 +6,7 @@
 //! Algorithm files (`voxelize/`) and certificates (`topology/`) import
 //! from here; nothing here imports from them.
 
-pub mod aabb;
+pub use crate::aabb;
 pub mod clip;
 pub mod closest;
 pub mod divide;

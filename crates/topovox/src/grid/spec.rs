@@ -7,7 +7,7 @@
 
 use glam::DVec3;
 
-use crate::geom::aabb::Aabb;
+use crate::aabb::Aabb;
 
 /// Largest number of voxels along one axis. Keeps every lattice coordinate
 /// of a clipped triangle inside the fixed-point range (see [`crate::geom::fixed`]).

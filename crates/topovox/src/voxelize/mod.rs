@@ -39,6 +39,8 @@ use crate::geom::lattice::{prepare, LatticeTriangle, PrepareStats};
 use crate::grid::dense::DenseBits;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
+/// Where long work looks whether to stop (re-exported: `topovox::voxelize::Stop`).
+pub use crate::stop::Stop;
 
 /// The shared shape of the references: for every voxel of every
 /// primitive's bounding box, evaluate the mode's definition. Serial, dense,
@@ -192,32 +194,6 @@ pub trait Progress: Sync {
     fn set_total(&self, total: u64);
     /// `n` more units are done.
     fn advance(&self, n: u64);
-}
-
-/// A request to stop long work early: a front end (Python on Ctrl-C)
-/// requests it from another thread, and the work checks it between slabs,
-/// tiles, triangle chunks and brick rows, skipping what is left. Work that
-/// was stopped returns an incomplete result: whoever requested the stop
-/// must discard it (`topovox-job` turns it into an `Interrupted` error).
-#[derive(Debug, Default)]
-pub struct Stop(std::sync::atomic::AtomicBool);
-
-impl Stop {
-    /// Not requested yet.
-    pub fn new() -> Stop {
-        Stop::default()
-    }
-
-    /// Asks the work to stop.
-    pub fn request(&self) {
-        self.0.store(true, std::sync::atomic::Ordering::Relaxed);
-    }
-
-    /// Whether a stop was requested.
-    #[inline]
-    pub fn requested(&self) -> bool {
-        self.0.load(std::sync::atomic::Ordering::Relaxed)
-    }
 }
 
 /// How the fast `cover` path walks a triangle's voxels. Every choice gives
