@@ -1,10 +1,11 @@
 //! The distance field by brute force: for every voxel centre, the minimum
 //! over every triangle and segment of the exact point–piece distance, in
-//! f64, by a formula independent of the fast paths' (Ericson's Voronoi
-//! regions): the projection onto the triangle's plane when it falls inside
-//! the triangle (signs of the three sub-triangles' normals), else the
-//! nearest of the three edges; segments and degenerate triangles by their
-//! edges. Cost: voxels × pieces (planes in parallel); for tests on small
+//! f64, by a formula independent of the fast paths': the projection onto
+//! the triangle's plane when it falls inside the triangle (signs of the
+//! three sub-triangles' normals), else the nearest of the three edges;
+//! segments and degenerate triangles by their edges. Not Ericson's
+//! closest point (`geom/closest.rs`): by Voronoi regions it is off on
+//! sliver triangles, which the tests' soups hold, where this is exact. Cost: voxels × pieces (planes in parallel); for tests on small
 //! grids.
 
 use glam::DVec3;
