@@ -151,3 +151,44 @@ def test_a_distance_field_too_large_to_be_dense_refuses_dense_files_before_any_w
         assert not any(tmp_path.iterdir())
     field.save(tmp_path / "x.vdb")
     assert (tmp_path / "x.vdb").stat().st_size > 0
+
+
+def test_the_batch_manifest_is_a_file_of_the_output_folder(tmp_path):
+    # Issue 54: the manifest was appended through a link leading out of the
+    # output folder, and a FIFO manifest hung the batch.
+    box = pathlib.Path(__file__).resolve().parents[2] / "examples" / "meshes" / "box.obj"
+    outside = tmp_path / "users-notes.txt"
+    outside.write_text("mine\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "manifest.jsonl").symlink_to(outside)
+    with pytest.raises(OSError, match="link leading out of the output folder"):
+        topovox.batch([box], out, resolution=8)
+    assert outside.read_text() == "mine\n" and not (out / "box.npy").exists()
+    fifo = tmp_path / "fifo-out"
+    fifo.mkdir()
+    os.mkfifo(fifo / "manifest.jsonl")
+    result = {}
+    t = threading.Thread(target=lambda: result.setdefault("e", pytest.raises(OSError, topovox.batch, [box], fifo, resolution=8)))
+    t.start()
+    t.join(timeout=30)
+    assert not t.is_alive(), "the batch hung on a FIFO manifest"
+    assert "not a regular file" in str(result["e"].value)
+    # A link inside the folder to a regular file there is followed.
+    inside = tmp_path / "in-out"
+    inside.mkdir()
+    (inside / "real.jsonl").write_text("")
+    (inside / "manifest.jsonl").symlink_to(inside / "real.jsonl")
+    assert topovox.batch([box], inside, resolution=8)["done"] == 1
+    assert "box.obj" in (inside / "real.jsonl").read_text()
+
+
+def test_the_distance_estimate_is_capped_by_the_grid(meshes):
+    # Issue 54: a band covering a 16x1x13 grid was refused as needing
+    # thousands of TiB; it can never need more than every voxel.
+    cow = topovox.load_mesh(meshes / "cow.obj")
+    size = (0.05, 1000.0, 0.05)
+    banded = topovox.sdf(cow, voxel_size=size, band=3)
+    everything = topovox.sdf(cow, voxel_size=size, band="all")
+    assert banded.dims[1] == 1 and banded.count == everything.count == int(np.prod(banded.dims))
+    assert np.allclose(banded.to_dense(), everything.to_dense())

@@ -22,7 +22,7 @@ use std::io::Write;
 use glam::DVec3;
 use topovox::{GridSpec, VoxelSource};
 
-use crate::error::ErrorKind;
+use crate::error::{quoted, ErrorKind};
 use crate::LoadedVoxels;
 
 struct Rle<'a> {
@@ -130,19 +130,21 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         let mut it = l.split_whitespace();
         match it.next() {
             Some("dim") => {
-                let v: Vec<u32> = it.map(|s| s.parse()).collect::<Result<_, _>>().map_err(|_| bad(format!("bad dim line {l:?}")))?;
+                let v: Vec<u32> =
+                    it.map(|s| s.parse()).collect::<Result<_, _>>().map_err(|_| bad(format!("bad dim line {}", quoted(l))))?;
                 dims = Some(v);
             }
             Some("translate") => {
-                let v: Vec<f64> = it.map(|s| s.parse()).collect::<Result<_, _>>().map_err(|_| bad(format!("bad translate line {l:?}")))?;
+                let v: Vec<f64> =
+                    it.map(|s| s.parse()).collect::<Result<_, _>>().map_err(|_| bad(format!("bad translate line {}", quoted(l))))?;
                 if v.len() != 3 {
-                    return Err(bad(format!("bad translate line {l:?}")));
+                    return Err(bad(format!("bad translate line {}", quoted(l))));
                 }
                 translate = DVec3::new(v[0], v[1], v[2]);
             }
-            Some("scale") => scale = it.next().and_then(|s| s.parse().ok()).ok_or_else(|| bad(format!("bad scale line {l:?}")))?,
+            Some("scale") => scale = it.next().and_then(|s| s.parse().ok()).ok_or_else(|| bad(format!("bad scale line {}", quoted(l))))?,
             Some("data") => break,
-            _ => return Err(bad(format!("unexpected header line {l:?}"))),
+            _ => return Err(bad(format!("unexpected header line {}", quoted(l)))),
         }
     }
     let dims = dims.ok_or_else(|| bad("no dim line".into()))?;

@@ -96,6 +96,26 @@ impl ErrorKind {
     /// onto one line.
     pub(crate) fn malformed(format: &'static str, detail: impl std::fmt::Display) -> ErrorKind {
         let detail = detail.to_string().split('\n').map(str::trim).filter(|l| !l.is_empty()).collect::<Vec<_>>().join("; ");
-        ErrorKind::Malformed { format, detail }
+        // A file's content never makes a message long (a 100 MB header line).
+        ErrorKind::Malformed { format, detail: cut(&detail, MAX_MESSAGE) }
+    }
+}
+
+/// The most characters of a message or warning that quotes a file's content.
+pub(crate) const MAX_MESSAGE: usize = 300;
+
+/// `s`, cut to `max` characters with `…` where it was cut.
+pub(crate) fn cut(s: &str, max: usize) -> String {
+    match s.char_indices().nth(max) {
+        Some((i, _)) => format!("{}…", &s[..i]),
+        None => s.to_string(),
+    }
+}
+
+/// Text from a file, quoted for a message: at most 40 characters of it.
+pub(crate) fn quoted(s: &str) -> String {
+    match s.char_indices().nth(40) {
+        Some((i, _)) => format!("{:?}… ({} bytes)", &s[..i], s.len()),
+        None => format!("{s:?}"),
     }
 }

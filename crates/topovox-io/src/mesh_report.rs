@@ -81,6 +81,8 @@ pub(crate) fn finish_with_segments(
         segments: mesh.segments.len(),
         bounds: r.bounds(),
     };
+    // A warning may quote the file (a material library's name): never at length.
+    let warnings = warnings.iter().map(|w| crate::error::cut(w, crate::error::MAX_MESSAGE)).collect();
     Ok(LoadedMesh { mesh, report, warnings, appearance: Appearance::default(), sources: Vec::new() })
 }
 

@@ -26,7 +26,7 @@ use std::path::Path;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::error::ErrorKind;
+use crate::error::{quoted, ErrorKind};
 use crate::resources::Resources;
 use topovox::attributes::{Appearance, Material, DEFAULT_ROUGHNESS, NO_MATERIAL};
 
@@ -382,7 +382,7 @@ fn parse_chunk(chunk: &[u8], before: Counts, own: &Counts, appearance: bool) -> 
                     if k == 7 {
                         return Err(bad(n, "a vertex with more than 7 numbers".into()));
                     }
-                    c[k] = number(w).ok_or_else(|| bad(n, format!("bad number {:?} in 'v'", String::from_utf8_lossy(w))))?;
+                    c[k] = number(w).ok_or_else(|| bad(n, format!("bad number {} in 'v'", quoted(&String::from_utf8_lossy(w)))))?;
                     k += 1;
                 }
                 if k < 3 {
@@ -394,7 +394,7 @@ fn parse_chunk(chunk: &[u8], before: Counts, own: &Counts, appearance: bool) -> 
             b"vt" => {
                 let mut c = [0.0f32; 2];
                 for (k, w) in words(rest).take(2).enumerate() {
-                    c[k] = number(w).ok_or_else(|| bad(n, format!("bad number {:?} in 'vt'", String::from_utf8_lossy(w))))? as f32;
+                    c[k] = number(w).ok_or_else(|| bad(n, format!("bad number {} in 'vt'", quoted(&String::from_utf8_lossy(w)))))? as f32;
                 }
                 out.texcoords.push(c);
             }
@@ -403,11 +403,13 @@ fn parse_chunk(chunk: &[u8], before: Counts, own: &Counts, appearance: bool) -> 
                 let (nv, nvt) = (before.v + out.positions.len() as i64, before.vt + out.texcoords.len() as i64);
                 for w in words(rest) {
                     let mut parts = w.split(|&b| b == b'/');
-                    let vi =
-                        parts.next().and_then(index).ok_or_else(|| bad(n, format!("bad vertex index {:?}", String::from_utf8_lossy(w))))?;
+                    let vi = parts
+                        .next()
+                        .and_then(index)
+                        .ok_or_else(|| bad(n, format!("bad vertex index {}", quoted(&String::from_utf8_lossy(w)))))?;
                     let vt = match parts.next() {
                         Some(t) if !t.is_empty() => {
-                            index(t).ok_or_else(|| bad(n, format!("bad texture index {:?}", String::from_utf8_lossy(w))))?
+                            index(t).ok_or_else(|| bad(n, format!("bad texture index {}", quoted(&String::from_utf8_lossy(w)))))?
                         }
                         _ => 0,
                     };

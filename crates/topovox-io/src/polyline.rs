@@ -22,7 +22,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
         let values: Vec<f64> = line
             .split(|c: char| c.is_whitespace() || c == ',')
             .filter(|w| !w.is_empty())
-            .map(|w| w.parse::<f64>().map_err(|_| bad(format!("{w:?} is not a number"))))
+            .map(|w| w.parse::<f64>().map_err(|_| bad(format!("{} is not a number", crate::error::quoted(w)))))
             .collect::<Result<_, _>>()?;
         if values.len() % 3 != 0 || values.len() < 6 {
             return Err(bad(format!("expected x y z for at least two points, found {} numbers", values.len())));

@@ -277,11 +277,17 @@ fn flatten_cubic(p0: DVec2, c1: DVec2, c2: DVec2, p3: DVec2, tol: f64, depth: u3
 
 fn number(node: roxmltree::Node<'_, '_>, name: &str, default: f64) -> Result<f64, ErrorKind> {
     let Some(v) = node.attribute(name) else { return Ok(default) };
-    let l: svgtypes::Length =
-        v.parse().map_err(|e| ErrorKind::malformed("SVG", format!("<{}> {name}={v:?}: {e}", node.tag_name().name())))?;
+    let l: svgtypes::Length = v
+        .parse()
+        .map_err(|e| ErrorKind::malformed("SVG", format!("<{}> {name}={}: {e}", node.tag_name().name(), crate::error::quoted(v))))?;
     match l.unit {
         svgtypes::LengthUnit::None | svgtypes::LengthUnit::Px => Ok(l.number),
-        u => Err(ErrorKind::Unsupported(format!("<{}> {name}={v:?}: unit {u:?} (give plain numbers or px)", node.tag_name().name()))),
+        u => Err(ErrorKind::Unsupported(format!(
+            "<{}> {name}={}: unit {} (give plain numbers or px)",
+            node.tag_name().name(),
+            crate::error::quoted(v),
+            format!("{u:?}")
+        ))),
     }
 }
 
@@ -328,7 +334,8 @@ fn walk(
     let mut out = Vec::new();
     let local = match node.attribute("transform") {
         Some(t) => {
-            let ts: svgtypes::Transform = t.parse().map_err(|e| ErrorKind::malformed("SVG", format!("<{name}> transform={t:?}: {e}")))?;
+            let ts: svgtypes::Transform =
+                t.parse().map_err(|e| ErrorKind::malformed("SVG", format!("<{name}> transform={}: {e}", crate::error::quoted(t))))?;
             Affine([ts.a, ts.b, ts.c, ts.d, ts.e, ts.f])
         }
         None => Affine::ID,

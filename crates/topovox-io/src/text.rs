@@ -58,11 +58,10 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
-        let v: Vec<u32> = line
-            .split_whitespace()
-            .map(|s| s.parse())
-            .collect::<Result<_, _>>()
-            .map_err(|_| ErrorKind::malformed("text", format!("line {}: expected 'i j k', got {line:?}", n + 1)))?;
+        let v: Vec<u32> =
+            line.split_whitespace().map(|s| s.parse()).collect::<Result<_, _>>().map_err(|_| {
+                ErrorKind::malformed("text", format!("line {}: expected 'i j k', got {}", n + 1, crate::error::quoted(line)))
+            })?;
         let [i, j, k] = v[..] else {
             return Err(ErrorKind::malformed("text", format!("line {}: expected 3 integers", n + 1)));
         };

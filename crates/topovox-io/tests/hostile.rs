@@ -298,3 +298,34 @@ fn a_vdb_whose_tiles_cover_more_than_a_billion_voxels_reads_back() {
     let back = read_voxels(&out).unwrap();
     assert_eq!((back.bits.dims(), back.bits.count()), ([n; 3], (n as u64).pow(3)));
 }
+
+#[test]
+fn errors_and_warnings_quote_a_short_prefix_of_the_input() {
+    // Issue 54: a 100 MB binvox header line was echoed whole into the
+    // error, a 1 MB mtllib name into a warning, 300-digit numbers likewise.
+    let d = scratch("echo");
+    let long = "9".repeat(1 << 20);
+    let binvox = d.join("h.binvox");
+    std::fs::write(&binvox, format!("#binvox 1\ndim {long}\n")).unwrap();
+    let obj_number = d.join("n.obj");
+    std::fs::write(&obj_number, format!("v 0 0 {}\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "1".repeat(300) + "x")).unwrap();
+    let text = d.join("t.txt");
+    std::fs::write(&text, format!("# dims 4 4 4\n{long}\n")).unwrap();
+    for p in [&binvox, &obj_number, &text] {
+        let e = match topovox_io::read_voxels(p) {
+            Err(e) => e.to_string(),
+            Ok(_) => topovox_io::read_mesh(p).unwrap_err().to_string(),
+        };
+        assert!(e.len() < 500, "{}: {} bytes: {}", p.display(), e.len(), &e[..200]);
+    }
+    let e = topovox_io::read_mesh(&obj_number).unwrap_err().to_string();
+    assert!(e.contains("bad number \"1111") && e.contains("bytes)"), "{e}");
+    let mtl = d.join("m.obj");
+    std::fs::write(&mtl, format!("mtllib {}.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "a".repeat(1 << 20))).unwrap();
+    let m = topovox_io::read_mesh(&mtl).unwrap();
+    assert!(
+        !m.warnings.is_empty() && m.warnings.iter().all(|w| w.len() < 500),
+        "{:?}",
+        m.warnings.iter().map(|w| w.len()).collect::<Vec<_>>()
+    );
+}

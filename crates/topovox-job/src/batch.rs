@@ -147,6 +147,29 @@ pub fn collect_inputs(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path) ->
     Ok((out, warnings))
 }
 
+/// The manifest must be a regular file of the output folder (or not exist
+/// yet): a link leading out of the folder would have the batch append to a
+/// file of the user's elsewhere, and a FIFO or device would hang the read
+/// or swallow the records. Refused before anything is read or written.
+fn check_manifest_file(out_dir: &Path, path: &Path) -> std::io::Result<()> {
+    let refuse = |why: &str| Err(std::io::Error::other(why.to_string()));
+    let Ok(meta) = std::fs::symlink_metadata(path) else { return Ok(()) };
+    if meta.file_type().is_symlink() {
+        let (target, folder) = (std::fs::canonicalize(path), std::fs::canonicalize(out_dir));
+        match (target, folder) {
+            (Ok(t), Ok(f)) if t.starts_with(&f) && t.is_file() => return Ok(()),
+            (Ok(_), Ok(_)) => {
+                return refuse("a link leading out of the output folder (or to no regular file); the manifest is written only inside it")
+            }
+            _ => return refuse("a link to nothing; remove it or give another output folder"),
+        }
+    }
+    if !meta.is_file() {
+        return refuse("not a regular file (a FIFO, a device or a folder); the manifest must be a file of the output folder");
+    }
+    Ok(())
+}
+
 /// Whether `path`, found under the folder `input`, is an input: it matches
 /// `--glob`, or without one has a mesh file's extension.
 fn wanted(path: &Path, input: &Path, matcher: Option<&globset::GlobMatcher>) -> bool {
@@ -164,6 +187,10 @@ fn is_broken_link(path: &Path) -> bool {
 /// The keys of the outputs a manifest at `path` lists (none if there is
 /// no such file, or it is not a manifest).
 fn outputs_listed_in(path: &Path) -> Vec<String> {
+    // Only a regular file (a FIFO named so would hang the walk).
+    if !std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
+        return Vec::new();
+    }
     let Ok(text) = std::fs::read_to_string(path) else { return Vec::new() };
     text.lines()
         .filter_map(|l| serde_json::from_str::<Value>(l).ok())
@@ -318,6 +345,7 @@ impl Manifest {
     pub fn open(out_dir: &Path) -> Result<Manifest> {
         let path = out_dir.join(MANIFEST);
         let io = |e| JobError::Io(topovox_io::IoError::new(&path, topovox_io::ErrorKind::Write(e)));
+        check_manifest_file(out_dir, &path).map_err(io)?;
         let (mut done, mut failed) = (HashMap::new(), HashMap::new());
         if let Ok(text) = std::fs::read_to_string(&path) {
             for line in text.lines() {

@@ -177,7 +177,8 @@ fn check_fits(name: &str, req: &SdfRequest, pieces: &Pieces, mesh: MeshRef<'_>, 
     let mut need = match req.width {
         // The values, their bricks, and the dense copy a dense file needs.
         Width::All => cells.saturating_mul(12),
-        Width::Voxels(w) => band_estimate(pieces, grid, w),
+        // A band holds at most every voxel: never more than `all` needs.
+        Width::Voxels(w) => band_estimate(pieces, grid, w).min(cells.saturating_mul(12)),
     };
     if req.format.is_dense() && req.width != Width::All {
         need = need.saturating_add(cells.saturating_mul(4));
