@@ -286,8 +286,14 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     }
     let dims = [dims_u[0] as u32, dims_u[1] as u32, dims_u[2] as u32];
     let cells = dims.iter().map(|&d| d as u64).product::<u64>();
-    let origin = nums("Origin", 3).unwrap_or(vec![0.0; 3]);
-    let spacing = nums("Spacing", 3).unwrap_or(vec![1.0; 3]);
+    // Absent: the defaults; present, they must be what they say (a bad
+    // Spacing used to be dropped without a word).
+    let given = |name: &str, default: f64| if attr(image_tag, name).is_some() { nums(name, 3) } else { Ok(vec![default; 3]) };
+    let origin = given("Origin", 0.0)?;
+    let spacing = given("Spacing", 1.0)?;
+    if origin.iter().any(|v| !v.is_finite()) || spacing.iter().any(|&v| !(v.is_finite() && v > 0.0)) {
+        return Err(bad(format!("ImageData Origin {origin:?} and Spacing {spacing:?}: finite numbers, spacings above 0")));
+    }
     let cell_data = head.split("<CellData").nth(1).ok_or_else(|| bad("no <CellData> (voxels are cells)".into()))?;
     let cell_data = cell_data.split("</CellData>").next().unwrap_or(cell_data);
     let mut arrays: Vec<(String, String, usize, Vec<u8>)> = Vec::new();
@@ -367,10 +373,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if let Some(n) = at("normal", "Float32", 3) {
         attrs.normal = Some(attrs.keys.iter().map(|&k| [0, 1, 2].map(|a| f32_at(n, 3 * k as usize + a))).collect());
     }
-    let placement = spacing
-        .iter()
-        .all(|&v| v.is_finite() && v > 0.0)
-        .then(|| (DVec3::new(origin[0], origin[1], origin[2]), DVec3::new(spacing[0], spacing[1], spacing[2])));
+    let placement = Some((DVec3::new(origin[0], origin[1], origin[2]), DVec3::new(spacing[0], spacing[1], spacing[2])));
     Ok(LoadedVoxels { bits, placement, attributes: Some(attrs) })
 }
 

@@ -329,3 +329,27 @@ fn errors_and_warnings_quote_a_short_prefix_of_the_input() {
         m.warnings.iter().map(|w| w.len()).collect::<Vec<_>>()
     );
 }
+
+#[test]
+fn a_vti_with_a_bad_spacing_is_refused_not_read_as_unit_cubes() {
+    // Issue 54: a bad Spacing (0, negative, NaN) was dropped without a word.
+    let d = scratch("spacing");
+    let good = d.join("g.vti");
+    write_voxels(&good, VoxelFormat::Vti, &some_voxels([4, 4, 4]), &grid([4, 4, 4])).unwrap();
+    let bytes = std::fs::read(&good).unwrap();
+    let head =
+        String::from_utf8_lossy(&bytes[..bytes.windows(7).position(|w| w == b"_").map_or(600, |p| p + 1).min(bytes.len())]).into_owned();
+    let spacing = head.split("Spacing=\"").nth(1).and_then(|t| t.split('"').next()).unwrap().to_string();
+    for bad in ["0 1 1", "-1 1 1", "NaN 1 1", "1 1"] {
+        let p = d.join("b.vti");
+        let find = format!("Spacing=\"{spacing}\"");
+        let at = bytes.windows(find.len()).position(|w| w == find.as_bytes()).unwrap();
+        let mut b = bytes[..at].to_vec();
+        b.extend(format!("Spacing=\"{bad}\"").as_bytes());
+        b.extend(&bytes[at + find.len()..]);
+        std::fs::write(&p, b).unwrap();
+        let e = read_voxels(&p).unwrap_err().to_string();
+        assert!(e.contains("Spacing") && e.lines().count() == 1, "{bad}: {e}");
+    }
+    assert!(read_voxels(&good).unwrap().placement.is_some());
+}
