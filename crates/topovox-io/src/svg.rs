@@ -283,10 +283,9 @@ fn number(node: roxmltree::Node<'_, '_>, name: &str, default: f64) -> Result<f64
     match l.unit {
         svgtypes::LengthUnit::None | svgtypes::LengthUnit::Px => Ok(l.number),
         u => Err(ErrorKind::Unsupported(format!(
-            "<{}> {name}={}: unit {} (give plain numbers or px)",
+            "<{}> {name}={}: unit {u:?} (give plain numbers or px)",
             node.tag_name().name(),
-            crate::error::quoted(v),
-            format!("{u:?}")
+            crate::error::quoted(v)
         ))),
     }
 }
