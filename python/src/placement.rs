@@ -2,7 +2,8 @@
 //! dims, origin, bounds, voxel size, spacing, and the maps between world
 //! points and voxel indices. Each grid class's getters are one-line calls
 //! of these (PyO3 gives a frozen class no shared method block), and the
-//! tests check both classes expose every name in [`NAMES`].
+//! tests (`test_distance_grids_have_the_voxel_grids_placement`) check both
+//! classes expose the same placement.
 //!
 //! The maps take what NumPy users pass: arrays of any dtype NumPy converts
 //! safely, lists, tuples, and one point (which gives one row back, `(3,)`).
@@ -15,10 +16,6 @@ use topovox::{GridSpec, VoxelSource};
 
 use crate::convert::{indices_from, points_from, shape, size_to_py};
 use crate::errors::value_err;
-
-/// Every placement member both grid classes have (checked by the tests).
-#[allow(dead_code)]
-pub(crate) const NAMES: [&str; 8] = ["dims", "shape", "origin", "bounds", "voxel_size", "spacing", "world_to_index", "index_to_world"];
 
 /// Voxels along x, y, z.
 pub(crate) fn dims(g: &GridSpec) -> (u32, u32, u32) {
