@@ -271,7 +271,13 @@ struct Size {
     vertices: u64,
     indices: u64,
     instances: u64,
+    /// Nodes the expansion walks (a node without a mesh still costs a visit).
+    visits: u64,
 }
+
+/// The most node visits a scene's expansion may take: about a second of
+/// transforms. A scene of empty nodes that share children can ask for 10⁹.
+const MAX_NODE_VISITS: u64 = 1 << 24;
 
 impl Size {
     fn add(self, o: Size) -> Size {
@@ -279,6 +285,7 @@ impl Size {
             vertices: self.vertices.saturating_add(o.vertices),
             indices: self.indices.saturating_add(o.indices),
             instances: self.instances.saturating_add(o.instances),
+            visits: self.visits.saturating_add(o.visits),
         }
     }
 
@@ -291,14 +298,15 @@ impl Size {
 
 /// Refuses a scene whose nodes share children so often that expanding
 /// every instance would not fit in the memory a read may take: a 9.5 KB
-/// file can place one mesh 10⁹ times. Counted from the accessors' counts,
-/// each node once (memoized), before anything is expanded.
+/// file can place one mesh 10⁹ times, or walk 10⁹ nodes without a mesh.
+/// Counted from the accessors' counts, each node once (memoized), before
+/// anything is expanded.
 fn check_instances(scene: &gltf::Scene<'_>) -> Result<(), ErrorKind> {
     fn mesh_size(mesh: &gltf::Mesh<'_>) -> Size {
         mesh.primitives().fold(Size { instances: 1, ..Size::default() }, |s, p| {
             let v = p.get(&gltf::Semantic::Positions).map_or(0, |a| a.count() as u64);
             let i = p.indices().map_or(v, |a| a.count() as u64);
-            s.add(Size { vertices: v, indices: i, instances: 0 })
+            s.add(Size { vertices: v, indices: i, ..Size::default() })
         })
     }
     fn size(node: &gltf::Node<'_>, depth: usize, memo: &mut HashMap<usize, Size>) -> Result<Size, ErrorKind> {
@@ -309,6 +317,7 @@ fn check_instances(scene: &gltf::Scene<'_>) -> Result<(), ErrorKind> {
             return Ok(s);
         }
         let mut s = node.mesh().map(|m| mesh_size(&m)).unwrap_or_default();
+        s.visits = 1;
         for child in node.children() {
             s = s.add(size(&child, depth + 1, memo)?);
         }
@@ -330,6 +339,15 @@ fn check_instances(scene: &gltf::Scene<'_>) -> Result<(), ErrorKind> {
                 total.vertices,
                 crate::bytes(total.bytes()),
                 crate::bytes(limit)
+            ),
+        ));
+    }
+    if total.visits > MAX_NODE_VISITS {
+        return Err(ErrorKind::malformed(
+            "glTF",
+            format!(
+                "the scene's nodes share children so often that expanding it visits {} nodes, more than {MAX_NODE_VISITS}",
+                total.visits
             ),
         ));
     }

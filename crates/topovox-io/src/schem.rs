@@ -199,6 +199,24 @@ struct V3Blocks {
     data: ByteArray,
 }
 
+/// Why a schematic cannot hold a grid of `dims`: at most 65535 blocks a
+/// side (NBT shorts), and at most 2³¹ − 1 blocks, the longest NBT byte
+/// array (one byte per block while the palette has fewer than 128
+/// entries). `None` when it can.
+pub fn too_large(dims: [u32; 3]) -> Option<String> {
+    let [nx, ny, nz] = dims;
+    if dims.iter().any(|&d| d > u16::MAX as u32) {
+        return Some(format!("a schematic holds at most {} blocks on a side; the grid is {nx}x{ny}x{nz}", u16::MAX));
+    }
+    let blocks = nx as u64 * ny as u64 * nz as u64;
+    (blocks > i32::MAX as u64).then(|| {
+        format!(
+            "a schematic holds at most {} blocks (an NBT array); the grid {nx}x{ny}x{nz} has {blocks}; write .vdb, .zarr or .npz",
+            i32::MAX
+        )
+    })
+}
+
 /// Writes `bits` as a Sponge schematic (version 2), blocks chosen by
 /// colour, rotated so `up` points up (Minecraft is y-up).
 pub fn write(
@@ -209,8 +227,8 @@ pub fn write(
     up: Up,
 ) -> std::io::Result<()> {
     let [nx, ny, nz] = bits.dims();
-    if [nx, ny, nz].iter().any(|&d| d > u16::MAX as u32) {
-        return Err(std::io::Error::other(format!("a schematic holds at most {} blocks on a side; the grid is {nx}x{ny}x{nz}", u16::MAX)));
+    if let Some(why) = too_large([nx, ny, nz]) {
+        return Err(std::io::Error::other(why));
     }
     let orient = Orientation::minecraft(up);
     let src_dims = [nx, ny, nz];
@@ -247,6 +265,12 @@ pub fn write(
             }
             data.push((b | 0x80) as i8);
         }
+    }
+    if data.len() > i32::MAX as usize {
+        return Err(std::io::Error::other(format!(
+            "the block data takes {} bytes (block ids past 127 take two), more than an NBT array holds",
+            data.len()
+        )));
     }
     let s = V2 {
         version: 2,
@@ -286,6 +310,15 @@ enum Open {
 /// at least one byte, so the walk ends; a truncated or malformed stream
 /// is left for fastnbt to report.
 fn nbt_depth(b: &[u8], limit: usize) -> Result<(), String> {
+    nbt_walk(b, limit, false).map(|_| ())
+}
+
+/// [`nbt_depth`]'s walk, which also returns the schematic's `Width`,
+/// `Height` and `Length` once all three have been read (in the root, or
+/// in version 3's `Schematic` compound) — from a prefix of the stream too;
+/// `early`: stop there.
+fn nbt_walk(b: &[u8], limit: usize, early: bool) -> Result<Option<[u16; 3]>, String> {
+    let mut dims: [Option<u16>; 3] = [None; 3];
     let mut at = 0usize;
     let take = |at: &mut usize, n: usize| -> Option<usize> {
         let start = *at;
@@ -325,12 +358,16 @@ fn nbt_depth(b: &[u8], limit: usize) -> Result<(), String> {
         Some(())
     };
     // The root: a named tag.
-    let Some(t) = take(&mut at, 1).map(|i| b[i]) else { return Ok(()) };
-    let named = |at: &mut usize| take(at, 2).and_then(|i| take(at, int(i, 2) as usize));
+    let Some(t) = take(&mut at, 1).map(|i| b[i]) else { return Ok(None) };
+    let named = |at: &mut usize| take(at, 2).and_then(|i| Some(&b[take(at, int(i, 2) as usize)?..*at]));
     if named(&mut at).and_then(|_| payload(t, &mut at, &mut stack)).is_none() {
-        return Ok(());
+        return Ok(None);
     }
+    let found = |dims: &[Option<u16>; 3]| -> Option<[u16; 3]> { Some([dims[0]?, dims[1]?, dims[2]?]) };
     while !stack.is_empty() {
+        if let (true, Some(d)) = (early, found(&dims)) {
+            return Ok(Some(d));
+        }
         if stack.len() > limit {
             return Err(format!("NBT nested more than {limit} deep"));
         }
@@ -350,15 +387,63 @@ fn nbt_depth(b: &[u8], limit: usize) -> Result<(), String> {
             Some(of) => payload(of, &mut at, &mut stack),
             None => match take(&mut at, 1).map(|i| b[i]) {
                 Some(0) => stack.pop().map(|_| ()),
+                Some(2) if stack.len() <= 2 => named(&mut at).and_then(|name| {
+                    let v = int(take(&mut at, 2)?, 2) as u16;
+                    if let Some(d) = ["Width", "Height", "Length"].iter().position(|n| n.as_bytes() == name) {
+                        dims[d] = Some(v);
+                    }
+                    Some(())
+                }),
                 Some(t) => named(&mut at).and_then(|_| payload(t, &mut at, &mut stack)),
                 None => None,
             },
         };
         if step.is_none() {
-            return Ok(());
+            return Ok(found(&dims));
         }
     }
-    Ok(())
+    Ok(found(&dims))
+}
+
+/// Bytes of NBT a schematic may hold besides its block data (palette,
+/// metadata, block entities), once its size is known.
+const NBT_BESIDES_BLOCKS: u64 = 64 << 20;
+
+/// Decompresses a schematic, bounded by what its header allows: once
+/// `Width`, `Height` and `Length` have been read, at most five bytes per
+/// block (a varint's longest) plus [`NBT_BESIDES_BLOCKS`]; before that,
+/// and in all, what a read may take (and never past 2 GiB, NBT's array
+/// limit). A 3 MB gzip bomb stops at its bound, not at 2 GB.
+fn inflate(bytes: &[u8]) -> Result<Vec<u8>, String> {
+    let mut gz = flate2::read::GzDecoder::new(bytes);
+    let mut nbt = Vec::new();
+    let mut bound = crate::read_limit().min(1 << 31);
+    let mut dims = None;
+    let mut next_look = 1 << 16;
+    loop {
+        let before = nbt.len();
+        let step = (bound + 1).saturating_sub(before as u64).min(1 << 20);
+        let read = (&mut gz).take(step).read_to_end(&mut nbt).map_err(|e| format!("not gzip-compressed NBT ({e})"))?;
+        if read == 0 {
+            return Ok(nbt);
+        }
+        if dims.is_none() && (nbt.len() >= next_look || read < step as usize) {
+            // Looked for again each time the stream doubles: linear in all.
+            next_look = nbt.len() * 2;
+            if let Some([w, h, l]) = nbt_walk(&nbt, MAX_NBT_DEPTH, true)? {
+                dims = Some([w, h, l]);
+                let blocks = w as u64 * h as u64 * l as u64;
+                bound = bound.min(blocks.saturating_mul(5).saturating_add(NBT_BESIDES_BLOCKS).saturating_add(nbt.len() as u64));
+            }
+        }
+        if nbt.len() as u64 > bound {
+            let why = match dims {
+                Some([w, h, l]) => format!("{w}x{h}x{l} blocks"),
+                None => "a read".into(),
+            };
+            return Err(format!("decompresses to more than the {} that {why} may take (a gzip bomb?)", crate::bytes(bound)));
+        }
+    }
 }
 
 /// Reads a Sponge schematic (version 2 or 3): every non-air block is a
@@ -367,12 +452,14 @@ fn nbt_depth(b: &[u8], limit: usize) -> Result<(), String> {
 /// (topovox's), else by `up`.
 pub fn read(bytes: &[u8], up: Up) -> Result<LoadedVoxels, ErrorKind> {
     let bad = |m: String| ErrorKind::malformed("schem", m);
-    let mut nbt = Vec::new();
-    flate2::read::GzDecoder::new(bytes).take(1 << 31).read_to_end(&mut nbt).map_err(|e| bad(format!("not gzip-compressed NBT ({e})")))?;
+    let nbt = inflate(bytes).map_err(bad)?;
     nbt_depth(&nbt, MAX_NBT_DEPTH).map_err(bad)?;
-    let (w, h, l, palette, data, recorded) = match fastnbt::from_bytes::<V2>(&nbt) {
+    // fastnbt refuses sequences past 10⁸ elements by default; a 512³
+    // schematic has 1.3·10⁸ blocks. No sequence is longer than the stream.
+    let opts = || fastnbt::DeOpts::new().max_seq_len(nbt.len());
+    let (w, h, l, palette, data, recorded) = match fastnbt::from_bytes_with_opts::<V2>(&nbt, opts()) {
         Ok(v) => (v.width, v.height, v.length, v.palette, v.block_data, v.metadata.and_then(|m| m.topovox_up)),
-        Err(e2) => match fastnbt::from_bytes::<V3Root>(&nbt) {
+        Err(e2) => match fastnbt::from_bytes_with_opts::<V3Root>(&nbt, opts()) {
             Ok(r) => (r.schematic.width, r.schematic.height, r.schematic.length, r.schematic.blocks.palette, r.schematic.blocks.data, None),
             Err(e3) => return Err(bad(format!("neither a version 2 ({e2}) nor a version 3 ({e3}) schematic"))),
         },
@@ -465,6 +552,34 @@ mod tests {
         // Shallow but not a schematic: fastnbt says what is wrong.
         let e = read(&gzip(&nested(20)), Up::Y).unwrap_err().to_string();
         assert!(!e.contains("nested") && e.contains("schematic"), "{e}");
+    }
+
+    #[test]
+    fn gzip_bombs_stop_at_the_bound_their_header_allows() {
+        // Issue 54: a 2.9 MB file cost 2.1 GB before its refusal. A 2x2x2
+        // schematic's header, then 400 MB of zeros in an unknown byte array.
+        let mut b = vec![10, 0, 9];
+        b.extend_from_slice(b"Schematic");
+        for name in ["Width", "Height", "Length"] {
+            b.extend_from_slice(&[2, 0, name.len() as u8]);
+            b.extend_from_slice(name.as_bytes());
+            b.extend_from_slice(&[0, 2]);
+        }
+        let zeros = 400usize << 20;
+        b.extend_from_slice(&[7, 0, 1, b'z']);
+        b.extend_from_slice(&(zeros as i32).to_be_bytes());
+        let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        std::io::Write::write_all(&mut e, &b).unwrap();
+        let chunk = vec![0u8; 1 << 20];
+        for _ in 0..zeros >> 20 {
+            std::io::Write::write_all(&mut e, &chunk).unwrap();
+        }
+        let bomb = e.finish().unwrap();
+        assert!(bomb.len() < 1 << 20, "{}", bomb.len());
+        let e = inflate(&bomb).unwrap_err();
+        assert!(e.contains("MiB that 2x2x2 blocks may take"), "{e}");
+        // The header alone, read in full: its dims are found.
+        assert_eq!(nbt_walk(&b[..b.len() - 8], 8, true), Ok(Some([2, 2, 2])));
     }
 
     #[test]

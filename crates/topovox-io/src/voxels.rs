@@ -101,6 +101,15 @@ impl VoxelFormat {
         })
     }
 
+    /// Why the format cannot hold a grid of `dims`, whatever its voxels
+    /// (a schematic's sides and block count); `None` when it can.
+    pub fn refuses_dims(self, dims: [u32; 3]) -> Option<String> {
+        match self {
+            VoxelFormat::Schem => crate::schem::too_large(dims),
+            _ => None,
+        }
+    }
+
     /// True when the format stores voxel colours.
     pub fn has_colour(self) -> bool {
         matches!(self, VoxelFormat::Vox | VoxelFormat::Schem | VoxelFormat::Vti | VoxelFormat::Ply)

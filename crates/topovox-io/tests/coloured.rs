@@ -91,6 +91,27 @@ fn ply_point_cloud_round_trips_voxels_and_colours() {
 }
 
 #[test]
+fn schem_past_a_hundred_million_blocks_reads_back() {
+    // Issue 54: `voxelize bunny -o b.schem --resolution 512` wrote 1.03·10⁸
+    // blocks, which fastnbt's default limit of 10⁸ then refused to read.
+    let dims: [u32; 3] = [512, 508, 397];
+    let grid = GridSpec::new(DVec3::ZERO, 1.0, dims.map(u64::from)).unwrap();
+    let mut b = topovox::DenseBits::new(dims);
+    for (i, j, k) in [(0, 0, 0), (511, 507, 396), (100, 7, 300), (3, 400, 1)] {
+        b.set(i, j, k);
+    }
+    let p = tmp("big.schem");
+    write_voxels_with(&p, VoxelFormat::Schem, &b, &grid, None, &WriteOptions::default()).unwrap();
+    let back = read_voxels(&p).unwrap_or_else(|e| panic!("{e}"));
+    assert!(back.bits.first_difference(&b).is_none());
+    // Past 2³¹ − 1 blocks (NBT's longest array) nothing is written, in one line.
+    let e = VoxelFormat::Schem.refuses_dims([2048, 2048, 513]).unwrap();
+    assert!(e.contains("at most 2147483647 blocks"), "{e}");
+    assert!(VoxelFormat::Schem.refuses_dims([2048, 2048, 511]).is_none());
+    assert!(VoxelFormat::Schem.refuses_dims([65536, 1, 1]).unwrap().contains("65535 blocks on a side"));
+}
+
+#[test]
 fn schem_is_valid_nbt_and_round_trips_voxels() {
     let grid = GridSpec::new(DVec3::ZERO, 1.0, [20, 12, 7]).unwrap();
     let (b, a) = scene([20, 12, 7], 40, 400);

@@ -297,4 +297,12 @@ fn gltf_instancing_past_memory_is_refused_before_expanding() {
     // A thousand instances are read (and are every one of them).
     let few = json.replacen(&many(1), "[1]", 1).replacen(&many(2), "[2]", 1);
     assert_eq!(read_mesh(&write("few.gltf", few.as_bytes())).unwrap().report.triangles, 1000);
+    // The same chain whose leaves hold no mesh: 10⁹ node visits place
+    // nothing, and are refused as quickly (the mesh is placed once, by the root).
+    let empty = json.replacen(r#"{"mesh": 0}]"#, "{}]", 1).replacen(r#"[{"children""#, r#"[{"mesh": 0, "children""#, 1);
+    assert_ne!(empty, json);
+    let t = std::time::Instant::now();
+    let e = read_mesh(&write("empty.gltf", empty.as_bytes())).unwrap_err().to_string();
+    assert!(e.contains("visits 1001001001 nodes"), "{e}");
+    assert!(t.elapsed().as_secs() < 5, "counted, not walked: {:?}", t.elapsed());
 }

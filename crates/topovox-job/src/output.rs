@@ -148,6 +148,12 @@ pub fn check_fits(target: Output, grid: &GridSpec, max_memory: Option<u64>) -> R
     if let Some(why) = refuses(target, grid.size()) {
         return Err(JobError::invalid(why));
     }
+    if let Some(why) = match target {
+        Output::Voxels(f) => f.refuses_dims(grid.dims()),
+        Output::Mesh(_) => None,
+    } {
+        return Err(JobError::invalid(why));
+    }
     let budget = crate::memory::budget(max_memory);
     if is_sparse(target) || crate::memory::dense_fits(grid, budget) {
         return Ok(());

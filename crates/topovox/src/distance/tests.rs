@@ -82,6 +82,26 @@ fn band_and_dense_match_the_reference() {
 }
 
 #[test]
+fn a_band_covering_the_grid_is_the_dense_field_with_the_same_values() {
+    let mut rng = Xorshift(0x0c0f_fee5);
+    for round in 0..6 {
+        let mesh = soup(&mut rng, 8 + round * 3);
+        let g = grid(&mut rng);
+        let pieces = Pieces::of(mesh.as_ref()).unwrap();
+        let h = g.voxel_size().max_element();
+        // Wide enough to cover the grid: the dense route is taken, and
+        // gives what the bricks give.
+        let wide = 80.0 * g.dims().iter().copied().max().unwrap() as f64;
+        assert!(band::covers_grid(&pieces, &g, wide * h), "round {round}");
+        let fast = band::band(&pieces, &g, wide, &Stop::new()).unwrap();
+        assert_eq!(fast, band::by_bricks(&pieces, &g, wide * h, &Stop::new()).unwrap(), "round {round}");
+        assert_eq!(fast.count(), g.voxel_count());
+        // A narrow band does not cover it.
+        assert!(!band::covers_grid(&pieces, &g, 0.5 * h));
+    }
+}
+
+#[test]
 fn results_do_not_depend_on_the_thread_count() {
     let mut rng = Xorshift(0xabcd_0123);
     let mesh = soup(&mut rng, 60);
