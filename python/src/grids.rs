@@ -335,18 +335,18 @@ impl VoxelGrid {
             Some(m) => Some(py.import("topovox")?.getattr("as_mesh")?.call1((m,))?.cast_into::<Mesh>()?.get().inner.clone()),
             None => None,
         };
-        let v = py
-            .detach(move || {
-                let mesh = m.as_ref().map(|m| (m.mesh.as_ref(), &inner.grid, "grid"));
-                match &inner.voxels {
-                    topovox_job::Voxels::Sparse(s) => {
-                        let layers = topovox_job::check::window_layers(s.dims(), topovox_job::budget(None));
-                        topovox_job::check::report_sparse(s, mesh, layers)
-                    }
-                    voxels => topovox_job::check::report(&voxels.to_dense(), mesh),
+        // Ctrl-C returns at once; the check, left to finish, is dropped.
+        let v = crate::interrupt::interruptible_read(py, move || {
+            let mesh = m.as_ref().map(|m| (m.mesh.as_ref(), &inner.grid, "grid"));
+            match &inner.voxels {
+                topovox_job::Voxels::Sparse(s) => {
+                    let layers = topovox_job::check::window_layers(s.dims(), topovox_job::budget(None));
+                    topovox_job::check::report_sparse(s, mesh, layers)
                 }
-            })
-            .map_err(py_err)?;
+                voxels => topovox_job::check::report(&voxels.to_dense(), mesh),
+            }
+        })?
+        .map_err(py_err)?;
         to_py(py, &v)
     }
 
@@ -786,7 +786,7 @@ pub(crate) fn load_voxels(
     let p = path.clone();
     let up = up_of(up)?;
     let opts = topovox_io::ReadOptions { allow_external_paths };
-    let loaded = py.detach(move || topovox_io::read_voxels_opts(&p, up, &opts)).map_err(io_err)?;
+    let loaded = crate::interrupt::interruptible_read(py, move || topovox_io::read_voxels_opts(&p, up, &opts))?.map_err(io_err)?;
     let dims = loaded.bits.dims();
     let o = match origin {
         Some(o) if o.len() == 3 => DVec3::new(o[0], o[1], o[2]),

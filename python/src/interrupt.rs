@@ -2,6 +2,8 @@
 //! the work ends, and Python's signal handlers run while it has not.
 
 use pyo3::exceptions::PyRuntimeError;
+use std::sync::mpsc::{self, RecvTimeoutError};
+
 use pyo3::prelude::*;
 use topovox::voxelize::Stop;
 
@@ -28,11 +30,10 @@ pub(crate) fn interruptible_ticking<T: Send>(
     py: Python<'_>,
     stop: &Stop,
     work: impl FnOnce() -> T + Send,
-    mut tick: impl FnMut(Python<'_>) -> PyResult<()>,
+    tick: impl FnMut(Python<'_>) -> PyResult<()>,
 ) -> PyResult<T> {
-    use std::sync::mpsc::{self, RecvTimeoutError};
     std::thread::scope(|s| {
-        let (done, mut result) = mpsc::sync_channel(1);
+        let (done, result) = mpsc::sync_channel(1);
         // The stack of the main thread the work would otherwise run on.
         let worker = std::thread::Builder::new()
             .stack_size(8 << 20)
@@ -41,27 +42,76 @@ pub(crate) fn interruptible_ticking<T: Send>(
                 let _ = done.send(work());
             })
             .map_err(|e| PyRuntimeError::new_err(format!("cannot start a worker thread: {e}")))?;
-        loop {
-            // The receiver travels into the wait and back: it is not `Sync`.
-            let got;
-            (got, result) = py.detach(move || (result.recv_timeout(SIGNAL_POLL), result));
-            match got {
-                Ok(r) => return tick(py).map(|()| r),
-                // The worker ended without a result: it panicked.
-                Err(RecvTimeoutError::Disconnected) => {
-                    return Err(worker.join().map_or_else(
-                        |p| std::panic::resume_unwind(p),
-                        |()| PyRuntimeError::new_err("the worker thread ended without a result"),
-                    ))
-                }
-                Err(RecvTimeoutError::Timeout) => {}
-            }
-            if let Err(e) = py.check_signals().and_then(|()| tick(py)) {
+        let panicked = |worker: std::thread::ScopedJoinHandle<'_, ()>| {
+            worker
+                .join()
+                .map_or_else(|p| std::panic::resume_unwind(p), |()| PyRuntimeError::new_err("the worker thread ended without a result"))
+        };
+        wait(py, result, tick, move |interrupted| match interrupted {
+            // Its result (incomplete, or an Interrupted error) is dropped.
+            true => {
                 stop.request();
-                // Its result (incomplete, or an Interrupted error) is dropped.
                 let _ = py.detach(|| worker.join());
-                return Err(e);
+                None
             }
-        }
+            false => Some(panicked(worker)),
+        })
     })
+}
+
+/// [`interruptible`] for work that cannot be stopped part way and changes
+/// nothing (a read, a check): on Ctrl-C the caller returns at once and the
+/// work, left to finish on its own thread, is dropped when it ends.
+pub(crate) fn interruptible_read<T: Send + 'static>(py: Python<'_>, work: impl FnOnce() -> T + Send + 'static) -> PyResult<T> {
+    let (done, result) = mpsc::sync_channel(1);
+    let worker = std::thread::Builder::new()
+        .stack_size(8 << 20)
+        .spawn(move || {
+            let _ = done.send(work());
+        })
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start a worker thread: {e}")))?;
+    wait(
+        py,
+        result,
+        |_| Ok(()),
+        move |interrupted| {
+            (!interrupted).then(|| {
+                worker
+                    .join()
+                    .map_or_else(|p| std::panic::resume_unwind(p), |()| PyRuntimeError::new_err("the worker thread ended without a result"))
+            })
+        },
+    )
+}
+
+/// Waits for `result`, running Python's signal handlers and `tick` every
+/// [`SIGNAL_POLL`] and once at the end. `end(true)` is called when a
+/// handler or `tick` raised (that error is returned); `end(false)` when the
+/// worker ended without a result, and returns its panic's error.
+fn wait<T>(
+    py: Python<'_>,
+    mut result: mpsc::Receiver<T>,
+    mut tick: impl FnMut(Python<'_>) -> PyResult<()>,
+    end: impl FnOnce(bool) -> Option<PyErr>,
+) -> PyResult<T>
+where
+    T: Send,
+{
+    loop {
+        // The receiver travels into the wait and back: it is not `Sync`.
+        let got;
+        (got, result) = py.detach(move || (result.recv_timeout(SIGNAL_POLL), result));
+        match got {
+            Ok(r) => return tick(py).map(|()| r),
+            // The worker ended without a result: it panicked.
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(end(false).unwrap_or_else(|| PyRuntimeError::new_err("the worker thread ended without a result")))
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+        }
+        if let Err(e) = py.check_signals().and_then(|()| tick(py)) {
+            end(true);
+            return Err(e);
+        }
+    }
 }
