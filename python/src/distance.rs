@@ -7,16 +7,16 @@ use std::sync::{Arc, OnceLock};
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::PyDict;
 use topovox::voxelize::Stop;
-use topovox_job::distance::{DistanceFormat, Sdf, SdfRequest, Sign, Width};
-use topovox_job::{Choice, GridRequest, JobError};
+use topovox_job::distance::{DistanceFormat, Sdf, SdfOptions};
+use topovox_job::JobError;
 
 use crate::convert::{array_protocol, to_py};
 use crate::errors::{py_err, value_err};
 use crate::interrupt::interruptible;
 use crate::meshes::Mesh;
-use crate::options::job_options;
+use crate::options::table_options;
 use crate::placement;
 
 mod state;
@@ -311,28 +311,13 @@ fn ordered(s: &Sdf) -> Ordered {
     v
 }
 
-/// The band keyword: a number of voxels, or `"all"`.
-fn width_of(v: &Bound<'_, PyAny>) -> PyResult<Width> {
-    let text = if v.is_instance_of::<PyString>() { v.extract::<String>()? } else { v.str()?.to_string() };
-    Width::parse(&text).map_err(py_err)
-}
-
 /// The native sdf: see `topovox.sdf` for the documentation.
 #[pyfunction]
 #[pyo3(signature = (mesh, options=None))]
 pub fn sdf(py: Python<'_>, mesh: &Mesh, options: Option<&Bound<'_, PyDict>>) -> PyResult<DistanceGrid> {
-    const OWN: [&str; 3] = ["band", "unsigned", "sign"];
-    let opts = job_options(options, &OWN)?;
-    let get = |k: &str| options.and_then(|d| d.get_item(k).ok().flatten()).filter(|v| !v.is_none());
-    let width = get("band").map(|v| width_of(&v)).transpose()?.unwrap_or(Width::Voxels(3.0));
-    let unsigned = get("unsigned").map(|v| v.extract::<bool>()).transpose()?.unwrap_or(false);
-    let sign = match get("sign") {
-        Some(v) => Sign::parse(&v.extract::<String>()?).map_err(|e| value_err(format!("sign: {e}")))?,
-        None => Sign::Auto,
-    };
-    let grid = GridRequest::new(&opts.grid).map_err(py_err)?;
-    let req = SdfRequest { grid, width, unsigned, sign, max_memory: opts.max_memory, format: DistanceFormat::Vdb };
-    let pool = opts.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
+    let opts: SdfOptions = table_options(options, &[])?;
+    let req = opts.request(DistanceFormat::Vdb).map_err(py_err)?;
+    let pool = opts.run.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
     let inner = &mesh.inner;
     let name = mesh.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into());
     let stop = Stop::new();

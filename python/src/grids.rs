@@ -17,7 +17,7 @@ use topovox::attributes::{VoxelAttributes, NO_MATERIAL};
 use topovox::voxelize::Stop;
 use topovox::{GridSpec, VoxelSource};
 use topovox_job::output::Output;
-use topovox_job::{JobOptions, Voxels};
+use topovox_job::{ExportOptions, Voxels};
 
 use crate::convert::{array_protocol, as_array, indices_from, rows_of, shape, size_to_py, to_py, triple_f64, triple_u64, SizeArg};
 use crate::errors::{io_err, py_err, value_err};
@@ -299,7 +299,7 @@ impl VoxelGrid {
         let format = format.map(|f| <Output as topovox_job::Choice>::parse(&f)).transpose().map_err(|e| value_err(e.to_string()))?;
         let target = topovox_job::output::output_format(format, &path).map_err(py_err)?;
         topovox_job::output::check_output_path(&path).map_err(py_err)?;
-        let job = JobOptions { dither, block_palette, up: up_of(up)?, watertight, triangulate, ..JobOptions::default() };
+        let job = ExportOptions { dither, block_palette, up: up_of(up)?, watertight, triangulate, ..ExportOptions::default() };
         let stop = Arc::new(Stop::new());
         let opts = topovox_io::WriteOptions { stop: Some(stop.clone()), ..job.write_options().map_err(py_err)? };
         let inner = &self.inner;

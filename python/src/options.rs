@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyList, PyString};
 use topovox::attributes::ColourRule;
-use topovox_job::{JobOptions, OptionValue};
+use topovox_job::{JobOptions, OptionValue, Table};
 
 use crate::errors::{py_err, value_err};
 
@@ -36,26 +36,38 @@ pub(crate) fn option_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<OptionVa
     Err(value_err(format!("{key} does not take {}", v.repr()?)))
 }
 
-/// The job options of keyword arguments (`None` keeps a default; the
-/// names in `skip` are the caller's own), checked by the job crate.
-pub(crate) fn job_options(options: Option<&Bound<'_, PyDict>>, skip: &[&str]) -> PyResult<JobOptions> {
-    let mut o = JobOptions::default();
+/// The options of a table (`JobOptions`, `SdfOptions`) from keyword
+/// arguments (`None` keeps a default; the names in `skip` are the caller's
+/// own), checked by the job crate.
+pub(crate) fn table_options<T: Table>(options: Option<&Bound<'_, PyDict>>, skip: &[&str]) -> PyResult<T> {
+    let mut o = T::default();
     for (k, v) in options.into_iter().flat_map(|d| d.iter()) {
         let k: String = k.extract()?;
         if !v.is_none() && !skip.contains(&k.as_str()) {
-            o.set(&k, &option_value(&k, &v)?).map_err(py_err)?;
+            o.set_named(&k, &option_value(&k, &v)?).map_err(py_err)?;
         }
     }
     Ok(o)
 }
 
-/// Every option `voxelize` and `batch` take: `[(name, help, example)]`
-/// (from the job crate's one list; the tests check both take each).
+/// [`table_options`] of a voxelization job.
+pub(crate) fn job_options(options: Option<&Bound<'_, PyDict>>, skip: &[&str]) -> PyResult<JobOptions> {
+    table_options(options, skip)
+}
+
+/// Every option `voxelize` and `batch` take (`command="sdf"`: every
+/// option `sdf` takes): `[(name, help, example)]`, from the job crate's
+/// tables; the tests check each front end takes each.
 #[pyfunction]
-pub(crate) fn options<'py>(py: Python<'py>) -> PyResult<Vec<(&'static str, &'static str, Bound<'py, PyAny>)>> {
-    use topovox_job::options::Example as E;
-    topovox_job::KEYWORDS
-        .iter()
+#[pyo3(signature = (command="voxelize"))]
+pub(crate) fn options<'py>(py: Python<'py>, command: &str) -> PyResult<Vec<(&'static str, &'static str, Bound<'py, PyAny>)>> {
+    use topovox_job::table::Example as E;
+    let rows: Vec<&'static topovox_job::Keyword> = match command {
+        "voxelize" | "batch" => JobOptions::keywords().collect(),
+        "sdf" => topovox_job::distance::SdfOptions::keywords().collect(),
+        _ => return Err(crate::errors::value_err(format!("options: no command {command:?} (expected voxelize, batch or sdf)"))),
+    };
+    rows.into_iter()
         .map(|k| {
             let example = match k.example {
                 E::Bool(b) => b.into_pyobject(py)?.to_owned().into_any(),

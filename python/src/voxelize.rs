@@ -19,10 +19,9 @@ use crate::options::job_options;
 pub(crate) fn voxelize(py: Python<'_>, mesh: &Mesh, options: Option<&Bound<'_, PyDict>>) -> PyResult<VoxelGrid> {
     let opts = job_options(options, &[])?;
     let plan = opts.plan().map_err(py_err)?;
-    let carry = opts.carry();
-    // Attributes are carried when any is asked for (normals are one).
-    let attributes = opts.attributes || opts.normals;
-    let pool = opts.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
+    let carry = opts.export.carry();
+    let attributes = opts.export.carries();
+    let pool = opts.run.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
     let inner = &mesh.inner;
     let name = mesh.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into());
     let stop = Stop::new();

@@ -29,6 +29,25 @@ def test_the_python_signature_is_the_list():
     assert topovox.MODES[0] == "cover" and "solid+surface" in topovox.MODES
 
 
+SDF_OPTIONS = _topovox.options("sdf")
+
+
+def test_the_sdf_signature_is_its_table():
+    params = set(inspect.signature(topovox.sdf).parameters) - {"mesh_or_vertices", "faces"}
+    assert params == {name for name, _, _ in SDF_OPTIONS}
+    with pytest.raises(ValueError, match="no command"):
+        _topovox.options("remesh")
+
+
+@pytest.mark.parametrize("name,example", [(n, e) for n, _, e in SDF_OPTIONS])
+def test_every_sdf_option_is_taken_by_sdf(name, example, meshes):
+    kw = dict(COMPANIONS.get(name, {}), **{name: example})
+    if "voxel_size" not in kw and "resolution" not in kw:
+        kw["resolution"] = 12
+    field = topovox.sdf(topovox.load_mesh(meshes / "cow.obj"), **kw)
+    assert field.dims[0] > 0
+
+
 @pytest.mark.parametrize("name,example", [(n, e) for n, _, e in OPTIONS])
 def test_every_option_is_taken_by_voxelize_and_by_batch(name, example, meshes, tmp_path):
     kw = dict(COMPANIONS.get(name, {}), **{name: example})

@@ -4,13 +4,14 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
 use topovox::raster::{RasterMethod, RasterMode};
-use topovox_job::distance::{DistanceFormat, Sign};
+use topovox_job::distance::{DistanceFormat, SdfOptions};
 use topovox_job::output::Output;
-use topovox_job::{ColourRule, Fill, Fit, GpuPath, Hollow, Method, Mode, Switch, Up};
+use topovox_job::{ColourRule, ExportOptions, GridOptions, JobOptions, Mode, Switch, Up};
 
 use topovox::render::raycast::View;
 
 use crate::choice::choice;
+use crate::flags::Flags;
 use crate::values::{self, CameraSpec, Size};
 
 /// topovox: voxelize triangle meshes with guaranteed topology.
@@ -74,89 +75,6 @@ topovox::choice! {
     }
 }
 
-/// How the grid is chosen.
-#[derive(Args, Debug, Clone, Default)]
-pub struct GridArgs {
-    /// Fit the grid so the longest side of the mesh's bounding box spans N voxels (default 128).
-    #[arg(long, value_name = "N")]
-    pub resolution: Option<u64>,
-    /// Voxel edge length, or SX,SY,SZ for a size per axis (boxes); alone, fits the grid to the mesh's bounding box.
-    #[arg(long, value_name = "S|SX,SY,SZ", value_parser = crate::values::voxel_size)]
-    pub voxel_size: Option<topovox::VoxelSize>,
-    /// Explicit grid origin (with --voxel-size and --dims).
-    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', allow_hyphen_values = true)]
-    pub origin: Option<Vec<f64>>,
-    /// Explicit grid dims (with --origin and --voxel-size).
-    #[arg(long, value_name = "NX,NY,NZ", value_delimiter = ',')]
-    pub dims: Option<Vec<u64>>,
-    /// Empty voxels added on every side of a fitted grid (default 0).
-    #[arg(long, value_name = "P")]
-    pub pad: Option<u32>,
-    /// How the grid is fitted to the mesh: `box` (default: origin at the
-    /// bounding box's corner) or `cube` (N³ voxels centred on it, the mesh's
-    /// longest side spanning N − 2·pad: the ShapeNet/ModelNet convention).
-    #[arg(long, value_parser = choice::<Fit>())]
-    pub fit: Option<Fit>,
-}
-
-/// Grids past memory: the tiled path and the memory it may use.
-#[derive(Args, Debug, Default)]
-pub struct MemoryArgs {
-    /// Memory the run may use, e.g. 8G or 512M (default: nine tenths of
-    /// what is available). Surface and line modes on grids that do not fit densely
-    /// run tile by tile into sparse storage; write those to .vdb, .txt or .ply.
-    #[arg(long, value_name = "SIZE", value_parser = values::memory)]
-    pub max_memory: Option<u64>,
-    /// Run the surface or line mode tile by tile with tiles of N voxels (a multiple
-    /// of 8; default: only when the grid does not fit in --max-memory, with
-    /// tiles of 512). Same voxels either way.
-    #[arg(long, value_name = "N")]
-    pub tile: Option<u32>,
-}
-
-/// The options of a voxelization job, shared by `voxelize` and `batch`
-/// (turned into the job's [`topovox_job::JobOptions`] in `plan.rs`).
-#[derive(Args, Debug)]
-pub struct JobArgs {
-    /// Read files the model names (OBJ material libraries and textures,
-    /// glTF buffers and images) even outside its folder: absolute paths,
-    /// `../`, links leading out. Off by default.
-    #[arg(long)]
-    pub allow_external_paths: bool,
-    /// Voxelization mode.
-    #[arg(long, value_parser = choice::<Mode>(), default_value = "cover")]
-    pub mode: Mode,
-    /// Method.
-    #[arg(long, value_parser = choice::<Method>(), default_value = "auto")]
-    pub method: Method,
-    /// `bubble`: the seed of its random points (same seed, same voxels; default 0).
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
-    /// Solid modes: the surface mode of `solid+surface` and of the
-    /// `--fill flood` shell (default cover).
-    #[arg(long, value_parser = choice::<Mode>(), value_name = "MODE")]
-    pub surface: Option<Mode>,
-    /// Solid modes: `flood` fills everything a surface shell encloses
-    /// (everything not reachable from the grid boundary through unset voxels).
-    #[arg(long, value_parser = choice::<Fill>())]
-    pub fill: Option<Fill>,
-    /// Solid modes: keep only the voxels touching the outside through a face
-    /// (6) or also an edge or corner (26).
-    #[arg(long, value_name = "6|26", value_parser = choice::<Hollow>())]
-    pub hollow: Option<Hollow>,
-    #[command(flatten)]
-    pub grid: GridArgs,
-    #[command(flatten)]
-    pub memory: MemoryArgs,
-    /// With --method gpu: `compute` (default), `raster` (the rasterizer path, same voxels), or
-    /// `msaa-approx` (rasterizer with 4x MSAA instead of conservative coverage: approximate, misses
-    /// voxels; the summary says how many).
-    #[arg(long, value_parser = choice::<GpuPath>(), default_value = "compute", value_name = "PATH")]
-    pub gpu_path: GpuPath,
-    #[command(flatten)]
-    pub export: ExportArgs,
-}
-
 #[derive(Args, Debug)]
 pub struct VoxelizeArgs {
     /// Input mesh (.obj, .stl, .ply, .gltf, .glb, .off).
@@ -168,7 +86,7 @@ pub struct VoxelizeArgs {
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     #[command(flatten)]
-    pub job: JobArgs,
+    pub job: Flags<JobOptions>,
     /// Output format (default: from the extension).
     #[arg(long, value_name = "FORMAT", value_parser = choice::<Output>())]
     pub format: Option<Output>,
@@ -177,9 +95,6 @@ pub struct VoxelizeArgs {
     pub preview: Option<PathBuf>,
     #[command(flatten)]
     pub picture: PictureArgs,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
     /// Print one JSON object on stdout instead of the summary line.
     #[arg(long)]
     pub json: bool,
@@ -197,77 +112,16 @@ pub struct SdfArgs {
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     #[command(flatten)]
-    pub grid: GridArgs,
-    /// Half width of the stored band in voxels: voxels nearer than W voxel sizes to the
-    /// mesh get their distance, the others ±W voxel sizes (OpenVDB's level-set
-    /// background). `all`: every voxel gets its distance.
-    #[arg(long, default_value = "3", value_name = "W|all", allow_hyphen_values = true, value_parser = values::band)]
-    pub band: topovox_job::distance::Width,
-    /// Unsigned distances (no inside): for open meshes, polylines and point-like data.
-    #[arg(long)]
-    pub unsigned: bool,
-    /// How inside is decided (the same rule, and the same voxels, as `voxelize --mode solid --method`).
-    #[arg(long, value_parser = choice::<Sign>(), default_value = "auto")]
-    pub sign: Sign,
+    pub sdf: Flags<SdfOptions>,
     /// Output format: vdb, npy, zarr or vti (default: from the extension).
     #[arg(long, value_name = "FORMAT", value_parser = choice::<DistanceFormat>())]
     pub format: Option<DistanceFormat>,
-    /// Memory the run may use, e.g. 8G or 512M (default: nine tenths of what is available).
-    #[arg(long, value_name = "SIZE", value_parser = values::memory)]
-    pub max_memory: Option<u64>,
-    /// Read files the model names even outside its folder. Off by default.
-    #[arg(long)]
-    pub allow_external_paths: bool,
-    /// Worker threads (default: all cores).
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
     /// Print one JSON object on stdout instead of the summary line.
     #[arg(long)]
     pub json: bool,
     /// No progress bar and no summary line.
     #[arg(long, short)]
     pub quiet: bool,
-}
-
-/// Colour and attribute options of the writers.
-#[derive(Args, Debug, Clone, Default)]
-pub struct ExportArgs {
-    /// How the colours of the surface inside a voxel combine: `dominant` (the colour covering the most area; never a new colour) or `blend` (area-weighted mean in linear light).
-    #[arg(long, visible_alias = "color-rule", value_parser = choice::<ColourRule>(), default_value = "dominant", value_name = "RULE")]
-    pub colour_rule: ColourRule,
-    /// .vti: also store each voxel's average surface normal.
-    #[arg(long)]
-    pub normals: bool,
-    /// .vdb and .zarr: also write what the surface carries into each voxel.
-    /// .vdb: grids over the same voxels beside the `voxels` bool grid: `Cd`
-    /// (colour, linear RGB; when the mesh has colours), `normal`, `coverage`
-    /// (surface area inside the voxel over a voxel face's) and `material`
-    /// (the id as a float, -1 for none). .zarr: a group of arrays `voxels`,
-    /// `colour` (uint8 sRGB, last axis of 3), `normal` (float32, 3),
-    /// `coverage` (float32) and `material` (int32, -1 for none).
-    #[arg(long)]
-    pub attributes: bool,
-    /// .vox: dither colours onto the 255-colour palette (error diffusion; off by default).
-    #[arg(long)]
-    pub dither: bool,
-    /// .schem: a colour -> block table, `namespace:block R G B` per line (default: the built-in table).
-    #[arg(long, value_name = "FILE")]
-    pub block_palette: Option<PathBuf>,
-    /// The axis of the mesh (and the voxel grid) that points up: .vox and
-    /// .schem are rotated (never mirrored) so the model stands upright in
-    /// MagicaVoxel (z-up) and Minecraft (y-up), and --preview draws it up.
-    /// Default: y, as for most OBJ, glTF, PLY and STL models.
-    #[arg(long, value_name = "x|y|z", value_parser = choice::<Up>())]
-    pub up: Option<Up>,
-    /// .obj and .glb meshes of the voxels: `on` (default) splits the greedy
-    /// quads at T-junctions so every edge is shared (watertight, for 3D
-    /// printing and booleans); `off` keeps the plain quads.
-    #[arg(long, value_name = "on|off", value_parser = choice::<Switch>())]
-    pub watertight: Option<Switch>,
-    /// .obj meshes of the voxels: triangles only (quads split in two); for
-    /// readers that take only triangles, such as Open3D.
-    #[arg(long)]
-    pub triangulate: bool,
 }
 
 /// How a picture is taken.
@@ -307,7 +161,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = choice::<Mode>(), default_value = "cover")]
     pub mode: Mode,
     #[command(flatten)]
-    pub grid: GridArgs,
+    pub grid: Flags<GridOptions>,
     /// For a mesh: how surface colours combine in a voxel (dominant or blend).
     #[arg(long, visible_alias = "color-rule", value_parser = choice::<ColourRule>(), default_value = "dominant", value_name = "RULE")]
     pub colour_rule: ColourRule,
@@ -434,7 +288,7 @@ pub struct ViewArgs {
     #[arg(long, value_parser = choice::<Mode>())]
     pub mode: Option<Mode>,
     #[command(flatten)]
-    pub grid: GridArgs,
+    pub grid: Flags<GridOptions>,
     /// Voxels beside the mesh (side) or in its place (overlay).
     #[arg(long, default_value = "side", value_parser = choice::<Layout>())]
     pub layout: Layout,
@@ -534,7 +388,7 @@ pub struct CheckArgs {
     /// (npy, vox); without these the grid is inferred as the mesh's fitted
     /// grid at resolution = the largest dimension.
     #[command(flatten)]
-    pub grid: GridArgs,
+    pub grid: Flags<GridOptions>,
     /// .vox and .schem files: the up axis they were written with (`--up` of
     /// voxelize; default y), when the file does not record it.
     #[arg(long, value_name = "x|y|z", value_parser = choice::<Up>())]
@@ -643,7 +497,7 @@ pub struct ConvertArgs {
     #[arg(long, value_name = "FORMAT", value_parser = choice::<Output>())]
     pub format: Option<Output>,
     #[command(flatten)]
-    pub export: ExportArgs,
+    pub export: Flags<ExportOptions>,
     /// Grid origin X,Y,Z for formats that record it (binvox, txt), when the input does not carry it (default 0,0,0).
     #[arg(long, value_delimiter = ',', value_name = "X,Y,Z", allow_hyphen_values = true)]
     pub origin: Option<Vec<f64>>,
@@ -676,7 +530,7 @@ pub struct BatchArgs {
     #[arg(long, default_value = "npy", value_name = "FORMAT", value_parser = choice::<Output>())]
     pub format: Output,
     #[command(flatten)]
-    pub job: JobArgs,
+    pub job: Flags<JobOptions>,
     /// Meshes processed at once (default: all cores); each is voxelized on the same threads.
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
@@ -726,6 +580,7 @@ pub struct RasterArgs {
 mod tests {
     use clap::Parser;
     use topovox::render::Culling;
+    use topovox_job::{Fill, GpuPath, Hollow, Method};
 
     use super::*;
 
@@ -761,10 +616,30 @@ mod tests {
         ]) else {
             panic!("not voxelize")
         };
-        let j = &v.job;
+        let j = &v.job.options;
         assert_eq!((j.mode, j.method, j.hollow, j.fill), (Mode::Solid, Method::Winding, Some(Hollow::TwentySix), Some(Fill::Flood)));
-        assert_eq!((j.export.colour_rule, j.export.up, j.export.watertight), (ColourRule::Blend, Some(Up::Z), Some(Switch::Off)));
-        assert_eq!((j.gpu_path, j.memory.max_memory), (GpuPath::MsaaApprox, Some(64 << 20)));
+        assert_eq!((j.export.colour_rule, j.export.up, j.export.watertight), (ColourRule::Blend, Up::Z, false));
+        assert_eq!((j.gpu_path, j.run.max_memory), (GpuPath::MsaaApprox, Some(64 << 20)));
+        assert!(v.job.given.contains(&"up") && !v.job.given.contains(&"resolution"));
+        // Negative numbers, lists and a size per axis; sdf's band by name.
+        let Command::Sdf(s) = parse(&[
+            "sdf",
+            "m.obj",
+            "-o",
+            "o.vdb",
+            "--origin",
+            "-1,-2.5,-3",
+            "--dims",
+            "4,5,6",
+            "--voxel-size",
+            "0.5,1,2",
+            "--band",
+            "all",
+        ]) else {
+            panic!("not sdf")
+        };
+        assert_eq!((s.sdf.grid.origin.clone(), s.sdf.grid.dims.clone()), (Some(vec![-1.0, -2.5, -3.0]), Some(vec![4, 5, 6])));
+        assert_eq!((s.sdf.grid.voxel_size, s.sdf.band), (Some([0.5, 1.0, 2.0].into()), topovox_job::distance::Width::All));
         let Command::Render(r) =
             parse(&["render", "s.obj", "-o", "a.png", "--gpu", "--camera", "-5,2,3,0,0,0", "--culling", "Frustum", "--gamma", "off"])
         else {
@@ -790,6 +665,10 @@ mod tests {
             &["render", "s.obj", "-o", "a.png", "--gpu", "--camera", "1,2,3"],
             &["spray", "s.obj", "-o", "a.ply", "--size", "0x5"],
             &["voxelize", "m.obj", "-o", "o.npy", "--max-memory", "lots"],
+            &["voxelize", "m.obj", "-o", "o.npy", "--resolution", "0"],
+            &["voxelize", "m.obj", "-o", "o.npy", "--dims", "1,2"],
+            &["sdf", "m.obj", "-o", "o.vdb", "--band", "-1"],
+            &["batch", "in", "-o", "out", "--tile", "4"],
         ] {
             assert!(Cli::try_parse_from(std::iter::once("topovox").chain(args.iter().copied())).is_err(), "{args:?}");
         }

@@ -4,15 +4,14 @@
 use std::path::Path;
 
 use topovox_job::output::{MeshKind, Output};
-use topovox_job::ColourRule;
-
-use crate::args::ExportArgs;
+use topovox_job::{ColourRule, ExportOptions};
 
 /// Warns, before any work, about export options that do nothing for this
 /// output (`from_mesh`: the voxels come from a mesh, so colours can be
-/// carried; `up_used`: `--up` also serves the input or a preview), and
-/// about an extension that names another format.
-pub fn warn_unused(e: &ExportArgs, format: Output, output: &Path, from_mesh: bool, up_used: bool) {
+/// carried; `up_used`: `--up` also serves the input or a preview; `given`:
+/// the options given on the command line), and about an extension that
+/// names another format.
+pub fn warn_unused(e: &ExportOptions, given: &[&str], format: Output, output: &Path, from_mesh: bool, up_used: bool) {
     use topovox_io::VoxelFormat as F;
     let name = format.name();
     let mut unused = Vec::new();
@@ -22,10 +21,10 @@ pub fn warn_unused(e: &ExportArgs, format: Output, output: &Path, from_mesh: boo
     if e.block_palette.is_some() && format != Output::Voxels(F::Schem) {
         unused.push("--block-palette (for .schem)");
     }
-    if e.up.is_some() && !up_used && !matches!(format, Output::Voxels(F::Vox | F::Schem)) {
+    if given.contains(&"up") && !up_used && !matches!(format, Output::Voxels(F::Vox | F::Schem)) {
         unused.push("--up (for .vox and .schem)");
     }
-    if (e.watertight.is_some() || e.triangulate) && !matches!(format, Output::Mesh(_)) {
+    if (given.contains(&"watertight") || e.triangulate) && !matches!(format, Output::Mesh(_)) {
         unused.push("--watertight and --triangulate (for .obj and .glb)");
     }
     if e.triangulate && format == Output::Mesh(MeshKind::Glb) {

@@ -5,6 +5,7 @@ mod choice;
 mod commands;
 mod console;
 mod export;
+mod flags;
 mod pictures;
 mod plan;
 mod progress;

@@ -88,18 +88,6 @@ pub fn camera(text: &str) -> Result<CameraSpec, String> {
     Ok(CameraSpec { eye, target, fov_deg })
 }
 
-/// A memory size: bytes, or with a unit (`512M`, `8G`).
-pub fn memory(text: &str) -> Result<u64, String> {
-    topovox_job::parse_size(text).map_err(|e| e.to_string())
-}
-
-/// `--band W|all`: a distance field's half width.
-pub fn band(text: &str) -> Result<topovox_job::distance::Width, String> {
-    use topovox_job::distance::Width;
-    // clap adds what was given.
-    Width::parse(text).map_err(|_| format!("band: expected {}", Width::EXPECTED))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -140,11 +128,5 @@ mod tests {
         for bad in ["1,2,3", "0,0,0,0,0,0", "1,2,3,0,0,0,180", "1,2,3,0,0,inf", "a,b,c,d,e,f"] {
             assert!(camera(bad).is_err(), "{bad}");
         }
-    }
-
-    #[test]
-    fn memory_sizes() {
-        assert_eq!(memory("512M"), Ok(512 << 20));
-        assert!(memory("lots").is_err());
     }
 }

@@ -8,6 +8,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use serde_json::{json, Value};
+use topovox::choice::Choice;
 use topovox::distance::band::{band, Band};
 use topovox::distance::field::Field;
 use topovox::distance::{nearest, DistanceError, Pieces};
@@ -15,9 +16,11 @@ use topovox::voxelize::{Options, Stop};
 use topovox::{GridSpec, MeshRef};
 
 use crate::error::{JobError, Result};
-use crate::grid::GridRequest;
+use crate::grid::{GridOptions, GridRequest};
 use crate::memory::{budget, bytes};
+use crate::options::RunOptions;
 use crate::plan::{SolidMethod, SolidPlan};
+use crate::table::{choice, chosen, flag, number, shown, value, Example, OptionValue, Shape};
 
 topovox::choice! {
     /// How the sign (inside or outside) of a distance is decided.
@@ -49,7 +52,6 @@ topovox::choice! {
 impl DistanceFormat {
     /// The format `format` names, else the one of `out`'s extension.
     pub fn of(format: Option<&str>, out: &Path) -> Result<DistanceFormat> {
-        use topovox::choice::Choice;
         if let Some(f) = format {
             return DistanceFormat::parse(f).map_err(|e| JobError::invalid(format!("--format: {e}")));
         }
@@ -108,6 +110,55 @@ impl Width {
             Width::Voxels(w) => json!(w),
             Width::All => json!("all"),
         }
+    }
+}
+
+/// A band given by name: a number of voxels, or `all` (a number's text too).
+fn width(key: &str, v: &OptionValue) -> Result<Width> {
+    match v {
+        OptionValue::Text(t) => Width::parse(t),
+        OptionValue::Int(_) | OptionValue::Float(_) => Width::parse(&number(key, v)?.to_string()),
+        v => Err(JobError::invalid(format!("band: expected {}, got {}", Width::EXPECTED, shown(v)))),
+    }
+}
+
+crate::option_table! {
+    /// Every option of a distance-field job (`topovox sdf`, `topovox.sdf`).
+    pub struct SdfOptions {
+        [group grid: GridOptions, "The grid."]
+        [group run: RunOptions, "Threads, memory, paths."]
+        band: Width = Width::Voxels(3.0),
+            parse width,
+            example Example::Float(2.5),
+            print |o| Some(o.band.label()),
+            cli value("W|all"),
+            "half width of the stored band in voxels: voxels nearer than W voxel sizes to the mesh get their distance, the others ±W voxel sizes (OpenVDB's level-set background); all: every voxel gets its distance";
+        unsigned: bool = false,
+            parse flag,
+            example Example::Bool(true),
+            print |o| Some(json!(o.unsigned)),
+            cli Shape::Flag,
+            "unsigned distances (no inside): for open meshes, polylines and point-like data";
+        sign: Sign = Sign::Auto,
+            parse chosen,
+            example Example::Text("winding"),
+            print |o| Some(json!(o.sign.name())),
+            cli choice::<Sign>("RULE"),
+            "how inside is decided (the same rule, and the same voxels, as voxelize --mode solid --method)";
+    }
+}
+
+impl SdfOptions {
+    /// The validated request for a field written as `format`.
+    pub fn request(&self, format: DistanceFormat) -> Result<SdfRequest> {
+        Ok(SdfRequest {
+            grid: GridRequest::new(&self.grid)?,
+            width: self.band,
+            unsigned: self.unsigned,
+            sign: self.sign,
+            max_memory: self.run.max_memory,
+            format,
+        })
     }
 }
 

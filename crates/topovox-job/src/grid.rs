@@ -5,8 +5,11 @@
 use glam::DVec3;
 use topovox::{Aabb, GridSpec, VoxelSize};
 
+use serde_json::json;
+
 use crate::error::{JobError, Result};
 use crate::invalid;
+use crate::table::{choice, chosen, int, number, numbers, shown, value, Example, OptionValue};
 
 topovox::choice! {
     /// How a grid is fitted to the mesh.
@@ -45,21 +48,66 @@ enum GridKind {
     Explicit { origin: DVec3, voxel_size: VoxelSize, dims: [u64; 3] },
 }
 
-/// The grid options as a user gives them (CLI flags, Python keywords).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct GridOptions {
-    /// Longest side of the mesh's bounding box in voxels.
-    pub resolution: Option<u64>,
-    /// Voxel edge length: one for cubes, or one per axis.
-    pub voxel_size: Option<VoxelSize>,
-    /// Explicit origin (with `voxel_size` and `dims`).
-    pub origin: Option<Vec<f64>>,
-    /// Explicit dims (with `origin` and `voxel_size`).
-    pub dims: Option<Vec<u64>>,
-    /// Empty voxels on every side of a fitted grid.
-    pub pad: Option<u32>,
-    /// How the grid is fitted (default: to the bounding box).
-    pub fit: Option<Fit>,
+crate::option_table! {
+    /// The grid options as a user gives them (CLI flags, Python keywords).
+    pub struct GridOptions {
+        resolution: Option<u64> = None,
+            parse |k, v| int(k, v, 1).map(Some),
+            example Example::Int(16),
+            print |o| Some(json!(o.resolution.or((!o.any()).then_some(128)))),
+            cli value("N"),
+            "fit the grid so the longest side of the mesh's bounding box spans N voxels (default 128)";
+        voxel_size: Option<VoxelSize> = None,
+            parse |k, v| voxel_size(k, v).map(Some),
+            example Example::Float(0.5),
+            print |o| Some(json!(o.voxel_size.map(topovox_io::size_json))),
+            cli value("S|SX,SY,SZ"),
+            "the voxel edge, or a size per axis (boxes); alone, the grid is fitted to the mesh's bounding box";
+        origin: Option<Vec<f64>> = None,
+            parse |k, v| numbers(k, v).map(Some),
+            example Example::Numbers(&[-1.0, -1.0, -1.0]),
+            print |o| Some(json!(o.origin)),
+            cli value("X,Y,Z"),
+            "an explicit grid's origin (with voxel_size and dims)";
+        dims: Option<Vec<u64>> = None,
+            parse |k, v| dims(k, v).map(Some),
+            example Example::Numbers(&[8.0, 8.0, 8.0]),
+            print |o| Some(json!(o.dims)),
+            cli value("NX,NY,NZ"),
+            "an explicit grid's dims (with origin and voxel_size)";
+        pad: Option<u32> = None,
+            // 0 is no pad (so a batch's fingerprint is the one without).
+            parse |k, v| Ok(Some(u32::try_from(int(k, v, 0)?).map_err(|_| JobError::invalid("pad is too large"))?).filter(|&p| p > 0)),
+            example Example::Int(1),
+            print |o| Some(json!(o.pad.unwrap_or(0))),
+            cli value("P"),
+            "empty voxels added on every side of a fitted grid (default 0)";
+        fit: Option<Fit> = None,
+            parse |k, v| chosen(k, v).map(Some),
+            example Example::Text("cube"),
+            print |o| o.cube().then(|| json!("cube")),
+            cli choice::<Fit>("box|cube"),
+            "how a fitted grid meets the mesh: box (default: origin at the bounding box's corner) or cube (N³ voxels centred on it, the longest side spanning N − 2·pad: ShapeNet's convention)";
+    }
+}
+
+/// One number (cubes) or three (a size per axis).
+fn voxel_size(key: &str, v: &OptionValue) -> Result<VoxelSize> {
+    match v {
+        OptionValue::Numbers(n) => Ok(<[f64; 3]>::try_from(numbers(key, v)?).unwrap_or([n[0]; 3]).into()),
+        v => number(key, v)
+            .map(VoxelSize::from)
+            .map_err(|_| JobError::invalid(format!("{key} must be a number or 3 numbers; got {}", shown(v)))),
+    }
+}
+
+/// Three integers of at least 1.
+fn dims(key: &str, v: &OptionValue) -> Result<Vec<u64>> {
+    let d = numbers(key, v)?;
+    if d.iter().any(|&x| x < 1.0 || x.fract() != 0.0 || x > u32::MAX as f64) {
+        invalid!("{key} must be 3 integers of at least 1; got {d:?}");
+    }
+    Ok(d.iter().map(|&x| x as u64).collect())
 }
 
 impl GridOptions {

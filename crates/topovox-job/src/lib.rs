@@ -28,11 +28,12 @@ pub mod check;
 pub mod distance;
 pub mod options;
 pub mod output;
+pub mod table;
 
 pub use error::{JobError, Result};
 pub use grid::{Fit, GridOptions, GridRequest};
 pub use memory::{available_memory, budget, bytes, check_memory, dense_fits, parse_size, peak_memory};
-pub use options::{JobOptions, OptionValue, KEYWORDS};
+pub use options::{ExportOptions, JobOptions, RunOptions, KEYWORDS};
 pub use plan::{
     auto_method, gpu_has, resolve_method, Fill, GpuPath, Hollow, Method, Mode, Plan, Request, SolidMethod, SolidPlan, SurfaceMethod,
     GPU_AUTO_MIN_SIDE,
@@ -41,6 +42,7 @@ pub use run::{
     attributes, attributes_for, check_attributes_carried, every_attribute, voxelize, Voxelized, Voxels, ATTRIBUTE_BYTES_PER_VOXEL,
 };
 pub use solid::Outcome as SolidOutcome;
+pub use table::{Keyword, OptionValue, Table};
 pub use topovox::attributes::ColourRule;
 pub use topovox::choice::{Choice, Switch, UnknownChoice};
 pub use topovox_io::orient::Up;

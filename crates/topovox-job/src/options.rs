@@ -6,318 +6,170 @@
 
 use std::path::PathBuf;
 
-use serde_json::{json, Value};
+use serde_json::{json, Map, Value};
 use topovox::attributes::carry::CarryOptions;
 use topovox::attributes::ColourRule;
-use topovox::choice::Choice;
+use topovox::choice::{Choice, Switch};
 use topovox_io::orient::Up;
 
 use crate::batch::BatchOptions;
 use crate::error::{JobError, Result};
 use crate::grid::{GridOptions, GridRequest};
-use crate::invalid;
 use crate::output::Output;
 use crate::plan::{Fill, GpuPath, Hollow, Method, Mode, Plan, Request};
+use crate::table::{choice, chosen, flag, int, text, value, Example, OptionValue, Shape, Table};
 
-/// Every option of a voxelization job, typed; `Default` gives each
-/// option's documented default.
-#[derive(Clone, Debug, PartialEq)]
-pub struct JobOptions {
-    /// The mode.
-    pub mode: Mode,
-    /// The method.
-    pub method: Method,
-    /// The grid.
-    pub grid: GridOptions,
-    /// Solid modes: the surface of `solid+surface` and of a flood fill's shell.
-    pub surface: Option<Mode>,
-    /// Solid modes: fill by flood instead of the inside test.
-    pub fill: Option<Fill>,
-    /// Solid modes: keep only the skin.
-    pub hollow: Option<Hollow>,
-    /// `method gpu`: which GPU path.
-    pub gpu_path: GpuPath,
-    /// `bubble`: the seed of its random points.
-    pub seed: u64,
-    /// Tiles of this many voxels (`None`: only past memory).
-    pub tile: Option<u32>,
-    /// Memory the run may use, bytes (`None`: nine tenths of what is available).
-    pub max_memory: Option<u64>,
-    /// How colours combine in a voxel.
-    pub colour_rule: ColourRule,
-    /// Carry the average surface normal (`.vti`).
-    pub normals: bool,
-    /// Carry every attribute (colour, material, coverage and normal) and,
-    /// for `.vdb` and `.zarr`, write every array.
-    pub attributes: bool,
-    /// `.vox`: dither colours onto the palette.
-    pub dither: bool,
-    /// `.vox` and `.schem`: the up axis of the data.
-    pub up: Up,
-    /// `.obj` and `.glb`: split T-junctions (watertight).
-    pub watertight: bool,
-    /// `.obj`: triangles only.
-    pub triangulate: bool,
-    /// `.schem`: a colour → block table file.
-    pub block_palette: Option<PathBuf>,
-    /// Read files the model names outside its folder.
-    pub allow_external_paths: bool,
-    /// Worker threads per mesh (`None`: all cores, or the batch's pool).
-    pub threads: Option<usize>,
-}
-
-impl Default for JobOptions {
-    fn default() -> JobOptions {
-        JobOptions {
-            mode: Mode::Cover,
-            method: Method::Auto,
-            grid: GridOptions::default(),
-            surface: None,
-            fill: None,
-            hollow: None,
-            gpu_path: GpuPath::Compute,
-            seed: 0,
-            tile: None,
-            max_memory: None,
-            colour_rule: ColourRule::Dominant,
-            normals: false,
-            attributes: false,
-            dither: false,
-            up: Up::Y,
-            watertight: true,
-            triangulate: false,
-            block_palette: None,
-            allow_external_paths: false,
-            threads: None,
-        }
+crate::option_table! {
+    /// How a run may use the machine: threads, memory, files outside the
+    /// model's folder (every command that runs a job).
+    pub struct RunOptions {
+        threads: Option<usize> = None,
+            parse |k, v| Ok(Some(int(k, v, 1)? as usize)),
+            example Example::Int(1),
+            print |_| None,
+            cli value("N"),
+            "worker threads (default: all cores)";
+        max_memory: Option<u64> = None,
+            parse |k, v| Ok(Some(match v {
+                OptionValue::Text(t) => crate::memory::parse_size(t)?,
+                v => int(k, v, 1)?,
+            })),
+            example Example::Text("2G"),
+            print |_| None,
+            cli value("SIZE"),
+            "memory the run may use, bytes or a size such as 8G or 512M (default: nine tenths of what is available)";
+        allow_external_paths: bool = false,
+            parse flag,
+            example Example::Bool(true),
+            print |_| None,
+            cli Shape::Flag,
+            "read files the model names (OBJ material libraries and textures, glTF buffers and images) even outside its folder: absolute paths, ../, links leading out (off by default)";
     }
 }
 
-/// A value given to an option by name (a Python keyword's value).
-#[derive(Clone, Debug, PartialEq)]
-pub enum OptionValue {
-    /// `True` / `False`.
-    Bool(bool),
-    /// An integer.
-    Int(i64),
-    /// A number.
-    Float(f64),
-    /// A name, a size (`"8G"`) or a path.
-    Text(String),
-    /// A sequence of numbers (`origin`, `dims`).
-    Numbers(Vec<f64>),
-}
-
-/// One option by name: its help and a valid value that is not its default
-/// (for the tests that check every front end takes every option).
-#[derive(Clone, Copy, Debug)]
-pub struct Keyword {
-    /// The name (Python's keyword; the CLI's flag with `-` for `_`).
-    pub name: &'static str,
-    /// What it does.
-    pub help: &'static str,
-    /// A valid value other than the default.
-    pub example: Example,
-}
-
-/// A [`Keyword`]'s example value.
-#[derive(Clone, Copy, Debug)]
-pub enum Example {
-    /// A boolean.
-    Bool(bool),
-    /// An integer.
-    Int(i64),
-    /// A number.
-    Float(f64),
-    /// A name or size.
-    Text(&'static str),
-    /// Numbers.
-    Numbers(&'static [f64]),
-}
-
-impl Example {
-    /// As an [`OptionValue`].
-    pub fn value(self) -> OptionValue {
-        match self {
-            Example::Bool(b) => OptionValue::Bool(b),
-            Example::Int(i) => OptionValue::Int(i),
-            Example::Float(f) => OptionValue::Float(f),
-            Example::Text(t) => OptionValue::Text(t.into()),
-            Example::Numbers(n) => OptionValue::Numbers(n.to_vec()),
-        }
+crate::option_table! {
+    /// What the writers carry and how they lay it out (`voxelize`, `batch`
+    /// and `convert`).
+    pub struct ExportOptions {
+        colour_rule: ColourRule = ColourRule::Dominant,
+            parse chosen,
+            example Example::Text("blend"),
+            print |o| Some(json!(o.colour_rule.name())),
+            cli choice::<ColourRule>("RULE"),
+            "how the colours of the surface inside a voxel combine: dominant (the colour covering the most area; never a new colour) or blend (area-weighted mean in linear light)";
+        normals: bool = false,
+            parse flag,
+            example Example::Bool(true),
+            print |o| Some(json!(o.normals)),
+            cli Shape::Flag,
+            "carry each voxel's average surface normal (.vti)";
+        attributes: bool = false,
+            parse flag,
+            example Example::Bool(true),
+            // Only when set, so manifests written before it existed still resume.
+            print |o| o.attributes.then_some(json!(true)),
+            cli Shape::Flag,
+            "carry colours, materials, coverage and normals: .vdb grids `Cd`, `normal`, `coverage` and `material` beside `voxels`; a .zarr group of arrays `voxels`, `colour`, `normal`, `coverage` and `material`";
+        dither: bool = false,
+            parse flag,
+            example Example::Bool(true),
+            print |o| Some(json!(o.dither)),
+            cli Shape::Flag,
+            ".vox: dither colours onto the 255-colour palette (error diffusion; off by default)";
+        up: Up = Up::Y,
+            parse chosen,
+            example Example::Text("z"),
+            print |o| Some(json!(o.up.name())),
+            cli choice::<Up>("x|y|z"),
+            "the axis of the mesh (and the voxel grid) that points up: .vox and .schem are rotated (never mirrored) so the model stands upright in MagicaVoxel and Minecraft (default y)";
+        watertight: bool = true,
+            parse flag,
+            example Example::Bool(false),
+            print |o| Some(json!(o.watertight)),
+            cli choice::<Switch>("on|off"),
+            ".obj and .glb meshes of the voxels: on (default) splits the greedy quads at T-junctions so every edge is shared; off keeps the plain quads";
+        triangulate: bool = false,
+            parse flag,
+            example Example::Bool(true),
+            print |o| Some(json!(o.triangulate)),
+            cli Shape::Flag,
+            ".obj meshes of the voxels: triangles only (quads split in two), for readers such as Open3D";
+        block_palette: Option<PathBuf> = None,
+            parse |k, v| Ok(Some(text(k, v)?).filter(|t| !t.is_empty()).map(PathBuf::from)),
+            example Example::Text(""),
+            print |_| None,
+            cli value("FILE"),
+            ".schem: a colour -> block table, `namespace:block R G B` per line (default, or empty: the built-in table)";
     }
 }
 
-macro_rules! keywords {
-    ($($name:literal: $example:expr, $help:literal;)+) => {
-        /// Every option [`JobOptions::set`] takes, in documentation order.
-        pub const KEYWORDS: &[Keyword] = &[$(Keyword { name: $name, help: $help, example: $example }),+];
-    };
-}
-
-keywords! {
-    "mode": Example::Text("sep6"), "the voxelization mode";
-    "method": Example::Text("fast"), "the method (every method gives the mode's voxels)";
-    "resolution": Example::Int(16), "the longest side of the bounding box spans N voxels";
-    "voxel_size": Example::Float(0.5), "the voxel edge, or (sx, sy, sz) per axis; alone, the grid is fitted to the mesh";
-    "origin": Example::Numbers(&[-1.0, -1.0, -1.0]), "an explicit grid's origin (with voxel_size and dims)";
-    "dims": Example::Numbers(&[8.0, 8.0, 8.0]), "an explicit grid's dims (with origin and voxel_size)";
-    "pad": Example::Int(1), "empty voxels on every side of a fitted grid";
-    "fit": Example::Text("cube"), "box: to the bounding box; cube: N³ voxels centred on it (ShapeNet's convention)";
-    "surface": Example::Text("sep26"), "solid modes: the surface of solid+surface and of a flood fill's shell";
-    "fill": Example::Text("flood"), "solid modes: flood fills what a surface shell encloses";
-    "hollow": Example::Int(6), "solid modes: keep the voxels 6- or 26-adjacent to the outside";
-    "gpu_path": Example::Text("raster"), "with method gpu: compute, raster or msaa-approx";
-    "seed": Example::Int(5), "bubble: the seed of its random points";
-    "tile": Example::Int(64), "run tile by tile with tiles of N voxels (a multiple of 8)";
-    "max_memory": Example::Text("2G"), "memory the run may use, bytes or a size such as 8G";
-    "colour_rule": Example::Text("blend"), "how colours combine in a voxel: dominant or blend";
-    "normals": Example::Bool(true), "carry the average surface normal";
-    "attributes": Example::Bool(true), "carry colours, materials, coverage and normals";
-    "dither": Example::Bool(true), ".vox: dither colours onto the palette";
-    "up": Example::Text("z"), ".vox and .schem: the data's up axis";
-    "watertight": Example::Bool(false), ".obj and .glb: split T-junctions (on by default)";
-    "triangulate": Example::Bool(true), ".obj: triangles only";
-    "block_palette": Example::Text(""), ".schem: a colour -> block table file (empty: the built-in one)";
-    "allow_external_paths": Example::Bool(true), "read files the model names outside its folder";
-    "threads": Example::Int(1), "worker threads";
-}
-
-/// Other spellings of option names (the ecosystem's American ones).
-const ALIASES: &[(&str, &str)] = &[("color_rule", "colour_rule")];
-
-fn text<'a>(key: &str, v: &'a OptionValue) -> Result<&'a str> {
-    match v {
-        OptionValue::Text(t) => Ok(t),
-        v => invalid!("{key} must be a string; got {}", shown(v)),
+crate::option_table! {
+    /// Every option of a voxelization job, typed; `Default` gives each
+    /// option's documented default.
+    pub struct JobOptions {
+        [group grid: GridOptions, "The grid."]
+        [group export: ExportOptions, "What the writers carry."]
+        [group run: RunOptions, "Threads, memory, paths."]
+        mode: Mode = Mode::Cover,
+            parse chosen,
+            example Example::Text("sep6"),
+            print |o| Some(json!(o.mode.name())),
+            cli choice::<Mode>("MODE"),
+            "the voxelization mode";
+        method: Method = Method::Auto,
+            parse chosen,
+            example Example::Text("fast"),
+            print |o| Some(json!(o.method.name())),
+            cli choice::<Method>("METHOD"),
+            "the method (every method gives the mode's voxels)";
+        surface: Option<Mode> = None,
+            parse |k, v| chosen(k, v).map(Some),
+            example Example::Text("sep26"),
+            print |o| Some(json!(o.surface.map(Mode::name))),
+            cli choice::<Mode>("MODE"),
+            "solid modes: the surface mode of solid+surface and of the fill flood shell (default cover)";
+        fill: Option<Fill> = None,
+            parse |k, v| chosen(k, v).map(Some),
+            example Example::Text("flood"),
+            print |o| Some(json!(o.fill.map(Choice::name))),
+            cli choice::<Fill>("flood"),
+            "solid modes: flood fills everything a surface shell encloses (everything not reachable from the grid boundary through unset voxels)";
+        hollow: Option<Hollow> = None,
+            parse |k, v| chosen(k, v).map(Some),
+            example Example::Int(6),
+            print |o| Some(json!(o.hollow.map(|h| h.name().parse::<u32>().expect("6 or 26")))),
+            cli choice::<Hollow>("6|26"),
+            "solid modes: keep only the voxels touching the outside through a face (6) or also an edge or corner (26)";
+        gpu_path: GpuPath = GpuPath::Compute,
+            parse chosen,
+            example Example::Text("raster"),
+            print |o| Some(json!(o.gpu_path.name())),
+            cli choice::<GpuPath>("PATH"),
+            "with method gpu: compute (default), raster (the rasterizer path, same voxels) or msaa-approx (4x MSAA instead of conservative coverage: approximate, the summary says how many voxels it misses)";
+        seed: u64 = 0,
+            parse |k, v| int(k, v, 0),
+            example Example::Int(5),
+            print |o| Some(json!(o.seed)),
+            cli value("SEED"),
+            "bubble: the seed of its random points (same seed, same voxels; default 0)";
+        tile: Option<u32> = None,
+            parse |k, v| Ok(Some(u32::try_from(int(k, v, 8)?).map_err(|_| JobError::invalid("tile is too large"))?)),
+            example Example::Int(64),
+            // Only when set, so manifests written before it existed still resume.
+            print |o| o.tile.map(|t| json!(t)),
+            cli value("N"),
+            "run the surface or line mode tile by tile with tiles of N voxels (a multiple of 8; default: only when the grid does not fit in max_memory, with tiles of 512); same voxels either way";
     }
 }
 
-fn flag(key: &str, v: &OptionValue) -> Result<bool> {
-    match v {
-        OptionValue::Bool(b) => Ok(*b),
-        v => invalid!("{key} must be True or False; got {}", shown(v)),
-    }
-}
+/// Every option [`JobOptions::set`] takes, in documentation order.
+pub const KEYWORDS: &[&[crate::table::Keyword]] = <JobOptions as Table>::KEYWORDS;
 
-fn int(key: &str, v: &OptionValue, least: i64) -> Result<u64> {
-    match v {
-        OptionValue::Int(i) if *i >= least => Ok(*i as u64),
-        OptionValue::Int(i) => invalid!("{key} must be at least {least}; got {i}"),
-        v => invalid!("{key} must be an integer; got {}", shown(v)),
-    }
-}
-
-fn number(key: &str, v: &OptionValue) -> Result<f64> {
-    match v {
-        OptionValue::Float(f) => Ok(*f),
-        OptionValue::Int(i) => Ok(*i as f64),
-        v => invalid!("{key} must be a number; got {}", shown(v)),
-    }
-}
-
-/// One number (cubes) or three (a size per axis).
-fn voxel_size(key: &str, v: &OptionValue) -> Result<topovox::VoxelSize> {
-    match v {
-        OptionValue::Numbers(n) => Ok(<[f64; 3]>::try_from(numbers(key, v)?).unwrap_or([n[0]; 3]).into()),
-        v => number(key, v)
-            .map(topovox::VoxelSize::from)
-            .map_err(|_| JobError::invalid(format!("{key} must be a number or 3 numbers; got {}", shown(v)))),
-    }
-}
-
-fn numbers(key: &str, v: &OptionValue) -> Result<Vec<f64>> {
-    match v {
-        OptionValue::Numbers(n) if n.len() == 3 => Ok(n.clone()),
-        OptionValue::Numbers(n) => invalid!("{key} must have 3 values; got {}", n.len()),
-        v => invalid!("{key} must be a sequence of 3 numbers; got {}", shown(v)),
-    }
-}
-
-fn shown(v: &OptionValue) -> String {
-    match v {
-        OptionValue::Bool(b) => if *b { "True" } else { "False" }.into(),
-        OptionValue::Int(i) => i.to_string(),
-        OptionValue::Float(f) => f.to_string(),
-        OptionValue::Text(t) => format!("{t:?}"),
-        OptionValue::Numbers(n) => format!("{n:?}"),
-    }
-}
-
-/// A choice given by name (or, for `hollow`, by number).
-fn chosen<T: Choice>(key: &str, v: &OptionValue) -> Result<T> {
-    let name = match v {
-        OptionValue::Int(i) => i.to_string(),
-        v => text(key, v)?.to_string(),
-    };
-    T::parse(&name).map_err(|e| JobError::invalid(format!("{key}: {e}")))
-}
-
-impl JobOptions {
-    /// Sets the option called `key` (see [`KEYWORDS`]; `color_rule` is
-    /// `colour_rule`) from a value given by name, checking its type and range.
-    pub fn set(&mut self, key: &str, v: &OptionValue) -> Result<()> {
-        let key = ALIASES.iter().find(|a| a.0 == key).map_or(key, |a| a.1);
-        match key {
-            "mode" => self.mode = chosen(key, v)?,
-            "method" => self.method = chosen(key, v)?,
-            "resolution" => self.grid.resolution = Some(int(key, v, 1)?),
-            "voxel_size" => self.grid.voxel_size = Some(voxel_size(key, v)?),
-            "origin" => self.grid.origin = Some(numbers(key, v)?),
-            "dims" => {
-                let d = numbers(key, v)?;
-                if d.iter().any(|&x| x < 1.0 || x.fract() != 0.0 || x > u32::MAX as f64) {
-                    invalid!("dims must be 3 integers of at least 1; got {d:?}");
-                }
-                self.grid.dims = Some(d.iter().map(|&x| x as u64).collect());
-            }
-            // 0 is no pad (so a batch's fingerprint is the one without).
-            "pad" => {
-                self.grid.pad = Some(u32::try_from(int(key, v, 0)?).map_err(|_| JobError::invalid("pad is too large"))?).filter(|&p| p > 0)
-            }
-            "fit" => self.grid.fit = Some(chosen(key, v)?),
-            "surface" => self.surface = Some(chosen(key, v)?),
-            "fill" => self.fill = Some(chosen(key, v)?),
-            "hollow" => self.hollow = Some(chosen(key, v)?),
-            "gpu_path" => self.gpu_path = chosen(key, v)?,
-            "seed" => self.seed = int(key, v, 0)?,
-            "tile" => self.tile = Some(u32::try_from(int(key, v, 8)?).map_err(|_| JobError::invalid("tile is too large"))?),
-            "max_memory" => {
-                self.max_memory = Some(match v {
-                    OptionValue::Text(t) => crate::memory::parse_size(t)?,
-                    v => int(key, v, 1)?,
-                })
-            }
-            "colour_rule" => self.colour_rule = chosen(key, v)?,
-            "normals" => self.normals = flag(key, v)?,
-            "attributes" => self.attributes = flag(key, v)?,
-            "dither" => self.dither = flag(key, v)?,
-            "up" => self.up = chosen(key, v)?,
-            "watertight" => self.watertight = flag(key, v)?,
-            "triangulate" => self.triangulate = flag(key, v)?,
-            "block_palette" => self.block_palette = Some(text(key, v)?).filter(|t| !t.is_empty()).map(PathBuf::from),
-            "allow_external_paths" => self.allow_external_paths = flag(key, v)?,
-            "threads" => self.threads = Some(int(key, v, 1)? as usize),
-            _ => invalid!("unknown option {key:?} (expected one of: {})", KEYWORDS.iter().map(|k| k.name).collect::<Vec<_>>().join(", ")),
-        }
-        Ok(())
-    }
-
-    /// The validated plan.
-    pub fn plan(&self) -> Result<Plan> {
-        Plan::new(Request {
-            mode: self.mode,
-            method: self.method,
-            grid: GridRequest::new(&self.grid)?,
-            surface: self.surface,
-            fill: self.fill,
-            hollow: self.hollow,
-            gpu_path: self.gpu_path,
-            seed: self.seed,
-            tile: self.tile,
-            max_memory: self.max_memory,
-            writer_bytes_per_brick: 0,
-        })
+impl ExportOptions {
+    /// Whether attributes are carried at all: when any is asked for
+    /// (normals are one). The one attribute rule of every front end.
+    pub fn carries(&self) -> bool {
+        self.attributes || self.normals
     }
 
     /// What the attribute carrier computes, the same in every front end:
@@ -337,50 +189,47 @@ impl JobOptions {
             stop: None,
         })
     }
+}
 
+impl RunOptions {
     /// How meshes are read.
     pub fn read_options(&self) -> topovox_io::ReadOptions {
         topovox_io::ReadOptions { allow_external_paths: self.allow_external_paths }
     }
+}
 
-    /// The options as one JSON object (keys sorted, defaults filled in),
-    /// the same from every front end: what a batch's manifest records and a
-    /// resumed run compares. Unchanged from earlier releases, so their
-    /// manifests resume.
+/// A table's options as one JSON object (keys sorted, defaults filled in),
+/// the same from every front end: what a batch's manifest records and a
+/// resumed run compares.
+pub fn fingerprint_of<T: Table>(options: &T, format: &str) -> Value {
+    let mut out = Map::new();
+    options.fingerprint(&mut out);
+    out.insert("format".into(), json!(format));
+    Value::Object(out)
+}
+
+impl JobOptions {
+    /// The validated plan.
+    pub fn plan(&self) -> Result<Plan> {
+        Plan::new(Request {
+            mode: self.mode,
+            method: self.method,
+            grid: GridRequest::new(&self.grid)?,
+            surface: self.surface,
+            fill: self.fill,
+            hollow: self.hollow,
+            gpu_path: self.gpu_path,
+            seed: self.seed,
+            tile: self.tile,
+            max_memory: self.run.max_memory,
+            writer_bytes_per_brick: 0,
+        })
+    }
+
+    /// What a batch's manifest records, unchanged from earlier releases so
+    /// their manifests resume ([`fingerprint_of`]).
     pub fn fingerprint(&self, format: Output) -> Value {
-        let g = &self.grid;
-        let mut v = json!({
-            "mode": self.mode.name(),
-            "method": self.method.name(),
-            "resolution": g.resolution.or((!g.any()).then_some(128)),
-            "voxel_size": g.voxel_size.map(topovox_io::size_json),
-            "origin": g.origin,
-            "dims": g.dims,
-            "pad": g.pad.unwrap_or(0),
-            "surface": self.surface.map(Mode::name),
-            "fill": self.fill.map(Choice::name),
-            "hollow": self.hollow.map(|h| h.name().parse::<u32>().expect("6 or 26")),
-            "gpu_path": self.gpu_path.name(),
-            "format": format.name(),
-            "colour_rule": self.colour_rule.name(),
-            "normals": self.normals,
-            "dither": self.dither,
-            "up": self.up.name(),
-            "watertight": self.watertight,
-            "triangulate": self.triangulate,
-            "seed": self.seed,
-        });
-        // Only when set, so manifests written before these existed still resume.
-        if self.attributes {
-            v["attributes"] = json!(true);
-        }
-        if let Some(t) = self.tile {
-            v["tile"] = json!(t);
-        }
-        if g.cube() {
-            v["fit"] = json!("cube");
-        }
-        v
+        fingerprint_of(self, format.name())
     }
 
     /// The options of a batch writing `format`.
@@ -393,11 +242,11 @@ impl JobOptions {
         Ok(BatchOptions {
             plan,
             format,
-            carry: self.carry(),
-            attributes: self.attributes,
-            write: self.write_options()?,
-            threads: self.threads,
-            read: self.read_options(),
+            carry: self.export.carry(),
+            attributes: self.export.attributes,
+            write: self.export.write_options()?,
+            threads: self.run.threads,
+            read: self.run.read_options(),
             fingerprint: self.fingerprint(format),
         })
     }
@@ -409,14 +258,14 @@ mod tests {
 
     #[test]
     fn every_keyword_is_set_by_its_example_and_changes_the_options() {
-        for k in KEYWORDS {
+        for k in JobOptions::keywords() {
             let mut o = JobOptions::default();
-            o.set(k.name, &k.example.value()).unwrap_or_else(|e| panic!("{}: {e}", k.name));
+            o.set_named(k.name, &k.example.value()).unwrap_or_else(|e| panic!("{}: {e}", k.name));
             assert!(o != JobOptions::default() || k.name == "block_palette", "{}: the example is the default", k.name);
         }
         let mut o = JobOptions::default();
-        o.set("color_rule", &OptionValue::Text("BLEND".into())).unwrap();
-        assert_eq!(o.colour_rule, ColourRule::Blend);
+        o.set_named("color_rule", &OptionValue::Text("BLEND".into())).unwrap();
+        assert_eq!(o.export.colour_rule, ColourRule::Blend);
     }
 
     #[test]
@@ -432,7 +281,7 @@ mod tests {
             ("normals", OptionValue::Int(1), "normals must be True or False"),
             ("sed", OptionValue::Int(1), "unknown option \"sed\""),
         ] {
-            let e = o.set(k, &v).unwrap_err().to_string();
+            let e = o.set_named(k, &v).unwrap_err().to_string();
             assert!(e.contains(want), "{k}: {e}");
         }
     }
@@ -440,12 +289,33 @@ mod tests {
     #[test]
     fn the_fingerprint_keeps_its_released_form() {
         let mut o = JobOptions::default();
-        o.set("hollow", &OptionValue::Text("26".into())).unwrap();
-        o.set("mode", &OptionValue::Text("solid".into())).unwrap();
+        o.set_named("hollow", &OptionValue::Text("26".into())).unwrap();
+        o.set_named("mode", &OptionValue::Text("solid".into())).unwrap();
         let f = o.fingerprint(Output::from_name("npy").unwrap());
         assert_eq!(f["hollow"], 26);
         assert_eq!((f["mode"].as_str(), f["up"].as_str(), f["colour_rule"].as_str()), (Some("solid"), Some("y"), Some("dominant")));
         assert_eq!(f["resolution"], 128);
         assert!(f.get("attributes").is_none() && f.get("tile").is_none());
+        // The defaults, byte for byte as releases wrote them.
+        let released = r#"{"colour_rule":"dominant","dims":null,"dither":false,"fill":null,"format":"npy","gpu_path":"compute","hollow":null,"method":"auto","mode":"cover","normals":false,"origin":null,"pad":0,"resolution":128,"seed":0,"surface":null,"triangulate":false,"up":"y","voxel_size":null,"watertight":true}"#;
+        assert_eq!(JobOptions::default().fingerprint(Output::from_name("npy").unwrap()).to_string(), released);
+        // Options recorded only when set; the run's own are never recorded.
+        let mut o = JobOptions::default();
+        for (k, v) in [
+            ("attributes", OptionValue::Bool(true)),
+            ("tile", OptionValue::Int(64)),
+            ("fit", OptionValue::Text("cube".into())),
+            ("threads", OptionValue::Int(3)),
+            ("max_memory", OptionValue::Text("1G".into())),
+            ("pad", OptionValue::Int(2)),
+        ] {
+            o.set_named(k, &v).unwrap();
+        }
+        let f = o.fingerprint(Output::from_name("vdb").unwrap());
+        assert_eq!(
+            (f["attributes"].clone(), f["tile"].clone(), f["fit"].clone(), f["pad"].clone()),
+            (json!(true), json!(64), json!("cube"), json!(2))
+        );
+        assert!(f.get("threads").is_none() && f.get("max_memory").is_none() && f.get("allow_external_paths").is_none());
     }
 }

@@ -27,7 +27,7 @@ impl BatchProgress for Bar {
 
 pub fn run(a: &BatchArgs) -> Result<()> {
     let format = a.format;
-    let opts = crate::plan::job_options(&a.job, None)?.batch(format)?;
+    let opts = a.job.options.batch(format)?;
     let pool = topovox_job::pool_for(a.jobs, "--jobs")?;
     let (items, warnings) = batch::items(&a.inputs, a.glob.as_deref(), &a.output, format)?;
     for w in &warnings {

@@ -51,7 +51,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
             let (grid, source) = topovox_job::check::check_grid(
                 dims,
                 placement,
-                &crate::plan::grid_options(&a.grid),
+                &a.grid.options,
                 &m.report.bounds,
                 &a.voxels.display().to_string(),
                 &path.display().to_string(),

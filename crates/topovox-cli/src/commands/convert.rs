@@ -11,13 +11,12 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
     let format = topovox_job::output::output_format(a.format, &a.output)?;
     topovox_job::output::check_output_path(&a.output)?;
     topovox_job::output::refuse_overwriting(&a.output, format, std::slice::from_ref(&a.input))?;
-    let mut job = topovox_job::JobOptions::default();
-    crate::plan::export_options(&a.export, &mut job);
+    let job = &a.export.options;
     let write_opts = job.write_options()?;
     use topovox_io::VoxelFormat as F;
     let input_format = F::from_path(&a.input);
     let input_has_up = matches!(input_format, Some(F::Vox | F::Schem));
-    crate::export::warn_unused(&a.export, format, &a.output, false, input_has_up);
+    crate::export::warn_unused(job, &a.export.given, format, &a.output, false, input_has_up);
     // The up axis is the data's: .vox and .schem files are read back with it too.
     let loaded =
         match topovox_io::read_voxels_opts(&a.input, job.up, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths }) {

@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use anyhow::Result;
 use serde_json::json;
-use topovox_job::distance::{DistanceFormat, SdfRequest};
+use topovox_job::distance::DistanceFormat;
 use topovox_job::Choice;
 
 use crate::args::SdfArgs;
@@ -13,20 +13,18 @@ use crate::progress::Bar;
 pub fn run(a: &SdfArgs) -> Result<()> {
     let t_total = Instant::now();
     // Everything that does not need the mesh first.
-    let grid = crate::plan::grid_request(&a.grid)?;
-    let width = a.band;
+    let opts = &a.sdf.options;
     let format = DistanceFormat::of(a.format.map(|f| f.name()), &a.output)?;
-    let req = SdfRequest { grid, width, unsigned: a.unsigned, sign: a.sign, max_memory: a.max_memory, format };
+    let req = opts.request(format)?;
     topovox_job::output::check_output_path(&a.output)?;
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.mesh))?;
-    let pool = topovox_job::pool_for(a.threads, "--threads")?;
+    let pool = topovox_job::pool_for(opts.run.threads, "--threads")?;
     let threads = pool.current_num_threads();
 
     let bar = Bar::new(a.quiet || a.json);
     bar.phase("loading mesh");
     let t_load = Instant::now();
-    let read = topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths };
-    let loaded = topovox_io::read_mesh_with(&a.mesh, &read)?;
+    let loaded = topovox_io::read_mesh_with(&a.mesh, &opts.run.read_options())?;
     let load_s = t_load.elapsed().as_secs_f64();
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
     for w in &loaded.warnings {
@@ -76,7 +74,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
             "sdf: {} voxels stored ({}, band {}) on grid {}x{}x{} (origin {}, {}, {}; voxel size {}); distances in {:.1} ms; total {:.2} s -> {}",
             sdf.field.band.count(),
             kind,
-            a.band,
+            opts.band,
             dims[0],
             dims[1],
             dims[2],

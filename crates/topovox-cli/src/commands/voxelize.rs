@@ -8,13 +8,12 @@ use topovox_job::output::{check_output_path, output_format};
 use topovox_job::Choice;
 
 use crate::args::VoxelizeArgs;
-use crate::plan;
 use crate::progress::Bar;
 
 pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let t_total = Instant::now();
     // Validate everything that does not need the mesh first.
-    let opts = plan::job_options(&a.job, a.threads)?;
+    let opts = &a.job.options;
     let mut plan = opts.plan()?;
     let format = output_format(a.format, &a.output)?;
     plan.request.writer_bytes_per_brick = topovox_job::output::writer_bytes_per_brick(format);
@@ -24,24 +23,24 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     if let Some(p) = &a.preview {
         topovox_io::atomic::refuse_overwriting_inputs(p, std::slice::from_ref(&a.mesh))?;
     }
-    let write_opts = opts.write_options()?;
+    let write_opts = opts.export.write_options()?;
     if !a.quiet && !a.json {
-        crate::export::warn_unused(&a.job.export, format, &a.output, true, a.preview.is_some());
+        crate::export::warn_unused(&opts.export, &a.job.given, format, &a.output, true, a.preview.is_some());
     }
     let preview = match &a.preview {
         Some(p) => {
             crate::pictures::check_png_path(p)?;
-            Some((p, crate::pictures::options(&a.picture, a.job.export.up)?))
+            Some((p, crate::pictures::options(&a.picture, Some(opts.export.up))?))
         }
         None => None,
     };
-    let pool = topovox_job::pool_for(a.threads, "--threads")?;
+    let pool = topovox_job::pool_for(opts.run.threads, "--threads")?;
     let threads = pool.current_num_threads();
 
     let bar = Bar::new(a.quiet || a.json);
     bar.phase("loading mesh");
     let t_load = Instant::now();
-    let loaded = topovox_io::read_mesh_with(&a.mesh, &opts.read_options())?;
+    let loaded = topovox_io::read_mesh_with(&a.mesh, &opts.run.read_options())?;
     let load_s = t_load.elapsed().as_secs_f64();
     // Nor any file the mesh led to (its .mtl, textures, buffers).
     topovox_job::output::refuse_overwriting(&a.output, format, &loaded.sources)?;
@@ -65,7 +64,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     // Attributes: colours for the formats that store them (and the preview),
     // every array (coverage, material, normal) for .vti, and for .vdb and
     // .zarr with --attributes; tiled grids too, while they fit in memory.
-    let every = topovox_job::every_attribute(format, opts.attributes);
+    let every = topovox_job::every_attribute(format, opts.export.attributes);
     let app = &loaded.appearance;
     let want_colour = app.has_colour() && (format.has_colour() || preview.is_some());
     let t_attr = Instant::now();
@@ -74,7 +73,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     }
     let attrs = (want_colour || every).then(|| {
         bar.phase("carrying colours into voxels");
-        pool.install(|| topovox_job::attributes(&plan, loaded.mesh.as_ref(), app, &v, &opts.carry()))
+        pool.install(|| topovox_job::attributes(&plan, loaded.mesh.as_ref(), app, &v, &opts.export.carry()))
     });
     let attrs = attrs.flatten();
     let attributes_s = t_attr.elapsed().as_secs_f64();
@@ -111,7 +110,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
             "attributes_s": attributes_s,
             "attributes": attrs.as_ref().map(|t| json!({
                 "colour": t.colour.is_some(),
-                "colour_rule": opts.colour_rule.name(),
+                "colour_rule": opts.export.colour_rule.name(),
                 "material": t.material.is_some(),
                 "normal": t.normal.is_some(),
                 "coverage": t.coverage.is_some(),
@@ -145,7 +144,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
             to_stdout,
             &format!(
                 "{}: {} voxels set on grid {}x{}x{} (origin {}, {}, {}; voxel size {}) by {} in {:.1} ms; total {:.2} s -> {}{}",
-                a.job.mode.name(),
+                opts.mode.name(),
                 v.report.voxels,
                 dims[0],
                 dims[1],

@@ -1,0 +1,115 @@
+//! A table of options (`topovox_job::table`) as clap flags: one flag per
+//! row, named, described and read as the row says, so the CLI never
+//! repeats an option the job declares. `#[command(flatten)]` a
+//! `Flags<GridOptions>`, `Flags<JobOptions>`, … into a command's arguments.
+
+use std::ffi::OsStr;
+
+use clap::builder::{PossibleValue, TypedValueParser, ValueParser};
+use clap::error::{ContextKind, ContextValue, ErrorKind};
+use clap::{Arg, ArgAction, ArgMatches, Args, Command, FromArgMatches};
+use topovox_job::table::{Example, Keyword, Shape, ALIASES};
+use topovox_job::{OptionValue, Table};
+
+/// The options of table `T`, read from its flags, and which were given.
+#[derive(Clone, Debug, Default)]
+pub struct Flags<T: Table> {
+    /// The options.
+    pub options: T,
+    /// The names of the options given on the command line.
+    pub given: Vec<&'static str>,
+}
+
+impl<T: Table> std::ops::Deref for Flags<T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        &self.options
+    }
+}
+
+/// A choice's names as clap's possible values (listed in `--help`,
+/// checked in any case, a bad one refused with the list).
+#[derive(Clone)]
+struct Names(fn() -> Vec<(&'static str, &'static str)>);
+
+impl TypedValueParser for Names {
+    type Value = String;
+
+    fn parse_ref(&self, cmd: &Command, arg: Option<&Arg>, value: &OsStr) -> Result<String, clap::Error> {
+        let given = value.to_string_lossy();
+        let names = (self.0)();
+        if names.iter().any(|(n, _)| n.eq_ignore_ascii_case(given.trim())) {
+            return Ok(given.into_owned());
+        }
+        let mut e = clap::Error::new(ErrorKind::InvalidValue).with_cmd(cmd);
+        e.insert(ContextKind::InvalidArg, ContextValue::String(arg.map_or_else(String::new, ToString::to_string)));
+        e.insert(ContextKind::InvalidValue, ContextValue::String(given.into_owned()));
+        e.insert(ContextKind::ValidValue, ContextValue::Strings(names.iter().map(|n| n.0.to_string()).collect()));
+        Err(e)
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        Some(Box::new((self.0)().into_iter().map(|(n, h)| PossibleValue::new(n).help(h))))
+    }
+}
+
+/// The clap argument of one row.
+fn arg(k: &'static Keyword) -> Arg {
+    let mut a = Arg::new(k.name).long(k.name.replace('_', "-")).help(k.help);
+    for (alias, name) in ALIASES {
+        if *name == k.name {
+            a = a.visible_alias(alias.replace('_', "-"));
+        }
+    }
+    match k.shape {
+        Shape::Flag => a.action(ArgAction::SetTrue),
+        Shape::Choice(name, names) => a.value_name(name).action(ArgAction::Set).value_parser(Names(names)),
+        Shape::Value(name) => {
+            // Numbers may be negative (`--origin -1,-1,-1`).
+            let numeric = matches!(k.example, Example::Float(_) | Example::Numbers(_));
+            a.value_name(name).action(ArgAction::Set).value_parser(ValueParser::string()).allow_hyphen_values(numeric)
+        }
+    }
+}
+
+impl<T: Table> Args for Flags<T> {
+    fn augment_args(cmd: Command) -> Command {
+        T::keywords().fold(cmd, |c, k| c.arg(arg(k)))
+    }
+
+    fn augment_args_for_update(cmd: Command) -> Command {
+        Self::augment_args(cmd)
+    }
+}
+
+impl<T: Table> FromArgMatches for Flags<T> {
+    fn from_arg_matches(m: &ArgMatches) -> Result<Self, clap::Error> {
+        let mut flags = Flags { options: T::default(), given: Vec::new() };
+        flags.update_from_arg_matches(m)?;
+        Ok(flags)
+    }
+
+    fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
+        for k in T::keywords() {
+            let (value, raw) = if k.shape.value_name().is_none() {
+                (m.get_flag(k.name).then_some(OptionValue::Bool(true)), "")
+            } else {
+                match m.get_one::<String>(k.name) {
+                    Some(raw) => (Some(k.parse_text(raw).map_err(|e| refused(k, raw, e))?), raw.as_str()),
+                    None => (None, ""),
+                }
+            };
+            if let Some(v) = value {
+                self.options.set_named(k.name, &v).map_err(|e| refused(k, raw, e))?;
+                self.given.push(k.name);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// clap's one-line error for a bad value (exit status 2, as clap's own).
+fn refused(k: &Keyword, raw: &str, e: topovox_job::JobError) -> clap::Error {
+    let shown: String = raw.chars().take(40).collect();
+    clap::Error::raw(ErrorKind::ValueValidation, format!("invalid value '{shown}' for '{}': {e}\n", k.flag()))
+}
