@@ -9,32 +9,51 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde_json::Value;
 use topovox::voxelize::Stop;
-use topovox_job::batch::BatchProgress;
+use topovox_job::batch::{BatchOptions, BatchProgress, Run};
+use topovox_job::distance::{DistanceFormat, SdfOptions};
 use topovox_job::{JobError, OptionValue};
 
 use crate::convert::to_py;
 use crate::errors::{py_err, value_err};
 use crate::interrupt::interruptible_ticking;
-use crate::options::{job_options, option_value};
+use crate::options::{job_options, option_value, table_options};
 
 /// `(input, output, done)` per mesh of a batch, and the options' fingerprint.
 pub(crate) type BatchListing<'py> = (Vec<(String, String, bool)>, Bound<'py, PyAny>);
 
-/// The options of a batch, validated (with its fingerprint), and `jobs`.
+/// The options of a batch, validated (with its fingerprint), and `jobs`:
+/// `run="sdf"` takes `sdf`'s options, else `voxelize`'s.
 pub(crate) fn batch_options(
     options: Option<&Bound<'_, PyDict>>,
     format: &str,
 ) -> PyResult<(topovox_job::batch::BatchOptions, Option<usize>)> {
-    let target = <topovox_job::output::Output as topovox_job::Choice>::parse(format).map_err(|e| value_err(e.to_string()))?;
-    let jobs = match options.map(|d| d.get_item("jobs")).transpose()?.flatten().filter(|v| !v.is_none()) {
-        Some(v) => match option_value("jobs", &v)? {
-            OptionValue::Int(n) if n >= 1 => Some(n as usize),
-            _ => return Err(value_err(format!("jobs must be an integer of at least 1; got {}", v.repr()?))),
-        },
+    let get = |k: &str| -> PyResult<Option<OptionValue>> {
+        match options.map(|d| d.get_item(k)).transpose()?.flatten().filter(|v| !v.is_none()) {
+            Some(v) => Ok(Some(option_value(k, &v)?)),
+            None => Ok(None),
+        }
+    };
+    let jobs = match get("jobs")? {
+        Some(OptionValue::Int(n)) if n >= 1 => Some(n as usize),
+        Some(v) => return Err(value_err(format!("jobs must be an integer of at least 1; got {}", topovox_job::table::shown(&v)))),
         None => None,
     };
-    let opts = job_options(options, &["jobs"])?.batch(target).map_err(py_err)?;
-    Ok((opts, jobs))
+    let run = match get("run")? {
+        Some(v) => topovox_job::table::chosen::<Run>("run", &v).map_err(py_err)?,
+        None => Run::Voxelize,
+    };
+    let own = ["jobs", "run"];
+    let opts = match run {
+        Run::Voxelize => {
+            let target = <topovox_job::output::Output as topovox_job::Choice>::parse(format).map_err(|e| value_err(e.to_string()))?;
+            BatchOptions::voxelize(&job_options(options, &own)?, target)
+        }
+        Run::Sdf => {
+            let target = <DistanceFormat as topovox_job::Choice>::parse(format).map_err(|e| value_err(format!("run=\"sdf\": {e}")))?;
+            BatchOptions::sdf(&table_options::<SdfOptions>(options, &own)?, target)
+        }
+    };
+    Ok((opts.map_err(py_err)?, jobs))
 }
 
 /// Meshes finished of all (skipped ones count as finished), shared by the
@@ -87,7 +106,7 @@ pub(crate) fn batch<'py>(
         Ok(())
     };
     let work = || -> Result<(topovox_job::batch::Summary, Vec<String>), JobError> {
-        let (items, warnings) = topovox_job::batch::items(&inputs, glob.as_deref(), &out_dir, opts.format)?;
+        let (items, warnings) = topovox_job::batch::items(&inputs, glob.as_deref(), &out_dir, &opts)?;
         let pool = topovox_job::pool_for(jobs, "jobs")?;
         let summary = pool.install(|| topovox_job::batch::run(&items, &out_dir, &opts, &counts, Some(&stop)))?;
         Ok((summary, warnings))
@@ -112,7 +131,7 @@ pub(crate) fn batch_plan<'py>(
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<BatchListing<'py>> {
     let (opts, _) = batch_options(options, format)?;
-    let (items, _) = topovox_job::batch::items(&inputs, glob.as_deref(), &out_dir, opts.format).map_err(py_err)?;
+    let (items, _) = topovox_job::batch::items(&inputs, glob.as_deref(), &out_dir, &opts).map_err(py_err)?;
     topovox_job::batch::create_out_dir(&out_dir).map_err(py_err)?;
     let manifest = topovox_job::batch::Manifest::open(&out_dir).map_err(py_err)?;
     manifest.refuse_other_options(&items, &opts.fingerprint).map_err(py_err)?;

@@ -108,3 +108,20 @@ def test_every_public_function_has_a_numpy_style_docstring(name, f):
             continue
         assert section in doc, f"{name}: no {section.strip()} section"
     assert "Parameters\n" in doc or "()" in doc.splitlines()[0] or name.endswith(("coords", "indices", "to_dense", "greedy_mesh", "to_trimesh", "to_trimesh_mesh")), name
+
+
+def test_batch_runs_sdf_with_its_options_and_refuses_the_others(meshes, tmp_path):
+    # Issue 53.7: `batch` refused `band`.
+    s = topovox.batch(meshes / "cow.obj", tmp_path / "f", run="sdf", band=2, resolution=12, format="vdb")
+    assert (s["done"], s["failed"]) == (1, 0), s
+    line = json.loads((tmp_path / "f" / "manifest.jsonl").read_text().splitlines()[-1])
+    assert line["options"]["run"] == "sdf" and line["options"]["band"] == 2
+    one = topovox.sdf(topovox.load_mesh(meshes / "cow.obj"), band=2, resolution=12)
+    one.save(tmp_path / "one.vdb")
+    assert (tmp_path / "f" / "cow.vdb").read_bytes() == (tmp_path / "one.vdb").read_bytes()
+    with pytest.raises(ValueError, match='unknown option "band"'):
+        topovox.batch(meshes / "cow.obj", tmp_path / "g", band=2)
+    with pytest.raises(ValueError, match='unknown option "mode"'):
+        topovox.batch(meshes / "cow.obj", tmp_path / "h", run="sdf", mode="solid")
+    with pytest.raises(ValueError, match="run"):
+        topovox.batch(meshes / "cow.obj", tmp_path / "i", run="remesh")

@@ -480,6 +480,7 @@ def batch(
     glob: Optional[str] = None,
     jobs: Optional[int] = None,
     progress: Union[None, bool, Callable[[int, int], Any]] = None,
+    run: Literal["voxelize", "sdf"] = "voxelize",
     **options: Any,
 ) -> Dict[str, Any]:
     """Voxelizes whole datasets, resumably, as ``topovox batch`` does.
@@ -511,10 +512,15 @@ def batch(
         calling thread as meshes finish (at most every 50 ms, and once at
         the end; meshes skipped as done count as finished). An exception it
         raises stops the batch as Ctrl-C does.
+    run : {"voxelize", "sdf"}
+        What runs on each mesh: :func:`voxelize`, or :func:`sdf` (a
+        distance field per mesh; ``format`` is then ``"npy"``, ``"vdb"``,
+        ``"zarr"`` or ``"vti"``).
     **options
-        Every option :func:`voxelize` takes (:data:`OPTIONS`);
-        ``attributes=True`` writes every attribute grid into ``.vdb`` and
-        ``.zarr`` outputs.
+        Every option :func:`voxelize` takes (:data:`OPTIONS`), or with
+        ``run="sdf"`` every option :func:`sdf` takes (``band``, ``sign``,
+        ``unsigned`` and the grid's); ``attributes=True`` writes every
+        attribute grid into ``.vdb`` and ``.zarr`` outputs.
 
     Returns
     -------
@@ -540,7 +546,7 @@ def batch(
     """
     if isinstance(paths, (str, bytes, os.PathLike)):
         paths = [paths]
-    opts = _options(dict(options, jobs=jobs))
+    opts = _options(dict(options, jobs=jobs, run=run))
     # fsdecode: str and bytes paths alike (names that are not UTF-8 survive).
     report = _stderr_progress() if progress is True else progress or None
     return _topovox.batch([os.fsdecode(p) for p in paths], os.fsdecode(out_dir), format=format, glob=glob, options=opts, progress=report)

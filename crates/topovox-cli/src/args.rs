@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
 use topovox::raster::{RasterMethod, RasterMode};
-use topovox_job::distance::{DistanceFormat, SdfOptions};
+use topovox_job::batch::Run;
+use topovox_job::distance::{DistanceFormat, FieldOptions, SdfOptions};
 use topovox_job::output::Output;
 use topovox_job::{ColourRule, ExportOptions, GridOptions, JobOptions, Mode, Switch, Up};
 
@@ -529,8 +530,14 @@ pub struct BatchArgs {
     /// Output format.
     #[arg(long, default_value = "npy", value_name = "FORMAT", value_parser = choice::<Output>())]
     pub format: Output,
+    /// What runs on each mesh: voxelize (the voxelize options) or sdf (a
+    /// distance field: the grid options, --band, --unsigned, --sign; --format npy, vdb, zarr or vti).
+    #[arg(long, value_parser = choice::<Run>(), default_value = "voxelize")]
+    pub run: Run,
     #[command(flatten)]
     pub job: Flags<JobOptions>,
+    #[command(flatten)]
+    pub field: Flags<FieldOptions>,
     /// Meshes processed at once (default: all cores); each is voxelized on the same threads.
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
@@ -639,7 +646,7 @@ mod tests {
             panic!("not sdf")
         };
         assert_eq!((s.sdf.grid.origin.clone(), s.sdf.grid.dims.clone()), (Some(vec![-1.0, -2.5, -3.0]), Some(vec![4, 5, 6])));
-        assert_eq!((s.sdf.grid.voxel_size, s.sdf.band), (Some([0.5, 1.0, 2.0].into()), topovox_job::distance::Width::All));
+        assert_eq!((s.sdf.grid.voxel_size, s.sdf.field.band), (Some([0.5, 1.0, 2.0].into()), topovox_job::distance::Width::All));
         let Command::Render(r) =
             parse(&["render", "s.obj", "-o", "a.png", "--gpu", "--camera", "-5,2,3,0,0,0", "--culling", "Frustum", "--gamma", "off"])
         else {

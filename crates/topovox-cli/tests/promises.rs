@@ -306,3 +306,37 @@ fn a_small_solid_in_a_vast_grid_follows_its_surface() {
         assert!(v["peak_memory_bytes"].as_u64().unwrap() <= 256 << 20, "{v}");
     }
 }
+
+#[test]
+fn batch_runs_distance_fields_too_and_refuses_the_other_commands_options() {
+    // Issue 53.7: `batch` refused `band`; every command of the options
+    // table runs over folders.
+    let d = folder("sdf-batch");
+    let inputs = d.join("in");
+    std::fs::create_dir_all(&inputs).unwrap();
+    std::fs::copy(repo("examples/meshes/cow.obj"), inputs.join("cow.obj")).unwrap();
+    std::fs::copy(repo("examples/meshes/box.obj"), inputs.join("box.obj")).unwrap();
+    let out = d.join("out");
+    let args = ["batch", s(&inputs), "-o", s(&out), "--run", "sdf", "--band", "2", "--resolution", "16", "--format", "vdb", "--json"];
+    let j = succeeded(&topovox(&args));
+    assert_eq!((j["done"].as_u64(), j["failed"].as_u64()), (Some(2), Some(0)), "{j}");
+    // Each field is the one `sdf` writes, byte for byte.
+    let one = d.join("cow.vdb");
+    succeeded(&topovox(&["sdf", s(&inputs.join("cow.obj")), "-o", s(&one), "--band", "2", "--resolution", "16", "--json"]));
+    assert_eq!(std::fs::read(out.join("cow.vdb")).unwrap(), std::fs::read(&one).unwrap());
+    let manifest = std::fs::read_to_string(out.join("manifest.jsonl")).unwrap();
+    let line: serde_json::Value = serde_json::from_str(manifest.lines().next().unwrap()).unwrap();
+    assert_eq!((line["options"]["run"].as_str(), line["options"]["band"].as_f64()), (Some("sdf"), Some(2.0)), "{line}");
+    assert!(line["stored_voxels"].as_u64().unwrap() > 0, "{line}");
+    // A rerun resumes; another band is another batch, refused by name.
+    assert_eq!(succeeded(&topovox(&args))["skipped"].as_u64(), Some(2));
+    let other = ["batch", s(&inputs), "-o", s(&out), "--run", "sdf", "--band", "3", "--resolution", "16", "--format", "vdb"];
+    assert!(refused(&topovox(&other)).contains("band 2.0 → 3.0"));
+    // Options of the other command are refused in one line.
+    let e = refused(&topovox(&["batch", s(&inputs), "-o", s(&d.join("o2")), "--band", "2"]));
+    assert!(e.contains("--band applies to --run sdf"), "{e}");
+    let e = refused(&topovox(&["batch", s(&inputs), "-o", s(&d.join("o3")), "--run", "sdf", "--mode", "solid"]));
+    assert!(e.contains("--mode is a voxelize option"), "{e}");
+    let e = refused(&topovox(&["batch", s(&inputs), "-o", s(&d.join("o4")), "--run", "sdf", "--format", "binvox"]));
+    assert!(e.contains("binvox"), "{e}");
+}

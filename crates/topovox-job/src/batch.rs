@@ -32,9 +32,12 @@ use topovox::attributes::carry::CarryOptions;
 use topovox::voxelize::Stop;
 use topovox_io::WriteOptions;
 
+use crate::distance::{DistanceFormat, SdfOptions, SdfRequest};
 use crate::error::{JobError, Result};
+use crate::options::JobOptions;
 use crate::output::Output;
 use crate::plan::Plan;
+use topovox::choice::Choice;
 
 /// The manifest's file name in the output folder.
 pub const MANIFEST: &str = "manifest.jsonl";
@@ -42,19 +45,21 @@ pub const MANIFEST: &str = "manifest.jsonl";
 /// Mesh extensions taken from folders when no glob is given.
 pub const MESH_EXTENSIONS: [&str; 7] = ["obj", "stl", "ply", "gltf", "glb", "lines", "off"];
 
+topovox::choice! {
+    /// What a batch runs on each mesh.
+    pub enum Run: "run" default Voxelize {
+        /// `voxelize`: a voxel file (or a mesh of the voxels) per mesh.
+        Voxelize = "voxelize",
+        /// `sdf`: a distance field per mesh.
+        Sdf = "sdf",
+    }
+}
+
 /// What every mesh of a batch gets done to it.
 #[derive(Clone, Debug)]
 pub struct BatchOptions {
-    /// The voxelization.
-    pub plan: Plan,
-    /// The output format.
-    pub format: Output,
-    /// Colour rule and normals, when the format stores attributes.
-    pub carry: CarryOptions,
-    /// `--attributes`: every attribute array into `.vdb` and `.zarr` outputs.
-    pub attributes: bool,
-    /// Writer options.
-    pub write: WriteOptions,
+    /// The work, and how its result is written.
+    pub work: Work,
     /// Worker threads per mesh (`None`: share the batch's pool).
     pub threads: Option<usize>,
     /// How meshes are read (external paths allowed or not).
@@ -62,6 +67,68 @@ pub struct BatchOptions {
     /// The options as the user gave them, recorded in each manifest line
     /// and compared on resume.
     pub fingerprint: Value,
+}
+
+/// The work a batch does to each mesh.
+#[derive(Clone, Debug)]
+pub enum Work {
+    /// `voxelize`.
+    Voxelize {
+        /// The voxelization.
+        plan: Plan,
+        /// The output format.
+        format: Output,
+        /// Colour rule and normals, when the format stores attributes.
+        carry: CarryOptions,
+        /// `--attributes`: every attribute array into `.vdb` and `.zarr` outputs.
+        attributes: bool,
+        /// Writer options.
+        write: WriteOptions,
+    },
+    /// `sdf`: a distance field.
+    Sdf {
+        /// The field, and the format it is written in.
+        request: SdfRequest,
+    },
+}
+
+impl BatchOptions {
+    /// A batch voxelizing each mesh and writing `format`.
+    pub fn voxelize(o: &JobOptions, format: Output) -> Result<BatchOptions> {
+        let mut plan = o.plan()?;
+        if let Some(why) = plan.request.grid.boxes().and_then(|s| crate::output::refuses(format, s)) {
+            return Err(JobError::invalid(why));
+        }
+        plan.request.writer_bytes_per_brick = crate::output::writer_bytes_per_brick(format);
+        let e = &o.export;
+        Ok(BatchOptions {
+            work: Work::Voxelize { plan, format, carry: e.carry(), attributes: e.attributes, write: e.write_options()? },
+            threads: o.run.threads,
+            read: o.run.read_options(),
+            fingerprint: o.fingerprint(format),
+        })
+    }
+
+    /// A batch writing each mesh's distance field as `format`; the
+    /// manifest records `"run": "sdf"` beside the options.
+    pub fn sdf(o: &SdfOptions, format: DistanceFormat) -> Result<BatchOptions> {
+        let mut fingerprint = crate::options::fingerprint_of(o, format.name());
+        fingerprint["run"] = json!("sdf");
+        Ok(BatchOptions {
+            work: Work::Sdf { request: o.request(format)? },
+            threads: o.run.threads,
+            read: o.run.read_options(),
+            fingerprint,
+        })
+    }
+
+    /// The outputs' extension.
+    pub fn extension(&self) -> String {
+        match &self.work {
+            Work::Voxelize { format, .. } => format.name().replace("npy-bool", "npy"),
+            Work::Sdf { request } => request.format.name().to_string(),
+        }
+    }
 }
 
 /// One input and where its output goes.
@@ -220,10 +287,9 @@ fn absolute(p: &Path) -> PathBuf {
 /// The items of a batch writing `format` under `out_dir`: the inputs found
 /// ([`collect_inputs`]) paired with their outputs ([`plan_items`]), and
 /// the walk's warnings. What every front end runs before [`run`].
-pub fn items(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path, format: crate::output::Output) -> Result<(Vec<Item>, Vec<String>)> {
+pub fn items(inputs: &[PathBuf], glob: Option<&str>, out_dir: &Path, opts: &BatchOptions) -> Result<(Vec<Item>, Vec<String>)> {
     let (files, warnings) = collect_inputs(inputs, glob, out_dir)?;
-    let ext = format.name().replace("npy-bool", "npy");
-    Ok((plan_items(&files, out_dir, &ext)?, warnings))
+    Ok((plan_items(&files, out_dir, &opts.extension())?, warnings))
 }
 
 /// Pairs each input with its output under `out_dir`: the input's path
@@ -475,28 +541,24 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
         let t = Instant::now();
         let loaded = topovox_io::read_mesh_with(&item.input, &opts.read)?;
         let load_s = t.elapsed().as_secs_f64();
-        crate::output::refuse_overwriting(&item.output, opts.format, &loaded.sources)?;
         let name = item.input.display().to_string();
         let run = || -> Result<Value> {
-            let v = crate::voxelize(&opts.plan, loaded.mesh.as_ref(), &name, None, stop.map(|s| &**s))?;
-            let t = Instant::now();
-            let attrs = crate::run::attributes_for(&opts.plan, &loaded, &v, opts.format, (false, opts.attributes), &opts.carry)?;
-            let attributes_s = t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let write = topovox_io::WriteOptions { stop: stop.cloned(), ..opts.write.clone() };
-            crate::output::write(&item.output, opts.format, &v.voxels, &v.grid, attrs.as_ref(), &write)?;
-            let write_s = t.elapsed().as_secs_f64();
-            let o = v.grid.origin();
+            let mut facts = match &opts.work {
+                Work::Voxelize { plan, format, carry, attributes, write } => {
+                    crate::output::refuse_overwriting(&item.output, *format, &loaded.sources)?;
+                    voxelize_one(&loaded, &name, &item.output, (plan, *format, carry, *attributes, write), stop)?
+                }
+                Work::Sdf { request } => {
+                    topovox_io::atomic::refuse_overwriting_inputs(&item.output, &loaded.sources)?;
+                    sdf_one(&loaded, &name, &item.output, request, stop.map(|s| &**s))?
+                }
+            };
+            facts["times"]["load_s"] = json!(load_s);
+            facts["triangles"] = json!(loaded.report.triangles);
             let mut warnings = loaded.warnings.clone();
-            warnings.extend(v.warnings.iter().cloned());
-            Ok(json!({
-                "grid": {"origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(v.grid.size()), "dims": v.grid.dims()},
-                "voxels": v.report.voxels,
-                "method": v.method,
-                "triangles": loaded.report.triangles,
-                "times": {"load_s": load_s, "voxelize_s": v.voxelize_s, "attributes_s": attributes_s, "write_s": write_s},
-                "warnings": warnings,
-            }))
+            warnings.extend(facts["warnings"].as_array().into_iter().flatten().filter_map(|w| w.as_str().map(String::from)));
+            facts["warnings"] = json!(warnings);
+            Ok(facts)
         };
         match opts.threads {
             Some(n) => crate::pool(n)?.install(run),
@@ -524,6 +586,52 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
     }
     record["times"]["total_s"] = json!(t0.elapsed().as_secs_f64());
     record
+}
+
+/// The grid as a manifest records it.
+fn grid_json(g: &topovox::GridSpec) -> Value {
+    let o = g.origin();
+    json!({"origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(g.size()), "dims": g.dims()})
+}
+
+/// Voxelizes one loaded mesh and writes it: the record's facts.
+fn voxelize_one(
+    loaded: &topovox_io::LoadedMesh,
+    name: &str,
+    out: &Path,
+    (plan, format, carry, attributes, write): (&Plan, Output, &CarryOptions, bool, &WriteOptions),
+    stop: Option<&Arc<Stop>>,
+) -> Result<Value> {
+    let v = crate::voxelize(plan, loaded.mesh.as_ref(), name, None, stop.map(|s| &**s))?;
+    let t = Instant::now();
+    let attrs = crate::run::attributes_for(plan, loaded, &v, format, (false, attributes), carry)?;
+    let attributes_s = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let write = WriteOptions { stop: stop.cloned(), ..write.clone() };
+    crate::output::write(out, format, &v.voxels, &v.grid, attrs.as_ref(), &write)?;
+    Ok(json!({
+        "grid": grid_json(&v.grid),
+        "voxels": v.report.voxels,
+        "method": v.method,
+        "times": {"voxelize_s": v.voxelize_s, "attributes_s": attributes_s, "write_s": t.elapsed().as_secs_f64()},
+        "warnings": v.warnings,
+    }))
+}
+
+/// The distance field of one loaded mesh, written: the record's facts.
+fn sdf_one(loaded: &topovox_io::LoadedMesh, name: &str, out: &Path, request: &SdfRequest, stop: Option<&Stop>) -> Result<Value> {
+    let t = Instant::now();
+    let sdf = crate::distance::sdf(loaded.mesh.as_ref(), name, request, stop)?;
+    let distance_s = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    crate::distance::write(out, request.format, &sdf, stop)?;
+    Ok(json!({
+        "grid": grid_json(&sdf.grid),
+        "stored_voxels": sdf.field.band.count(),
+        "signed": sdf.signed,
+        "times": {"sdf_s": distance_s, "write_s": t.elapsed().as_secs_f64()},
+        "warnings": sdf.warnings,
+    }))
 }
 
 /// Told about a batch's progress (the CLI draws a bar; core never prints).

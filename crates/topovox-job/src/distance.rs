@@ -123,10 +123,8 @@ fn width(key: &str, v: &OptionValue) -> Result<Width> {
 }
 
 crate::option_table! {
-    /// Every option of a distance-field job (`topovox sdf`, `topovox.sdf`).
-    pub struct SdfOptions {
-        [group grid: GridOptions, "The grid."]
-        [group run: RunOptions, "Threads, memory, paths."]
+    /// What a distance field stores: the band, the sign.
+    pub struct FieldOptions {
         band: Width = Width::Voxels(3.0),
             parse width,
             example Example::Float(2.5),
@@ -148,14 +146,24 @@ crate::option_table! {
     }
 }
 
+crate::option_table! {
+    /// Every option of a distance-field job (`topovox sdf`, `topovox.sdf`,
+    /// `topovox batch --run sdf`).
+    pub struct SdfOptions {
+        [group field: FieldOptions, "The band and the sign."]
+        [group grid: GridOptions, "The grid."]
+        [group run: RunOptions, "Threads, memory, paths."]
+    }
+}
+
 impl SdfOptions {
     /// The validated request for a field written as `format`.
     pub fn request(&self, format: DistanceFormat) -> Result<SdfRequest> {
         Ok(SdfRequest {
             grid: GridRequest::new(&self.grid)?,
-            width: self.band,
-            unsigned: self.unsigned,
-            sign: self.sign,
+            width: self.field.band,
+            unsigned: self.field.unsigned,
+            sign: self.field.sign,
             max_memory: self.run.max_memory,
             format,
         })

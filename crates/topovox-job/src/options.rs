@@ -12,7 +12,6 @@ use topovox::attributes::ColourRule;
 use topovox::choice::{Choice, Switch};
 use topovox_io::orient::Up;
 
-use crate::batch::BatchOptions;
 use crate::error::{JobError, Result};
 use crate::grid::{GridOptions, GridRequest};
 use crate::output::Output;
@@ -230,25 +229,6 @@ impl JobOptions {
     /// their manifests resume ([`fingerprint_of`]).
     pub fn fingerprint(&self, format: Output) -> Value {
         fingerprint_of(self, format.name())
-    }
-
-    /// The options of a batch writing `format`.
-    pub fn batch(&self, format: Output) -> Result<BatchOptions> {
-        let mut plan = self.plan()?;
-        if let Some(why) = plan.request.grid.boxes().and_then(|s| crate::output::refuses(format, s)) {
-            return Err(JobError::invalid(why));
-        }
-        plan.request.writer_bytes_per_brick = crate::output::writer_bytes_per_brick(format);
-        Ok(BatchOptions {
-            plan,
-            format,
-            carry: self.export.carry(),
-            attributes: self.export.attributes,
-            write: self.export.write_options()?,
-            threads: self.run.threads,
-            read: self.run.read_options(),
-            fingerprint: self.fingerprint(format),
-        })
     }
 }
 

@@ -244,14 +244,14 @@ macro_rules! option_table {
                 $(if $crate::table::Table::set(&mut self.$gfield, key, v)? {
                     return Ok(true);
                 })*
-                match key {
+                Ok(match key {
                     $(stringify!($field) => {
                         let parse: fn(&str, &$crate::table::OptionValue) -> $crate::Result<$ty> = $parse;
                         self.$field = parse(key, v)?;
+                        true
                     })*
-                    _ => return Ok(false),
-                }
-                Ok(true)
+                    _ => false,
+                })
             }
 
             fn fingerprint(&self, out: &mut $crate::table::Map<String, $crate::table::Value>) {

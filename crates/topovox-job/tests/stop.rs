@@ -100,11 +100,13 @@ fn a_stopped_batch_records_only_finished_meshes_and_resumes() {
     }
     let out = d.join("out");
     let opts = BatchOptions {
-        plan: plan("cover", 48, None),
-        format: Output::Voxels(VoxelFormat::Npy),
-        carry: Default::default(),
-        attributes: false,
-        write: WriteOptions::default(),
+        work: batch::Work::Voxelize {
+            plan: plan("cover", 48, None),
+            format: Output::Voxels(VoxelFormat::Npy),
+            carry: Default::default(),
+            attributes: false,
+            write: WriteOptions::default(),
+        },
         threads: None,
         read: Default::default(),
         fingerprint: json!({"test": "stop"}),

@@ -3,7 +3,9 @@
 use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde_json::Value;
-use topovox_job::batch::{self, BatchProgress};
+use topovox_job::batch::{self, BatchProgress, Run};
+use topovox_job::distance::{DistanceFormat, SdfOptions};
+use topovox_job::{GridOptions, RunOptions, Table};
 
 use crate::args::BatchArgs;
 
@@ -25,11 +27,34 @@ impl BatchProgress for Bar {
     }
 }
 
+/// The batch's work: `--run voxelize` takes the voxelize options, `--run
+/// sdf` the grid and run options and the field's; an option of the other
+/// kind is refused in one line.
+fn options(a: &BatchArgs) -> Result<batch::BatchOptions> {
+    let shared = |n: &str| GridOptions::keywords().chain(RunOptions::keywords()).any(|k| k.name == n);
+    match a.run {
+        Run::Voxelize => {
+            if let Some(n) = a.field.given.first() {
+                bail!("--{} applies to --run sdf, not --run voxelize", n.replace('_', "-"));
+            }
+            Ok(batch::BatchOptions::voxelize(&a.job.options, a.format)?)
+        }
+        Run::Sdf => {
+            if let Some(n) = a.job.given.iter().find(|n| !shared(n)) {
+                bail!("--{} is a voxelize option; --run sdf takes the grid options, --band, --unsigned and --sign", n.replace('_', "-"));
+            }
+            let format = DistanceFormat::of(Some(a.format.name()), &a.output)?;
+            let job = &a.job.options;
+            let sdf = SdfOptions { field: a.field.options.clone(), grid: job.grid.clone(), run: job.run.clone() };
+            Ok(batch::BatchOptions::sdf(&sdf, format)?)
+        }
+    }
+}
+
 pub fn run(a: &BatchArgs) -> Result<()> {
-    let format = a.format;
-    let opts = a.job.options.batch(format)?;
+    let opts = options(a)?;
     let pool = topovox_job::pool_for(a.jobs, "--jobs")?;
-    let (items, warnings) = batch::items(&a.inputs, a.glob.as_deref(), &a.output, format)?;
+    let (items, warnings) = batch::items(&a.inputs, a.glob.as_deref(), &a.output, &opts)?;
     for w in &warnings {
         eprintln!("topovox: warning: {w}");
     }

@@ -74,7 +74,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
             "sdf: {} voxels stored ({}, band {}) on grid {}x{}x{} (origin {}, {}, {}; voxel size {}); distances in {:.1} ms; total {:.2} s -> {}",
             sdf.field.band.count(),
             kind,
-            opts.band,
+            opts.field.band,
             dims[0],
             dims[1],
             dims[2],
