@@ -8,6 +8,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# The test meshes: $TOPOVOX_SHARED/meshes, else ../shared/meshes, else
+# fetched once into target/test-meshes (pinned, checksummed).
+if [ -z "${TOPOVOX_SHARED:-}" ] && [ ! -d ../shared/meshes ]; then
+    [ -d target/test-meshes/meshes ] || bash scripts/test-meshes.sh target/test-meshes
+    export TOPOVOX_SHARED="$PWD/target/test-meshes"
+fi
+
 echo "== cargo test --workspace --release"
 cargo test --workspace --release
 

@@ -705,38 +705,13 @@ pub(crate) fn import_trimesh<'py>(py: Python<'py>, what: &str) -> PyResult<Bound
 /// Vertices, faces and optional face colours of a mesh of the voxels.
 pub(crate) type MeshArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>, Option<Bound<'py, PyArray2<u8>>>);
 
-pub(crate) type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>, Option<Vec<[u8; 3]>>);
+pub(crate) use topovox_io::voxel_mesh::Triangles;
 
 /// Greedy quads of the voxels (coloured when the grid has colours), with
 /// their T-junctions split (watertight), as world-space triangles.
 pub(crate) fn greedy_triangles(g: &GridData) -> Triangles {
     let (palette, quads) = topovox_job::output::palette_quads(&g.voxels.to_dense(), g.attrs.as_ref());
-    let (o, s) = (g.grid.origin(), g.grid.voxel_size() / 2.0);
-    let mut index: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::with_capacity(quads.len() * 2);
-    let mut verts = Vec::with_capacity(quads.len() * 2);
-    let mut faces = Vec::with_capacity(quads.len() * 3);
-    let mut colours = palette.as_ref().map(|_| Vec::with_capacity(quads.len() * 3));
-    for f in topovox::export::watertight::conform(&quads) {
-        let ids: Vec<u32> = f
-            .vertices
-            .iter()
-            .map(|&c| {
-                *index.entry(c).or_insert_with(|| {
-                    verts.push([o.x + c[0] as f64 * s.x, o.y + c[1] as f64 * s.y, o.z + c[2] as f64 * s.z]);
-                    verts.len() as u32 - 1
-                })
-            })
-            .collect();
-        for t in 1..ids.len() - 1 {
-            faces.push([ids[0], ids[t], ids[t + 1]]);
-            if let (Some(out), Some(p)) = (colours.as_mut(), palette.as_ref()) {
-                out.push(
-                    f.class.checked_sub(1).and_then(|i| p.get(i as usize)).copied().unwrap_or(topovox::attributes::carry::DEFAULT_COLOUR),
-                );
-            }
-        }
-    }
-    (verts, faces, colours)
+    topovox_io::voxel_mesh::triangles(&quads, &g.grid, palette.as_deref())
 }
 
 /// `x`, `y` or `z` as an up axis.

@@ -11,11 +11,15 @@ REPO = pathlib.Path(__file__).resolve().parents[2]
 
 
 def shared_meshes() -> pathlib.Path:
+    """$TOPOVOX_SHARED/meshes, else ../shared/meshes, else what
+    scripts/test-meshes.sh fetched into target/test-meshes."""
     env = os.environ.get("TOPOVOX_SHARED")
-    root = pathlib.Path(env) if env else REPO.parent / "shared"
-    d = root / "meshes"
+    if env:
+        d = pathlib.Path(env) / "meshes"
+    else:
+        d = next((c for c in (REPO.parent / "shared" / "meshes", REPO / "target" / "test-meshes" / "meshes") if c.is_dir()), REPO.parent / "shared" / "meshes")
     if not d.is_dir():
-        pytest.fail(f"shared meshes not found at {d} (set TOPOVOX_SHARED)")
+        pytest.fail(f"shared meshes not found at {d} (set TOPOVOX_SHARED, or fetch them: bash scripts/test-meshes.sh)")
     return d
 
 

@@ -1,6 +1,8 @@
 """What a new user and a data-loader user ran into (issue 53): calls that
 cost what their work costs, and the habits NumPy users bring."""
 
+import os
+import pathlib
 import statistics
 import time
 
@@ -328,3 +330,30 @@ def test_format_is_one_named_choice_everywhere(tmp_path, cli):
         assert f"  {name}" in h or f" {name}:" in h, (name, h[-2000:])
     r = subprocess.run([str(cli), "batch", str(tmp_path), "-o", str(tmp_path / "o"), "--format", "nope"], capture_output=True, text=True)
     assert r.returncode == 2 and "nope" in r.stderr and "npy-bool" in r.stderr, r.stderr
+
+
+def test_a_clone_without_the_shared_folder_fetches_the_test_meshes_checked(tmp_path, meshes):
+    # Issue 53.4: the test command needed ../shared beside the clone. The
+    # script fetches the ten collection meshes (here from the shared folder
+    # through file://) and checks each one's SHA-256; a changed file fails
+    # in one line and leaves nothing.
+    import shutil
+    import subprocess
+
+    script = pathlib.Path(__file__).resolve().parents[2] / "scripts" / "test-meshes.sh"
+    env = dict(os.environ, TOPOVOX_MESH_BASE=meshes.as_uri())
+    r = subprocess.run(["bash", str(script), str(tmp_path / "good")], env=env, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    got = sorted(p.name for p in (tmp_path / "good" / "meshes").iterdir())
+    assert got == sorted(p.name for p in meshes.iterdir() if p.name != "README.md")
+    for name in got:
+        assert (tmp_path / "good" / "meshes" / name).read_bytes() == (meshes / name).read_bytes(), name
+    bad = tmp_path / "bad-source"
+    shutil.copytree(meshes, bad)
+    with open(bad / "teapot.obj", "a") as f:
+        f.write("# changed\n")
+    env["TOPOVOX_MESH_BASE"] = bad.as_uri()
+    r = subprocess.run(["bash", str(script), str(tmp_path / "bad")], env=env, capture_output=True, text=True)
+    assert r.returncode == 1 and "teapot.obj" in r.stderr and "SHA-256" in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert not (tmp_path / "bad").exists() and not list(tmp_path.glob("bad.part-*"))

@@ -67,14 +67,13 @@ def _remote_manifest_mirror(out_dir: str) -> str:
     return local
 
 
-def process(inp: str, out: str, out_dir: str, format: str, options: Dict[str, Any]) -> Dict[str, Any]:
-    """One mesh: voxelize ``inp``, write ``out`` (uploading it through
-    fsspec when ``out`` is a URL), append the manifest line, return it."""
+def run_one(inp: str, out: str, format: str, options: Dict[str, Any]) -> Dict[str, Any]:
+    """One mesh: voxelize ``inp`` and write ``out`` (written locally and
+    uploaded through fsspec when ``out`` is a URL); returns its manifest
+    record, without appending it."""
     proto, _ = split_protocol(out)
     if proto is None:
-        record = _topovox.process_one(split_protocol(inp)[1], split_protocol(out)[1], format=format, options=options)
-        append_manifest(out_dir, [record])
-        return record
+        return _topovox.process_one(split_protocol(inp)[1], split_protocol(out)[1], format=format, options=options)
     import fsspec
 
     with tempfile.TemporaryDirectory(prefix="topovox-") as tmp:
@@ -85,6 +84,12 @@ def process(inp: str, out: str, out_dir: str, format: str, options: Dict[str, An
             fs.makedirs(os.path.dirname(path), exist_ok=True)
             fs.put_file(local, path)
         record["output"] = out
+    return record
+
+
+def process(inp: str, out: str, out_dir: str, format: str, options: Dict[str, Any]) -> Dict[str, Any]:
+    """One mesh as :func:`run_one` does it, its manifest line appended."""
+    record = run_one(inp, out, format, options)
     append_manifest(out_dir, [record])
     return record
 

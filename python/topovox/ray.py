@@ -70,25 +70,9 @@ def voxelize_paths(
     def one(inp: str, out: str) -> Dict[str, Any]:
         import json
 
-        from topovox import _topovox
-
-        proto, _ = _paths.split_protocol(out)
-        if proto is None:
-            return _topovox.process_one(inp, out, format=format, options=opts)
-        import tempfile
-
-        import fsspec  # type: ignore[import-untyped]
-
-        with tempfile.TemporaryDirectory(prefix="topovox-") as tmp:
-            local = os.path.join(tmp, os.path.basename(out))
-            record = _topovox.process_one(inp, local, format=format, options=opts)
-            if record.get("status") == "done":
-                fs, path = fsspec.core.url_to_fs(out)
-                fs.makedirs(os.path.dirname(path), exist_ok=True)
-                fs.put_file(local, path)
-            record["output"] = out
-            out_record: Dict[str, Any] = json.loads(json.dumps(record))
-            return out_record
+        # Plain data back to the driver, which appends the manifest.
+        record: Dict[str, Any] = json.loads(json.dumps(_paths.run_one(inp, out, format, opts)))
+        return record
 
     pending = [one.remote(i, o) for i, o in todo]
     records = []

@@ -15,7 +15,7 @@ fn tmp(name: &str) -> String {
 }
 
 fn shared(name: &str) -> String {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes").join(name);
+    let p = topovox_testkit::shared_meshes_dir().join(name);
     assert!(p.exists(), "missing {}", p.display());
     p.to_string_lossy().into_owned()
 }

@@ -25,7 +25,7 @@ fn folder(name: &str) -> PathBuf {
 }
 
 fn shared(name: &str) -> PathBuf {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes").join(name);
+    let p = topovox_testkit::shared_meshes_dir().join(name);
     assert!(p.exists(), "missing {}", p.display());
     p
 }

@@ -257,7 +257,7 @@ fn max_memory_is_kept_or_the_run_is_refused_before_work() {
 #[test]
 fn max_memory_is_kept_by_solids_of_open_meshes_or_refused_before_work() {
     let d = folder("memory-solid");
-    let mesh = repo("../shared/meshes/stanford-bunny.obj");
+    let mesh = topovox_testkit::shared_meshes_dir().join("stanford-bunny.obj");
     let out = d.join("bunny.vdb");
     let run = |bound: &str| {
         topovox(&["voxelize", s(&mesh), "-o", s(&out), "--mode", "solid", "--resolution", "2048", "--max-memory", bound, "--json"])

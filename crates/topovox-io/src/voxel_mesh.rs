@@ -10,6 +10,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use serde_json::json;
+use topovox::attributes::carry::DEFAULT_COLOUR;
 use topovox::attributes::colour::to_linear;
 use topovox::export::greedy::Quad;
 use topovox::GridSpec;
@@ -141,6 +142,41 @@ pub fn write_quads_obj(
     }
     staged_obj.commit()?;
     Ok(order.len())
+}
+
+/// Vertices (world coordinates, shared), triangles and, with a palette,
+/// one colour per triangle.
+pub type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>, Option<Vec<[u8; 3]>>);
+
+/// `quads` on `grid` as an indexed triangle mesh: T-junctions split (so it
+/// is watertight), each face fan-triangulated, its colour from `palette`
+/// (class `c` is `palette[c - 1]`). What Python's `VoxelGrid.to_mesh` returns.
+pub fn triangles(quads: &[Quad], grid: &GridSpec, palette: Option<&[[u8; 3]]>) -> Triangles {
+    let (o, s) = (grid.origin(), grid.voxel_size() / 2.0);
+    let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity(quads.len() * 2);
+    let mut verts = Vec::with_capacity(quads.len() * 2);
+    let mut faces = Vec::with_capacity(quads.len() * 3);
+    let mut colours = palette.map(|_| Vec::with_capacity(quads.len() * 3));
+    for f in topovox::export::watertight::conform(quads) {
+        let ids: Vec<u32> = f
+            .vertices
+            .iter()
+            .map(|&c| {
+                *index.entry(c).or_insert_with(|| {
+                    verts.push([o.x + c[0] as f64 * s.x, o.y + c[1] as f64 * s.y, o.z + c[2] as f64 * s.z]);
+                    verts.len() as u32 - 1
+                })
+            })
+            .collect();
+        let colour = palette.map(|p| f.class.checked_sub(1).and_then(|i| p.get(i as usize)).copied().unwrap_or(DEFAULT_COLOUR));
+        for t in 1..ids.len() - 1 {
+            faces.push([ids[0], ids[t], ids[t + 1]]);
+            if let (Some(out), Some(c)) = (colours.as_mut(), colour) {
+                out.push(c);
+            }
+        }
+    }
+    (verts, faces, colours)
 }
 
 /// Writes `quads` as a binary glTF 2.0 file: triangles (T-junctions split

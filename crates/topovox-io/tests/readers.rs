@@ -18,8 +18,16 @@ fn write(name: &str, bytes: &[u8]) -> PathBuf {
 }
 
 fn shared(name: &str) -> PathBuf {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes").join(name);
-    assert!(p.exists(), "shared mesh {} missing", p.display());
+    // As topovox-testkit's `shared_meshes_dir` (which depends on this crate).
+    let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let dir = match std::env::var_os("TOPOVOX_SHARED") {
+        Some(s) => PathBuf::from(s).join("meshes"),
+        None => {
+            [repo.join("../shared/meshes"), repo.join("target/test-meshes/meshes")].into_iter().find(|d| d.is_dir()).unwrap_or_default()
+        }
+    };
+    let p = dir.join(name);
+    assert!(p.exists(), "shared mesh {} missing (set TOPOVOX_SHARED, or fetch them: bash scripts/test-meshes.sh)", p.display());
     p
 }
 

@@ -21,15 +21,21 @@ pub const SHARED_MESHES: &[&str] = &[
     "woody.obj",
 ];
 
-/// `shared/meshes`: `$TOPOVOX_SHARED/meshes` or `../shared/meshes` beside the
-/// repository. Panics with a clear message if missing: tests that need the
-/// shared meshes must not pass silently without them.
+/// `shared/meshes`: `$TOPOVOX_SHARED/meshes`, else `../shared/meshes`
+/// beside the repository, else `target/test-meshes/meshes` (what
+/// `scripts/test-meshes.sh` fetches). Panics with a clear message if none
+/// is there: tests that need the shared meshes must not pass silently
+/// without them.
 pub fn shared_meshes_dir() -> PathBuf {
+    let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
     let dir = match std::env::var_os("TOPOVOX_SHARED") {
         Some(s) => PathBuf::from(s).join("meshes"),
-        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes"),
+        None => [repo.join("../shared/meshes"), repo.join("target/test-meshes/meshes")]
+            .into_iter()
+            .find(|d| d.is_dir())
+            .unwrap_or_else(|| repo.join("../shared/meshes")),
     };
-    assert!(dir.is_dir(), "shared meshes not found at {} (set TOPOVOX_SHARED)", dir.display());
+    assert!(dir.is_dir(), "shared meshes not found at {} (set TOPOVOX_SHARED, or fetch them: bash scripts/test-meshes.sh)", dir.display());
     dir
 }
 

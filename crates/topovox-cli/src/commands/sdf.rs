@@ -45,7 +45,6 @@ pub fn run(a: &SdfArgs) -> Result<()> {
     let (g, dims) = (sdf.grid, sdf.grid.dims());
     let o = g.origin();
     if a.json {
-        let mut j = sdf.facts.clone();
         let extra = json!({
             "origin": [o.x, o.y, o.z],
             "voxel_size": topovox_io::size_json(g.size()),
@@ -60,9 +59,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
             "mesh": {"vertices": loaded.report.vertices, "triangles": loaded.report.triangles, "segments": loaded.report.segments},
             "warnings": loaded.warnings,
         });
-        if let (Some(obj), Some(add)) = (j.as_object_mut(), extra.as_object()) {
-            obj.extend(add.clone());
-        }
+        let j = crate::console::summary_json(sdf.facts.clone(), extra);
         crate::console::print_stdout(&j.to_string())?;
     } else if !a.quiet {
         let kind = if sdf.signed {

@@ -103,7 +103,6 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     // With `-o -` the voxels are on stdout: the summary goes to stderr.
     let to_stdout = a.output.as_os_str() == "-";
     if a.json {
-        let mut j = v.facts(&plan);
         let extra = json!({
             "load_s": load_s,
             "write_s": write_s,
@@ -130,9 +129,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
             },
             "warnings": loaded.warnings,
         });
-        if let (Some(obj), Some(add)) = (j.as_object_mut(), extra.as_object()) {
-            obj.extend(add.clone());
-        }
+        let j = crate::console::summary_json(v.facts(&plan), extra);
         summary(to_stdout, &j.to_string())?;
     } else if !a.quiet {
         let method = match v.solid.get("closed").and_then(|c| c.as_bool()) {
