@@ -43,4 +43,8 @@ impl topovox::voxelize::Progress for Bar {
     fn advance(&self, n: u64) {
         self.0.inc(n);
     }
+
+    fn phase(&self, name: &'static str) {
+        Bar::phase(self, name);
+    }
 }

@@ -28,15 +28,13 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use serde_json::{json, Value};
-use topovox::attributes::carry::CarryOptions;
 use topovox::voxelize::Stop;
-use topovox_io::WriteOptions;
 
 use crate::distance::{DistanceFormat, SdfOptions, SdfRequest};
 use crate::error::{JobError, Result};
+use crate::job::VoxelizeJob;
 use crate::options::JobOptions;
 use crate::output::Output;
-use crate::plan::Plan;
 use topovox::choice::Choice;
 
 /// The manifest's file name in the output folder.
@@ -73,18 +71,7 @@ pub struct BatchOptions {
 #[derive(Clone, Debug)]
 pub enum Work {
     /// `voxelize`.
-    Voxelize {
-        /// The voxelization.
-        plan: Plan,
-        /// The output format.
-        format: Output,
-        /// Colour rule and normals, when the format stores attributes.
-        carry: CarryOptions,
-        /// `--attributes`: every attribute array into `.vdb` and `.zarr` outputs.
-        attributes: bool,
-        /// Writer options.
-        write: WriteOptions,
-    },
+    Voxelize(Box<VoxelizeJob>),
     /// `sdf`: a distance field.
     Sdf {
         /// The field, and the format it is written in.
@@ -95,14 +82,8 @@ pub enum Work {
 impl BatchOptions {
     /// A batch voxelizing each mesh and writing `format`.
     pub fn voxelize(o: &JobOptions, format: Output) -> Result<BatchOptions> {
-        let mut plan = o.plan()?;
-        if let Some(why) = plan.request.grid.boxes().and_then(|s| crate::output::refuses(format, s)) {
-            return Err(JobError::invalid(why));
-        }
-        plan.request.writer_bytes_per_brick = crate::output::writer_bytes_per_brick(format);
-        let e = &o.export;
         Ok(BatchOptions {
-            work: Work::Voxelize { plan, format, carry: e.carry(), attributes: e.attributes, write: e.write_options()? },
+            work: Work::Voxelize(Box::new(VoxelizeJob::new(o, format, None)?)),
             threads: o.run.threads,
             read: o.run.read_options(),
             fingerprint: o.fingerprint(format),
@@ -125,7 +106,7 @@ impl BatchOptions {
     /// The outputs' extension.
     pub fn extension(&self) -> String {
         match &self.work {
-            Work::Voxelize { format, .. } => format.name().replace("npy-bool", "npy"),
+            Work::Voxelize(job) => job.format.name().replace("npy-bool", "npy"),
             Work::Sdf { request } => request.format.name().to_string(),
         }
     }
@@ -544,10 +525,7 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
         let name = item.input.display().to_string();
         let run = || -> Result<Value> {
             let mut facts = match &opts.work {
-                Work::Voxelize { plan, format, carry, attributes, write } => {
-                    crate::output::refuse_overwriting(&item.output, *format, &loaded.sources)?;
-                    voxelize_one(&loaded, &name, &item.output, (plan, *format, carry, *attributes, write), stop)?
-                }
+                Work::Voxelize(job) => voxelize_one(job, &loaded, &name, &item.output, stop)?,
                 Work::Sdf { request } => {
                     topovox_io::atomic::refuse_overwriting_inputs(&item.output, &loaded.sources)?;
                     sdf_one(&loaded, &name, &item.output, request, stop.map(|s| &**s))?
@@ -595,25 +573,14 @@ fn grid_json(g: &topovox::GridSpec) -> Value {
 }
 
 /// Voxelizes one loaded mesh and writes it: the record's facts.
-fn voxelize_one(
-    loaded: &topovox_io::LoadedMesh,
-    name: &str,
-    out: &Path,
-    (plan, format, carry, attributes, write): (&Plan, Output, &CarryOptions, bool, &WriteOptions),
-    stop: Option<&Arc<Stop>>,
-) -> Result<Value> {
-    let v = crate::voxelize(plan, loaded.mesh.as_ref(), name, None, stop.map(|s| &**s))?;
-    let t = Instant::now();
-    let attrs = crate::run::attributes_for(plan, loaded, &v, format, (false, attributes), carry)?;
-    let attributes_s = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let write = WriteOptions { stop: stop.cloned(), ..write.clone() };
-    crate::output::write(out, format, &v.voxels, &v.grid, attrs.as_ref(), &write)?;
+fn voxelize_one(job: &VoxelizeJob, loaded: &topovox_io::LoadedMesh, name: &str, out: &Path, stop: Option<&Arc<Stop>>) -> Result<Value> {
+    let done = job.run(out, loaded, name, None, stop)?;
+    let v = &done.voxels;
     Ok(json!({
         "grid": grid_json(&v.grid),
         "voxels": v.report.voxels,
         "method": v.method,
-        "times": {"voxelize_s": v.voxelize_s, "attributes_s": attributes_s, "write_s": t.elapsed().as_secs_f64()},
+        "times": {"voxelize_s": v.voxelize_s, "attributes_s": done.attributes_s, "write_s": done.write_s},
         "warnings": v.warnings,
     }))
 }

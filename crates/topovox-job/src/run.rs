@@ -308,6 +308,12 @@ pub fn attributes_for(
 }
 
 impl Voxelized {
+    /// A solid mode's test of the mesh: closed and consistently oriented
+    /// (`Some(true)`), not (`Some(false)`); `None` when nothing tested it.
+    pub fn mesh_closed(&self) -> Option<bool> {
+        self.solid.get("closed").and_then(Value::as_bool)
+    }
+
     /// The facts `topovox voxelize --json` reports about the voxelization
     /// (mode, method, grid, counts, triangles, solid and GPU facts).
     pub fn facts(&self, plan: &Plan) -> Value {

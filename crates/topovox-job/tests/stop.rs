@@ -99,18 +99,10 @@ fn a_stopped_batch_records_only_finished_meshes_and_resumes() {
         std::fs::copy(repo("examples/meshes/cow.obj"), inputs.join(format!("cow{n}.obj"))).unwrap();
     }
     let out = d.join("out");
-    let opts = BatchOptions {
-        work: batch::Work::Voxelize {
-            plan: plan("cover", 48, None),
-            format: Output::Voxels(VoxelFormat::Npy),
-            carry: Default::default(),
-            attributes: false,
-            write: WriteOptions::default(),
-        },
-        threads: None,
-        read: Default::default(),
-        fingerprint: json!({"test": "stop"}),
-    };
+    let mut o = topovox_job::JobOptions::default();
+    o.grid.resolution = Some(48);
+    let opts =
+        BatchOptions { fingerprint: json!({"test": "stop"}), ..BatchOptions::voxelize(&o, Output::Voxels(VoxelFormat::Npy)).unwrap() };
     let (files, _) = batch::collect_inputs(&[inputs], None, &out).unwrap();
     let items: Vec<Item> = batch::plan_items(&files, &out, "npy").unwrap();
     let stop = Arc::new(Stop::new());

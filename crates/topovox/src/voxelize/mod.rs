@@ -194,6 +194,8 @@ pub trait Progress: Sync {
     fn set_total(&self, total: u64);
     /// `n` more units are done.
     fn advance(&self, n: u64);
+    /// A phase of unknown length begins (`"writing"`); nothing by default.
+    fn phase(&self, _name: &'static str) {}
 }
 
 /// How the fast `cover` path walks a triangle's voxels. Every choice gives
