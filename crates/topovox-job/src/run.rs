@@ -127,25 +127,7 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
     };
     let mut opts = Options { progress, stop, ..Options::default() };
     if tile.is_some() {
-        // A tiled surface (or sparse solid) holds its non-empty bricks:
-        // refused before any work when they would not fit, and reserved at
-        // once otherwise.
-        let mut e = match &plan.solid {
-            None => crate::memory::tiled_estimate(mesh, &grid),
-            Some(sp) => crate::memory::sparse_solid_estimate(mesh, &grid, sp.method == crate::plan::SolidMethod::Flood),
-        };
-        e.bytes += e.bricks * plan.request.writer_bytes_per_brick;
-        if e.bytes > budget {
-            let [x, y, z] = grid.dims();
-            return Err(JobError::failed(format!(
-                "{name}: the {} on the {x}x{y}x{z} grid needs about {} (up to {} bricks of 8x8x8 voxels), more than the {} this run may use; raise --max-memory or lower the resolution",
-                if plan.solid.is_some() { "solid" } else { "surface" },
-                crate::memory::bytes(e.bytes),
-                e.bricks,
-                crate::memory::bytes(budget)
-            )));
-        }
-        opts.brick_capacity = usize::try_from(e.bricks).unwrap_or(0);
+        opts.brick_capacity = brick_capacity(plan, mesh, &grid, name, budget)?;
     }
     let opts = opts;
     let mut gpu = Value::Null;
@@ -179,28 +161,7 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
         let voxels = out.bits.count();
         (Voxels::Dense(out.bits), Report { voxels, prepare: Default::default() }, out.method, out.facts)
     } else {
-        let mode = plan.core;
-        let (v, r) = match surface_method {
-            SurfaceMethod::Reference => {
-                let (b, r) = voxelize::reference(mode, mesh, &grid);
-                (Voxels::Dense(b), r)
-            }
-            SurfaceMethod::Scanline => {
-                let (b, r) = voxelize::scanline::scanline(mode, mesh, &grid, &opts)
-                    .ok_or_else(|| JobError::invalid(format!("--method scanline exists for cover, sep26 and sep6, not {}", mode.name())))?;
-                (Voxels::Bricks(b), r)
-            }
-            SurfaceMethod::Fast => {
-                let (b, r) = voxelize::fast(mode, mesh, &grid, &opts);
-                (Voxels::Bricks(b), r)
-            }
-            SurfaceMethod::Gpu => {
-                let (b, r, facts, w) = gpu_voxelize(mode, plan.request.gpu_path, mesh, &grid)?;
-                gpu = facts;
-                warnings.extend(w);
-                (Voxels::Bricks(b), r)
-            }
-        };
+        let (v, r) = untiled_surface(plan, surface_method, mesh, &grid, &opts, (&mut gpu, &mut warnings))?;
         (v, r, surface_method.name(), Value::Null)
     };
     if stop.is_some_and(Stop::requested) {
@@ -219,6 +180,62 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
         warnings.push(format!("{name}: skipped {} primitives with invalid vertices", p.non_finite + p.invalid_index));
     }
     Ok(Voxelized { voxels, grid, method, report, solid, gpu, warnings, voxelize_s, tile, tile_kernel })
+}
+
+/// A tiled surface (or sparse solid) holds its non-empty bricks: refused
+/// before any work when they would not fit in `budget`, and their count
+/// (to reserve at once) otherwise.
+fn brick_capacity(plan: &Plan, mesh: MeshRef<'_>, grid: &GridSpec, name: &str, budget: u64) -> Result<usize> {
+    let mut e = match &plan.solid {
+        None => crate::memory::tiled_estimate(mesh, grid),
+        Some(sp) => crate::memory::sparse_solid_estimate(mesh, grid, sp.method == crate::plan::SolidMethod::Flood),
+    };
+    e.bytes += e.bricks * plan.request.writer_bytes_per_brick;
+    if e.bytes > budget {
+        let [x, y, z] = grid.dims();
+        return Err(JobError::failed(format!(
+            "{name}: the {} on the {x}x{y}x{z} grid needs about {} (up to {} bricks of 8x8x8 voxels), more than the {} this run may use; raise --max-memory or lower the resolution",
+            if plan.solid.is_some() { "solid" } else { "surface" },
+            crate::memory::bytes(e.bytes),
+            e.bricks,
+            crate::memory::bytes(budget)
+        )));
+    }
+    Ok(usize::try_from(e.bricks).unwrap_or(0))
+}
+
+/// A surface or line mode on the whole grid by `method`; the GPU's facts
+/// and warnings go to `out`.
+fn untiled_surface(
+    plan: &Plan,
+    method: SurfaceMethod,
+    mesh: MeshRef<'_>,
+    grid: &GridSpec,
+    opts: &Options<'_>,
+    out: (&mut Value, &mut Vec<String>),
+) -> Result<(Voxels, Report)> {
+    let mode = plan.core;
+    Ok(match method {
+        SurfaceMethod::Reference => {
+            let (b, r) = voxelize::reference(mode, mesh, grid);
+            (Voxels::Dense(b), r)
+        }
+        SurfaceMethod::Scanline => {
+            let (b, r) = voxelize::scanline::scanline(mode, mesh, grid, opts)
+                .ok_or_else(|| JobError::invalid(format!("--method scanline exists for cover, sep26 and sep6, not {}", mode.name())))?;
+            (Voxels::Bricks(b), r)
+        }
+        SurfaceMethod::Fast => {
+            let (b, r) = voxelize::fast(mode, mesh, grid, opts);
+            (Voxels::Bricks(b), r)
+        }
+        SurfaceMethod::Gpu => {
+            let (b, r, facts, w) = gpu_voxelize(mode, plan.request.gpu_path, mesh, grid)?;
+            *out.0 = facts;
+            out.1.extend(w);
+            (Voxels::Bricks(b), r)
+        }
+    })
 }
 
 /// The tile edge of the tiled path, when it runs: asked for with `--tile`,

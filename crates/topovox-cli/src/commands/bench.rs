@@ -142,9 +142,25 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         owned = subdivide(&owned);
     }
     let mesh = owned.as_ref();
-    let bounds = loaded.report.bounds;
-    let mut rows = Vec::new();
+    let m = measure(a, mesh, &loaded.report.bounds)?;
+    if a.json {
+        return print_json(a, &m);
+    }
+    print_table(a, mesh, &m)
+}
 
+/// The rows of the table, with the reference's and brute force's times.
+struct Measured {
+    rows: Vec<Row>,
+    /// Per mode: the reference's resolution and median seconds.
+    ref_s: std::collections::HashMap<&'static str, (u64, f64)>,
+    /// Per resolution: the brute-force loop's median seconds.
+    brute_s: std::collections::HashMap<u64, f64>,
+}
+
+/// Times every engine of `a.modes` at every thread count and resolution.
+fn measure(a: &BenchArgs, mesh: topovox::MeshRef<'_>, bounds: &topovox::Aabb) -> Result<Measured> {
+    let mut rows = Vec::new();
     let mut ref_s = std::collections::HashMap::new();
     let mut brute_s = std::collections::HashMap::new();
     let groups: Vec<Vec<Engine>> = a.modes.iter().map(|&m| Engine::new(m)).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect();
@@ -153,7 +169,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         // the solids.
         let first = &group[0];
         let ref_res = a.reference_resolution.min(first.reference_cap());
-        let grid = GridSpec::from_resolution(&bounds, ref_res).context("invalid grid")?;
+        let grid = GridSpec::from_resolution(bounds, ref_res).context("invalid grid")?;
         let (s, voxels) = time(a.repeats.clamp(1, 3), || first.reference(mesh, &grid));
         let voxels = voxels?;
         ref_s.insert(first.name(), (ref_res, s));
@@ -171,7 +187,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         for (n_threads, &threads) in a.threads.iter().enumerate() {
             let pool = topovox_job::pool_for(Some(threads), "--threads")?;
             for &res in &a.resolutions {
-                let grid = GridSpec::from_resolution(&bounds, res).context("invalid grid")?;
+                let grid = GridSpec::from_resolution(bounds, res).context("invalid grid")?;
                 crate::plan::check_memory(&grid)?;
                 // The brute-force baseline runs on one thread whatever the
                 // pool, so it is timed (in alternation) with the first thread
@@ -240,15 +256,23 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         }
     }
 
-    if a.json {
-        for r in &rows {
-            let v = json!({"mode": r.mode, "method": r.method, "threads": r.threads, "resolution": r.resolution, "dims": r.dims, "voxels": r.voxels,
+    Ok(Measured { rows, ref_s, brute_s })
+}
+
+/// `--json`: one object per row.
+fn print_json(a: &BenchArgs, m: &Measured) -> Result<()> {
+    for r in &m.rows {
+        let v = json!({"mode": r.mode, "method": r.method, "threads": r.threads, "resolution": r.resolution, "dims": r.dims, "voxels": r.voxels,
                 "voxelize_median_s": r.voxelize_s, "with_loading_median_s": r.with_loading_s, "repeats": a.repeats,
-                "brute_median_s": brute_s.get(&r.resolution)});
-            crate::console::print_stdout(&v.to_string())?;
-        }
-        return Ok(());
+                "brute_median_s": m.brute_s.get(&r.resolution)});
+        crate::console::print_stdout(&v.to_string())?;
     }
+    Ok(())
+}
+
+/// The Markdown table.
+fn print_table(a: &BenchArgs, mesh: topovox::MeshRef<'_>, m: &Measured) -> Result<()> {
+    let (rows, ref_s, brute_s) = (&m.rows, &m.ref_s, &m.brute_s);
     let mut out = format!(
         "mesh: {}{} ({} triangles); median of {} repeats ({} with loading); {} hardware threads\n\n",
         a.mesh.display(),
@@ -264,7 +288,7 @@ pub fn run(a: &BenchArgs) -> Result<()> {
         if brute_col { " vs brute |" } else { "" },
         if brute_col { "---|" } else { "" }
     );
-    for r in &rows {
+    for r in rows {
         let vs_fast = rows
             .iter()
             .find(|f| f.method == "fast" && f.mode == r.mode && f.threads == r.threads && f.resolution == r.resolution)

@@ -7,13 +7,15 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use serde_json::json;
 use topovox::glam::Vec3;
-use topovox_view::{Camera, FrameOptions, FrameStats, Renderer};
+use topovox_view::{Camera, FrameOptions, FrameStats, GpuScene, Renderer};
 
-use crate::args::RenderArgs;
+use crate::args::{GpuRenderArgs, RenderArgs};
 use crate::pictures::{check_png_path, options};
 use crate::scene_input::{camera, load_scene, read_points};
 
-pub fn run(a: &RenderArgs) -> Result<()> {
+/// The flags checked and the files the run will write (the picture and
+/// `--stats-json`), none of them the input.
+fn checked(a: &RenderArgs) -> Result<(topovox::render::raycast::RenderOptions, Vec<PathBuf>)> {
     let g = &a.gpu;
     if a.picture.outline {
         bail!("--outline belongs to the CPU ray caster; leave out --gpu");
@@ -37,6 +39,12 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     for out in &outputs {
         topovox_io::atomic::refuse_overwriting_inputs(out, std::slice::from_ref(&a.input))?;
     }
+    Ok((o, outputs))
+}
+
+pub fn run(a: &RenderArgs) -> Result<()> {
+    let g = &a.gpu;
+    let (o, outputs) = checked(a)?;
     let mut up = Vec3::ZERO;
     up[o.up] = 1.0;
 
@@ -63,51 +71,9 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     let mut uploaded = renderer.upload(&scene)?;
     renderer.add_points(&mut uploaded, &points)?;
     let upload_s = t1.elapsed().as_secs_f64();
-    let culling = g.culling;
-    let mut frames = Vec::with_capacity(cameras.len());
+    let mut frames: Vec<serde_json::Value> = Vec::with_capacity(cameras.len());
     for (camera, out) in cameras.iter().zip(&outputs_png) {
-        let opts = FrameOptions {
-            width: o.width,
-            height: o.height,
-            camera: *camera,
-            culling,
-            prepass: g.prepass.on(),
-            gamma: g.gamma.on(),
-            light_grid_view: g.light_grid.on(),
-            read_hiz: false,
-            mesh: g.mesh.on(),
-            boxes: g.boxes.on(),
-        };
-        // Every run's statistics, the last run's picture.
-        let mut frame = renderer.render(&uploaded, &opts)?;
-        let mut runs = vec![frame.stats.clone()];
-        for _ in 1..g.repeat {
-            frame = renderer.render(&uploaded, &opts)?;
-            runs.push(frame.stats.clone());
-        }
-        let median = |f: &dyn Fn(&FrameStats) -> Option<f64>| -> Option<f64> {
-            let mut v: Vec<f64> = runs.iter().filter_map(f).collect();
-            v.sort_by(f64::total_cmp);
-            (!v.is_empty()).then(|| v[v.len() / 2])
-        };
-        topovox_io::write_png(out, frame.width, frame.height, &frame.rgb())?;
-        let s = &frame.stats;
-        frames.push(json!({
-            "output": out,
-            "camera": {"eye": camera.eye.to_array(), "target": camera.target.to_array(), "up": camera.up.to_array(), "fov_deg": camera.fov_deg},
-            "clusters_after_frustum": s.clusters_after_frustum,
-            "clusters_after_occlusion": s.clusters_after_occlusion,
-            "triangles_drawn": s.triangles_drawn,
-            "points_drawn": s.points_drawn,
-            "frame_ms": {
-                "repeats": g.repeat,
-                "cpu": median(&|s| Some(s.cpu_ms)),
-                "gpu_cull": median(&|s| s.gpu.map(|t| t.cull_ms)),
-                "gpu_depth_pass": median(&|s| s.gpu.map(|t| t.depth_ms)),
-                "gpu_hiz": median(&|s| s.gpu.map(|t| t.hiz_ms)),
-                "gpu_shade": median(&|s| s.gpu.map(|t| t.shade_ms)),
-            },
-        }));
+        frames.push(render_frame(&renderer, &uploaded, g, (o.width, o.height), camera, out)?);
     }
     let first = &frames[0];
     let (total, mean, max) = uploaded.grid.stats();
@@ -161,6 +127,61 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         stats["frame_ms"]["cpu"].as_f64().unwrap_or(0.0),
         a.output.display()
     ))
+}
+
+/// One frame from `camera` into `out`, rendered `--repeat` times: its
+/// statistics (medians of the runs), the last run's picture written.
+fn render_frame(
+    renderer: &Renderer,
+    uploaded: &GpuScene,
+    g: &GpuRenderArgs,
+    size: (u32, u32),
+    camera: &Camera,
+    out: &Path,
+) -> Result<serde_json::Value> {
+    let (width, height) = size;
+    let opts = FrameOptions {
+        width,
+        height,
+        camera: *camera,
+        culling: g.culling,
+        prepass: g.prepass.on(),
+        gamma: g.gamma.on(),
+        light_grid_view: g.light_grid.on(),
+        read_hiz: false,
+        mesh: g.mesh.on(),
+        boxes: g.boxes.on(),
+    };
+    // Every run's statistics, the last run's picture.
+    let mut frame = renderer.render(uploaded, &opts)?;
+    let mut runs = vec![frame.stats.clone()];
+    for _ in 1..g.repeat {
+        frame = renderer.render(uploaded, &opts)?;
+        runs.push(frame.stats.clone());
+    }
+    let median = |f: &dyn Fn(&FrameStats) -> Option<f64>| -> Option<f64> {
+        let mut v: Vec<f64> = runs.iter().filter_map(f).collect();
+        v.sort_by(f64::total_cmp);
+        (!v.is_empty()).then(|| v[v.len() / 2])
+    };
+    topovox_io::write_png(out, frame.width, frame.height, &frame.rgb())?;
+    let s = &frame.stats;
+    Ok(json!({
+        "output": out,
+        "camera": {"eye": camera.eye.to_array(), "target": camera.target.to_array(), "up": camera.up.to_array(), "fov_deg": camera.fov_deg},
+        "clusters_after_frustum": s.clusters_after_frustum,
+        "clusters_after_occlusion": s.clusters_after_occlusion,
+        "triangles_drawn": s.triangles_drawn,
+        "points_drawn": s.points_drawn,
+        "frame_ms": {
+            "repeats": g.repeat,
+            "cpu": median(&|s| Some(s.cpu_ms)),
+            "gpu_cull": median(&|s| s.gpu.map(|t| t.cull_ms)),
+            "gpu_depth_pass": median(&|s| s.gpu.map(|t| t.depth_ms)),
+            "gpu_hiz": median(&|s| s.gpu.map(|t| t.hiz_ms)),
+            "gpu_shade": median(&|s| s.gpu.map(|t| t.shade_ms)),
+        },
+    }))
 }
 
 /// `out.png` → `out-0003.png` for frame 3.
