@@ -93,26 +93,7 @@ pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKin
         chunks.par_iter().zip(&before).zip(&counts).map(|((c, b), own)| parse_chunk(c, *b, own, appearance)).collect::<Result<_, _>>()?;
 
     let mut warnings = Vec::new();
-    // Material libraries, in order of first mention.
-    let mut libs: Vec<&str> = Vec::new();
-    for lib in parsed.iter().flat_map(|c| &c.mtllibs) {
-        if !libs.contains(&lib.as_str()) {
-            libs.push(lib);
-        }
-    }
-    let mut materials: Vec<tobj::Material> = Vec::new();
-    for lib in libs {
-        if res.base().is_none() {
-            continue;
-        }
-        match res.resolve(Path::new(lib)) {
-            Ok(full) => match tobj::load_mtl(&full) {
-                Ok((mats, _)) => materials.extend(mats),
-                Err(_) => warnings.push(format!("material library {} could not be read; materials ignored", full.display())),
-            },
-            Err(why) => warnings.push(format!("material library {why}; materials ignored")),
-        }
-    }
+    let materials = material_libraries(&parsed, res, &mut warnings);
     let by_name: HashMap<&str, u32> = materials.iter().enumerate().rev().map(|(i, m)| (m.name.as_str(), i as u32)).collect();
 
     let (nv, nt) = (total.v as usize, parsed.iter().map(|c| c.triangles.len()).sum::<usize>());
@@ -148,53 +129,7 @@ pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKin
 
     let mut app = Appearance::default();
     if res.base().is_some() {
-        for (index, mat) in materials.iter().enumerate() {
-            let factor = mat.diffuse.unwrap_or([1.0; 3]);
-            let texture = mat.diffuse_texture.as_deref().filter(|t| !t.trim().is_empty()).and_then(|statement| {
-                let (reference, wrap) = crate::texture::parse_map_statement(statement);
-                match res.resolve(&reference).and_then(|path| crate::texture::load(&path, wrap)) {
-                    Ok(t) => {
-                        app.textures.push(t);
-                        Some(app.textures.len() as u32 - 1)
-                    }
-                    Err(e) => {
-                        warnings.push(format!("material {:?}: {e}; its Kd colour is used instead", mat.name));
-                        None
-                    }
-                }
-            });
-            let name = if mat.name.is_empty() { format!("material {index}") } else { mat.name.clone() };
-            // map_d: a cut-out mask (its alpha channel, or for an opaque
-            // image its red channel: masks are usually grey), moved into
-            // the alpha channel of its own texture.
-            let alpha_texture = mat.dissolve_texture.as_deref().filter(|t| !t.trim().is_empty()).and_then(|statement| {
-                let (reference, wrap) = crate::texture::parse_map_statement(statement);
-                match res.resolve(&reference).and_then(|path| crate::texture::load(&path, wrap)) {
-                    Ok(mut t) => {
-                        if t.rgba.chunks_exact(4).all(|p| p[3] == 255) {
-                            t.rgba.chunks_exact_mut(4).for_each(|p| p[3] = p[0]);
-                        }
-                        app.textures.push(t);
-                        Some(app.textures.len() as u32 - 1)
-                    }
-                    Err(e) => {
-                        warnings.push(format!("material {name:?}: map_d {e}; the material is drawn opaque"));
-                        None
-                    }
-                }
-            });
-            let see_through = texture.is_some_and(|t| app.textures[t as usize].rgba.chunks_exact(4).any(|p| p[3] < 255));
-            let alpha_cutoff = (alpha_texture.is_some() || see_through).then_some(0.5);
-            app.materials.push(Material {
-                name,
-                factor,
-                texture,
-                emission: obj_emission(mat),
-                roughness: obj_roughness(mat),
-                alpha_cutoff,
-                alpha_texture,
-            });
-        }
+        add_materials(&materials, res, &mut app, &mut warnings);
     }
     if !app.materials.is_empty() {
         // OBJ puts v = 0 at the bottom of the image; topovox's textures at the top.
@@ -211,6 +146,84 @@ pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKin
     let mut loaded = finish_with_segments(positions, triangles, segments, warnings)?;
     loaded.appearance = app;
     Ok(loaded)
+}
+
+/// The materials of the libraries the chunks name (`mtllib`), in order of
+/// first mention; a library that cannot be read is a warning.
+fn material_libraries(parsed: &[Chunk], res: &Resources, warnings: &mut Vec<String>) -> Vec<tobj::Material> {
+    // Material libraries, in order of first mention.
+    let mut libs: Vec<&str> = Vec::new();
+    for lib in parsed.iter().flat_map(|c| &c.mtllibs) {
+        if !libs.contains(&lib.as_str()) {
+            libs.push(lib);
+        }
+    }
+    let mut materials: Vec<tobj::Material> = Vec::new();
+    for lib in libs {
+        if res.base().is_none() {
+            continue;
+        }
+        match res.resolve(Path::new(lib)) {
+            Ok(full) => match tobj::load_mtl(&full) {
+                Ok((mats, _)) => materials.extend(mats),
+                Err(_) => warnings.push(format!("material library {} could not be read; materials ignored", full.display())),
+            },
+            Err(why) => warnings.push(format!("material library {why}; materials ignored")),
+        }
+    }
+    materials
+}
+
+/// `materials` as topovox's (colours, textures, cut-out masks, emission,
+/// roughness) into `app`; a texture that cannot be read is a warning.
+fn add_materials(materials: &[tobj::Material], res: &Resources, app: &mut Appearance, warnings: &mut Vec<String>) {
+    for (index, mat) in materials.iter().enumerate() {
+        let factor = mat.diffuse.unwrap_or([1.0; 3]);
+        let texture = mat.diffuse_texture.as_deref().filter(|t| !t.trim().is_empty()).and_then(|statement| {
+            let (reference, wrap) = crate::texture::parse_map_statement(statement);
+            match res.resolve(&reference).and_then(|path| crate::texture::load(&path, wrap)) {
+                Ok(t) => {
+                    app.textures.push(t);
+                    Some(app.textures.len() as u32 - 1)
+                }
+                Err(e) => {
+                    warnings.push(format!("material {:?}: {e}; its Kd colour is used instead", mat.name));
+                    None
+                }
+            }
+        });
+        let name = if mat.name.is_empty() { format!("material {index}") } else { mat.name.clone() };
+        // map_d: a cut-out mask (its alpha channel, or for an opaque
+        // image its red channel: masks are usually grey), moved into
+        // the alpha channel of its own texture.
+        let alpha_texture = mat.dissolve_texture.as_deref().filter(|t| !t.trim().is_empty()).and_then(|statement| {
+            let (reference, wrap) = crate::texture::parse_map_statement(statement);
+            match res.resolve(&reference).and_then(|path| crate::texture::load(&path, wrap)) {
+                Ok(mut t) => {
+                    if t.rgba.chunks_exact(4).all(|p| p[3] == 255) {
+                        t.rgba.chunks_exact_mut(4).for_each(|p| p[3] = p[0]);
+                    }
+                    app.textures.push(t);
+                    Some(app.textures.len() as u32 - 1)
+                }
+                Err(e) => {
+                    warnings.push(format!("material {name:?}: map_d {e}; the material is drawn opaque"));
+                    None
+                }
+            }
+        });
+        let see_through = texture.is_some_and(|t| app.textures[t as usize].rgba.chunks_exact(4).any(|p| p[3] < 255));
+        let alpha_cutoff = (alpha_texture.is_some() || see_through).then_some(0.5);
+        app.materials.push(Material {
+            name,
+            factor,
+            texture,
+            emission: obj_emission(mat),
+            roughness: obj_roughness(mat),
+            alpha_cutoff,
+            alpha_texture,
+        });
+    }
 }
 
 /// Cuts `bytes` into about `pieces` chunks (none shorter than

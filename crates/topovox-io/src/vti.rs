@@ -294,28 +294,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if origin.iter().any(|v| !v.is_finite()) || spacing.iter().any(|&v| !(v.is_finite() && v > 0.0)) {
         return Err(bad(format!("ImageData Origin {origin:?} and Spacing {spacing:?}: finite numbers, spacings above 0")));
     }
-    let cell_data = head.split("<CellData").nth(1).ok_or_else(|| bad("no <CellData> (voxels are cells)".into()))?;
-    let cell_data = cell_data.split("</CellData>").next().unwrap_or(cell_data);
-    let mut arrays: Vec<(String, String, usize, Vec<u8>)> = Vec::new();
-    for tag in cell_data.split("<DataArray").skip(1) {
-        let tag = tag.split('>').next().unwrap_or(tag);
-        let name = attr(tag, "Name").unwrap_or("").to_string();
-        let ty = attr(tag, "type").unwrap_or("").to_string();
-        let comps: u64 = attr(tag, "NumberOfComponents").and_then(|c| c.parse().ok()).unwrap_or(1);
-        let offset: usize =
-            attr(tag, "offset").and_then(|c| c.parse().ok()).ok_or_else(|| bad(format!("array {name:?} has no appended offset")))?;
-        let width = match ty.as_str() {
-            "UInt8" | "Int8" => 1,
-            "Int32" | "UInt32" | "Float32" => 4,
-            "Float64" | "Int64" | "UInt64" => 8,
-            t => return Err(ErrorKind::Unsupported(format!("{t} arrays in .vti"))),
-        };
-        let want = cells.checked_mul(comps * width).ok_or_else(|| bad("array size overflows".into()))?;
-        let raw =
-            decode(data.get(offset..).ok_or_else(|| bad(format!("array {name:?} starts past the end")))?, want, compressed, u64_header)
-                .map_err(bad)?;
-        arrays.push((name, ty, comps as usize, raw));
-    }
+    let arrays = cell_arrays(head, data, cells, compressed, u64_header)?;
     let occ = arrays.iter().find(|a| a.0 == "occupancy").or(arrays.first()).ok_or_else(|| bad("no cell arrays".into()))?;
     let mut bits = crate::dense_grid(dims)?;
     let (ow, ot) = (occ.3.len() / cells as usize / occ.2, occ.1.clone());
@@ -352,11 +331,51 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         let [i, j, kk] = attrs.voxel(*k);
         bits.set(i, j, kk);
     }
+    carried(&arrays, &mut attrs);
+    let placement = Some((DVec3::new(origin[0], origin[1], origin[2]), DVec3::new(spacing[0], spacing[1], spacing[2])));
+    Ok(LoadedVoxels { bits, placement, attributes: Some(attrs) })
+}
+
+/// One cell array: its name, type, components and raw bytes.
+type CellArray = (String, String, usize, Vec<u8>);
+
+/// The `<CellData>` arrays of the XML header `head`, each decoded from
+/// the appended `data` (`cells` values of its components).
+fn cell_arrays(head: &str, data: &[u8], cells: u64, compressed: bool, u64_header: bool) -> Result<Vec<CellArray>, ErrorKind> {
+    let bad = |m: String| ErrorKind::malformed("vti", m);
+    let cell_data = head.split("<CellData").nth(1).ok_or_else(|| bad("no <CellData> (voxels are cells)".into()))?;
+    let cell_data = cell_data.split("</CellData>").next().unwrap_or(cell_data);
+    let mut arrays: Vec<CellArray> = Vec::new();
+    for tag in cell_data.split("<DataArray").skip(1) {
+        let tag = tag.split('>').next().unwrap_or(tag);
+        let name = attr(tag, "Name").unwrap_or("").to_string();
+        let ty = attr(tag, "type").unwrap_or("").to_string();
+        let comps: u64 = attr(tag, "NumberOfComponents").and_then(|c| c.parse().ok()).unwrap_or(1);
+        let offset: usize =
+            attr(tag, "offset").and_then(|c| c.parse().ok()).ok_or_else(|| bad(format!("array {name:?} has no appended offset")))?;
+        let width = match ty.as_str() {
+            "UInt8" | "Int8" => 1,
+            "Int32" | "UInt32" | "Float32" => 4,
+            "Float64" | "Int64" | "UInt64" => 8,
+            t => return Err(ErrorKind::Unsupported(format!("{t} arrays in .vti"))),
+        };
+        let want = cells.checked_mul(comps * width).ok_or_else(|| bad("array size overflows".into()))?;
+        let raw =
+            decode(data.get(offset..).ok_or_else(|| bad(format!("array {name:?} starts past the end")))?, want, compressed, u64_header)
+                .map_err(bad)?;
+        arrays.push((name, ty, comps as usize, raw));
+    }
+    Ok(arrays)
+}
+
+/// The attribute arrays topovox writes (`colour`, `material`, `coverage`,
+/// `normal`), at `attrs`' voxels.
+fn carried(arrays: &[CellArray], attrs: &mut VoxelAttributes) {
     let at = |name: &str, ty: &str, comps: usize| arrays.iter().find(|a| a.0 == name && a.1 == ty && a.2 == comps).map(|a| &a.3);
     if let Some(c) = at("colour", "UInt8", 3) {
         attrs.colour = Some(attrs.keys.iter().map(|&k| [0, 1, 2].map(|a| c[3 * k as usize + a])).collect());
     }
-    let f32_at = |buf: &Vec<u8>, i: usize| f32::from_le_bytes([buf[4 * i], buf[4 * i + 1], buf[4 * i + 2], buf[4 * i + 3]]);
+    let f32_at = |buf: &[u8], i: usize| f32::from_le_bytes([buf[4 * i], buf[4 * i + 1], buf[4 * i + 2], buf[4 * i + 3]]);
     if let Some(m) = at("material", "Int32", 1) {
         attrs.material = Some(
             attrs
@@ -373,8 +392,6 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
     if let Some(n) = at("normal", "Float32", 3) {
         attrs.normal = Some(attrs.keys.iter().map(|&k| [0, 1, 2].map(|a| f32_at(n, 3 * k as usize + a))).collect());
     }
-    let placement = Some((DVec3::new(origin[0], origin[1], origin[2]), DVec3::new(spacing[0], spacing[1], spacing[2])));
-    Ok(LoadedVoxels { bits, placement, attributes: Some(attrs) })
 }
 
 /// One appended array: `want` bytes after its header.
