@@ -299,16 +299,7 @@ fn read_into<R: Read + Seek>(r: R, total: u64, sparse: bool) -> Result<(Read3, O
         None => None,
     };
     // Indices come in chunks; without dims the grid is sized after reading them all.
-    let mut sink = match dims {
-        Some(d) if sparse => {
-            if d.iter().any(|&x| x > SparseBricks::MAX_DIM) {
-                return Err(ErrorKind::malformed(FORMAT, format!("grid dims {d:?} beyond {} voxels per axis", SparseBricks::MAX_DIM)));
-            }
-            Sink::Bricks(Bricks::default())
-        }
-        Some(d) => Sink::Dense(crate::dense_grid(d)?),
-        None => Sink::Unsized(Bricks::default(), [1; 3]),
-    };
+    let mut sink = sink_for(dims, sparse)?;
     let mut left = k as usize;
     while left > 0 {
         let n = left.min(1 << 16);
@@ -336,7 +327,27 @@ fn read_into<R: Read + Seek>(r: R, total: u64, sparse: bool) -> Result<(Read3, O
         }
         left -= n;
     }
-    let grid = match sink {
+    Ok((finish(sink, dims, sparse)?, placement_of(origin, size)?))
+}
+
+/// Where the indices go: a dense grid, bricks of known dims, or bricks
+/// whose dims grow with the indices.
+fn sink_for(dims: Option<[u32; 3]>, sparse: bool) -> Result<Sink, ErrorKind> {
+    Ok(match dims {
+        Some(d) if sparse => {
+            if d.iter().any(|&x| x > SparseBricks::MAX_DIM) {
+                return Err(ErrorKind::malformed(FORMAT, format!("grid dims {d:?} beyond {} voxels per axis", SparseBricks::MAX_DIM)));
+            }
+            Sink::Bricks(Bricks::default())
+        }
+        Some(d) => Sink::Dense(crate::dense_grid(d)?),
+        None => Sink::Unsized(Bricks::default(), [1; 3]),
+    })
+}
+
+/// The grid the indices made.
+fn finish(sink: Sink, dims: Option<[u32; 3]>, sparse: bool) -> Result<Read3, ErrorKind> {
+    Ok(match sink {
         Sink::Dense(b) => Read3::Dense(b),
         Sink::Bricks(b) => Read3::Sparse(SparseBricks::from_parts(dims.expect("bricks need dims"), b.into_parts(), Vec::new())),
         Sink::Unsized(bricks, d) => {
@@ -349,14 +360,17 @@ fn read_into<R: Read + Seek>(r: R, total: u64, sparse: bool) -> Result<(Read3, O
                 Read3::Dense(b)
             }
         }
-    };
-    let placement = match (origin, size) {
+    })
+}
+
+/// The recorded origin and voxel size, both or neither.
+fn placement_of(origin: Option<Vec<f64>>, size: Option<Vec<f64>>) -> Result<Option<(DVec3, DVec3)>, ErrorKind> {
+    Ok(match (origin, size) {
         (Some(o), Some(s)) if o.iter().all(|c| c.is_finite()) && s.iter().all(|&v| v.is_finite() && v > 0.0) => {
             let s = if s.len() == 3 { DVec3::new(s[0], s[1], s[2]) } else { DVec3::splat(s[0]) };
             Some((DVec3::new(o[0], o[1], o[2]), s))
         }
         (None, None) => None,
         _ => return Err(ErrorKind::malformed(FORMAT, "origin and voxel_size must both be finite, the size positive")),
-    };
-    Ok((grid, placement))
+    })
 }

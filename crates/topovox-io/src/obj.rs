@@ -389,20 +389,9 @@ fn parse_chunk(chunk: &[u8], before: Counts, own: &Counts, appearance: bool) -> 
         let (key, rest) = keyword(line);
         match key {
             b"v" => {
-                let mut c = [0.0f64; 7];
-                let mut k = 0;
-                for w in words(rest) {
-                    if k == 7 {
-                        return Err(bad(n, "a vertex with more than 7 numbers".into()));
-                    }
-                    c[k] = number(w).ok_or_else(|| bad(n, format!("bad number {} in 'v'", quoted(&String::from_utf8_lossy(w)))))?;
-                    k += 1;
-                }
-                if k < 3 {
-                    return Err(bad(n, "a vertex needs 3 coordinates".into()));
-                }
-                out.positions.push(DVec3::new(c[0], c[1], c[2]));
-                out.colours.push((k == 6).then(|| [3, 4, 5].map(|a| (c[a].clamp(0.0, 1.0) * 255.0).round() as u8)));
+                let (p, colour) = vertex(rest).map_err(|w| bad(n, w))?;
+                out.positions.push(p);
+                out.colours.push(colour);
             }
             b"vt" => {
                 let mut c = [0.0f32; 2];
@@ -412,29 +401,8 @@ fn parse_chunk(chunk: &[u8], before: Counts, own: &Counts, appearance: bool) -> 
                 out.texcoords.push(c);
             }
             b"f" | b"l" => {
-                poly.clear();
-                let (nv, nvt) = (before.v + out.positions.len() as i64, before.vt + out.texcoords.len() as i64);
-                for w in words(rest) {
-                    let mut parts = w.split(|&b| b == b'/');
-                    let vi = parts
-                        .next()
-                        .and_then(index)
-                        .ok_or_else(|| bad(n, format!("bad vertex index {}", quoted(&String::from_utf8_lossy(w)))))?;
-                    let vt = match parts.next() {
-                        Some(t) if !t.is_empty() => {
-                            index(t).ok_or_else(|| bad(n, format!("bad texture index {}", quoted(&String::from_utf8_lossy(w)))))?
-                        }
-                        _ => 0,
-                    };
-                    let resolve = |i: i64, count: i64, what: &str| match i {
-                        0 => Err(bad(n, format!("{what} index 0 (OBJ indices start at 1)"))),
-                        i if i > 0 => Ok(i - 1),
-                        i => Ok(count + i),
-                    };
-                    let v = resolve(vi, nv, "vertex")?;
-                    let t = if vt == 0 { -1 } else { resolve(vt, nvt, "texture")? };
-                    poly.push((v, t));
-                }
+                let counts = (before.v + out.positions.len() as i64, before.vt + out.texcoords.len() as i64);
+                polygon(rest, counts, &mut poly).map_err(|w| bad(n, w))?;
                 if key == b"f" {
                     if poly.len() < 3 {
                         return Err(bad(n, "a face needs at least 3 vertices".into()));
@@ -486,6 +454,47 @@ fn parse_chunk(chunk: &[u8], before: Counts, own: &Counts, appearance: bool) -> 
         }
     }
     Ok(out)
+}
+
+/// A `v` line's rest: the position, and the colour when it has six numbers.
+fn vertex(rest: &[u8]) -> Result<(DVec3, Option<[u8; 3]>), String> {
+    let mut c = [0.0f64; 7];
+    let mut k = 0;
+    for w in words(rest) {
+        if k == 7 {
+            return Err("a vertex with more than 7 numbers".into());
+        }
+        c[k] = number(w).ok_or_else(|| format!("bad number {} in 'v'", quoted(&String::from_utf8_lossy(w))))?;
+        k += 1;
+    }
+    if k < 3 {
+        return Err("a vertex needs 3 coordinates".into());
+    }
+    Ok((DVec3::new(c[0], c[1], c[2]), (k == 6).then(|| [3, 4, 5].map(|a| (c[a].clamp(0.0, 1.0) * 255.0).round() as u8))))
+}
+
+/// An `f` or `l` line's rest into `poly`: 0-based vertex and texture
+/// indices (texture −1 when absent); negative indices count back from the
+/// `(vertices, texture coordinates)` read so far.
+fn polygon(rest: &[u8], (nv, nvt): (i64, i64), poly: &mut Vec<(i64, i64)>) -> Result<(), String> {
+    poly.clear();
+    for w in words(rest) {
+        let mut parts = w.split(|&b| b == b'/');
+        let vi = parts.next().and_then(index).ok_or_else(|| format!("bad vertex index {}", quoted(&String::from_utf8_lossy(w))))?;
+        let vt = match parts.next() {
+            Some(t) if !t.is_empty() => index(t).ok_or_else(|| format!("bad texture index {}", quoted(&String::from_utf8_lossy(w))))?,
+            _ => 0,
+        };
+        let resolve = |i: i64, count: i64, what: &str| match i {
+            0 => Err(format!("{what} index 0 (OBJ indices start at 1)")),
+            i if i > 0 => Ok(i - 1),
+            i => Ok(count + i),
+        };
+        let v = resolve(vi, nv, "vertex")?;
+        let t = if vt == 0 { -1 } else { resolve(vt, nvt, "texture")? };
+        poly.push((v, t));
+    }
+    Ok(())
 }
 
 /// A material's `Ke` (emitted colour), non-negative; zero when absent or not finite.

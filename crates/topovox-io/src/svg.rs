@@ -311,6 +311,54 @@ fn check_depth(doc: &roxmltree::Document<'_>) -> Result<(), ErrorKind> {
     Ok(())
 }
 
+/// A `<path>`'s `d` as pieces, each point mapped by `p`.
+fn path_pieces(d: &str, p: &impl Fn(f64, f64) -> DVec2) -> Result<Vec<Piece>, ErrorKind> {
+    check_path_numbers(d)?;
+    let mut pieces = Vec::new();
+    // The current point and the subpath's start, in plane coordinates.
+    let (mut at, mut start) = (DVec2::ZERO, DVec2::ZERO);
+    for seg in svgtypes::SimplifyingPathParser::from(d) {
+        let seg = seg.map_err(|e| ErrorKind::malformed("SVG", format!("<path> d: {e}")))?;
+        use svgtypes::SimplePathSegment as S;
+        let piece = match seg {
+            S::MoveTo { x, y } => {
+                start = p(x, y);
+                Piece::Move(start)
+            }
+            S::LineTo { x, y } => Piece::Line(p(x, y)),
+            S::CurveTo { x1, y1, x2, y2, x, y } => Piece::Cubic(p(x1, y1), p(x2, y2), p(x, y)),
+            S::Quadratic { x1, y1, x, y } => {
+                // Elevated to a cubic from the current point.
+                let (q, end) = (p(x1, y1), p(x, y));
+                Piece::Cubic(at + (q - at) * (2.0 / 3.0), end + (q - end) * (2.0 / 3.0), end)
+            }
+            S::ClosePath => Piece::Close,
+        };
+        at = match &piece {
+            Piece::Move(a) | Piece::Line(a) | Piece::Cubic(_, _, a) => *a,
+            Piece::Close => start,
+        };
+        pieces.push(piece);
+    }
+    Ok(pieces)
+}
+
+/// An ellipse of centre `c` and radii `r` as four cubic quarter arcs
+/// (kappa = 0.5523), flattened like paths; points mapped by `p`.
+fn ellipse_pieces(c: DVec2, r: DVec2, p: &impl Fn(f64, f64) -> DVec2) -> Vec<Piece> {
+    let k = 0.552_284_749_830_793_4;
+    let (cx, cy, rx, ry) = (c.x, c.y, r.x, r.y);
+    let q = |ax: f64, ay: f64| p(cx + ax, cy + ay);
+    vec![
+        Piece::Move(q(rx, 0.0)),
+        Piece::Cubic(q(rx, k * ry), q(k * rx, ry), q(0.0, ry)),
+        Piece::Cubic(q(-k * rx, ry), q(-rx, k * ry), q(-rx, 0.0)),
+        Piece::Cubic(q(-rx, -k * ry), q(-k * rx, -ry), q(0.0, -ry)),
+        Piece::Cubic(q(k * rx, -ry), q(rx, -k * ry), q(rx, 0.0)),
+        Piece::Close,
+    ]
+}
+
 /// Reads the drawn elements under `node`, with the transform and painting
 /// its parent passes on.
 fn walk(
@@ -342,37 +390,7 @@ fn walk(
     let m = parent.then(local);
     let p = |x: f64, y: f64| m.apply(DVec2::new(x, y));
     match name {
-        "path" => {
-            let d = node.attribute("d").unwrap_or("");
-            check_path_numbers(d)?;
-            let mut pieces = Vec::new();
-            // The current point and the subpath's start, in plane coordinates.
-            let (mut at, mut start) = (DVec2::ZERO, DVec2::ZERO);
-            for seg in svgtypes::SimplifyingPathParser::from(d) {
-                let seg = seg.map_err(|e| ErrorKind::malformed("SVG", format!("<path> d: {e}")))?;
-                use svgtypes::SimplePathSegment as S;
-                let piece = match seg {
-                    S::MoveTo { x, y } => {
-                        start = p(x, y);
-                        Piece::Move(start)
-                    }
-                    S::LineTo { x, y } => Piece::Line(p(x, y)),
-                    S::CurveTo { x1, y1, x2, y2, x, y } => Piece::Cubic(p(x1, y1), p(x2, y2), p(x, y)),
-                    S::Quadratic { x1, y1, x, y } => {
-                        // Elevated to a cubic from the current point.
-                        let (q, end) = (p(x1, y1), p(x, y));
-                        Piece::Cubic(at + (q - at) * (2.0 / 3.0), end + (q - end) * (2.0 / 3.0), end)
-                    }
-                    S::ClosePath => Piece::Close,
-                };
-                at = match &piece {
-                    Piece::Move(a) | Piece::Line(a) | Piece::Cubic(_, _, a) => *a,
-                    Piece::Close => start,
-                };
-                pieces.push(piece);
-            }
-            out.push(pieces);
-        }
+        "path" => out.push(path_pieces(node.attribute("d").unwrap_or(""), &p)?),
         "polyline" | "polygon" => {
             let pts: Vec<DVec2> = svgtypes::PointsParser::from(node.attribute("points").unwrap_or("")).map(|(x, y)| p(x, y)).collect();
             let mut pieces: Vec<Piece> =
@@ -408,17 +426,7 @@ fn walk(
             } else {
                 (number(node, "rx", 0.0)?, number(node, "ry", 0.0)?)
             };
-            // Four cubic quarter arcs (kappa = 0.5523), flattened like paths.
-            let k = 0.552_284_749_830_793_4;
-            let q = |ax: f64, ay: f64| p(cx + ax, cy + ay);
-            out.push(vec![
-                Piece::Move(q(rx, 0.0)),
-                Piece::Cubic(q(rx, k * ry), q(k * rx, ry), q(0.0, ry)),
-                Piece::Cubic(q(-k * rx, ry), q(-rx, k * ry), q(-rx, 0.0)),
-                Piece::Cubic(q(-rx, -k * ry), q(-k * rx, -ry), q(0.0, -ry)),
-                Piece::Cubic(q(k * rx, -ry), q(rx, -k * ry), q(rx, 0.0)),
-                Piece::Close,
-            ]);
+            out.push(ellipse_pieces(DVec2::new(cx, cy), DVec2::new(rx, ry), &p));
         }
         "use" => return Err(ErrorKind::Unsupported("<use> references (inline the referenced shapes)".into())),
         "text" | "image" | "foreignObject" => warnings.push(format!("<{name}> is not an outline; skipped")),
