@@ -32,7 +32,7 @@ fuzz_target!(
     if std::fs::write(&o, &text).is_err() || std::fs::write(&m, mtl).is_err() || std::fs::write(&t, png).is_err() {
         return;
     }
-    if let Ok(loaded) = topovox_io::read_mesh(&o) {
+    if let Ok(loaded) = topovox_io::read_mesh(&o, &topovox_io::ReadOptions::default()) {
         assert!(loaded.mesh.triangles.iter().flatten().all(|&i| (i as usize) < loaded.mesh.positions.len()));
         let root = std::fs::canonicalize(&dir).expect("folder");
         assert!(loaded.sources.iter().all(|s| s.starts_with(&root)), "read outside the folder: {:?}", loaded.sources);

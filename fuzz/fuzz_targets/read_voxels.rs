@@ -10,7 +10,7 @@ fuzz_target!(
     for f in
         [VoxelFormat::Npy, VoxelFormat::Binvox, VoxelFormat::Vox, VoxelFormat::Text, VoxelFormat::Schem, VoxelFormat::Vti, VoxelFormat::Ply, VoxelFormat::Vdb]
     {
-        let _ = topovox_io::read_voxels_bytes(data, f);
+        let _ = topovox_io::read_voxels_bytes(data, f, &topovox_io::ReadOptions::default());
     }
     }
 );

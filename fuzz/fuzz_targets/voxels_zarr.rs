@@ -11,7 +11,7 @@
 use libfuzzer_sys::fuzz_target;
 
 fn summary(dir: &std::path::Path) -> Option<String> {
-    let v = topovox_io::read_voxels(dir).ok()?;
+    let v = topovox_io::read_voxels(dir, &topovox_io::ReadOptions::default()).ok()?;
     let mut set = Vec::new();
     v.bits.for_each_set(|i, j, k| {
         if set.len() < 4096 {
@@ -29,8 +29,8 @@ fuzz_target!(init: topovox_fuzz::fence_panics(), |data: &[u8]| {
     for b in &baits {
         let _ = std::fs::write(b, vec![1u8; 4096]);
     }
-    let sparse = topovox_io::read_voxels_sparse(&dir, true).ok();
-    if let Ok(v) = topovox_io::read_voxels(&dir) {
+    let sparse = topovox_io::read_voxels_sparse(&dir, &topovox_io::ReadOptions { attributes: true, ..Default::default() }).ok();
+    if let Ok(v) = topovox_io::read_voxels(&dir, &topovox_io::ReadOptions::default()) {
         topovox_fuzz::check_loaded(&v, sparse.as_ref());
     }
     let with_bait = summary(&dir);

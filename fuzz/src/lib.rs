@@ -35,7 +35,7 @@ pub fn check_voxels(data: &[u8], format: VoxelFormat) {
         VoxelFormat::Npz => topovox_io::npz::read_sparse_from(std::io::Cursor::new(data), data.len() as u64).ok(),
         _ => None,
     };
-    let Ok(v) = topovox_io::read_voxels_bytes(data, format) else { return };
+    let Ok(v) = topovox_io::read_voxels_bytes(data, format, &topovox_io::ReadOptions::default()) else { return };
     check_loaded(&v, sparse.as_ref());
 }
 

@@ -760,8 +760,9 @@ pub(crate) fn load_voxels(
 ) -> PyResult<VoxelGrid> {
     let p = path.clone();
     let up = up_of(up)?;
-    let opts = topovox_io::ReadOptions { allow_external_paths };
-    let loaded = crate::interrupt::interruptible_read(py, move || topovox_io::read_voxels_opts(&p, up, &opts))?.map_err(io_err)?;
+    let opts = topovox_io::ReadOptions { allow_external_paths, ..Default::default() };
+    let loaded = crate::interrupt::interruptible_read(py, move || topovox_io::read_voxels(&p, &topovox_io::ReadOptions { up, ..opts }))?
+        .map_err(io_err)?;
     let dims = loaded.bits.dims();
     let o = match origin {
         Some(o) if o.len() == 3 => DVec3::new(o[0], o[1], o[2]),

@@ -255,7 +255,7 @@ impl Mesh {
 #[pyo3(signature = (path, allow_external_paths=false))]
 pub(crate) fn load_mesh(py: Python<'_>, path: PathBuf, allow_external_paths: bool) -> PyResult<Mesh> {
     let p = path.clone();
-    let read = move || topovox_io::read_mesh_with(&p, &topovox_io::ReadOptions { allow_external_paths });
+    let read = move || topovox_io::read_mesh(&p, &topovox_io::ReadOptions { allow_external_paths, ..Default::default() });
     let loaded = crate::interrupt::interruptible_read(py, read)?.map_err(io_err)?;
     Ok(Mesh { inner: Arc::new(loaded), path: Some(path) })
 }

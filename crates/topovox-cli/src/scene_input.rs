@@ -16,7 +16,7 @@ const VOXEL_COLOUR: [f32; 3] = [0.72, 0.72, 0.70];
 /// voxel `(i, j, k)` at `(i, j, k)`), moved by `offset`.
 pub fn add_voxel_file(scene: &mut Scene, path: &Path, up: Option<topovox_io::orient::Up>, offset: Vec3) -> Result<()> {
     let upname = up.unwrap_or_default();
-    let loaded = topovox_io::read_voxels_with(path, upname)?;
+    let loaded = topovox_io::read_voxels(path, &topovox_io::ReadOptions { up: upname, ..Default::default() })?;
     let (origin, size) = loaded.placement.map(|(o, s)| (o.as_vec3(), s.as_vec3())).unwrap_or((Vec3::ZERO, Vec3::ONE));
     add_voxels(scene, &loaded.bits, origin + offset, size);
     Ok(())
@@ -43,7 +43,7 @@ pub fn load_scene(
         add_voxel_file(&mut scene, input, up, Vec3::ZERO)?;
         return Ok((scene, "voxel file"));
     }
-    let loaded = topovox_io::read_mesh_with(input, &topovox_io::ReadOptions { allow_external_paths })?;
+    let loaded = topovox_io::read_mesh(input, &topovox_io::ReadOptions { allow_external_paths, ..Default::default() })?;
     for out in outputs {
         topovox_io::atomic::refuse_overwriting_inputs(out, &loaded.sources)?;
     }

@@ -181,7 +181,7 @@ fn voxel_meshes_are_watertight_by_default_and_triangulate_on_request() {
     // GLB too.
     let glb = d.join("t.glb");
     ok(topovox(&["voxelize", &bunny, "-o", s(&glb), "--resolution", "32", "--quiet"]));
-    let loaded = topovox_io::read_mesh(&glb).unwrap();
+    let loaded = topovox_io::read_mesh(&glb, &topovox_io::ReadOptions::default()).unwrap();
     let mut edges: HashMap<([i64; 3], [i64; 3]), usize> = HashMap::new();
     let key = |i: u32| loaded.mesh.positions[i as usize].to_array().map(|c| (c * 1e5).round() as i64);
     for t in &loaded.mesh.triangles {

@@ -22,7 +22,7 @@ fn main() {
         std::process::exit(2);
     }
     let target: usize = args[3].parse().expect("TRIANGLES is a count");
-    let loaded = topovox_io::read_mesh(std::path::Path::new(&args[1])).unwrap_or_else(|e| {
+    let loaded = topovox_io::read_mesh(std::path::Path::new(&args[1]), &topovox_io::ReadOptions::default()).unwrap_or_else(|e| {
         eprintln!("subdivide: {e}");
         std::process::exit(1)
     });

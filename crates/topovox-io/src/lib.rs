@@ -53,13 +53,13 @@ pub(crate) use budget::{dense_grid, read_limit};
 pub use error::{ErrorKind, IoError};
 pub use fence::{fenced, panic_is_fenced};
 pub use mesh_report::{validate_mesh, LoadedMesh, MeshReport};
-pub use meshes::{read_mesh, read_mesh_bytes, read_mesh_with, read_svg, MeshFormat};
+pub use meshes::{read_mesh, read_mesh_bytes, read_svg, MeshFormat};
 pub use png::{write_png, write_png_rgba};
 pub use resources::ReadOptions;
 pub(crate) use runs::runs;
 pub(crate) use spacing::half_diagonal;
 pub use spacing::{size_from_json, size_json};
 pub use voxels::{
-    is_voxel_file, read_voxels, read_voxels_bytes, read_voxels_bytes_with, read_voxels_opts, read_voxels_sparse, read_voxels_sparse_opts,
-    read_voxels_with, write_voxels, write_voxels_with, LoadedVoxels, SparseVoxels, VoxelFormat, WriteOptions,
+    is_voxel_file, read_voxels, read_voxels_bytes, read_voxels_sparse, write_voxels, write_voxels_with, LoadedVoxels, SparseVoxels,
+    VoxelFormat, WriteOptions,
 };

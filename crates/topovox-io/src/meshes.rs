@@ -42,14 +42,10 @@ impl MeshFormat {
 }
 
 /// Reads a mesh file, choosing the format from its extension; external
-/// files it names are read only from inside its folder.
-pub fn read_mesh(path: &Path) -> Result<LoadedMesh, IoError> {
-    read_mesh_with(path, &ReadOptions::default())
-}
-
-/// [`read_mesh`] with options (external paths allowed or not). The
-/// result's `sources` lists the mesh file and every file it led to.
-pub fn read_mesh_with(path: &Path, opts: &ReadOptions) -> Result<LoadedMesh, IoError> {
+/// files it names are read only from inside its folder unless
+/// `opts.allow_external_paths`. The result's `sources` lists the mesh file
+/// and every file it led to.
+pub fn read_mesh(path: &Path, opts: &ReadOptions) -> Result<LoadedMesh, IoError> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     let format = MeshFormat::from_extension(ext).ok_or_else(|| {
         IoError::new(path, ErrorKind::UnknownFormat { ext: ext.to_string(), expected: "obj, stl, ply, gltf, glb, off, lines" })

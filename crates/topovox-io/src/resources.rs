@@ -12,12 +12,20 @@
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-/// How mesh files are read.
+/// How files are read: one set of options for every reader
+/// ([`crate::read_mesh`], [`crate::read_voxels`], [`crate::read_voxels_sparse`],
+/// [`crate::read_voxels_bytes`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ReadOptions {
     /// Read external files a model names wherever they are (absolute paths,
-    /// `../` outside the model's folder, links leading out). Default: off.
+    /// `../` outside the model's folder, links leading out), and voxel
+    /// folders through links leading out. Default: off.
     pub allow_external_paths: bool,
+    /// The data's up axis: `.vox` and `.schem` files that record none are
+    /// rotated back by it. Default: y.
+    pub up: crate::orient::Up,
+    /// Sparse reads: the attribute grids or arrays too. Default: off.
+    pub attributes: bool,
 }
 
 /// The model's folder and the files read through it.

@@ -209,20 +209,12 @@ pub fn is_voxel_file(path: &Path) -> bool {
     }
 }
 
-/// Reads any voxel file topovox writes, choosing the format from the extension.
-pub fn read_voxels(path: &Path) -> Result<LoadedVoxels, IoError> {
-    read_voxels_with(path, orient::Up::default())
-}
-
-/// [`read_voxels`], `.vox` and `.schem` files without a recorded up axis
-/// being rotated back by `up` (see [`orient`]).
-pub fn read_voxels_with(path: &Path, up: orient::Up) -> Result<LoadedVoxels, IoError> {
-    read_voxels_opts(path, up, &ReadOptions::default())
-}
-
-/// [`read_voxels_with`]; `opts` says whether a voxel folder (`.zarr`) may
-/// be read through links that lead outside it.
-pub fn read_voxels_opts(path: &Path, up: orient::Up, opts: &ReadOptions) -> Result<LoadedVoxels, IoError> {
+/// Reads any voxel file topovox writes, choosing the format from the
+/// extension. `opts.up`: the data's up axis, by which `.vox` and `.schem`
+/// files that record none are rotated back (see [`orient`]);
+/// `opts.allow_external_paths`: whether a voxel folder (`.zarr`) may be
+/// read through links that lead outside it.
+pub fn read_voxels(path: &Path, opts: &ReadOptions) -> Result<LoadedVoxels, IoError> {
     let format = VoxelFormat::from_path(path).ok_or_else(|| {
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_string();
         IoError::new(path, ErrorKind::UnknownFormat { ext, expected: VoxelFormat::NAMES })
@@ -243,7 +235,7 @@ pub fn read_voxels_opts(path: &Path, up: orient::Up, opts: &ReadOptions) -> Resu
         return fence("voxel", || npz::read_from(std::io::BufReader::new(file), total)).map_err(|k| IoError::new(path, k));
     }
     let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
-    read_voxels_bytes_with(&bytes, format, up).map_err(|k| IoError::new(path, k))
+    read_voxels_bytes(&bytes, format, opts).map_err(|k| IoError::new(path, k))
 }
 
 /// Voxels read without a dense grid.
@@ -264,14 +256,11 @@ pub struct SparseVoxels {
 /// [`ErrorKind::TooLarge`]): memory follows the set voxels. Other formats
 /// are refused by name.
 ///
-/// With `attributes`, the attribute grids or arrays of a `.vdb` or `.zarr`
-/// written with `--attributes` are read too (about 32 bytes per set voxel).
-pub fn read_voxels_sparse(path: &Path, attributes: bool) -> Result<SparseVoxels, IoError> {
-    read_voxels_sparse_opts(path, attributes, &ReadOptions::default())
-}
-
-/// [`read_voxels_sparse`]; `opts` as for [`read_voxels_opts`].
-pub fn read_voxels_sparse_opts(path: &Path, attributes: bool, opts: &ReadOptions) -> Result<SparseVoxels, IoError> {
+/// With `opts.attributes`, the attribute grids or arrays of a `.vdb` or
+/// `.zarr` written with `--attributes` are read too (about 32 bytes per set
+/// voxel); `opts.allow_external_paths` as for [`read_voxels`].
+pub fn read_voxels_sparse(path: &Path, opts: &ReadOptions) -> Result<SparseVoxels, IoError> {
+    let attributes = opts.attributes;
     match VoxelFormat::from_path(path) {
         Some(VoxelFormat::Vdb) => {
             let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
@@ -287,14 +276,9 @@ pub fn read_voxels_sparse_opts(path: &Path, attributes: bool, opts: &ReadOptions
     }
 }
 
-/// Parses a voxel file from memory.
-pub fn read_voxels_bytes(bytes: &[u8], format: VoxelFormat) -> Result<LoadedVoxels, ErrorKind> {
-    read_voxels_bytes_with(bytes, format, orient::Up::default())
-}
-
-/// [`read_voxels_bytes`] with the up axis of `.vox` and `.schem` files that
-/// do not record one.
-pub fn read_voxels_bytes_with(bytes: &[u8], format: VoxelFormat, up: orient::Up) -> Result<LoadedVoxels, ErrorKind> {
+/// Parses a voxel file from memory (`opts.up` as for [`read_voxels`]).
+pub fn read_voxels_bytes(bytes: &[u8], format: VoxelFormat, opts: &ReadOptions) -> Result<LoadedVoxels, ErrorKind> {
+    let up = opts.up;
     fence("voxel", || match format {
         VoxelFormat::Npy | VoxelFormat::NpyBool => npy::read(bytes),
         VoxelFormat::Binvox => binvox::read(bytes),

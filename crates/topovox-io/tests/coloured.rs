@@ -44,14 +44,14 @@ fn vox_keeps_up_to_255_colours_exactly_and_quantizes_more() {
     let (b, a) = scene([300, 40, 30], 200, 5000);
     let p = tmp("c.vox");
     write_voxels_with(&p, VoxelFormat::Vox, &b, &grid, Some(&a), &WriteOptions::default()).unwrap();
-    let back = read_voxels(&p).unwrap();
+    let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert!(back.bits.first_difference(&b).is_none());
     assert_eq!(back.attributes.unwrap().colour, a.colour);
 
     let (b, a) = scene([50, 40, 30], 2000, 8000);
     for dither in [false, true] {
         write_voxels_with(&p, VoxelFormat::Vox, &b, &grid, Some(&a), &WriteOptions { dither, blocks: None, ..Default::default() }).unwrap();
-        let back = read_voxels(&p).unwrap().attributes.unwrap();
+        let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap().attributes.unwrap();
         let got: std::collections::HashSet<_> = back.colour.as_ref().unwrap().iter().copied().collect();
         let input: std::collections::HashSet<_> = a.colour.as_ref().unwrap().iter().copied().collect();
         assert!(got.len() <= 255 && got.len() > 100, "{}", got.len());
@@ -65,13 +65,13 @@ fn vti_round_trips_every_array() {
     let (b, a) = scene([37, 20, 9], 50, 900);
     let p = tmp("c.vti");
     write_voxels_with(&p, VoxelFormat::Vti, &b, &grid, Some(&a), &WriteOptions::default()).unwrap();
-    let back = read_voxels(&p).unwrap();
+    let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert!(back.bits.first_difference(&b).is_none());
     assert_eq!(back.placement, Some((grid.origin(), glam::DVec3::splat(0.25))));
     assert_eq!(back.attributes.unwrap(), a);
     // Without attributes: occupancy only.
     write_voxels_with(&p, VoxelFormat::Vti, &b, &grid, None, &WriteOptions::default()).unwrap();
-    let back = read_voxels(&p).unwrap();
+    let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert!(back.bits.first_difference(&b).is_none());
     assert!(back.attributes.unwrap().colour.is_none());
 }
@@ -83,11 +83,11 @@ fn ply_point_cloud_round_trips_voxels_and_colours() {
     let p = tmp("c.ply");
     write_voxels_with(&p, VoxelFormat::Ply, &b, &grid, Some(&a), &WriteOptions::default()).unwrap();
     assert!(topovox_io::is_voxel_file(&p));
-    let back = read_voxels(&p).unwrap();
+    let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert!(back.bits.first_difference(&b).is_none());
     assert_eq!(back.attributes.unwrap().colour, a.colour);
     // As a mesh file it is a point cloud without faces: not a surface.
-    assert!(topovox_io::read_mesh(&p).is_err());
+    assert!(topovox_io::read_mesh(&p, &topovox_io::ReadOptions::default()).is_err());
 }
 
 #[test]
@@ -102,7 +102,7 @@ fn schem_past_a_hundred_million_blocks_reads_back() {
     }
     let p = tmp("big.schem");
     write_voxels_with(&p, VoxelFormat::Schem, &b, &grid, None, &WriteOptions::default()).unwrap();
-    let back = read_voxels(&p).unwrap_or_else(|e| panic!("{e}"));
+    let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     assert!(back.bits.first_difference(&b).is_none());
     // Past 2³¹ − 1 blocks (NBT's longest array) nothing is written, in one line.
     let e = VoxelFormat::Schem.refuses_dims([2048, 2048, 513]).unwrap();
@@ -117,7 +117,7 @@ fn schem_is_valid_nbt_and_round_trips_voxels() {
     let (b, a) = scene([20, 12, 7], 40, 400);
     let p = tmp("c.schem");
     write_voxels_with(&p, VoxelFormat::Schem, &b, &grid, Some(&a), &WriteOptions::default()).unwrap();
-    let back = read_voxels(&p).unwrap();
+    let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert!(back.bits.first_difference(&b).is_none());
     // Every voxel became a block of the built-in table, nearest in colour.
     let table: std::collections::HashSet<[u8; 3]> = topovox_io::schem::BLOCKS.iter().map(|b| b.1).collect();
@@ -148,7 +148,7 @@ fn schem_is_valid_nbt_and_round_trips_voxels() {
     std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(&std::fs::read(&pz).unwrap()[..]), &mut nbt).unwrap();
     let fastnbt::Value::Compound(rz) = fastnbt::from_bytes::<fastnbt::Value>(&nbt).unwrap() else { panic!() };
     assert_eq!(rz.get("Height"), Some(&fastnbt::Value::Short(7)));
-    let back = topovox_io::read_voxels_with(&pz, topovox_io::orient::Up::X).unwrap();
+    let back = topovox_io::read_voxels(&pz, &topovox_io::ReadOptions { up: topovox_io::orient::Up::X, ..Default::default() }).unwrap();
     assert!(back.bits.first_difference(&b).is_none());
     // A user palette with two blocks: only those (and air) appear.
     let pal = tmp("blocks.txt");
@@ -210,7 +210,7 @@ fn coloured_greedy_meshes_load_in_gltf_and_tobj() {
         .collect();
     assert_eq!(colours.len(), palette.len());
     // The voxelized-back GLB (topovox's own reader, which uses the gltf crate) is the voxels again.
-    let loaded = topovox_io::read_mesh(&glb).unwrap();
+    let loaded = topovox_io::read_mesh(&glb, &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!(loaded.appearance.vertex_colour.len(), nv);
     let obj = tmp("m.obj");
     topovox_io::voxel_mesh::write_quads_obj(&obj, &quads, &grid, Some(&palette), &plain).unwrap();

@@ -30,8 +30,8 @@ fn set_voxels(v: &dyn VoxelSource) -> Vec<[u32; 3]> {
 /// Reads `name` and its recorded `.vti` and asserts they are the same grid.
 fn reads_as_recorded(name: &str) -> LoadedVoxels {
     let path = fixture(name);
-    let got = read_voxels(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
-    let want = read_voxels(Path::new(&format!("{}.vti", path.display()))).unwrap();
+    let got = read_voxels(&path, &topovox_io::ReadOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let want = read_voxels(Path::new(&format!("{}.vti", path.display())), &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!(got.bits.dims(), want.bits.dims(), "{name}: dims");
     assert!(got.bits.count() > 0, "{name}: no voxels");
     assert!(got.bits == want.bits, "{name}: voxels differ");
@@ -67,7 +67,8 @@ fn ply_point_cloud_with_voxkit_grid_comment_is_a_voxel_file() {
 fn vdb_with_voxkit_metadata_keeps_grid_and_attributes() {
     let got = reads_as_recorded("voxkit-spot.vdb");
     assert!(got.attributes.is_some(), "written with --attributes");
-    let sparse = read_voxels_sparse(&fixture("voxkit-spot.vdb"), true).unwrap();
+    let sparse =
+        read_voxels_sparse(&fixture("voxkit-spot.vdb"), &topovox_io::ReadOptions { attributes: true, ..Default::default() }).unwrap();
     assert_eq!(sparse.placement, got.placement);
     assert_eq!(sparse.bits.dims(), got.bits.dims());
     assert_eq!(set_voxels(&sparse.bits), set_voxels(&got.bits));
@@ -78,7 +79,7 @@ fn zarr_with_voxkit_attributes_keeps_its_placement() {
     for name in ["voxkit-box.zarr", "voxkit-spot.zarr"] {
         let got = reads_as_recorded(name);
         assert!(got.placement.is_some(), "{name}");
-        let sparse = read_voxels_sparse(&fixture(name), true).unwrap();
+        let sparse = read_voxels_sparse(&fixture(name), &topovox_io::ReadOptions { attributes: true, ..Default::default() }).unwrap();
         assert_eq!(sparse.placement, got.placement, "{name}");
         assert_eq!(set_voxels(&sparse.bits), set_voxels(&got.bits), "{name}");
     }

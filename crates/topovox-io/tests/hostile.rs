@@ -14,7 +14,7 @@ use std::time::Duration;
 
 use glam::DVec3;
 use topovox::{DenseBits, GridSpec};
-use topovox_io::{read_voxels, read_voxels_opts, read_voxels_sparse, write_voxels, ReadOptions, VoxelFormat};
+use topovox_io::{read_voxels, read_voxels_sparse, write_voxels, VoxelFormat};
 
 fn grid(dims: [u32; 3]) -> GridSpec {
     GridSpec::new(DVec3::ZERO, 1.0, dims.map(u64::from)).unwrap()
@@ -68,7 +68,10 @@ fn zarr_separator_that_climbs_out_is_refused() {
         v["codecs"] = serde_json::json!([{"name": "bytes"}]);
         v["chunk_grid"]["configuration"]["chunk_shape"] = serde_json::json!([64, 64, 64]);
     });
-    for e in [read_voxels(&a).unwrap_err().to_string(), read_voxels_sparse(&a, false).unwrap_err().to_string()] {
+    for e in [
+        read_voxels(&a, &topovox_io::ReadOptions::default()).unwrap_err().to_string(),
+        read_voxels_sparse(&a, &topovox_io::ReadOptions { attributes: false, ..Default::default() }).unwrap_err().to_string(),
+    ] {
         assert!(e.contains("separator") && e.contains("sep.zarr"), "{e}");
     }
 }
@@ -89,7 +92,7 @@ fn dot_separated_chunk_keys_still_read() {
     chunk[5] = 1; // (0, 1, 1) of chunk (1, 0, 0): voxel (2, 1, 1)
     std::fs::write(a.join("c.1.0.0"), &chunk).unwrap();
     std::fs::write(a.join("c.9.0.0"), &chunk).unwrap(); // not a chunk of this shape: ignored
-    let v = read_voxels(&a).unwrap();
+    let v = read_voxels(&a, &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!(v.bits.count(), 1);
     assert!(v.bits.get(2, 1, 1));
 }
@@ -102,22 +105,23 @@ fn links_inside_a_zarr_folder_do_not_lead_outside() {
     // A chunk file that is a link to another array's chunk.
     std::fs::remove_file(inside.join("c/0/0/0")).unwrap();
     std::os::unix::fs::symlink(other.join("c/0/0/0"), inside.join("c/0/0/0")).unwrap();
-    let e = read_voxels(&inside).unwrap_err().to_string();
+    let e = read_voxels(&inside, &topovox_io::ReadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("outside the Zarr folder") && e.contains("--allow-external-paths"), "{e}");
-    assert!(read_voxels_sparse(&inside, false).is_err());
+    assert!(read_voxels_sparse(&inside, &topovox_io::ReadOptions { attributes: false, ..Default::default() }).is_err());
     // Allowed, it reads the other array's voxels.
-    let v = read_voxels_opts(&inside, Default::default(), &ReadOptions { allow_external_paths: true }).unwrap();
+    let v = read_voxels(&inside, &topovox_io::ReadOptions { up: Default::default(), allow_external_paths: true, ..Default::default() })
+        .unwrap();
     assert_eq!(v.bits.count(), 2);
     // The whole `c/` folder as a link.
     std::fs::remove_dir_all(inside.join("c")).unwrap();
     std::os::unix::fs::symlink(other.join("c"), inside.join("c")).unwrap();
-    assert!(read_voxels(&inside).unwrap_err().to_string().contains("outside the Zarr folder"));
+    assert!(read_voxels(&inside, &topovox_io::ReadOptions::default()).unwrap_err().to_string().contains("outside the Zarr folder"));
     // An attribute array of a group pointing at another array.
     let group = d.join("group.zarr");
     std::fs::create_dir_all(&group).unwrap();
     std::fs::write(group.join("zarr.json"), br#"{"zarr_format": 3, "node_type": "group", "attributes": {}}"#).unwrap();
     std::os::unix::fs::symlink(&other, group.join("voxels")).unwrap();
-    assert!(read_voxels(&group).unwrap_err().to_string().contains("outside the Zarr folder"));
+    assert!(read_voxels(&group, &topovox_io::ReadOptions::default()).unwrap_err().to_string().contains("outside the Zarr folder"));
 }
 
 #[test]
@@ -127,20 +131,24 @@ fn special_files_inside_a_zarr_folder_are_not_read() {
     std::fs::remove_file(a.join("c/0/0/0")).unwrap();
     mkfifo(&a.join("c/0/0/0"));
     let p = a.clone();
-    let e = within_a_minute(move || read_voxels(&p).map(|_| ()).unwrap_err().to_string());
+    let e = within_a_minute(move || read_voxels(&p, &topovox_io::ReadOptions::default()).map(|_| ()).unwrap_err().to_string());
     assert!(e.contains("not a regular file"), "{e}");
     // A device (an endless stream of zeros) as a chunk, and as zarr.json.
     std::fs::remove_file(a.join("c/0/0/0")).unwrap();
     std::os::unix::fs::symlink("/dev/zero", a.join("c/0/0/0")).unwrap();
     let p = a.clone();
     let e = within_a_minute(move || {
-        read_voxels_opts(&p, Default::default(), &ReadOptions { allow_external_paths: true }).unwrap_err().to_string()
+        read_voxels(&p, &topovox_io::ReadOptions { up: Default::default(), allow_external_paths: true, ..Default::default() })
+            .unwrap_err()
+            .to_string()
     });
     assert!(e.contains("not a regular file"), "{e}");
     std::fs::remove_file(a.join("zarr.json")).unwrap();
     mkfifo(&a.join("zarr.json"));
     let p = a.clone();
-    let e = within_a_minute(move || read_voxels_sparse(&p, false).unwrap_err().to_string());
+    let e = within_a_minute(move || {
+        read_voxels_sparse(&p, &topovox_io::ReadOptions { attributes: false, ..Default::default() }).unwrap_err().to_string()
+    });
     assert!(e.contains("not a regular file"), "{e}");
 }
 
@@ -150,7 +158,7 @@ fn an_mtllib_that_is_a_fifo_is_a_warning_not_a_hang() {
     mkfifo(&d.join("m.mtl"));
     std::fs::write(d.join("a.obj"), "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let p = d.join("a.obj");
-    let loaded = within_a_minute(move || topovox_io::read_mesh(&p)).unwrap();
+    let loaded = within_a_minute(move || topovox_io::read_mesh(&p, &topovox_io::ReadOptions::default())).unwrap();
     assert!(loaded.warnings.iter().any(|w| w.contains("not a regular file")), "{:?}", loaded.warnings);
 }
 
@@ -160,7 +168,7 @@ fn a_zarr_claiming_a_vast_grid_reads_only_what_it_stores() {
     let a = zarr_array(&d, "vast", [64, 64, 64]);
     // A billion chunks claimed, one stored.
     edit_json(&a, |v| v["shape"] = serde_json::json!([65536, 65536, 65536]));
-    let s = read_voxels_sparse(&a, false).unwrap();
+    let s = read_voxels_sparse(&a, &topovox_io::ReadOptions { attributes: false, ..Default::default() }).unwrap();
     assert_eq!(s.bits.dims(), [65536, 65536, 65536]);
     assert_eq!(s.bits.count(), 2);
 }
@@ -188,10 +196,10 @@ fn writing_over_a_zarr_folder_that_is_not_ours_is_refused() {
     // Our own array, and an empty folder, are replaced.
     std::fs::remove_file(ours.join("notes.txt")).unwrap();
     write_voxels(&ours, VoxelFormat::Zarr, &some_voxels([9, 9, 9]), &grid([9, 9, 9])).unwrap();
-    assert_eq!(read_voxels(&ours).unwrap().bits.dims(), [9, 9, 9]);
+    assert_eq!(read_voxels(&ours, &topovox_io::ReadOptions::default()).unwrap().bits.dims(), [9, 9, 9]);
     std::fs::create_dir_all(d.join("empty.zarr")).unwrap();
     write_voxels(&d.join("empty.zarr"), VoxelFormat::Zarr, &some_voxels([8, 8, 8]), &grid([8, 8, 8])).unwrap();
-    assert_eq!(read_voxels(&d.join("empty.zarr")).unwrap().bits.count(), 2);
+    assert_eq!(read_voxels(&d.join("empty.zarr"), &topovox_io::ReadOptions::default()).unwrap().bits.count(), 2);
     assert_eq!(leftovers(&d), Vec::<String>::new());
 }
 
@@ -272,12 +280,12 @@ fn a_killed_runs_hidden_zarr_array_is_put_back_by_the_next_write() {
     std::fs::create_dir(&mine).unwrap();
     topovox_io::atomic::recover_replaced(&out);
     assert!(!aside.exists());
-    assert_eq!(read_voxels(&out).unwrap().bits.count(), some_voxels([8, 8, 8]).count());
+    assert_eq!(read_voxels(&out, &topovox_io::ReadOptions::default()).unwrap().bits.count(), some_voxels([8, 8, 8]).count());
     // Left beside a complete new output, the old one is removed; a write
     // does both first, then replaces the output.
     std::fs::create_dir(&aside).unwrap();
     write_voxels(&out, VoxelFormat::Zarr, &some_voxels([9, 9, 9]), &grid([9, 9, 9])).unwrap();
-    assert_eq!(read_voxels(&out).unwrap().bits.dims(), [9, 9, 9]);
+    assert_eq!(read_voxels(&out, &topovox_io::ReadOptions::default()).unwrap().bits.dims(), [9, 9, 9]);
     std::fs::remove_dir(&mine).unwrap();
     assert_eq!(leftovers(&d), Vec::<String>::new());
 }
@@ -295,7 +303,7 @@ fn a_vdb_whose_tiles_cover_more_than_a_billion_voxels_reads_back() {
     let out = d.join("solid.vdb");
     write_voxels(&out, VoxelFormat::Vdb, &solid, &grid([n; 3])).unwrap();
     assert!(std::fs::metadata(&out).unwrap().len() < 1 << 20, "tiles, not leaves");
-    let back = read_voxels(&out).unwrap();
+    let back = read_voxels(&out, &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!((back.bits.dims(), back.bits.count()), ([n; 3], (n as u64).pow(3)));
 }
 
@@ -312,17 +320,17 @@ fn errors_and_warnings_quote_a_short_prefix_of_the_input() {
     let text = d.join("t.txt");
     std::fs::write(&text, format!("# dims 4 4 4\n{long}\n")).unwrap();
     for p in [&binvox, &obj_number, &text] {
-        let e = match topovox_io::read_voxels(p) {
+        let e = match topovox_io::read_voxels(p, &topovox_io::ReadOptions::default()) {
             Err(e) => e.to_string(),
-            Ok(_) => topovox_io::read_mesh(p).unwrap_err().to_string(),
+            Ok(_) => topovox_io::read_mesh(p, &topovox_io::ReadOptions::default()).unwrap_err().to_string(),
         };
         assert!(e.len() < 500, "{}: {} bytes: {}", p.display(), e.len(), &e[..200]);
     }
-    let e = topovox_io::read_mesh(&obj_number).unwrap_err().to_string();
+    let e = topovox_io::read_mesh(&obj_number, &topovox_io::ReadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("bad number \"1111") && e.contains("bytes)"), "{e}");
     let mtl = d.join("m.obj");
     std::fs::write(&mtl, format!("mtllib {}.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "a".repeat(1 << 20))).unwrap();
-    let m = topovox_io::read_mesh(&mtl).unwrap();
+    let m = topovox_io::read_mesh(&mtl, &topovox_io::ReadOptions::default()).unwrap();
     assert!(
         !m.warnings.is_empty() && m.warnings.iter().all(|w| w.len() < 500),
         "{:?}",
@@ -348,8 +356,8 @@ fn a_vti_with_a_bad_spacing_is_refused_not_read_as_unit_cubes() {
         b.extend(format!("Spacing=\"{bad}\"").as_bytes());
         b.extend(&bytes[at + find.len()..]);
         std::fs::write(&p, b).unwrap();
-        let e = read_voxels(&p).unwrap_err().to_string();
+        let e = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap_err().to_string();
         assert!(e.contains("Spacing") && e.lines().count() == 1, "{bad}: {e}");
     }
-    assert!(read_voxels(&good).unwrap().placement.is_some());
+    assert!(read_voxels(&good, &topovox_io::ReadOptions::default()).unwrap().placement.is_some());
 }

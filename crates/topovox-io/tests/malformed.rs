@@ -11,7 +11,7 @@ fn malformed_corpus_is_rejected_with_clear_errors() {
     assert!(entries.len() >= 30, "corpus missing");
     for path in entries {
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        match topovox_io::read_mesh(&path) {
+        match topovox_io::read_mesh(&path, &topovox_io::ReadOptions::default()) {
             Ok(m) => panic!("{name}: accepted ({} triangles)", m.report.triangles),
             Err(e) => {
                 let msg = e.to_string();
@@ -28,9 +28,9 @@ fn malformed_corpus_is_rejected_with_clear_errors() {
 
 #[test]
 fn missing_file_and_unknown_extension() {
-    let e = topovox_io::read_mesh(std::path::Path::new("/nonexistent/dir/mesh.obj")).unwrap_err();
+    let e = topovox_io::read_mesh(std::path::Path::new("/nonexistent/dir/mesh.obj"), &topovox_io::ReadOptions::default()).unwrap_err();
     assert!(e.to_string().contains("/nonexistent/dir/mesh.obj: cannot read"), "{e}");
-    let e = topovox_io::read_mesh(std::path::Path::new("mesh.xyz")).unwrap_err();
+    let e = topovox_io::read_mesh(std::path::Path::new("mesh.xyz"), &topovox_io::ReadOptions::default()).unwrap_err();
     assert!(e.to_string().contains("unknown file extension"), "{e}");
 }
 
@@ -63,7 +63,7 @@ fn random_bytes_never_panic_any_reader() {
                 VoxelFormat::Ply,
                 VoxelFormat::Npz,
             ] {
-                let _ = read_voxels_bytes(&bytes, f);
+                let _ = read_voxels_bytes(&bytes, f, &topovox_io::ReadOptions::default());
             }
         }
     }
@@ -81,7 +81,7 @@ fn voxel_files_claiming_grids_beyond_memory_are_refused() {
     let binvox = dir.join("huge.binvox");
     std::fs::write(&binvox, b"#binvox 1\ndim 60000 60000 60000\ntranslate 0 0 0\nscale 1\ndata\n\x00\xff").unwrap();
     for p in [txt, binvox] {
-        let e = topovox_io::read_voxels(&p).unwrap_err().to_string();
+        let e = topovox_io::read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap_err().to_string();
         assert!(e.contains("of memory") || e.contains("malformed"), "{}: {e}", p.display());
         assert!(e.contains(&p.file_name().unwrap().to_string_lossy().into_owned()), "{e}");
     }

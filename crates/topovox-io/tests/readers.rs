@@ -34,7 +34,7 @@ fn shared(name: &str) -> PathBuf {
 #[test]
 fn obj_polygons_are_fanned_and_negative_indices_resolved() {
     let p = write("quad.obj", b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf -5 -4 -3 -2\nf 1 2 5\n");
-    let m = read_mesh(&p).unwrap();
+    let m = read_mesh(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!(m.report.triangles, 3);
     assert_eq!(m.mesh.triangles[0], [0, 1, 2]);
     assert_eq!(m.mesh.triangles[1], [0, 2, 3]);
@@ -44,14 +44,14 @@ fn obj_polygons_are_fanned_and_negative_indices_resolved() {
 
 #[test]
 fn obj_with_missing_mtl_warns() {
-    let m = read_mesh(&shared("beetle.obj")).unwrap();
+    let m = read_mesh(&shared("beetle.obj"), &topovox_io::ReadOptions::default()).unwrap();
     assert!(m.report.triangles >= 2053, "{}", m.report.triangles);
     assert!(m.warnings.iter().any(|w| w.contains(".mtl")), "{:?}", m.warnings);
 }
 
 #[test]
 fn suzanne_quads_become_triangles() {
-    let m = read_mesh(&shared("suzanne.obj")).unwrap();
+    let m = read_mesh(&shared("suzanne.obj"), &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!(m.report.vertices, 507);
     assert!(m.report.triangles > 500, "{}", m.report.triangles);
 }
@@ -81,8 +81,8 @@ fn stl_ascii_and_binary_agree() {
         bin.extend([0u8; 2]);
     }
     ascii += "endsolid cube\n";
-    let a = read_mesh(&write("cube_ascii.stl", ascii.as_bytes())).unwrap();
-    let b = read_mesh(&write("cube_bin.stl", &bin)).unwrap();
+    let a = read_mesh(&write("cube_ascii.stl", ascii.as_bytes()), &topovox_io::ReadOptions::default()).unwrap();
+    let b = read_mesh(&write("cube_bin.stl", &bin), &topovox_io::ReadOptions::default()).unwrap();
     for m in [&a, &b] {
         assert_eq!(m.report.triangles, 12);
         assert_eq!(m.report.vertices, 8);
@@ -118,7 +118,7 @@ fn ply_ascii_and_binary_with_polygons() {
         be.extend(i.to_be_bytes());
     }
     for (name, bytes) in [("a.ply", ascii.into_bytes()), ("le.ply", le), ("be.ply", be)] {
-        let m = read_mesh(&write(name, &bytes)).unwrap_or_else(|e| panic!("{e}"));
+        let m = read_mesh(&write(name, &bytes), &topovox_io::ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(m.mesh.triangles, vec![[0, 1, 2], [0, 2, 3]], "{name}");
         assert_eq!(m.report.bounds.max, DVec3::new(1.0, 1.0, 0.5), "{name}");
     }
@@ -159,7 +159,7 @@ fn ply_triangle_strips_read_as_their_triangles() {
     // The same closed, outward surface (the quads' diagonals may differ):
     // 12 triangles, every edge used once each way, volume +1.
     for (name, text) in [("faces.ply", faces), ("strips.ply", strips)] {
-        let m = read_mesh(&write(name, text.as_bytes())).unwrap_or_else(|e| panic!("{e}"));
+        let m = read_mesh(&write(name, text.as_bytes()), &topovox_io::ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
         let t = &m.mesh.triangles;
         assert_eq!(t.len(), 12, "{name}");
         let edges: std::collections::HashSet<(u32, u32)> = t.iter().flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]).collect();
@@ -201,7 +201,7 @@ fn gltf_bin() -> Vec<u8> {
 }
 
 fn check_gltf(path: &Path) {
-    let m = read_mesh(path).unwrap_or_else(|e| panic!("{e}"));
+    let m = read_mesh(path, &topovox_io::ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(m.report.triangles, 2);
     let b = m.report.bounds;
     // Parent at x = 10; child scaled by 2 inside the parent: x in [10, 12].
@@ -244,7 +244,7 @@ fn obj_polylines_become_segments_next_to_faces() {
     // A triangle, a 3-point polyline (tobj alone would read it as a
     // triangle) with a relative index and a v/vt form, and a 2-point line.
     let p = write("lines.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 2 2 2\nl 1 4 -3/1\nvt 0 0\nl 2 3\n");
-    let m = topovox_io::read_mesh(&p).unwrap();
+    let m = topovox_io::read_mesh(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!((m.report.triangles, m.report.segments), (1, 3));
     let seg = |s: [u32; 2]| [m.mesh.positions[s[0] as usize], m.mesh.positions[s[1] as usize]];
     let v = |x: f64, y: f64, z: f64| glam::DVec3::new(x, y, z);
@@ -257,7 +257,7 @@ fn obj_polylines_become_segments_next_to_faces() {
 #[test]
 fn text_polylines() {
     let p = write("poly.lines", b"# two polylines\n0 0 0 1 1 1 2 0 0\n\n5,5,5, 6,6,6\n");
-    let m = topovox_io::read_mesh(&p).unwrap();
+    let m = topovox_io::read_mesh(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!((m.report.triangles, m.report.segments, m.report.vertices), (0, 3, 5));
 }
 
@@ -271,7 +271,7 @@ fn gltf_alpha_modes_become_cutoffs() {
         r#""buffers":"#,
         r#""materials": [{"alphaMode": "MASK", "alphaCutoff": 0.3}, {"alphaMode": "MASK"}, {"alphaMode": "BLEND"}], "buffers":"#,
     );
-    let m = read_mesh(&write("alpha.gltf", json.as_bytes())).unwrap_or_else(|e| panic!("{e}"));
+    let m = read_mesh(&write("alpha.gltf", json.as_bytes()), &topovox_io::ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     let cut: Vec<Option<f32>> = m.appearance.materials.iter().map(|m| m.alpha_cutoff).collect();
     assert_eq!(cut, [Some(0.3), Some(0.5), None, None], "the last is glTF's default material");
 }
@@ -299,18 +299,18 @@ fn gltf_instancing_past_memory_is_refused_before_expanding() {
     );
     assert!(json.len() < 16_000);
     let t = std::time::Instant::now();
-    let e = read_mesh(&write("inst.gltf", json.as_bytes())).unwrap_err().to_string();
+    let e = read_mesh(&write("inst.gltf", json.as_bytes()), &topovox_io::ReadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("places its meshes 1000000000 times") && e.contains("more than"), "{e}");
     assert!(t.elapsed().as_secs() < 5, "counted, not expanded: {:?}", t.elapsed());
     // A thousand instances are read (and are every one of them).
     let few = json.replacen(&many(1), "[1]", 1).replacen(&many(2), "[2]", 1);
-    assert_eq!(read_mesh(&write("few.gltf", few.as_bytes())).unwrap().report.triangles, 1000);
+    assert_eq!(read_mesh(&write("few.gltf", few.as_bytes()), &topovox_io::ReadOptions::default()).unwrap().report.triangles, 1000);
     // The same chain whose leaves hold no mesh: 10⁹ node visits place
     // nothing, and are refused as quickly (the mesh is placed once, by the root).
     let empty = json.replacen(r#"{"mesh": 0}]"#, "{}]", 1).replacen(r#"[{"children""#, r#"[{"mesh": 0, "children""#, 1);
     assert_ne!(empty, json);
     let t = std::time::Instant::now();
-    let e = read_mesh(&write("empty.gltf", empty.as_bytes())).unwrap_err().to_string();
+    let e = read_mesh(&write("empty.gltf", empty.as_bytes()), &topovox_io::ReadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("visits 1001001001 nodes"), "{e}");
     assert!(t.elapsed().as_secs() < 5, "counted, not walked: {:?}", t.elapsed());
 }

@@ -34,7 +34,7 @@ fn npy_and_text_round_trip_exactly() {
     for (name, f) in [("a.npy", VoxelFormat::Npy), ("b.npy", VoxelFormat::NpyBool), ("c.txt", VoxelFormat::Text)] {
         let p = tmp(name);
         write_voxels(&p, f, &bits, &grid).unwrap();
-        let back = read_voxels(&p).unwrap();
+        let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap();
         assert_eq!(back.bits, bits, "{name}");
     }
     let bytes = std::fs::read(tmp("a.npy")).unwrap();
@@ -55,7 +55,7 @@ fn binvox_is_a_padded_cube_that_round_trips() {
     write_voxels(&p, VoxelFormat::Binvox, &bits, &grid).unwrap();
     let text = std::fs::read(&p).unwrap();
     assert!(text.starts_with(b"#binvox 1\ndim 9 9 9\ntranslate 1 2 3\nscale 4.5\ndata\n"));
-    let back = read_voxels(&p).unwrap();
+    let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!(back.bits.dims(), [9, 9, 9]);
     assert_eq!(back.placement, Some((DVec3::new(1.0, 2.0, 3.0), DVec3::splat(0.5))));
     let mut a = Vec::new();
@@ -75,7 +75,7 @@ fn vox_splits_large_grids_into_models_that_reassemble() {
     let data = dot_vox_models(&p);
     assert!(data.0 >= 4, "expected several models, got {}", data.0);
     assert!(data.1.iter().all(|s| s.iter().all(|&d| d <= 256)));
-    let back = read_voxels(&p).unwrap();
+    let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!(back.bits, bits);
 }
 
@@ -150,7 +150,7 @@ fn truncated_npy_files_are_rejected_when_streamed() {
     let bytes = std::fs::read(&p).unwrap();
     for cut in [5, 60, bytes.len() - 1] {
         std::fs::write(&p, &bytes[..cut]).unwrap();
-        let e = read_voxels(&p).unwrap_err().to_string();
+        let e = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap_err().to_string();
         assert!(e.contains("trunc.npy") && (e.contains("truncated") || e.contains("magic")), "{cut}: {e}");
     }
 }
@@ -169,7 +169,7 @@ fn an_npy_header_promising_a_huge_grid_is_rejected_before_allocating() {
     h.extend_from_slice(header.as_bytes());
     h.extend_from_slice(&[1, 0, 1]);
     std::fs::write(&p, h).unwrap();
-    let e = read_voxels(&p).unwrap_err().to_string();
+    let e = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("huge.npy") && e.contains("truncated"), "{e}");
 }
 
@@ -185,18 +185,20 @@ fn npz_round_trips_and_refuses_hostile_archives() {
     let grid = GridSpec::new(DVec3::new(-1.0, 2.0, 0.5), 0.25, [13, 70, 5]).unwrap();
     let p = tmp("a.npz");
     write_voxels(&p, VoxelFormat::Npz, &bits, &grid).unwrap();
-    let back = read_voxels(&p).unwrap();
+    let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!(back.bits, bits);
     assert_eq!(back.placement, Some((DVec3::new(-1.0, 2.0, 0.5), DVec3::splat(0.25))));
     // Without a dense grid (grids past memory): the same voxels and placement.
-    let sparse = topovox_io::read_voxels_sparse(std::path::Path::new(&p), false).unwrap();
+    let sparse =
+        topovox_io::read_voxels_sparse(std::path::Path::new(&p), &topovox_io::ReadOptions { attributes: false, ..Default::default() })
+            .unwrap();
     assert_eq!((sparse.bits.to_dense(), sparse.placement), (bits.clone(), back.placement));
     // From memory too, and an empty grid.
     let bytes = std::fs::read(&p).unwrap();
-    assert_eq!(topovox_io::read_voxels_bytes(&bytes, VoxelFormat::Npz).unwrap().bits, bits);
+    assert_eq!(topovox_io::read_voxels_bytes(&bytes, VoxelFormat::Npz, &topovox_io::ReadOptions::default()).unwrap().bits, bits);
     let empty = DenseBits::new([3, 4, 5]);
     write_voxels(&p, VoxelFormat::Npz, &empty, &GridSpec::new(DVec3::ZERO, 1.0, [3, 4, 5]).unwrap()).unwrap();
-    assert_eq!(read_voxels(&p).unwrap().bits, empty);
+    assert_eq!(read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap().bits, empty);
 
     // An archive built as numpy.savez_compressed would: deflated members,
     // big-endian int16 indices, no dims (the grid is the smallest holding them).
@@ -223,7 +225,7 @@ fn npz_round_trips_and_refuses_hostile_archives() {
     };
     let be16: Vec<u8> = [0i16, 0, 0, 4, 1, 2].iter().flat_map(|c| c.to_be_bytes()).collect();
     let a = archive(&[("indices.npy", npy(">i2", "(2, 3)", &be16))]);
-    let got = topovox_io::read_voxels_bytes(&a, VoxelFormat::Npz).unwrap();
+    let got = topovox_io::read_voxels_bytes(&a, VoxelFormat::Npz, &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!(got.bits.dims(), [5, 2, 3]);
     assert!(got.bits.get(0, 0, 0) && got.bits.get(4, 1, 2));
     assert_eq!(got.placement, None);
@@ -245,7 +247,7 @@ fn npz_round_trips_and_refuses_hostile_archives() {
         (archive(&[("indices.npy", b"\x93NUMPY\x01\x00\xff\xff{".to_vec())]), "header cut short"),
     ];
     for (bytes, want) in cases {
-        let err = topovox_io::read_voxels_bytes(&bytes, VoxelFormat::Npz).unwrap_err().to_string();
+        let err = topovox_io::read_voxels_bytes(&bytes, VoxelFormat::Npz, &topovox_io::ReadOptions::default()).unwrap_err().to_string();
         assert!(err.contains(want), "expected {want:?} in {err:?}");
         assert!(!err.contains('\n'), "{err}");
     }
@@ -270,11 +272,15 @@ fn grids_of_boxes_round_trip_their_spacing() {
     ] {
         let p = tmp(name);
         write_voxels(&p, f, &bits, &grid).unwrap();
-        let back = read_voxels(&p).unwrap();
+        let back = read_voxels(&p, &topovox_io::ReadOptions::default()).unwrap();
         assert_eq!(back.bits, bits, "{name}");
         assert_eq!(back.placement, want, "{name}");
         if f.reads_sparsely() {
-            assert_eq!(topovox_io::read_voxels_sparse(&p, false).unwrap().placement, want, "{name} sparse");
+            assert_eq!(
+                topovox_io::read_voxels_sparse(&p, &topovox_io::ReadOptions { attributes: false, ..Default::default() }).unwrap().placement,
+                want,
+                "{name} sparse"
+            );
         }
     }
     for (name, f) in [("s.binvox", VoxelFormat::Binvox), ("s.vox", VoxelFormat::Vox), ("s.schem", VoxelFormat::Schem)] {
@@ -286,5 +292,5 @@ fn grids_of_boxes_round_trip_their_spacing() {
     // Written before boxes: one size means cubes.
     let cubes = GridSpec::new(DVec3::ZERO, [0.5; 3], dims.map(u64::from)).unwrap();
     write_voxels(&tmp("c.npz"), VoxelFormat::Npz, &bits, &cubes).unwrap();
-    assert_eq!(read_voxels(&tmp("c.npz")).unwrap().placement, Some((DVec3::ZERO, DVec3::splat(0.5))));
+    assert_eq!(read_voxels(&tmp("c.npz"), &topovox_io::ReadOptions::default()).unwrap().placement, Some((DVec3::ZERO, DVec3::splat(0.5))));
 }

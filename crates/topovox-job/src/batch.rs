@@ -520,7 +520,7 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
             std::fs::create_dir_all(dir).map_err(|e| JobError::Io(topovox_io::IoError::new(dir, topovox_io::ErrorKind::Write(e))))?;
         }
         let t = Instant::now();
-        let loaded = topovox_io::read_mesh_with(&item.input, &opts.read)?;
+        let loaded = topovox_io::read_mesh(&item.input, &opts.read)?;
         let load_s = t.elapsed().as_secs_f64();
         let name = item.input.display().to_string();
         let run = || -> Result<Value> {

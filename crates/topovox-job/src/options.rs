@@ -193,7 +193,7 @@ impl ExportOptions {
 impl RunOptions {
     /// How meshes are read.
     pub fn read_options(&self) -> topovox_io::ReadOptions {
-        topovox_io::ReadOptions { allow_external_paths: self.allow_external_paths }
+        topovox_io::ReadOptions { allow_external_paths: self.allow_external_paths, ..Default::default() }
     }
 }
 

@@ -244,7 +244,7 @@ fn written_fields_read_back_as_their_inside() {
             }
             let out = dir.join(format!("{what}.{format}"));
             write(&out, format, &s, None).unwrap();
-            let back = topovox_io::read_voxels(&out).unwrap();
+            let back = topovox_io::read_voxels(&out, &topovox_io::ReadOptions::default()).unwrap();
             assert_eq!(back.bits.dims(), s.grid.dims(), "{what} {format}");
             let [_, ny, nz] = s.grid.dims().map(|x| x as usize);
             for (n, &w) in want.iter().enumerate() {

@@ -32,7 +32,7 @@ fn one_thread_calls_from_two_threads_run_at_once() {
 /// alone.
 #[test]
 fn concurrent_voxelizations_give_the_same_voxels() {
-    let cow = topovox_io::read_mesh(&common::repo("examples/meshes/cow.obj")).unwrap();
+    let cow = topovox_io::read_mesh(&common::repo("examples/meshes/cow.obj"), &topovox_io::ReadOptions::default()).unwrap();
     let plan = common::plan("sep26", 64, None);
     let run = || {
         topovox_job::pool(1)

@@ -37,7 +37,7 @@ fn requested() -> Arc<Stop> {
 
 #[test]
 fn a_stopped_voxelization_is_interrupted_on_every_path() {
-    let cow = topovox_io::read_mesh(&repo("examples/meshes/cow.obj")).unwrap();
+    let cow = topovox_io::read_mesh(&repo("examples/meshes/cow.obj"), &topovox_io::ReadOptions::default()).unwrap();
     for (mode, tile) in [("cover", None), ("cover", Some(32)), ("solid", None), ("solid", Some(32)), ("tunnel26", Some(32))] {
         let p = plan(mode, 96, tile);
         let free = topovox_job::voxelize(&p, cow.mesh.as_ref(), "cow", None, Some(&Stop::new())).unwrap();
@@ -50,7 +50,7 @@ fn a_stopped_voxelization_is_interrupted_on_every_path() {
 #[test]
 fn a_stopped_write_leaves_the_old_output_and_no_temporary() {
     let d = folder("write");
-    let cow = topovox_io::read_mesh(&repo("examples/meshes/cow.obj")).unwrap();
+    let cow = topovox_io::read_mesh(&repo("examples/meshes/cow.obj"), &topovox_io::ReadOptions::default()).unwrap();
     let v = topovox_job::voxelize(&plan("cover", 40, None), cow.mesh.as_ref(), "cow", None, None).unwrap();
     let formats = [
         ("old.npy", Output::Voxels(VoxelFormat::Npy)),

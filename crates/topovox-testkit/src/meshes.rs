@@ -42,7 +42,7 @@ pub fn shared_meshes_dir() -> PathBuf {
 /// Loads a mesh from `shared/meshes`.
 pub fn shared_mesh(name: &str) -> Mesh {
     let path = shared_meshes_dir().join(name);
-    topovox_io::read_mesh(&path).unwrap_or_else(|e| panic!("{e}")).mesh
+    topovox_io::read_mesh(&path, &topovox_io::ReadOptions::default()).unwrap_or_else(|e| panic!("{e}")).mesh
 }
 
 /// An axis-aligned box `[lo, hi]` as 12 outward-facing triangles.

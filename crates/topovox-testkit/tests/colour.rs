@@ -18,7 +18,7 @@ fn spot_path() -> PathBuf {
 }
 
 fn attrs_for(path: &Path, mode: Mode, res: u64, rule: ColourRule) -> (topovox_io::LoadedMesh, GridSpec, VoxelAttributes) {
-    let loaded = topovox_io::read_mesh(path).unwrap();
+    let loaded = topovox_io::read_mesh(path, &topovox_io::ReadOptions::default()).unwrap();
     let grid = GridSpec::from_resolution(&loaded.report.bounds, res).unwrap();
     let (bits, _) = voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &Options::default());
     let a = carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &bits, &CarryOptions { rule, normals: true });
@@ -189,7 +189,7 @@ fn quad_scene(dir: &Path, u0: f64, map: &str) -> PathBuf {
 }
 
 fn quad_colours(path: &Path) -> Vec<[u8; 3]> {
-    let loaded = topovox_io::read_mesh(path).unwrap();
+    let loaded = topovox_io::read_mesh(path, &topovox_io::ReadOptions::default()).unwrap();
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
     let grid = GridSpec::new(DVec3::ZERO, 0.5, [2, 2, 1]).unwrap();
     let (bits, _) = voxelize::fast(Mode::Cover, loaded.mesh.as_ref(), &grid, &Options::default());
@@ -216,7 +216,7 @@ fn a_missing_texture_warns_and_uses_the_material_colour() {
     std::fs::write(d.join("q.mtl"), "newmtl q\nKd 0.5 0.25 1\nmap_Kd nowhere.png\n").unwrap();
     std::fs::write(d.join("q.obj"), "mtllib q.mtl\nusemtl q\nv 0 0 0.25\nv 1 0 0.25\nv 1 1 0.25\nvt 0 0\nvt 1 0\nvt 1 1\nf 1/1 2/2 3/3\n")
         .unwrap();
-    let loaded = topovox_io::read_mesh(&d.join("q.obj")).unwrap();
+    let loaded = topovox_io::read_mesh(&d.join("q.obj"), &topovox_io::ReadOptions::default()).unwrap();
     assert!(loaded.warnings.iter().any(|w| w.contains("nowhere.png") && w.contains("Kd")), "{:?}", loaded.warnings);
     let grid = GridSpec::new(DVec3::ZERO, 0.5, [2, 2, 1]).unwrap();
     let (bits, _) = voxelize::fast(Mode::Cover, loaded.mesh.as_ref(), &grid, &Options::default());
@@ -231,7 +231,7 @@ fn vertex_colours_dominant_picks_a_vertex_colour_blend_mixes() {
     let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0.1 255 0 0\n4 0 0.1 0 255 0\n0 4 0.1 0 0 255\n3 0 1 2\n";
     let p = d.join("t.ply");
     std::fs::write(&p, ply).unwrap();
-    let loaded = topovox_io::read_mesh(&p).unwrap();
+    let loaded = topovox_io::read_mesh(&p, &topovox_io::ReadOptions::default()).unwrap();
     assert_eq!(loaded.appearance.vertex_colour.len(), 3);
     let grid = GridSpec::new(DVec3::ZERO, 0.5, [8, 8, 1]).unwrap();
     let (bits, _) = voxelize::fast(Mode::Cover, loaded.mesh.as_ref(), &grid, &Options::default());
@@ -247,7 +247,7 @@ fn vertex_colours_dominant_picks_a_vertex_colour_blend_mixes() {
 
 #[test]
 fn solid_interiors_take_the_nearest_surface_colour() {
-    let loaded = topovox_io::read_mesh(&spot_path()).unwrap();
+    let loaded = topovox_io::read_mesh(&spot_path(), &topovox_io::ReadOptions::default()).unwrap();
     let grid = GridSpec::from_resolution(&loaded.report.bounds, 40).unwrap();
     let (solid, _) = topovox::voxelize::solid::parity(loaded.mesh.as_ref(), &grid).unwrap();
     let a = carry(loaded.mesh.as_ref(), &loaded.appearance, &grid, &solid, &CarryOptions::default());
@@ -263,7 +263,7 @@ fn solid_interiors_take_the_nearest_surface_colour() {
 
 #[test]
 fn attributes_do_not_depend_on_the_thread_count() {
-    let loaded = topovox_io::read_mesh(&spot_path()).unwrap();
+    let loaded = topovox_io::read_mesh(&spot_path(), &topovox_io::ReadOptions::default()).unwrap();
     let grid = GridSpec::from_resolution(&loaded.report.bounds, 64).unwrap();
     let (bits, _) = voxelize::fast(Mode::Cover, loaded.mesh.as_ref(), &grid, &Options::default());
     let run = |threads: usize, rule| {
@@ -346,7 +346,7 @@ fn assert_matches_reference(
 #[test]
 fn carried_attributes_equal_the_reference_on_rotated_spot() {
     use rand::{Rng, SeedableRng};
-    let loaded = topovox_io::read_mesh(&spot_path()).unwrap();
+    let loaded = topovox_io::read_mesh(&spot_path(), &topovox_io::ReadOptions::default()).unwrap();
     let mut rng = rand::rngs::SmallRng::seed_from_u64(14);
     for (n, res) in [37u64, 61, 90].into_iter().enumerate() {
         let mut mesh = loaded.mesh.clone();

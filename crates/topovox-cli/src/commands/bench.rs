@@ -130,7 +130,7 @@ struct Row {
 }
 
 pub fn run(a: &BenchArgs) -> Result<()> {
-    let loaded = topovox_io::read_mesh(&a.mesh)?;
+    let loaded = topovox_io::read_mesh(&a.mesh, &topovox_io::ReadOptions::default())?;
     if a.attributes {
         return attributes(a, &loaded);
     }
@@ -231,7 +231,7 @@ fn measure(a: &BenchArgs, mesh: topovox::MeshRef<'_>, bounds: &topovox::Aabb) ->
                     let load_s = if a.subdivide == 0 {
                         let (load_s, r) = pool.install(|| {
                             time(a.repeats.min(5), || -> Result<u64> {
-                                let l = topovox_io::read_mesh(&a.mesh)?;
+                                let l = topovox_io::read_mesh(&a.mesh, &topovox_io::ReadOptions::default())?;
                                 let g = GridSpec::from_resolution(&l.report.bounds, res)?;
                                 engine.fast(l.mesh.as_ref(), &g)
                             })

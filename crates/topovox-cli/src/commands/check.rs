@@ -16,20 +16,21 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         bail!("{}: --sparse reads only .vdb, .zarr and .npz files", a.voxels.display());
     }
     let voxels = if a.sparse {
-        Voxels::Sparse(topovox_io::read_voxels_sparse_opts(
+        Voxels::Sparse(topovox_io::read_voxels_sparse(
             &a.voxels,
-            false,
-            &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
+            &topovox_io::ReadOptions { attributes: false, allow_external_paths: a.allow_external_paths, ..Default::default() },
         )?)
     } else {
-        match topovox_io::read_voxels_opts(&a.voxels, up, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths }) {
+        match topovox_io::read_voxels(
+            &a.voxels,
+            &topovox_io::ReadOptions { up, allow_external_paths: a.allow_external_paths, ..Default::default() },
+        ) {
             Ok(l) => Voxels::Dense(l),
             // Past memory: checked window by window.
             Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && sparse_format => {
-                Voxels::Sparse(topovox_io::read_voxels_sparse_opts(
+                Voxels::Sparse(topovox_io::read_voxels_sparse(
                     &a.voxels,
-                    false,
-                    &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
+                    &topovox_io::ReadOptions { attributes: false, allow_external_paths: a.allow_external_paths, ..Default::default() },
                 )?)
             }
             Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) => {
@@ -44,7 +45,10 @@ pub fn run(a: &CheckArgs) -> Result<()> {
     };
     let mesh = match &a.mesh {
         Some(path) => {
-            let m = topovox_io::read_mesh_with(path, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
+            let m = topovox_io::read_mesh(
+                path,
+                &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths, ..Default::default() },
+            )?;
             for w in &m.warnings {
                 eprintln!("topovox: warning: {}: {w}", path.display());
             }

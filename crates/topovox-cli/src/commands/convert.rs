@@ -18,54 +18,54 @@ pub fn run(a: &ConvertArgs) -> Result<()> {
     let input_has_up = matches!(input_format, Some(F::Vox | F::Schem));
     crate::export::warn_unused(job, &a.export.given, format, &a.output, false, input_has_up);
     // The up axis is the data's: .vox and .schem files are read back with it too.
-    let loaded =
-        match topovox_io::read_voxels_opts(&a.input, job.up, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths }) {
-            Ok(l) => l,
-            // A .vdb or .zarr grid past memory, to a format that holds only the
-            // set voxels: read and written without a dense grid.
-            Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && topovox_job::output::is_sparse(format) => {
-                let sparse = match topovox_io::read_voxels_sparse_opts(
-                    &a.input,
-                    false,
-                    &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
-                ) {
-                    Ok(s) => s,
-                    // Formats read only densely: the grid's size is the error.
-                    Err(s) if matches!(s.kind, topovox_io::ErrorKind::Unsupported(_)) && !input_format.is_some_and(F::reads_sparsely) => {
-                        return Err(e.into())
-                    }
-                    Err(s) => return Err(s.into()),
-                };
-                // Attributes the output stores are read too (a second pass over
-                // the file, at the set voxels only) while they fit in memory.
-                let wanted = format.has_colour() || topovox_job::every_attribute(format, true);
-                let need = sparse.bits.count().saturating_mul(topovox_job::ATTRIBUTE_BYTES_PER_VOXEL);
-                let attributes = if sparse.attributes_left && wanted {
-                    if need <= topovox_job::budget(None) {
-                        topovox_io::read_voxels_sparse_opts(
-                            &a.input,
-                            true,
-                            &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
-                        )?
-                        .attributes
-                    } else {
-                        eprintln!(
-                            "topovox: warning: {}: its attributes are not carried: they would need {} of memory",
-                            a.input.display(),
-                            topovox_job::bytes(need)
-                        );
-                        None
-                    }
+    let loaded = match topovox_io::read_voxels(
+        &a.input,
+        &topovox_io::ReadOptions { up: job.up, allow_external_paths: a.allow_external_paths, ..Default::default() },
+    ) {
+        Ok(l) => l,
+        // A .vdb or .zarr grid past memory, to a format that holds only the
+        // set voxels: read and written without a dense grid.
+        Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && topovox_job::output::is_sparse(format) => {
+            let sparse = match topovox_io::read_voxels_sparse(
+                &a.input,
+                &topovox_io::ReadOptions { attributes: false, allow_external_paths: a.allow_external_paths, ..Default::default() },
+            ) {
+                Ok(s) => s,
+                // Formats read only densely: the grid's size is the error.
+                Err(s) if matches!(s.kind, topovox_io::ErrorKind::Unsupported(_)) && !input_format.is_some_and(F::reads_sparsely) => {
+                    return Err(e.into())
+                }
+                Err(s) => return Err(s.into()),
+            };
+            // Attributes the output stores are read too (a second pass over
+            // the file, at the set voxels only) while they fit in memory.
+            let wanted = format.has_colour() || topovox_job::every_attribute(format, true);
+            let need = sparse.bits.count().saturating_mul(topovox_job::ATTRIBUTE_BYTES_PER_VOXEL);
+            let attributes = if sparse.attributes_left && wanted {
+                if need <= topovox_job::budget(None) {
+                    topovox_io::read_voxels_sparse(
+                        &a.input,
+                        &topovox_io::ReadOptions { attributes: true, allow_external_paths: a.allow_external_paths, ..Default::default() },
+                    )?
+                    .attributes
                 } else {
+                    eprintln!(
+                        "topovox: warning: {}: its attributes are not carried: they would need {} of memory",
+                        a.input.display(),
+                        topovox_job::bytes(need)
+                    );
                     None
-                };
-                return finish(a, format, &sparse.bits, sparse.placement, attributes.as_ref(), &write_opts, true);
-            }
-            Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && input_format.is_some_and(F::reads_sparsely) => {
-                bail!("{e}; {} is a dense format: convert it to .vdb, .zarr, .npz, .txt or .ply, which need no dense grid", format.name())
-            }
-            Err(e) => return Err(e.into()),
-        };
+                }
+            } else {
+                None
+            };
+            return finish(a, format, &sparse.bits, sparse.placement, attributes.as_ref(), &write_opts, true);
+        }
+        Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && input_format.is_some_and(F::reads_sparsely) => {
+            bail!("{e}; {} is a dense format: convert it to .vdb, .zarr, .npz, .txt or .ply, which need no dense grid", format.name())
+        }
+        Err(e) => return Err(e.into()),
+    };
     finish(a, format, &loaded.bits, loaded.placement, loaded.attributes.as_ref(), &write_opts, false)
 }
 

@@ -29,7 +29,7 @@ pub fn run(a: &GapsArgs) -> Result<()> {
         table += "|\n";
     }
     for path in &a.meshes {
-        let loaded = topovox_io::read_mesh(path)?;
+        let loaded = topovox_io::read_mesh(path, &topovox_io::ReadOptions::default())?;
         let mesh = loaded.mesh.as_ref();
         let name = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
         for &res in &a.resolutions {

@@ -6,7 +6,8 @@ use serde_json::json;
 use crate::args::InfoArgs;
 
 pub fn run(a: &InfoArgs) -> Result<()> {
-    let loaded = topovox_io::read_mesh_with(&a.mesh, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
+    let loaded =
+        topovox_io::read_mesh(&a.mesh, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths, ..Default::default() })?;
     let r = &loaded.report;
     let (mn, mx) = (r.bounds.min, r.bounds.max);
     let app = &loaded.appearance;

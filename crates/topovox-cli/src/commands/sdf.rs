@@ -24,7 +24,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
     let bar = Bar::new(a.quiet || a.json);
     bar.phase("loading mesh");
     let t_load = Instant::now();
-    let loaded = topovox_io::read_mesh_with(&a.mesh, &opts.run.read_options())?;
+    let loaded = topovox_io::read_mesh(&a.mesh, &opts.run.read_options())?;
     let load_s = t_load.elapsed().as_secs_f64();
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
     for w in &loaded.warnings {

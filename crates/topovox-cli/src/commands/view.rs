@@ -36,7 +36,10 @@ pub fn run(a: &ViewArgs) -> Result<()> {
         }
         add_voxel_file(&mut scene, &a.input, a.up, Vec3::ZERO)?;
     } else {
-        let loaded = topovox_io::read_mesh_with(&a.input, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
+        let loaded = topovox_io::read_mesh(
+            &a.input,
+            &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths, ..Default::default() },
+        )?;
         if let Some(p) = &a.screenshot {
             topovox_io::atomic::refuse_overwriting_inputs(p, &loaded.sources)?;
         }

@@ -32,7 +32,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let bar = Bar::new(a.quiet || a.json);
     bar.phase("loading mesh");
     let t_load = Instant::now();
-    let loaded = topovox_io::read_mesh_with(&a.mesh, &opts.run.read_options())?;
+    let loaded = topovox_io::read_mesh(&a.mesh, &opts.run.read_options())?;
     let load_s = t_load.elapsed().as_secs_f64();
     for w in &loaded.warnings {
         eprintln!("topovox: warning: {}: {w}", a.mesh.display());

@@ -28,7 +28,7 @@ impl Profiled {
         let res: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(res);
         let threads: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1);
         let reps: usize = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(reps);
-        let loaded = topovox_io::read_mesh(std::path::Path::new(path)).expect("mesh");
+        let loaded = topovox_io::read_mesh(std::path::Path::new(path), &topovox_io::ReadOptions::default()).expect("mesh");
         let grid = GridSpec::from_resolution(&loaded.report.bounds, res).expect("grid");
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
         Profiled { args, res, threads, reps, loaded, grid, pool }

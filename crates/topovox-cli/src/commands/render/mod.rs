@@ -48,17 +48,19 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         // .vox and .schem are rotated back so the --up axis is up again.
         let up = a.up.unwrap_or_default();
         use topovox_io::VoxelFormat as F;
-        match topovox_io::read_voxels_opts(&a.input, up, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths }) {
+        match topovox_io::read_voxels(
+            &a.input,
+            &topovox_io::ReadOptions { up, allow_external_paths: a.allow_external_paths, ..Default::default() },
+        ) {
             Ok(loaded) => {
                 o.voxel_shape = shape(loaded.placement);
                 (Box::new(loaded.bits), "voxel file", loaded.attributes, None)
             }
             // A .vdb, .zarr or .npz grid past memory: drawn from its bricks.
             Err(e) if matches!(e.kind, topovox_io::ErrorKind::TooLarge { .. }) && F::from_path(&a.input).is_some_and(F::reads_sparsely) => {
-                let sparse = topovox_io::read_voxels_sparse_opts(
+                let sparse = topovox_io::read_voxels_sparse(
                     &a.input,
-                    false,
-                    &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths },
+                    &topovox_io::ReadOptions { attributes: false, allow_external_paths: a.allow_external_paths, ..Default::default() },
                 )?;
                 if sparse.attributes_left {
                     eprintln!("topovox: warning: {}: drawn without its colours: the grid does not fit densely", a.input.display());
@@ -72,7 +74,10 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     } else {
         let (mode, _) = topovox_job::resolve_method(a.mode, topovox_job::Method::Fast)
             .context("render voxelizes meshes with a surface or line mode; voxelize solids to a file first")?;
-        let loaded = topovox_io::read_mesh_with(&a.input, &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths })?;
+        let loaded = topovox_io::read_mesh(
+            &a.input,
+            &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths, ..Default::default() },
+        )?;
         topovox_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
         let grid = plan::grid_request(&a.grid)?.fit(&loaded.report.bounds)?;
         plan::check_memory(&grid)?;
