@@ -195,7 +195,11 @@ pub struct Sdf {
     pub grid: GridSpec,
     /// Negative inside.
     pub signed: bool,
-    /// Facts for the summary and JSON.
+    /// How inside was decided (`parity`, `winding`); `None` when unsigned.
+    pub sign: Option<String>,
+    /// Seconds computing the distances.
+    pub distance_s: f64,
+    /// Facts for the JSON summary.
     pub facts: Value,
     /// Things the user should know (an open mesh under parity).
     pub warnings: Vec<String>,
@@ -302,11 +306,13 @@ pub fn sdf(mesh: MeshRef<'_>, name: &str, req: &SdfRequest, stop: Option<&Stop>)
             (Band::from_dense(grid.dims(), bg as f64, &dense), bg)
         }
     };
-    facts["distance_s"] = json!(t.elapsed().as_secs_f64());
+    let distance_s = t.elapsed().as_secs_f64();
+    facts["distance_s"] = json!(distance_s);
     facts["stored_voxels"] = json!(values.count());
     facts["background"] = json!(background);
     let field = Field::signed(values, inside, background);
-    Ok(Sdf { field, grid, signed: !req.unsigned, facts, warnings })
+    let sign = facts["sign"].as_str().map(String::from);
+    Ok(Sdf { field, grid, signed: !req.unsigned, sign, distance_s, facts, warnings })
 }
 
 /// Writes `sdf` to `out` in `format`: to a temporary beside it, renamed

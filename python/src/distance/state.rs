@@ -92,9 +92,11 @@ pub(crate) fn load(d: &Bound<'_, PyDict>) -> PyResult<Sdf> {
         Some(_) => Some(inside(d, grid.dims(), nb)?),
         None => None,
     };
-    let facts = serde_json::from_str(&get::<String>(d, "facts")?).map_err(|_| bad("facts"))?;
+    let facts: serde_json::Value = serde_json::from_str(&get::<String>(d, "facts")?).map_err(|_| bad("facts"))?;
     let field = Field { band, inside, background: get(d, "background")? };
-    Ok(Sdf { field, grid, signed: get(d, "signed")?, facts, warnings: get(d, "warnings")? })
+    // What the facts record of the sign and the time, typed again.
+    let (sign, distance_s) = (facts["sign"].as_str().map(String::from), facts["distance_s"].as_f64().unwrap_or(0.0));
+    Ok(Sdf { field, grid, signed: get(d, "signed")?, sign, distance_s, facts, warnings: get(d, "warnings")? })
 }
 
 /// The inside voxels: bricks (`run` 1) and runs of full bricks along x.

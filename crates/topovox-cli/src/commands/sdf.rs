@@ -63,7 +63,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
         crate::console::print_stdout(&j.to_string())?;
     } else if !a.quiet {
         let kind = if sdf.signed {
-            format!("signed distances (inside by {})", sdf.facts["sign"].as_str().unwrap_or("?"))
+            format!("signed distances (inside by {})", sdf.sign.as_deref().unwrap_or("?"))
         } else {
             "unsigned distances".into()
         };
@@ -79,7 +79,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
             o.y,
             o.z,
             g.size(),
-            sdf.facts["distance_s"].as_f64().unwrap_or(0.0) * 1e3,
+            sdf.distance_s * 1e3,
             total_s,
             a.output.display()
         ))?;
