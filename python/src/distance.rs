@@ -298,7 +298,7 @@ impl DistanceGrid {
         format!(
             "<topovox.DistanceGrid {kind} {x}x{y}x{z}, {} voxels stored, voxel size {}>",
             self.inner.field.band.count(),
-            self.inner.grid.size()
+            self.inner.grid.voxel_size()
         )
     }
 }

@@ -443,7 +443,7 @@ impl VoxelGrid {
     /// >>> grid.to_trimesh().points
     fn to_trimesh<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let trimesh = import_trimesh(py, "to_trimesh")?;
-        let (o, s) = (self.inner.grid.origin(), self.inner.grid.voxel_size());
+        let (o, s) = (self.inner.grid.origin(), self.inner.grid.voxel_size().0);
         let t = Array2::from_shape_fn((4, 4), |(r, c)| match (r, c) {
             (r, c) if r == c && r < 3 => s[r],
             (3, 3) => 1.0,
@@ -633,7 +633,7 @@ impl VoxelGrid {
                 let o = g.origin();
                 (o.x, o.y, o.z)
             },
-            size_to_py(py, g.size())?,
+            size_to_py(py, g.voxel_size())?,
             self.colours(py),
             self.materials(py),
             self.normals(py),
@@ -658,7 +658,7 @@ impl VoxelGrid {
     fn __repr__(&self) -> String {
         let [x, y, z] = self.inner.grid.dims();
         let mode = self.inner.facts.get("mode").and_then(Value::as_str).map(|m| format!(" {m}")).unwrap_or_default();
-        format!("<topovox.VoxelGrid{mode} {x}x{y}x{z}, {} voxels, voxel size {}>", self.inner.voxels.count(), self.inner.grid.size())
+        format!("<topovox.VoxelGrid{mode} {x}x{y}x{z}, {} voxels, voxel size {}>", self.inner.voxels.count(), self.inner.grid.voxel_size())
     }
 }
 

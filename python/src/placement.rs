@@ -30,18 +30,18 @@ pub(crate) fn origin<'py>(py: Python<'py>, g: &GridSpec) -> Bound<'py, PyArray1<
 
 /// The world box, `(2, 3)` float64: low and high corners.
 pub(crate) fn bounds<'py>(py: Python<'py>, g: &GridSpec) -> Bound<'py, PyArray2<f64>> {
-    let (o, s, d) = (g.origin(), g.voxel_size(), g.dims());
+    let (o, s, d) = (g.origin(), g.voxel_size().0, g.dims());
     Array2::from_shape_fn((2, 3), |(r, c)| o[c] + r as f64 * d[c] as f64 * s[c]).into_pyarray(py)
 }
 
 /// A float for cubes, `(sx, sy, sz)` for boxes.
 pub(crate) fn voxel_size<'py>(py: Python<'py>, g: &GridSpec) -> PyResult<Bound<'py, PyAny>> {
-    size_to_py(py, g.size())
+    size_to_py(py, g.voxel_size())
 }
 
 /// The three edge lengths, `(3,)` float64.
 pub(crate) fn spacing<'py>(py: Python<'py>, g: &GridSpec) -> Bound<'py, PyArray1<f64>> {
-    Array1::from(g.voxel_size().to_array().to_vec()).into_pyarray(py)
+    Array1::from(g.voxel_size().0.to_array().to_vec()).into_pyarray(py)
 }
 
 /// `a` as a 2-D `(n, 3)` NumPy array of `dtype` (NumPy's `safe` casting),
@@ -90,13 +90,13 @@ pub(crate) fn world_to_index<'py>(py: Python<'py>, g: &GridSpec, points: &Bound<
 pub(crate) fn index_to_world<'py>(py: Python<'py>, g: &GridSpec, indices: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
     let (arr, one) = rows(py, "indices", indices, "int64", "integers")?;
     let ijk = indices_from::<3>("indices", &arr)?;
-    let (o, s) = (g.origin(), g.voxel_size());
+    let (o, s) = (g.origin(), g.voxel_size().0);
     shaped(Array2::from_shape_fn((ijk.len(), 3), |(n, c)| o[c] + (ijk[n][c] as f64 + 0.5) * s[c]), one, py)
 }
 
 /// The same place: origin, voxel size and dims, exactly (`==` on grids).
 pub(crate) fn same_place(a: &GridSpec, b: &GridSpec) -> bool {
-    a.origin() == b.origin() && a.voxel_size() == b.voxel_size() && a.dims() == b.dims()
+    a.origin() == b.origin() && a.voxel_size().0 == b.voxel_size().0 && a.dims() == b.dims()
 }
 
 /// The same set voxels, whatever holds them (dense bits, sparse bricks):
@@ -119,6 +119,6 @@ pub(crate) fn same_voxels(a: &dyn VoxelSource, b: &dyn VoxelSource) -> bool {
 pub(crate) fn hash_of(g: &GridSpec, count: u64) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();
-    (g.dims(), g.origin().to_array().map(f64::to_bits), g.voxel_size().to_array().map(f64::to_bits), count).hash(&mut h);
+    (g.dims(), g.origin().to_array().map(f64::to_bits), g.voxel_size().0.to_array().map(f64::to_bits), count).hash(&mut h);
     h.finish()
 }

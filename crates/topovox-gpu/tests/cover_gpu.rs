@@ -95,7 +95,7 @@ fn grids_of_boxes_equal_the_reference_on_every_path() {
     for name in ["suzanne.obj", "cow.obj", "fandisk.obj"] {
         let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
         let grid = topovox_testkit::box_grid(&mesh.as_ref().bounds(), 64, &mut r);
-        let what = format!("rotated {name} on sizes {}", grid.size());
+        let what = format!("rotated {name} on sizes {}", grid.voxel_size());
         check(&g, &mesh, &grid, &what);
         for mode in MODES {
             let (want, _) = voxelize::reference(mode, mesh.as_ref(), &grid);

@@ -75,8 +75,8 @@ impl Rle<'_> {
 /// Writes `bits` on `grid` as binvox.
 /// A grid of boxes is refused (binvox's one `scale` makes cubes).
 pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
-    let Some(s) = grid.cube_size() else {
-        return Err(std::io::Error::other(crate::VoxelFormat::Binvox.refuses(grid.size()).unwrap_or_default()));
+    let Some(s) = grid.voxel_size().cube() else {
+        return Err(std::io::Error::other(crate::VoxelFormat::Binvox.refuses(grid.voxel_size()).unwrap_or_default()));
     };
     let [nx, ny, nz] = bits.dims();
     let d = nx.max(ny).max(nz);

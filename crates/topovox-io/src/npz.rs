@@ -52,7 +52,7 @@ pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std:
     member(&mut zip, "dims.npy", header("<i8", "(3,)"), &dims_le)?;
     let origin_le: Vec<u8> = [o.x, o.y, o.z].iter().flat_map(|c| c.to_le_bytes()).collect();
     member(&mut zip, "origin.npy", header("<f8", "(3,)"), &origin_le)?;
-    let size = grid.size().recorded();
+    let size = grid.voxel_size().recorded();
     let size_le: Vec<u8> = size.iter().flat_map(|v| v.to_le_bytes()).collect();
     member(&mut zip, "voxel_size.npy", header("<f8", if size.len() == 1 { "()" } else { "(3,)" }), &size_le)?;
 

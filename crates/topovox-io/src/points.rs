@@ -21,7 +21,7 @@ const GRID_COMMENT: &str = "comment topovox grid";
 pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec, attrs: Option<&VoxelAttributes>) -> std::io::Result<()> {
     let colours = attrs.and_then(|a| a.colour.as_ref().map(|c| (a, c)));
     let o = grid.origin();
-    let size = grid.size().recorded().iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(" ");
+    let size = grid.voxel_size().recorded().iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(" ");
     let d = grid.dims();
     let mut head = format!(
         "ply\nformat binary_little_endian 1.0\ncomment voxel centres written by topovox\n{GRID_COMMENT} origin {:?} {:?} {:?} voxel_size {size} dims {} {} {}\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n",
@@ -131,5 +131,5 @@ pub fn read(bytes: &[u8]) -> Result<LoadedVoxels, ErrorKind> {
         }
     }
     let attributes = has_colour.then(|| VoxelAttributes::from_coloured(dims, coloured));
-    Ok(LoadedVoxels { bits, placement: Some((grid.origin(), grid.voxel_size())), attributes })
+    Ok(LoadedVoxels { bits, placement: Some((grid.origin(), grid.voxel_size().0)), attributes })
 }

@@ -21,7 +21,7 @@ use crate::LoadedVoxels;
 pub fn write(w: &mut dyn Write, bits: &dyn VoxelSource, grid: &GridSpec) -> std::io::Result<()> {
     let [nx, ny, nz] = bits.dims();
     let o = grid.origin();
-    let size = grid.size().recorded().iter().map(f64::to_string).collect::<Vec<_>>().join(" ");
+    let size = grid.voxel_size().recorded().iter().map(f64::to_string).collect::<Vec<_>>().join(" ");
     writeln!(w, "# topovox voxels dims {nx} {ny} {nz} origin {} {} {} voxel_size {size}", o.x, o.y, o.z)?;
     let mut result = Ok(());
     bits.for_each_set(&mut |i, j, k| {

@@ -86,7 +86,7 @@ pub fn write_quads_obj(
             (*class, f)
         })
         .collect();
-    let (o, s) = (grid.origin(), grid.voxel_size() / 2.0);
+    let (o, s) = (grid.origin(), grid.voxel_size().0 / 2.0);
     if palette.is_some() && !matches!(crate::atomic::target(path), crate::atomic::Target::Regular(_)) {
         return Err(IoError::new(
             path,
@@ -152,7 +152,7 @@ pub type Triangles = (Vec<[f64; 3]>, Vec<[u32; 3]>, Option<Vec<[u8; 3]>>);
 /// is watertight), each face fan-triangulated, its colour from `palette`
 /// (class `c` is `palette[c - 1]`). What Python's `VoxelGrid.to_mesh` returns.
 pub fn triangles(quads: &[Quad], grid: &GridSpec, palette: Option<&[[u8; 3]]>) -> Triangles {
-    let (o, s) = (grid.origin(), grid.voxel_size() / 2.0);
+    let (o, s) = (grid.origin(), grid.voxel_size().0 / 2.0);
     let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity(quads.len() * 2);
     let mut verts = Vec::with_capacity(quads.len() * 2);
     let mut faces = Vec::with_capacity(quads.len() * 3);
@@ -189,7 +189,7 @@ pub fn write_quads_glb(
     palette: Option<&[[u8; 3]]>,
     opts: &MeshOptions,
 ) -> Result<usize, IoError> {
-    let (o, s) = (grid.origin(), grid.voxel_size() / 2.0);
+    let (o, s) = (grid.origin(), grid.voxel_size().0 / 2.0);
     let faces = faces(quads, &MeshOptions { triangulate: false, ..*opts });
     let nv: usize = faces.iter().map(|f| f.2.len()).sum();
     let ni: usize = faces.iter().map(|f| 3 * (f.2.len() - 2)).sum();

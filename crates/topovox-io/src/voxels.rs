@@ -153,7 +153,7 @@ pub fn write_voxels_with(
     attrs: Option<&VoxelAttributes>,
     opts: &WriteOptions,
 ) -> Result<(), IoError> {
-    if let Some(why) = format.refuses(grid.size()) {
+    if let Some(why) = format.refuses(grid.voxel_size()) {
         return Err(IoError::new(path, ErrorKind::Unsupported(why)));
     }
     if format == VoxelFormat::Zarr {

@@ -217,7 +217,7 @@ pub fn write_distance(w: &mut dyn Write, values: &[f32], grid: &GridSpec) -> std
 
 /// The document up to the first cell array, with `scalars` the active one.
 fn head(grid: &GridSpec, scalars: &str) -> String {
-    let (dims, o, s) = (grid.dims(), grid.origin(), grid.voxel_size());
+    let (dims, o, s) = (grid.dims(), grid.origin(), grid.voxel_size().0);
     let mut xml = String::new();
     xml.push_str("<?xml version=\"1.0\"?>\n");
     xml.push_str("<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\" compressor=\"vtkZLibDataCompressor\">\n");

@@ -84,7 +84,7 @@ const EMPTY: u64 = u64::MAX;
 /// The grid placement topovox records in `attributes.topovox`.
 fn placement(grid: &GridSpec) -> Value {
     let o = grid.origin();
-    json!({"topovox": {"origin": [o.x, o.y, o.z], "voxel_size": crate::size_json(grid.size())}})
+    json!({"topovox": {"origin": [o.x, o.y, o.z], "voxel_size": crate::size_json(grid.voxel_size())}})
 }
 
 /// An array's metadata document: occupancy (`bool`), or an attribute with

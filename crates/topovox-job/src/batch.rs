@@ -569,7 +569,7 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
 /// The grid as a manifest records it.
 fn grid_json(g: &topovox::GridSpec) -> Value {
     let o = g.origin();
-    json!({"origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(g.size()), "dims": g.dims()})
+    json!({"origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(g.voxel_size()), "dims": g.dims()})
 }
 
 /// Voxelizes one loaded mesh and writes it: the record's facts.

@@ -111,7 +111,7 @@ fn to_json(report: &CheckReport, dims: [u32; 3], grid: Option<(&GridSpec, &str)>
         }),
         "grid": grid.map(|(g, source)| {
             let o = g.origin();
-            json!({"origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(g.size()), "dims": g.dims(), "source": source})
+            json!({"origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(g.voxel_size()), "dims": g.dims(), "source": source})
         }),
     })
 }

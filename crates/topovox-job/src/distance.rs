@@ -219,7 +219,7 @@ fn stopped() -> JobError {
 /// over a voxel's volume (on the cow within 1 % of the stored count, cubes
 /// and 1:1:8 boxes alike), plus `(2w+1)³` a piece for rims and slivers.
 fn band_estimate(pieces: &Pieces, grid: &GridSpec, w: f64) -> u64 {
-    let h = grid.voxel_size();
+    let h = grid.voxel_size().0;
     let radius = w * h.max_element();
     let mut area = 0.0;
     let mut pairs = 0.0;
@@ -269,7 +269,7 @@ pub fn sdf(mesh: MeshRef<'_>, name: &str, req: &SdfRequest, stop: Option<&Stop>)
     let grid = req.grid.fit(&mesh.bounds())?;
     check_fits(name, req, &pieces, mesh, &grid)?;
     // The band's unit: the largest voxel edge (see `topovox::distance::band`).
-    let h = grid.voxel_size().max_element();
+    let h = grid.voxel_size().0.max_element();
     let mut warnings = Vec::new();
     let mut facts = json!({"band": req.width.label(), "signed": !req.unsigned, "skipped": pieces.skipped});
     // The sign first: the solid of `--mode solid` with the same method.

@@ -162,8 +162,8 @@ impl GridRequest {
         if self.pad == 0 {
             return Ok(g);
         }
-        let (p, s) = (self.pad as f64, g.voxel_size());
-        GridSpec::new(g.origin() - p * s, g.size(), g.dims().map(|d| d as u64 + 2 * self.pad as u64))
+        let (p, s) = (self.pad as f64, g.voxel_size().0);
+        GridSpec::new(g.origin() - p * s, g.voxel_size(), g.dims().map(|d| d as u64 + 2 * self.pad as u64))
             .map_err(|e| JobError::invalid(format!("invalid grid: {e}")))
     }
 
@@ -196,10 +196,10 @@ impl GridRequest {
             ref k => k.clone(),
         }
         .fit(bounds)?;
-        let s = box_grid.voxel_size();
+        let s = box_grid.voxel_size().0;
         let side = box_grid.dims().into_iter().max().unwrap_or(1) as u64 + 2 * self.pad as u64;
         let centre = (bounds.min + bounds.max) * 0.5;
-        GridSpec::new(centre - side as f64 * s * 0.5, box_grid.size(), [side; 3])
+        GridSpec::new(centre - side as f64 * s * 0.5, box_grid.voxel_size(), [side; 3])
             .map_err(|e| JobError::invalid(format!("invalid grid: {e}")))
     }
 
@@ -280,7 +280,7 @@ mod cube_tests {
         let b = Aabb { min: DVec3::new(-1.0, 2.0, 0.5), max: DVec3::new(3.0, 2.5, 1.5) };
         for (r, v, pad) in [(Some(32), None, 0), (Some(64), None, 3), (None, Some(0.3), 2), (Some(7), None, 3)] {
             let g = request(r, v, pad).fit(&b).unwrap();
-            let s = g.cube_size().unwrap();
+            let s = g.voxel_size().cube().unwrap();
             let [nx, ny, nz] = g.dims();
             assert!(nx == ny && ny == nz, "{:?}", g.dims());
             if let Some(n) = r {

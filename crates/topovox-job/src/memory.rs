@@ -65,7 +65,7 @@ pub struct TiledEstimate {
 /// the writer's buffers.
 pub fn tiled_estimate(mesh: MeshRef<'_>, grid: &GridSpec) -> TiledEstimate {
     let dims = grid.dims().map(|d| u64::from(d.div_ceil(8)));
-    let bricks = GridSpec::new(grid.origin(), grid.voxel_size() * 8.0, dims)
+    let bricks = GridSpec::new(grid.origin(), grid.voxel_size().0 * 8.0, dims)
         .ok()
         .and_then(|coarse| voxelize::tiled::tiled(Mode::Cover, mesh, &coarse, voxelize::tiled::DEFAULT_TILE, &Options::default()).ok())
         .map(|(b, _)| b.count())

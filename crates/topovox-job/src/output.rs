@@ -145,7 +145,7 @@ pub fn writer_bytes_per_brick(target: Output) -> u64 {
 /// that cannot be dense in the memory the run may use (`max_memory`, else
 /// nine tenths of what is available).
 pub fn check_fits(target: Output, grid: &GridSpec, max_memory: Option<u64>) -> Result<()> {
-    if let Some(why) = refuses(target, grid.size()) {
+    if let Some(why) = refuses(target, grid.voxel_size()) {
         return Err(JobError::invalid(why));
     }
     if let Some(why) = match target {

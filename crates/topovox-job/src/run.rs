@@ -340,7 +340,7 @@ impl Voxelized {
             "mode": plan.request.mode.name(),
             "method": self.method,
             "origin": [o.x, o.y, o.z],
-            "voxel_size": topovox_io::size_json(self.grid.size()),
+            "voxel_size": topovox_io::size_json(self.grid.voxel_size()),
             "dims": self.grid.dims(),
             "voxels": self.report.voxels,
             "voxelize_s": self.voxelize_s,

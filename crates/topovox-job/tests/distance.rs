@@ -33,7 +33,7 @@ fn assert_exact(mesh: &Mesh, s: &Sdf, what: &str) {
 /// [`assert_exact`] against reference distances `want` of the same grid.
 fn assert_close(want: &[f64], s: &Sdf, what: &str) {
     let got = s.field.dense();
-    let h = s.grid.voxel_size().max_element();
+    let h = s.grid.voxel_size().0.max_element();
     let bg = s.field.background as f64;
     for (n, (&g, &w)) in got.iter().zip(want).enumerate() {
         let g = g.abs() as f64;
@@ -53,7 +53,7 @@ fn assert_sign_is_solid(mesh: &Mesh, s: &Sdf, method: Method, what: &str) -> usi
         method,
         grid: GridRequest::new(&GridOptions {
             origin: Some(s.grid.origin().to_array().to_vec()),
-            voxel_size: Some(s.grid.size()),
+            voxel_size: Some(s.grid.voxel_size()),
             dims: Some(s.grid.dims().map(|d| d as u64).to_vec()),
             ..GridOptions::default()
         })
@@ -113,7 +113,7 @@ fn grids_of_boxes_keep_world_distances_and_the_solid_sign() {
     let mut r = rng(43);
     for name in ["suzanne.obj", "cow.obj"] {
         let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
-        let sizes = box_grid(&mesh.as_ref().bounds(), 40, &mut r).voxel_size().to_array();
+        let sizes = box_grid(&mesh.as_ref().bounds(), 40, &mut r).voxel_size().0.to_array();
         let grid = GridRequest::new(&GridOptions { voxel_size: Some(sizes.into()), pad: Some(2), ..GridOptions::default() }).unwrap();
         let what = format!("{name} on sizes {sizes:?}");
         let req = SdfRequest {
@@ -125,7 +125,7 @@ fn grids_of_boxes_keep_world_distances_and_the_solid_sign() {
             format: DistanceFormat::Vdb,
         };
         let s = run(&mesh, &req, 2);
-        assert_eq!(s.grid.voxel_size().to_array(), sizes);
+        assert_eq!(s.grid.voxel_size().0.to_array(), sizes);
         assert_exact(&mesh, &s, &what);
         let largest = sizes.iter().fold(0f64, |a, &b| a.max(b));
         assert_eq!(s.field.background, (2.0 * largest) as f32, "{what}: the band is measured in the largest edge");
@@ -235,7 +235,7 @@ fn written_fields_read_back_as_their_inside() {
     ] {
         let s = run(&mesh, &req, 2);
         let d = s.field.dense();
-        let near = (0.5 * s.grid.voxel_size().length()) as f32;
+        let near = (0.5 * s.grid.voxel_size().0.length()) as f32;
         let want: Vec<bool> = d.iter().map(|&v| if s.signed { v < 0.0 } else { v <= near }).collect();
         assert!(want.iter().filter(|&&w| w).count() > 100, "{what}");
         for format in [DistanceFormat::Vdb, DistanceFormat::Npy, DistanceFormat::Zarr, DistanceFormat::Vti] {
@@ -253,7 +253,7 @@ fn written_fields_read_back_as_their_inside() {
             }
             if format != DistanceFormat::Npy {
                 let (o, size) = back.placement.unwrap();
-                assert_eq!((o, size), (s.grid.origin(), s.grid.voxel_size()), "{what} {format}");
+                assert_eq!((o, size), (s.grid.origin(), s.grid.voxel_size().0), "{what} {format}");
             }
         }
     }

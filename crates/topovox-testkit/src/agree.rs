@@ -114,7 +114,7 @@ pub fn assert_whole_voxel_shift(
     margin: u32,
     voxelize: impl Fn(&Mesh, &GridSpec) -> DenseBits,
 ) {
-    let s = grid.voxel_size();
+    let s = grid.voxel_size().0;
     let big = GridSpec::new(grid.origin() - margin as f64 * s, s, grid.dims().map(|d| (d + 2 * margin) as u64)).unwrap();
     let a = voxelize(mesh, &big);
     let mut moved = mesh.clone();

@@ -39,7 +39,7 @@ pub fn box_grid(bounds: &topovox::Aabb, res: u64, r: &mut impl Rng) -> GridSpec 
 /// its origin: `p / s`; with [`unit_grid`] the same voxels are asked for on
 /// unit cubes (the metamorphic twin of a grid of boxes).
 pub fn scaled_to_unit(mesh: &Mesh, grid: &GridSpec) -> Mesh {
-    let s = grid.voxel_size();
+    let s = grid.voxel_size().0;
     let mut m = mesh.clone();
     m.transform(|p| p / s);
     m
@@ -48,7 +48,7 @@ pub fn scaled_to_unit(mesh: &Mesh, grid: &GridSpec) -> Mesh {
 /// `grid` with unit cubes and its origin divided by its voxel size: the grid
 /// [`scaled_to_unit`]'s mesh is voxelized on.
 pub fn unit_grid(grid: &GridSpec) -> GridSpec {
-    GridSpec::new(grid.origin() / grid.voxel_size(), 1.0, grid.dims().map(u64::from)).unwrap()
+    GridSpec::new(grid.origin() / grid.voxel_size().0, 1.0, grid.dims().map(u64::from)).unwrap()
 }
 
 /// `mesh` rotated by `rot` about the centre of its bounding box.

@@ -26,7 +26,7 @@ fn assert_metamorphic(what: &str, mesh: &Mesh, grid: &GridSpec, run: impl Fn(&Me
     let a = run(mesh, grid);
     let b = run(&scaled_to_unit(mesh, grid), &unit_grid(grid));
     if let Some(v) = a.first_difference(&b) {
-        panic!("{what}: sizes {} and the scaled mesh on cubes differ at {v:?} ({} vs {})", grid.size(), a.count(), b.count());
+        panic!("{what}: sizes {} and the scaled mesh on cubes differ at {v:?} ({} vs {})", grid.voxel_size(), a.count(), b.count());
     }
 }
 
@@ -37,7 +37,7 @@ fn every_surface_mode_agrees_on_boxes() {
         let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
         let grid = box_grid(&mesh.as_ref().bounds(), 40, &mut r);
         for mode in SURFACE {
-            let bits = agree_mode(mode, &mesh, &grid).unwrap_or_else(|e| panic!("{name} on {}: {e}", grid.size()));
+            let bits = agree_mode(mode, &mesh, &grid).unwrap_or_else(|e| panic!("{name} on {}: {e}", grid.voxel_size()));
             assert!(bits.count() > 0, "{name} {mode:?}: empty");
             assert_metamorphic(&format!("{name} {mode:?}"), &mesh, &grid, |m, g| fast(mode, m, g));
         }
@@ -58,7 +58,7 @@ fn solids_agree_on_boxes() {
         let (wind, _) = solid::winding_closed(mesh.as_ref(), &grid).unwrap();
         assert!(slow.count() > 0, "{name}: empty");
         if let Some(v) = slow.first_difference(&wind) {
-            panic!("{name} on {}: winding differs from the reference at {v:?}", grid.size());
+            panic!("{name} on {}: winding differs from the reference at {v:?}", grid.voxel_size());
         }
         let (par, _) = solid::parity(mesh.as_ref(), &grid).unwrap();
         par.for_each_set(|i, j, k| assert!(wind.get(i, j, k), "{name}: parity sets {i} {j} {k} outside the winding solid"));

@@ -133,7 +133,7 @@ fn few_voxels_in_a_wide_grid() {
     let mut mesh = shared_mesh("cow.obj");
     let fit = GridSpec::from_resolution(&mesh.as_ref().bounds(), 60).unwrap();
     let q = (1u64 << 20) as f64;
-    mesh.positions.iter_mut().for_each(|p| *p = (((*p - fit.origin()) / fit.voxel_size() + 1.0) * q).round() / q);
+    mesh.positions.iter_mut().for_each(|p| *p = (((*p - fit.origin()) / fit.voxel_size().0 + 1.0) * q).round() / q);
     let small = GridSpec::new(glam::DVec3::ZERO, 1.0, fit.dims().map(|d| d as u64 + 2)).unwrap();
     let wide = GridSpec::new(glam::DVec3::ZERO, 1.0, [8192, 8192, small.dims()[2] as u64]).unwrap();
     let mut moved = mesh.clone();

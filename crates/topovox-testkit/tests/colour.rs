@@ -134,7 +134,7 @@ fn spot_voxel_colours_match_direct_texture_lookups() {
     for slot in (0..a.keys.len()).step_by(a.keys.len() / 150) {
         let v = a.voxel(a.keys[slot]);
         let lo = grid.voxel_min(v);
-        let hi = lo + grid.voxel_size();
+        let hi = lo + grid.voxel_size().0;
         let direct = direct_lookup(&spot, lo, hi);
         let total: f64 = direct.iter().map(|d| d.1).sum();
         if total <= 0.0 {
@@ -155,7 +155,7 @@ fn spot_voxel_colours_match_direct_texture_lookups() {
             &direct[..direct.len().min(3)]
         );
         let cov = a.coverage.as_ref().unwrap()[slot] as f64;
-        let s = grid.cube_size().unwrap();
+        let s = grid.voxel_size().cube().unwrap();
         let want = total / (s * s);
         assert!((cov - want).abs() < 0.02 + 0.02 * want, "voxel {v:?}: coverage {cov} vs sampled {want}");
     }

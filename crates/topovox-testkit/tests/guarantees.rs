@@ -105,7 +105,7 @@ fn closed_shared_meshes_on_grids_of_boxes() {
         let mesh = rotated(&shared_mesh(name), random_rotation(&mut r));
         let base = mesh.as_ref().bounds().extent().max_element() / 40.0;
         let grid = with_margin(&mesh, DVec3::new(base * r.random_range(1.0..8.0), base * r.random_range(1.0..8.0), base));
-        surface_guarantees(&format!("{name} on sizes {}", grid.size()), &mesh, &grid);
+        surface_guarantees(&format!("{name} on sizes {}", grid.voxel_size()), &mesh, &grid);
     }
 }
 

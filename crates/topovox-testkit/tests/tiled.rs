@@ -85,7 +85,7 @@ fn a_window_of_a_large_grid_equals_the_window_run_alone() {
     let mesh = shared_mesh("cheburashka.obj");
     let big = GridSpec::from_resolution(&mesh.as_ref().bounds(), 4096).unwrap();
     let (whole, _) = tiled(Mode::Sep26, mesh.as_ref(), &big, 512, &Options::default()).unwrap();
-    let s = big.voxel_size();
+    let s = big.voxel_size().0;
     // A window around the middle voxel of the surface, in a corner of
     // tiles (it spans 8 of them).
     let mut all = Vec::new();
@@ -283,7 +283,7 @@ fn sparse_flood_fill_equals_dense() {
     }
     let cow = rotated(&shared_mesh("cow.obj"), random_rotation(&mut r));
     let grid = GridSpec::from_resolution(&cow.as_ref().bounds(), 60).unwrap();
-    let wide = GridSpec::new(grid.origin() - grid.voxel_size() * 37.0, grid.voxel_size(), grid.dims().map(|d| d as u64 + 80)).unwrap();
+    let wide = GridSpec::new(grid.origin() - grid.voxel_size().0 * 37.0, grid.voxel_size().0, grid.dims().map(|d| d as u64 + 80)).unwrap();
     check(Mode::Cover, &cow, &wide, "rotated cow with room around it");
 }
 

@@ -103,7 +103,7 @@ fn swapping_axes_transposes_the_solid_of_open_meshes() {
         s.transform(|p| DVec3::new(p.y, p.x, p.z));
         let o = grid.origin();
         let d = grid.dims();
-        let sgrid = GridSpec::new(DVec3::new(o.y, o.x, o.z), grid.voxel_size(), [d[1] as u64, d[0] as u64, d[2] as u64]).unwrap();
+        let sgrid = GridSpec::new(DVec3::new(o.y, o.x, o.z), grid.voxel_size().0, [d[1] as u64, d[0] as u64, d[2] as u64]).unwrap();
         let (a, _) = winding::winding(m.as_ref(), &grid).unwrap();
         let (b, _) = winding::winding(s.as_ref(), &sgrid).unwrap();
         let mut differ = 0u64;

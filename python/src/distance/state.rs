@@ -22,7 +22,7 @@ pub(crate) fn save<'py>(py: Python<'py>, s: &Sdf) -> PyResult<Bound<'py, PyAny>>
     let d = PyDict::new(py);
     let g = &s.grid;
     d.set_item("origin", g.origin().to_array().to_vec())?;
-    d.set_item("spacing", g.voxel_size().to_array().to_vec())?;
+    d.set_item("spacing", g.voxel_size().0.to_array().to_vec())?;
     d.set_item("dims", g.dims().to_vec())?;
     d.set_item("signed", s.signed)?;
     d.set_item("background", s.field.background)?;

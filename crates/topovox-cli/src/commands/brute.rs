@@ -18,7 +18,7 @@ pub fn cover(mesh: MeshRef<'_>, grid: &GridSpec) -> Vec<u64> {
     let wpr = (nx as usize).div_ceil(64);
     let mut bits = vec![0u64; wpr * ny as usize * nz as usize];
     // Vertices to grid units once, as a C loop would.
-    let (o, inv) = (grid.origin(), 1.0 / grid.voxel_size());
+    let (o, inv) = (grid.origin(), 1.0 / grid.voxel_size().0);
     let verts: Vec<V> = mesh.positions.iter().map(|p| ((*p - o) * inv).to_array()).collect();
     for t in mesh.triangles {
         let (Some(&a), Some(&b), Some(&c)) = (verts.get(t[0] as usize), verts.get(t[1] as usize), verts.get(t[2] as usize)) else {

@@ -86,7 +86,7 @@ fn finish(
     if a.json {
         let o = grid.origin();
         let v = json!({"input": a.input, "output": a.output, "format": format.name(), "dims": dims, "voxels": voxels,
-            "origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(grid.size()), "grid_from": source, "export": facts, "sparse": sparse});
+            "origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(grid.voxel_size()), "grid_from": source, "export": facts, "sparse": sparse});
         return crate::console::print_stdout(&v.to_string());
     }
     if a.quiet {

@@ -47,7 +47,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
     if a.json {
         let extra = json!({
             "origin": [o.x, o.y, o.z],
-            "voxel_size": topovox_io::size_json(g.size()),
+            "voxel_size": topovox_io::size_json(g.voxel_size()),
             "dims": dims,
             "load_s": load_s,
             "write_s": write_s,
@@ -78,7 +78,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
             o.x,
             o.y,
             o.z,
-            g.size(),
+            g.voxel_size(),
             sdf.distance_s * 1e3,
             total_s,
             a.output.display()

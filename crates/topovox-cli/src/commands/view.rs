@@ -62,7 +62,7 @@ pub fn run(a: &ViewArgs) -> Result<()> {
             let grid = plan::grid_request(&a.grid)?.fit(&loaded.report.bounds)?;
             plan::check_memory(&grid)?;
             let (bits, _) = voxelize::fast(mode, loaded.mesh.as_ref(), &grid, &Options::default());
-            add_voxels(&mut scene, &bits.to_dense(), grid.origin().as_vec3() + offset, grid.voxel_size().as_vec3());
+            add_voxels(&mut scene, &bits.to_dense(), grid.origin().as_vec3() + offset, grid.voxel_size().0.as_vec3());
         }
     }
     let culling = a.culling;

@@ -45,7 +45,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     if let Some((path, o)) = &preview {
         bar.phase("rendering the preview");
         let (v, attrs) = (&done.voxels, done.attributes.as_ref());
-        let o = &topovox::render::raycast::RenderOptions { voxel_shape: v.grid.voxel_size().to_array(), ..*o };
+        let o = &topovox::render::raycast::RenderOptions { voxel_shape: v.grid.voxel_size().0.to_array(), ..*o };
         let outline = a.picture.outline.then(|| crate::pictures::outline_triangles(loaded.mesh.as_ref(), &v.grid));
         match &v.voxels {
             topovox_job::Voxels::Sparse(sparse) => {
@@ -125,7 +125,7 @@ fn print_summary(a: &VoxelizeArgs, job: &VoxelizeJob, loaded: &topovox_io::Loade
                 o.x,
                 o.y,
                 o.z,
-                grid.size(),
+                grid.voxel_size(),
                 method,
                 v.voxelize_s * 1e3,
                 total_s,

@@ -97,7 +97,7 @@ pub(super) fn put_grid_head(o: &mut dyn Out, g: &GridOut<'_>, grid: &GridSpec) -
         }
     }
     let o_ = grid.origin();
-    let s = grid.voxel_size();
+    let s = grid.voxel_size().0;
     let dims = grid.dims().map(|d| d as i32);
     let mut entries: Vec<(&str, &str, Vec<u8>)> = Vec::new();
     if let Some(class) = g.class {
@@ -111,7 +111,7 @@ pub(super) fn put_grid_head(o: &mut dyn Out, g: &GridOut<'_>, grid: &GridSpec) -
     entries.push(("name", "string", name.as_bytes().to_vec()));
     entries.push(("topovox_dims", "vec3i", vec3i(dims)));
     entries.push(("topovox_origin", "vec3d", vec3d(o_.to_array())));
-    entries.push(match grid.cube_size() {
+    entries.push(match grid.voxel_size().cube() {
         Some(c) => ("topovox_voxel_size", "double", c.to_le_bytes().to_vec()),
         None => ("topovox_voxel_size", "vec3d", vec3d(s.to_array())),
     });
@@ -121,7 +121,7 @@ pub(super) fn put_grid_head(o: &mut dyn Out, g: &GridOut<'_>, grid: &GridSpec) -
     }
     // OpenVDB's `ScaleTranslateMap::write` order: translation, scale, voxel
     // size, 1/scale, 1/scale², 1/(2·scale); the uniform map is the same.
-    put_str(o, if grid.cube_size().is_some() { "UniformScaleTranslateMap" } else { "ScaleTranslateMap" })?;
+    put_str(o, if grid.voxel_size().cube().is_some() { "UniformScaleTranslateMap" } else { "ScaleTranslateMap" })?;
     let t = o_ + 0.5 * s;
     for v in [t, s, s, 1.0 / s, 1.0 / (s * s), 0.5 / s] {
         o.put(&vec3d(v.to_array()))?;
@@ -281,7 +281,7 @@ pub(super) fn put_bool_leaves(o: &mut dyn Out, tree: &Tree) -> std::io::Result<(
 /// A deterministic UUID-shaped identifier of the contents.
 pub(super) fn uuid(grid: &GridSpec, count: u64) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    let sizes = grid.size().recorded().into_iter().map(f64::to_bits);
+    let sizes = grid.voxel_size().recorded().into_iter().map(f64::to_bits);
     for v in grid.dims().iter().map(|&d| d as u64).chain([count]).chain(sizes) {
         h = (h ^ v).wrapping_mul(0x0100_0000_01b3);
     }

@@ -416,9 +416,9 @@ impl<'a> Ctx<'a> {
     /// by the inverse transpose of `u = (p - origin) / s`, which is `n / s`.
     fn unit_normal(&self, t: usize) -> DVec3 {
         let n = self.corners(t).map(|p| (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero()).unwrap_or(DVec3::ZERO);
-        match self.grid.cube_size() {
+        match self.grid.voxel_size().cube() {
             Some(_) => n,
-            None => (n / self.grid.voxel_size()).normalize_or_zero(),
+            None => (n / self.grid.voxel_size().0).normalize_or_zero(),
         }
     }
 

@@ -159,7 +159,7 @@ pub(crate) fn centre_range(grid: &GridSpec, lo: DVec3, hi: DVec3) -> Option<([u3
 /// evaluate every piece's grown box, many times the grid (issue 54: band 3
 /// on a 16×1×13 grid took 21.6 s where the dense field took 0.7 s).
 pub fn band(pieces: &Pieces, grid: &GridSpec, width: f64, stop: &Stop) -> Option<Band> {
-    let radius = width * grid.voxel_size().max_element();
+    let radius = width * grid.voxel_size().0.max_element();
     if covers_grid(pieces, grid, radius) {
         return super::nearest::dense(pieces, grid, stop).map(|d| Band::from_dense(grid.dims(), radius, &d));
     }
@@ -211,7 +211,7 @@ pub(crate) fn by_bricks(pieces: &Pieces, grid: &GridSpec, radius: f64, stop: &St
 /// `(brick key, piece)` for every brick a piece's grown box reaches that
 /// can hold a centre within `radius` of it, sorted.
 fn bin(pieces: &Pieces, grid: &GridSpec, radius: f64) -> Vec<(u64, u32)> {
-    let h = grid.voxel_size();
+    let h = grid.voxel_size().0;
     // A brick's centres lie within this of the brick's centre.
     let half_diagonal = 3.5 * h.length();
     let mut bins: Vec<(u64, u32)> = pieces
@@ -264,7 +264,7 @@ fn brick(pieces: &Pieces, ids: impl Iterator<Item = usize>, grid: &GridSpec, at:
     let dims = grid.dims();
     let size: [usize; 3] = std::array::from_fn(|a| (dims[a] - origin[a]).min(8) as usize);
     // The centres' coordinates, as `GridSpec::voxel_center` computes them.
-    let (o, h) = (grid.origin(), grid.voxel_size());
+    let (o, h) = (grid.origin(), grid.voxel_size().0);
     let axis = |a: usize| -> [f64; 8] { std::array::from_fn(|x| o[a] + (origin[a] + x as u32) as f64 * h[a] + 0.5 * h[a]) };
     let (xs, ys, zs) = (axis(0), axis(1), axis(2));
     // Nearest pieces first: their distances make the box test below turn

@@ -60,11 +60,11 @@ fn band_and_dense_match_the_reference() {
         let [_, ny, nz] = g.dims().map(|d| d as usize);
         let at = |i: u32, j: u32, k: u32| (i as usize * ny + j as usize) * nz + k as usize;
         for (n, (&d, &w)) in dense.iter().zip(&want).enumerate() {
-            assert!(close(d, w, g.voxel_size().max_element()), "round {round}: voxel {n}: dense {d}, reference {w}");
+            assert!(close(d, w, g.voxel_size().0.max_element()), "round {round}: voxel {n}: dense {d}, reference {w}");
         }
         for width in [1.0, 2.5, 3.0] {
             let b = band::band(&pieces, &g, width, &Stop::new()).unwrap();
-            let r = width * g.voxel_size().max_element();
+            let r = width * g.voxel_size().0.max_element();
             let mut seen = vec![false; want.len()];
             b.for_each(|i, j, k, d| {
                 let n = at(i, j, k);
@@ -88,7 +88,7 @@ fn a_band_covering_the_grid_is_the_dense_field_with_the_same_values() {
         let mesh = soup(&mut rng, 8 + round * 3);
         let g = grid(&mut rng);
         let pieces = Pieces::of(mesh.as_ref()).unwrap();
-        let h = g.voxel_size().max_element();
+        let h = g.voxel_size().0.max_element();
         // Wide enough to cover the grid: the dense route is taken, and
         // gives what the bricks give.
         let wide = 80.0 * g.dims().iter().copied().max().unwrap() as f64;

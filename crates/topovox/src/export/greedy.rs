@@ -285,7 +285,7 @@ fn clear(row: &mut [u64], x0: u32, x1: u32) {
 pub fn quads_to_mesh(quads: &[Quad], grid: &GridSpec) -> Mesh {
     let mut positions = Vec::with_capacity(quads.len() * 4);
     let mut triangles = Vec::with_capacity(quads.len() * 2);
-    let (o, s) = (grid.origin(), grid.voxel_size());
+    let (o, s) = (grid.origin(), grid.voxel_size().0);
     for q in quads {
         let base = positions.len() as u32;
         for c in q.corners() {

@@ -169,19 +169,10 @@ impl GridSpec {
         self.origin
     }
 
-    /// A voxel's edge lengths along x, y, z.
-    pub fn voxel_size(&self) -> DVec3 {
-        self.voxel_size
-    }
-
-    /// The voxel size as given: one number for cubes, three otherwise.
-    pub fn size(&self) -> VoxelSize {
+    /// A voxel's edge lengths: `.0` along x, y, z; `.cube()` the edge of
+    /// cubic voxels; shown as one number for cubes, three otherwise.
+    pub fn voxel_size(&self) -> VoxelSize {
         VoxelSize(self.voxel_size)
-    }
-
-    /// The edge length when voxels are cubes; `None` for boxes.
-    pub fn cube_size(&self) -> Option<f64> {
-        self.size().cube()
     }
 
     /// Voxels along x, y, z.
@@ -243,7 +234,7 @@ mod tests {
     fn resolution_fits_longest_side() {
         let g = GridSpec::from_resolution(&bbox([0.0; 3], [2.0, 1.0, 0.5]), 8).unwrap();
         assert_eq!(g.dims(), [8, 4, 2]);
-        assert_eq!(g.cube_size(), Some(0.25));
+        assert_eq!(g.voxel_size().cube(), Some(0.25));
     }
 
     #[test]
@@ -280,10 +271,10 @@ mod tests {
     fn boxes_fit_per_axis() {
         let g = GridSpec::from_voxel_size(&bbox([0.0; 3], [1.4, 1.4, 5.0]), [0.7, 0.7, 2.5]).unwrap();
         assert_eq!(g.dims(), [2, 2, 2]);
-        assert_eq!(g.cube_size(), None);
+        assert_eq!(g.voxel_size().cube(), None);
         assert_eq!(g.to_grid_units(DVec3::new(0.7, 1.4, 2.5)), DVec3::new(1.0, 2.0, 1.0));
         assert!((g.voxel_center([1, 0, 1]) - DVec3::new(1.05, 0.35, 3.75)).length() < 1e-12);
-        assert_eq!(g.size().to_string(), "0.7,0.7,2.5");
+        assert_eq!(g.voxel_size().to_string(), "0.7,0.7,2.5");
         assert_eq!(VoxelSize::from(0.5).to_string(), "0.5");
     }
 }

@@ -107,7 +107,7 @@ pub fn prefers(mode: Mode, mesh: MeshRef<'_>, grid: &GridSpec) -> bool {
         .step_by(step)
         .filter_map(|t| {
             let [a, b, c] = [mesh.positions.get(t[0] as usize)?, mesh.positions.get(t[1] as usize)?, mesh.positions.get(t[2] as usize)?];
-            let e = ((a.max(*b).max(*c) - a.min(*b).min(*c)) / grid.voxel_size()).max_element();
+            let e = ((a.max(*b).max(*c) - a.min(*b).min(*c)) / grid.voxel_size().0).max_element();
             e.is_finite().then_some(e)
         })
         .collect();

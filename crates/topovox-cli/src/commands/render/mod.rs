@@ -81,7 +81,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         topovox_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
         let grid = plan::grid_request(&a.grid)?.fit(&loaded.report.bounds)?;
         plan::check_memory(&grid)?;
-        o.voxel_shape = grid.voxel_size().to_array();
+        o.voxel_shape = grid.voxel_size().0.to_array();
         for w in &loaded.warnings {
             eprintln!("topovox: warning: {}: {w}", a.input.display());
         }
