@@ -30,9 +30,9 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 use topovox::voxelize::Stop;
 
-use crate::distance::{DistanceFormat, SdfOptions, SdfRequest};
+use crate::distance::{DistanceFormat, SdfOptions};
 use crate::error::{JobError, Result};
-use crate::job::VoxelizeJob;
+use crate::job::{SdfJob, VoxelizeJob};
 use crate::options::JobOptions;
 use crate::output::Output;
 use topovox::choice::Choice;
@@ -73,10 +73,7 @@ pub enum Work {
     /// `voxelize`.
     Voxelize(Box<VoxelizeJob>),
     /// `sdf`: a distance field.
-    Sdf {
-        /// The field, and the format it is written in.
-        request: SdfRequest,
-    },
+    Sdf(SdfJob),
 }
 
 impl BatchOptions {
@@ -96,7 +93,7 @@ impl BatchOptions {
         let mut fingerprint = crate::options::fingerprint_of(o, format.name());
         fingerprint["run"] = json!("sdf");
         Ok(BatchOptions {
-            work: Work::Sdf { request: o.request(format)? },
+            work: Work::Sdf(SdfJob { request: o.request(format)? }),
             threads: o.run.threads,
             read: o.run.read_options(),
             fingerprint,
@@ -107,7 +104,7 @@ impl BatchOptions {
     pub fn extension(&self) -> String {
         match &self.work {
             Work::Voxelize(job) => job.format.name().replace("npy-bool", "npy"),
-            Work::Sdf { request } => request.format.name().to_string(),
+            Work::Sdf(job) => job.request.format.name().to_string(),
         }
     }
 }
@@ -526,10 +523,7 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
         let run = || -> Result<Value> {
             let mut facts = match &opts.work {
                 Work::Voxelize(job) => voxelize_one(job, &loaded, &name, &item.output, stop)?,
-                Work::Sdf { request } => {
-                    topovox_io::atomic::refuse_overwriting_inputs(&item.output, &loaded.sources)?;
-                    sdf_one(&loaded, &name, &item.output, request, stop.map(|s| &**s))?
-                }
+                Work::Sdf(job) => sdf_one(job, &loaded, &name, &item.output, stop.map(|s| &**s))?,
             };
             facts["times"]["load_s"] = json!(load_s);
             facts["triangles"] = json!(loaded.report.triangles);
@@ -586,17 +580,14 @@ fn voxelize_one(job: &VoxelizeJob, loaded: &topovox_io::LoadedMesh, name: &str, 
 }
 
 /// The distance field of one loaded mesh, written: the record's facts.
-fn sdf_one(loaded: &topovox_io::LoadedMesh, name: &str, out: &Path, request: &SdfRequest, stop: Option<&Stop>) -> Result<Value> {
-    let t = Instant::now();
-    let sdf = crate::distance::sdf(loaded.mesh.as_ref(), name, request, stop)?;
-    let distance_s = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    crate::distance::write(out, request.format, &sdf, stop)?;
+fn sdf_one(job: &SdfJob, loaded: &topovox_io::LoadedMesh, name: &str, out: &Path, stop: Option<&Stop>) -> Result<Value> {
+    let done = job.run(out, loaded, name, None, stop)?;
+    let sdf = &done.sdf;
     Ok(json!({
         "grid": grid_json(&sdf.grid),
         "stored_voxels": sdf.field.band.count(),
         "signed": sdf.signed,
-        "times": {"sdf_s": distance_s, "write_s": t.elapsed().as_secs_f64()},
+        "times": {"sdf_s": done.sdf_s, "write_s": done.write_s},
         "warnings": sdf.warnings,
     }))
 }

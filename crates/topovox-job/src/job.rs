@@ -6,6 +6,8 @@
 //! voxels, the one attribute rule ([`crate::attributes_for`]) and the write.
 //! `topovox voxelize` and `topovox batch` run it; Python's `voxelize`,
 //! which writes nothing, runs the plan and the rule directly.
+//! [`SdfJob`] is the same two steps for distance fields (`topovox sdf`,
+//! `topovox batch --run sdf`).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -106,5 +108,59 @@ impl VoxelizeJob {
         let write = topovox_io::WriteOptions { stop: stop.cloned(), ..self.write.clone() };
         let export = crate::output::write(out, self.format, &v.voxels, &v.grid, attributes.as_ref(), &write)?;
         Ok(Done { voxels: v, attributes, export, attributes_s, write_s: t.elapsed().as_secs_f64() })
+    }
+}
+
+/// A distance-field job checked before any mesh is read.
+#[derive(Clone, Debug)]
+pub struct SdfJob {
+    /// The validated request (grid, band, sign, the format it is written in).
+    pub request: crate::distance::SdfRequest,
+}
+
+/// What [`SdfJob::run`] made and wrote.
+pub struct SdfDone {
+    /// The field and the facts of its making.
+    pub sdf: crate::distance::Sdf,
+    /// Seconds making it (the sign and the distances).
+    pub sdf_s: f64,
+    /// Seconds writing.
+    pub write_s: f64,
+}
+
+impl SdfJob {
+    /// Checks everything that needs no mesh: the options, the output's
+    /// folder, and that the output is none of `inputs`.
+    pub fn prepare(
+        options: &crate::distance::SdfOptions,
+        out: &Path,
+        format: crate::distance::DistanceFormat,
+        inputs: &[PathBuf],
+    ) -> Result<SdfJob> {
+        let job = SdfJob { request: options.request(format)? };
+        crate::output::check_output_path(out)?;
+        topovox_io::atomic::refuse_overwriting_inputs(out, inputs)?;
+        Ok(job)
+    }
+
+    /// The field of `loaded` (named `name` in messages), written to `out`;
+    /// `stop` ends it early (nothing is written).
+    pub fn run(
+        &self,
+        out: &Path,
+        loaded: &LoadedMesh,
+        name: &str,
+        progress: Option<&dyn Progress>,
+        stop: Option<&Stop>,
+    ) -> Result<SdfDone> {
+        topovox_io::atomic::refuse_overwriting_inputs(out, &loaded.sources)?;
+        progress.inspect(|p| p.phase("computing distances"));
+        let t = Instant::now();
+        let sdf = crate::distance::sdf(loaded.mesh.as_ref(), name, &self.request, stop)?;
+        let sdf_s = t.elapsed().as_secs_f64();
+        progress.inspect(|p| p.phase("writing"));
+        let t = Instant::now();
+        crate::distance::write(out, self.request.format, &sdf, stop)?;
+        Ok(SdfDone { sdf, sdf_s, write_s: t.elapsed().as_secs_f64() })
     }
 }

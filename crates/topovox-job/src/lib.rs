@@ -33,7 +33,7 @@ pub mod table;
 
 pub use error::{JobError, Result};
 pub use grid::{Fit, GridOptions, GridRequest};
-pub use job::{Done, VoxelizeJob};
+pub use job::{Done, SdfDone, SdfJob, VoxelizeJob};
 pub use memory::{available_memory, budget, bytes, check_memory, dense_fits, parse_size, peak_memory};
 pub use options::{ExportOptions, JobOptions, RunOptions, KEYWORDS};
 pub use plan::{

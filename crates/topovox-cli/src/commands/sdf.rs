@@ -5,7 +5,7 @@ use std::time::Instant;
 use anyhow::Result;
 use serde_json::json;
 use topovox_job::distance::DistanceFormat;
-use topovox_job::Choice;
+use topovox_job::{Choice, SdfJob};
 
 use crate::args::SdfArgs;
 use crate::progress::Bar;
@@ -15,9 +15,7 @@ pub fn run(a: &SdfArgs) -> Result<()> {
     // Everything that does not need the mesh first.
     let opts = &a.sdf.options;
     let format = DistanceFormat::of(a.format.map(|f| f.name()), &a.output)?;
-    let req = opts.request(format)?;
-    topovox_job::output::check_output_path(&a.output)?;
-    topovox_io::atomic::refuse_overwriting_inputs(&a.output, std::slice::from_ref(&a.mesh))?;
+    let job = SdfJob::prepare(opts, &a.output, format, std::slice::from_ref(&a.mesh))?;
     let pool = topovox_job::pool_for(opts.run.threads, "--threads")?;
     let threads = pool.current_num_threads();
 
@@ -26,20 +24,15 @@ pub fn run(a: &SdfArgs) -> Result<()> {
     let t_load = Instant::now();
     let loaded = topovox_io::read_mesh(&a.mesh, &opts.run.read_options())?;
     let load_s = t_load.elapsed().as_secs_f64();
-    topovox_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
     for w in &loaded.warnings {
         eprintln!("topovox: warning: {}: {w}", a.mesh.display());
     }
-    bar.phase("computing distances");
     let name = a.mesh.display().to_string();
-    let sdf = pool.install(|| topovox_job::distance::sdf(loaded.mesh.as_ref(), &name, &req, None))?;
+    let done = pool.install(|| job.run(&a.output, &loaded, &name, Some(&bar), None))?;
+    let (sdf, write_s) = (&done.sdf, done.write_s);
     for w in &sdf.warnings {
         eprintln!("topovox: warning: {w}");
     }
-    bar.phase("writing");
-    let t_write = Instant::now();
-    pool.install(|| topovox_job::distance::write(&a.output, format, &sdf, None))?;
-    let write_s = t_write.elapsed().as_secs_f64();
     bar.finish();
     let total_s = t_total.elapsed().as_secs_f64();
     let (g, dims) = (sdf.grid, sdf.grid.dims());
