@@ -42,20 +42,16 @@ pub(crate) fn interruptible_ticking<T: Send>(
                 let _ = done.send(work());
             })
             .map_err(|e| PyRuntimeError::new_err(format!("cannot start a worker thread: {e}")))?;
-        let panicked = |worker: std::thread::ScopedJoinHandle<'_, ()>| {
-            worker
-                .join()
-                .map_or_else(|p| std::panic::resume_unwind(p), |()| PyRuntimeError::new_err("the worker thread ended without a result"))
-        };
-        wait(py, result, tick, move |interrupted| match interrupted {
-            // Its result (incomplete, or an Interrupted error) is dropped.
-            true => {
+        match wait(py, result, tick) {
+            Waited::Done(r) => Ok(r),
+            Waited::Raised(e) => {
                 stop.request();
+                // Its result (incomplete, or an Interrupted error) is dropped.
                 let _ = py.detach(|| worker.join());
-                None
+                Err(e)
             }
-            false => Some(panicked(worker)),
-        })
+            Waited::Died => Err(died(worker.join())),
+        }
     })
 }
 
@@ -70,48 +66,48 @@ pub(crate) fn interruptible_read<T: Send + 'static>(py: Python<'_>, work: impl F
             let _ = done.send(work());
         })
         .map_err(|e| PyRuntimeError::new_err(format!("cannot start a worker thread: {e}")))?;
-    wait(
-        py,
-        result,
-        |_| Ok(()),
-        move |interrupted| {
-            (!interrupted).then(|| {
-                worker
-                    .join()
-                    .map_or_else(|p| std::panic::resume_unwind(p), |()| PyRuntimeError::new_err("the worker thread ended without a result"))
-            })
-        },
-    )
+    match wait(py, result, |_| Ok(())) {
+        Waited::Done(r) => Ok(r),
+        Waited::Raised(e) => Err(e),
+        Waited::Died => Err(died(worker.join())),
+    }
+}
+
+/// How [`wait`] ended.
+enum Waited<T> {
+    /// The work's result.
+    Done(T),
+    /// A signal handler or `tick` raised this.
+    Raised(PyErr),
+    /// The worker ended without a result: it panicked.
+    Died,
+}
+
+/// The error of a worker that ended without a result: its panic goes on
+/// here.
+fn died(joined: std::thread::Result<()>) -> PyErr {
+    joined.map_or_else(|p| std::panic::resume_unwind(p), |()| PyRuntimeError::new_err("the worker thread ended without a result"))
 }
 
 /// Waits for `result`, running Python's signal handlers and `tick` every
-/// [`SIGNAL_POLL`] and once at the end. `end(true)` is called when a
-/// handler or `tick` raised (that error is returned); `end(false)` when the
-/// worker ended without a result, and returns its panic's error.
-fn wait<T>(
-    py: Python<'_>,
-    mut result: mpsc::Receiver<T>,
-    mut tick: impl FnMut(Python<'_>) -> PyResult<()>,
-    end: impl FnOnce(bool) -> Option<PyErr>,
-) -> PyResult<T>
-where
-    T: Send,
-{
+/// [`SIGNAL_POLL`] and once at the end.
+fn wait<T: Send>(py: Python<'_>, mut result: mpsc::Receiver<T>, mut tick: impl FnMut(Python<'_>) -> PyResult<()>) -> Waited<T> {
     loop {
         // The receiver travels into the wait and back: it is not `Sync`.
         let got;
         (got, result) = py.detach(move || (result.recv_timeout(SIGNAL_POLL), result));
         match got {
-            Ok(r) => return tick(py).map(|()| r),
-            // The worker ended without a result: it panicked.
-            Err(RecvTimeoutError::Disconnected) => {
-                return Err(end(false).unwrap_or_else(|| PyRuntimeError::new_err("the worker thread ended without a result")))
+            Ok(r) => {
+                return match tick(py) {
+                    Ok(()) => Waited::Done(r),
+                    Err(e) => Waited::Raised(e),
+                }
             }
+            Err(RecvTimeoutError::Disconnected) => return Waited::Died,
             Err(RecvTimeoutError::Timeout) => {}
         }
         if let Err(e) = py.check_signals().and_then(|()| tick(py)) {
-            end(true);
-            return Err(e);
+            return Waited::Raised(e);
         }
     }
 }
