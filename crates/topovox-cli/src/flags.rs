@@ -55,7 +55,7 @@ impl TypedValueParser for Names {
 
 /// The clap argument of one row.
 fn arg(k: &'static Keyword) -> Arg {
-    let mut a = Arg::new(k.name).long(k.name.replace('_', "-")).help(k.help);
+    let mut a = Arg::new(k.name).long(k.long()).help(k.help);
     for (alias, name) in ALIASES {
         if *name == k.name {
             a = a.visible_alias(alias.replace('_', "-"));

@@ -112,8 +112,9 @@ pub(crate) fn cut(s: &str, max: usize) -> String {
     }
 }
 
-/// Text from a file, quoted for a message: at most 40 characters of it.
-pub(crate) fn quoted(s: &str) -> String {
+/// Text from a file or a user, quoted for a message: at most 40
+/// characters of it (and its length when cut).
+pub fn quoted(s: &str) -> String {
     match s.char_indices().nth(40) {
         Some((i, _)) => format!("{:?}… ({} bytes)", &s[..i], s.len()),
         None => format!("{s:?}"),

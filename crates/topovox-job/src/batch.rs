@@ -28,6 +28,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use serde_json::{json, Value};
+use topovox::choice::Choice;
 use topovox::voxelize::Stop;
 
 use crate::distance::{DistanceFormat, SdfOptions};
@@ -35,7 +36,6 @@ use crate::error::{JobError, Result};
 use crate::job::{SdfJob, VoxelizeJob};
 use crate::options::JobOptions;
 use crate::output::Output;
-use topovox::choice::Choice;
 
 /// The manifest's file name in the output folder.
 pub const MANIFEST: &str = "manifest.jsonl";
@@ -527,9 +527,6 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
             };
             facts["times"]["load_s"] = json!(load_s);
             facts["triangles"] = json!(loaded.report.triangles);
-            let mut warnings = loaded.warnings.clone();
-            warnings.extend(facts["warnings"].as_array().into_iter().flatten().filter_map(|w| w.as_str().map(String::from)));
-            facts["warnings"] = json!(warnings);
             Ok(facts)
         };
         match opts.threads {
@@ -566,6 +563,11 @@ fn grid_json(g: &topovox::GridSpec) -> Value {
     json!({"origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(g.voxel_size()), "dims": g.dims()})
 }
 
+/// The record's warnings: the mesh's, then the work's.
+fn warnings<'a>(loaded: &'a topovox_io::LoadedMesh, work: &'a [String]) -> Vec<&'a String> {
+    loaded.warnings.iter().chain(work).collect()
+}
+
 /// Voxelizes one loaded mesh and writes it: the record's facts.
 fn voxelize_one(job: &VoxelizeJob, loaded: &topovox_io::LoadedMesh, name: &str, out: &Path, stop: Option<&Arc<Stop>>) -> Result<Value> {
     let done = job.run(out, loaded, name, None, stop)?;
@@ -575,7 +577,7 @@ fn voxelize_one(job: &VoxelizeJob, loaded: &topovox_io::LoadedMesh, name: &str, 
         "voxels": v.report.voxels,
         "method": v.method,
         "times": {"voxelize_s": v.voxelize_s, "attributes_s": done.attributes_s, "write_s": done.write_s},
-        "warnings": v.warnings,
+        "warnings": warnings(loaded, &v.warnings),
     }))
 }
 
@@ -588,7 +590,7 @@ fn sdf_one(job: &SdfJob, loaded: &topovox_io::LoadedMesh, name: &str, out: &Path
         "stored_voxels": sdf.field.band.count(),
         "signed": sdf.signed,
         "times": {"sdf_s": done.sdf_s, "write_s": done.write_s},
-        "warnings": sdf.warnings,
+        "warnings": warnings(loaded, &sdf.warnings),
     }))
 }
 

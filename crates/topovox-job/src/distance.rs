@@ -274,6 +274,7 @@ pub fn sdf(mesh: MeshRef<'_>, name: &str, req: &SdfRequest, stop: Option<&Stop>)
     let mut facts = json!({"band": req.width.label(), "signed": !req.unsigned, "skipped": pieces.skipped});
     // The sign first: the solid of `--mode solid` with the same method.
     let t = Instant::now();
+    let mut sign = None;
     let inside = if req.unsigned {
         None
     } else {
@@ -291,6 +292,7 @@ pub fn sdf(mesh: MeshRef<'_>, name: &str, req: &SdfRequest, stop: Option<&Stop>)
         }
         warnings.extend(out.warnings);
         facts["sign"] = json!(out.method);
+        sign = Some(out.method.to_string());
         facts["solid"] = out.facts;
         facts["inside_voxels"] = json!(out.bits.count());
         Some(out.bits)
@@ -311,7 +313,6 @@ pub fn sdf(mesh: MeshRef<'_>, name: &str, req: &SdfRequest, stop: Option<&Stop>)
     facts["stored_voxels"] = json!(values.count());
     facts["background"] = json!(background);
     let field = Field::signed(values, inside, background);
-    let sign = facts["sign"].as_str().map(String::from);
     Ok(Sdf { field, grid, signed: !req.unsigned, sign, distance_s, facts, warnings })
 }
 

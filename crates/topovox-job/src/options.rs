@@ -1,6 +1,6 @@
 //! Every option of a voxelization job, once: what `topovox voxelize` and
 //! `topovox batch` take as flags and the Python package as keywords, typed
-//! ([`JobOptions`]), named ([`KEYWORDS`], [`JobOptions::set`]), and turned
+//! ([`JobOptions`]), named ([`KEYWORDS`], [`Table::set_named`]), and turned
 //! here — and nowhere else — into the plan, the attribute policy, the
 //! writer options, the batch options and the batch's fingerprint.
 
@@ -161,12 +161,13 @@ crate::option_table! {
     }
 }
 
-/// Every option [`JobOptions::set`] takes, in documentation order.
+/// Every option [`JobOptions`] takes by name, in documentation order.
 pub const KEYWORDS: &[&[crate::table::Keyword]] = <JobOptions as Table>::KEYWORDS;
 
 impl ExportOptions {
-    /// Whether attributes are carried at all: when any is asked for
-    /// (normals are one). The one attribute rule of every front end.
+    /// Whether Python's `voxelize`, which writes no file, carries
+    /// attributes: when any is asked for (normals are one). Writers follow
+    /// [`crate::attributes_for`], which also asks what the format stores.
     pub fn carries(&self) -> bool {
         self.attributes || self.normals
     }

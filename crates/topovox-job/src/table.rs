@@ -10,6 +10,7 @@
 
 pub use serde_json::{Map, Value};
 use topovox::choice::{Choice, Switch};
+use topovox_io::error::quoted;
 
 use crate::error::{JobError, Result};
 use crate::invalid;
@@ -108,9 +109,14 @@ impl Example {
 }
 
 impl Keyword {
-    /// The CLI flag: `--` and the name with `-` for `_`.
+    /// The CLI's long name: the name with `-` for `_`.
+    pub fn long(&self) -> String {
+        self.name.replace('_', "-")
+    }
+
+    /// The CLI flag: `--` and [`Keyword::long`].
     pub fn flag(&self) -> String {
-        format!("--{}", self.name.replace('_', "-"))
+        format!("--{}", self.long())
     }
 
     /// A CLI flag's text as the value its kind takes: integers and numbers
@@ -146,16 +152,6 @@ impl Keyword {
             },
             Example::Text(_) => OptionValue::Text(raw.into()),
         })
-    }
-}
-
-/// At most 40 characters of what the user wrote.
-fn quoted(raw: &str) -> String {
-    let cut: String = raw.chars().take(40).collect();
-    if cut.len() < raw.len() {
-        format!("{cut:?}…")
-    } else {
-        format!("{cut:?}")
     }
 }
 
