@@ -47,6 +47,7 @@ pub mod export;
 pub mod geom;
 pub mod grid;
 pub mod mesh;
+pub mod mesh_check;
 pub mod raster;
 pub mod render;
 pub mod stop;
