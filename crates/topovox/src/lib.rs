@@ -51,6 +51,7 @@ pub mod mesh_check;
 pub mod raster;
 pub mod render;
 pub mod stop;
+pub mod surface;
 pub mod topology;
 pub mod voxelize;
 

@@ -111,6 +111,21 @@ impl DenseBits {
         }
     }
 
+    /// Sets every voxel `other` sets (same dims).
+    pub fn or_assign(&mut self, other: &DenseBits) {
+        assert_eq!(self.dims, other.dims, "or_assign: dims differ");
+        self.words.par_iter_mut().zip(other.words.par_iter()).for_each(|(a, b)| *a |= b);
+    }
+
+    /// Clears the bits past `nx` in each row (after word-wise shifts).
+    pub fn clear_padding(&mut self) {
+        let tail = self.dims[0] % 64;
+        if tail != 0 {
+            let mask = (1u64 << tail) - 1;
+            self.par_rows_mut().for_each(|row| *row.last_mut().expect("rows have words") &= mask);
+        }
+    }
+
     /// Is `(i, j, k)` inside the grid and set? Signed coordinates, so
     /// neighbour lookups need no bounds checks of their own.
     #[inline]

@@ -1,0 +1,160 @@
+//! Surfaces from voxels: a closed, 2-manifold, oriented,
+//! self-intersection-free triangle mesh around the inside voxels, its
+//! topology decided by the voxels alone ([`tets`]), its vertices placed on
+//! the lattice edges by the caller's rule.
+//!
+//! - [`blocky`]: the boundary of the inside voxels. The voxels are split
+//!   in two along each axis and the surface extracted between the
+//!   half-voxel centres with every vertex at the middle of its edge, so
+//!   flat stretches lie exactly on the voxel faces; where voxels meet only
+//!   along an edge or at a corner the surface passes a quarter voxel from
+//!   it, on one side (Kuhn's diagonal decides which), so it stays a
+//!   manifold and never touches itself.
+//! - [`smooth`]: the surface between the voxel centres, each vertex where
+//!   the exact signed distance to the input mesh crosses zero along its
+//!   edge (linear interpolation of the two exact distances), kept a
+//!   hundredth of the edge away from the centres.
+//! - [`wrap`]: the inside voxels for shells around any input: the solid,
+//!   the cover grown by one voxel, and every cavity they enclose.
+
+pub mod tets;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::distance::nearest::Hierarchy;
+use crate::distance::Pieces;
+use crate::grid::dense::DenseBits;
+use crate::stop::Stop;
+use crate::voxelize::fill::flood_fill;
+use crate::GridSpec;
+
+/// An indexed triangle mesh in world coordinates.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriMesh {
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Triangles, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// How far from the lattice points a smooth vertex is kept, as a fraction
+/// of its edge: the triangles keep a size the output's precision can hold.
+pub const MARGIN: f64 = 0.01;
+
+/// The blocky surface of `inside` on `grid` (see the module doc).
+pub fn blocky(inside: &DenseBits, grid: &GridSpec, stop: &Stop) -> Option<TriMesh> {
+    let halves = refine(inside);
+    let e = tets::extract(&halves, stop)?;
+    let (o, q) = (grid.origin(), grid.voxel_size().0 / 4.0);
+    // Half-voxel centre s sits at (2s + 1) quarters; the middle of an edge
+    // at the sum of its ends' quarters, halved: exact integers.
+    let positions = e
+        .crossings
+        .par_iter()
+        .map(|(a, b)| {
+            let quarters = DVec3::new((a[0] + b[0] + 1) as f64, (a[1] + b[1] + 1) as f64, (a[2] + b[2] + 1) as f64);
+            o + quarters * q
+        })
+        .collect();
+    Some(TriMesh { positions, triangles: e.triangles })
+}
+
+/// The smooth surface of `inside` on `grid`: each vertex on the zero of
+/// the linear interpolation along its edge of the signed distance to
+/// `pieces` (negative at inside centres), or with `offset` (world units)
+/// of `distance − offset` (wrap's shells, which sit off the input),
+/// clamped to [`MARGIN`]`..1 − MARGIN` of the edge.
+pub fn smooth(inside: &DenseBits, grid: &GridSpec, pieces: &Pieces, offset: Option<f64>, stop: &Stop) -> Option<TriMesh> {
+    let e = tets::extract(inside, stop)?;
+    let centre = |p: [i64; 3]| grid.origin() + (DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) + 0.5) * grid.voxel_size().0;
+    let mut points: Vec<[i64; 3]> = e.crossings.iter().flat_map(|(a, b)| [*a, *b]).collect();
+    points.par_sort_unstable();
+    points.dedup();
+    let tree = Hierarchy::new(pieces);
+    let dist: Vec<f64> = points.par_iter().map(|&p| tree.nearest(centre(p), (f64::INFINITY, u32::MAX)).0.sqrt()).collect();
+    let d = |p: &[i64; 3]| dist[points.binary_search(p).expect("every end is listed")];
+    let positions = e
+        .crossings
+        .par_iter()
+        .map(|(a, b)| {
+            // The inside end's value ≤ 0, the outside end's ≥ 0.
+            let (fa, fb) = match offset {
+                None => (-d(a), d(b)),
+                Some(r) => ((d(a) - r).min(0.0), (d(b) - r).max(0.0)),
+            };
+            let t = if fb > fa { -fa / (fb - fa) } else { 0.5 };
+            let (pa, pb) = (centre(*a), centre(*b));
+            pa + (pb - pa) * t.clamp(MARGIN, 1.0 - MARGIN)
+        })
+        .collect();
+    Some(TriMesh { positions, triangles: e.triangles })
+}
+
+/// Wrap's inside voxels: `solid`, `cover` grown by one voxel (26
+/// neighbours), and every voxel they enclose. The grown cover puts every
+/// point of every cover voxel's box strictly inside the extracted
+/// surface, whichever surface, so the shell contains the whole input.
+pub fn wrap(solid: &DenseBits, cover: &DenseBits) -> DenseBits {
+    let mut shell = dilate(cover);
+    shell.or_assign(solid);
+    flood_fill(&shell).0
+}
+
+/// Every voxel within one step (26 neighbours) of a set voxel.
+pub fn dilate(bits: &DenseBits) -> DenseBits {
+    let [_, ny, nz] = bits.dims();
+    let w = bits.words_per_row();
+    let mut out = DenseBits::new(bits.dims());
+    out.par_rows_mut().enumerate().for_each(|(r, row)| {
+        let (j, k) = ((r % ny as usize) as i64, (r / ny as usize) as i64);
+        for dk in -1..=1i64 {
+            for dj in -1..=1i64 {
+                let (jj, kk) = (j + dj, k + dk);
+                if !(0..ny as i64).contains(&jj) || !(0..nz as i64).contains(&kk) {
+                    continue;
+                }
+                let start = (kk as usize * ny as usize + jj as usize) * w;
+                let src = &bits.words()[start..start + w];
+                for n in 0..w {
+                    let lower = if n > 0 { src[n - 1] >> 63 } else { 0 };
+                    let upper = if n + 1 < w { src[n + 1] << 63 } else { 0 };
+                    row[n] |= src[n] | (src[n] << 1 | lower) | (src[n] >> 1 | upper);
+                }
+            }
+        }
+    });
+    out.clear_padding();
+    out
+}
+
+/// Each voxel split in two along each axis (8 half-voxels of its label).
+pub fn refine(bits: &DenseBits) -> DenseBits {
+    let [nx, ny, nz] = bits.dims();
+    let mut out = DenseBits::new([2 * nx, 2 * ny, 2 * nz]);
+    let w = out.words_per_row();
+    out.par_rows_mut().enumerate().for_each(|(r, row)| {
+        let (j, k) = ((r % (2 * ny as usize)) as u32 / 2, (r / (2 * ny as usize)) as u32 / 2);
+        let start = (k as usize * ny as usize + j as usize) * bits.words_per_row();
+        let src = &bits.words()[start..start + bits.words_per_row()];
+        for (n, word) in row.iter_mut().enumerate().take(w) {
+            // Output bits 64n..64n+63 are input bits 32n..32n+31, each twice.
+            let half = (src[n / 2] >> (32 * (n % 2))) as u32;
+            *word = spread(half) * 3;
+        }
+    });
+    out
+}
+
+/// The 32 bits of `x` spread to the even bits of a word.
+fn spread(x: u32) -> u64 {
+    let mut v = x as u64;
+    v = (v | v << 16) & 0x0000_FFFF_0000_FFFF;
+    v = (v | v << 8) & 0x00FF_00FF_00FF_00FF;
+    v = (v | v << 4) & 0x0F0F_0F0F_0F0F_0F0F;
+    v = (v | v << 2) & 0x3333_3333_3333_3333;
+    (v | v << 1) & 0x5555_5555_5555_5555
+}
+
+#[cfg(test)]
+mod tests;
