@@ -4,9 +4,11 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
 use topovox::raster::{RasterMethod, RasterMode};
+use topovox_io::mesh_out::MeshOut;
 use topovox_job::batch::Run;
 use topovox_job::distance::{DistanceFormat, FieldOptions, SdfOptions};
 use topovox_job::output::Output;
+use topovox_job::remesh::RemeshOptions;
 use topovox_job::{ColourRule, ExportOptions, GridOptions, JobOptions, Mode, Switch, Up};
 
 use topovox::render::raycast::View;
@@ -31,6 +33,11 @@ pub enum Command {
     /// mesh in a narrow band (or on every voxel), negative exactly where
     /// `voxelize --mode solid` sets voxels; to .vdb (an OpenVDB level set), .npy, .zarr or .vti.
     Sdf(SdfArgs),
+    /// Watertight mesh of a mesh: closed, 2-manifold, oriented, without
+    /// self-intersections, every part kept, around the voxels `voxelize --mode
+    /// solid` sets (or, with --inside wrap, shells around any input); to .obj,
+    /// .ply, .stl or .glb.
+    Remesh(RemeshArgs),
     /// Print a report of a mesh file: vertices, triangles, degenerate triangles, bounds.
     Info(InfoArgs),
     /// Benchmark voxelization (medians over repeats) on a mesh at several resolutions.
@@ -117,6 +124,26 @@ pub struct SdfArgs {
     /// Output format: vdb, npy, zarr or vti (default: from the extension).
     #[arg(long, value_name = "FORMAT", value_parser = choice::<DistanceFormat>())]
     pub format: Option<DistanceFormat>,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress bar and no summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct RemeshArgs {
+    /// Input mesh (.obj, .stl, .ply, .gltf, .glb, .off).
+    pub mesh: PathBuf,
+    /// Output mesh: .obj or .ply (coordinates exact), .stl or .glb (float).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub remesh: Flags<RemeshOptions>,
+    /// Output format: obj, ply, stl or glb (default: from the extension).
+    #[arg(long, value_name = "FORMAT", value_parser = choice::<MeshOut>())]
+    pub format: Option<MeshOut>,
     /// Print one JSON object on stdout instead of the summary line.
     #[arg(long)]
     pub json: bool,

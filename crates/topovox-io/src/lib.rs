@@ -20,6 +20,7 @@ pub mod error;
 mod fence;
 mod former_name;
 pub mod gltf;
+pub mod mesh_out;
 pub mod mesh_report;
 mod meshes;
 pub mod npy;

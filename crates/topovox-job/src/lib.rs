@@ -29,6 +29,7 @@ pub mod check;
 pub mod distance;
 pub mod options;
 pub mod output;
+pub mod remesh;
 pub mod table;
 
 pub use error::{JobError, Result};

@@ -8,6 +8,7 @@ pub mod convert;
 pub mod gaps;
 pub mod info;
 pub mod raster;
+pub mod remesh;
 pub mod render;
 #[cfg(feature = "gpu")]
 pub mod scene;

@@ -26,6 +26,7 @@ use crate::distance::nearest::Hierarchy;
 use crate::distance::Pieces;
 use crate::grid::dense::DenseBits;
 use crate::stop::Stop;
+use crate::topology::runs::{components, Connectivity, Runs};
 use crate::voxelize::fill::flood_fill;
 use crate::GridSpec;
 
@@ -68,12 +69,26 @@ pub fn blocky(inside: &DenseBits, grid: &GridSpec, stop: &Stop) -> Option<TriMes
 pub fn smooth(inside: &DenseBits, grid: &GridSpec, pieces: &Pieces, offset: Option<f64>, stop: &Stop) -> Option<TriMesh> {
     let e = tets::extract(inside, stop)?;
     let centre = |p: [i64; 3]| grid.origin() + (DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) + 0.5) * grid.voxel_size().0;
-    let mut points: Vec<[i64; 3]> = e.crossings.iter().flat_map(|(a, b)| [*a, *b]).collect();
-    points.par_sort_unstable();
-    points.dedup();
-    let tree = Hierarchy::new(pieces);
-    let dist: Vec<f64> = points.par_iter().map(|&p| tree.nearest(centre(p), (f64::INFINITY, u32::MAX)).0.sqrt()).collect();
-    let d = |p: &[i64; 3]| dist[points.binary_search(p).expect("every end is listed")];
+    let tree = &Hierarchy::new(pieces);
+    // Every end once: inside ends come grouped (crossings are in order of
+    // them), outside ends are sorted out; runs of neighbours share bounds.
+    let mut ends: Vec<[i64; 3]> = e.crossings.iter().flat_map(|(a, b)| [*a, *b]).collect();
+    ends.par_sort_unstable_by_key(|p| [p[2], p[1], p[0]]);
+    ends.dedup();
+    let dist: Vec<f64> = ends
+        .par_chunks(256)
+        .flat_map_iter(|chunk| {
+            let mut best = (f64::INFINITY, u32::MAX);
+            chunk.iter().map(move |&p| {
+                let q = centre(p);
+                // The previous end's nearest piece bounds this search.
+                let bound = if best.1 == u32::MAX { best } else { (pieces.items[best.1 as usize].distance_squared(q), best.1) };
+                best = tree.nearest(q, bound);
+                best.0.sqrt()
+            })
+        })
+        .collect();
+    let d = |p: &[i64; 3]| dist[ends.binary_search_by_key(&[p[2], p[1], p[0]], |e| [e[2], e[1], e[0]]).expect("every end is listed")];
     let positions = e
         .crossings
         .par_iter()
@@ -99,6 +114,29 @@ pub fn wrap(solid: &DenseBits, cover: &DenseBits) -> DenseBits {
     let mut shell = dilate(cover);
     shell.or_assign(solid);
     flood_fill(&shell).0
+}
+
+/// `bits` without its parts (26-connected components) of fewer than `min`
+/// voxels, with how many parts were kept and dropped.
+pub fn drop_small_parts(bits: &DenseBits, min: u64) -> (DenseBits, u64, u64) {
+    let runs = Runs::of(bits, true);
+    // Labels are each component's smallest run index.
+    let (label, count) = components(&runs, Connectivity::TwentySix);
+    let mut size = vec![0u64; runs.len()];
+    for (n, &l) in label.iter().enumerate() {
+        size[l as usize] += (runs.end[n] - runs.start[n] + 1) as u64;
+    }
+    let keep: Vec<bool> = size.iter().map(|&s| s >= min).collect();
+    let kept = (0..runs.len()).filter(|&n| label[n] as usize == n && keep[n]).count() as u64;
+    let mut out = DenseBits::new(bits.dims());
+    for (r, row) in out.rows_mut().enumerate() {
+        for n in runs.row_start[r] as usize..runs.row_start[r + 1] as usize {
+            if keep[label[n] as usize] {
+                DenseBits::fill_row(row, runs.start[n], runs.end[n]);
+            }
+        }
+    }
+    (out, kept, count as u64 - kept)
 }
 
 /// Every voxel within one step (26 neighbours) of a set voxel.

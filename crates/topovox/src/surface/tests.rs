@@ -183,3 +183,16 @@ fn refine_and_dilate_are_what_they_say() {
     assert_eq!(d.words().len(), bits.words().len());
     assert!(d.words().chunks(2).all(|row| row[1] >> 3 == 0), "padding stays clear");
 }
+
+#[test]
+fn small_parts_go_only_when_asked() {
+    let mut bits = DenseBits::new([8, 8, 8]);
+    bits.fill_box([0, 0, 0], [2, 2, 2]);
+    bits.set(5, 5, 5);
+    bits.set(6, 6, 6); // 26-connected to (5, 5, 5): one part of two voxels
+    bits.set(7, 0, 7);
+    assert_eq!(drop_small_parts(&bits, 0), (bits.clone(), 3, 0));
+    let (kept, n, dropped) = drop_small_parts(&bits, 2);
+    assert_eq!((n, dropped, kept.count()), (2, 1, 29));
+    assert!(!kept.get(7, 0, 7) && kept.get(6, 6, 6));
+}

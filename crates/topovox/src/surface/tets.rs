@@ -24,8 +24,8 @@
 //! Triangles are oriented with the inside behind them: the orientation is
 //! decided in integers on the lattice (the sign does not depend on where
 //! on its edges the caller puts each vertex, see [`orient`]). Vertex ids
-//! are the crossing edges in sorted order, so the result is the same for
-//! any thread count.
+//! number the crossing edges in order of their inside end (layer, row,
+//! `i`) and direction, so the result is the same for any thread count.
 //!
 //! **Cost.** Only cubes around boundary points (inside points with an
 //! outside neighbour) are visited, found with word operations on the bit
@@ -51,32 +51,93 @@ pub struct Extracted {
 /// The six tetrahedra of a cube, as corner codes (`x = 1, y = 2, z = 4`).
 const TETS: [[u8; 4]; 6] = [[0, 1, 3, 7], [0, 1, 5, 7], [0, 2, 3, 7], [0, 2, 6, 7], [0, 4, 5, 7], [0, 4, 6, 7]];
 
-/// An edge of the triangulation: its lower point (shifted by one so
-/// `-1` is 0) as a linear index, times 8, plus its axis set.
-type EdgeKey = u64;
+/// A crossing edge by its inside end and direction: `0..7` is
+/// `+e_S`, `7..14` is `−e_S`, for the axis set `S = 1 + (dir % 7)`.
+type Edge = ([i64; 3], u8);
+
+/// The `±e_S` of a direction.
+fn step(dir: u8) -> [i64; 3] {
+    let (s, sign) = (dir % 7 + 1, if dir < 7 { 1 } else { -1 });
+    [(s & 1) as i64 * sign, (s >> 1 & 1) as i64 * sign, (s >> 2 & 1) as i64 * sign]
+}
+
+/// One layer's boundary points (inside points with an outside neighbour
+/// among their 26), in `(j, i)` order, with which of their 14 triangulation
+/// edges cross and where each point's first vertex id starts.
+struct Layer {
+    /// `row_start[j]..row_start[j + 1]` index the points of row `j`.
+    row_start: Vec<u32>,
+    /// The points' `i`.
+    i: Vec<u32>,
+    /// Crossing edges, one bit per direction.
+    mask: Vec<u16>,
+    /// Vertex id of each point's first crossing edge.
+    first: Vec<u32>,
+}
+
+impl Layer {
+    /// The vertex id of a crossing edge whose inside end lies in this layer.
+    fn id(&self, p: [i64; 3], dir: u8) -> u32 {
+        let j = p[1] as usize;
+        let row = self.row_start[j] as usize..self.row_start[j + 1] as usize;
+        let n = row.start + self.i[row].binary_search(&(p[0] as u32)).expect("a crossing's inside end is a boundary point");
+        self.first[n] + (self.mask[n] & ((1u16 << dir) - 1)).count_ones()
+    }
+}
 
 /// The surface between the set and clear points of `labels`. `None` when
 /// `stop` was requested.
 pub fn extract(labels: &DenseBits, stop: &Stop) -> Option<Extracted> {
     let dims = labels.dims();
-    let boundary: Vec<Vec<(u32, u32)>> = (0..dims[2]).into_par_iter().map(|k| boundary_points(labels, k)).collect();
-    let layers: Option<Vec<Vec<[EdgeKey; 3]>>> = (-1..dims[2] as i64)
-        .into_par_iter()
-        .map(|k| {
-            if stop.requested() {
-                return None;
-            }
-            Some(layer_triangles(labels, &boundary, k))
-        })
-        .collect();
-    let tris: Vec<[EdgeKey; 3]> = layers?.into_iter().flatten().collect();
-    let mut keys: Vec<EdgeKey> = tris.iter().flatten().copied().collect();
-    keys.par_sort_unstable();
-    keys.dedup();
-    let id = |k: &EdgeKey| keys.binary_search(k).expect("every key is listed") as u32;
-    let triangles = tris.par_iter().map(|t| [id(&t[0]), id(&t[1]), id(&t[2])]).collect();
-    let crossings = keys.par_iter().map(|&k| crossing(labels, k)).collect();
+    let mut layers: Vec<Layer> = (0..dims[2]).into_par_iter().map(|k| layer(labels, k)).collect();
+    // Vertex ids in order of (k, j, i, direction): the same for any threads.
+    let mut next = 0u32;
+    for l in &mut layers {
+        for &m in &l.mask {
+            l.first.push(next);
+            next += m.count_ones();
+        }
+    }
+    let tris: Option<Vec<Vec<[u32; 3]>>> =
+        (-1..dims[2] as i64).into_par_iter().map(|k| (!stop.requested()).then(|| layer_triangles(labels, &layers, k))).collect();
+    let triangles = tris?.into_iter().flatten().collect();
+    let crossings = layers.par_iter().enumerate().flat_map_iter(|(k, l)| crossings(l, k as i64)).collect();
     Some(Extracted { crossings, triangles })
+}
+
+/// A layer's crossing edges as (inside point, outside point), in id order.
+fn crossings(l: &Layer, k: i64) -> impl Iterator<Item = ([i64; 3], [i64; 3])> + '_ {
+    (0..l.row_start.len() - 1).flat_map(move |j| {
+        (l.row_start[j] as usize..l.row_start[j + 1] as usize).flat_map(move |n| {
+            let p = [l.i[n] as i64, j as i64, k];
+            (0..14u8).filter(move |d| l.mask[n] >> d & 1 == 1).map(move |d| {
+                let s = step(d);
+                (p, [p[0] + s[0], p[1] + s[1], p[2] + s[2]])
+            })
+        })
+    })
+}
+
+/// Layer `k`'s boundary points and their crossing edges.
+fn layer(labels: &DenseBits, k: u32) -> Layer {
+    let ny = labels.dims()[1];
+    let points = boundary_points(labels, k);
+    let mut row_start = vec![0u32; ny as usize + 1];
+    for &(j, _) in &points {
+        row_start[j as usize + 1] += 1;
+    }
+    for j in 0..ny as usize {
+        row_start[j + 1] += row_start[j];
+    }
+    let crossing = |p: [i64; 3], d: u8| {
+        let s = step(d);
+        !labels.get_signed(p[0] + s[0], p[1] + s[1], p[2] + s[2])
+    };
+    let mask = points
+        .iter()
+        .map(|&(j, i)| (0..14u8).filter(|&d| crossing([i as i64, j as i64, k as i64], d)).fold(0u16, |m, d| m | 1 << d))
+        .collect();
+    Layer { row_start, i: points.iter().map(|&(_, i)| i).collect(), mask, first: Vec::with_capacity(points.len()) }
 }
 
 /// The `(j, i)` of layer `k`'s inside points that have an outside point
@@ -129,24 +190,26 @@ fn and_with_neighbours(acc: &mut [u64], r: &[u64]) {
 
 /// The triangles of the cubes with lower corner in layer `k` (−1 included)
 /// that have a boundary point as a corner.
-fn layer_triangles(labels: &DenseBits, boundary: &[Vec<(u32, u32)>], k: i64) -> Vec<[EdgeKey; 3]> {
+fn layer_triangles(labels: &DenseBits, layers: &[Layer], k: i64) -> Vec<[u32; 3]> {
     let mut cells: Vec<(i64, i64)> = Vec::new();
     for kk in [k, k + 1] {
-        if let Some(points) = usize::try_from(kk).ok().and_then(|kk| boundary.get(kk)) {
-            for &(j, i) in points {
-                for (dj, di) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
-                    cells.push((j as i64 - dj, i as i64 - di));
+        if let Some(l) = usize::try_from(kk).ok().and_then(|kk| layers.get(kk)) {
+            for j in 0..l.row_start.len() - 1 {
+                for n in l.row_start[j] as usize..l.row_start[j + 1] as usize {
+                    for (dj, di) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+                        cells.push((j as i64 - dj, l.i[n] as i64 - di));
+                    }
                 }
             }
         }
     }
     cells.sort_unstable();
     cells.dedup();
-    let mut out = Vec::new();
+    let mut edges = Vec::new();
     for (j, i) in cells {
-        cube_triangles(labels, [i, j, k], &mut out);
+        cube_triangles(labels, [i, j, k], &mut edges);
     }
-    out
+    edges.iter().map(|t| t.map(|(p, d)| layers[p[2] as usize].id(p, d))).collect()
 }
 
 /// The corner with code `c` (`x = 1, y = 2, z = 4`) of the cube at `at`.
@@ -155,7 +218,7 @@ fn corner(at: [i64; 3], c: u8) -> [i64; 3] {
 }
 
 /// The triangles of the cube with lower corner `at`.
-fn cube_triangles(labels: &DenseBits, at: [i64; 3], out: &mut Vec<[EdgeKey; 3]>) {
+fn cube_triangles(labels: &DenseBits, at: [i64; 3], out: &mut Vec<[Edge; 3]>) {
     let inside: [bool; 8] = std::array::from_fn(|c| {
         let p = corner(at, c as u8);
         labels.get_signed(p[0], p[1], p[2])
@@ -163,10 +226,13 @@ fn cube_triangles(labels: &DenseBits, at: [i64; 3], out: &mut Vec<[EdgeKey; 3]>)
     if inside.iter().all(|&s| s) || inside.iter().all(|&s| !s) {
         return;
     }
-    let dims = labels.dims();
     for tet in TETS {
-        let (ins, outs): (Vec<u8>, Vec<u8>) = tet.iter().partition(|&&c| inside[c as usize]);
-        let edge = |a: u8, b: u8| key(dims, at, a, b);
+        // Inside corners first, then outside ones, each in tet order.
+        let mut split = tet;
+        split.sort_by_key(|&c| !inside[c as usize]);
+        let n_in = tet.iter().filter(|&&c| inside[c as usize]).count();
+        let (ins, outs) = split.split_at(n_in);
+        let edge = |a: u8, b: u8| edge(at, &inside, a, b);
         let mut emit = |apex: u8, t: [(u8, u8); 3]| {
             let mut keys = t.map(|(a, b)| edge(a, b));
             if orient(apex, inside[apex as usize], t) {
@@ -174,7 +240,7 @@ fn cube_triangles(labels: &DenseBits, at: [i64; 3], out: &mut Vec<[EdgeKey; 3]>)
             }
             out.push(keys);
         };
-        match (ins.as_slice(), outs.as_slice()) {
+        match (ins, outs) {
             ([a], [b, c, d]) | ([b, c, d], [a]) => emit(*a, [(*a, *b), (*a, *c), (*a, *d)]),
             ([a, b], [c, d]) => {
                 emit(*a, [(*a, *c), (*a, *d), (*b, *d)]);
@@ -206,28 +272,15 @@ fn orient(apex: u8, apex_inside: bool, t: [(u8, u8); 3]) -> bool {
     (det > 0) != apex_inside
 }
 
-/// The key of the edge between corners `a` and `b` of the cube at `at`
-/// (in Kuhn's triangulation one corner's code is a subset of the other's).
-fn key(dims: [u32; 3], at: [i64; 3], a: u8, b: u8) -> EdgeKey {
-    let (lo, hi) = if a & b == a { (a, b) } else { (b, a) };
-    debug_assert_eq!(lo & hi, lo);
-    let p = corner(at, lo);
-    let [nx, ny, _] = dims.map(|d| d as u64 + 2);
-    let lin = ((p[2] + 1) as u64 * ny + (p[1] + 1) as u64) * nx + (p[0] + 1) as u64;
-    lin * 8 + (hi ^ lo) as u64
-}
-
-/// The crossing edge `k` as (inside point, outside point).
-fn crossing(labels: &DenseBits, k: EdgeKey) -> ([i64; 3], [i64; 3]) {
-    let [nx, ny, _] = labels.dims().map(|d| d as u64 + 2);
-    let (lin, s) = (k / 8, (k % 8) as u8);
-    let p = [(lin % nx) as i64 - 1, (lin / nx % ny) as i64 - 1, (lin / nx / ny) as i64 - 1];
-    let q = corner(p, s);
-    if labels.get_signed(p[0], p[1], p[2]) {
-        (p, q)
-    } else {
-        (q, p)
-    }
+/// The edge between corners `a` and `b` of the cube at `at`, by its
+/// inside end (in Kuhn's triangulation one corner's code is a subset of
+/// the other's, so the direction is `±e_S`, `S = a ^ b`).
+fn edge(at: [i64; 3], inside: &[bool; 8], a: u8, b: u8) -> Edge {
+    let (i, o) = if inside[a as usize] { (a, b) } else { (b, a) };
+    debug_assert!(i & o == i || i & o == o);
+    let s = i ^ o;
+    let dir = if i & o == i { s - 1 } else { 7 + s - 1 };
+    (corner(at, i), dir)
 }
 
 /// The reference: every cube of the grid and its border, one by one, vertex
@@ -252,9 +305,10 @@ pub mod reference {
         let triangles = keys
             .iter()
             .map(|t| {
-                t.map(|k| {
-                    *ids.entry(k).or_insert_with(|| {
-                        crossings.push(crossing(labels, k));
+                t.map(|(p, d)| {
+                    *ids.entry((p, d)).or_insert_with(|| {
+                        let s = step(d);
+                        crossings.push((p, [p[0] + s[0], p[1] + s[1], p[2] + s[2]]));
                         crossings.len() as u32 - 1
                     })
                 })

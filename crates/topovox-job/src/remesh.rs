@@ -1,0 +1,386 @@
+//! Watertight meshes (`topovox remesh`, `topovox.remesh`): the inside
+//! voxels by the rule of `voxelize --mode solid` (or wrap's shells), the
+//! surface around them by [`topovox::surface`], the certificate by
+//! [`topovox::mesh_check`].
+//!
+//! The topology is the voxels': closed, 2-manifold, oriented,
+//! self-intersection-free and separating every inside voxel centre from
+//! every other by construction (see `topovox::surface::tets`). Debug builds
+//! and `--check` certify the result exactly before it is written.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::DVec3;
+use serde_json::{json, Value};
+use topovox::choice::Choice;
+use topovox::distance::nearest::Hierarchy;
+use topovox::distance::Pieces;
+use topovox::grid::dense::DenseBits;
+use topovox::mesh_check::{check_mesh, MeshCheck};
+use topovox::surface::{self, TriMesh};
+use topovox::voxelize::{self, Options, Progress, Stop};
+use topovox::{GridSpec, MeshRef};
+use topovox_io::mesh_out::MeshOut;
+use topovox_io::LoadedMesh;
+
+use crate::error::{JobError, Result};
+use crate::grid::{GridOptions, GridRequest};
+use crate::memory::{budget, bytes};
+use crate::options::RunOptions;
+use crate::plan::{SolidMethod, SolidPlan};
+use crate::table::{choice, chosen, flag, int, value, Example, Shape};
+
+topovox::choice! {
+    /// Which voxels the surface closes around.
+    pub enum Inside: "inside" default Auto {
+        /// As `--mode solid --method auto`: parity on closed, consistently
+        /// oriented meshes, the generalized winding number otherwise.
+        Auto = "auto",
+        /// Ray parity (right for closed meshes; streaks through holes).
+        Parity = "parity",
+        /// The winding number (generalized on open meshes: ≥ ½ is inside).
+        Winding = "winding",
+        /// The solid, the cover grown by one voxel and every cavity they
+        /// enclose: closed shells around sheets, open surfaces, thin walls
+        /// and loose parts, containing the whole input surface.
+        Wrap = "wrap",
+    }
+}
+
+topovox::choice! {
+    /// Where the surface's vertices go.
+    pub enum SurfaceKind: "surface" default Smooth {
+        /// On the zero of the exact signed distance along the lattice edges
+        /// between inside and outside voxel centres (marching tetrahedra).
+        Smooth = "smooth",
+        /// On the faces of the inside voxels (a quarter voxel off where
+        /// voxels meet only along an edge or at a corner).
+        Blocky = "blocky",
+    }
+}
+
+crate::option_table! {
+    /// What `remesh` closes and how (`topovox remesh`, `topovox.remesh`).
+    pub struct ShellOptions {
+        inside: Inside = Inside::Auto,
+            parse chosen,
+            example Example::Text("wrap"),
+            print |o| Some(json!(o.inside.name())),
+            cli choice::<Inside>("RULE"),
+            "which voxels the surface closes around: auto, parity or winding (the voxels of voxelize --mode solid with that method) or wrap (shells around any input)";
+        surface: SurfaceKind = SurfaceKind::Smooth,
+            parse chosen,
+            example Example::Text("blocky"),
+            print |o| Some(json!(o.surface.name())),
+            cli choice::<SurfaceKind>("KIND"),
+            "smooth (vertices where the exact signed distance crosses zero) or blocky (the inside voxels' faces)";
+        min_part: u64 = 0,
+            parse |k, v| int(k, v, 0),
+            example Example::Int(8),
+            print |o| Some(json!(o.min_part)),
+            cli value("VOXELS"),
+            "drop inside parts (26-connected voxels) of fewer voxels than this (default 0: every part is kept)";
+        check: bool = false,
+            parse flag,
+            example Example::Bool(true),
+            print |_| None,
+            cli Shape::Flag,
+            "certify the result exactly before writing it (closed, manifold, oriented, no self-intersection, no zero-area face) and report the certificate";
+    }
+}
+
+crate::option_table! {
+    /// Every option of a remesh job.
+    pub struct RemeshOptions {
+        [group shell: ShellOptions, "What is closed and how."]
+        [group grid: GridOptions, "The grid."]
+        [group run: RunOptions, "Threads, memory, paths."]
+    }
+}
+
+/// A validated remesh request.
+#[derive(Clone, Debug)]
+pub struct RemeshRequest {
+    /// The grid.
+    pub grid: GridRequest,
+    /// The inside rule.
+    pub inside: Inside,
+    /// The surface.
+    pub surface: SurfaceKind,
+    /// Smallest part kept, in voxels.
+    pub min_part: u64,
+    /// Certify before returning.
+    pub check: bool,
+    /// Round vertices to f32 (the output stores floats).
+    pub single: bool,
+    /// `--max-memory`.
+    pub max_memory: Option<u64>,
+}
+
+impl RemeshOptions {
+    /// The validated request; `single`: the output stores f32.
+    pub fn request(&self, single: bool) -> Result<RemeshRequest> {
+        let mut grid = self.grid.clone();
+        // Wrap grows the cover by a voxel: a fitted grid keeps room for it.
+        if self.shell.inside == Inside::Wrap && grid.pad.is_none() && grid.origin.is_none() && grid.dims.is_none() {
+            grid.pad = Some(1);
+        }
+        Ok(RemeshRequest {
+            grid: GridRequest::new(&grid)?,
+            inside: self.shell.inside,
+            surface: self.shell.surface,
+            min_part: self.shell.min_part,
+            check: self.shell.check,
+            single,
+            max_memory: self.run.max_memory,
+        })
+    }
+}
+
+/// What [`remesh`] found on the way, for the summary.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RemeshFacts {
+    /// How inside was decided (`parity`, `winding`, and `+wrap`).
+    pub inside: String,
+    /// Inside voxels the surface closes around.
+    pub inside_voxels: u64,
+    /// Parts (26-connected) kept and dropped by `min_part`.
+    pub parts: u64,
+    /// Parts dropped.
+    pub dropped_parts: u64,
+    /// Seconds deciding the inside, and making the surface.
+    pub inside_s: f64,
+    /// Seconds making the surface.
+    pub surface_s: f64,
+    /// Largest and mean distance (voxels) from the output's vertices to
+    /// the input, and from the input's vertices and face centres to the
+    /// output (wrap and `check` only).
+    pub distance: Option<[f64; 4]>,
+    /// Facts of the solid (its JSON).
+    pub solid: Value,
+}
+
+impl RemeshFacts {
+    /// As the JSON summary writes it.
+    pub fn to_json(&self) -> Value {
+        let d = self.distance.map(|d| {
+            json!({"output_to_input_max": d[0], "output_to_input_mean": d[1], "input_to_output_max": d[2], "input_to_output_mean": d[3]})
+        });
+        json!({
+            "inside": self.inside, "inside_voxels": self.inside_voxels, "parts": self.parts,
+            "dropped_parts": self.dropped_parts, "inside_s": self.inside_s, "surface_s": self.surface_s,
+            "distance_voxels": d, "solid": self.solid,
+        })
+    }
+}
+
+/// A watertight mesh and how it was made.
+pub struct Remeshed {
+    /// The mesh.
+    pub mesh: TriMesh,
+    /// The grid of its voxels.
+    pub grid: GridSpec,
+    /// Facts for the summary.
+    pub facts: RemeshFacts,
+    /// The certificate (with `check`, and in debug builds).
+    pub certificate: Option<MeshCheck>,
+    /// Things the user should know (an open mesh under parity).
+    pub warnings: Vec<String>,
+}
+
+/// The certificate as JSON.
+pub fn certificate_json(c: &MeshCheck) -> Value {
+    json!({
+        "watertight": c.watertight(), "closed": c.closed(), "manifold": c.manifold(), "oriented": c.oriented(),
+        "faces": c.faces, "vertices": c.vertices, "edges": c.edges,
+        "degenerate_faces": c.degenerate_faces, "boundary_edges": c.boundary_edges,
+        "non_manifold_edges": c.non_manifold_edges, "inconsistent_edges": c.inconsistent_edges,
+        "non_manifold_vertices": c.non_manifold_vertices, "self_intersections": c.self_intersections,
+        "intersecting_pairs": c.intersecting_pairs, "components": c.components, "euler": c.euler,
+        "genus": c.genus, "volume": c.volume,
+    })
+}
+
+/// Refuses a grid whose voxels and surface would not fit in memory: one
+/// bit per voxel for the solid (wrap: three grids), eight for the blocky
+/// surface's half voxels, and about 100 bytes per triangle, estimated as
+/// four per voxel face of the input's area (sixteen for blocky).
+fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec) -> Result<()> {
+    let cells = grid.voxel_count();
+    let grids = if req.inside == Inside::Wrap { 3 } else { 1 } + if req.surface == SurfaceKind::Blocky { 8 } else { 0 };
+    let h = grid.voxel_size().0;
+    let area: f64 = pieces.items.iter().map(|p| 0.5 * (p.p[1] - p.p[0]).cross(p.p[2] - p.p[0]).length()).sum();
+    let per_face = if req.surface == SurfaceKind::Blocky { 16.0 } else { 4.0 };
+    let triangles = area / (h.x * h.y).min(h.y * h.z).min(h.x * h.z) * per_face;
+    let need = (cells / 8).saturating_mul(grids + 1).saturating_add((triangles * 100.0) as u64);
+    let limit = budget(req.max_memory);
+    if need > limit {
+        let [x, y, z] = grid.dims();
+        return Err(JobError::failed(format!(
+            "{name}: remeshing on the {x}x{y}x{z} grid needs about {}, more than the {} this run may use; raise --max-memory or lower the resolution",
+            bytes(need),
+            bytes(limit)
+        )));
+    }
+    Ok(())
+}
+
+/// The inside voxels by `req`'s rule, with the method's name, the solid's
+/// facts and warnings.
+fn inside(
+    mesh: MeshRef<'_>,
+    name: &str,
+    req: &RemeshRequest,
+    grid: &GridSpec,
+    stop: &Stop,
+) -> Result<(DenseBits, String, Value, Vec<String>)> {
+    let method = match req.inside {
+        Inside::Auto | Inside::Wrap => SolidMethod::Auto,
+        Inside::Parity => SolidMethod::Parity,
+        Inside::Winding => SolidMethod::Winding,
+    };
+    let plan = SolidPlan { method, surface: None, hollow: None };
+    let opts = Options { stop: Some(stop), ..Default::default() };
+    let solid = crate::solid::run(&plan, mesh, name, grid, &opts)?;
+    if stop.requested() {
+        return Err(JobError::Interrupted);
+    }
+    if req.inside != Inside::Wrap {
+        return Ok((solid.bits, solid.method.to_string(), solid.facts, solid.warnings));
+    }
+    let cover = voxelize::fast(voxelize::Mode::Cover, mesh, grid, &opts).0.to_dense();
+    // Wrap closes open meshes on purpose: parity's warning does not apply.
+    Ok((surface::wrap(&solid.bits, &cover), format!("{}+wrap", solid.method), solid.facts, Vec::new()))
+}
+
+/// The watertight mesh of `mesh` (named `name` in messages).
+pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&Stop>) -> Result<Remeshed> {
+    let never = Stop::new();
+    let stop = stop.unwrap_or(&never);
+    let pieces = Pieces::of(mesh).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+    let grid = req.grid.fit(&mesh.bounds())?;
+    check_fits(name, req, &pieces, &grid)?;
+    let t = Instant::now();
+    let (bits, method, solid, warnings) = inside(mesh, name, req, &grid, stop)?;
+    let (bits, parts, dropped_parts) = surface::drop_small_parts(&bits, req.min_part);
+    let inside_voxels = bits.count();
+    if inside_voxels == 0 {
+        let why = if req.inside == Inside::Wrap {
+            "its triangles are all degenerate or outside the grid"
+        } else {
+            "no voxel centre is inside; --inside wrap closes open surfaces, sheets and loose parts"
+        };
+        return Err(JobError::invalid(format!("{name}: nothing to close on this grid: {why}")));
+    }
+    let inside_s = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let made = match req.surface {
+        SurfaceKind::Blocky => surface::blocky(&bits, &grid, stop),
+        SurfaceKind::Smooth => {
+            let offset = (req.inside == Inside::Wrap).then(|| grid.voxel_size().0.max_element());
+            surface::smooth(&bits, &grid, &pieces, offset, stop)
+        }
+    };
+    let mut out = made.ok_or(JobError::Interrupted)?;
+    if req.single {
+        out.positions.iter_mut().for_each(|p| *p = p.as_vec3().as_dvec3());
+    }
+    let surface_s = t.elapsed().as_secs_f64();
+    let distance = (req.check || req.inside == Inside::Wrap).then(|| two_sided(mesh, &pieces, &out, &grid));
+    let certificate = if req.check || cfg!(debug_assertions) { Some(certify(name, &out, stop)?) } else { None };
+    let facts = RemeshFacts { inside: method, inside_voxels, parts, dropped_parts, inside_s, surface_s, distance, solid };
+    Ok(Remeshed { mesh: out, grid, facts, certificate, warnings })
+}
+
+/// The certificate of `out`; an error (nothing is written) if it fails.
+fn certify(name: &str, out: &TriMesh, stop: &Stop) -> Result<MeshCheck> {
+    let c = check_mesh(&out.positions, &out.triangles, stop).map_err(|e| match e {
+        topovox::mesh_check::MeshCheckError::Stopped => JobError::Interrupted,
+        e => JobError::failed(format!("{name}: the surface could not be certified: {e}")),
+    })?;
+    if !c.watertight() {
+        return Err(JobError::failed(format!(
+            "{name}: internal error: the surface failed its certificate ({}); nothing was written; please report this mesh",
+            certificate_json(&c)
+        )));
+    }
+    Ok(c)
+}
+
+/// Largest and mean distances (voxels, the largest edge): output vertices
+/// to the input, input vertices and face centres to the output.
+fn two_sided(mesh: MeshRef<'_>, pieces: &Pieces, out: &TriMesh, grid: &GridSpec) -> [f64; 4] {
+    use rayon::prelude::*;
+    let h = grid.voxel_size().0.max_element();
+    let stats = |tree: &Hierarchy, points: &[DVec3]| -> (f64, f64) {
+        let d: Vec<f64> = points.par_iter().map(|&p| tree.nearest(p, (f64::INFINITY, u32::MAX)).0.sqrt() / h).collect();
+        (d.iter().fold(0.0, |a: f64, &b| a.max(b)), d.iter().sum::<f64>() / d.len().max(1) as f64)
+    };
+    let to_input = stats(&Hierarchy::new(pieces), &out.positions);
+    let out_ref = MeshRef { positions: &out.positions, triangles: &out.triangles, segments: &[] };
+    let out_pieces = Pieces::of(out_ref).expect("a surface has triangles and finite vertices");
+    let mut samples: Vec<DVec3> = pieces.items.iter().flat_map(|p| [p.p[0], (p.p[0] + p.p[1] + p.p[2]) / 3.0]).collect();
+    samples.extend(mesh.positions.iter().filter(|p| p.is_finite()));
+    let to_output = stats(&Hierarchy::new(&out_pieces), &samples);
+    [to_input.0, to_input.1, to_output.0, to_output.1]
+}
+
+/// A remesh job's two steps.
+pub struct RemeshJob {
+    /// The validated request.
+    pub request: RemeshRequest,
+    /// The output format.
+    pub format: MeshOut,
+}
+
+/// What [`RemeshJob::run`] made and wrote.
+pub struct RemeshDone {
+    /// The mesh and the facts of its making.
+    pub remeshed: Remeshed,
+    /// Seconds writing.
+    pub write_s: f64,
+}
+
+/// The format `format` names, else the one of `out`'s extension.
+pub fn format_of(format: Option<&str>, out: &Path) -> Result<MeshOut> {
+    if let Some(f) = format {
+        return MeshOut::parse(f).map_err(|e| JobError::invalid(format!("--format: {e}")));
+    }
+    MeshOut::of_path(out).ok_or_else(|| {
+        JobError::invalid(format!(
+            "{}: cannot tell the format from the extension; remesh writes .obj, .ply, .stl or .glb (or give --format)",
+            out.display()
+        ))
+    })
+}
+
+impl RemeshJob {
+    /// Checks everything that needs no mesh: the options, the format, the
+    /// output's folder, and that the output is none of `inputs`.
+    pub fn prepare(options: &RemeshOptions, out: &Path, format: MeshOut, inputs: &[PathBuf]) -> Result<RemeshJob> {
+        let request = options.request(format.single())?;
+        crate::output::check_output_path(out)?;
+        topovox_io::atomic::refuse_overwriting_inputs(out, inputs)?;
+        Ok(RemeshJob { request, format })
+    }
+
+    /// The watertight mesh of `loaded`, written to `out`; `stop` ends it
+    /// early (nothing is written).
+    pub fn run(
+        &self,
+        out: &Path,
+        loaded: &LoadedMesh,
+        name: &str,
+        progress: Option<&dyn Progress>,
+        stop: Option<&Stop>,
+    ) -> Result<RemeshDone> {
+        topovox_io::atomic::refuse_overwriting_inputs(out, &loaded.sources)?;
+        progress.inspect(|p| p.phase("remeshing"));
+        let remeshed = remesh(loaded.mesh.as_ref(), name, &self.request, stop)?;
+        progress.inspect(|p| p.phase("writing"));
+        let t = Instant::now();
+        topovox_io::mesh_out::write_mesh(out, &remeshed.mesh.positions, &remeshed.mesh.triangles, self.format, stop)?;
+        Ok(RemeshDone { remeshed, write_s: t.elapsed().as_secs_f64() })
+    }
+}
