@@ -25,7 +25,7 @@ if [ ! -x target/venv/bin/python ]; then
 fi
 VPY=target/venv/bin/python
 "$VPY" -m pip install --quiet --disable-pip-version-check --upgrade pip
-"$VPY" -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" numpy pytest trimesh pillow "dask[bag]" distributed ray fsspec mypy
+"$VPY" -m pip install --quiet --disable-pip-version-check "maturin>=1.5,<2" numpy pytest trimesh pillow "dask[bag]" distributed ray fsspec mypy pymeshlab
 rm -rf target/dist
 "$VPY" -m maturin build --release --manifest-path python/Cargo.toml --out target/dist
 "$VPY" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps target/dist/topovox-*.whl

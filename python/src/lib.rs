@@ -32,6 +32,7 @@ mod interrupt;
 mod meshes;
 mod options;
 mod placement;
+mod remesh;
 mod voxelize;
 
 use pyo3::prelude::*;
@@ -44,6 +45,8 @@ fn _topovox(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<grids::VoxelGrid>()?;
     m.add_class::<distance::DistanceGrid>()?;
     m.add_function(wrap_pyfunction!(distance::sdf, m)?)?;
+    m.add_function(wrap_pyfunction!(remesh::remesh, m)?)?;
+    m.add_function(wrap_pyfunction!(remesh::check_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(meshes::load_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(voxelize::voxelize, m)?)?;
     m.add_function(wrap_pyfunction!(grids::load_voxels, m)?)?;

@@ -218,6 +218,24 @@ impl Mesh {
         Array2::from_shape_fn((2, 3), |(r, c)| if r == 0 { b.min[c] } else { b.max[c] }).into_pyarray(py)
     }
 
+    /// save(path, format=None): writes the triangles as OBJ or PLY (exact
+    /// coordinates), STL or GLB (float32), by `format` or the extension;
+    /// the file is replaced all or nothing.
+    #[pyo3(signature = (path, format=None))]
+    fn save(&self, py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyResult<()> {
+        crate::remesh::save(py, self, path, format)
+    }
+
+    /// to_trimesh(): a `trimesh.Trimesh` of the vertices and faces
+    /// (`process=False`: nothing merged or reordered); imports trimesh.
+    fn to_trimesh<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let kw = PyDict::new(py);
+        kw.set_item("vertices", self.vertices(py))?;
+        kw.set_item("faces", self.faces(py))?;
+        kw.set_item("process", false)?;
+        py.import("trimesh")?.getattr("Trimesh")?.call((), Some(&kw))
+    }
+
     fn __repr__(&self) -> String {
         let r = &self.inner.report;
         let from = self.path.as_ref().map(|p| format!(" from {:?}", p.display().to_string())).unwrap_or_default();

@@ -65,7 +65,8 @@ pub(crate) fn options<'py>(py: Python<'py>, command: &str) -> PyResult<Vec<(&'st
     let rows: Vec<&'static topovox_job::Keyword> = match command {
         "voxelize" | "batch" => JobOptions::keywords().collect(),
         "sdf" => topovox_job::distance::SdfOptions::keywords().collect(),
-        _ => return Err(crate::errors::value_err(format!("options: no command {command:?} (expected voxelize, batch or sdf)"))),
+        "remesh" => topovox_job::remesh::RemeshOptions::keywords().collect(),
+        _ => return Err(crate::errors::value_err(format!("options: no command {command:?} (expected voxelize, batch, sdf or remesh)"))),
     };
     rows.into_iter()
         .map(|k| {
@@ -97,5 +98,7 @@ pub(crate) fn choices(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("colour_rule", names::<ColourRule>())?;
     d.set_item("up", names::<topovox_job::Up>())?;
     d.set_item("format", names::<topovox_job::output::Output>())?;
+    d.set_item("inside", names::<topovox_job::remesh::Inside>())?;
+    d.set_item("surface_kind", names::<topovox_job::remesh::SurfaceKind>())?;
     Ok(d)
 }

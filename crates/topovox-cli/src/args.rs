@@ -6,6 +6,7 @@ use clap::{Args, Parser, Subcommand};
 use topovox::raster::{RasterMethod, RasterMode};
 use topovox_io::mesh_out::MeshOut;
 use topovox_job::batch::Run;
+use topovox_job::check::MeshProperty;
 use topovox_job::distance::{DistanceFormat, FieldOptions, SdfOptions};
 use topovox_job::output::Output;
 use topovox_job::remesh::RemeshOptions;
@@ -407,8 +408,15 @@ pub struct CheckArgs {
     #[arg(long)]
     pub allow_external_paths: bool,
     /// Voxel file (any format topovox reads: .npy, .binvox, .vox, .vti,
-    /// .vdb, .zarr, .npz, ...).
+    /// .vdb, .zarr, .npz, ...), or a mesh file alone (.obj, .stl, .off,
+    /// .gltf, .glb, a .ply with faces): its certificate (closed, manifold,
+    /// oriented, self-intersections, degenerate faces, components, genus,
+    /// volume), each decided exactly.
     pub voxels: PathBuf,
+    /// A mesh file: the properties it must have, else the exit status is 1
+    /// (default: watertight, which is all of them).
+    #[arg(long, value_name = "PROPS", value_delimiter = ',', value_parser = choice::<MeshProperty>())]
+    pub require: Vec<MeshProperty>,
     /// The source mesh (a closed surface for the separation checks).
     #[arg(long)]
     pub mesh: Option<PathBuf>,

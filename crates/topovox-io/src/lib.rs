@@ -54,7 +54,7 @@ pub(crate) use budget::{dense_grid, read_limit};
 pub use error::{ErrorKind, IoError};
 pub use fence::{fenced, panic_is_fenced};
 pub use mesh_report::{validate_mesh, LoadedMesh, MeshReport};
-pub use meshes::{read_mesh, read_mesh_bytes, read_svg, MeshFormat};
+pub use meshes::{is_mesh_file, read_mesh, read_mesh_bytes, read_svg, MeshFormat};
 pub use png::{write_png, write_png_rgba};
 pub use resources::ReadOptions;
 pub(crate) use runs::runs;

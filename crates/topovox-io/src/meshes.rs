@@ -89,3 +89,30 @@ pub fn read_svg(path: &Path, opts: &svg::SvgOptions) -> Result<svg::LoadedSvg, I
     let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
     fence("SVG", || svg::read(&bytes, opts)).map_err(|k| IoError::new(path, k))
 }
+
+/// Whether `path` holds a triangle mesh rather than voxels: an OBJ, STL,
+/// OFF or glTF file, or a PLY whose header declares faces (topovox writes
+/// voxels as PLY points without faces). Reads at most the PLY's first 64 KiB.
+pub fn is_mesh_file(path: &Path) -> bool {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    match MeshFormat::from_extension(&ext) {
+        Some(MeshFormat::Ply) => ply_declares_faces(path),
+        Some(MeshFormat::Polyline) | None => false,
+        Some(_) => true,
+    }
+}
+
+fn ply_declares_faces(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = Vec::new();
+    let read = std::fs::File::open(path).and_then(|f| f.take(64 << 10).read_to_end(&mut head));
+    if read.is_err() {
+        return false;
+    }
+    let text = String::from_utf8_lossy(&head);
+    let header = text.split("end_header").next().unwrap_or("");
+    header.lines().any(|l| {
+        let w: Vec<&str> = l.split_whitespace().collect();
+        matches!(w.as_slice(), ["element", "face" | "tristrips", n] if n.parse::<u64>().is_ok_and(|n| n > 0))
+    })
+}

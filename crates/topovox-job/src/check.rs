@@ -6,6 +6,9 @@ use topovox::grid::sparse::SparseBricks;
 use topovox::topology::{certify, certify_sparse, CheckReport};
 use topovox::{DenseBits, GridSpec, MeshRef};
 
+use topovox::mesh_check::{check_mesh, MeshCheck, MeshCheckError};
+use topovox::voxelize::Stop;
+
 use crate::error::{JobError, Result};
 use crate::grid::{GridOptions, GridRequest};
 
@@ -113,5 +116,60 @@ fn to_json(report: &CheckReport, dims: [u32; 3], grid: Option<(&GridSpec, &str)>
             let o = g.origin();
             json!({"origin": [o.x, o.y, o.z], "voxel_size": topovox_io::size_json(g.voxel_size()), "dims": g.dims(), "source": source})
         }),
+    })
+}
+
+topovox::choice! {
+    /// A property `topovox check MESH` can require.
+    pub enum MeshProperty: "property" default Watertight {
+        /// All of the others, and a positive volume (normals outwards).
+        Watertight = "watertight",
+        /// Every edge has exactly two faces.
+        Closed = "closed",
+        /// No edge with more than two faces, every vertex's faces one disk.
+        Manifold = "manifold",
+        /// Every edge's two faces run it in opposite directions.
+        Oriented = "oriented",
+        /// No two faces meet beyond the vertices and edge they share.
+        IntersectionFree = "intersection-free",
+        /// No face of zero area.
+        NoDegenerate = "no-degenerate",
+    }
+}
+
+impl MeshProperty {
+    /// Whether the certificate has this property.
+    pub fn holds(self, c: &MeshCheck) -> bool {
+        match self {
+            MeshProperty::Watertight => c.watertight(),
+            MeshProperty::Closed => c.closed(),
+            MeshProperty::Manifold => c.manifold(),
+            MeshProperty::Oriented => c.oriented(),
+            MeshProperty::IntersectionFree => c.self_intersections == 0,
+            MeshProperty::NoDegenerate => c.degenerate_faces == 0,
+        }
+    }
+}
+
+/// The certificate of `mesh` (named `name` in messages); see
+/// [`topovox::mesh_check`]. Segments are not faces and are not checked.
+pub fn mesh_certificate(mesh: MeshRef<'_>, name: &str, stop: Option<&Stop>) -> Result<MeshCheck> {
+    let never = Stop::new();
+    check_mesh(mesh.positions, mesh.triangles, stop.unwrap_or(&never)).map_err(|e| match e {
+        MeshCheckError::Stopped => JobError::Interrupted,
+        e => JobError::invalid(format!("{name}: {e}")),
+    })
+}
+
+/// A certificate as JSON.
+pub fn certificate_json(c: &MeshCheck) -> Value {
+    json!({
+        "watertight": c.watertight(), "closed": c.closed(), "manifold": c.manifold(), "oriented": c.oriented(),
+        "faces": c.faces, "vertices": c.vertices, "edges": c.edges,
+        "degenerate_faces": c.degenerate_faces, "boundary_edges": c.boundary_edges,
+        "non_manifold_edges": c.non_manifold_edges, "inconsistent_edges": c.inconsistent_edges,
+        "non_manifold_vertices": c.non_manifold_vertices, "self_intersections": c.self_intersections,
+        "intersecting_pairs": c.intersecting_pairs, "components": c.components, "euler": c.euler,
+        "genus": c.genus, "volume": c.volume,
     })
 }

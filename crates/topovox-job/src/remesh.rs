@@ -24,6 +24,7 @@ use topovox::{GridSpec, MeshRef};
 use topovox_io::mesh_out::MeshOut;
 use topovox_io::LoadedMesh;
 
+use crate::check::certificate_json;
 use crate::error::{JobError, Result};
 use crate::grid::{GridOptions, GridRequest};
 use crate::memory::{budget, bytes};
@@ -189,19 +190,6 @@ pub struct Remeshed {
     pub warnings: Vec<String>,
 }
 
-/// The certificate as JSON.
-pub fn certificate_json(c: &MeshCheck) -> Value {
-    json!({
-        "watertight": c.watertight(), "closed": c.closed(), "manifold": c.manifold(), "oriented": c.oriented(),
-        "faces": c.faces, "vertices": c.vertices, "edges": c.edges,
-        "degenerate_faces": c.degenerate_faces, "boundary_edges": c.boundary_edges,
-        "non_manifold_edges": c.non_manifold_edges, "inconsistent_edges": c.inconsistent_edges,
-        "non_manifold_vertices": c.non_manifold_vertices, "self_intersections": c.self_intersections,
-        "intersecting_pairs": c.intersecting_pairs, "components": c.components, "euler": c.euler,
-        "genus": c.genus, "volume": c.volume,
-    })
-}
-
 /// Refuses a grid whose voxels and surface would not fit in memory: one
 /// bit per voxel for the solid (wrap: three grids), eight for the blocky
 /// surface's half voxels, and about 100 bytes per triangle, estimated as
@@ -278,7 +266,9 @@ pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&
     let made = match req.surface {
         SurfaceKind::Blocky => surface::blocky(&bits, &grid, stop),
         SurfaceKind::Smooth => {
-            let offset = (req.inside == Inside::Wrap).then(|| grid.voxel_size().0.max_element());
+            // Wrap's outside centres lie at least 1.5 voxels from the input
+            // (no 26-neighbour's box meets it): its shell sits there.
+            let offset = (req.inside == Inside::Wrap).then(|| 1.5 * grid.voxel_size().0.max_element());
             surface::smooth(&bits, &grid, &pieces, offset, stop)
         }
     };

@@ -10,6 +10,12 @@ use crate::args::CheckArgs;
 pub fn run(a: &CheckArgs) -> Result<()> {
     let t0 = Instant::now();
     let pool = topovox_job::pool_for(a.threads, "--threads")?;
+    if a.mesh.is_none() && topovox_io::is_mesh_file(&a.voxels) {
+        return pool.install(|| check_mesh_file(a, t0));
+    }
+    if !a.require.is_empty() {
+        bail!("--require applies to a mesh file checked alone; {} is read as voxels", a.voxels.display());
+    }
     let up = a.up.unwrap_or_default();
     let sparse_format = topovox_io::VoxelFormat::from_path(&a.voxels).is_some_and(topovox_io::VoxelFormat::reads_sparsely);
     if a.sparse && !sparse_format {
@@ -77,6 +83,54 @@ pub fn run(a: &CheckArgs) -> Result<()> {
         return crate::console::print_stdout(&v.to_string());
     }
     crate::console::print_stdout(&text(&v, a))
+}
+
+/// `topovox check MESH`: the mesh's certificate; exit status 1 when a
+/// required property fails.
+fn check_mesh_file(a: &CheckArgs, t0: Instant) -> Result<()> {
+    use topovox_job::check::{certificate_json, mesh_certificate, MeshProperty};
+    use topovox_job::Choice;
+    let opts = topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths, ..Default::default() };
+    let loaded = topovox_io::read_mesh(&a.voxels, &opts)?;
+    for w in &loaded.warnings {
+        eprintln!("topovox: warning: {}: {w}", a.voxels.display());
+    }
+    let name = a.voxels.display().to_string();
+    let c = mesh_certificate(loaded.mesh.as_ref(), &name, None)?;
+    let required = if a.require.is_empty() { vec![MeshProperty::Watertight] } else { a.require.clone() };
+    let failed: Vec<&str> = required.iter().filter(|p| !p.holds(&c)).map(|p| p.name()).collect();
+    let mut v = certificate_json(&c);
+    v["input"] = json!(name);
+    v["required"] = json!(required.iter().map(|p| p.name()).collect::<Vec<_>>());
+    v["failed"] = json!(failed);
+    v["check_s"] = json!(t0.elapsed().as_secs_f64());
+    if a.json {
+        crate::console::print_stdout(&v.to_string())?;
+    } else {
+        crate::console::print_stdout(&mesh_text(&name, &v))?;
+    }
+    if !failed.is_empty() {
+        eprintln!("topovox: {name}: not {}", failed.join(", not "));
+        std::process::exit(1);
+    }
+    Ok(())
+}
+
+fn mesh_text(name: &str, v: &Value) -> String {
+    let yes = |k: &str| if v[k].as_bool() == Some(true) { "yes" } else { "NO" };
+    format!(
+        "{name}: {} faces, {} vertices, {} edges, {} component(s), genus {}, volume {}\n  closed: {} ({} boundary edges, {} edges with more than two faces)\n  manifold: {} ({} non-manifold vertices)\n  oriented: {} ({} inconsistent edges)\n  self-intersecting face pairs: {}{}\n  degenerate faces: {}\n  watertight: {}",
+        v["faces"], v["vertices"], v["edges"], v["components"],
+        if v["genus"].is_null() { "n/a".to_string() } else { v["genus"].to_string() },
+        v["volume"],
+        yes("closed"), v["boundary_edges"], v["non_manifold_edges"],
+        yes("manifold"), v["non_manifold_vertices"],
+        yes("oriented"), v["inconsistent_edges"],
+        v["self_intersections"],
+        if v["self_intersections"].as_u64().unwrap_or(0) > 0 { format!(" (first: {})", v["intersecting_pairs"]) } else { String::new() },
+        v["degenerate_faces"],
+        yes("watertight"),
+    )
 }
 
 /// The voxels, read densely or (past memory, or with `--sparse`) as bricks.

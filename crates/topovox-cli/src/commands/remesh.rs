@@ -4,7 +4,8 @@ use std::time::Instant;
 
 use anyhow::Result;
 use serde_json::json;
-use topovox_job::remesh::{certificate_json, format_of, RemeshJob};
+use topovox_job::check::certificate_json;
+use topovox_job::remesh::{format_of, RemeshJob};
 use topovox_job::Choice;
 
 use crate::args::RemeshArgs;

@@ -30,6 +30,7 @@ pub mod intersect;
 mod pairs;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::stop::Stop;
 
@@ -160,7 +161,7 @@ fn weld(positions: &[DVec3], triangles: &[[u32; 3]]) -> Result<(Vec<DVec3>, Vec<
     }
     let key = |p: DVec3| [p.x, p.y, p.z].map(|c| if c == 0.0 { 0u64 } else { c.to_bits() });
     let mut order: Vec<u32> = (0..positions.len() as u32).filter(|&v| used[v as usize]).collect();
-    order.sort_unstable_by_key(|&v| (key(positions[v as usize]), v));
+    order.par_sort_unstable_by_key(|&v| (key(positions[v as usize]), v));
     let mut id = vec![u32::MAX; positions.len()];
     let mut welded: Vec<DVec3> = Vec::new();
     for (n, &v) in order.iter().enumerate() {
@@ -193,7 +194,7 @@ fn edge_counts(faces: &[[u32; 3]], r: &mut MeshCheck) {
         .filter(|(a, b)| a != b)
         .map(|(a, b)| (a.min(b), a.max(b), a < b))
         .collect();
-    e.sort_unstable();
+    e.par_sort_unstable();
     for run in e.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
         r.edges += 1;
         match run.len() {
@@ -214,14 +215,9 @@ fn non_manifold_vertices(faces: &[[u32; 3]]) -> u64 {
             link.push((f[c], f[(c + 1) % 3], f[(c + 2) % 3]));
         }
     }
-    link.sort_unstable();
-    let mut bad = 0;
-    for star in link.chunk_by(|a, b| a.0 == b.0) {
-        if !is_disk(star) {
-            bad += 1;
-        }
-    }
-    bad
+    link.par_sort_unstable();
+    let stars: Vec<&[(u32, u32, u32)]> = link.chunk_by(|a, b| a.0 == b.0).collect();
+    stars.par_iter().filter(|star| !is_disk(star)).count() as u64
 }
 
 /// Whether a vertex's link edges form one cycle or one simple path.

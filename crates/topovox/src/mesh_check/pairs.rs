@@ -35,7 +35,9 @@ pub fn intersecting(pos: &[DVec3], faces: &[[u32; 3]], degenerate: &[bool], stop
     let mean = live.iter().map(|&f| boxes[f as usize].1 - boxes[f as usize].0).fold(DVec3::ZERO, |s, e| s + e) / live.len() as f64;
     let size = mean.max_element().max((hi - lo).max_element() / MAX_CELLS).max(f64::MIN_POSITIVE);
     let cell = |p: DVec3| ((p - lo) / size).floor().as_uvec3().min(glam::UVec3::splat(MAX_CELLS as u32)).to_array();
-    let mut entries: Vec<([u32; 3], u32)> = Vec::new();
+    let n = cell(hi).map(|c| c as u64 + 1);
+    let key = |c: [u32; 3]| (c[2] as u64 * n[1] + c[1] as u64) * n[0] + c[0] as u64;
+    let mut entries: Vec<(u64, u32)> = Vec::new();
     let mut big = Vec::new();
     for &f in &live {
         let (a, b) = (cell(boxes[f as usize].0), cell(boxes[f as usize].1));
@@ -46,13 +48,13 @@ pub fn intersecting(pos: &[DVec3], faces: &[[u32; 3]], degenerate: &[bool], stop
         for z in a[2]..=b[2] {
             for y in a[1]..=b[1] {
                 for x in a[0]..=b[0] {
-                    entries.push(([z, y, x], f));
+                    entries.push((key([x, y, z]), f));
                 }
             }
         }
     }
     entries.par_sort_unstable();
-    let groups: Vec<&[([u32; 3], u32)]> = entries.chunk_by(|a, b| a.0 == b.0).filter(|g| g.len() > 1).collect();
+    let groups: Vec<&[(u64, u32)]> = entries.chunk_by(|a, b| a.0 == b.0).filter(|g| g.len() > 1).collect();
     let found: Option<Vec<Vec<[u32; 2]>>> = groups
         .par_iter()
         .map(|g| {
@@ -64,7 +66,7 @@ pub fn intersecting(pos: &[DVec3], faces: &[[u32; 3]], degenerate: &[bool], stop
                 for &(_, h) in &g[n + 1..] {
                     let (bf, bh) = (boxes[f as usize], boxes[h as usize]);
                     let (olo, ohi) = (bf.0.max(bh.0), bf.1.min(bh.1));
-                    if olo.cmpgt(ohi).any() || cell(olo) != [c[2], c[1], c[0]] {
+                    if olo.cmpgt(ohi).any() || key(cell(olo)) != c {
                         continue;
                     }
                     if faces_meet(pos, &faces[f as usize], &faces[h as usize]) {

@@ -13,7 +13,7 @@
 //! - [`smooth`]: the surface between the voxel centres, each vertex where
 //!   the exact signed distance to the input mesh crosses zero along its
 //!   edge (linear interpolation of the two exact distances), kept a
-//!   hundredth of the edge away from the centres.
+//!   twentieth of the edge away from the centres.
 //! - [`wrap`]: the inside voxels for shells around any input: the solid,
 //!   the cover grown by one voxel, and every cavity they enclose.
 
@@ -41,7 +41,13 @@ pub struct TriMesh {
 
 /// How far from the lattice points a smooth vertex is kept, as a fraction
 /// of its edge: the triangles keep a size the output's precision can hold.
-pub const MARGIN: f64 = 0.01;
+pub const MARGIN: f64 = 0.05;
+
+/// The same for wrap's shells, whose inside ends lie anywhere from 0 to
+/// about 2.6 voxels from the input: most would sit at the margin, in
+/// near-coplanar pieces a twentieth of a voxel apart; a quarter keeps
+/// them apart by half a voxel.
+pub const WRAP_MARGIN: f64 = 0.25;
 
 /// The blocky surface of `inside` on `grid` (see the module doc).
 pub fn blocky(inside: &DenseBits, grid: &GridSpec, stop: &Stop) -> Option<TriMesh> {
@@ -63,9 +69,10 @@ pub fn blocky(inside: &DenseBits, grid: &GridSpec, stop: &Stop) -> Option<TriMes
 
 /// The smooth surface of `inside` on `grid`: each vertex on the zero of
 /// the linear interpolation along its edge of the signed distance to
-/// `pieces` (negative at inside centres), or with `offset` (world units)
-/// of `distance − offset` (wrap's shells, which sit off the input),
-/// clamped to [`MARGIN`]`..1 − MARGIN` of the edge.
+/// `pieces` (negative at inside centres), clamped to
+/// [`MARGIN`]`..1 − MARGIN` of the edge; or with `offset` (world units)
+/// of `distance − offset`, clamped to [`WRAP_MARGIN`] (wrap's shells,
+/// which sit off the input).
 pub fn smooth(inside: &DenseBits, grid: &GridSpec, pieces: &Pieces, offset: Option<f64>, stop: &Stop) -> Option<TriMesh> {
     let e = tets::extract(inside, stop)?;
     let centre = |p: [i64; 3]| grid.origin() + (DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) + 0.5) * grid.voxel_size().0;
@@ -100,7 +107,8 @@ pub fn smooth(inside: &DenseBits, grid: &GridSpec, pieces: &Pieces, offset: Opti
             };
             let t = if fb > fa { -fa / (fb - fa) } else { 0.5 };
             let (pa, pb) = (centre(*a), centre(*b));
-            pa + (pb - pa) * t.clamp(MARGIN, 1.0 - MARGIN)
+            let margin = if offset.is_some() { WRAP_MARGIN } else { MARGIN };
+            pa + (pb - pa) * t.clamp(margin, 1.0 - margin)
         })
         .collect();
     Some(TriMesh { positions, triangles: e.triangles })
