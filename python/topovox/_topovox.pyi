@@ -7,7 +7,7 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
-__all__ = ["__version__", "FileFormatError", "Mesh", "VoxelGrid", "DistanceGrid", "load_mesh", "voxelize", "sdf", "load_voxels", "batch", "batch_plan", "process_one", "append_manifest", "options", "choices"]
+__all__ = ["__version__", "FileFormatError", "Mesh", "VoxelGrid", "DistanceGrid", "load_mesh", "voxelize", "sdf", "remesh", "check_mesh", "load_voxels", "batch", "batch_plan", "process_one", "append_manifest", "options", "choices"]
 
 class FileFormatError(OSError):
     """A file's content does not follow its format (the message names the file)."""

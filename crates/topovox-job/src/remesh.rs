@@ -255,7 +255,7 @@ pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&
     let inside_voxels = bits.count();
     if inside_voxels == 0 {
         let why = if req.inside == Inside::Wrap {
-            "its triangles are all degenerate or outside the grid"
+            "it has no triangle of positive area in the grid (polylines are not wrapped)"
         } else {
             "no voxel centre is inside; --inside wrap closes open surfaces, sheets and loose parts"
         };
