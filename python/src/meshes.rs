@@ -223,7 +223,9 @@ impl Mesh {
     /// the file is replaced all or nothing.
     #[pyo3(signature = (path, format=None))]
     fn save(&self, py: Python<'_>, path: PathBuf, format: Option<&str>) -> PyResult<()> {
-        crate::remesh::save(py, self, path, format)
+        let format = topovox_job::remesh::format_of(format, &path).map_err(crate::errors::py_err)?;
+        let m = &self.inner.mesh;
+        py.detach(|| topovox_io::mesh_out::write_mesh(&path, &m.positions, &m.triangles, format, None)).map_err(io_err)
     }
 
     /// to_trimesh(): a `trimesh.Trimesh` of the vertices and faces

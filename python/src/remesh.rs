@@ -7,7 +7,6 @@ use std::sync::Arc;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use topovox::voxelize::Stop;
-use topovox_io::mesh_out::MeshOut;
 use topovox_job::check::{certificate_json, mesh_certificate};
 use topovox_job::remesh::{RemeshOptions, Remeshed};
 use topovox_job::JobError;
@@ -55,12 +54,4 @@ pub fn check_mesh<'py>(py: Python<'py>, mesh: &Mesh) -> PyResult<Bound<'py, PyAn
     let stop = Stop::new();
     let c = interruptible(py, &stop, || mesh_certificate(inner.mesh.as_ref(), &name, Some(&stop)))?.map_err(py_err)?;
     to_py(py, &certificate_json(&c))
-}
-
-/// Writes `mesh`'s triangles to `path` as OBJ, PLY, STL or GLB (the format
-/// from `format` or the extension), replaced all or nothing.
-pub(crate) fn save(py: Python<'_>, mesh: &Mesh, path: std::path::PathBuf, format: Option<&str>) -> PyResult<()> {
-    let format: MeshOut = topovox_job::remesh::format_of(format, &path).map_err(py_err)?;
-    let m = &mesh.inner.mesh;
-    py.detach(|| topovox_io::mesh_out::write_mesh(&path, &m.positions, &m.triangles, format, None)).map_err(crate::errors::io_err)
 }

@@ -36,7 +36,7 @@ def test_the_sdf_signature_is_its_table():
     params = set(inspect.signature(topovox.sdf).parameters) - {"mesh_or_vertices", "faces"}
     assert params == {name for name, _, _ in SDF_OPTIONS}
     with pytest.raises(ValueError, match="no command"):
-        _topovox.options("remesh")
+        _topovox.options("nope")
 
 
 @pytest.mark.parametrize("name,example", [(n, e) for n, _, e in SDF_OPTIONS])

@@ -563,6 +563,24 @@ def check_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray], faces: Optional[An
     ``intersecting_pairs``), ``degenerate_faces``, ``components``,
     ``euler``, ``genus`` (closed, oriented, manifold meshes) and ``volume``.
 
+    Parameters
+    ----------
+    mesh_or_vertices : Mesh, path, trimesh or Open3D mesh, or array_like
+        Anything :func:`as_mesh` takes, or an ``(n, 3)`` vertex array with
+        ``faces``.
+    faces : array_like, optional
+        ``(m, 3)`` integer vertex indices, when vertices are given.
+
+    Returns
+    -------
+    dict
+        The certificate (the keys above).
+
+    Raises
+    ------
+    ValueError
+        A mesh without faces, non-finite vertices.
+
     Examples
     --------
     >>> topovox.check_mesh("bunny.obj")["closed"]

@@ -23,7 +23,7 @@
 //! outside one, and it meets itself only along shared edges and vertices.
 //! Triangles are oriented with the inside behind them: the orientation is
 //! decided in integers on the lattice (the sign does not depend on where
-//! on its edges the caller puts each vertex, see [`orient`]). Vertex ids
+//! on its edges the caller puts each vertex, see `orient`). Vertex ids
 //! number the crossing edges in order of their inside end (layer, row,
 //! `i`) and direction, so the result is the same for any thread count.
 //!
