@@ -226,3 +226,12 @@ def test_bad_input_is_one_line_and_writes_nothing(vertices, faces, message, cli,
     r = subprocess.run([cli, "remesh", src, "-o", tmp_path / "out.obj"], capture_output=True, text=True)
     assert r.returncode != 0 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert not (tmp_path / "out.obj").exists()
+
+
+def test_a_grid_past_memory_is_refused_before_any_work(meshes, cli, tmp_path):
+    out = tmp_path / "big.ply"
+    r = subprocess.run([cli, "remesh", meshes / "stanford-bunny.obj", "-o", out, "--resolution", "2048", "--max-memory", "64M"], capture_output=True, text=True)
+    assert r.returncode != 0 and "more than the" in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert not out.exists()
+    with pytest.raises(RuntimeError, match="raise --max-memory"):
+        topovox.remesh(meshes / "stanford-bunny.obj", resolution=2048, max_memory="64M")
