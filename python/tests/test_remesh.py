@@ -179,11 +179,12 @@ def test_every_part_is_kept_and_min_part_drops_only_when_asked():
     assert (info["parts"], info["dropped_parts"], topovox.check_mesh(out)["components"]) == (1, 1, 1)
 
 
-def test_threads_give_the_same_bytes(meshes, cli, tmp_path):
+@pytest.mark.parametrize("extra", [[], ["--surface", "blocky"], ["--inside", "wrap"], ["--inside", "parity", "--surface", "blocky"]])
+def test_threads_give_the_same_bytes(meshes, cli, tmp_path, extra):
     outs = []
     for t in (1, 2):
         out = tmp_path / f"b{t}.ply"
-        subprocess.run([cli, "remesh", meshes / "stanford-bunny.obj", "-o", out, "--resolution", "48", "--threads", str(t), "--quiet"], check=True)
+        subprocess.run([cli, "remesh", meshes / "stanford-bunny.obj", "-o", out, "--resolution", "48", "--threads", str(t), "--quiet", *extra], check=True)
         outs.append(out.read_bytes())
     assert outs[0] == outs[1]
 

@@ -21,3 +21,20 @@ pub fn summary_json(facts: serde_json::Value, extra: serde_json::Value) -> serde
     }
     j
 }
+
+/// Reads the mesh a command works on, the bar showing it: the mesh and
+/// the seconds it took; its warnings go to stderr, naming the file.
+pub fn load_mesh(
+    path: &std::path::Path,
+    opts: &topovox_io::ReadOptions,
+    bar: &crate::progress::Bar,
+) -> Result<(topovox_io::LoadedMesh, f64)> {
+    bar.phase("loading mesh");
+    let t = std::time::Instant::now();
+    let loaded = topovox_io::read_mesh(path, opts)?;
+    let load_s = t.elapsed().as_secs_f64();
+    for w in &loaded.warnings {
+        eprintln!("topovox: warning: {}: {w}", path.display());
+    }
+    Ok((loaded, load_s))
+}

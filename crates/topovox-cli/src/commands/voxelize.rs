@@ -30,13 +30,7 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let pool = topovox_job::pool_for(opts.run.threads, "--threads")?;
 
     let bar = Bar::new(a.quiet || a.json);
-    bar.phase("loading mesh");
-    let t_load = Instant::now();
-    let loaded = topovox_io::read_mesh(&a.mesh, &opts.run.read_options())?;
-    let load_s = t_load.elapsed().as_secs_f64();
-    for w in &loaded.warnings {
-        eprintln!("topovox: warning: {}: {w}", a.mesh.display());
-    }
+    let (loaded, load_s) = crate::console::load_mesh(&a.mesh, &opts.run.read_options(), &bar)?;
     let name = a.mesh.display().to_string();
     let done = pool.install(|| job.run(&a.output, &loaded, &name, Some(&bar), None))?;
     for w in &done.voxels.warnings {
