@@ -192,8 +192,10 @@ pub struct Remeshed {
 
 /// Refuses a grid whose voxels and surface would not fit in memory: one
 /// bit per voxel for the solid (wrap: three grids), eight for the blocky
-/// surface's half voxels, and about 100 bytes per triangle, estimated as
-/// four per voxel face of the input's area (sixteen for blocky).
+/// surface's half voxels, and per triangle (estimated as four per voxel
+/// face of the input's area, sixteen for blocky) about 100 bytes, plus the
+/// output's distance pieces and hierarchy where the two-sided distance is
+/// measured (wrap, `check`) and the certificate's sorts where it runs.
 fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec) -> Result<()> {
     let cells = grid.voxel_count();
     let grids = if req.inside == Inside::Wrap { 3 } else { 1 } + if req.surface == SurfaceKind::Blocky { 8 } else { 0 };
@@ -201,7 +203,11 @@ fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec)
     let area: f64 = pieces.items.iter().map(|p| 0.5 * (p.p[1] - p.p[0]).cross(p.p[2] - p.p[0]).length()).sum();
     let per_face = if req.surface == SurfaceKind::Blocky { 16.0 } else { 4.0 };
     let triangles = area / (h.x * h.y).min(h.y * h.z).min(h.x * h.z) * per_face;
-    let need = (cells / 8).saturating_mul(grids + 1).saturating_add((triangles * 100.0) as u64);
+    let measured = req.inside == Inside::Wrap || req.check;
+    let certified = req.check || cfg!(debug_assertions);
+    let per_triangle =
+        100 + if measured { std::mem::size_of::<topovox::distance::Piece>() + 16 } else { 0 } + if certified { 150 } else { 0 };
+    let need = (cells / 8).saturating_mul(grids + 1).saturating_add((triangles * per_triangle as f64) as u64);
     let limit = budget(req.max_memory);
     if need > limit {
         let [x, y, z] = grid.dims();
