@@ -33,6 +33,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::stop::Stop;
+use crate::topology::runs::UnionFind;
 
 /// Why a mesh could not be checked.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -227,44 +228,26 @@ fn is_disk(star: &[(u32, u32, u32)]) -> bool {
     ends.dedup();
     let at = |v: u32| ends.binary_search(&v).expect("a link vertex");
     let mut degree = vec![0u32; ends.len()];
-    let mut parent: Vec<usize> = (0..ends.len()).collect();
-    fn root(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
+    let mut sets = UnionFind::new(ends.len());
     for s in star {
         let (a, b) = (at(s.1), at(s.2));
         degree[a] += 1;
         degree[b] += 1;
-        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
-        parent[ra] = rb;
+        sets.union(a, b);
     }
-    let one = (0..ends.len()).all(|x| root(&mut parent, x) == root(&mut parent, 0));
+    let one = (0..ends.len()).all(|x| sets.find(x) == 0);
     let ones = degree.iter().filter(|&&d| d == 1).count();
     one && degree.iter().all(|&d| d == 1 || d == 2) && (ones == 0 || ones == 2)
 }
 
 /// Components of the faces, connected through shared vertices.
 fn components(n: usize, faces: &[[u32; 3]]) -> u64 {
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn root(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            p[x as usize] = p[p[x as usize] as usize];
-            x = p[x as usize];
-        }
-        x
-    }
+    let mut sets = UnionFind::new(n);
     for f in faces {
-        let r0 = root(&mut parent, f[0]);
-        for &v in &f[1..] {
-            let r = root(&mut parent, v);
-            parent[r as usize] = r0;
-        }
+        sets.union(f[0] as usize, f[1] as usize);
+        sets.union(f[0] as usize, f[2] as usize);
     }
-    (0..n as u32).filter(|&v| root(&mut parent, v) == v).count() as u64
+    (0..n).filter(|&v| sets.find(v) == v).count() as u64
 }
 
 /// The signed volume (divergence theorem, about the first vertex).

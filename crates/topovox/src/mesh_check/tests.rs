@@ -130,7 +130,7 @@ fn the_broad_phase_equals_every_pair() {
         let mut brute = Vec::new();
         for a in 0..faces.len() {
             for b in a + 1..faces.len() {
-                if !deg[a] && !deg[b] && pairs_meet(&pos, &faces[a], &faces[b]) {
+                if !deg[a] && !deg[b] && pairs::faces_meet(&pos, &faces[a], &faces[b]) {
                     brute.push([a as u32, b as u32]);
                 }
             }
@@ -138,8 +138,4 @@ fn the_broad_phase_equals_every_pair() {
         assert_eq!(r.self_intersections, brute.len() as u64, "round {round}");
         assert_eq!(r.intersecting_pairs, brute.into_iter().take(MeshCheck::SHOWN).collect::<Vec<_>>());
     }
-}
-
-fn pairs_meet(pos: &[DVec3], f: &[u32; 3], h: &[u32; 3]) -> bool {
-    pairs::faces_meet(pos, f, h)
 }

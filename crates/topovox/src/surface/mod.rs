@@ -162,16 +162,24 @@ pub fn dilate(bits: &DenseBits) -> DenseBits {
                 }
                 let start = (kk as usize * ny as usize + jj as usize) * w;
                 let src = &bits.words()[start..start + w];
-                for n in 0..w {
-                    let lower = if n > 0 { src[n - 1] >> 63 } else { 0 };
-                    let upper = if n + 1 < w { src[n + 1] << 63 } else { 0 };
-                    row[n] |= src[n] | (src[n] << 1 | lower) | (src[n] >> 1 | upper);
+                for (n, word) in row.iter_mut().enumerate() {
+                    let [me, left, right] = row_words(src, n);
+                    *word |= me | left | right;
                 }
             }
         }
     });
     out.clear_padding();
     out
+}
+
+/// Word `n` of bit row `r` and of the row shifted one voxel either way:
+/// bit `i` of each says whether voxel `i`, `i − 1` and `i + 1` is set
+/// (outside the row: clear).
+fn row_words(r: &[u64], n: usize) -> [u64; 3] {
+    let lower = if n > 0 { r[n - 1] >> 63 } else { 0 };
+    let upper = if n + 1 < r.len() { r[n + 1] << 63 } else { 0 };
+    [r[n], r[n] << 1 | lower, r[n] >> 1 | upper]
 }
 
 /// Each voxel split in two along each axis (8 half-voxels of its label).

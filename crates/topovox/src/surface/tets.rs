@@ -181,10 +181,9 @@ fn boundary_points(labels: &DenseBits, k: u32) -> Vec<(u32, u32)> {
 /// `acc &= r & (r shifted by one either way)`: the points whose row
 /// neighbours `i − 1, i, i + 1` are all set in `r`.
 fn and_with_neighbours(acc: &mut [u64], r: &[u64]) {
-    for n in 0..r.len() {
-        let lower = if n > 0 { r[n - 1] >> 63 } else { 0 };
-        let upper = if n + 1 < r.len() { r[n + 1] << 63 } else { 0 };
-        acc[n] &= r[n] & (r[n] << 1 | lower) & (r[n] >> 1 | upper);
+    for (n, a) in acc.iter_mut().enumerate() {
+        let [me, left, right] = super::row_words(r, n);
+        *a &= me & left & right;
     }
 }
 
