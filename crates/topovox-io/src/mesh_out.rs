@@ -113,7 +113,7 @@ fn stl(w: &mut impl Write, p: &[DVec3], t: &[[u32; 3]]) -> std::io::Result<()> {
     Ok(())
 }
 
-fn glb(w: &mut impl Write, p: &[DVec3], t: &[[u32; 3]]) -> std::io::Result<()> {
+fn glb(w: &mut dyn Write, p: &[DVec3], t: &[[u32; 3]]) -> std::io::Result<()> {
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     let mut bin = Vec::with_capacity(t.len() * 12 + p.len() * 12);
     for f in t {
@@ -145,12 +145,24 @@ fn glb(w: &mut impl Write, p: &[DVec3], t: &[[u32; 3]]) -> std::io::Result<()> {
             {"bufferView": 1, "componentType": 5126, "count": p.len(), "type": "VEC3", "min": lo, "max": hi},
         ],
     });
+    write_glb(w, &doc, &bin, |total| format!("a {total}-byte mesh cannot be a .glb file (the format ends at 4 GiB)"))
+}
+
+/// Writes a binary glTF container: the 12-byte header, the JSON chunk
+/// (padded with spaces to 4 bytes) and the BIN chunk (`bin` already
+/// padded). A file past 4 GiB is refused with `too_large(total bytes)`.
+pub(crate) fn write_glb(
+    w: &mut dyn Write,
+    doc: &serde_json::Value,
+    bin: &[u8],
+    too_large: impl FnOnce(usize) -> String,
+) -> std::io::Result<()> {
     let mut text = doc.to_string().into_bytes();
     while text.len() % 4 != 0 {
         text.push(b' ');
     }
     let total = 12 + 8 + text.len() + 8 + bin.len();
-    let total = u32::try_from(total).map_err(|_| std::io::Error::other("a mesh past 4 GiB cannot be a .glb file"))?;
+    let total = u32::try_from(total).map_err(|_| std::io::Error::other(too_large(total)))?;
     w.write_all(b"glTF")?;
     w.write_all(&2u32.to_le_bytes())?;
     w.write_all(&total.to_le_bytes())?;
@@ -159,7 +171,7 @@ fn glb(w: &mut impl Write, p: &[DVec3], t: &[[u32; 3]]) -> std::io::Result<()> {
     w.write_all(&text)?;
     w.write_all(&(bin.len() as u32).to_le_bytes())?;
     w.write_all(b"BIN\0")?;
-    w.write_all(&bin)
+    w.write_all(bin)
 }
 
 #[cfg(test)]

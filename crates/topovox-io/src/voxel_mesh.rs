@@ -254,27 +254,10 @@ pub fn write_quads_glb(
         "bufferViews": views,
         "accessors": accessors,
     });
-    let mut text = doc.to_string().into_bytes();
-    while text.len() % 4 != 0 {
-        text.push(b' ');
-    }
     write_atomically(path, |w| {
-        let total = 12 + 8 + text.len() + 8 + bin.len();
-        if total > u32::MAX as usize {
-            return Err(std::io::Error::other(format!(
-                "{} quads make a {total}-byte GLB; the format ends at 4 GiB (write .obj instead)",
-                quads.len()
-            )));
-        }
-        w.write_all(b"glTF")?;
-        w.write_all(&2u32.to_le_bytes())?;
-        w.write_all(&(total as u32).to_le_bytes())?;
-        w.write_all(&(text.len() as u32).to_le_bytes())?;
-        w.write_all(b"JSON")?;
-        w.write_all(&text)?;
-        w.write_all(&(bin.len() as u32).to_le_bytes())?;
-        w.write_all(b"BIN\0")?;
-        w.write_all(&bin)
+        crate::mesh_out::write_glb(w, &doc, &bin, |total| {
+            format!("{} quads make a {total}-byte GLB; the format ends at 4 GiB (write .obj instead)", quads.len())
+        })
     })?;
     Ok(nv)
 }
