@@ -319,7 +319,7 @@ pub fn sdf(py: Python<'_>, mesh: &Mesh, options: Option<&Bound<'_, PyDict>>) -> 
     let req = opts.request(DistanceFormat::Vdb).map_err(py_err)?;
     let pool = opts.run.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
     let inner = &mesh.inner;
-    let name = mesh.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into());
+    let name = mesh.name();
     let stop = Stop::new();
     let run = || -> Result<Sdf, JobError> {
         let go = || topovox_job::distance::sdf(inner.mesh.as_ref(), &name, &req, Some(&stop));

@@ -21,6 +21,13 @@ pub(crate) struct Mesh {
     pub(crate) path: Option<PathBuf>,
 }
 
+impl Mesh {
+    /// How messages name it: its file, or `mesh`.
+    pub(crate) fn name(&self) -> String {
+        self.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into())
+    }
+}
+
 /// An `(h, w, 3|4)` uint8 image as a texture.
 pub(crate) fn texture_from(py: Python<'_>, t: &Bound<'_, PyAny>) -> PyResult<topovox::attributes::Texture> {
     let arr = py.import("numpy")?.call_method1("asarray", (t, "uint8"))?;

@@ -17,10 +17,6 @@ use crate::interrupt::interruptible;
 use crate::meshes::Mesh;
 use crate::options::table_options;
 
-fn name_of(mesh: &Mesh) -> String {
-    mesh.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into())
-}
-
 /// The native remesh: see `topovox.remesh` for the documentation. Returns
 /// the mesh and the summary's facts (with the certificate when asked).
 #[pyfunction]
@@ -29,7 +25,7 @@ pub fn remesh<'py>(py: Python<'py>, mesh: &Mesh, options: Option<&Bound<'py, PyD
     let opts: RemeshOptions = table_options(options, &[])?;
     let req = opts.request(false).map_err(py_err)?;
     let pool = opts.run.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
-    let (inner, name) = (&mesh.inner, name_of(mesh));
+    let (inner, name) = (&mesh.inner, mesh.name());
     let stop = Stop::new();
     let run = || -> Result<Remeshed, JobError> {
         let go = || topovox_job::remesh::remesh(inner.mesh.as_ref(), &name, &req, Some(&stop));
@@ -39,8 +35,7 @@ pub fn remesh<'py>(py: Python<'py>, mesh: &Mesh, options: Option<&Bound<'py, PyD
         }
     };
     let r = interruptible(py, &stop, run)?.map_err(py_err)?;
-    let mut facts = r.facts.to_json();
-    facts["certificate"] = r.certificate.as_ref().map(certificate_json).unwrap_or_default();
+    let mut facts = r.summary();
     facts["warnings"] = serde_json::json!(r.warnings);
     let (positions, triangles) = (r.mesh.positions, r.mesh.triangles.iter().map(|t| t.map(i64::from)).collect());
     let loaded = py.detach(|| topovox_io::validate_mesh(positions, triangles, Vec::new())).map_err(|k| value_err(k.to_string()))?;
@@ -50,7 +45,7 @@ pub fn remesh<'py>(py: Python<'py>, mesh: &Mesh, options: Option<&Bound<'py, PyD
 /// check_mesh(mesh) -> dict: the mesh certificate (see `topovox.check_mesh`).
 #[pyfunction]
 pub fn check_mesh<'py>(py: Python<'py>, mesh: &Mesh) -> PyResult<Bound<'py, PyAny>> {
-    let (inner, name) = (&mesh.inner, name_of(mesh));
+    let (inner, name) = (&mesh.inner, mesh.name());
     let stop = Stop::new();
     let c = interruptible(py, &stop, || mesh_certificate(inner.mesh.as_ref(), &name, Some(&stop)))?.map_err(py_err)?;
     to_py(py, &certificate_json(&c))

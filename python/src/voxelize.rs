@@ -23,7 +23,7 @@ pub(crate) fn voxelize(py: Python<'_>, mesh: &Mesh, options: Option<&Bound<'_, P
     let attributes = opts.export.carries();
     let pool = opts.run.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
     let inner = &mesh.inner;
-    let name = mesh.path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| "mesh".into());
+    let name = mesh.name();
     let stop = Stop::new();
     let data = interruptible(py, &stop, || {
         let run = || -> Result<GridData, JobError> {

@@ -289,6 +289,16 @@ pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&
     Ok(Remeshed { mesh: out, grid, facts, certificate, warnings })
 }
 
+impl Remeshed {
+    /// The summary's facts and the certificate (`null` when none ran), as
+    /// JSON.
+    pub fn summary(&self) -> Value {
+        let mut facts = self.facts.to_json();
+        facts["certificate"] = self.certificate.as_ref().map(certificate_json).unwrap_or_default();
+        facts
+    }
+}
+
 /// The certificate of `out`; an error (nothing is written) if it fails.
 fn certify(name: &str, out: &TriMesh, stop: &Stop) -> Result<MeshCheck> {
     let c = check_mesh(&out.positions, &out.triangles, stop).map_err(|e| match e {

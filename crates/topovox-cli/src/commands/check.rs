@@ -107,7 +107,7 @@ fn check_mesh_file(a: &CheckArgs, t0: Instant) -> Result<()> {
     if a.json {
         crate::console::print_stdout(&v.to_string())?;
     } else {
-        crate::console::print_stdout(&mesh_text(&name, &v))?;
+        crate::console::print_stdout(&mesh_text(&name, &c))?;
     }
     if !failed.is_empty() {
         eprintln!("topovox: {name}: not {}", failed.join(", not "));
@@ -116,20 +116,18 @@ fn check_mesh_file(a: &CheckArgs, t0: Instant) -> Result<()> {
     Ok(())
 }
 
-fn mesh_text(name: &str, v: &Value) -> String {
-    let yes = |k: &str| if v[k].as_bool() == Some(true) { "yes" } else { "NO" };
+fn mesh_text(name: &str, c: &topovox::mesh_check::MeshCheck) -> String {
+    let yes = |b: bool| if b { "yes" } else { "NO" };
+    let genus = c.genus.map_or("n/a".to_string(), |g| g.to_string());
+    let first = if c.self_intersections > 0 { format!(" (first: {:?})", c.intersecting_pairs) } else { String::new() };
     format!(
-        "{name}: {} faces, {} vertices, {} edges, {} component(s), genus {}, volume {}\n  closed: {} ({} boundary edges, {} edges with more than two faces)\n  manifold: {} ({} non-manifold vertices)\n  oriented: {} ({} inconsistent edges)\n  self-intersecting face pairs: {}{}\n  degenerate faces: {}\n  watertight: {}",
-        v["faces"], v["vertices"], v["edges"], v["components"],
-        if v["genus"].is_null() { "n/a".to_string() } else { v["genus"].to_string() },
-        v["volume"],
-        yes("closed"), v["boundary_edges"], v["non_manifold_edges"],
-        yes("manifold"), v["non_manifold_vertices"],
-        yes("oriented"), v["inconsistent_edges"],
-        v["self_intersections"],
-        if v["self_intersections"].as_u64().unwrap_or(0) > 0 { format!(" (first: {})", v["intersecting_pairs"]) } else { String::new() },
-        v["degenerate_faces"],
-        yes("watertight"),
+        "{name}: {} faces, {} vertices, {} edges, {} component(s), genus {genus}, volume {}\n  closed: {} ({} boundary edges, {} edges with more than two faces)\n  manifold: {} ({} non-manifold vertices)\n  oriented: {} ({} inconsistent edges)\n  self-intersecting face pairs: {}{first}\n  degenerate faces: {}\n  watertight: {}",
+        c.faces, c.vertices, c.edges, c.components, c.volume,
+        yes(c.closed()), c.boundary_edges, c.non_manifold_edges,
+        yes(c.manifold()), c.non_manifold_vertices,
+        yes(c.oriented()), c.inconsistent_edges,
+        c.self_intersections, c.degenerate_faces,
+        yes(c.watertight()),
     )
 }
 

@@ -4,7 +4,6 @@ use std::time::Instant;
 
 use anyhow::Result;
 use serde_json::json;
-use topovox_job::check::certificate_json;
 use topovox_job::remesh::{format_of, RemeshJob};
 use topovox_job::Choice;
 
@@ -32,8 +31,7 @@ pub fn run(a: &RemeshArgs) -> Result<()> {
     let (g, dims) = (r.grid, r.grid.dims());
     let o = g.origin();
     if a.json {
-        let mut facts = r.facts.to_json();
-        facts["certificate"] = r.certificate.as_ref().map(certificate_json).unwrap_or(serde_json::Value::Null);
+        let facts = r.summary();
         let extra = json!({
             "origin": [o.x, o.y, o.z],
             "voxel_size": topovox_io::size_json(g.voxel_size()),
