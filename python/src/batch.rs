@@ -9,8 +9,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde_json::Value;
 use topovox::voxelize::Stop;
+use topovox_io::mesh_out::MeshOut;
 use topovox_job::batch::{BatchOptions, BatchProgress, Run};
 use topovox_job::distance::{DistanceFormat, SdfOptions};
+use topovox_job::remesh::RemeshOptions;
 use topovox_job::{JobError, OptionValue};
 
 use crate::convert::to_py;
@@ -22,10 +24,11 @@ use crate::options::{job_options, option_value, table_options};
 pub(crate) type BatchListing<'py> = (Vec<(String, String, bool)>, Bound<'py, PyAny>);
 
 /// The options of a batch, validated (with its fingerprint), and `jobs`:
-/// `run="sdf"` takes `sdf`'s options, else `voxelize`'s.
+/// `run="sdf"` takes `sdf`'s options, `run="remesh"` `remesh`'s, else
+/// `voxelize`'s; `format` defaults to the run's.
 pub(crate) fn batch_options(
     options: Option<&Bound<'_, PyDict>>,
-    format: &str,
+    format: Option<&str>,
 ) -> PyResult<(topovox_job::batch::BatchOptions, Option<usize>)> {
     let get = |k: &str| -> PyResult<Option<OptionValue>> {
         match options.map(|d| d.get_item(k)).transpose()?.flatten().filter(|v| !v.is_none()) {
@@ -43,6 +46,7 @@ pub(crate) fn batch_options(
         None => Run::Voxelize,
     };
     let own = ["jobs", "run"];
+    let format = format.unwrap_or(run.default_format());
     let opts = match run {
         Run::Voxelize => {
             let target = <topovox_job::output::Output as topovox_job::Choice>::parse(format).map_err(|e| value_err(e.to_string()))?;
@@ -51,6 +55,10 @@ pub(crate) fn batch_options(
         Run::Sdf => {
             let target = <DistanceFormat as topovox_job::Choice>::parse(format).map_err(|e| value_err(format!("run=\"sdf\": {e}")))?;
             BatchOptions::sdf(&table_options::<SdfOptions>(options, &own)?, target)
+        }
+        Run::Remesh => {
+            let target = <MeshOut as topovox_job::Choice>::parse(format).map_err(|e| value_err(format!("run=\"remesh\": {e}")))?;
+            BatchOptions::remesh(&table_options::<RemeshOptions>(options, &own)?, target)
         }
     };
     Ok((opts.map_err(py_err)?, jobs))
@@ -79,12 +87,12 @@ impl BatchProgress for Counts {
 /// called on the caller's thread as meshes finish (at most every 50 ms)
 /// and once at the end.
 #[pyfunction]
-#[pyo3(signature = (inputs, out_dir, format="npy", glob=None, options=None, progress=None))]
+#[pyo3(signature = (inputs, out_dir, format=None, glob=None, options=None, progress=None))]
 pub(crate) fn batch<'py>(
     py: Python<'py>,
     inputs: Vec<PathBuf>,
     out_dir: PathBuf,
-    format: &str,
+    format: Option<&str>,
     glob: Option<String>,
     options: Option<&Bound<'py, PyDict>>,
     progress: Option<Bound<'py, PyAny>>,
@@ -121,12 +129,12 @@ pub(crate) fn batch<'py>(
 /// options' fingerprint (for the Dask and Ray helpers, which run
 /// [`process_one`] per mesh and write the same manifest).
 #[pyfunction]
-#[pyo3(signature = (inputs, out_dir, format="npy", glob=None, options=None))]
+#[pyo3(signature = (inputs, out_dir, format=None, glob=None, options=None))]
 pub(crate) fn batch_plan<'py>(
     py: Python<'py>,
     inputs: Vec<PathBuf>,
     out_dir: PathBuf,
-    format: &str,
+    format: Option<&str>,
     glob: Option<String>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<BatchListing<'py>> {
@@ -145,12 +153,12 @@ pub(crate) fn batch_plan<'py>(
 /// One mesh of a batch: voxelizes `input`, writes `output`, returns the
 /// manifest record (a dict; failures are its `error`, never exceptions).
 #[pyfunction]
-#[pyo3(signature = (input, output, format="npy", options=None))]
+#[pyo3(signature = (input, output, format=None, options=None))]
 pub(crate) fn process_one<'py>(
     py: Python<'py>,
     input: PathBuf,
     output: PathBuf,
-    format: &str,
+    format: Option<&str>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (mut opts, _) = batch_options(options, format)?;

@@ -236,3 +236,43 @@ def test_a_grid_past_memory_is_refused_before_any_work(meshes, cli, tmp_path):
     assert not out.exists()
     with pytest.raises(RuntimeError, match="raise --max-memory"):
         topovox.remesh(meshes / "stanford-bunny.obj", resolution=2048, max_memory="64M")
+
+
+def test_batch_and_dask_remesh_folders_as_the_cli_does(meshes, cli, tmp_path):
+    """The batch (Python and CLI) and the Dask helper run remesh over a
+    folder, resumable, writing what `topovox.remesh` makes; `surface` is
+    remesh's under run="remesh"."""
+    from conftest import run_cli
+
+    root = tmp_path / "in"
+    (root / "sub").mkdir(parents=True)
+    for name, where in [("cow.obj", root), ("teapot.obj", root / "sub")]:
+        (where / name).write_bytes((meshes / name).read_bytes())
+    py_out, cli_out = tmp_path / "py", tmp_path / "cli"
+    s = topovox.batch(root, py_out, run="remesh", surface="blocky", resolution=20, format="ply")
+    assert (s["done"], s["failed"]) == (2, 0), s
+    run_cli(cli, "batch", root, "-o", cli_out, "--run", "remesh", "--surface", "blocky", "--resolution", 20, "--format", "ply", "--quiet")
+    for rel in ["cow.ply", "sub/teapot.ply"]:
+        assert (py_out / rel).read_bytes() == (cli_out / rel).read_bytes(), rel
+    one = topovox.remesh(topovox.load_mesh(root / "cow.obj"), surface="blocky", resolution=20)
+    back = topovox.load_mesh(py_out / "cow.ply")
+    assert np.array_equal(back.vertices, one.vertices) and np.array_equal(back.faces, one.faces)
+    certify(back)
+    # The CLI resumes the Python run; other options are refused by name.
+    assert topovox.batch(root, py_out, run="remesh", surface="blocky", resolution=20, format="ply")["skipped"] == 2
+    with pytest.raises(FileExistsError, match="surface"):
+        topovox.batch(root, py_out, run="remesh", resolution=20, format="ply")
+    with pytest.raises(ValueError, match="unknown option"):
+        topovox.batch(root, tmp_path / "x", run="remesh", mode="solid")
+    with pytest.raises(ValueError, match="remesh"):
+        topovox.batch(root, tmp_path / "y", run="remesh", format="npy")
+    # Dask: one task per mesh, the same files, obj by default.
+    pytest.importorskip("dask")
+    import topovox.dask as vd
+
+    ref = tmp_path / "ref"
+    topovox.batch(root, ref, run="remesh", resolution=16)
+    records = vd.voxelize_paths([root], tmp_path / "dask", run="remesh", resolution=16).compute(scheduler="threads")
+    assert sorted(r["status"] for r in records) == ["done", "done"]
+    for rel in ["cow.obj", "sub/teapot.obj"]:
+        assert (tmp_path / "dask" / rel).read_bytes() == (ref / rel).read_bytes(), rel

@@ -124,4 +124,4 @@ def test_batch_runs_sdf_with_its_options_and_refuses_the_others(meshes, tmp_path
     with pytest.raises(ValueError, match='unknown option "mode"'):
         topovox.batch(meshes / "cow.obj", tmp_path / "h", run="sdf", mode="solid")
     with pytest.raises(ValueError, match="run"):
-        topovox.batch(meshes / "cow.obj", tmp_path / "i", run="remesh")
+        topovox.batch(meshes / "cow.obj", tmp_path / "i", run="render")

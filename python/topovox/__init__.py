@@ -605,11 +605,11 @@ def batch(
     paths: Union[str, os.PathLike[str], Iterable[Union[str, os.PathLike[str]]]],
     out_dir: Union[str, os.PathLike[str]],
     *,
-    format: str = "npy",
+    format: Optional[str] = None,
     glob: Optional[str] = None,
     jobs: Optional[int] = None,
     progress: Union[None, bool, Callable[[int, int], Any]] = None,
-    run: Literal["voxelize", "sdf"] = "voxelize",
+    run: Literal["voxelize", "sdf", "remesh"] = "voxelize",
     **options: Any,
 ) -> Dict[str, Any]:
     """Voxelizes whole datasets, resumably, as ``topovox batch`` does.
@@ -629,8 +629,11 @@ def batch(
         Files, or folders walked for meshes.
     out_dir : path
         The output folder.
-    format : str
-        One of :data:`FORMATS`.
+    format : str, optional
+        One of :data:`FORMATS` (default ``"npy"``); with ``run="sdf"``
+        ``"npy"``, ``"vdb"``, ``"zarr"`` or ``"vti"`` (default ``"npy"``);
+        with ``run="remesh"`` ``"obj"``, ``"ply"``, ``"stl"`` or ``"glb"``
+        (default ``"obj"``).
     glob : str, optional
         Which files of the folders to take, such as ``"**/*.obj"``.
     jobs : int, optional
@@ -641,14 +644,15 @@ def batch(
         calling thread as meshes finish (at most every 50 ms, and once at
         the end; meshes skipped as done count as finished). An exception it
         raises stops the batch as Ctrl-C does.
-    run : {"voxelize", "sdf"}
-        What runs on each mesh: :func:`voxelize`, or :func:`sdf` (a
-        distance field per mesh; ``format`` is then ``"npy"``, ``"vdb"``,
-        ``"zarr"`` or ``"vti"``).
+    run : {"voxelize", "sdf", "remesh"}
+        What runs on each mesh: :func:`voxelize`, :func:`sdf` (a distance
+        field per mesh) or :func:`remesh` (a watertight mesh per mesh).
     **options
         Every option :func:`voxelize` takes (:data:`OPTIONS`), or with
         ``run="sdf"`` every option :func:`sdf` takes (``band``, ``sign``,
-        ``unsigned`` and the grid's); ``attributes=True`` writes every
+        ``unsigned`` and the grid's), or with ``run="remesh"`` every option
+        :func:`remesh` takes (``inside``, ``surface``, ``min_part``,
+        ``check`` and the grid's); ``attributes=True`` writes every
         attribute grid into ``.vdb`` and ``.zarr`` outputs.
 
     Returns

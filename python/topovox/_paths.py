@@ -32,7 +32,7 @@ def options_dict(options: Dict[str, Any]) -> Dict[str, Any]:
 
 
 def plan(
-    paths: Union[PathLike, Iterable[PathLike]], out_dir: str, format: str, glob: Optional[str], options: Dict[str, Any]
+    paths: Union[PathLike, Iterable[PathLike]], out_dir: str, format: Optional[str], glob: Optional[str], options: Dict[str, Any]
 ) -> Tuple[List[Tuple[str, str]], Any]:
     """The meshes still to do as ``(input, output)`` pairs, and the options'
     fingerprint. For an fsspec URL ``out_dir`` the outputs are named under
@@ -67,7 +67,7 @@ def _remote_manifest_mirror(out_dir: str) -> str:
     return local
 
 
-def run_one(inp: str, out: str, format: str, options: Dict[str, Any]) -> Dict[str, Any]:
+def run_one(inp: str, out: str, format: Optional[str], options: Dict[str, Any]) -> Dict[str, Any]:
     """One mesh: voxelize ``inp`` and write ``out`` (written locally and
     uploaded through fsspec when ``out`` is a URL); returns its manifest
     record, without appending it."""
@@ -87,7 +87,7 @@ def run_one(inp: str, out: str, format: str, options: Dict[str, Any]) -> Dict[st
     return record
 
 
-def process(inp: str, out: str, out_dir: str, format: str, options: Dict[str, Any]) -> Dict[str, Any]:
+def process(inp: str, out: str, out_dir: str, format: Optional[str], options: Dict[str, Any]) -> Dict[str, Any]:
     """One mesh as :func:`run_one` does it, its manifest line appended."""
     record = run_one(inp, out, format, options)
     append_manifest(out_dir, [record])

@@ -26,7 +26,7 @@ def voxelize_paths(
     paths: Union[str, os.PathLike[str], Iterable[Union[str, os.PathLike[str]]]],
     out_dir: Union[str, os.PathLike[str]],
     *,
-    format: str = "npy",
+    format: Optional[str] = None,
     glob: Optional[str] = None,
     npartitions: Optional[int] = None,
     **options: Any,
@@ -44,14 +44,17 @@ def voxelize_paths(
         Files, or folders walked for meshes.
     out_dir : path or str
         The output folder, or an fsspec URL.
-    format : str
-        One of :data:`topovox.FORMATS`.
+    format : str, optional
+        As :func:`topovox.batch` takes it (default: the run's, ``"npy"``
+        or with ``run="remesh"`` ``"obj"``).
     glob : str, optional
         Which files of the folders to take.
     npartitions : int, optional
         Partitions of the bag (default: one per mesh).
     **options
-        Every option :func:`topovox.voxelize` takes.
+        Every option :func:`topovox.voxelize` takes, or ``run="sdf"`` or
+        ``run="remesh"`` and the options of :func:`topovox.sdf` or
+        :func:`topovox.remesh`, as :func:`topovox.batch` takes them.
 
     Returns
     -------

@@ -7,7 +7,7 @@ use topovox::raster::{RasterMethod, RasterMode};
 use topovox_io::mesh_out::MeshOut;
 use topovox_job::batch::Run;
 use topovox_job::check::MeshProperty;
-use topovox_job::distance::{DistanceFormat, FieldOptions, SdfOptions};
+use topovox_job::distance::{DistanceFormat, SdfOptions};
 use topovox_job::output::Output;
 use topovox_job::remesh::RemeshOptions;
 use topovox_job::{ColourRule, ExportOptions, GridOptions, JobOptions, Mode, Switch, Up};
@@ -15,7 +15,7 @@ use topovox_job::{ColourRule, ExportOptions, GridOptions, JobOptions, Mode, Swit
 use topovox::render::raycast::View;
 
 use crate::choice::choice;
-use crate::flags::Flags;
+use crate::flags::{Flags, RunFlags, Runs};
 use crate::values::{self, CameraSpec, Size};
 
 /// topovox: voxelize triangle meshes with guaranteed topology.
@@ -562,17 +562,19 @@ pub struct BatchArgs {
     /// every mesh extension topovox reads).
     #[arg(long, value_name = "PATTERN")]
     pub glob: Option<String>,
-    /// Output format.
-    #[arg(long, default_value = "npy", value_name = "FORMAT", value_parser = choice::<Output>())]
-    pub format: Output,
-    /// What runs on each mesh: voxelize (the voxelize options) or sdf (a
-    /// distance field: the grid options, --band, --unsigned, --sign; --format npy, vdb, zarr or vti).
+    /// Output format: with --run voxelize one of the voxelize formats
+    /// (default npy), with --run sdf npy, vdb, zarr or vti (default npy),
+    /// with --run remesh obj, ply, stl or glb (default obj).
+    #[arg(long, value_name = "FORMAT")]
+    pub format: Option<String>,
+    /// What runs on each mesh: voxelize (the voxelize options), sdf (a
+    /// distance field: the grid options, --band, --unsigned, --sign) or
+    /// remesh (a watertight mesh: the grid options, --inside, --surface,
+    /// --min-part, --check).
     #[arg(long, value_parser = choice::<Run>(), default_value = "voxelize")]
     pub run: Run,
     #[command(flatten)]
-    pub job: Flags<JobOptions>,
-    #[command(flatten)]
-    pub field: Flags<FieldOptions>,
+    pub options: RunFlags<BatchRuns>,
     /// Meshes processed at once (default: all cores); each is voxelized on the same threads.
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
@@ -582,6 +584,21 @@ pub struct BatchArgs {
     /// No progress bar and no summary line.
     #[arg(long, short)]
     pub quiet: bool,
+}
+
+/// The works `batch --run` chooses between, with their tables.
+#[derive(Clone, Debug)]
+pub struct BatchRuns;
+
+impl Runs for BatchRuns {
+    fn tables() -> Vec<(&'static str, Vec<&'static topovox_job::table::Keyword>)> {
+        use topovox_job::Table;
+        vec![
+            ("voxelize", JobOptions::keywords().collect()),
+            ("sdf", SdfOptions::keywords().collect()),
+            ("remesh", RemeshOptions::keywords().collect()),
+        ]
+    }
 }
 
 #[derive(Args, Debug)]

@@ -30,14 +30,14 @@ impl<T: Table> std::ops::Deref for Flags<T> {
 /// A choice's names as clap's possible values (listed in `--help`,
 /// checked in any case, a bad one refused with the list).
 #[derive(Clone)]
-struct Names(fn() -> Vec<(&'static str, &'static str)>);
+struct Names(Vec<(&'static str, &'static str)>);
 
 impl TypedValueParser for Names {
     type Value = String;
 
     fn parse_ref(&self, cmd: &Command, arg: Option<&Arg>, value: &OsStr) -> Result<String, clap::Error> {
         let given = value.to_string_lossy();
-        let names = (self.0)();
+        let names = &self.0;
         if names.iter().any(|(n, _)| n.eq_ignore_ascii_case(given.trim())) {
             return Ok(given.into_owned());
         }
@@ -49,7 +49,7 @@ impl TypedValueParser for Names {
     }
 
     fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
-        Some(Box::new((self.0)().into_iter().map(|(n, h)| PossibleValue::new(n).help(h))))
+        Some(Box::new(self.0.iter().map(|&(n, h)| PossibleValue::new(n).help(h))))
     }
 }
 
@@ -63,7 +63,7 @@ fn arg(k: &'static Keyword) -> Arg {
     }
     match k.shape {
         Shape::Flag => a.action(ArgAction::SetTrue),
-        Shape::Choice(name, names) => a.value_name(name).action(ArgAction::Set).value_parser(Names(names)),
+        Shape::Choice(name, names) => a.value_name(name).action(ArgAction::Set).value_parser(Names(names())),
         Shape::Value(name) => {
             // Numbers may be negative (`--origin -1,-1,-1`).
             let numeric = matches!(k.example, Example::Float(_) | Example::Numbers(_));
@@ -110,6 +110,114 @@ impl<T: Table> FromArgMatches for Flags<T> {
 
 /// clap's one-line error for a bad value (exit status 2, as clap's own).
 fn refused(k: &Keyword, raw: &str, e: topovox_job::JobError) -> clap::Error {
+    clap::Error::raw(ErrorKind::ValueValidation, format!("{}\n", refusal(k, raw, e)))
+}
+
+/// The line refusing a bad value.
+fn refusal(k: &Keyword, raw: &str, e: topovox_job::JobError) -> String {
     let shown: String = raw.chars().take(40).collect();
-    clap::Error::raw(ErrorKind::ValueValidation, format!("invalid value '{shown}' for '{}': {e}\n", k.flag()))
+    format!("invalid value '{shown}' for '{}': {e}", k.flag())
+}
+
+/// The tables of the works one command chooses between (`batch --run`),
+/// each named as the choice names it.
+pub trait Runs {
+    /// `(run, the table's options)`, in the order `--help` lists them.
+    fn tables() -> Vec<(&'static str, Vec<&'static Keyword>)>;
+}
+
+/// The options of several tables under one set of flags, read later by the
+/// table of the work chosen: a name two tables share is one flag (with
+/// both meanings in its help, and both choices' names where they differ),
+/// and each table reads its text its own way.
+#[derive(Clone, Debug)]
+pub struct RunFlags<R: Runs> {
+    /// The options given, by name, as text (`on` for a flag).
+    pub given: Vec<(&'static str, String)>,
+    runs: std::marker::PhantomData<R>,
+}
+
+/// Each option name once, in order, with every `(run, keyword)` having it.
+fn merged<R: Runs>() -> Vec<(&'static str, Vec<(&'static str, &'static Keyword)>)> {
+    let mut out: Vec<(&'static str, Vec<(&'static str, &'static Keyword)>)> = Vec::new();
+    for (run, keywords) in R::tables() {
+        for k in keywords {
+            match out.iter_mut().find(|(n, _)| *n == k.name) {
+                Some((_, rows)) => rows.push((run, k)),
+                None => out.push((k.name, vec![(run, k)])),
+            }
+        }
+    }
+    out
+}
+
+/// One flag for rows of one name: the row's own where all agree.
+fn merged_arg(rows: &[(&'static str, &'static Keyword)]) -> Arg {
+    let first = rows[0].1;
+    if rows.iter().all(|(_, k)| k.help == first.help) {
+        return arg(first);
+    }
+    let help: Vec<String> = rows.iter().map(|(run, k)| format!("--run {run}: {}", k.help)).collect();
+    let mut a = Arg::new(first.name).long(first.long()).help(help.join("; "));
+    let mut names = Vec::new();
+    for (_, k) in rows {
+        match k.shape {
+            Shape::Choice(_, of) => names.extend(of().into_iter().filter(|n| !names.contains(n)).collect::<Vec<_>>()),
+            _ => return a.value_name("VALUE").action(ArgAction::Set).value_parser(ValueParser::string()),
+        }
+    }
+    a = a.value_name(first.shape.value_name().unwrap_or("VALUE")).action(ArgAction::Set);
+    a.value_parser(Names(names))
+}
+
+impl<R: Runs> Args for RunFlags<R> {
+    fn augment_args(cmd: Command) -> Command {
+        merged::<R>().iter().fold(cmd, |c, (_, rows)| c.arg(merged_arg(rows)))
+    }
+
+    fn augment_args_for_update(cmd: Command) -> Command {
+        Self::augment_args(cmd)
+    }
+}
+
+impl<R: Runs> FromArgMatches for RunFlags<R> {
+    fn from_arg_matches(m: &ArgMatches) -> Result<Self, clap::Error> {
+        let mut flags = RunFlags { given: Vec::new(), runs: std::marker::PhantomData };
+        flags.update_from_arg_matches(m)?;
+        Ok(flags)
+    }
+
+    fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
+        for (name, rows) in merged::<R>() {
+            if rows[0].1.shape.value_name().is_none() {
+                if m.get_flag(name) {
+                    self.given.push((name, "on".to_string()));
+                }
+            } else if let Some(raw) = m.get_one::<String>(name) {
+                self.given.push((name, raw.clone()));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl<R: Runs> RunFlags<R> {
+    /// The options of `run`'s table `T`; an option of another run's only
+    /// is refused, naming the runs that take it.
+    pub fn table<T: Table>(&self, run: &str) -> anyhow::Result<T> {
+        let mut out = T::default();
+        for (name, raw) in &self.given {
+            let Some(k) = T::keywords().find(|k| k.name == *name) else {
+                let runs: Vec<String> = R::tables()
+                    .into_iter()
+                    .filter(|(_, ks)| ks.iter().any(|k| k.name == *name))
+                    .map(|(r, _)| format!("--run {r}"))
+                    .collect();
+                anyhow::bail!("--{} applies to {}, not --run {run}", name.replace('_', "-"), runs.join(" or "));
+            };
+            let value = k.parse_text(raw).map_err(|e| anyhow::anyhow!(refusal(k, raw, e)))?;
+            out.set_named(k.name, &value).map_err(|e| anyhow::anyhow!(refusal(k, raw, e)))?;
+        }
+        Ok(out)
+    }
 }

@@ -336,7 +336,56 @@ fn batch_runs_distance_fields_too_and_refuses_the_other_commands_options() {
     let e = refused(&topovox(&["batch", s(&inputs), "-o", s(&d.join("o2")), "--band", "2"]));
     assert!(e.contains("--band applies to --run sdf"), "{e}");
     let e = refused(&topovox(&["batch", s(&inputs), "-o", s(&d.join("o3")), "--run", "sdf", "--mode", "solid"]));
-    assert!(e.contains("--mode is a voxelize option"), "{e}");
+    assert!(e.contains("--mode applies to --run voxelize, not --run sdf"), "{e}");
     let e = refused(&topovox(&["batch", s(&inputs), "-o", s(&d.join("o4")), "--run", "sdf", "--format", "binvox"]));
     assert!(e.contains("binvox"), "{e}");
+}
+
+#[test]
+fn batch_remeshes_folders_resumably_and_reads_surface_by_the_run() {
+    // Issue 55: the batch command runs remesh over folders, resumable,
+    // like voxelize. `--surface` is voxelize's solid+surface shell under
+    // --run voxelize and remesh's smooth|blocky under --run remesh.
+    let d = folder("remesh-batch");
+    let inputs = d.join("in");
+    std::fs::create_dir_all(inputs.join("sub")).unwrap();
+    std::fs::copy(repo("examples/meshes/cow.obj"), inputs.join("cow.obj")).unwrap();
+    std::fs::copy(repo("examples/meshes/box.obj"), inputs.join("sub/box.obj")).unwrap();
+    let out = d.join("out");
+    let args = ["batch", s(&inputs), "-o", s(&out), "--run", "remesh", "--surface", "blocky", "--resolution", "24", "--json"];
+    let j = succeeded(&topovox(&args));
+    assert_eq!((j["done"].as_u64(), j["failed"].as_u64()), (Some(2), Some(0)), "{j}");
+    // Each mesh is the one `remesh` writes, byte for byte (obj by default).
+    let one = d.join("cow.obj");
+    let cow = inputs.join("cow.obj");
+    let single = ["remesh", s(&cow), "-o", s(&one), "--surface", "blocky", "--resolution", "24", "--json"];
+    succeeded(&topovox(&single));
+    assert_eq!(std::fs::read(out.join("cow.obj")).unwrap(), std::fs::read(&one).unwrap());
+    for f in [out.join("cow.obj"), out.join("sub/box.obj")] {
+        succeeded(&topovox(&["check", s(&f), "--json"]));
+    }
+    let manifest = std::fs::read_to_string(out.join("manifest.jsonl")).unwrap();
+    let line: serde_json::Value = serde_json::from_str(manifest.lines().next().unwrap()).unwrap();
+    assert_eq!((line["options"]["run"].as_str(), line["options"]["surface"].as_str()), (Some("remesh"), Some("blocky")), "{line}");
+    assert!(line["faces"].as_u64().unwrap() > 0 && line["remesh"]["inside_voxels"].as_u64().unwrap() > 0, "{line}");
+    // A rerun resumes; another surface is another batch, refused by name.
+    assert_eq!(succeeded(&topovox(&args))["skipped"].as_u64(), Some(2));
+    let other = ["batch", s(&inputs), "-o", s(&out), "--run", "remesh", "--resolution", "24"];
+    assert!(refused(&topovox(&other)).contains("surface"));
+    // Another format by name; a voxel format or option is refused in one line.
+    let (stl_dir, v_dir) = (d.join("stl"), d.join("v"));
+    let stl = ["batch", s(&inputs), "-o", s(&stl_dir), "--run", "remesh", "--resolution", "16", "--format", "stl", "--json"];
+    assert_eq!(succeeded(&topovox(&stl))["done"].as_u64(), Some(2));
+    assert!(d.join("stl/sub/box.stl").is_file());
+    let e = refused(&topovox(&["batch", s(&inputs), "-o", s(&d.join("o1")), "--run", "remesh", "--format", "npy"]));
+    assert!(e.contains("npy") && e.contains("obj"), "{e}");
+    let e = refused(&topovox(&["batch", s(&inputs), "-o", s(&d.join("o2")), "--run", "remesh", "--mode", "solid"]));
+    assert!(e.contains("--mode applies to --run voxelize, not --run remesh"), "{e}");
+    let e = refused(&topovox(&["batch", s(&inputs), "-o", s(&d.join("o3")), "--surface", "smooth"]));
+    assert!(e.contains("smooth") && e.contains("cover"), "{e}");
+    let e = refused(&topovox(&["batch", s(&inputs), "-o", s(&d.join("o4")), "--run", "remesh", "--surface", "sep26"]));
+    assert!(e.contains("blocky"), "{e}");
+    // voxelize's --surface still works in a batch.
+    let v = ["batch", s(&inputs), "-o", s(&v_dir), "--mode", "solid+surface", "--surface", "sep26", "--resolution", "16", "--json"];
+    assert_eq!(succeeded(&topovox(&v))["done"].as_u64(), Some(2));
 }

@@ -36,6 +36,8 @@ use crate::error::{JobError, Result};
 use crate::job::{SdfJob, VoxelizeJob};
 use crate::options::JobOptions;
 use crate::output::Output;
+use crate::remesh::{RemeshJob, RemeshOptions};
+use topovox_io::mesh_out::MeshOut;
 
 /// The manifest's file name in the output folder.
 pub const MANIFEST: &str = "manifest.jsonl";
@@ -50,6 +52,18 @@ topovox::choice! {
         Voxelize = "voxelize",
         /// `sdf`: a distance field per mesh.
         Sdf = "sdf",
+        /// `remesh`: a watertight mesh per mesh.
+        Remesh = "remesh",
+    }
+}
+
+impl Run {
+    /// The output format when none is given.
+    pub fn default_format(self) -> &'static str {
+        match self {
+            Run::Voxelize | Run::Sdf => "npy",
+            Run::Remesh => "obj",
+        }
     }
 }
 
@@ -74,6 +88,8 @@ pub enum Work {
     Voxelize(Box<VoxelizeJob>),
     /// `sdf`: a distance field.
     Sdf(SdfJob),
+    /// `remesh`: a watertight mesh.
+    Remesh(RemeshJob),
 }
 
 impl BatchOptions {
@@ -100,11 +116,25 @@ impl BatchOptions {
         })
     }
 
+    /// A batch writing each mesh's watertight mesh as `format`; the
+    /// manifest records `"run": "remesh"` beside the options.
+    pub fn remesh(o: &RemeshOptions, format: MeshOut) -> Result<BatchOptions> {
+        let mut fingerprint = crate::options::fingerprint_of(o, format.name());
+        fingerprint["run"] = json!("remesh");
+        Ok(BatchOptions {
+            work: Work::Remesh(RemeshJob { request: o.request(format.single())?, format }),
+            threads: o.run.threads,
+            read: o.run.read_options(),
+            fingerprint,
+        })
+    }
+
     /// The outputs' extension.
     pub fn extension(&self) -> String {
         match &self.work {
             Work::Voxelize(job) => job.format.name().replace("npy-bool", "npy"),
             Work::Sdf(job) => job.request.format.name().to_string(),
+            Work::Remesh(job) => job.format.name().to_string(),
         }
     }
 }
@@ -524,6 +554,7 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
             let mut facts = match &opts.work {
                 Work::Voxelize(job) => voxelize_one(job, &loaded, &name, &item.output, stop)?,
                 Work::Sdf(job) => sdf_one(job, &loaded, &name, &item.output, stop.map(|s| &**s))?,
+                Work::Remesh(job) => remesh_one(job, &loaded, &name, &item.output, stop.map(|s| &**s))?,
             };
             facts["times"]["load_s"] = json!(load_s);
             facts["triangles"] = json!(loaded.report.triangles);
@@ -591,6 +622,20 @@ fn sdf_one(job: &SdfJob, loaded: &topovox_io::LoadedMesh, name: &str, out: &Path
         "signed": sdf.signed,
         "times": {"sdf_s": done.sdf_s, "write_s": done.write_s},
         "warnings": warnings(loaded, &sdf.warnings),
+    }))
+}
+
+/// The watertight mesh of one loaded mesh, written: the record's facts.
+fn remesh_one(job: &RemeshJob, loaded: &topovox_io::LoadedMesh, name: &str, out: &Path, stop: Option<&Stop>) -> Result<Value> {
+    let done = job.run(out, loaded, name, None, stop)?;
+    let r = &done.remeshed;
+    Ok(json!({
+        "grid": grid_json(&r.grid),
+        "vertices": r.mesh.positions.len(),
+        "faces": r.mesh.triangles.len(),
+        "remesh": r.summary(),
+        "times": {"inside_s": r.facts.inside_s, "surface_s": r.facts.surface_s, "write_s": done.write_s},
+        "warnings": warnings(loaded, &r.warnings),
     }))
 }
 

@@ -333,6 +333,7 @@ fn two_sided(mesh: MeshRef<'_>, pieces: &Pieces, out: &TriMesh, grid: &GridSpec)
 }
 
 /// A remesh job's two steps.
+#[derive(Clone, Debug)]
 pub struct RemeshJob {
     /// The validated request.
     pub request: RemeshRequest,

@@ -3,9 +3,13 @@
 use anyhow::{bail, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde_json::Value;
+use topovox::choice::Choice;
+use topovox_io::mesh_out::MeshOut;
 use topovox_job::batch::{self, BatchProgress, Run};
 use topovox_job::distance::{DistanceFormat, SdfOptions};
-use topovox_job::{GridOptions, RunOptions, Table};
+use topovox_job::output::Output;
+use topovox_job::remesh::RemeshOptions;
+use topovox_job::JobOptions;
 
 use crate::args::BatchArgs;
 
@@ -27,28 +31,29 @@ impl BatchProgress for Bar {
     }
 }
 
-/// The batch's work: `--run voxelize` takes the voxelize options, `--run
-/// sdf` the grid and run options and the field's; an option of the other
-/// kind is refused in one line.
+/// The batch's work: each run reads its own options (`--run sdf` the
+/// grid and run options and the field's, `--run remesh` the grid and run
+/// options and the shell's) and its own formats; an option of another run
+/// only is refused in one line.
 fn options(a: &BatchArgs) -> Result<batch::BatchOptions> {
-    let shared = |n: &str| GridOptions::keywords().chain(RunOptions::keywords()).any(|k| k.name == n);
-    match a.run {
+    let run = a.run.name();
+    let format = a.format.as_deref().unwrap_or(a.run.default_format());
+    let given = &a.options;
+    let refuse = |e: &dyn std::fmt::Display| anyhow::anyhow!("--format {format:?} with --run {run}: {e}");
+    Ok(match a.run {
         Run::Voxelize => {
-            if let Some(n) = a.field.given.first() {
-                bail!("--{} applies to --run sdf, not --run voxelize", n.replace('_', "-"));
-            }
-            Ok(batch::BatchOptions::voxelize(&a.job.options, a.format)?)
+            let format = <Output as Choice>::parse(format).map_err(|e| refuse(&e))?;
+            batch::BatchOptions::voxelize(&given.table::<JobOptions>(run)?, format)?
         }
         Run::Sdf => {
-            if let Some(n) = a.job.given.iter().find(|n| !shared(n)) {
-                bail!("--{} is a voxelize option; --run sdf takes the grid options, --band, --unsigned and --sign", n.replace('_', "-"));
-            }
-            let format = DistanceFormat::of(Some(a.format.name()), &a.output)?;
-            let job = &a.job.options;
-            let sdf = SdfOptions { field: a.field.options.clone(), grid: job.grid.clone(), run: job.run.clone() };
-            Ok(batch::BatchOptions::sdf(&sdf, format)?)
+            let format = <DistanceFormat as Choice>::parse(format).map_err(|e| refuse(&e))?;
+            batch::BatchOptions::sdf(&given.table::<SdfOptions>(run)?, format)?
         }
-    }
+        Run::Remesh => {
+            let format = <MeshOut as Choice>::parse(format).map_err(|e| refuse(&e))?;
+            batch::BatchOptions::remesh(&given.table::<RemeshOptions>(run)?, format)?
+        }
+    })
 }
 
 pub fn run(a: &BatchArgs) -> Result<()> {
