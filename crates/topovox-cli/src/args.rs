@@ -565,7 +565,7 @@ pub struct BatchArgs {
     /// Output format: with --run voxelize one of the voxelize formats
     /// (default npy), with --run sdf npy, vdb, zarr or vti (default npy),
     /// with --run remesh obj, ply, stl or glb (default obj).
-    #[arg(long, value_name = "FORMAT")]
+    #[arg(long, value_name = "FORMAT", ignore_case = true, value_parser = clap::builder::PossibleValuesParser::new(batch_formats()))]
     pub format: Option<String>,
     /// What runs on each mesh: voxelize (the voxelize options), sdf (a
     /// distance field: the grid options, --band, --unsigned, --sign) or
@@ -586,6 +586,18 @@ pub struct BatchArgs {
     pub quiet: bool,
 }
 
+/// Every format some run of `batch` writes (each run checks its own).
+fn batch_formats() -> Vec<clap::builder::PossibleValue> {
+    use topovox::choice::Choice;
+    let mut names: Vec<&'static str> = Output::ALL.iter().map(|f| Choice::name(*f)).collect();
+    for n in DistanceFormat::ALL.iter().map(|f| f.name()).chain(MeshOut::ALL.iter().map(|f| f.name())) {
+        if !names.contains(&n) {
+            names.push(n);
+        }
+    }
+    names.into_iter().map(clap::builder::PossibleValue::new).collect()
+}
+
 /// The works `batch --run` chooses between, with their tables.
 #[derive(Clone, Debug)]
 pub struct BatchRuns;
@@ -598,6 +610,15 @@ impl Runs for BatchRuns {
             ("sdf", SdfOptions::keywords().collect()),
             ("remesh", RemeshOptions::keywords().collect()),
         ]
+    }
+
+    fn try_set(run: &str, name: &str, v: &topovox_job::OptionValue) -> topovox_job::Result<()> {
+        use topovox_job::Table;
+        match run {
+            "sdf" => SdfOptions::default().set_named(name, v),
+            "remesh" => RemeshOptions::default().set_named(name, v),
+            _ => JobOptions::default().set_named(name, v),
+        }
     }
 }
 
@@ -728,6 +749,8 @@ mod tests {
             &["voxelize", "m.obj", "-o", "o.npy", "--dims", "1,2"],
             &["sdf", "m.obj", "-o", "o.vdb", "--band", "-1"],
             &["batch", "in", "-o", "out", "--tile", "4"],
+            &["batch", "in", "-o", "out", "--run", "remesh", "--min-part", "-1"],
+            &["batch", "in", "-o", "out", "--surface", "round"],
         ] {
             assert!(Cli::try_parse_from(std::iter::once("topovox").chain(args.iter().copied())).is_err(), "{args:?}");
         }

@@ -124,6 +124,10 @@ fn refusal(k: &Keyword, raw: &str, e: topovox_job::JobError) -> String {
 pub trait Runs {
     /// `(run, the table's options)`, in the order `--help` lists them.
     fn tables() -> Vec<(&'static str, Vec<&'static Keyword>)>;
+
+    /// Sets option `name` of `run`'s table, as [`Table::set_named`] does
+    /// (so a bad value is refused while the flags are read).
+    fn try_set(run: &str, name: &str, v: &OptionValue) -> topovox_job::Result<()>;
 }
 
 /// The options of several tables under one set of flags, read later by the
@@ -189,13 +193,29 @@ impl<R: Runs> FromArgMatches for RunFlags<R> {
 
     fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
         for (name, rows) in merged::<R>() {
-            if rows[0].1.shape.value_name().is_none() {
-                if m.get_flag(name) {
-                    self.given.push((name, "on".to_string()));
+            let raw = if rows[0].1.shape.value_name().is_none() {
+                m.get_flag(name).then(|| "on".to_string())
+            } else {
+                m.get_one::<String>(name).cloned()
+            };
+            let Some(raw) = raw else { continue };
+            // A value no run takes is refused now, as Flags refuses it.
+            let mut first_error = None;
+            for (run, k) in &rows {
+                match k.parse_text(&raw).and_then(|v| R::try_set(run, name, &v)) {
+                    Ok(()) => {
+                        first_error = None;
+                        break;
+                    }
+                    Err(e) => {
+                        first_error.get_or_insert(refused(k, &raw, e));
+                    }
                 }
-            } else if let Some(raw) = m.get_one::<String>(name) {
-                self.given.push((name, raw.clone()));
             }
+            if let Some(e) = first_error {
+                return Err(e);
+            }
+            self.given.push((name, raw));
         }
         Ok(())
     }
