@@ -179,7 +179,43 @@ def test_every_part_is_kept_and_min_part_drops_only_when_asked():
     assert (info["parts"], info["dropped_parts"], topovox.check_mesh(out)["components"]) == (1, 1, 1)
 
 
-@pytest.mark.parametrize("extra", [[], ["--surface", "blocky"], ["--inside", "wrap"], ["--inside", "parity", "--surface", "blocky"]])
+@pytest.mark.parametrize("name", ["stanford-bunny.obj", "fandisk.obj", "beetle.obj"])
+@pytest.mark.parametrize("inside", ["auto", "wrap"])
+@pytest.mark.parametrize("surface", ["smooth", "blocky"])
+def test_simplify_keeps_every_guarantee(meshes, name, inside, surface):
+    """--simplify: far fewer faces, still certified (ours and PyMeshLab),
+    still separating the same voxel centres (NumPy winding numbers)."""
+    src = topovox.load_mesh(meshes / name)
+    res = 20 if surface == "smooth" else 12
+    full, fewer = {}, {}
+    a = topovox.remesh(src, resolution=res, inside=inside, surface=surface, info=full)
+    b = topovox.remesh(src, resolution=res, inside=inside, surface=surface, simplify=1.0, check=True, info=fewer)
+    s = fewer["simplify"]
+    assert s["kept"] and s["faces_before"] == len(a.faces) and s["faces"] == len(b.faces), s
+    assert len(b.faces) * 3 < len(a.faces), (len(b.faces), len(a.faces))
+    assert set(map(tuple, b.vertices)) <= set(map(tuple, a.vertices))  # every vertex is one of the surface's own
+    certify(b, fewer)
+    # (5) the same centres inside: the solid's (wrap pads the grid by one).
+    grid = topovox.voxelize(src, resolution=res, mode="solid", method="auto", pad=1 if inside == "wrap" else 0)
+    points = centres(grid)
+    w = winding(b.vertices, b.faces, points)
+    assert np.abs(w - np.round(w)).max() < 1e-6
+    if inside == "wrap":
+        assert np.array_equal(np.round(w), np.round(winding(a.vertices, a.faces, points)))
+    else:
+        assert np.array_equal(np.round(w).astype(int), grid.occupancy.reshape(-1).astype(int))
+
+
+def test_simplify_is_refused_out_of_range(meshes):
+    src = topovox.load_mesh(meshes / "cow.obj")
+    for bad in (-0.5, 3, float("nan")):
+        with pytest.raises(ValueError, match="simplify"):
+            topovox.remesh(src, resolution=16, simplify=bad)
+
+
+@pytest.mark.parametrize(
+    "extra", [[], ["--surface", "blocky"], ["--inside", "wrap"], ["--inside", "parity", "--surface", "blocky"], ["--simplify", "1"]]
+)
 def test_threads_give_the_same_bytes(meshes, cli, tmp_path, extra):
     outs = []
     for t in (1, 2):

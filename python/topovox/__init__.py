@@ -477,6 +477,7 @@ def remesh(
     inside: InsideName = "auto",
     surface: SurfaceKindName = "smooth",
     min_part: int = 0,
+    simplify: float = 0.0,
     check: bool = False,
     threads: Optional[int] = None,
     max_memory: Optional[Union[int, str]] = None,
@@ -514,6 +515,12 @@ def remesh(
         the inside voxels' faces.
     min_part : int
         Drop inside parts (26-connected) of fewer voxels (default 0).
+    simplify : float
+        Merge faces while each vertex kept stays within this many voxels
+        (0 to 2) of the planes merged into it (default 0: none). A collapse
+        that would break a guarantee above is refused, and the result is
+        certified again; ``info["simplify"]`` reports the faces before and
+        after.
     check : bool
         Certify the result exactly before returning it (see
         :func:`check_mesh`); the certificate goes into ``info``.

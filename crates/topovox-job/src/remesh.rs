@@ -30,7 +30,7 @@ use crate::grid::{GridOptions, GridRequest};
 use crate::memory::{budget, bytes};
 use crate::options::RunOptions;
 use crate::plan::{SolidMethod, SolidPlan};
-use crate::table::{choice, chosen, flag, int, value, Example, Shape};
+use crate::table::{choice, chosen, flag, int, number, value, Example, Shape};
 
 topovox::choice! {
     /// Which voxels the surface closes around.
@@ -82,6 +82,18 @@ crate::option_table! {
             print |o| Some(json!(o.min_part)),
             cli value("VOXELS"),
             "drop inside parts (26-connected voxels) of fewer voxels than this (default 0: every part is kept)";
+        simplify: f64 = 0.0,
+            parse |k, v| {
+                let e = number(k, v)?;
+                if !(0.0..=2.0).contains(&e) {
+                    return Err(JobError::invalid(format!("{k} must be between 0 and 2 (voxels); got {e}")));
+                }
+                Ok(e)
+            },
+            example Example::Float(0.5),
+            print |o| (o.simplify > 0.0).then(|| json!(o.simplify)),
+            cli value("VOXELS"),
+            "merge faces while each kept vertex stays within this many voxels of the planes merged into it (0 to 2; default 0: none); a collapse that would break a guarantee is refused, and the result is certified again";
         check: bool = false,
             parse flag,
             example Example::Bool(true),
@@ -111,6 +123,8 @@ pub struct RemeshRequest {
     pub surface: SurfaceKind,
     /// Smallest part kept, in voxels.
     pub min_part: u64,
+    /// The simplification's bound in voxels (0: none).
+    pub simplify: f64,
     /// Certify before returning.
     pub check: bool,
     /// Round vertices to f32 (the output stores floats).
@@ -132,6 +146,7 @@ impl RemeshOptions {
             inside: self.shell.inside,
             surface: self.shell.surface,
             min_part: self.shell.min_part,
+            simplify: self.shell.simplify,
             check: self.shell.check,
             single,
             max_memory: self.run.max_memory,
@@ -160,6 +175,8 @@ pub struct RemeshFacts {
     pub distance: Option<[f64; 4]>,
     /// Facts of the solid (its JSON).
     pub solid: Value,
+    /// What `simplify` did (its JSON), `None` when not asked.
+    pub simplify: Option<Value>,
 }
 
 impl RemeshFacts {
@@ -171,7 +188,7 @@ impl RemeshFacts {
         json!({
             "inside": self.inside, "inside_voxels": self.inside_voxels, "parts": self.parts,
             "dropped_parts": self.dropped_parts, "inside_s": self.inside_s, "surface_s": self.surface_s,
-            "distance_voxels": d, "solid": self.solid,
+            "distance_voxels": d, "solid": self.solid, "simplify": self.simplify,
         })
     }
 }
@@ -204,7 +221,7 @@ fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec)
     let per_face = if req.surface == SurfaceKind::Blocky { 16.0 } else { 4.0 };
     let triangles = area / (h.x * h.y).min(h.y * h.z).min(h.x * h.z) * per_face;
     let measured = req.inside == Inside::Wrap || req.check;
-    let certified = req.check || cfg!(debug_assertions);
+    let certified = req.check || cfg!(debug_assertions) || req.simplify > 0.0;
     let per_triangle =
         100 + if measured { std::mem::size_of::<topovox::distance::Piece>() + 16 } else { 0 } + if certified { 150 } else { 0 };
     let need = (cells / 8).saturating_mul(grids + 1).saturating_add((triangles * per_triangle as f64) as u64);
@@ -282,11 +299,57 @@ pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&
     if req.single {
         out.positions.iter_mut().for_each(|p| *p = p.as_vec3().as_dvec3());
     }
+    let mut warnings = warnings;
+    let (out, simplify, certified) = simplified(out, &bits, &grid, req.simplify, stop, &mut warnings)?;
     let surface_s = t.elapsed().as_secs_f64();
     let distance = (req.check || req.inside == Inside::Wrap).then(|| two_sided(mesh, &pieces, &out, &grid));
-    let certificate = if req.check || cfg!(debug_assertions) { Some(certify(name, &out, stop)?) } else { None };
-    let facts = RemeshFacts { inside: method, inside_voxels, parts, dropped_parts, inside_s, surface_s, distance, solid };
+    let certificate = match certified {
+        Some(c) => Some(c),
+        None if req.check || cfg!(debug_assertions) => Some(certify(name, &out, stop)?),
+        None => None,
+    };
+    let facts = RemeshFacts { inside: method, inside_voxels, parts, dropped_parts, inside_s, surface_s, distance, solid, simplify };
     Ok(Remeshed { mesh: out, grid, facts, certificate, warnings })
+}
+
+/// `out` simplified within `error` voxels ([`surface::simplify`]; 0: as
+/// it is), with its facts and its certificate. The simplified surface is
+/// certified again, exactly, and must still separate `bits` (its parity
+/// solid on `grid` is `bits`); otherwise `out` is kept with a warning.
+fn simplified(
+    out: TriMesh,
+    bits: &DenseBits,
+    grid: &GridSpec,
+    error: f64,
+    stop: &Stop,
+    warnings: &mut Vec<String>,
+) -> Result<(TriMesh, Option<Value>, Option<MeshCheck>)> {
+    if error <= 0.0 {
+        return Ok((out, None, None));
+    }
+    let t = Instant::now();
+    let h = grid.voxel_size().0.max_element();
+    let fewer = surface::simplify::simplify(&out, grid, error * h, stop).ok_or(JobError::Interrupted)?;
+    let certificate = match check_mesh(&fewer.positions, &fewer.triangles, stop) {
+        Ok(c) => Some(c).filter(|c| c.watertight()),
+        Err(topovox::mesh_check::MeshCheckError::Stopped) => return Err(JobError::Interrupted),
+        Err(_) => None,
+    };
+    let separates = certificate.is_some() && {
+        let r = MeshRef { positions: &fewer.positions, triangles: &fewer.triangles, segments: &[] };
+        topovox::voxelize::solid::parity(r, grid).is_ok_and(|(solid, _)| solid == *bits)
+    };
+    let faces_before = out.triangles.len();
+    let facts = |kept: &TriMesh, ok: bool| json!({"error_voxels": error, "faces_before": faces_before, "faces": kept.triangles.len(), "kept": ok, "seconds": t.elapsed().as_secs_f64()});
+    if !separates {
+        warnings.push(format!(
+            "--simplify {error}: the simplified surface failed its certificate or its separation check; the surface is left unsimplified (please report this mesh)"
+        ));
+        let f = facts(&out, false);
+        return Ok((out, Some(f), None));
+    }
+    let f = facts(&fewer, true);
+    Ok((fewer, Some(f), certificate))
 }
 
 impl Remeshed {

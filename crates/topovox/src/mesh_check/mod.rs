@@ -176,7 +176,7 @@ fn weld(positions: &[DVec3], triangles: &[[u32; 3]]) -> Result<(Vec<DVec3>, Vec<
 }
 
 /// Whether a face has zero area: a repeated vertex, or three collinear points.
-fn is_degenerate(pos: &[DVec3], f: &[u32; 3]) -> bool {
+pub(crate) fn is_degenerate(pos: &[DVec3], f: &[u32; 3]) -> bool {
     if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] {
         return true;
     }

@@ -17,6 +17,7 @@
 //! - [`wrap`]: the inside voxels for shells around any input: the solid,
 //!   the cover grown by one voxel, and every cavity they enclose.
 
+pub mod simplify;
 pub mod tets;
 
 use glam::DVec3;

@@ -196,3 +196,44 @@ fn small_parts_go_only_when_asked() {
     assert_eq!((n, dropped, kept.count()), (2, 1, 29));
     assert!(!kept.get(7, 0, 7) && kept.get(6, 6, 6));
 }
+
+#[test]
+fn simplified_surfaces_keep_every_guarantee() {
+    // Random voxels (many small parts, tunnels and cavities) and a ball:
+    // blocky and smooth surfaces lose faces and stay certified and
+    // separating, at every bound.
+    let mut rng = Xorshift(17);
+    let (positions, triangles) = sphere(2.0, DVec3::new(2.5, 2.5, 2.5), 12);
+    let pieces = Pieces::of(MeshRef { positions: &positions, triangles: &triangles, segments: &[] }).unwrap();
+    let mut fewer = 0;
+    for round in 0..6u32 {
+        let dims = [6 + round % 3, 7, 5 + round % 4];
+        let bits = random_bits(&mut rng, dims, 25 + 10 * round as u64);
+        let g = grid(dims);
+        for m in [blocky(&bits, &g, &Stop::new()).unwrap(), smooth(&bits, &g, &pieces, None, &Stop::new()).unwrap()] {
+            for bound in [0.25, 1.0, 2.0] {
+                let s = simplify::simplify(&m, &g, bound * 0.5, &Stop::new()).unwrap();
+                certified(&s, &bits, &g);
+                assert!(s.triangles.len() <= m.triangles.len());
+                fewer += (s.triangles.len() < m.triangles.len()) as u32;
+            }
+        }
+    }
+    assert!(fewer >= 30, "only {fewer} of 36 surfaces lost faces");
+    // The ball: a large flat-ish surface loses most of its faces.
+    let g = GridSpec::new(DVec3::ZERO, 0.25, [20, 20, 20]).unwrap();
+    let mut inside = DenseBits::new([20, 20, 20]);
+    for k in 0..20 {
+        for j in 0..20 {
+            for i in 0..20 {
+                if (g.voxel_center([i, j, k]) - DVec3::splat(2.5)).length() < 2.0 {
+                    inside.set(i, j, k);
+                }
+            }
+        }
+    }
+    let m = blocky(&inside, &g, &Stop::new()).unwrap();
+    let s = simplify::simplify(&m, &g, 0.25, &Stop::new()).unwrap();
+    certified(&s, &inside, &g);
+    assert!(s.triangles.len() * 4 < m.triangles.len(), "{} of {}", s.triangles.len(), m.triangles.len());
+}
