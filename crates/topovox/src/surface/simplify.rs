@@ -111,7 +111,7 @@ pub fn simplify(mesh: &TriMesh, grid: &GridSpec, bound: f64, stop: &Stop) -> Opt
     let mut popped = 0u64;
     while let Some(Reverse((_, u, v, su, sv))) = c.heap.pop() {
         popped += 1;
-        if popped.is_multiple_of(4096) && stop.requested() {
+        if popped % 4096 == 0 && stop.requested() {
             return None;
         }
         if c.stamp[u as usize] != su || c.stamp[v as usize] != sv || c.vertex_faces[u as usize].is_empty() {
