@@ -120,22 +120,29 @@ fn smooth_surfaces_of_a_ball_are_certified_and_near_it() {
     // An octahedron-ish ball mesh: distances come from its triangles.
     let (positions, triangles) = sphere(2.0, DVec3::new(2.5, 2.5, 2.5), 12);
     let mesh = MeshRef { positions: &positions, triangles: &triangles, segments: &[] };
-    let g = GridSpec::new(DVec3::ZERO, 0.5, [10, 10, 10]).unwrap();
-    let mut inside = DenseBits::new([10, 10, 10]);
-    for k in 0..10 {
-        for j in 0..10 {
-            for i in 0..10 {
+    let (g, inside) = ball(0.5, 10);
+    let pieces = Pieces::of(mesh).unwrap();
+    let m = smooth(&inside, &g, &pieces, None, &Stop::new()).unwrap();
+    certified(&m, &inside, &g);
+    let far = m.positions.iter().map(|p| ((*p - DVec3::splat(2.5)).length() - 2.0).abs()).fold(0.0, f64::max);
+    assert!(far < 0.2, "a vertex {far} from the sphere");
+}
+
+/// A grid of `n`³ voxels of size `h` from the origin, and the centres
+/// within 2 of (2.5, 2.5, 2.5).
+fn ball(h: f64, n: u32) -> (GridSpec, DenseBits) {
+    let g = GridSpec::new(DVec3::ZERO, h, [n as u64; 3]).unwrap();
+    let mut inside = DenseBits::new([n; 3]);
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
                 if (g.voxel_center([i, j, k]) - DVec3::splat(2.5)).length() < 2.0 {
                     inside.set(i, j, k);
                 }
             }
         }
     }
-    let pieces = Pieces::of(mesh).unwrap();
-    let m = smooth(&inside, &g, &pieces, None, &Stop::new()).unwrap();
-    certified(&m, &inside, &g);
-    let far = m.positions.iter().map(|p| ((*p - DVec3::splat(2.5)).length() - 2.0).abs()).fold(0.0, f64::max);
-    assert!(far < 0.2, "a vertex {far} from the sphere");
+    (g, inside)
 }
 
 /// A UV sphere: `n` rings of `2n` quads, split into triangles.
@@ -221,17 +228,7 @@ fn simplified_surfaces_keep_every_guarantee() {
     }
     assert!(fewer >= 30, "only {fewer} of 36 surfaces lost faces");
     // The ball: a large flat-ish surface loses most of its faces.
-    let g = GridSpec::new(DVec3::ZERO, 0.25, [20, 20, 20]).unwrap();
-    let mut inside = DenseBits::new([20, 20, 20]);
-    for k in 0..20 {
-        for j in 0..20 {
-            for i in 0..20 {
-                if (g.voxel_center([i, j, k]) - DVec3::splat(2.5)).length() < 2.0 {
-                    inside.set(i, j, k);
-                }
-            }
-        }
-    }
+    let (g, inside) = ball(0.25, 20);
     let m = blocky(&inside, &g, &Stop::new()).unwrap();
     let s = simplify::simplify(&m, &g, 0.25, &Stop::new()).unwrap();
     certified(&s, &inside, &g);
