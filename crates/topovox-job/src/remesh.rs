@@ -272,6 +272,10 @@ pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&
     let pieces = Pieces::of(mesh).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
     let grid = req.grid.fit(&mesh.bounds())?;
     check_fits(name, req, &pieces, &grid)?;
+    // The input's hierarchy, built once when the smooth surface or the
+    // two-sided distance first needs it.
+    let tree = std::cell::OnceCell::new();
+    let input_tree = || tree.get_or_init(|| Hierarchy::new(&pieces));
     let t = Instant::now();
     let (bits, method, solid, warnings) = inside(mesh, name, req, &grid, stop)?;
     let (bits, parts, dropped_parts) = surface::drop_small_parts(&bits, req.min_part);
@@ -292,7 +296,7 @@ pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&
             // Wrap's outside centres lie at least 1.5 voxels from the input
             // (no 26-neighbour's box meets it): its shell sits there.
             let offset = (req.inside == Inside::Wrap).then(|| 1.5 * grid.voxel_size().0.max_element());
-            surface::smooth(&bits, &grid, &pieces, offset, stop)
+            surface::smooth(&bits, &grid, &pieces, input_tree(), offset, stop)
         }
     };
     let mut out = made.ok_or(JobError::Interrupted)?;
@@ -302,7 +306,7 @@ pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&
     let mut warnings = warnings;
     let (out, simplify, certified) = simplified(out, &bits, &grid, req.simplify, stop, &mut warnings)?;
     let surface_s = t.elapsed().as_secs_f64();
-    let distance = (req.check || req.inside == Inside::Wrap).then(|| two_sided(mesh, &pieces, &out, &grid));
+    let distance = (req.check || req.inside == Inside::Wrap).then(|| two_sided(mesh, &pieces, input_tree(), &out, &grid));
     let certificate = match certified {
         Some(c) => Some(c),
         None if req.check || cfg!(debug_assertions) => Some(certify(name, &out, stop)?),
@@ -379,14 +383,14 @@ fn certify(name: &str, out: &TriMesh, stop: &Stop) -> Result<MeshCheck> {
 
 /// Largest and mean distances (voxels, the largest edge): output vertices
 /// to the input, input vertices and face centres to the output.
-fn two_sided(mesh: MeshRef<'_>, pieces: &Pieces, out: &TriMesh, grid: &GridSpec) -> [f64; 4] {
+fn two_sided(mesh: MeshRef<'_>, pieces: &Pieces, tree: &Hierarchy, out: &TriMesh, grid: &GridSpec) -> [f64; 4] {
     use rayon::prelude::*;
     let h = grid.voxel_size().0.max_element();
     let stats = |tree: &Hierarchy, points: &[DVec3]| -> (f64, f64) {
         let d: Vec<f64> = points.par_iter().map(|&p| tree.nearest(p, (f64::INFINITY, u32::MAX)).0.sqrt() / h).collect();
         (d.iter().fold(0.0, |a: f64, &b| a.max(b)), d.iter().sum::<f64>() / d.len().max(1) as f64)
     };
-    let to_input = stats(&Hierarchy::new(pieces), &out.positions);
+    let to_input = stats(tree, &out.positions);
     let out_ref = MeshRef { positions: &out.positions, triangles: &out.triangles, segments: &[] };
     let out_pieces = Pieces::of(out_ref).expect("a surface has triangles and finite vertices");
     let mut samples: Vec<DVec3> = pieces.items.iter().flat_map(|p| [p.p[0], (p.p[0] + p.p[1] + p.p[2]) / 3.0]).collect();

@@ -70,14 +70,14 @@ pub fn blocky(inside: &DenseBits, grid: &GridSpec, stop: &Stop) -> Option<TriMes
 
 /// The smooth surface of `inside` on `grid`: each vertex on the zero of
 /// the linear interpolation along its edge of the signed distance to
-/// `pieces` (negative at inside centres), clamped to
+/// `pieces` (negative at inside centres; `tree` is their hierarchy, which
+/// the caller may use again), clamped to
 /// [`MARGIN`]`..1 − MARGIN` of the edge; or with `offset` (world units)
 /// of `distance − offset`, clamped to [`WRAP_MARGIN`] (wrap's shells,
 /// which sit off the input).
-pub fn smooth(inside: &DenseBits, grid: &GridSpec, pieces: &Pieces, offset: Option<f64>, stop: &Stop) -> Option<TriMesh> {
+pub fn smooth(inside: &DenseBits, grid: &GridSpec, pieces: &Pieces, tree: &Hierarchy, offset: Option<f64>, stop: &Stop) -> Option<TriMesh> {
     let e = tets::extract(inside, stop)?;
     let centre = |p: [i64; 3]| grid.origin() + (DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) + 0.5) * grid.voxel_size().0;
-    let tree = &Hierarchy::new(pieces);
     // Every end once: inside ends come grouped (crossings are in order of
     // them), outside ends are sorted out; runs of neighbours share bounds.
     let mut ends: Vec<[i64; 3]> = e.crossings.iter().flat_map(|(a, b)| [*a, *b]).collect();

@@ -97,7 +97,7 @@ fn random_voxels_give_certified_separating_surfaces() {
         let triangles = [[0, 1, 2], [3, 4, 5], [6, 7, 8], [0, 4, 8]];
         let pieces = Pieces::of(MeshRef { positions: &positions, triangles: &triangles, segments: &[] }).unwrap();
         for offset in [None, Some(0.3)] {
-            certified(&smooth(&bits, &g, &pieces, offset, &Stop::new()).unwrap(), &bits, &g);
+            certified(&smooth(&bits, &g, &pieces, &Hierarchy::new(&pieces), offset, &Stop::new()).unwrap(), &bits, &g);
         }
     }
 }
@@ -122,7 +122,7 @@ fn smooth_surfaces_of_a_ball_are_certified_and_near_it() {
     let mesh = MeshRef { positions: &positions, triangles: &triangles, segments: &[] };
     let (g, inside) = ball(0.5, 10);
     let pieces = Pieces::of(mesh).unwrap();
-    let m = smooth(&inside, &g, &pieces, None, &Stop::new()).unwrap();
+    let m = smooth(&inside, &g, &pieces, &Hierarchy::new(&pieces), None, &Stop::new()).unwrap();
     certified(&m, &inside, &g);
     let far = m.positions.iter().map(|p| ((*p - DVec3::splat(2.5)).length() - 2.0).abs()).fold(0.0, f64::max);
     assert!(far < 0.2, "a vertex {far} from the sphere");
@@ -217,7 +217,9 @@ fn simplified_surfaces_keep_every_guarantee() {
         let dims = [6 + round % 3, 7, 5 + round % 4];
         let bits = random_bits(&mut rng, dims, 25 + 10 * round as u64);
         let g = grid(dims);
-        for m in [blocky(&bits, &g, &Stop::new()).unwrap(), smooth(&bits, &g, &pieces, None, &Stop::new()).unwrap()] {
+        for m in
+            [blocky(&bits, &g, &Stop::new()).unwrap(), smooth(&bits, &g, &pieces, &Hierarchy::new(&pieces), None, &Stop::new()).unwrap()]
+        {
             for bound in [0.25, 1.0, 2.0] {
                 let s = simplify::simplify(&m, &g, bound * 0.5, &Stop::new()).unwrap();
                 certified(&s, &bits, &g);
