@@ -15,7 +15,7 @@ use topovox_job::{ColourRule, ExportOptions, GridOptions, JobOptions, Mode, Swit
 use topovox::render::raycast::View;
 
 use crate::choice::choice;
-use crate::flags::{Flags, RunFlags, Runs};
+use crate::flags::{Flags, RunFlags, RunTable, Runs};
 use crate::values::{self, CameraSpec, Size};
 
 /// topovox: voxelize triangle meshes with guaranteed topology.
@@ -603,22 +603,13 @@ fn batch_formats() -> Vec<clap::builder::PossibleValue> {
 pub struct BatchRuns;
 
 impl Runs for BatchRuns {
-    fn tables() -> Vec<(&'static str, Vec<&'static topovox_job::table::Keyword>)> {
-        use topovox_job::Table;
+    fn tables() -> Vec<RunTable> {
+        use topovox::choice::Choice;
         vec![
-            ("voxelize", JobOptions::keywords().collect()),
-            ("sdf", SdfOptions::keywords().collect()),
-            ("remesh", RemeshOptions::keywords().collect()),
+            RunTable::of::<JobOptions>(Run::Voxelize.name()),
+            RunTable::of::<SdfOptions>(Run::Sdf.name()),
+            RunTable::of::<RemeshOptions>(Run::Remesh.name()),
         ]
-    }
-
-    fn try_set(run: &str, name: &str, v: &topovox_job::OptionValue) -> topovox_job::Result<()> {
-        use topovox_job::Table;
-        match run {
-            "sdf" => SdfOptions::default().set_named(name, v),
-            "remesh" => RemeshOptions::default().set_named(name, v),
-            _ => JobOptions::default().set_named(name, v),
-        }
     }
 }
 

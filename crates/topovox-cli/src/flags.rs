@@ -119,15 +119,35 @@ fn refusal(k: &Keyword, raw: &str, e: topovox_job::JobError) -> String {
     format!("invalid value '{shown}' for '{}': {e}", k.flag())
 }
 
-/// The tables of the works one command chooses between (`batch --run`),
-/// each named as the choice names it.
+/// The tables of the works one command chooses between (`batch --run`).
 pub trait Runs {
-    /// `(run, the table's options)`, in the order `--help` lists them.
-    fn tables() -> Vec<(&'static str, Vec<&'static Keyword>)>;
+    /// One per run, in the order `--help` lists them.
+    fn tables() -> Vec<RunTable>;
+}
 
-    /// Sets option `name` of `run`'s table, as [`Table::set_named`] does
-    /// (so a bad value is refused while the flags are read).
-    fn try_set(run: &str, name: &str, v: &OptionValue) -> topovox_job::Result<()>;
+/// A run's name as the choice names it, and its table.
+pub struct RunTable {
+    /// The run.
+    pub run: &'static str,
+    /// Its table's options.
+    pub keywords: Vec<&'static Keyword>,
+    /// Sets one option on the table's defaults, as [`Table::set_named`]
+    /// does (so a bad value is refused while the flags are read).
+    pub try_set: fn(&str, &OptionValue) -> topovox_job::Result<()>,
+}
+
+impl RunTable {
+    /// Run `run`, reading table `T`.
+    pub fn of<T: Table>(run: &'static str) -> RunTable {
+        RunTable { run, keywords: T::keywords().collect(), try_set: |name, v| T::default().set_named(name, v) }
+    }
+}
+
+/// One row of a merged flag: a run that takes the option, and how.
+struct Row {
+    run: &'static str,
+    keyword: &'static Keyword,
+    try_set: fn(&str, &OptionValue) -> topovox_job::Result<()>,
 }
 
 /// The options of several tables under one set of flags, read later by the
@@ -141,14 +161,15 @@ pub struct RunFlags<R: Runs> {
     runs: std::marker::PhantomData<R>,
 }
 
-/// Each option name once, in order, with every `(run, keyword)` having it.
-fn merged<R: Runs>() -> Vec<(&'static str, Vec<(&'static str, &'static Keyword)>)> {
-    let mut out: Vec<(&'static str, Vec<(&'static str, &'static Keyword)>)> = Vec::new();
-    for (run, keywords) in R::tables() {
-        for k in keywords {
-            match out.iter_mut().find(|(n, _)| *n == k.name) {
-                Some((_, rows)) => rows.push((run, k)),
-                None => out.push((k.name, vec![(run, k)])),
+/// Each option name once, in order, with a row for every run having it.
+fn merged<R: Runs>() -> Vec<(&'static str, Vec<Row>)> {
+    let mut out: Vec<(&'static str, Vec<Row>)> = Vec::new();
+    for t in R::tables() {
+        for keyword in t.keywords {
+            let row = Row { run: t.run, keyword, try_set: t.try_set };
+            match out.iter_mut().find(|(n, _)| *n == keyword.name) {
+                Some((_, rows)) => rows.push(row),
+                None => out.push((keyword.name, vec![row])),
             }
         }
     }
@@ -156,16 +177,16 @@ fn merged<R: Runs>() -> Vec<(&'static str, Vec<(&'static str, &'static Keyword)>
 }
 
 /// One flag for rows of one name: the row's own where all agree.
-fn merged_arg(rows: &[(&'static str, &'static Keyword)]) -> Arg {
-    let first = rows[0].1;
-    if rows.iter().all(|(_, k)| k.help == first.help) {
+fn merged_arg(rows: &[Row]) -> Arg {
+    let first = rows[0].keyword;
+    if rows.iter().all(|r| r.keyword.help == first.help) {
         return arg(first);
     }
-    let help: Vec<String> = rows.iter().map(|(run, k)| format!("--run {run}: {}", k.help)).collect();
+    let help: Vec<String> = rows.iter().map(|r| format!("--run {}: {}", r.run, r.keyword.help)).collect();
     let mut a = Arg::new(first.name).long(first.long()).help(help.join("; "));
     let mut names = Vec::new();
-    for (_, k) in rows {
-        match k.shape {
+    for r in rows {
+        match r.keyword.shape {
             Shape::Choice(_, of) => names.extend(of().into_iter().filter(|n| !names.contains(n)).collect::<Vec<_>>()),
             _ => return a.value_name("VALUE").action(ArgAction::Set).value_parser(ValueParser::string()),
         }
@@ -193,27 +214,21 @@ impl<R: Runs> FromArgMatches for RunFlags<R> {
 
     fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
         for (name, rows) in merged::<R>() {
-            let raw = if rows[0].1.shape.value_name().is_none() {
+            let raw = if rows[0].keyword.shape.value_name().is_none() {
                 m.get_flag(name).then(|| "on".to_string())
             } else {
                 m.get_one::<String>(name).cloned()
             };
             let Some(raw) = raw else { continue };
-            // A value no run takes is refused now, as Flags refuses it.
-            let mut first_error = None;
-            for (run, k) in &rows {
-                match k.parse_text(&raw).and_then(|v| R::try_set(run, name, &v)) {
-                    Ok(()) => {
-                        first_error = None;
-                        break;
-                    }
-                    Err(e) => {
-                        first_error.get_or_insert(refused(k, &raw, e));
-                    }
+            // A value no run takes is refused now (the first run's
+            // refusal), as Flags refuses it.
+            let mut tries = rows
+                .iter()
+                .map(|r| r.keyword.parse_text(&raw).and_then(|v| (r.try_set)(name, &v)).map_err(|e| refused(r.keyword, &raw, e)));
+            if let Some(Err(e)) = tries.next() {
+                if !tries.any(|t| t.is_ok()) {
+                    return Err(e);
                 }
-            }
-            if let Some(e) = first_error {
-                return Err(e);
             }
             self.given.push((name, raw));
         }
@@ -230,8 +245,8 @@ impl<R: Runs> RunFlags<R> {
             let Some(k) = T::keywords().find(|k| k.name == *name) else {
                 let runs: Vec<String> = R::tables()
                     .into_iter()
-                    .filter(|(_, ks)| ks.iter().any(|k| k.name == *name))
-                    .map(|(r, _)| format!("--run {r}"))
+                    .filter(|t| t.keywords.iter().any(|k| k.name == *name))
+                    .map(|t| format!("--run {}", t.run))
                     .collect();
                 anyhow::bail!("--{} applies to {}, not --run {run}", name.replace('_', "-"), runs.join(" or "));
             };
