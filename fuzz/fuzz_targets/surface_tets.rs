@@ -6,6 +6,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
+use topovox::distance::nearest::Hierarchy;
 use topovox::distance::Pieces;
 use topovox::glam::DVec3;
 use topovox::grid::dense::DenseBits;
@@ -52,7 +53,7 @@ fuzz_target!(|data: &[u8]| {
     }
     let surfaces = [Some(blocky(&inside, &grid, &stop).expect("not stopped"))];
     let pieces = Pieces::of(MeshRef { positions: &positions, triangles: &triangles, segments: &[] }).ok();
-    let smooth = pieces.map(|p| smooth(&inside, &grid, &p, None, &stop).expect("not stopped"));
+    let smooth = pieces.map(|p| smooth(&inside, &grid, &p, &Hierarchy::new(&p), None, &stop).expect("not stopped"));
     for m in surfaces.into_iter().chain([smooth]).flatten() {
         let c = check_mesh(&m.positions, &m.triangles, &stop).expect("a surface has faces");
         assert!(c.watertight(), "{c:?}");
