@@ -23,6 +23,8 @@
 //!   fill of a surface shell, hollowing.
 //! - [`distance`] — distance fields: the exact distance from voxel
 //!   centres to the mesh, in a narrow band or on every voxel.
+//! - [`query`] — the same distance, the closest point, the winding number
+//!   and inside at any point ([`query::Query`]).
 //! - [`attributes`] (colours, materials, normals, coverage carried into
 //!   the voxels), [`export`] (greedy quads of the voxels' boundary) and
 //!   [`render`] (CPU ray casting of a grid).
@@ -48,6 +50,7 @@ pub mod geom;
 pub mod grid;
 pub mod mesh;
 pub mod mesh_check;
+pub mod query;
 pub mod raster;
 pub mod render;
 pub mod stop;

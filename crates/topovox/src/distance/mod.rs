@@ -129,6 +129,47 @@ impl Piece {
         d
     }
 
+    /// The point of the piece nearest to `q`, as barycentric weights of
+    /// its three corners, by the same case split as
+    /// [`Piece::distance_squared`] (so the point is the one that distance
+    /// measures): the foot of the perpendicular, else the nearest point of
+    /// the first nearest edge.
+    pub fn closest(&self, q: DVec3) -> [f64; 3] {
+        let edge = |e: usize| -> [f64; 3] {
+            let t = ((q - self.p[e]).dot(self.e[e]) * self.inv[e]).clamp(0.0, 1.0);
+            let mut w = [0.0; 3];
+            w[e] += 1.0 - t;
+            w[(e + 1) % 3] += t;
+            w
+        };
+        let nearest_of = |edges: &[usize]| {
+            let mut best = (f64::INFINITY, edges[0]);
+            for &e in edges {
+                let d = self.edge(e, q);
+                if d < best.0 {
+                    best = (d, e);
+                }
+            }
+            edge(best.1)
+        };
+        if self.flat {
+            return nearest_of(&[0, 1, 2]);
+        }
+        let s = [self.m[0].dot(q - self.p[0]), self.m[1].dot(q - self.p[1]), self.m[2].dot(q - self.p[2])];
+        if s.iter().all(|&s| s >= 0.0) {
+            // Weight of each corner: the edge opposite it, over |n|².
+            return [s[1] * self.inv_n, s[2] * self.inv_n, s[0] * self.inv_n];
+        }
+        let outside: Vec<usize> = (0..3).filter(|&e| s[e] < 0.0).collect();
+        nearest_of(&outside)
+    }
+
+    /// The point with barycentric weights `w`; the foot of the
+    /// perpendicular when `w` came from inside the triangle.
+    pub fn point(&self, w: [f64; 3]) -> DVec3 {
+        self.p[0] * w[0] + self.p[1] * w[1] + self.p[2] * w[2]
+    }
+
     /// The squared distance from `q` to the piece's bounding box (a lower bound).
     #[inline]
     pub fn box_distance_squared(&self, q: DVec3) -> f64 {
@@ -151,6 +192,9 @@ pub struct Pieces {
     pub items: Vec<Piece>,
     /// Triangles and segments with an index out of range.
     pub skipped: u64,
+    /// Per piece, what it came from: triangle `t` is `t`, segment `s` is
+    /// `triangles + s` (the numbering of [`Piece::closest`]'s callers).
+    pub element: Vec<u32>,
 }
 
 impl Pieces {
@@ -158,6 +202,7 @@ impl Pieces {
     pub fn of(mesh: MeshRef<'_>) -> Result<Pieces, DistanceError> {
         let mut items = Vec::with_capacity(mesh.triangles.len() + mesh.segments.len());
         let mut skipped = 0;
+        let mut element = Vec::with_capacity(items.capacity());
         let at = |i: u32| -> Result<Option<DVec3>, DistanceError> {
             match mesh.positions.get(i as usize) {
                 Some(p) if p.is_finite() => Ok(Some(*p)),
@@ -165,22 +210,28 @@ impl Pieces {
                 None => Ok(None),
             }
         };
-        for t in mesh.triangles {
+        for (n, t) in mesh.triangles.iter().enumerate() {
             match (at(t[0])?, at(t[1])?, at(t[2])?) {
-                (Some(a), Some(b), Some(c)) => items.push(Piece::new([a, b, c])),
+                (Some(a), Some(b), Some(c)) => {
+                    items.push(Piece::new([a, b, c]));
+                    element.push(n as u32);
+                }
                 _ => skipped += 1,
             }
         }
-        for s in mesh.segments {
+        for (n, s) in mesh.segments.iter().enumerate() {
             match (at(s[0])?, at(s[1])?) {
-                (Some(a), Some(b)) => items.push(Piece::new([a, b, b])),
+                (Some(a), Some(b)) => {
+                    items.push(Piece::new([a, b, b]));
+                    element.push((mesh.triangles.len() + n) as u32);
+                }
                 _ => skipped += 1,
             }
         }
         if items.is_empty() {
             return Err(DistanceError::Empty);
         }
-        Ok(Pieces { items, skipped })
+        Ok(Pieces { items, skipped, element })
     }
 }
 

@@ -87,9 +87,16 @@ impl Hierarchy {
         Hierarchy { nodes, order, sorted }
     }
 
+    /// The box of every piece.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        (self.nodes[0].lo, self.nodes[0].hi)
+    }
+
     /// The squared distance from `q` to the nearest piece and that piece,
     /// given a piece whose squared distance `bound` is known (or
-    /// `(f64::INFINITY, u32::MAX)`): only strictly nearer pieces replace it.
+    /// `(f64::INFINITY, u32::MAX)`): only nearer pieces, or equally near
+    /// ones with a smaller number, replace it. So among equally near pieces
+    /// the lowest numbered is found, whatever the start.
     pub fn nearest(&self, q: DVec3, mut best: (f64, u32)) -> (f64, u32) {
         // Median splits of < 2^32 pieces make at most 32 levels, each
         // leaving one node on the stack: 64 slots never fill.
@@ -99,15 +106,15 @@ impl Hierarchy {
             top -= 1;
             let node = &self.nodes[stack[top] as usize];
             // Checked again: the best may have improved since it was pushed.
-            if box_distance_squared(node.lo, node.hi, q) >= best.0 {
+            if box_distance_squared(node.lo, node.hi, q) > best.0 {
                 continue;
             }
             if node.count > 0 {
                 let leaf = node.start as usize..(node.start + node.count) as usize;
                 for (p, &n) in self.sorted[leaf.clone()].iter().zip(&self.order[leaf]) {
-                    if p.box_distance_squared(q) < best.0 {
+                    if p.box_distance_squared(q) <= best.0 {
                         let d = p.distance_squared(q);
-                        if d < best.0 {
+                        if d < best.0 || (d == best.0 && n < best.1) {
                             best = (d, n);
                         }
                     }
@@ -120,11 +127,11 @@ impl Hierarchy {
             // Nearer child on top of the stack, visited first; a child no
             // nearer than the best found is not pushed at all.
             let ((far, df), (near, dn)) = if da <= db { ((b, db), (a, da)) } else { ((a, da), (b, db)) };
-            if df < best.0 {
+            if df <= best.0 {
                 stack[top] = far;
                 top += 1;
             }
-            if dn < best.0 {
+            if dn <= best.0 {
                 stack[top] = near;
                 top += 1;
             }

@@ -36,6 +36,11 @@ fn piece(p: [DVec3; 3], q: DVec3) -> f64 {
     }
 }
 
+/// The distance from `q` to the nearest of `pieces`, by this formula.
+pub fn distance_at(pieces: &Pieces, q: DVec3) -> f64 {
+    pieces.items.iter().map(|p| piece(p.p, q)).fold(f64::INFINITY, f64::min)
+}
+
 /// The unsigned distance of every voxel of `grid` to `mesh`, C order
 /// (`[i][j][k]`).
 pub fn distances(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<Vec<f64>, DistanceError> {
@@ -49,7 +54,7 @@ pub fn distances(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<Vec<f64>, Distanc
             for j in 0..ny {
                 for k in 0..nz {
                     let q = grid.voxel_center([i, j, k]);
-                    out.push(pieces.items.iter().map(|p| piece(p.p, q)).fold(f64::INFINITY, f64::min));
+                    out.push(distance_at(&pieces, q));
                 }
             }
             out

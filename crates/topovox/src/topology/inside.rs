@@ -168,7 +168,7 @@ enum Corner {
 /// `points`) used an odd number of times, and those not used equally
 /// often in both directions, as `(lo, hi, uses lo → hi − uses hi → lo)`.
 /// An edge joining a point to itself is none.
-fn count_edges(ends: &[[u32; 3]], points: usize) -> (usize, Vec<(u32, u32, i64)>) {
+pub(crate) fn count_edges(ends: &[[u32; 3]], points: usize) -> (usize, Vec<(u32, u32, i64)>) {
     let edges = || ends.iter().flat_map(|e| (0..3).map(move |i| (e[i], e[(i + 1) % 3]))).filter(|(a, b)| a != b);
     // Each edge in the bucket of its lower end.
     let start = row_starts(points, edges().map(|(a, b)| a.min(b) as usize));

@@ -50,7 +50,7 @@ use crate::grid::dense::DenseBits;
 use crate::grid::sparse::SparseBricks;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
-use crate::topology::inside::{row_crossings, snap_all, ClassifyError, NetEdge, Snapped};
+use crate::topology::inside::{row_crossings, snap_all, ClassifyError, Snapped};
 
 /// What the winding-number solid did beyond [`SolidReport`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -98,21 +98,21 @@ pub fn winding_of(t: &[P3; 3], q: P3) -> f64 {
 
 /// The oriented boundary of a mesh, from its [`Snapped::net_edges`], as
 /// closed cycles of lattice points.
-fn boundary_cycles(net: &[NetEdge]) -> Vec<Vec<P3>> {
+pub(crate) fn boundary_cycles<P: Copy + Ord + std::hash::Hash>(net: &[(P, P, i64)]) -> Vec<Vec<P>> {
     // Outgoing boundary half-edges per vertex (with multiplicity), in a
     // deterministic order.
-    let mut half: Vec<(P3, P3)> = Vec::new();
+    let mut half: Vec<(P, P)> = Vec::new();
     for &(a, b, n) in net {
         for _ in 0..n.unsigned_abs() {
             half.push(if n > 0 { (a, b) } else { (b, a) });
         }
     }
     half.sort_unstable();
-    let mut out: FxHashMap<P3, Vec<P3>> = FxHashMap::default();
+    let mut out: FxHashMap<P, Vec<P>> = FxHashMap::default();
     for &(a, b) in half.iter().rev() {
         out.entry(a).or_default().push(b);
     }
-    let mut starts: Vec<P3> = half.iter().map(|h| h.0).collect();
+    let mut starts: Vec<P> = half.iter().map(|h| h.0).collect();
     starts.dedup();
     let mut cycles = Vec::new();
     for s in starts {
@@ -283,7 +283,7 @@ fn point_segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
 /// Triangulates the polygon of vertices `p` (indices; any shape, only its
 /// boundary matters) by splitting it along the diagonal from its first
 /// vertex to its middle one, keeping the polygon's orientation.
-fn triangulate(p: &[u32], out: &mut Vec<[u32; 3]>) {
+pub(crate) fn triangulate(p: &[u32], out: &mut Vec<[u32; 3]>) {
     match p.len() {
         0..=2 => {}
         3 => out.push([p[0], p[1], p[2]]),
