@@ -28,6 +28,7 @@
 
 pub mod caps;
 pub mod ray;
+pub mod sample;
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -116,6 +117,12 @@ impl Query {
         let mesh = RayIndex::new(tris.into_iter());
         let cap_rays = RayIndex::new(caps.tris.iter().copied());
         Ok(Query { pieces, tree, mesh, cap_rays, caps, facts, triangles: mesh_triangles })
+    }
+
+    /// The mesh's triangles with valid indices, in mesh order (world
+    /// coordinates), as the samples draw from them.
+    pub fn triangles(&self) -> Vec<[DVec3; 3]> {
+        self.pieces.items.iter().zip(&self.pieces.element).filter(|(_, &e)| (e as usize) < self.triangles).map(|(p, _)| p.p).collect()
     }
 
     /// What the query knows of its mesh.

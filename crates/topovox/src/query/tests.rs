@@ -213,3 +213,39 @@ fn batches_equal_single_points_and_bad_points_are_nan() {
     assert!(q.distance(pts[17]).is_nan() && !q.contains(pts[4000]) && q.closest(pts[17]).element == u32::MAX);
     assert_eq!(Query::new(Mesh::default().as_ref(), Sign::Auto).err(), Some(DistanceError::Empty));
 }
+
+#[test]
+fn samples_are_reproducible_and_signed_by_the_query() {
+    use super::sample::{sample, Kind, SampleSpec};
+    let mut rng = Xorshift(21);
+    let m = blob(&mut rng, DVec3::ZERO);
+    let q = Query::new(m.as_ref(), Sign::Auto).unwrap();
+    let spec = SampleSpec { surface: 5000, near: 9000, sigma: vec![0.05, 0.01], uniform: 4100, bounds: (DVec3::splat(-2.0), DVec3::splat(2.0)), seed: 7 };
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(|| sample(&q, &spec).unwrap());
+    let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap().install(|| sample(&q, &spec).unwrap());
+    assert_eq!(one.points.len(), 18_100);
+    assert!(one.points.iter().zip(&two.points).all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits)));
+    let other = sample(&q, &SampleSpec { seed: 8, ..spec.clone() }).unwrap();
+    assert_ne!(one.points[..10], other.points[..10]);
+    for (n, &p) in one.points.iter().enumerate() {
+        assert_eq!(one.sdf[n] < 0.0, one.occupancy[n]);
+        assert_eq!(one.sdf[n], super::signed(q.distance(p), one.occupancy[n]));
+        assert_eq!(one.occupancy[n], q.contains(p));
+        match one.kind[n] {
+            Kind::Surface => {
+                assert!(one.sdf[n].abs() < 1e-12);
+                assert!((one.normals[n].length() - 1.0).abs() < 1e-12);
+            }
+            Kind::Near => assert!(one.normals[n].is_nan() && one.sdf[n].abs() < 0.5),
+            Kind::Uniform => assert!(p.cmpge(DVec3::splat(-2.0)).all() && p.cmplt(DVec3::splat(2.0)).all()),
+        }
+    }
+    // The two sigmas alternate: their spreads show.
+    let spread = |k: usize| {
+        let d: Vec<f64> = (5000..14_000).filter(|n| (n - 5000) % 2 == k).map(|n| one.sdf[n].abs()).collect();
+        d.iter().sum::<f64>() / d.len() as f64
+    };
+    assert!(spread(0) > 3.0 * spread(1), "{} {}", spread(0), spread(1));
+    let bad = SampleSpec { sigma: vec![0.0], ..spec.clone() };
+    assert!(sample(&q, &bad).is_err());
+}
