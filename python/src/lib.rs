@@ -19,7 +19,7 @@
 //!   failures while running (no GPU, not enough memory).
 //!
 //! Rooms: `meshes` (Mesh, load_mesh), `grids` (VoxelGrid, load_voxels),
-//! `distance` (DistanceGrid, sdf), `placement` (the getters both grids
+//! `distance` (DistanceGrid, sdf), `query` (Query, sample), `placement` (the getters both grids
 //! share), `voxelize`, `batch`, `options` (keywords → job options),
 //! `convert` (arrays and values in and out), `errors`, `interrupt`.
 
@@ -32,6 +32,7 @@ mod interrupt;
 mod meshes;
 mod options;
 mod placement;
+mod query;
 mod remesh;
 mod voxelize;
 
@@ -44,6 +45,8 @@ fn _topovox(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<meshes::Mesh>()?;
     m.add_class::<grids::VoxelGrid>()?;
     m.add_class::<distance::DistanceGrid>()?;
+    m.add_class::<query::Query>()?;
+    m.add_function(wrap_pyfunction!(query::sample, m)?)?;
     m.add_function(wrap_pyfunction!(distance::sdf, m)?)?;
     m.add_function(wrap_pyfunction!(remesh::remesh, m)?)?;
     m.add_function(wrap_pyfunction!(remesh::check_mesh, m)?)?;

@@ -185,3 +185,42 @@ pub fn sample(query: &Query, spec: &SampleSpec) -> Result<Samples, SampleError> 
     out.sdf = dist.iter().zip(&out.occupancy).map(|(&d, &i)| super::signed(d, i)).collect();
     Ok(out)
 }
+
+/// How the mesh is moved and scaled before sampling.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Normalize {
+    /// As given.
+    #[default]
+    None,
+    /// Box centre to the origin, longest side 1 (the box in `[−½, ½]³`;
+    /// Occupancy Networks, IF-Net).
+    UnitCube,
+    /// Box centre to the origin, farthest vertex at distance 1 (DeepSDF).
+    UnitSphere,
+}
+
+/// `(offset, scale)` such that `(p − offset) · scale` normalizes the
+/// points `p` of `tris` as `how` says (`(0, 1)` for none or no extent).
+pub fn normalization(tris: &[[DVec3; 3]], how: Normalize) -> (DVec3, f64) {
+    let pts = || tris.iter().flatten();
+    let (lo, hi) = pts().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let centre = (lo + hi) * 0.5;
+    let size = match how {
+        Normalize::None => return (DVec3::ZERO, 1.0),
+        Normalize::UnitCube => (hi - lo).max_element(),
+        Normalize::UnitSphere => pts().map(|p| p.distance(centre)).fold(0.0, f64::max),
+    };
+    if size > 0.0 && size.is_finite() {
+        (centre, 1.0 / size)
+    } else {
+        (DVec3::ZERO, 1.0)
+    }
+}
+
+/// The default box of the uniform points: the box of `tris` grown by 5 %
+/// of its longest side on every side.
+pub fn default_bounds(tris: &[[DVec3; 3]]) -> (DVec3, DVec3) {
+    let (lo, hi) = tris.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let pad = DVec3::splat((hi - lo).max_element() * 0.05);
+    (lo - pad, hi + pad)
+}

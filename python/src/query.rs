@@ -1,0 +1,185 @@
+//! `topovox.Query` and `topovox.sample`: exact point queries and training
+//! samples (`topovox::query`). Points are copied once (any float dtype and
+//! strides), the work runs without the GIL, on `threads` threads.
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use topovox::query::sample::{default_bounds, normalization, sample as draw, Normalize, SampleSpec};
+use topovox::query::{Ask, Closest, Query as Core, Sign};
+
+use crate::convert::points_from;
+use crate::errors::{py_err, value_err};
+use crate::meshes::Mesh;
+
+fn sign_of(s: &str) -> PyResult<Sign> {
+    match s.to_ascii_lowercase().as_str() {
+        "auto" => Ok(Sign::Auto),
+        "parity" => Ok(Sign::Parity),
+        "winding" => Ok(Sign::Winding),
+        _ => Err(value_err(format!("sign must be 'auto', 'parity' or 'winding'; got {s:?}"))),
+    }
+}
+
+fn sign_name(s: Sign) -> &'static str {
+    match s {
+        Sign::Auto => "auto",
+        Sign::Parity => "parity",
+        Sign::Winding => "winding",
+    }
+}
+
+/// A mesh prepared for point queries: see `topovox.Query`.
+#[pyclass(module = "topovox._topovox", name = "Query", frozen)]
+pub struct Query {
+    inner: Arc<Core>,
+    pool: Option<Arc<rayon::ThreadPool>>,
+}
+
+impl Query {
+    /// Runs `f` without the GIL on the query's threads.
+    fn run<T: Send>(&self, py: Python<'_>, f: impl FnOnce(&Core) -> T + Send) -> T {
+        let (inner, pool) = (&self.inner, &self.pool);
+        py.detach(|| match pool {
+            Some(p) => p.install(|| f(inner)),
+            None => f(inner),
+        })
+    }
+
+    fn values<'py>(&self, py: Python<'py>, points: &Bound<'py, PyAny>, ask: Ask) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let pts = points_from("points", points)?;
+        let out = self.run(py, |q| {
+            let mut out = vec![0.0; pts.len()];
+            q.batch(&pts, ask, &mut out);
+            out
+        });
+        Ok(Array1::from(out).into_pyarray(py))
+    }
+}
+
+fn pool(threads: Option<usize>) -> PyResult<Option<Arc<rayon::ThreadPool>>> {
+    Ok(threads.map(topovox_job::pool).transpose().map_err(py_err)?.map(Arc::new))
+}
+
+#[pymethods]
+impl Query {
+    #[new]
+    #[pyo3(signature = (mesh, sign="auto", threads=None))]
+    fn new(py: Python<'_>, mesh: &Mesh, sign: &str, threads: Option<usize>) -> PyResult<Query> {
+        let (sign, pool) = (sign_of(sign)?, pool(threads)?);
+        let (inner, name) = (mesh.inner.clone(), mesh.name());
+        let q = py.detach(|| Core::new(inner.mesh.as_ref(), sign)).map_err(|e| value_err(format!("{name}: {e}")))?;
+        Ok(Query { inner: Arc::new(q), pool })
+    }
+
+    /// distances(points, signed) -> (n,) float64
+    fn distance<'py>(&self, py: Python<'py>, points: &Bound<'py, PyAny>, signed: bool) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.values(py, points, if signed { Ask::SignedDistance } else { Ask::Distance })
+    }
+
+    /// contains(points) -> (n,) float64 of 0 and 1 (the Python side makes bools)
+    fn contains<'py>(&self, py: Python<'py>, points: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.values(py, points, Ask::Contains)
+    }
+
+    /// winding_number(points) -> (n,) float64
+    fn winding_number<'py>(&self, py: Python<'py>, points: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        self.values(py, points, Ask::WindingNumber)
+    }
+
+    /// closest(points) -> (points (n, 3), distances (n,), elements (n,) int64, weights (n, 3))
+    #[allow(clippy::type_complexity)]
+    fn closest<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>)> {
+        let pts = points_from("points", points)?;
+        let got = self.run(py, |q| {
+            let mut out = vec![Closest { point: DVec3::NAN, distance: f64::NAN, element: u32::MAX, weights: [f64::NAN; 3] }; pts.len()];
+            q.closest_batch(&pts, &mut out);
+            out
+        });
+        let n = got.len();
+        let at = Array2::from_shape_fn((n, 3), |(i, a)| got[i].point[a]);
+        let w = Array2::from_shape_fn((n, 3), |(i, a)| got[i].weights[a]);
+        let d = Array1::from_iter(got.iter().map(|c| c.distance));
+        let e = Array1::from_iter(got.iter().map(|c| if c.element == u32::MAX { -1 } else { i64::from(c.element) }));
+        Ok((at.into_pyarray(py), d.into_pyarray(py), e.into_pyarray(py), w.into_pyarray(py)))
+    }
+
+    /// What the query knows of its mesh: a dict.
+    #[getter]
+    fn facts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let f = self.inner.facts();
+        let d = PyDict::new(py);
+        d.set_item("elements", f.elements)?;
+        d.set_item("skipped", f.skipped)?;
+        d.set_item("watertight", f.watertight)?;
+        d.set_item("boundary_cycles", f.cycles)?;
+        d.set_item("sign", sign_name(f.sign))?;
+        Ok(d)
+    }
+}
+
+/// The native `topovox.sample`: see its documentation. Returns a dict of arrays.
+#[pyfunction]
+#[pyo3(signature = (mesh, surface, near, sigma, uniform, bounds, normalize, seed, sign, threads))]
+#[allow(clippy::too_many_arguments)]
+pub fn sample<'py>(
+    py: Python<'py>,
+    mesh: &Mesh,
+    surface: usize,
+    near: usize,
+    sigma: Vec<f64>,
+    uniform: usize,
+    bounds: Option<[[f64; 3]; 2]>,
+    normalize: Option<&str>,
+    seed: u64,
+    sign: &str,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (sign, pool) = (sign_of(sign)?, pool(threads)?);
+    let how = match normalize.map(str::to_ascii_lowercase).as_deref() {
+        None | Some("none") => Normalize::None,
+        Some("unit-cube") => Normalize::UnitCube,
+        Some("unit-sphere") => Normalize::UnitSphere,
+        Some(o) => return Err(value_err(format!("normalize must be 'unit-cube', 'unit-sphere' or None; got {o:?}"))),
+    };
+    let (inner, name) = (mesh.inner.clone(), mesh.name());
+    let work = move || -> Result<_, String> {
+        let mut m = inner.mesh.clone();
+        let tris: Vec<[DVec3; 3]> = m.triangles.iter().filter_map(|t| t.iter().map(|&i| m.positions.get(i as usize).copied()).collect::<Option<Vec<_>>>()).map(|v| [v[0], v[1], v[2]]).collect();
+        let (offset, scale) = normalization(&tris, how);
+        m.transform(|p| (p - offset) * scale);
+        let q = Core::new(m.as_ref(), sign).map_err(|e| format!("{name}: {e}"))?;
+        let bounds = match bounds {
+            Some([lo, hi]) => (DVec3::from(lo), DVec3::from(hi)),
+            None => default_bounds(&q.triangles()),
+        };
+        let spec = SampleSpec { surface, near, sigma, uniform, bounds, seed };
+        let s = draw(&q, &spec).map_err(|e| format!("{name}: {e}"))?;
+        Ok((s, offset, scale, bounds))
+    };
+    let (s, offset, scale, bounds) = py
+        .detach(|| match &pool {
+            Some(p) => p.install(work),
+            None => work(),
+        })
+        .map_err(value_err)?;
+    let n = s.points.len();
+    let d = PyDict::new(py);
+    d.set_item("points", Array2::from_shape_fn((n, 3), |(i, a)| s.points[i][a]).into_pyarray(py))?;
+    d.set_item("sdf", Array1::from(s.sdf).into_pyarray(py))?;
+    d.set_item("occupancy", Array1::from_iter(s.occupancy.iter().map(|&o| u8::from(o))).into_pyarray(py))?;
+    d.set_item("normals", Array2::from_shape_fn((n, 3), |(i, a)| s.normals[i][a]).into_pyarray(py))?;
+    d.set_item("kind", Array1::from_iter(s.kind.iter().map(|&k| k as u8)).into_pyarray(py))?;
+    d.set_item("offset", Array1::from(offset.to_array().to_vec()).into_pyarray(py))?;
+    d.set_item("scale", scale)?;
+    d.set_item("bounds", Array2::from_shape_fn((2, 3), |(r, a)| if r == 0 { bounds.0[a] } else { bounds.1[a] }).into_pyarray(py))?;
+    Ok(d)
+}

@@ -1,0 +1,135 @@
+"""Point queries and training samples (issue 56): exact against analytic
+distances and brute force, equal to the grids at voxel centres, and
+reproducible for a seed on any thread count."""
+
+import numpy as np
+import pytest
+
+import topovox
+
+
+def box(lo, hi):
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    v = np.array([[hi[0] if i & 1 else lo[0], hi[1] if i & 2 else lo[1], hi[2] if i & 4 else lo[2]] for i in range(8)])
+    quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]]
+    f = np.array([t for q in quads for t in ([q[0], q[1], q[2]], [q[0], q[2], q[3]])])
+    return v, f
+
+
+def rotation(seed):
+    q, _ = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+    return q * np.sign(np.linalg.det(q))
+
+
+def box_sdf(p, lo, hi):
+    c, h = (np.asarray(lo) + hi) / 2, (np.asarray(hi) - lo) / 2
+    d = np.abs(p - c) - h
+    return np.linalg.norm(np.maximum(d, 0), axis=1) + np.minimum(d.max(axis=1), 0)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_distances_equal_the_analytic_box_sdf(seed):
+    lo, hi = np.array([-1.0, -0.5, -0.25]), np.array([1.0, 0.75, 0.5])
+    v, f = box(lo, hi)
+    r = rotation(seed)
+    q = topovox.Query(v @ r.T, f)
+    p = np.random.default_rng(seed).uniform(-2, 2, size=(20_000, 3))
+    want = box_sdf(p, lo, hi)
+    got = q.distance(p @ r.T)
+    assert np.all(np.abs(got - want) <= 1e-9 * np.maximum(np.abs(want), 1e-9) + 1e-12)
+    assert np.array_equal(q.contains(p @ r.T), want < 0)
+    pts, d, tri, bary = q.closest(p @ r.T)
+    assert np.allclose(np.linalg.norm(pts - p @ r.T, axis=1), np.abs(want), atol=1e-9)
+    corners = (v @ r.T)[f[tri]]
+    assert np.allclose(np.einsum("nk,nkj->nj", bary, corners), pts, atol=1e-9)
+    assert q.facts["watertight"] and q.facts["sign"] == "parity"
+
+
+def dyadic(mesh, res):
+    """The mesh's vertices on the 1/4096 lattice of a power-of-two grid,
+    and that grid's origin, voxel size and dims."""
+    v = np.asarray(mesh.vertices, dtype=np.float64)
+    lo, hi = v.min(0), v.max(0)
+    h = 2.0 ** np.floor(np.log2((hi - lo).max() / res))
+    origin = np.floor(lo / h) * h - h
+    dims = (np.ceil((hi - origin) / h) + 1).astype(int)
+    step = h / 4096
+    return origin + np.round((v - origin) / step) * step, np.asarray(mesh.faces), origin, h, dims
+
+
+@pytest.mark.parametrize("name", ["stanford-bunny.obj", "teapot.obj", "suzanne.obj"])
+def test_contains_and_signed_distance_equal_the_grids(name, meshes):
+    v, f, origin, h, dims = dyadic(topovox.load_mesh(meshes / name), 24)
+    grid = topovox.voxelize(v, f, mode="solid", origin=origin, voxel_size=h, dims=dims)
+    field = topovox.sdf(v, f, origin=origin, voxel_size=h, dims=dims, band="all")
+    idx = np.indices(grid.shape).reshape(3, -1).T
+    centres = grid.index_to_world(idx)
+    q = topovox.Query(v, f)
+    assert np.array_equal(q.contains(centres).reshape(grid.shape), np.asarray(grid))
+    d = q.distance(centres).astype(np.float32).reshape(grid.shape)
+    assert np.array_equal(d.view(np.uint32), np.asarray(field).view(np.uint32))
+
+
+def test_on_any_mesh_contains_differs_only_at_the_surface(meshes):
+    m = topovox.load_mesh(meshes / "stanford-bunny.obj")
+    grid = topovox.voxelize(m, mode="solid", resolution=48)
+    centres = grid.index_to_world(np.indices(grid.shape).reshape(3, -1).T)
+    q = topovox.Query(m)
+    differ = q.contains(centres) != np.asarray(grid).reshape(-1)
+    assert np.all(np.abs(q.distance(centres[differ])) < 1e-3 * grid.voxel_size)
+
+
+def test_winding_numbers_match_the_direct_sum(meshes):
+    m = topovox.load_mesh(meshes / "teapot.obj")
+    v, f = np.asarray(m.vertices), np.asarray(m.faces)
+    p = np.random.default_rng(3).uniform(v.min(0), v.max(0), size=(300, 3))
+    a, b, c = (v[f[:, i]][None] - p[:, None] for i in range(3))
+    la, lb, lc = (np.linalg.norm(x, axis=2) for x in (a, b, c))
+    det = np.einsum("pti,pti->pt", a, np.cross(b, c))
+    den = la * lb * lc + np.einsum("pti,pti->pt", a, b) * lc + np.einsum("pti,pti->pt", b, c) * la + np.einsum("pti,pti->pt", c, a) * lb
+    direct = (2 * np.arctan2(det, den)).sum(1) / (4 * np.pi)
+    q = topovox.Query(m)
+    assert np.allclose(q.winding_number(p), direct, atol=1e-9)
+    assert q.facts["sign"] == "winding"
+    assert np.array_equal(q.contains(p), np.abs(q.winding_number(p)) >= 0.5)
+
+
+def test_points_in_any_layout_and_bad_points():
+    v, f = box([0, 0, 0], [1, 1, 1])
+    q = topovox.Query(v, f, threads=1)
+    p = np.random.default_rng(0).uniform(-1, 2, size=(1000, 6))[:, ::2]
+    assert np.array_equal(q.distance(p), q.distance(np.ascontiguousarray(p)))
+    assert np.allclose(q.distance(p.astype(np.float32)), q.distance(p.astype(np.float32).astype(np.float64)))
+    assert q.distance([0.5, 0.5, 2.0]) == 1.0 and q.contains([0.5, 0.5, 0.5])
+    bad = np.array([[np.nan, 0, 0], [0, np.inf, 0]])
+    assert np.isnan(q.distance(bad)).all() and not q.contains(bad).any()
+    assert list(q.closest(bad)[2]) == [-1, -1]
+    assert topovox.distance(v, [[0.5, 0.5, 2.0]], faces=f)[0] == 1.0
+    assert topovox.contains(v, [[0.5, 0.5, 0.5]], faces=f)[0]
+    with pytest.raises(ValueError, match="shape"):
+        q.distance(np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="no triangles"):
+        topovox.Query(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64))
+    with pytest.raises(ValueError, match="sign"):
+        topovox.Query(v, f, sign="odd")
+
+
+def test_samples_are_reproducible_and_consistent(meshes):
+    kw = dict(surface=3000, near=6000, sigma=(0.01, 0.05), uniform=5000, normalize="unit-cube", seed=4)
+    one = topovox.sample(meshes / "stanford-bunny.obj", threads=1, **kw)
+    two = topovox.sample(meshes / "stanford-bunny.obj", threads=2, **kw)
+    for k in ("points", "sdf", "occupancy", "normals", "kind"):
+        assert np.array_equal(one[k], two[k], equal_nan=k == "normals"), k
+    assert len(one["points"]) == 14_000 and np.array_equal(np.bincount(one["kind"]), [3000, 6000, 5000])
+    assert np.array_equal(one["sdf"] < 0, one["occupancy"])
+    surf = one["kind"] == 0
+    assert np.allclose(np.linalg.norm(one["normals"][surf], axis=1), 1) and np.isnan(one["normals"][~surf]).all()
+    assert np.abs(one["sdf"][surf]).max() < 1e-12
+    p = one["points"] / one["scale"] + one["offset"]
+    q = topovox.Query(meshes / "stanford-bunny.obj")
+    assert np.allclose(np.abs(q.distance(p)), np.abs(one["sdf"]) / one["scale"], atol=1e-9)
+    uni = one["points"][one["kind"] == 2]
+    assert np.all(uni >= one["bounds"][0]) and np.all(uni <= one["bounds"][1])
+    assert not np.array_equal(topovox.sample(meshes / "stanford-bunny.obj", surface=10, seed=5)["points"], topovox.sample(meshes / "stanford-bunny.obj", surface=10, seed=6)["points"])
+    with pytest.raises(ValueError, match="sigma"):
+        topovox.sample(meshes / "stanford-bunny.obj", near=10, sigma=0)
