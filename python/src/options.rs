@@ -66,7 +66,12 @@ pub(crate) fn options<'py>(py: Python<'py>, command: &str) -> PyResult<Vec<(&'st
         "voxelize" | "batch" => JobOptions::keywords().collect(),
         "sdf" => topovox_job::distance::SdfOptions::keywords().collect(),
         "remesh" => topovox_job::remesh::RemeshOptions::keywords().collect(),
-        _ => return Err(crate::errors::value_err(format!("options: no command {command:?} (expected voxelize, batch, sdf or remesh)"))),
+        "sample" => topovox_job::sample::SampleOptions::keywords().collect(),
+        _ => {
+            return Err(crate::errors::value_err(format!(
+                "options: no command {command:?} (expected voxelize, batch, sdf, remesh or sample)"
+            )))
+        }
     };
     rows.into_iter()
         .map(|k| {

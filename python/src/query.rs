@@ -9,12 +9,14 @@ use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use topovox::query::sample::{default_bounds, normalization, sample as draw, Normalize, SampleSpec};
 use topovox::query::{Ask, Closest, Query as Core, Sign};
 
-use crate::convert::points_from;
+use topovox_job::sample::SampleOptions;
+
+use crate::convert::{points_from, to_py};
 use crate::errors::{py_err, value_err};
 use crate::meshes::Mesh;
+use crate::options::table_options;
 
 fn sign_of(s: &str) -> PyResult<Sign> {
     match s.to_ascii_lowercase().as_str() {
@@ -128,58 +130,28 @@ impl Query {
 
 /// The native `topovox.sample`: see its documentation. Returns a dict of arrays.
 #[pyfunction]
-#[pyo3(signature = (mesh, surface, near, sigma, uniform, bounds, normalize, seed, sign, threads))]
-#[allow(clippy::too_many_arguments)]
-pub fn sample<'py>(
-    py: Python<'py>,
-    mesh: &Mesh,
-    surface: usize,
-    near: usize,
-    sigma: Vec<f64>,
-    uniform: usize,
-    bounds: Option<[[f64; 3]; 2]>,
-    normalize: Option<&str>,
-    seed: u64,
-    sign: &str,
-    threads: Option<usize>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let (sign, pool) = (sign_of(sign)?, pool(threads)?);
-    let how = match normalize.map(str::to_ascii_lowercase).as_deref() {
-        None | Some("none") => Normalize::None,
-        Some("unit-cube") => Normalize::UnitCube,
-        Some("unit-sphere") => Normalize::UnitSphere,
-        Some(o) => return Err(value_err(format!("normalize must be 'unit-cube', 'unit-sphere' or None; got {o:?}"))),
-    };
+#[pyo3(signature = (mesh, options=None))]
+pub fn sample<'py>(py: Python<'py>, mesh: &Mesh, options: Option<&Bound<'py, PyDict>>) -> PyResult<Bound<'py, PyDict>> {
+    let opts: SampleOptions = table_options(options, &[])?;
+    let pool = pool(opts.run.threads)?;
     let (inner, name) = (mesh.inner.clone(), mesh.name());
-    let work = move || -> Result<_, String> {
-        let mut m = inner.mesh.clone();
-        let tris: Vec<[DVec3; 3]> = m.triangles.iter().filter_map(|t| t.iter().map(|&i| m.positions.get(i as usize).copied()).collect::<Option<Vec<_>>>()).map(|v| [v[0], v[1], v[2]]).collect();
-        let (offset, scale) = normalization(&tris, how);
-        m.transform(|p| (p - offset) * scale);
-        let q = Core::new(m.as_ref(), sign).map_err(|e| format!("{name}: {e}"))?;
-        let bounds = match bounds {
-            Some([lo, hi]) => (DVec3::from(lo), DVec3::from(hi)),
-            None => default_bounds(&q.triangles()),
-        };
-        let spec = SampleSpec { surface, near, sigma, uniform, bounds, seed };
-        let s = draw(&q, &spec).map_err(|e| format!("{name}: {e}"))?;
-        Ok((s, offset, scale, bounds))
-    };
-    let (s, offset, scale, bounds) = py
+    let work = || topovox_job::sample::sample(inner.mesh.as_ref(), &name, &opts);
+    let s = py
         .detach(|| match &pool {
             Some(p) => p.install(work),
             None => work(),
         })
-        .map_err(value_err)?;
-    let n = s.points.len();
+        .map_err(py_err)?;
+    let (samples, n) = (&s.samples, s.samples.points.len());
     let d = PyDict::new(py);
-    d.set_item("points", Array2::from_shape_fn((n, 3), |(i, a)| s.points[i][a]).into_pyarray(py))?;
-    d.set_item("sdf", Array1::from(s.sdf).into_pyarray(py))?;
-    d.set_item("occupancy", Array1::from_iter(s.occupancy.iter().map(|&o| u8::from(o))).into_pyarray(py))?;
-    d.set_item("normals", Array2::from_shape_fn((n, 3), |(i, a)| s.normals[i][a]).into_pyarray(py))?;
-    d.set_item("kind", Array1::from_iter(s.kind.iter().map(|&k| k as u8)).into_pyarray(py))?;
-    d.set_item("offset", Array1::from(offset.to_array().to_vec()).into_pyarray(py))?;
-    d.set_item("scale", scale)?;
-    d.set_item("bounds", Array2::from_shape_fn((2, 3), |(r, a)| if r == 0 { bounds.0[a] } else { bounds.1[a] }).into_pyarray(py))?;
+    d.set_item("points", Array2::from_shape_fn((n, 3), |(i, a)| samples.points[i][a]).into_pyarray(py))?;
+    d.set_item("sdf", Array1::from(samples.sdf.clone()).into_pyarray(py))?;
+    d.set_item("occupancy", Array1::from_iter(samples.occupancy.iter().map(|&o| u8::from(o))).into_pyarray(py))?;
+    d.set_item("normals", Array2::from_shape_fn((n, 3), |(i, a)| samples.normals[i][a]).into_pyarray(py))?;
+    d.set_item("kind", Array1::from_iter(samples.kind.iter().map(|&k| k as u8)).into_pyarray(py))?;
+    d.set_item("offset", Array1::from(s.offset.to_array().to_vec()).into_pyarray(py))?;
+    d.set_item("scale", s.scale)?;
+    d.set_item("bounds", Array2::from_shape_fn((2, 3), |(r, a)| if r == 0 { s.bounds.0[a] } else { s.bounds.1[a] }).into_pyarray(py))?;
+    d.set_item("info", to_py(py, &s.summary())?)?;
     Ok(d)
 }

@@ -133,3 +133,29 @@ def test_samples_are_reproducible_and_consistent(meshes):
     assert not np.array_equal(topovox.sample(meshes / "stanford-bunny.obj", surface=10, seed=5)["points"], topovox.sample(meshes / "stanford-bunny.obj", surface=10, seed=6)["points"])
     with pytest.raises(ValueError, match="sigma"):
         topovox.sample(meshes / "stanford-bunny.obj", near=10, sigma=0)
+
+
+def test_the_command_line_writes_the_same_samples(tmp_path, meshes, cli):
+    import subprocess, json, inspect
+    out = tmp_path / "s.npz"
+    r = subprocess.run(
+        [cli, "sample", meshes / "suzanne.obj", "-o", out, "--surface", "500", "--near", "700", "--sigma", "0.02,0.1", "--uniform", "300", "--normalize", "unit-cube", "--seed", "9", "--json"],
+        check=True, capture_output=True, text=True,
+    )
+    facts = json.loads(r.stdout)
+    assert facts["points"] == 1500 and facts["surface"] == 500 and facts["sign"] in ("parity", "winding")
+    z = np.load(out)
+    py = topovox.sample(meshes / "suzanne.obj", surface=500, near=700, sigma=(0.02, 0.1), uniform=300, normalize="unit-cube", seed=9)
+    assert np.array_equal(z["points"], py["points"].astype(np.float32))
+    assert np.array_equal(z["sdf"], py["sdf"].astype(np.float32))
+    assert np.array_equal(z["occupancy"], py["occupancy"]) and np.array_equal(z["kind"], py["kind"])
+    assert np.array_equal(z["offset"], py["offset"]) and z["scale"] == py["scale"]
+    # Every option of the one table is a keyword here and a flag there.
+    params = inspect.signature(topovox.sample).parameters
+    help_text = subprocess.run([cli, "sample", "--help"], check=True, capture_output=True, text=True).stdout
+    for name, _help, _example in topovox._topovox.options("sample"):
+        assert name in params, name
+        assert "--" + name.replace("_", "-") in help_text, name
+    # The input is never overwritten; bad values are one-line errors.
+    r = subprocess.run([cli, "sample", meshes / "suzanne.obj", "-o", tmp_path / "x.npz", "--near", "5", "--sigma", "0"], capture_output=True, text=True)
+    assert r.returncode == 2 and "sigma must be positive" in r.stderr and not (tmp_path / "x.npz").exists()

@@ -588,6 +588,8 @@ def sample(
     seed: int = 0,
     sign: SignName = "auto",
     threads: Optional[int] = None,
+    max_memory: Optional[Union[int, str]] = None,
+    allow_external_paths: bool = False,
 ) -> Dict[str, Any]:
     """Training samples: points on, near and around the mesh with their
     signed distance and occupancy (the :class:`Query`'s, so ``sdf < 0``
@@ -617,6 +619,9 @@ def sample(
         The same seed gives the same samples on any machine and thread count.
     sign, threads
         As :class:`Query`.
+    max_memory, allow_external_paths
+        As :func:`voxelize`: a count of samples that needs more memory is
+        refused before any work.
 
     Returns
     -------
@@ -625,7 +630,7 @@ def sample(
         uniform; ``sdf`` (N,) float64; ``occupancy`` (N,) bool; ``normals``
         (N, 3) float64 (NaN except for surface points); ``kind`` (N,) uint8
         (0 surface, 1 near, 2 uniform); ``offset`` (3,), ``scale`` and
-        ``bounds`` (2, 3).
+        ``bounds`` (2, 3); ``info``: counts, the sign rule, times.
 
     Examples
     --------
@@ -634,9 +639,13 @@ def sample(
     >>> s = topovox.sample("bunny.obj", near=500_000, sigma=(0.05, 0.0158),
     ...                    normalize="unit-sphere", seed=1)
     """
-    sig = [float(sigma)] if isinstance(sigma, (int, float)) else [float(x) for x in sigma]
-    box = None if bounds is None else np.asarray(bounds, dtype=np.float64).reshape(2, 3).tolist()
-    out = _topovox.sample(as_mesh(mesh_or_vertices, faces), int(surface), int(near), sig, int(uniform), box, normalize, int(seed), sign, threads)
+    mesh = as_mesh(mesh_or_vertices, faces)
+    options = dict(locals())
+    for k in ("mesh_or_vertices", "faces", "mesh"):
+        options.pop(k)
+    if options["bounds"] is not None:
+        options["bounds"] = np.asarray(options["bounds"], dtype=np.float64).reshape(-1).tolist()
+    out = _topovox.sample(mesh, _options(options))
     out["occupancy"] = out["occupancy"].astype(bool)
     return out
 

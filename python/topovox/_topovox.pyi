@@ -173,18 +173,7 @@ class Query:
     @property
     def facts(self) -> Dict[str, Any]: ...
 
-def sample(
-    mesh: Mesh,
-    surface: int,
-    near: int,
-    sigma: Sequence[float],
-    uniform: int,
-    bounds: Optional[Sequence[Sequence[float]]],
-    normalize: Optional[str],
-    seed: int,
-    sign: str,
-    threads: Optional[int],
-) -> Dict[str, Any]: ...
+def sample(mesh: Mesh, options: Optional[Dict[str, Any]] = None) -> Dict[str, Any]: ...
 def remesh(mesh: Mesh, options: Optional[Dict[str, Any]] = None) -> Tuple[Mesh, Dict[str, Any]]: ...
 def check_mesh(mesh: Mesh) -> Dict[str, Any]: ...
 def load_mesh(path: Union[str, PathLike[str]], allow_external_paths: bool = False) -> Mesh: ...

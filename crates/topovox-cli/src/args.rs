@@ -10,6 +10,7 @@ use topovox_job::check::MeshProperty;
 use topovox_job::distance::{DistanceFormat, SdfOptions};
 use topovox_job::output::Output;
 use topovox_job::remesh::RemeshOptions;
+use topovox_job::sample::SampleOptions;
 use topovox_job::{ColourRule, ExportOptions, GridOptions, JobOptions, Mode, Switch, Up};
 
 use topovox::render::raycast::View;
@@ -39,6 +40,10 @@ pub enum Command {
     /// solid` sets (or, with --inside wrap, shells around any input); to .obj,
     /// .ply, .stl or .glb.
     Remesh(RemeshArgs),
+    /// Training samples of a mesh: points on, near and around it with their
+    /// exact signed distance (negative where `voxelize --mode solid` would
+    /// call them inside) and occupancy, surface normals; to .npz.
+    Sample(SampleArgs),
     /// Print a report of a mesh file: vertices, triangles, degenerate triangles, bounds.
     Info(InfoArgs),
     /// Benchmark voxelization (medians over repeats) on a mesh at several resolutions.
@@ -145,6 +150,23 @@ pub struct RemeshArgs {
     /// Output format: obj, ply, stl or glb (default: from the extension).
     #[arg(long, value_name = "FORMAT", value_parser = choice::<MeshOut>())]
     pub format: Option<MeshOut>,
+    /// Print one JSON object on stdout instead of the summary line.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress bar and no summary line.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct SampleArgs {
+    /// Input mesh (.obj, .stl, .ply, .gltf, .glb, .off).
+    pub mesh: PathBuf,
+    /// Output: an .npz archive (points, sdf, occupancy, normals, kind, offset, scale, bounds).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub sample: Flags<SampleOptions>,
     /// Print one JSON object on stdout instead of the summary line.
     #[arg(long)]
     pub json: bool,

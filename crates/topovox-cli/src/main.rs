@@ -40,6 +40,7 @@ fn main() -> ExitCode {
         Command::Voxelize(a) => commands::voxelize::run(a),
         Command::Sdf(a) => commands::sdf::run(a),
         Command::Remesh(a) => commands::remesh::run(a),
+        Command::Sample(a) => commands::sample::run(a),
         Command::Info(a) => commands::info::run(a),
         Command::Bench(a) => commands::bench::run(a),
         Command::Check(a) => commands::check::run(a),

@@ -374,3 +374,35 @@ fn placement_of(origin: Option<Vec<f64>>, size: Option<Vec<f64>>) -> Result<Opti
         _ => return Err(ErrorKind::malformed(FORMAT, "origin and voxel_size must both be finite, the size positive")),
     })
 }
+
+/// One array of a [`write_arrays`] archive: its dtype (`<f4`, `<f8`,
+/// `|u1`, …), shape, and little-endian bytes.
+pub struct Member<'a> {
+    /// The member's name without `.npy`.
+    pub name: &'a str,
+    /// NumPy's dtype string.
+    pub descr: &'a str,
+    /// The shape.
+    pub shape: Vec<u64>,
+    /// The data, C order, little endian.
+    pub bytes: Vec<u8>,
+}
+
+/// Writes named arrays as an `.npz` archive (stored, no compression), as
+/// `numpy.savez` does: `numpy.load(path)["name"]` reads each.
+pub fn write_arrays(w: &mut dyn Write, members: &[Member<'_>]) -> std::io::Result<()> {
+    let mut zip = zip::ZipWriter::new_stream(w);
+    for m in members {
+        let large = m.bytes.len() as u64 >= u32::MAX as u64 / 2;
+        let opts = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored).large_file(large);
+        zip.start_file(format!("{}.npy", m.name), opts).map_err(std::io::Error::other)?;
+        let shape = match m.shape.as_slice() {
+            [n] => format!("({n},)"),
+            s => format!("({})", s.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")),
+        };
+        zip.write_all(&header(m.descr, &shape))?;
+        zip.write_all(&m.bytes)?;
+    }
+    zip.finish().map_err(std::io::Error::other)?;
+    Ok(())
+}

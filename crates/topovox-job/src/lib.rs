@@ -30,6 +30,7 @@ pub mod distance;
 pub mod options;
 pub mod output;
 pub mod remesh;
+pub mod sample;
 pub mod table;
 
 pub use error::{JobError, Result};

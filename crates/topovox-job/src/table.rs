@@ -144,8 +144,9 @@ impl Keyword {
             Example::Numbers(ex) => match numbers(raw)? {
                 n if n.len() == ex.len() => OptionValue::Numbers(n),
                 n => invalid!(
-                    "{} takes three comma-separated values ({}); got {}",
+                    "{} takes {} comma-separated values ({}); got {}",
                     self.name,
+                    ["no", "one", "two", "three", "four", "five", "six"].get(ex.len()).copied().unwrap_or("more"),
                     self.shape.value_name().unwrap_or_default(),
                     n.len()
                 ),
@@ -305,6 +306,15 @@ pub fn numbers(key: &str, v: &OptionValue) -> Result<Vec<f64>> {
         OptionValue::Numbers(n) if n.len() == 3 => Ok(n.clone()),
         OptionValue::Numbers(n) => invalid!("{key} must have 3 values; got {}", n.len()),
         v => invalid!("{key} must be a sequence of 3 numbers; got {}", shown(v)),
+    }
+}
+
+/// One number or several.
+pub fn number_list(key: &str, v: &OptionValue) -> Result<Vec<f64>> {
+    match v {
+        OptionValue::Numbers(n) => Ok(n.clone()),
+        OptionValue::Float(_) | OptionValue::Int(_) => Ok(vec![number(key, v)?]),
+        v => invalid!("{key} must be a number or a sequence of numbers; got {}", shown(v)),
     }
 }
 

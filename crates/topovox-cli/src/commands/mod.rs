@@ -10,6 +10,7 @@ pub mod info;
 pub mod raster;
 pub mod remesh;
 pub mod render;
+pub mod sample;
 #[cfg(feature = "gpu")]
 pub mod scene;
 pub mod sdf;

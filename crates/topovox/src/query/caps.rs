@@ -31,6 +31,8 @@ pub struct Caps {
     pub tris: Vec<[DVec3; 3]>,
     /// Boundary cycles closed.
     pub cycles: usize,
+    /// Per cap: a bounding sphere (centre, radius) and its area.
+    spheres: Vec<(DVec3, f64, f64)>,
 }
 
 impl Caps {
@@ -43,10 +45,33 @@ impl Caps {
             let order: Vec<u32> = (0..verts.len() as u32).collect();
             let mut index = Vec::with_capacity(verts.len() - 2);
             triangulate(&order, &mut index);
-            out.tris.extend(index.iter().map(|ix| ix.map(|i| verts[i as usize])));
+            let tris: Vec<[DVec3; 3]> = index.iter().map(|ix| ix.map(|i| verts[i as usize])).collect();
+            let centre = verts.iter().sum::<DVec3>() / verts.len() as f64;
+            let radius = verts.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
+            let area = tris.iter().map(|t| (t[1] - t[0]).cross(t[2] - t[0]).length() * 0.5).sum::<f64>();
+            out.spheres.push((centre, radius, area));
+            out.tris.extend(tris);
             out.cycles += 1;
         }
         out
+    }
+
+    /// An upper bound of `|w_caps(q)|`: each cap's area over `4π d²`, `d`
+    /// the distance from `q` to its bounding sphere (infinite within it).
+    /// Each triangle's solid angle is at most its area over its squared
+    /// distance, which is no less than `d`.
+    pub fn bound(&self, q: DVec3) -> f64 {
+        self.spheres
+            .iter()
+            .map(|&(c, r, area)| {
+                let d = q.distance(c) - r;
+                if d > 0.0 {
+                    area / (4.0 * std::f64::consts::PI * d * d)
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .sum()
     }
 
     /// `w_caps(q)`: the caps' solid angles at `q` over 4π.

@@ -190,7 +190,16 @@ impl Query {
         }
         match self.facts.sign {
             Sign::Parity => self.mesh.crossings(q).count % 2 == 1,
-            _ => self.winding_number(q).abs() >= 0.5,
+            _ if self.caps.tris.is_empty() => self.mesh.crossings(q).winding != 0,
+            _ => {
+                // |w − J| = |w_caps| is below the caps' bound: where that is
+                // below ½, J alone decides (no solid angle needed).
+                let j = self.mesh.crossings(q).winding + self.cap_rays.crossings(q).winding;
+                if self.caps.bound(q) < 0.5 {
+                    return j != 0;
+                }
+                (j as f64 - self.caps.winding(q)).abs() >= 0.5
+            }
         }
     }
 
@@ -226,36 +235,39 @@ pub enum Ask {
     WindingNumber,
 }
 
-/// Points per task; within a task, points are visited in Morton order so
-/// each one's nearest piece bounds the next one's search.
+/// Points per task (in Morton order).
 const CHUNK: usize = 2048;
 
 impl Query {
     /// `ask` at every point, into `out` (same length); parallel, and the
     /// same values for any thread count or order.
     pub fn batch(&self, points: &[DVec3], ask: Ask, out: &mut [f64]) {
-        out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK)).for_each(|(out, pts)| match ask {
-            Ask::Contains => pts.iter().zip(out).for_each(|(&q, o)| *o = f64::from(u8::from(self.contains(q)))),
-            Ask::WindingNumber => pts.iter().zip(out).for_each(|(&q, o)| *o = self.winding_number(q)),
-            Ask::Distance | Ask::SignedDistance => {
-                self.in_order(pts, |n, c| {
-                    out[n] = if ask == Ask::SignedDistance { signed(c.distance, self.contains(pts[n])) } else { c.distance };
-                });
+        match ask {
+            Ask::Contains => {
+                out.par_iter_mut().zip(points).with_min_len(256).for_each(|(o, &q)| *o = f64::from(u8::from(self.contains(q))))
             }
-        });
+            Ask::WindingNumber => out.par_iter_mut().zip(points).with_min_len(256).for_each(|(o, &q)| *o = self.winding_number(q)),
+            Ask::Distance | Ask::SignedDistance => {
+                let signed = ask == Ask::SignedDistance;
+                self.in_order(points, out, |q, c| if signed { self::signed(c.distance, self.contains(q)) } else { c.distance });
+            }
+        }
     }
 
     /// The nearest point to every point, into `out` (same length); parallel.
     pub fn closest_batch(&self, points: &[DVec3], out: &mut [Closest]) {
-        out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK)).for_each(|(out, pts)| self.in_order(pts, |n, c| out[n] = c));
+        self.in_order(points, out, |_, c| c);
     }
 
-    /// Calls `f(n, closest)` for every point of `pts`, in Morton order.
-    fn in_order(&self, pts: &[DVec3], mut f: impl FnMut(usize, Closest)) {
+    /// `out[n] = f(points[n], closest point)` for every point: the points
+    /// are visited in Morton order, in runs of [`CHUNK`] per task, so each
+    /// one's nearest piece bounds the next one's search.
+    fn in_order<T: Send + Copy>(&self, points: &[DVec3], out: &mut [T], f: impl Fn(DVec3, Closest) -> T + Sync) {
         let (lo, hi) = self.tree.bounds();
         let scale = (hi - lo).max(DVec3::splat(f64::MIN_POSITIVE)).recip() * 1023.0;
-        let mut order: Vec<(u32, u32)> = pts
-            .iter()
+        let mut order: Vec<(u32, u32)> = points
+            .par_iter()
+            .with_min_len(4096)
             .enumerate()
             .map(|(n, &q)| {
                 let c = ((q - lo) * scale).clamp(DVec3::ZERO, DVec3::splat(1023.0));
@@ -263,12 +275,23 @@ impl Query {
                 (morton(c.x as u32, c.y as u32, c.z as u32), n as u32)
             })
             .collect();
-        order.sort_unstable();
-        let mut seed = u32::MAX;
-        for (_, n) in order {
-            let (c, piece) = self.closest_from(pts[n as usize], seed);
-            seed = piece;
-            f(n as usize, c);
+        order.par_sort_unstable();
+        let done: Vec<Vec<T>> = order
+            .par_chunks(CHUNK)
+            .map(|run| {
+                let mut seed = u32::MAX;
+                run.iter()
+                    .map(|&(_, n)| {
+                        let q = points[n as usize];
+                        let (c, piece) = self.closest_from(q, seed);
+                        seed = piece;
+                        f(q, c)
+                    })
+                    .collect()
+            })
+            .collect();
+        for (&(_, n), v) in order.iter().zip(done.into_iter().flatten()) {
+            out[n as usize] = v;
         }
     }
 }

@@ -220,7 +220,14 @@ fn samples_are_reproducible_and_signed_by_the_query() {
     let mut rng = Xorshift(21);
     let m = blob(&mut rng, DVec3::ZERO);
     let q = Query::new(m.as_ref(), Sign::Auto).unwrap();
-    let spec = SampleSpec { surface: 5000, near: 9000, sigma: vec![0.05, 0.01], uniform: 4100, bounds: (DVec3::splat(-2.0), DVec3::splat(2.0)), seed: 7 };
+    let spec = SampleSpec {
+        surface: 5000,
+        near: 9000,
+        sigma: vec![0.05, 0.01],
+        uniform: 4100,
+        bounds: (DVec3::splat(-2.0), DVec3::splat(2.0)),
+        seed: 7,
+    };
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(|| sample(&q, &spec).unwrap());
     let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap().install(|| sample(&q, &spec).unwrap());
     assert_eq!(one.points.len(), 18_100);
