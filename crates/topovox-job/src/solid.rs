@@ -7,6 +7,8 @@ use topovox::grid::sparse::SparseBricks;
 use topovox::voxelize::{self, fill, solid, winding, Options, Stop};
 use topovox::{GridSpec, MeshRef};
 
+use topovox::query::{Inside, Sign};
+
 use crate::error::{JobError, Result};
 use crate::plan::{SolidMethod, SolidPlan};
 
@@ -53,7 +55,10 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         let snapped = topovox::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
         let inspect = solid::inspect(&snapped);
         let dims = grid.dims();
-        let watertight = inspect.watertight();
+        // Closed by the vertices as given: the rule the point queries use.
+        let exact = Inside::new(mesh, Sign::Auto);
+        let watertight = exact.watertight();
+        let mut near_half = Vec::new();
         let open = || {
             format!(
                 "{name}: not closed and consistently oriented ({} boundary edges, {} inconsistently oriented edges)",
@@ -80,6 +85,7 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
             SolidMethod::Auto | SolidMethod::Winding => {
                 let (b, r) = winding::winding_snapped(&snapped, dims, stop);
                 gwn = Some(json!({"boundary_cycles": r.cycles, "cap_triangles": r.cap_triangles, "evaluated_voxels": r.evaluated}));
+                near_half = r.near_half;
                 (b, r.solid, "winding")
             }
             SolidMethod::Reference if watertight => {
@@ -101,8 +107,24 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
             }
             SolidMethod::Flood => unreachable!("handled above"),
         };
+        let mut bits = bits;
+        // The references decide by the winding number (the definition).
+        let rule = if method == "parity" || method == "gpu-parity" { Sign::Parity } else { Sign::Winding };
+        let (checked, fixes) = exact_fixes(mesh, grid, exact.with_sign(rule), &near_half, stop);
+        let mut changed = 0;
+        for ([i, j, k], inside) in fixes {
+            if bits.get(i, j, k) != inside {
+                changed += 1;
+                if inside {
+                    bits.set(i, j, k);
+                } else {
+                    bits.clear(i, j, k);
+                }
+            }
+        }
         let mut facts = mesh_facts(&rep);
         facts["generalized_winding"] = gwn.unwrap_or(Value::Null);
+        facts["exact"] = json!({"checked_voxels": checked, "changed_voxels": changed});
         (bits, method, facts)
     };
     if plan.surface.is_some() && plan.method != SolidMethod::Flood {
@@ -173,17 +195,21 @@ pub fn run_sparse(
     );
     let dims = grid.dims();
     let mut gwn = None;
+    let exact = Inside::new(mesh, Sign::Auto);
+    let watertight = exact.watertight();
+    let mut near_half = Vec::new();
     let (bits, rep, method) = match plan.method {
         SolidMethod::Parity => {
-            if !inspect.watertight() {
+            if !watertight {
                 warnings.push(format!("{open}: ray parity may streak through holes"));
             }
             let (b, r) = solid::parity_sparse(&snapped, dims, stop);
             (b, r, "parity")
         }
-        _ if !inspect.watertight() => {
+        _ if !watertight => {
             let (b, r) = winding::winding_sparse(&snapped, dims, stop);
             gwn = Some(json!({"boundary_cycles": r.cycles, "cap_triangles": r.cap_triangles, "evaluated_voxels": r.evaluated}));
+            near_half = r.near_half;
             (b, r.solid, "winding")
         }
         SolidMethod::Winding => {
@@ -196,8 +222,14 @@ pub fn run_sparse(
         }
     };
     drop(snapped);
+    let rule = if method == "parity" { Sign::Parity } else { Sign::Winding };
+    let (checked, fixes) = exact_fixes(mesh, grid, exact.with_sign(rule), &near_half, stop);
+    let fixes: Vec<([u32; 3], bool)> = fixes.into_iter().filter(|&([i, j, k], inside)| bits.get(i, j, k) != inside).collect();
+    let changed = fixes.len();
+    let bits = if fixes.is_empty() { bits } else { bits.with_changes(&fixes) };
     let mut facts = mesh_facts(&rep);
     facts["generalized_winding"] = gwn.unwrap_or(Value::Null);
+    facts["exact"] = json!({"checked_voxels": checked, "changed_voxels": changed});
     facts["full_bricks"] = json!(bits.full_bricks());
     let bits = match plan.surface {
         Some(surface) => {
@@ -228,6 +260,26 @@ fn flood_leak_warning(surface: voxelize::Mode) -> String {
         "the {} shell encloses no voxel: it leaks through a hole wider than the shell, or the mesh is too thin for this grid",
         surface.name()
     )
+}
+
+/// The voxels whose decision snapping to the lattice could change (those
+/// near the surface, and `near_half` of the generalized winding number),
+/// decided again by `exact` on the vertices as given
+/// ([`topovox::query::grid`]): how many, and the decisions. So the solid is
+/// what `topovox.Query(mesh).contains` says at every voxel centre. Nothing
+/// once `stop` is requested.
+fn exact_fixes(mesh: MeshRef<'_>, grid: &GridSpec, exact: Inside, near_half: &[[u32; 3]], stop: &Stop) -> (usize, Vec<([u32; 3], bool)>) {
+    if stop.requested() {
+        return (0, Vec::new());
+    }
+    let tris = topovox::query::inside::triangles(mesh);
+    let mut voxels = topovox::query::grid::near_surface(&tris, grid, topovox::query::grid::RADIUS);
+    if !near_half.is_empty() {
+        voxels.extend_from_slice(near_half);
+        voxels.sort_unstable_by_key(|v| [v[2], v[1], v[0]]);
+        voxels.dedup();
+    }
+    (voxels.len(), topovox::query::grid::redecide(&exact, grid, &voxels))
 }
 
 /// What the solid learned about the mesh's closedness, as the JSON summary

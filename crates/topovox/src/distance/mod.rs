@@ -79,7 +79,7 @@ pub struct Piece {
 }
 
 impl Piece {
-    fn new(p: [DVec3; 3]) -> Piece {
+    pub fn new(p: [DVec3; 3]) -> Piece {
         let e = [p[1] - p[0], p[2] - p[1], p[0] - p[2]];
         let len2 = e.map(|e| e.length_squared());
         let inv = len2.map(|l| if l > 0.0 { 1.0 / l } else { 0.0 });

@@ -70,6 +70,14 @@ impl DenseBits {
         self.words[w] |= 1u64 << (i & 63);
     }
 
+    /// Clears voxel `(i,j,k)`. Panics if out of range.
+    #[inline]
+    pub fn clear(&mut self, i: u32, j: u32, k: u32) {
+        assert!(i < self.dims[0] && j < self.dims[1] && k < self.dims[2], "voxel out of range");
+        let w = self.word_index(i, j, k);
+        self.words[w] &= !(1u64 << (i & 63));
+    }
+
     /// The rows (`j`, then `k`; `words_per_row` words each), mutable.
     pub fn rows_mut(&mut self) -> std::slice::ChunksExactMut<'_, u64> {
         let wpr = self.words_per_row.max(1);

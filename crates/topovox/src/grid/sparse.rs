@@ -126,6 +126,51 @@ impl SparseBricks {
         out
     }
 
+    /// This grid with voxels set or cleared as `changes` say (`(voxel,
+    /// set)`; a voxel given twice takes its last value): full runs holding
+    /// a changed brick are split around it.
+    pub fn with_changes(&self, changes: &[([u32; 3], bool)]) -> SparseBricks {
+        let mut touched: Vec<(u64, usize)> = changes.iter().enumerate().map(|(n, (v, _))| (key(v.map(|c| c / BRICK)), n)).collect();
+        touched.sort_unstable();
+        let mut changed: Vec<([u32; 3], Brick)> = Vec::new();
+        for group in touched.chunk_by(|a, b| a.0 == b.0) {
+            let at = unkey(group[0].0);
+            let mut bits = self.brick_bits(at);
+            for &(_, n) in group {
+                let (v, set) = changes[n];
+                let slot = (v[2] % BRICK) * 64 + (v[1] % BRICK) * 8 + v[0] % BRICK;
+                let (w, bit) = ((slot / 64) as usize, slot % 64);
+                if set {
+                    bits[w] |= 1 << bit;
+                } else {
+                    bits[w] &= !(1 << bit);
+                }
+            }
+            changed.push((at, bits));
+        }
+        let is_changed = |k: u64| changed.binary_search_by_key(&k, |(b, _)| key(*b)).is_ok();
+        let mut bricks: Vec<([u32; 3], Brick)> =
+            self.keys.iter().zip(&self.bricks).filter(|(k, _)| !is_changed(**k)).map(|(k, b)| (unkey(*k), *b)).collect();
+        bricks.extend(changed.iter().copied());
+        let mut runs = Vec::with_capacity(self.full.len());
+        for &(k, n) in &self.full {
+            // Split the run around its changed bricks (a run stays in one row).
+            let mut start = k;
+            for b in k..k + n as u64 {
+                if is_changed(b) {
+                    if b > start {
+                        runs.push((unkey(start), (b - start) as u32));
+                    }
+                    start = b + 1;
+                }
+            }
+            if k + (n as u64) > start {
+                runs.push((unkey(start), (k + n as u64 - start) as u32));
+            }
+        }
+        SparseBricks::from_parts(self.dims, bricks, runs)
+    }
+
     /// Builds a grid from bricks in any order; bricks given twice are
     /// merged by union, empty ones dropped. Brick coordinates must lie in
     /// the grid and bits outside `dims` must be clear.

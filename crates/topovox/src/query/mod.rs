@@ -27,18 +27,18 @@
 //! not inside, and have no nearest element (`u32::MAX`).
 
 pub mod caps;
+pub mod grid;
+pub mod inside;
 pub mod ray;
 pub mod sample;
 
 use glam::DVec3;
 use rayon::prelude::*;
-use rustc_hash::FxHashMap;
 
 use crate::distance::nearest::Hierarchy;
 use crate::distance::{DistanceError, Pieces};
 use crate::MeshRef;
-use caps::Caps;
-use ray::RayIndex;
+pub use inside::Inside;
 
 /// Which rule decides inside.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -87,11 +87,7 @@ pub struct QueryFacts {
 pub struct Query {
     pieces: Pieces,
     tree: Hierarchy,
-    /// The mesh's triangles, for crossings.
-    mesh: RayIndex,
-    /// The caps' triangles, for crossings, and their solid angles.
-    cap_rays: RayIndex,
-    caps: Caps,
+    inside: Inside,
     facts: QueryFacts,
     /// The mesh's triangle count (valid or not): segment numbers start here.
     triangles: usize,
@@ -103,20 +99,16 @@ impl Query {
         let pieces = Pieces::of(mesh)?;
         let mesh_triangles = mesh.triangles.len();
         let tree = Hierarchy::new(&pieces);
-        let tris: Vec<[DVec3; 3]> =
-            pieces.items.iter().zip(&pieces.element).filter(|(_, &e)| (e as usize) < mesh.triangles.len()).map(|(p, _)| p.p).collect();
-        let (watertight, cycles) = boundary(&tris);
-        let caps = Caps::new(&cycles);
-        let sign = match sign {
-            Sign::Auto if watertight => Sign::Parity,
-            Sign::Auto => Sign::Winding,
-            s => s,
+        let tris = pieces.items.iter().zip(&pieces.element).filter(|(_, &e)| (e as usize) < mesh_triangles).map(|(p, _)| p.p);
+        let inside = Inside::of_triangles(tris.collect(), sign);
+        let facts = QueryFacts {
+            elements: pieces.items.len() as u64,
+            skipped: pieces.skipped,
+            watertight: inside.watertight(),
+            cycles: inside.cycles(),
+            sign: inside.sign(),
         };
-        let facts =
-            QueryFacts { elements: pieces.items.len() as u64, skipped: pieces.skipped, watertight, cycles: caps.cycles as u64, sign };
-        let mesh = RayIndex::new(tris.into_iter());
-        let cap_rays = RayIndex::new(caps.tris.iter().copied());
-        Ok(Query { pieces, tree, mesh, cap_rays, caps, facts, triangles: mesh_triangles })
+        Ok(Query { pieces, tree, inside, facts, triangles: mesh_triangles })
     }
 
     /// The mesh's triangles with valid indices, in mesh order (world
@@ -173,34 +165,12 @@ impl Query {
     /// The winding number at `q`: an exact integer for a closed mesh, the
     /// generalized winding number otherwise (NaN for a point not finite).
     pub fn winding_number(&self, q: DVec3) -> f64 {
-        if !q.is_finite() {
-            return f64::NAN;
-        }
-        let j = self.mesh.crossings(q).winding + self.cap_rays.crossings(q).winding;
-        if self.caps.tris.is_empty() {
-            return j as f64;
-        }
-        j as f64 - self.caps.winding(q)
+        self.inside.winding_number(q)
     }
 
     /// Whether `q` is inside, by the query's rule (false when not finite).
     pub fn contains(&self, q: DVec3) -> bool {
-        if !q.is_finite() {
-            return false;
-        }
-        match self.facts.sign {
-            Sign::Parity => self.mesh.crossings(q).count % 2 == 1,
-            _ if self.caps.tris.is_empty() => self.mesh.crossings(q).winding != 0,
-            _ => {
-                // |w − J| = |w_caps| is below the caps' bound: where that is
-                // below ½, J alone decides (no solid angle needed).
-                let j = self.mesh.crossings(q).winding + self.cap_rays.crossings(q).winding;
-                if self.caps.bound(q) < 0.5 {
-                    return j != 0;
-                }
-                (j as f64 - self.caps.winding(q)).abs() >= 0.5
-            }
-        }
+        self.inside.contains(q)
     }
 
     /// The signed distance at `q`: negative inside (see the module doc).
@@ -306,56 +276,6 @@ fn morton(x: u32, y: u32, z: u32) -> u32 {
         (v | v << 2) & 0x09249249
     };
     spread(x) | spread(y) << 1 | spread(z) << 2
-}
-
-/// A total-order key of a point's coordinates (`−0` as `+0`), so points
-/// are identified by equal coordinates and ordered as the lattice orders
-/// its points.
-fn key(p: DVec3) -> [i64; 3] {
-    p.to_array().map(|v| {
-        let b = (v + 0.0).to_bits() as i64;
-        b ^ (((b >> 63) as u64) >> 1) as i64
-    })
-}
-
-fn unkey(k: [i64; 3]) -> DVec3 {
-    let f = |b: i64| f64::from_bits((b ^ (((b >> 63) as u64) >> 1) as i64) as u64);
-    DVec3::new(f(k[0]), f(k[1]), f(k[2]))
-}
-
-/// Whether triangles `tris` close up consistently, and the boundary
-/// cycles (points in the boundary's direction) when not.
-fn boundary(tris: &[[DVec3; 3]]) -> (bool, Vec<Vec<DVec3>>) {
-    let mut numbers: FxHashMap<[i64; 3], u32> = FxHashMap::default();
-    let mut points = Vec::new();
-    let ends: Vec<[u32; 3]> = tris
-        .iter()
-        .map(|t| {
-            t.map(|p| {
-                let k = key(p);
-                *numbers.entry(k).or_insert_with(|| {
-                    points.push(k);
-                    (points.len() - 1) as u32
-                })
-            })
-        })
-        .collect();
-    let (odd, net) = crate::topology::inside::count_edges(&ends, points.len());
-    let watertight = odd == 0 && net.is_empty() && !tris.is_empty();
-    let mut net: Vec<([i64; 3], [i64; 3], i64)> = net
-        .into_iter()
-        .map(|(lo, hi, balance)| {
-            let (a, b) = (points[lo as usize], points[hi as usize]);
-            if a < b {
-                (a, b, balance)
-            } else {
-                (b, a, -balance)
-            }
-        })
-        .collect();
-    net.sort_unstable();
-    let cycles = crate::voxelize::winding::boundary_cycles(&net);
-    (watertight, cycles.into_iter().map(|c| c.into_iter().map(unkey).collect()).collect())
 }
 
 #[cfg(test)]

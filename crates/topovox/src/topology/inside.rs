@@ -41,6 +41,9 @@ pub struct Snapped {
     /// a)` with `a < b` (lexicographic), sorted: the boundary a closed
     /// surface lacks.
     pub net_edges: Vec<NetEdge>,
+    /// The voxel's edges over its smallest edge: lattice differences times
+    /// this have the world's shape (solid angles are measured in it).
+    pub scale: glam::DVec3,
 }
 
 /// An edge `(a, b)`, `a < b`, and how many more times it is used from `a`
@@ -150,7 +153,8 @@ pub fn snap_all(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<Snapped, ClassifyE
         })
         .collect();
     net_edges.sort_unstable();
-    Ok(Snapped { triangles, boundary_edges, net_edges })
+    let size = grid.voxel_size().0;
+    Ok(Snapped { triangles, boundary_edges, net_edges, scale: size / size.min_element() })
 }
 
 /// A mesh position on the lattice (see [`snap_all`]).

@@ -8,7 +8,9 @@
 //!
 //! **Definition.** Voxel `(i,j,k)` is set iff `|w(c)| >= 1/2` at its centre
 //! `c`, with `w(q) = Σ_T Ω_T(q) / 4π` over the snapped triangles
-//! (Van Oosterom–Strackee solid angles). Right for holes, open boundaries,
+//! (Van Oosterom–Strackee solid angles), measured in the world's shape (on
+//! a grid of boxes, lattice coordinates scaled by the voxel's edges: solid
+//! angles are not kept by stretching). Right for holes, open boundaries,
 //! nested or overlapping shells and inconsistent orientation; for a
 //! watertight mesh it is the integer winding number.
 //!
@@ -53,7 +55,7 @@ use crate::mesh::MeshRef;
 use crate::topology::inside::{row_crossings, snap_all, ClassifyError, Snapped};
 
 /// What the winding-number solid did beyond [`SolidReport`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct WindingReport {
     /// Closedness facts and the voxel count.
     pub solid: SolidReport,
@@ -63,6 +65,11 @@ pub struct WindingReport {
     pub cap_triangles: u64,
     /// Voxels whose decision needed the caps' solid angles.
     pub evaluated: u64,
+    /// Voxels whose winding number came within its error bound (the
+    /// neglected far caps, rounding) of a half-integer: the only voxels off
+    /// the surface whose decision a nearby mesh (such as the mesh before
+    /// snapping) can change; the job decides them again exactly.
+    pub near_half: Vec<[u32; 3]>,
 }
 
 /// Edge (voxels) of the blocks the far-field refinement starts from (a
@@ -76,9 +83,9 @@ const NEGLECT: f64 = 1e-3;
 /// Solid angle of triangle `t` (lattice) seen from lattice point `q`,
 /// divided by 4π: the triangle's contribution to the winding number. A
 /// point in the triangle's plane takes the side of its displaced copy.
-pub fn winding_of(t: &[P3; 3], q: P3) -> f64 {
+pub fn winding_of(t: &[P3; 3], q: P3, scale: DVec3) -> f64 {
     let s = ONE as f64;
-    let rel = |p: P3| DVec3::new((p[0] - q[0]) as f64 / s, (p[1] - q[1]) as f64 / s, (p[2] - q[2]) as f64 / s);
+    let rel = |p: P3| DVec3::new((p[0] - q[0]) as f64 / s, (p[1] - q[1]) as f64 / s, (p[2] - q[2]) as f64 / s) * scale;
     let (a, b, c) = (rel(t[0]), rel(t[1]), rel(t[2]));
     let (la, lb, lc) = (a.length(), b.length(), c.length());
     let mut det = a.dot(b.cross(c));
@@ -152,6 +159,9 @@ struct Cap {
     centre: DVec3,
     radius: f64,
     area: f64,
+    /// Lattice differences times this have the world's shape
+    /// ([`Snapped::scale`]); every float here is in that metric.
+    scale: DVec3,
 }
 
 impl Cap {
@@ -167,7 +177,7 @@ impl Cap {
         let s = ONE as f64;
         scratch.clear();
         scratch.extend(self.verts.iter().map(|p| {
-            let r = DVec3::new((p[0] - q[0]) as f64 / s, (p[1] - q[1]) as f64 / s, (p[2] - q[2]) as f64 / s);
+            let r = DVec3::new((p[0] - q[0]) as f64 / s, (p[1] - q[1]) as f64 / s, (p[2] - q[2]) as f64 / s) * self.scale;
             (r, r.length())
         }));
         // Two running products (even and odd triangles) so that the
@@ -181,7 +191,7 @@ impl Cap {
             let l3 = la * lb * lc;
             let det = a.dot(b.cross(c));
             if det.abs() <= 1e-12 * l3 {
-                aside += winding_of(t, q);
+                aside += winding_of(t, q, self.scale);
                 continue;
             }
             let denom = l3 + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
@@ -297,9 +307,9 @@ pub(crate) fn triangulate(p: &[u32], out: &mut Vec<[u32; 3]>) {
     }
 }
 
-fn caps(cycles: &[Vec<P3>]) -> Vec<Cap> {
+fn caps(cycles: &[Vec<P3>], scale: DVec3) -> Vec<Cap> {
     let s = ONE as f64;
-    let f = |p: P3| DVec3::new(p[0] as f64 / s, p[1] as f64 / s, p[2] as f64 / s);
+    let f = |p: P3| DVec3::new(p[0] as f64 / s, p[1] as f64 / s, p[2] as f64 / s) * scale;
     cycles
         .iter()
         .filter(|c| c.len() >= 3)
@@ -330,7 +340,7 @@ fn caps(cycles: &[Vec<P3>]) -> Vec<Cap> {
                 })
                 .collect();
             let verts_f = verts.iter().map(|&p| f(p)).collect();
-            Cap { tris, verts, index, verts_f, float, spheres, centre, radius, area }
+            Cap { tris, verts, index, verts_f, float, spheres, centre, radius, area, scale }
         })
         .collect()
 }
@@ -396,6 +406,8 @@ struct Span {
     i0: u32,
     len: u32,
     rule: Rule,
+    /// `Rule::Exact` with `w` within its error bound of a half-integer.
+    near: bool,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -415,7 +427,8 @@ enum Rule {
 /// blocks around the caps are visited, however large the grid.
 fn blocks_near_caps(caps: &[Cap], dims: [u32; 3]) -> Vec<[u32; 3]> {
     let nb = dims.map(|d| d.div_ceil(TOP));
-    let rho = TOP as f64 * 3f64.sqrt() / 2.0;
+    let scale = caps.first().map_or(DVec3::ONE, |c| c.scale);
+    let rho = TOP as f64 * scale.length() / 2.0;
     let share = 0.49 / caps.len().max(1) as f64;
     let mut blocks = Vec::new();
     for c in caps {
@@ -423,8 +436,8 @@ fn blocks_near_caps(caps: &[Cap], dims: [u32; 3]) -> Vec<[u32; 3]> {
         let reach = c.radius + rho + (c.area / (4.0 * std::f64::consts::PI * share)).sqrt() + 1.0;
         let range: Vec<std::ops::Range<u32>> = (0..3)
             .map(|a| {
-                let lo = ((c.centre[a] - reach) / TOP as f64).floor().max(0.0);
-                let hi = ((c.centre[a] + reach) / TOP as f64).floor() + 1.0;
+                let lo = ((c.centre[a] - reach) / scale[a] / TOP as f64).floor().max(0.0);
+                let hi = ((c.centre[a] + reach) / scale[a] / TOP as f64).floor() + 1.0;
                 (lo.min(nb[a] as f64) as u32)..(hi.min(nb[a] as f64) as u32)
             })
             .collect();
@@ -458,9 +471,10 @@ fn refine_step(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut
     }
     // Centre (voxel units) and a lattice point for the exact-sided solid angles.
     let half = size as f64 / 2.0;
-    let q = DVec3::new(min[0] as f64 + half, min[1] as f64 + half, min[2] as f64 + half);
+    let scale = caps.first().map_or(DVec3::ONE, |c| c.scale);
+    let q = DVec3::new(min[0] as f64 + half, min[1] as f64 + half, min[2] as f64 + half) * scale;
     let ql = min.map(|m| (2 * m as i64 + size as i64) * (ONE / 2));
-    let rho = size as f64 * 3f64.sqrt() / 2.0;
+    let rho = half * scale.length();
     if size > 1 && caps.iter().map(|c| bound(c, q, rho)).sum::<f64>() < 0.49 {
         return;
     }
@@ -488,7 +502,9 @@ fn refine_step(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut
     let w: f64 = used.iter().map(|c| c.winding(ql, &mut scratch)).sum();
     if size == 1 {
         if w.abs() + spread >= 0.49 {
-            out.push(Span { row: min[2] * dims[1] + min[1], i0: min[0], len: 1, rule: Rule::Exact(w) });
+            let off_half = (w - 0.5 - (w - 0.5).round()).abs();
+            let near = off_half < spread + 1e-3;
+            out.push(Span { row: min[2] * dims[1] + min[1], i0: min[0], len: 1, rule: Rule::Exact(w), near });
         }
         return;
     }
@@ -502,7 +518,7 @@ fn refine_step(caps: &[Cap], min: [u32; 3], size: u32, dims: [u32; 3], out: &mut
         let len = size.min(dims[0] - min[0]);
         for k in min[2]..(min[2] + size).min(dims[2]) {
             for j in min[1]..(min[1] + size).min(dims[1]) {
-                out.push(Span { row: k * dims[1] + j, i0: min[0], len, rule: Rule::Offset(m) });
+                out.push(Span { row: k * dims[1] + j, i0: min[0], len, rule: Rule::Offset(m), near: false });
             }
         }
     }
@@ -541,7 +557,9 @@ pub fn winding_snapped(snapped: &Snapped, dims: [u32; 3], stop: &Stop) -> (Dense
         }
     });
     let voxels = bits.count();
-    (bits, plan.report(snapped, voxels, evaluated(&needed)))
+    let mut report = plan.report(snapped, voxels, evaluated(&needed));
+    report.near_half = near_half(&needed, dims).collect();
+    (bits, report)
 }
 
 /// [`winding_snapped`] without a dense grid, for grids past memory: the
@@ -553,9 +571,11 @@ pub fn winding_sparse(snapped: &Snapped, dims: [u32; 3], stop: &Stop) -> (Sparse
     // high, bands a whole number of blocks), so that at most one band's
     // are held.
     let mut evaluated_voxels = 0;
+    let mut near = Vec::new();
     let needed_in = |planes: std::ops::Range<u32>| {
         let needed = plan.needed_in(planes, stop);
         evaluated_voxels += evaluated(&needed);
+        near.extend(near_half(&needed, dims));
         let rows = brick_rows_of(needed.iter().map(|s| s.row), dims);
         (needed, rows)
     };
@@ -570,12 +590,19 @@ pub fn winding_sparse(snapped: &Snapped, dims: [u32; 3], stop: &Stop) -> (Sparse
         bricks_of_spans(&spans, dims, bj, bk)
     });
     let voxels = out.count();
-    (out, plan.report(snapped, voxels, evaluated_voxels))
+    let mut report = plan.report(snapped, voxels, evaluated_voxels);
+    report.near_half = near;
+    (out, report)
 }
 
 /// The voxels among `needed` where the caps' winding number is evaluated.
 fn evaluated(needed: &[Span]) -> u64 {
     needed.iter().filter(|s| matches!(s.rule, Rule::Exact(_))).count() as u64
+}
+
+/// The voxels among `needed` near a half-integer ([`WindingReport::near_half`]).
+fn near_half(needed: &[Span], dims: [u32; 3]) -> impl Iterator<Item = [u32; 3]> + '_ {
+    needed.iter().filter(|s| s.near).map(move |s| [s.i0, s.row % dims[1], s.row / dims[1]])
 }
 
 const _: () = assert!(BAND_PLANES % TOP == 0, "a block of TOP planes lies in one band");
@@ -596,7 +623,7 @@ struct Plan {
 impl Plan {
     fn new(snapped: &Snapped, dims: [u32; 3]) -> Plan {
         let cycles = boundary_cycles(&snapped.net_edges);
-        let caps = caps(&cycles);
+        let caps = caps(&cycles, snapped.scale);
         let mut closed = snapped.triangles.clone();
         for c in &caps {
             closed.extend(c.tris.iter().map(|&v| LatticeTriangle { v }));
@@ -695,7 +722,7 @@ impl Plan {
         let cap_triangles = self.caps.iter().map(|c| c.tris.len() as u64).sum();
         let mut solid = super::solid::inspect(snapped);
         solid.voxels = voxels;
-        WindingReport { solid, cycles: self.cycles, cap_triangles, evaluated }
+        WindingReport { solid, cycles: self.cycles, cap_triangles, evaluated, near_half: Vec::new() }
     }
 }
 
@@ -706,7 +733,8 @@ pub mod reference {
     /// `w` at every voxel centre by the direct sum over all triangles.
     /// Serial; small grids only.
     pub fn winding_numbers(mesh: MeshRef<'_>, grid: &GridSpec) -> Result<Vec<f64>, ClassifyError> {
-        let tris = snap_all(mesh, grid)?.crossing_triangles();
+        let snapped = snap_all(mesh, grid)?;
+        let (tris, scale) = (snapped.crossing_triangles(), snapped.scale);
         let dims = grid.dims();
         let h = ONE / 2;
         let mut out = Vec::with_capacity(dims.iter().map(|&d| d as usize).product());
@@ -714,7 +742,7 @@ pub mod reference {
             for j in 0..dims[1] as i64 {
                 for i in 0..dims[0] as i64 {
                     let q = [i * ONE + h, j * ONE + h, k * ONE + h];
-                    out.push(tris.iter().map(|t| winding_of(&t.v, q)).sum());
+                    out.push(tris.iter().map(|t| winding_of(&t.v, q, scale)).sum());
                 }
             }
         }
@@ -752,10 +780,10 @@ mod tests {
         for round in 0..200 {
             let n = 3 + (round % 40) as usize;
             let cycle: Vec<P3> = (0..n).map(|_| [rng.signed(8) * ONE / 2, rng.signed(8) * ONE / 2, rng.signed(2) * ONE / 2]).collect();
-            let cap = &caps(&[cycle])[0];
+            let cap = &caps(&[cycle], DVec3::ONE)[0];
             for _ in 0..50 {
                 let q = [rng.signed(12) * ONE / 2, rng.signed(12) * ONE / 2, rng.signed(4) * ONE / 2];
-                let slow: f64 = cap.tris.iter().map(|t| winding_of(t, q)).sum();
+                let slow: f64 = cap.tris.iter().map(|t| winding_of(t, q, DVec3::ONE)).sum();
                 let fast = cap.winding(q, &mut scratch);
                 assert!((slow - fast).abs() < 1e-9, "cycle {round}: {slow} vs {fast} at {q:?}");
                 wrapped += usize::from(slow.abs() > 0.5);
