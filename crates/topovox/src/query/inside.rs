@@ -106,6 +106,13 @@ impl Inside {
     }
 }
 
+/// Whether `tris` close up consistently (every edge used equally often in
+/// both directions, vertices identified by equal coordinates): the test
+/// `Sign::Auto` resolves by, without preparing anything.
+pub fn watertight(tris: &[[DVec3; 3]]) -> bool {
+    boundary(tris).0
+}
+
 /// The triangles of `mesh` whose indices are valid and whose corners are
 /// finite, in mesh order (world coordinates).
 pub fn triangles(mesh: MeshRef<'_>) -> Vec<[DVec3; 3]> {
