@@ -556,22 +556,120 @@ class Query:
 
 
 def distance(mesh_or_vertices: Union[MeshLike, np.ndarray], points: Any, *, faces: Optional[Any] = None, signed: bool = True, sign: SignName = "auto", threads: Optional[int] = None) -> Any:
-    """``Query(mesh).distance(points, signed)`` in one call (see :class:`Query`)."""
+    """The exact distance from each point to the mesh, negative inside when
+    ``signed``: ``Query(mesh).distance(points, signed)`` in one call (see
+    :class:`Query`; build a :class:`Query` once to ask many times).
+
+    Parameters
+    ----------
+    mesh_or_vertices : Mesh, path, trimesh or Open3D mesh, or array_like
+        Anything :func:`as_mesh` takes, or an ``(n, 3)`` vertex array with ``faces``.
+    points : array_like
+        ``(n, 3)`` (or one ``(3,)``) float64 or float32, any strides.
+    faces : array_like, optional
+        ``(m, 3)`` integer vertex indices, when vertices are given.
+    signed : bool
+        Negative inside, by ``sign`` (default True).
+    sign : {"auto", "parity", "winding"}
+        The inside rule (see :class:`Query`).
+    threads : int, optional
+        Worker threads (default: all cores).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n,)`` float64 (a float for one point); NaN for points that are not finite.
+
+    Examples
+    --------
+    >>> d = topovox.distance("bunny.obj", points)
+    """
     return Query(mesh_or_vertices, faces, sign=sign, threads=threads).distance(points, signed)
 
 
 def contains(mesh_or_vertices: Union[MeshLike, np.ndarray], points: Any, *, faces: Optional[Any] = None, sign: SignName = "auto", threads: Optional[int] = None) -> Any:
-    """``Query(mesh).contains(points)`` in one call (see :class:`Query`)."""
+    """Whether each point is inside the mesh, by the rule of
+    ``voxelize(mode="solid")``: ``Query(mesh).contains(points)`` in one call
+    (see :class:`Query`).
+
+    Parameters
+    ----------
+    mesh_or_vertices : Mesh, path, trimesh or Open3D mesh, or array_like
+        Anything :func:`as_mesh` takes, or an ``(n, 3)`` vertex array with ``faces``.
+    points : array_like
+        ``(n, 3)`` (or one ``(3,)``) float64 or float32, any strides.
+    faces : array_like, optional
+        ``(m, 3)`` integer vertex indices, when vertices are given.
+    sign : {"auto", "parity", "winding"}
+        The inside rule (see :class:`Query`).
+    threads : int, optional
+        Worker threads (default: all cores).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n,)`` bool (a bool for one point); False for points that are not finite.
+
+    Examples
+    --------
+    >>> inside = topovox.contains("bunny.obj", points)
+    """
     return Query(mesh_or_vertices, faces, sign=sign, threads=threads).contains(points)
 
 
 def closest(mesh_or_vertices: Union[MeshLike, np.ndarray], points: Any, *, faces: Optional[Any] = None, threads: Optional[int] = None) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``Query(mesh).closest(points)`` in one call (see :class:`Query`)."""
+    """The nearest point of the mesh to each point: ``Query(mesh).closest(points)``
+    in one call (see :class:`Query`).
+
+    Parameters
+    ----------
+    mesh_or_vertices : Mesh, path, trimesh or Open3D mesh, or array_like
+        Anything :func:`as_mesh` takes, or an ``(n, 3)`` vertex array with ``faces``.
+    points : array_like
+        ``(n, 3)`` (or one ``(3,)``) float64 or float32, any strides.
+    faces : array_like, optional
+        ``(m, 3)`` integer vertex indices, when vertices are given.
+    threads : int, optional
+        Worker threads (default: all cores).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``points (n, 3)``, ``distances (n,)``, ``triangles (n,)`` int64 (-1 for
+        points that are not finite) and ``barycentric (n, 3)``.
+
+    Examples
+    --------
+    >>> p, d, tri, bary = topovox.closest("bunny.obj", points)
+    """
     return Query(mesh_or_vertices, faces, threads=threads).closest(points)
 
 
 def winding_number(mesh_or_vertices: Union[MeshLike, np.ndarray], points: Any, *, faces: Optional[Any] = None, threads: Optional[int] = None) -> Any:
-    """``Query(mesh).winding_number(points)`` in one call (see :class:`Query`)."""
+    """The (generalized) winding number of the mesh at each point, an exact
+    integer on a closed mesh: ``Query(mesh).winding_number(points)`` in one
+    call (see :class:`Query`).
+
+    Parameters
+    ----------
+    mesh_or_vertices : Mesh, path, trimesh or Open3D mesh, or array_like
+        Anything :func:`as_mesh` takes, or an ``(n, 3)`` vertex array with ``faces``.
+    points : array_like
+        ``(n, 3)`` (or one ``(3,)``) float64 or float32, any strides.
+    faces : array_like, optional
+        ``(m, 3)`` integer vertex indices, when vertices are given.
+    threads : int, optional
+        Worker threads (default: all cores).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n,)`` float64 (a float for one point); NaN for points that are not finite.
+
+    Examples
+    --------
+    >>> w = topovox.winding_number("bunny.obj", points)
+    """
     return Query(mesh_or_vertices, faces, threads=threads).winding_number(points)
 
 
