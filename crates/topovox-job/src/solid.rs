@@ -111,17 +111,7 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         // The references decide by the winding number (the definition).
         let rule = if method == "parity" || method == "gpu-parity" { Sign::Parity } else { Sign::Winding };
         let (checked, fixes) = exact_fixes(tris, grid, rule, &near_half, stop);
-        let mut changed = 0;
-        for ([i, j, k], inside) in fixes {
-            if bits.get(i, j, k) != inside {
-                changed += 1;
-                if inside {
-                    bits.set(i, j, k);
-                } else {
-                    bits.clear(i, j, k);
-                }
-            }
-        }
+        let changed = apply(&mut bits, &fixes);
         let mut facts = mesh_facts(&rep);
         facts["generalized_winding"] = gwn.unwrap_or(Value::Null);
         facts["exact"] = json!({"checked_voxels": checked, "changed_voxels": changed});
@@ -287,6 +277,22 @@ fn exact_fixes(
     }
     let exact = Inside::of_triangles(tris, rule);
     (voxels.len(), topovox::query::grid::redecide(&exact, grid, &voxels))
+}
+
+/// Sets `bits` as `fixes` say; how many changed.
+fn apply(bits: &mut DenseBits, fixes: &[([u32; 3], bool)]) -> usize {
+    let mut changed = 0;
+    for &([i, j, k], inside) in fixes {
+        if bits.get(i, j, k) != inside {
+            changed += 1;
+            if inside {
+                bits.set(i, j, k);
+            } else {
+                bits.clear(i, j, k);
+            }
+        }
+    }
+    changed
 }
 
 /// What the solid learned about the mesh's closedness, as the JSON summary

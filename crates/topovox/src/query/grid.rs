@@ -62,7 +62,8 @@ pub fn near_surface(tris: &[[DVec3; 3]], grid: &GridSpec, radius: f64) -> Vec<[u
 fn centres(lo: f64, hi: f64, n: u32) -> std::ops::Range<u32> {
     let first = (lo - 0.5).ceil().max(0.0);
     let last = (hi - 0.5).floor().min(n as f64 - 1.0);
-    if !(first <= last) {
+    // Empty, or not a number (never for finite triangles).
+    if first.partial_cmp(&last).is_none_or(|o| o == std::cmp::Ordering::Greater) {
         return 0..0;
     }
     first as u32..last as u32 + 1
