@@ -17,7 +17,7 @@
 //! same per-piece distance the narrow band computes: equal bit for bit.
 //! Rows are computed independently, so the thread count changes nothing.
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::{box_distance_squared, Piece, Pieces};
@@ -28,18 +28,43 @@ const LEAF: usize = 4;
 
 /// A node: its box; a leaf holds `order[start .. start + count]`, an
 /// inner node (`count == 0`) its children at `start` and `start + 1`.
+/// Boxes are f32, rounded outwards (so each holds its f64 box): 32 bytes
+/// a node, two to a cache line.
 #[derive(Clone, Copy, Debug)]
 struct Node {
-    lo: DVec3,
-    hi: DVec3,
+    lo: Vec3,
+    hi: Vec3,
     start: u32,
     count: u32,
+}
+
+/// `[lo, hi]` as f32, rounded outwards.
+fn outward(lo: DVec3, hi: DVec3) -> (Vec3, Vec3) {
+    let down = |v: f64| {
+        let f = v as f32;
+        if f as f64 > v { f.next_down() } else { f }
+    };
+    let up = |v: f64| {
+        let f = v as f32;
+        if (f as f64) < v { f.next_up() } else { f }
+    };
+    (Vec3::new(down(lo.x), down(lo.y), down(lo.z)), Vec3::new(up(hi.x), up(hi.y), up(hi.z)))
+}
+
+/// The squared distance from `q` to the f32 box `[lo, hi]` (a lower bound
+/// of the distance to anything inside it).
+#[inline(always)]
+fn box_gap(lo: Vec3, hi: Vec3, q: DVec3) -> f64 {
+    box_distance_squared(lo.as_dvec3(), hi.as_dvec3(), q)
 }
 
 /// A bounding-volume hierarchy over the pieces of a mesh.
 pub struct Hierarchy {
     nodes: Vec<Node>,
     order: Vec<u32>,
+    /// The pieces' boxes in leaf order (f32, outwards): tested before a
+    /// piece's own data is touched.
+    boxes: Vec<(Vec3, Vec3)>,
     /// The pieces in leaf order, so a leaf's pieces are adjacent in memory.
     sorted: Vec<Piece>,
 }
@@ -49,7 +74,8 @@ impl Hierarchy {
     pub fn new(pieces: &Pieces) -> Hierarchy {
         let mut order: Vec<u32> = (0..pieces.items.len() as u32).collect();
         let centres: Vec<DVec3> = pieces.items.iter().map(|p| (p.lo + p.hi) * 0.5).collect();
-        let mut nodes = vec![Node { lo: DVec3::ZERO, hi: DVec3::ZERO, start: 0, count: 0 }];
+        let empty = Node { lo: Vec3::ZERO, hi: Vec3::ZERO, start: 0, count: 0 };
+        let mut nodes = vec![empty];
         let mut todo = vec![(0usize, 0usize, order.len())];
         while let Some((node, start, end)) = todo.pop() {
             let ids = &mut order[start..end];
@@ -61,8 +87,9 @@ impl Hierarchy {
                 let c = centres[n as usize];
                 (clo, chi) = (clo.min(c), chi.max(c));
             }
+            let (flo, fhi) = outward(lo, hi);
             if ids.len() <= LEAF {
-                nodes[node] = Node { lo, hi, start: start as u32, count: ids.len() as u32 };
+                nodes[node] = Node { lo: flo, hi: fhi, start: start as u32, count: ids.len() as u32 };
                 continue;
             }
             let ext = chi - clo;
@@ -77,19 +104,20 @@ impl Hierarchy {
             // Ties broken by piece number: the tree depends on the input only.
             ids.select_nth_unstable_by(mid, |&a, &b| centres[a as usize][axis].total_cmp(&centres[b as usize][axis]).then(a.cmp(&b)));
             let first = nodes.len();
-            nodes.push(Node { lo: DVec3::ZERO, hi: DVec3::ZERO, start: 0, count: 0 });
-            nodes.push(Node { lo: DVec3::ZERO, hi: DVec3::ZERO, start: 0, count: 0 });
-            nodes[node] = Node { lo, hi, start: first as u32, count: 0 };
+            nodes.push(empty);
+            nodes.push(empty);
+            nodes[node] = Node { lo: flo, hi: fhi, start: first as u32, count: 0 };
             todo.push((first, start, start + mid));
             todo.push((first + 1, start + mid, end));
         }
-        let sorted = order.iter().map(|&n| pieces.items[n as usize]).collect();
-        Hierarchy { nodes, order, sorted }
+        let sorted: Vec<Piece> = order.iter().map(|&n| pieces.items[n as usize]).collect();
+        let boxes = sorted.iter().map(|p| outward(p.lo, p.hi)).collect();
+        Hierarchy { nodes, order, boxes, sorted }
     }
 
     /// The box of every piece.
     pub fn bounds(&self) -> (DVec3, DVec3) {
-        (self.nodes[0].lo, self.nodes[0].hi)
+        (self.nodes[0].lo.as_dvec3(), self.nodes[0].hi.as_dvec3())
     }
 
     /// The squared distance from `q` to the nearest piece and that piece,
@@ -106,14 +134,14 @@ impl Hierarchy {
             top -= 1;
             let node = &self.nodes[stack[top] as usize];
             // Checked again: the best may have improved since it was pushed.
-            if box_distance_squared(node.lo, node.hi, q) > best.0 {
+            if box_gap(node.lo, node.hi, q) > best.0 {
                 continue;
             }
             if node.count > 0 {
                 let leaf = node.start as usize..(node.start + node.count) as usize;
-                for (p, &n) in self.sorted[leaf.clone()].iter().zip(&self.order[leaf]) {
-                    if p.box_distance_squared(q) <= best.0 {
-                        let d = p.distance_squared(q);
+                for (i, (b, &n)) in leaf.clone().zip(self.boxes[leaf.clone()].iter().zip(&self.order[leaf])) {
+                    if box_gap(b.0, b.1, q) <= best.0 {
+                        let d = self.sorted[i].distance_squared(q);
                         if d < best.0 || (d == best.0 && n < best.1) {
                             best = (d, n);
                         }
@@ -123,7 +151,7 @@ impl Hierarchy {
             }
             let (a, b) = (node.start, node.start + 1);
             let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
-            let (da, db) = (box_distance_squared(na.lo, na.hi, q), box_distance_squared(nb.lo, nb.hi, q));
+            let (da, db) = (box_gap(na.lo, na.hi, q), box_gap(nb.lo, nb.hi, q));
             // Nearer child on top of the stack, visited first; a child no
             // nearer than the best found is not pushed at all.
             let ((far, df), (near, dn)) = if da <= db { ((b, db), (a, da)) } else { ((a, da), (b, db)) };
