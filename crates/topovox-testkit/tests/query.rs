@@ -133,20 +133,3 @@ fn distances_equal_the_dense_field_bit_for_bit() {
     }
 }
 
-#[test]
-#[ignore]
-fn tmp_visits() {
-    let m = shared_mesh("stanford-bunny.obj");
-    let b = m.as_ref().bounds();
-    let q = Query::new(m.as_ref(), Sign::Auto).unwrap();
-    let mut r = rng(1);
-    use rand::Rng;
-    let pad = b.extent() * 0.05;
-    let pts: Vec<DVec3> = (0..400_000).map(|_| DVec3::new(r.random_range(b.min.x - pad.x..b.max.x + pad.x), r.random_range(b.min.y - pad.y..b.max.y + pad.y), r.random_range(b.min.z - pad.z..b.max.z + pad.z))).collect();
-    let mut out = vec![0.0; pts.len()];
-    for _ in 0..3 {
-        let t = std::time::Instant::now();
-        q.batch(&pts, topovox::query::Ask::Distance, &mut out);
-        eprintln!("{:?}", t.elapsed());
-    }
-}
