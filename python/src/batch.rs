@@ -13,6 +13,7 @@ use topovox_io::mesh_out::MeshOut;
 use topovox_job::batch::{BatchOptions, BatchProgress, Run};
 use topovox_job::distance::{DistanceFormat, SdfOptions};
 use topovox_job::remesh::RemeshOptions;
+use topovox_job::sample::SampleOptions;
 use topovox_job::{JobError, OptionValue};
 
 use crate::convert::to_py;
@@ -60,6 +61,7 @@ pub(crate) fn batch_options(
             let target = <MeshOut as topovox_job::Choice>::parse(format).map_err(|e| value_err(format!("run=\"remesh\": {e}")))?;
             BatchOptions::remesh(&table_options::<RemeshOptions>(options, &own)?, target)
         }
+        Run::Sample => BatchOptions::sample(&table_options::<SampleOptions>(options, &own)?, format),
     };
     Ok((opts.map_err(py_err)?, jobs))
 }

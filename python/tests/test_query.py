@@ -171,3 +171,35 @@ def test_the_command_line_writes_the_same_samples(tmp_path, meshes, cli):
     # The input is never overwritten; bad values are one-line errors.
     r = subprocess.run([cli, "sample", meshes / "suzanne.obj", "-o", tmp_path / "x.npz", "--near", "5", "--sigma", "0"], capture_output=True, text=True)
     assert r.returncode == 2 and "sigma must be positive" in r.stderr and not (tmp_path / "x.npz").exists()
+
+
+def test_batch_dask_and_the_cli_sample_folders_resumably(meshes, cli, tmp_path):
+    from conftest import run_cli
+
+    root = tmp_path / "in"
+    (root / "sub").mkdir(parents=True)
+    for name, where in [("cow.obj", root), ("teapot.obj", root / "sub")]:
+        (where / name).write_bytes((meshes / name).read_bytes())
+    kw = dict(surface=200, near=300, sigma=0.01, uniform=100, normalize="unit-sphere", seed=2)
+    py_out, cli_out = tmp_path / "py", tmp_path / "cli"
+    s = topovox.batch(root, py_out, run="sample", **kw)
+    assert (s["done"], s["failed"]) == (2, 0), s
+    run_cli(cli, "batch", root, "-o", cli_out, "--run", "sample", "--surface", 200, "--near", 300, "--sigma", 0.01, "--uniform", 100,
+            "--normalize", "unit-sphere", "--seed", 2, "--quiet")
+    for rel in ["cow.npz", "sub/teapot.npz"]:
+        assert (py_out / rel).read_bytes() == (cli_out / rel).read_bytes(), rel
+    one = topovox.sample(root / "cow.obj", **kw)
+    z = np.load(py_out / "cow.npz")
+    assert np.array_equal(z["sdf"], one["sdf"].astype(np.float32)) and np.array_equal(z["occupancy"], one["occupancy"])
+    assert topovox.batch(root, py_out, run="sample", **kw)["skipped"] == 2
+    with pytest.raises(FileExistsError, match="seed"):
+        topovox.batch(root, py_out, run="sample", **dict(kw, seed=3))
+    with pytest.raises(ValueError, match="npz"):
+        topovox.batch(root, tmp_path / "y", run="sample", format="npy", **kw)
+    pytest.importorskip("dask")
+    import topovox.dask as vd
+
+    bag = vd.voxelize_paths(root, tmp_path / "dask", run="sample", **kw)
+    bag.compute(scheduler="synchronous")
+    for rel in ["cow.npz", "sub/teapot.npz"]:
+        assert (tmp_path / "dask" / rel).read_bytes() == (py_out / rel).read_bytes(), rel

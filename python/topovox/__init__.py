@@ -899,7 +899,7 @@ def batch(
     glob: Optional[str] = None,
     jobs: Optional[int] = None,
     progress: Union[None, bool, Callable[[int, int], Any]] = None,
-    run: Literal["voxelize", "sdf", "remesh"] = "voxelize",
+    run: Literal["voxelize", "sdf", "remesh", "sample"] = "voxelize",
     **options: Any,
 ) -> Dict[str, Any]:
     """Voxelizes whole datasets, resumably, as ``topovox batch`` does.
@@ -923,7 +923,7 @@ def batch(
         One of :data:`FORMATS` (default ``"npy"``); with ``run="sdf"``
         ``"npy"``, ``"vdb"``, ``"zarr"`` or ``"vti"`` (default ``"npy"``);
         with ``run="remesh"`` ``"obj"``, ``"ply"``, ``"stl"`` or ``"glb"``
-        (default ``"obj"``).
+        (default ``"obj"``); with ``run="sample"`` ``"npz"``.
     glob : str, optional
         Which files of the folders to take, such as ``"**/*.obj"``.
     jobs : int, optional
@@ -934,15 +934,19 @@ def batch(
         calling thread as meshes finish (at most every 50 ms, and once at
         the end; meshes skipped as done count as finished). An exception it
         raises stops the batch as Ctrl-C does.
-    run : {"voxelize", "sdf", "remesh"}
+    run : {"voxelize", "sdf", "remesh", "sample"}
         What runs on each mesh: :func:`voxelize`, :func:`sdf` (a distance
-        field per mesh) or :func:`remesh` (a watertight mesh per mesh).
+        field per mesh), :func:`remesh` (a watertight mesh per mesh) or
+        :func:`sample` (training samples per mesh, ``.npz``: the arrays
+        ``topovox sample`` writes).
     **options
         Every option :func:`voxelize` takes (:data:`OPTIONS`), or with
         ``run="sdf"`` every option :func:`sdf` takes (``band``, ``sign``,
         ``unsigned`` and the grid's), or with ``run="remesh"`` every option
         :func:`remesh` takes (``inside``, ``surface``, ``min_part``,
-        ``check`` and the grid's); ``attributes=True`` writes every
+        ``check`` and the grid's), or with ``run="sample"`` every option
+        :func:`sample` takes (``surface``, ``near``, ``sigma``, ``uniform``,
+        ``bounds``, ``normalize``, ``seed``, ``sign``); ``attributes=True`` writes every
         attribute grid into ``.vdb`` and ``.zarr`` outputs.
 
     Returns

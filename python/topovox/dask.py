@@ -45,16 +45,17 @@ def voxelize_paths(
     out_dir : path or str
         The output folder, or an fsspec URL.
     format : str, optional
-        As :func:`topovox.batch` takes it (default: the run's, ``"npy"``
-        or with ``run="remesh"`` ``"obj"``).
+        As :func:`topovox.batch` takes it (default: the run's, ``"npy"``,
+        with ``run="remesh"`` ``"obj"``, with ``run="sample"`` ``"npz"``).
     glob : str, optional
         Which files of the folders to take.
     npartitions : int, optional
         Partitions of the bag (default: one per mesh).
     **options
-        Every option :func:`topovox.voxelize` takes, or ``run="sdf"`` or
-        ``run="remesh"`` and the options of :func:`topovox.sdf` or
-        :func:`topovox.remesh`, as :func:`topovox.batch` takes them.
+        Every option :func:`topovox.voxelize` takes, or ``run="sdf"``,
+        ``run="remesh"`` or ``run="sample"`` and the options of
+        :func:`topovox.sdf`, :func:`topovox.remesh` or :func:`topovox.sample`,
+        as :func:`topovox.batch` takes them.
 
     Returns
     -------

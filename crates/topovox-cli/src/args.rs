@@ -631,6 +631,7 @@ impl Runs for BatchRuns {
             RunTable::of::<JobOptions>(Run::Voxelize.name()),
             RunTable::of::<SdfOptions>(Run::Sdf.name()),
             RunTable::of::<RemeshOptions>(Run::Remesh.name()),
+            RunTable::of::<SampleOptions>(Run::Sample.name()),
         ]
     }
 }

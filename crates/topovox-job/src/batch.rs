@@ -37,6 +37,7 @@ use crate::job::{SdfJob, VoxelizeJob};
 use crate::options::JobOptions;
 use crate::output::Output;
 use crate::remesh::{RemeshJob, RemeshOptions};
+use crate::sample::SampleOptions;
 use topovox_io::mesh_out::MeshOut;
 
 /// The manifest's file name in the output folder.
@@ -54,6 +55,8 @@ topovox::choice! {
         Sdf = "sdf",
         /// `remesh`: a watertight mesh per mesh.
         Remesh = "remesh",
+        /// `sample`: training samples (an `.npz`) per mesh.
+        Sample = "sample",
     }
 }
 
@@ -63,6 +66,7 @@ impl Run {
         match self {
             Run::Voxelize | Run::Sdf => "npy",
             Run::Remesh => "obj",
+            Run::Sample => "npz",
         }
     }
 }
@@ -90,6 +94,8 @@ pub enum Work {
     Sdf(SdfJob),
     /// `remesh`: a watertight mesh.
     Remesh(RemeshJob),
+    /// `sample`: training samples.
+    Sample(Box<SampleOptions>),
 }
 
 impl BatchOptions {
@@ -129,12 +135,24 @@ impl BatchOptions {
         })
     }
 
+    /// A batch writing each mesh's training samples (`.npz`, the only
+    /// format); the manifest records `"run": "sample"` beside the options.
+    pub fn sample(o: &SampleOptions, format: &str) -> Result<BatchOptions> {
+        if format != "npz" {
+            return Err(JobError::invalid(format!("samples are written as npz; got format {format:?}")));
+        }
+        let mut fingerprint = crate::options::fingerprint_of(o, "npz");
+        fingerprint["run"] = json!("sample");
+        Ok(BatchOptions { work: Work::Sample(Box::new(o.clone())), threads: o.run.threads, read: o.run.read_options(), fingerprint })
+    }
+
     /// The outputs' extension.
     pub fn extension(&self) -> String {
         match &self.work {
             Work::Voxelize(job) => job.format.name().replace("npy-bool", "npy"),
             Work::Sdf(job) => job.request.format.name().to_string(),
             Work::Remesh(job) => job.format.name().to_string(),
+            Work::Sample(_) => "npz".to_string(),
         }
     }
 }
@@ -555,6 +573,7 @@ pub fn process_one(item: &Item, opts: &BatchOptions, stop: Option<&Arc<Stop>>) -
                 Work::Voxelize(job) => voxelize_one(job, &loaded, &name, &item.output, stop)?,
                 Work::Sdf(job) => sdf_one(job, &loaded, &name, &item.output, stop.map(|s| &**s))?,
                 Work::Remesh(job) => remesh_one(job, &loaded, &name, &item.output, stop.map(|s| &**s))?,
+                Work::Sample(o) => sample_one(o, &loaded, &name, &item.output)?,
             };
             facts["times"]["load_s"] = json!(load_s);
             facts["triangles"] = json!(loaded.report.triangles);
@@ -636,6 +655,21 @@ fn remesh_one(job: &RemeshJob, loaded: &topovox_io::LoadedMesh, name: &str, out:
         "remesh": r.summary(),
         "times": {"inside_s": r.facts.inside_s, "surface_s": r.facts.surface_s, "write_s": done.write_s},
         "warnings": warnings(loaded, &r.warnings),
+    }))
+}
+
+/// The training samples of one loaded mesh, written: the record's facts.
+fn sample_one(o: &SampleOptions, loaded: &topovox_io::LoadedMesh, name: &str, out: &Path) -> Result<Value> {
+    topovox_io::atomic::refuse_overwriting_inputs(out, &loaded.sources)?;
+    let s = crate::sample::sample(loaded.mesh.as_ref(), name, o)?;
+    let t = Instant::now();
+    s.write(out)?;
+    let summary = s.summary();
+    Ok(json!({
+        "points": s.samples.points.len(),
+        "sample": summary,
+        "times": {"query_s": s.seconds.0, "sample_s": s.seconds.1, "write_s": t.elapsed().as_secs_f64()},
+        "warnings": warnings(loaded, &[]),
     }))
 }
 

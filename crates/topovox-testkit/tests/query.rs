@@ -132,4 +132,3 @@ fn distances_equal_the_dense_field_bit_for_bit() {
         assert_eq!(bad, 0, "{name}: {bad} values differ");
     }
 }
-

@@ -9,6 +9,7 @@ use topovox_job::batch::{self, BatchProgress, Run};
 use topovox_job::distance::{DistanceFormat, SdfOptions};
 use topovox_job::output::Output;
 use topovox_job::remesh::RemeshOptions;
+use topovox_job::sample::SampleOptions;
 use topovox_job::JobOptions;
 
 use crate::args::BatchArgs;
@@ -53,6 +54,7 @@ fn options(a: &BatchArgs) -> Result<batch::BatchOptions> {
             let format = <MeshOut as Choice>::parse(format).map_err(|e| refuse(&e))?;
             batch::BatchOptions::remesh(&given.table::<RemeshOptions>(run)?, format)?
         }
+        Run::Sample => batch::BatchOptions::sample(&given.table::<SampleOptions>(run)?, format).map_err(|e| refuse(&e))?,
     })
 }
 

@@ -42,11 +42,19 @@ struct Node {
 fn outward(lo: DVec3, hi: DVec3) -> (Vec3, Vec3) {
     let down = |v: f64| {
         let f = v as f32;
-        if f as f64 > v { f.next_down() } else { f }
+        if f as f64 > v {
+            f.next_down()
+        } else {
+            f
+        }
     };
     let up = |v: f64| {
         let f = v as f32;
-        if (f as f64) < v { f.next_up() } else { f }
+        if (f as f64) < v {
+            f.next_up()
+        } else {
+            f
+        }
     };
     (Vec3::new(down(lo.x), down(lo.y), down(lo.z)), Vec3::new(up(hi.x), up(hi.y), up(hi.z)))
 }
