@@ -191,7 +191,7 @@ impl RayIndex {
 /// `Some(sign of the triangle's n_x)` when the displaced `−x` ray from `q`
 /// crosses triangle `t`, else `None`.
 #[inline]
-pub(crate) fn crosses(t: &[DVec3; 3], q: DVec3) -> Option<i32> {
+pub fn crosses(t: &[DVec3; 3], q: DVec3) -> Option<i32> {
     let s = yz_side(t[0], t[1], q);
     if s == 0 || yz_side(t[1], t[2], q) != s || yz_side(t[2], t[0], q) != s {
         return None;

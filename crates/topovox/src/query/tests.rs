@@ -256,3 +256,32 @@ fn samples_are_reproducible_and_signed_by_the_query() {
     let bad = SampleSpec { sigma: vec![0.0], ..spec.clone() };
     assert!(sample(&q, &bad).is_err());
 }
+
+#[test]
+fn a_flat_fan_sums_to_a_full_turn_at_its_inner_edges_and_corners() {
+    // A fan of six triangles around an inner vertex, in planes tilted every
+    // way (x̂ out of the plane, and in it); at the inner vertex, on the
+    // inner edges and inside, the angles sum to ±2π, and they sum to 0
+    // beyond the fan.
+    // Dyadic corners and integer frames: the fans are exactly flat.
+    let ring: Vec<DVec3> =
+        [(1.0, 0.0), (0.5, 1.0), (-0.5, 1.0), (-1.0, 0.0), (-0.5, -1.0), (0.5, -1.0)].iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect();
+    let frames = [
+        (DVec3::X, DVec3::Y),
+        (DVec3::Y, DVec3::Z),
+        (DVec3::new(1.0, 0.0, 1.0), DVec3::new(0.0, 1.0, 2.0)),
+        (DVec3::new(2.0, -1.0, 1.0), DVec3::new(1.0, 1.0, -3.0)),
+        (DVec3::new(0.0, 3.0, 1.0), DVec3::X),
+    ];
+    for (fu, fv) in frames {
+        let at = |p: DVec3| DVec3::new(0.25, -0.5, 0.75) + fu * p.x + fv * p.y;
+        let fan: Vec<[DVec3; 3]> = (0..6).map(|i| [at(DVec3::ZERO), at(ring[i]), at(ring[(i + 1) % 6])]).collect();
+        let total = |q: DVec3| fan.iter().map(|t| solid_angle(t, q)).sum::<f64>();
+        let tau = std::f64::consts::TAU;
+        for p in [DVec3::ZERO, ring[0] * 0.5, ring[1] * 0.25, DVec3::new(0.1, 0.05, 0.0)] {
+            let w = total(at(p));
+            assert!((w.abs() - tau).abs() < 1e-9, "{fu} {fv} at {p}: {w}");
+        }
+        assert!(total(at(DVec3::new(3.0, 0.1, 0.0))).abs() < 1e-9);
+    }
+}

@@ -46,7 +46,7 @@ use super::solid::{brick_rows_of, bricks_of_spans, by_bands, push_span, SolidRep
 use super::Stop;
 use crate::geom::fixed::ONE;
 use crate::geom::lattice::LatticeTriangle;
-use crate::geom::perturb::{orient, P3};
+use crate::geom::perturb::P3;
 use crate::grid::bricks::BRICK;
 use crate::grid::dense::DenseBits;
 use crate::grid::sparse::SparseBricks;
@@ -82,25 +82,12 @@ const NEGLECT: f64 = 1e-3;
 
 /// Solid angle of triangle `t` (lattice) seen from lattice point `q`,
 /// divided by 4π: the triangle's contribution to the winding number. A
-/// point in the triangle's plane takes the side of its displaced copy.
+/// point in the triangle's plane takes the limit from its displaced copy
+/// ([`crate::query::caps::solid_angle`], whose exact predicates the lattice
+/// coordinates, exact in f64, feed).
 pub fn winding_of(t: &[P3; 3], q: P3, scale: DVec3) -> f64 {
-    let s = ONE as f64;
-    let rel = |p: P3| DVec3::new((p[0] - q[0]) as f64 / s, (p[1] - q[1]) as f64 / s, (p[2] - q[2]) as f64 / s) * scale;
-    let (a, b, c) = (rel(t[0]), rel(t[1]), rel(t[2]));
-    let (la, lb, lc) = (a.length(), b.length(), c.length());
-    let mut det = a.dot(b.cross(c));
-    let denom = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-    if det.abs() <= 1e-12 * la * lb * lc {
-        // In (or numerically at) the plane: the exact displaced side.
-        // (A signed zero: atan2 then gives the limit from that side.)
-        let side = orient([q, t[0], t[1], t[2]], [true, false, false, false]);
-        det = match side {
-            1 => det.abs(),
-            -1 => -det.abs(),
-            _ => det,
-        };
-    }
-    (2.0 * det.atan2(denom)) / (4.0 * std::f64::consts::PI)
+    let f = |p: P3| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+    crate::query::caps::solid_angle_in(&t.map(f), f(q), scale) / (4.0 * std::f64::consts::PI)
 }
 
 /// The oriented boundary of a mesh, from its [`Snapped::net_edges`], as
