@@ -125,7 +125,13 @@ impl RayIndex {
         let ext = [(hi[0] - lo[0]).max(f64::MIN_POSITIVE), (hi[1] - lo[1]).max(f64::MIN_POSITIVE)];
         let n = (tris.len() as f64 * 2.0).max(1.0);
         let side = (ext[0] * ext[1] / n).sqrt().max(ext[0].max(ext[1]) / 4096.0);
-        let cells = [(ext[0] / side).ceil().clamp(1.0, 4096.0) as usize, (ext[1] / side).ceil().clamp(1.0, 4096.0) as usize];
+        let cells = if tris.is_empty() {
+            // Nothing to bin (a closed mesh's caps): one cell, not a grid
+            // sized by an empty box.
+            [1, 1]
+        } else {
+            [(ext[0] / side).ceil().clamp(1.0, 4096.0) as usize, (ext[1] / side).ceil().clamp(1.0, 4096.0) as usize]
+        };
         let scale = [cells[0] as f64 / ext[0], cells[1] as f64 / ext[1]];
         let mut out = RayIndex { tris, lo, hi, scale, cells, start: Vec::new(), items: Vec::new() };
         out.bin();
