@@ -56,8 +56,7 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         let inspect = solid::inspect(&snapped);
         let dims = grid.dims();
         // Closed by the vertices as given: the rule the point queries use.
-        let tris = topovox::query::inside::triangles(mesh);
-        let watertight = topovox::query::inside::watertight(&tris);
+        let watertight = topovox::query::inside::watertight(&topovox::query::inside::triangles(mesh));
         let mut near_half = Vec::new();
         let open = || {
             format!(
@@ -110,7 +109,7 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         let mut bits = bits;
         // The references decide by the winding number (the definition).
         let rule = if method == "parity" || method == "gpu-parity" { Sign::Parity } else { Sign::Winding };
-        let (checked, fixes) = exact_fixes(tris, grid, rule, &near_half, stop);
+        let (checked, fixes) = exact_fixes(mesh, grid, rule, &near_half, stop, |[i, j, k]| bits.get(i, j, k));
         let changed = apply(&mut bits, &fixes);
         let mut facts = mesh_facts(&rep);
         facts["generalized_winding"] = gwn.unwrap_or(Value::Null);
@@ -185,8 +184,7 @@ pub fn run_sparse(
     );
     let dims = grid.dims();
     let mut gwn = None;
-    let tris = topovox::query::inside::triangles(mesh);
-    let watertight = topovox::query::inside::watertight(&tris);
+    let watertight = topovox::query::inside::watertight(&topovox::query::inside::triangles(mesh));
     let mut near_half = Vec::new();
     let (bits, rep, method) = match plan.method {
         SolidMethod::Parity => {
@@ -213,8 +211,7 @@ pub fn run_sparse(
     };
     drop(snapped);
     let rule = if method == "parity" { Sign::Parity } else { Sign::Winding };
-    let (checked, fixes) = exact_fixes(tris, grid, rule, &near_half, stop);
-    let fixes: Vec<([u32; 3], bool)> = fixes.into_iter().filter(|&([i, j, k], inside)| bits.get(i, j, k) != inside).collect();
+    let (checked, fixes) = exact_fixes(mesh, grid, rule, &near_half, stop, |[i, j, k]| bits.get(i, j, k));
     let changed = fixes.len();
     let bits = if fixes.is_empty() { bits } else { bits.with_changes(&fixes) };
     let mut facts = mesh_facts(&rep);
@@ -254,29 +251,25 @@ fn flood_leak_warning(surface: voxelize::Mode) -> String {
 
 /// The voxels whose decision snapping to the lattice could change (those
 /// near the surface, and `near_half` of the generalized winding number),
-/// decided again by `rule` on the triangles `tris` as given
-/// ([`topovox::query::grid`]): how many, and the decisions. So the solid is
-/// what `topovox.Query(mesh).contains` says at every voxel centre. Nothing
-/// once `stop` is requested. (Prepared after the solid, so its memory and
-/// the solid's do not add up.)
+/// decided again by `rule` on the mesh as given
+/// ([`topovox::query::grid`]): how many decisions, and those that differ
+/// from `is_set` (the lattice solid). So the solid is what
+/// `topovox.Query(mesh).contains` says at every voxel centre. Nothing once
+/// `stop` is requested. Prepared after the solid, and keeping only the
+/// changes, so its memory and the solid's do not add up.
 fn exact_fixes(
-    tris: Vec<[glam::DVec3; 3]>,
+    mesh: MeshRef<'_>,
     grid: &GridSpec,
     rule: Sign,
     near_half: &[[u32; 3]],
     stop: &Stop,
-) -> (usize, Vec<([u32; 3], bool)>) {
+    is_set: impl Fn([u32; 3]) -> bool + Sync,
+) -> (u64, Vec<([u32; 3], bool)>) {
     if stop.requested() {
         return (0, Vec::new());
     }
-    let mut voxels = topovox::query::grid::near_surface(&tris, grid, topovox::query::grid::RADIUS);
-    if !near_half.is_empty() {
-        voxels.extend_from_slice(near_half);
-        voxels.sort_unstable_by_key(|v| [v[2], v[1], v[0]]);
-        voxels.dedup();
-    }
-    let exact = Inside::of_triangles(tris, rule);
-    (voxels.len(), topovox::query::grid::redecide(&exact, grid, &voxels))
+    let exact = Inside::new(mesh, rule);
+    topovox::query::grid::changes(mesh, &exact, grid, near_half, is_set)
 }
 
 /// Sets `bits` as `fixes` say; how many changed.

@@ -40,10 +40,22 @@ struct Node {
 
 /// `[lo, hi]` as f32, rounded outwards.
 fn outward(lo: DVec3, hi: DVec3) -> (Vec3, Vec3) {
+    // One f32 step towards −∞ (+∞ when `up`): the bits of a finite float
+    // count its steps away from zero. (`f32::next_up` is newer than the MSRV.)
+    let step = |f: f32, up: bool| -> f32 {
+        if !f.is_finite() {
+            return f;
+        }
+        if f == 0.0 {
+            return if up { f32::from_bits(1) } else { -f32::from_bits(1) };
+        }
+        let b = f.to_bits();
+        f32::from_bits(if (f > 0.0) == up { b + 1 } else { b - 1 })
+    };
     let down = |v: f64| {
         let f = v as f32;
         if f as f64 > v {
-            f.next_down()
+            step(f, false)
         } else {
             f
         }
@@ -51,7 +63,7 @@ fn outward(lo: DVec3, hi: DVec3) -> (Vec3, Vec3) {
     let up = |v: f64| {
         let f = v as f32;
         if (f as f64) < v {
-            f.next_up()
+            step(f, true)
         } else {
             f
         }

@@ -2,7 +2,8 @@
 //! fixed-point lattice ([`fixed`]), mesh preparation onto it ([`lattice`]:
 //! `prepare`), the tie rule ([`perturb`]), the triangle setup of the exact
 //! target tests ([`setup`]) and exact floor/ceiling division ([`divide`]), and nearest points
-//! of triangles and segments in f64 ([`closest`]).
+//! of triangles and segments in f64 ([`closest`]), and exact solid angles
+//! and orientations ([`solid_angle`]).
 //! Algorithm files (`voxelize/`) and certificates (`topology/`) import
 //! from here; nothing here imports from them.
 
@@ -14,3 +15,4 @@ pub mod fixed;
 pub mod lattice;
 pub mod perturb;
 pub mod setup;
+pub mod solid_angle;

@@ -21,7 +21,7 @@ use rayon::prelude::*;
 
 use super::Inside;
 use crate::distance::Piece;
-use crate::GridSpec;
+use crate::{GridSpec, MeshRef};
 
 /// Voxels (of the smallest edge) around the mesh decided again: above the
 /// snapping's reach (`√3/8192`) and where the caps' winding number of an
@@ -32,30 +32,63 @@ pub const RADIUS: f64 = 0.02;
 /// edge) of triangles `tris` (world coordinates; degenerate ones as their
 /// edges), sorted, each once.
 pub fn near_surface(tris: &[[DVec3; 3]], grid: &GridSpec, radius: f64) -> Vec<[u32; 3]> {
+    let mut out: Vec<[u32; 3]> = tris.par_iter().with_min_len(64).flat_map_iter(|t| near_triangle(t, grid, radius)).collect();
+    out.par_sort_unstable_by_key(|v| [v[2], v[1], v[0]]);
+    out.dedup();
+    out
+}
+
+/// The voxel centres within `radius` voxels of triangle `t` (see [`near_surface`]).
+fn near_triangle(t: &[DVec3; 3], grid: &GridSpec, radius: f64) -> Vec<[u32; 3]> {
     let s = grid.voxel_size().0;
     // In index units a world distance d is at least d / max edge… and at
     // most d / min edge: the radius there covers every axis.
     let r = radius * s.max_element() / s.min_element();
-    let dims = grid.dims();
-    let mut out: Vec<[u32; 3]> = tris
+    let piece = Piece::new(t.map(|p| grid.to_grid_units(p)));
+    let mut found = Vec::new();
+    if piece.flat {
+        for e in 0..3 {
+            along_segment(&piece, e, r, grid.dims(), &mut found);
+        }
+    } else {
+        across_plane(&piece, r, grid.dims(), &mut found);
+    }
+    found
+}
+
+/// The voxels whose decision snapping could change (within [`RADIUS`] of
+/// `mesh`'s triangles, and `flagged`) where `inside` decides otherwise than `is_set`
+/// (the lattice solid): the changes, sorted, and how many decisions were
+/// made. Only the changes are kept (a voxel near two triangles may be
+/// decided twice), so memory follows them, not the surface.
+pub fn changes(
+    mesh: MeshRef<'_>,
+    inside: &Inside,
+    grid: &GridSpec,
+    flagged: &[[u32; 3]],
+    is_set: impl Fn([u32; 3]) -> bool + Sync,
+) -> (u64, Vec<([u32; 3], bool)>) {
+    let decide = |v: [u32; 3]| {
+        let want = inside.contains(grid.voxel_center(v));
+        (want != is_set(v)).then_some((v, want))
+    };
+    let checked = std::sync::atomic::AtomicU64::new(flagged.len() as u64);
+    let corner = |i: u32| mesh.positions.get(i as usize).copied().filter(|p| p.is_finite());
+    let mut out: Vec<([u32; 3], bool)> = mesh
+        .triangles
         .par_iter()
         .with_min_len(64)
         .flat_map_iter(|t| {
-            let piece = Piece::new(t.map(|p| grid.to_grid_units(p)));
-            let mut found = Vec::new();
-            if piece.flat {
-                for e in 0..3 {
-                    along_segment(&piece, e, r, dims, &mut found);
-                }
-            } else {
-                across_plane(&piece, r, dims, &mut found);
-            }
-            found
+            let Some(t) = (|| Some([corner(t[0])?, corner(t[1])?, corner(t[2])?]))() else { return Vec::new() };
+            let near = near_triangle(&t, grid, RADIUS);
+            checked.fetch_add(near.len() as u64, std::sync::atomic::Ordering::Relaxed);
+            near.into_iter().filter_map(decide).collect::<Vec<_>>()
         })
         .collect();
-    out.par_sort_unstable_by_key(|v| [v[2], v[1], v[0]]);
+    out.extend(flagged.par_iter().filter_map(|&v| decide(v)).collect::<Vec<_>>());
+    out.sort_unstable_by_key(|(v, _)| [v[2], v[1], v[0]]);
     out.dedup();
-    out
+    (checked.into_inner(), out)
 }
 
 /// Centre indices along one axis whose centres `i + ½` lie in `[lo, hi]`.

@@ -171,6 +171,6 @@ fn boundary(tris: &[[DVec3; 3]]) -> (bool, Vec<Vec<DVec3>>) {
         })
         .collect();
     net.sort_unstable();
-    let cycles = crate::voxelize::winding::boundary_cycles(&net);
+    let cycles = crate::topology::cycles::boundary_cycles(&net);
     (watertight, cycles.into_iter().map(|c| c.into_iter().map(unkey).collect()).collect())
 }

@@ -29,13 +29,9 @@
 //! box holds it in `y` and `z` and starts at or before it in `x`.
 
 use glam::DVec3;
-use robust::{orient2d, orient3d, Coord, Coord3D};
+use robust::{orient2d, Coord};
 
-/// Sign (−1, 0, 1) of a float.
-#[inline]
-fn sign(v: f64) -> i32 {
-    (v > 0.0) as i32 - (v < 0.0) as i32
-}
+use crate::geom::solid_angle::{normal_signs, plane_side, sign};
 
 /// Exact sign of `(v − u) × (q − u)` in the `yz` plane, with `q`
 /// displaced by `δ` (its `y` by `−ε²`, its `z` by `−ε³`): the value, else
@@ -51,29 +47,6 @@ pub(crate) fn yz_side(u: DVec3, v: DVec3, q: DVec3) -> i32 {
         return if v.z > u.z { 1 } else { -1 };
     }
     sign(u.y - v.y)
-}
-
-/// Exact sign of each component of the normal `(b − a) × (c − a)`.
-pub(crate) fn normal_signs(t: &[DVec3; 3]) -> [i32; 3] {
-    let o = |x: usize, y: usize| {
-        let c = |p: DVec3| Coord { x: p[x], y: p[y] };
-        sign(orient2d(c(t[0]), c(t[1]), c(t[2])))
-    };
-    [o(1, 2), o(2, 0), o(0, 1)]
-}
-
-/// Exact sign of `n · (q + δ − a)`, `n = (b − a) × (c − a)`: which side of
-/// the triangle's plane the displaced point lies on (0 only when the
-/// triangle has no normal at all).
-pub(crate) fn plane_side(t: &[DVec3; 3], q: DVec3) -> i32 {
-    let c = |p: DVec3| Coord3D { x: p.x, y: p.y, z: p.z };
-    // orient3d(a, b, c, q) = −n · (q − a).
-    let s = -sign(orient3d(c(t[0]), c(t[1]), c(t[2]), c(q)));
-    if s != 0 {
-        return s;
-    }
-    // n · δ = −ε n_x − ε² n_y − ε³ n_z.
-    normal_signs(t).into_iter().find(|&n| n != 0).map_or(0, |n| -n)
 }
 
 /// A triangle as the index keeps it.

@@ -2,6 +2,7 @@
 //! classification, and the certificate `topovox check` prints.
 
 pub mod certify;
+pub mod cycles;
 pub mod inside;
 pub mod runs;
 

@@ -40,7 +40,6 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
-use rustc_hash::FxHashMap;
 
 use super::solid::{brick_rows_of, bricks_of_spans, by_bands, push_span, SolidReport, BAND_PLANES};
 use super::Stop;
@@ -52,6 +51,7 @@ use crate::grid::dense::DenseBits;
 use crate::grid::sparse::SparseBricks;
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
+use crate::topology::cycles::{boundary_cycles, triangulate};
 use crate::topology::inside::{row_crossings, snap_all, ClassifyError, Snapped};
 
 /// What the winding-number solid did beyond [`SolidReport`].
@@ -83,50 +83,11 @@ const NEGLECT: f64 = 1e-3;
 /// Solid angle of triangle `t` (lattice) seen from lattice point `q`,
 /// divided by 4π: the triangle's contribution to the winding number. A
 /// point in the triangle's plane takes the limit from its displaced copy
-/// ([`crate::query::caps::solid_angle`], whose exact predicates the lattice
+/// ([`crate::geom::solid_angle::solid_angle`], whose exact predicates the lattice
 /// coordinates, exact in f64, feed).
 pub fn winding_of(t: &[P3; 3], q: P3, scale: DVec3) -> f64 {
     let f = |p: P3| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-    crate::query::caps::solid_angle_in(&t.map(f), f(q), scale) / (4.0 * std::f64::consts::PI)
-}
-
-/// The oriented boundary of a mesh, from its [`Snapped::net_edges`], as
-/// closed cycles of lattice points.
-pub(crate) fn boundary_cycles<P: Copy + Ord + std::hash::Hash>(net: &[(P, P, i64)]) -> Vec<Vec<P>> {
-    // Outgoing boundary half-edges per vertex (with multiplicity), in a
-    // deterministic order.
-    let mut half: Vec<(P, P)> = Vec::new();
-    for &(a, b, n) in net {
-        for _ in 0..n.unsigned_abs() {
-            half.push(if n > 0 { (a, b) } else { (b, a) });
-        }
-    }
-    half.sort_unstable();
-    let mut out: FxHashMap<P, Vec<P>> = FxHashMap::default();
-    for &(a, b) in half.iter().rev() {
-        out.entry(a).or_default().push(b);
-    }
-    let mut starts: Vec<P> = half.iter().map(|h| h.0).collect();
-    starts.dedup();
-    let mut cycles = Vec::new();
-    for s in starts {
-        while out.get(&s).is_some_and(|v| !v.is_empty()) {
-            // Walk until back at the start: in- and out-degrees balance at
-            // every vertex (the boundary of a boundary is empty), so the
-            // walk cannot get stuck elsewhere.
-            let mut cycle = vec![s];
-            let mut at = s;
-            while let Some(next) = out.get_mut(&at).and_then(|v| v.pop()) {
-                if next == s {
-                    break;
-                }
-                cycle.push(next);
-                at = next;
-            }
-            cycles.push(cycle);
-        }
-    }
-    cycles
+    crate::geom::solid_angle::solid_angle_in(&t.map(f), f(q), scale) / (4.0 * std::f64::consts::PI)
 }
 
 /// A boundary cycle's cap: triangles over the cycle's vertices and a
@@ -275,23 +236,6 @@ fn point_segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
     let len2 = ab.length_squared();
     let t = if len2 > 0.0 { ((p - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
     p.distance(a + ab * t)
-}
-
-/// Triangulates the polygon of vertices `p` (indices; any shape, only its
-/// boundary matters) by splitting it along the diagonal from its first
-/// vertex to its middle one, keeping the polygon's orientation.
-pub(crate) fn triangulate(p: &[u32], out: &mut Vec<[u32; 3]>) {
-    match p.len() {
-        0..=2 => {}
-        3 => out.push([p[0], p[1], p[2]]),
-        n => {
-            let mid = n / 2;
-            triangulate(&p[..=mid], out);
-            let mut rest: Vec<u32> = p[mid..].to_vec();
-            rest.push(p[0]);
-            triangulate(&rest, out);
-        }
-    }
 }
 
 fn caps(cycles: &[Vec<P3>], scale: DVec3) -> Vec<Cap> {
