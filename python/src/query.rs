@@ -19,20 +19,11 @@ use crate::meshes::Mesh;
 use crate::options::table_options;
 
 fn sign_of(s: &str) -> PyResult<Sign> {
-    match s.to_ascii_lowercase().as_str() {
-        "auto" => Ok(Sign::Auto),
-        "parity" => Ok(Sign::Parity),
-        "winding" => Ok(Sign::Winding),
-        _ => Err(value_err(format!("sign must be 'auto', 'parity' or 'winding'; got {s:?}"))),
-    }
+    <topovox_job::distance::Sign as topovox_job::Choice>::parse(s).map(Sign::from).map_err(|e| value_err(e.to_string()))
 }
 
 fn sign_name(s: Sign) -> &'static str {
-    match s {
-        Sign::Auto => "auto",
-        Sign::Parity => "parity",
-        Sign::Winding => "winding",
-    }
+    topovox_job::Choice::name(topovox_job::distance::Sign::from(s))
 }
 
 /// A mesh prepared for point queries: see `topovox.Query`.

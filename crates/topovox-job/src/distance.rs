@@ -35,6 +35,26 @@ topovox::choice! {
     }
 }
 
+impl From<Sign> for topovox::query::Sign {
+    fn from(s: Sign) -> Self {
+        match s {
+            Sign::Auto => topovox::query::Sign::Auto,
+            Sign::Parity => topovox::query::Sign::Parity,
+            Sign::Winding => topovox::query::Sign::Winding,
+        }
+    }
+}
+
+impl From<topovox::query::Sign> for Sign {
+    fn from(s: topovox::query::Sign) -> Self {
+        match s {
+            topovox::query::Sign::Auto => Sign::Auto,
+            topovox::query::Sign::Parity => Sign::Parity,
+            topovox::query::Sign::Winding => Sign::Winding,
+        }
+    }
+}
+
 topovox::choice! {
     /// File formats of distance fields.
     pub enum DistanceFormat: "format" {

@@ -9,7 +9,7 @@ use std::time::Instant;
 use glam::DVec3;
 use serde_json::{json, Value};
 use topovox::query::sample::{default_bounds, normalization, sample as draw, Normalize, SampleSpec, Samples};
-use topovox::query::{Query, QueryFacts, Sign as Rule};
+use topovox::query::{Query, QueryFacts};
 use topovox::MeshRef;
 
 use crate::distance::Sign;
@@ -129,14 +129,6 @@ pub struct Sampled {
     pub seconds: (f64, f64),
 }
 
-fn rule(s: Sign) -> Rule {
-    match s {
-        Sign::Auto => Rule::Auto,
-        Sign::Parity => Rule::Parity,
-        Sign::Winding => Rule::Winding,
-    }
-}
-
 /// Bytes a sample takes while drawn and measured (point, normal, two
 /// f64 values, flags, the Morton order) and written (f32 copies).
 const BYTES_PER_SAMPLE: u64 = 136;
@@ -161,18 +153,11 @@ pub fn sample(mesh: MeshRef<'_>, name: &str, options: &SampleOptions) -> Result<
         Normalization::UnitCube => Normalize::UnitCube,
         Normalization::UnitSphere => Normalize::UnitSphere,
     };
-    let used: Vec<[DVec3; 3]> = mesh
-        .triangles
-        .iter()
-        .filter_map(|t| {
-            let p = |i: u32| mesh.positions.get(i as usize).copied();
-            Some([p(t[0])?, p(t[1])?, p(t[2])?])
-        })
-        .collect();
+    let used = topovox::query::inside::triangles(mesh);
     let (offset, scale) = normalization(&used, how);
     let moved: Vec<DVec3> = mesh.positions.iter().map(|&p| (p - offset) * scale).collect();
     let m = MeshRef { positions: &moved, triangles: mesh.triangles, segments: mesh.segments };
-    let q = Query::new(m, rule(o.sign)).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+    let q = Query::new(m, o.sign.into()).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
     let built = t.elapsed().as_secs_f64();
     let bounds = match &o.bounds {
         Some(b) => (DVec3::new(b[0], b[1], b[2]), DVec3::new(b[3], b[4], b[5])),
@@ -200,7 +185,7 @@ impl Sampled {
             "points": self.samples.points.len(),
             "surface": kinds(0), "near": kinds(1), "uniform": kinds(2),
             "inside": inside,
-            "sign": match self.facts.sign { Rule::Parity => "parity", _ => "winding" },
+            "sign": Sign::from(self.facts.sign).name(),
             "watertight": self.facts.watertight,
             "boundary_cycles": self.facts.cycles,
             "offset": self.offset.to_array(), "scale": self.scale,

@@ -109,7 +109,7 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         let mut bits = bits;
         // The references decide by the winding number (the definition).
         let rule = if method == "parity" || method == "gpu-parity" { Sign::Parity } else { Sign::Winding };
-        let (checked, fixes) = exact_fixes(mesh, grid, rule, &near_half, stop, |[i, j, k]| bits.get(i, j, k));
+        let (checked, fixes) = exact_fixes(mesh, grid, (rule, watertight), &near_half, stop, |[i, j, k]| bits.get(i, j, k));
         let changed = apply(&mut bits, &fixes);
         let mut facts = mesh_facts(&rep);
         facts["generalized_winding"] = gwn.unwrap_or(Value::Null);
@@ -211,7 +211,7 @@ pub fn run_sparse(
     };
     drop(snapped);
     let rule = if method == "parity" { Sign::Parity } else { Sign::Winding };
-    let (checked, fixes) = exact_fixes(mesh, grid, rule, &near_half, stop, |[i, j, k]| bits.get(i, j, k));
+    let (checked, fixes) = exact_fixes(mesh, grid, (rule, watertight), &near_half, stop, |[i, j, k]| bits.get(i, j, k));
     let changed = fixes.len();
     let bits = if fixes.is_empty() { bits } else { bits.with_changes(&fixes) };
     let mut facts = mesh_facts(&rep);
@@ -260,7 +260,7 @@ fn flood_leak_warning(surface: voxelize::Mode) -> String {
 fn exact_fixes(
     mesh: MeshRef<'_>,
     grid: &GridSpec,
-    rule: Sign,
+    (rule, watertight): (Sign, bool),
     near_half: &[[u32; 3]],
     stop: &Stop,
     is_set: impl Fn([u32; 3]) -> bool + Sync,
@@ -268,7 +268,9 @@ fn exact_fixes(
     if stop.requested() {
         return (0, Vec::new());
     }
-    let exact = Inside::new(mesh, rule);
+    // A mesh found closed needs no second look for its boundary.
+    let tris = topovox::query::inside::triangles(mesh);
+    let exact = if watertight { Inside::closed(tris, rule) } else { Inside::of_triangles(tris, rule) };
     topovox::query::grid::changes(mesh, &exact, grid, near_half, is_set)
 }
 

@@ -28,17 +28,8 @@ use crate::{GridSpec, MeshRef};
 /// open mesh can move by 10⁻³.
 pub const RADIUS: f64 = 0.02;
 
-/// The voxel centres of `grid` within `radius` voxels (of the smallest
-/// edge) of triangles `tris` (world coordinates; degenerate ones as their
-/// edges), sorted, each once.
-pub fn near_surface(tris: &[[DVec3; 3]], grid: &GridSpec, radius: f64) -> Vec<[u32; 3]> {
-    let mut out: Vec<[u32; 3]> = tris.par_iter().with_min_len(64).flat_map_iter(|t| near_triangle(t, grid, radius)).collect();
-    out.par_sort_unstable_by_key(|v| [v[2], v[1], v[0]]);
-    out.dedup();
-    out
-}
-
-/// The voxel centres within `radius` voxels of triangle `t` (see [`near_surface`]).
+/// The voxel centres within `radius` voxels (of the smallest edge) of
+/// triangle `t` (world coordinates; without area, as its edges).
 fn near_triangle(t: &[DVec3; 3], grid: &GridSpec, radius: f64) -> Vec<[u32; 3]> {
     let s = grid.voxel_size().0;
     // In index units a world distance d is at least d / max edge… and at
@@ -73,14 +64,11 @@ pub fn changes(
         (want != is_set(v)).then_some((v, want))
     };
     let checked = std::sync::atomic::AtomicU64::new(flagged.len() as u64);
-    let corner = |i: u32| mesh.positions.get(i as usize).copied().filter(|p| p.is_finite());
-    let mut out: Vec<([u32; 3], bool)> = mesh
-        .triangles
+    let mut out: Vec<([u32; 3], bool)> = super::inside::triangles(mesh)
         .par_iter()
         .with_min_len(64)
         .flat_map_iter(|t| {
-            let Some(t) = (|| Some([corner(t[0])?, corner(t[1])?, corner(t[2])?]))() else { return Vec::new() };
-            let near = near_triangle(&t, grid, RADIUS);
+            let near = near_triangle(t, grid, RADIUS);
             checked.fetch_add(near.len() as u64, std::sync::atomic::Ordering::Relaxed);
             near.into_iter().filter_map(decide).collect::<Vec<_>>()
         })
@@ -150,9 +138,4 @@ fn along_segment(piece: &Piece, e: usize, r: f64, dims: [u32; 3], out: &mut Vec<
             }
         }
     }
-}
-
-/// `inside`'s decision at each voxel's centre.
-pub fn redecide(inside: &Inside, grid: &GridSpec, voxels: &[[u32; 3]]) -> Vec<([u32; 3], bool)> {
-    voxels.par_iter().with_min_len(256).map(|&v| (v, inside.contains(grid.voxel_center(v)))).collect()
 }

@@ -46,7 +46,18 @@ impl Inside {
     /// Prepares `tris` (world coordinates).
     pub fn of_triangles(tris: Vec<[DVec3; 3]>, sign: Sign) -> Inside {
         let (watertight, cycles) = boundary(&tris);
-        let caps = Caps::new(&cycles);
+        Inside::with_cycles(tris, watertight, &cycles, sign)
+    }
+
+    /// Prepares `tris` that [`watertight`] found closed (no boundary to
+    /// find again, no caps): what the solids use after testing it.
+    pub fn closed(tris: Vec<[DVec3; 3]>, sign: Sign) -> Inside {
+        debug_assert!(watertight(&tris));
+        Inside::with_cycles(tris, true, &[], sign)
+    }
+
+    fn with_cycles(tris: Vec<[DVec3; 3]>, watertight: bool, cycles: &[Vec<DVec3>], sign: Sign) -> Inside {
+        let caps = Caps::new(cycles);
         let sign = match sign {
             Sign::Auto if watertight => Sign::Parity,
             Sign::Auto => Sign::Winding,

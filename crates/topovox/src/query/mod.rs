@@ -99,8 +99,7 @@ impl Query {
         let pieces = Pieces::of(mesh)?;
         let mesh_triangles = mesh.triangles.len();
         let tree = Hierarchy::new(&pieces);
-        let tris = pieces.items.iter().zip(&pieces.element).filter(|(_, &e)| (e as usize) < mesh_triangles).map(|(p, _)| p.p);
-        let inside = Inside::of_triangles(tris.collect(), sign);
+        let inside = Inside::new(mesh, sign);
         let facts = QueryFacts {
             elements: pieces.items.len() as u64,
             skipped: pieces.skipped,
