@@ -43,6 +43,16 @@ pub(crate) struct GridData {
 }
 
 impl GridData {
+    /// The grid the voxels lie on.
+    pub(crate) fn grid(&self) -> &GridSpec {
+        &self.grid
+    }
+
+    /// The carried attributes, if any (in key order: see [`GridData::ordered`]).
+    pub(crate) fn attributes(&self) -> Option<&VoxelAttributes> {
+        self.attrs.as_ref()
+    }
+
     pub(crate) fn new(voxels: Voxels, grid: GridSpec, attrs: Option<VoxelAttributes>, facts: Value) -> GridData {
         GridData { voxels, grid, attrs, facts, dense: OnceLock::new(), order: OnceLock::new() }
     }
@@ -50,7 +60,7 @@ impl GridData {
     /// Set voxels in the order of `numpy.argwhere(occupancy)` (i, then j,
     /// then k), each with its slot in key order (the attributes' order);
     /// sorted once.
-    fn ordered(&self) -> &[([u32; 3], usize)] {
+    pub(crate) fn ordered(&self) -> &[([u32; 3], usize)] {
         self.order.get_or_init(|| {
             let mut v = Vec::with_capacity(self.voxels.count() as usize);
             let mut slot = 0usize;
@@ -58,10 +68,39 @@ impl GridData {
                 v.push(([i, j, k], slot));
                 slot += 1;
             });
-            v.sort_unstable_by_key(|e| e.0);
+            let dims = self.grid.dims();
+            if v.len() > 1 << 24 {
+                // In place: the passes below hold a second copy.
+                v.sort_unstable_by_key(|e| e.0);
+                return v;
+            }
+            // C order by three stable counting passes (k, then j, then i):
+            // linear in the voxels, where a comparison sort was a quarter
+            // of a small batch's time.
+            for axis in [2, 1, 0] {
+                v = counting_sort(v, dims[axis] as usize, |e| e.0[axis] as usize);
+            }
             v
         })
     }
+}
+
+/// `items` stably sorted by `key` (below `buckets`).
+fn counting_sort<T: Copy>(items: Vec<T>, buckets: usize, key: impl Fn(&T) -> usize) -> Vec<T> {
+    let mut start = vec![0usize; buckets + 1];
+    for e in &items {
+        start[key(e) + 1] += 1;
+    }
+    for b in 0..buckets {
+        start[b + 1] += start[b];
+    }
+    let mut out = items.clone();
+    for e in items {
+        let k = key(&e);
+        out[start[k]] = e;
+        start[k] += 1;
+    }
+    out
 }
 
 #[pymethods]

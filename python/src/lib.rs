@@ -20,7 +20,7 @@
 //!
 //! Rooms: `meshes` (Mesh, load_mesh), `grids` (VoxelGrid, load_voxels),
 //! `distance` (DistanceGrid, sdf), `query` (Query, sample), `placement` (the getters both grids
-//! share), `voxelize`, `batch`, `options` (keywords → job options),
+//! share), `voxelize`, `many` (voxelize_many: sparse training batches), `batch`, `options` (keywords → job options),
 //! `convert` (arrays and values in and out), `errors`, `interrupt`.
 
 mod batch;
@@ -29,6 +29,7 @@ mod distance;
 mod errors;
 mod grids;
 mod interrupt;
+mod many;
 mod meshes;
 mod options;
 mod placement;
@@ -52,6 +53,8 @@ fn _topovox(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(remesh::check_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(meshes::load_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(voxelize::voxelize, m)?)?;
+    m.add_function(wrap_pyfunction!(many::voxelize_many, m)?)?;
+    m.add_function(wrap_pyfunction!(many::features, m)?)?;
     m.add_function(wrap_pyfunction!(grids::load_voxels, m)?)?;
     m.add_function(wrap_pyfunction!(batch::batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch::batch_plan, m)?)?;

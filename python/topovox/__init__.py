@@ -44,12 +44,13 @@ command line's.
 from __future__ import annotations
 
 import os
-from typing import Any, Callable, Dict, Iterable, Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterable, List, Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _topovox
 from ._topovox import DistanceGrid, FileFormatError, Mesh, VoxelGrid, load_mesh, load_voxels
+from .sparse import SparseBatch
 
 __version__ = _topovox.__version__
 
@@ -62,6 +63,9 @@ __all__ = [
     "load_voxels",
     "as_mesh",
     "voxelize",
+    "voxelize_many",
+    "SparseBatch",
+    "FEATURES",
     "sdf",
     "Query",
     "distance",
@@ -100,6 +104,9 @@ InsideName = Literal["auto", "parity", "winding", "wrap"]
 SurfaceKindName = Literal["smooth", "blocky"]
 #: A voxel size: one edge (cubes) or ``(sx, sy, sz)``.
 VoxelSizeLike = Union[float, Tuple[float, float, float]]
+#: The per-voxel features :func:`voxelize_many` measures, with their help.
+FEATURES = {name: help for name, help in _topovox.features()}
+FeatureName = Literal["occupancy", "normal", "colour", "color", "coverage", "material", "sdf"]
 #: Every option :func:`voxelize` and :func:`batch` take, with its help.
 OPTIONS = {name: help for name, help, _example in _topovox.options()}
 
@@ -107,7 +114,7 @@ MeshLike = Union[Mesh, Any]
 
 #: The submodules ``import topovox`` makes reachable on first use, without
 #: importing Dask or Ray before then.
-_LAZY = ("dask", "ray")
+_LAZY = ("dask", "ray", "torch")
 
 
 def __getattr__(name: str) -> Any:
@@ -388,6 +395,123 @@ def voxelize(
     for k in ("mesh_or_vertices", "faces", "mesh"):
         options.pop(k)
     return _topovox.voxelize(mesh, _options(options))
+
+
+def voxelize_many(
+    meshes: Iterable[Any],
+    *,
+    features: Union[FeatureName, Sequence[FeatureName]] = ("occupancy",),
+    on_error: Literal["raise", "skip"] = "raise",
+    mode: ModeName = "cover",
+    resolution: Optional[int] = None,
+    voxel_size: Optional[VoxelSizeLike] = None,
+    origin: Optional[Sequence[float]] = None,
+    dims: Optional[Sequence[int]] = None,
+    pad: int = 0,
+    fit: FitName = "cube",
+    method: MethodName = "auto",
+    threads: Optional[int] = None,
+    attributes: bool = False,
+    colour_rule: ColourRuleName = "dominant",
+    normals: bool = False,
+    surface: Optional[ModeName] = None,
+    fill: Optional[FillName] = None,
+    hollow: Optional[int] = None,
+    gpu_path: GpuPathName = "compute",
+    seed: int = 0,
+    tile: Optional[int] = None,
+    max_memory: Optional[Union[int, str]] = None,
+    up: UpName = "y",
+    dither: bool = False,
+    watertight: bool = True,
+    triangulate: bool = False,
+    block_palette: Optional[Union[str, os.PathLike[str]]] = None,
+    allow_external_paths: bool = False,
+    color_rule: Optional[ColourRuleName] = None,
+) -> SparseBatch:
+    """Voxelizes many meshes in one call into one sparse training batch.
+
+    Each item is exactly what :func:`voxelize` gives for that mesh alone
+    with the same options (tested voxel for voxel); the work is spread
+    over the meshes and within them, without the GIL.
+
+    Parameters
+    ----------
+    meshes : iterable
+        Paths, :class:`Mesh`\ es, trimesh or Open3D meshes, or
+        ``(vertices, faces)`` pairs.
+    features : str or sequence of str
+        Per-voxel feature columns, in this order (see :data:`FEATURES`):
+        ``occupancy`` (1), ``normal`` (3), ``colour`` (3, sRGB in [0, 1];
+        ``color`` is the same), ``coverage`` (1), ``material`` (1, -1 for
+        none), ``sdf`` (1: the signed distance from the voxel centre, world
+        units, negative inside by the solid's rule, equal to ``topovox
+        sdf --band all`` there).
+    on_error : {"raise", "skip"}
+        ``"raise"``: the first mesh that fails (by index) raises, its index
+        and name in the message. ``"skip"``: it becomes an empty item and
+        ``batch.errors[index]`` says why; the others are unaffected.
+    fit : {"cube", "box"}
+        ``"cube"`` (the default here): every item ``resolution**3`` voxels,
+        the mesh centred (the ShapeNet/ModelNet convention).
+    mode, resolution, voxel_size, origin, dims, pad, method, threads, ...
+        As :func:`voxelize`. ``method="gpu"`` voxelizes the meshes one
+        after another on the GPU (one dispatch per mesh; a single dispatch
+        for the whole batch is not built yet).
+
+    Returns
+    -------
+    SparseBatch
+        ``coords`` int32 ``(N, 4)`` ``[b, i, j, k]`` sorted by item then C
+        order, ``features`` float32 ``(N, C)``, ``offsets`` ``(B + 1,)``,
+        each item's grid (``origins``, ``voxel_sizes``, ``dims``,
+        ``item(b)``), ``to_dense()`` and ``layout(library)``.
+
+    Raises
+    ------
+    ValueError, OSError, RuntimeError
+        As :func:`voxelize`, naming the mesh's index (``on_error="raise"``).
+
+    Examples
+    --------
+    >>> batch = topovox.voxelize_many(paths, resolution=32, features=("occupancy", "normal"))
+    >>> batch.coords.shape, batch.features.shape, batch.offsets
+    >>> t = batch.layout("spconv")
+    """
+    if on_error not in ("raise", "skip"):
+        raise ValueError(f"on_error must be 'raise' or 'skip'; got {on_error!r}")
+    if isinstance(meshes, (str, os.PathLike, Mesh)):
+        raise TypeError("voxelize_many takes a list of meshes; for one mesh, pass [mesh] (or call voxelize)")
+    given: List[str] = [features] if isinstance(features, str) else [str(f) for f in features]
+    names = ["colour" if f.lower() == "color" else f for f in given]
+    options = dict(locals())
+    for k in ("meshes", "features", "on_error", "given", "names"):
+        options.pop(k)
+    loaded: List[Optional[Mesh]] = []
+    failed: Dict[int, str] = {}
+    for b, m in enumerate(meshes):
+        try:
+            loaded.append(m if isinstance(m, Mesh) else as_mesh(*m) if isinstance(m, tuple) else as_mesh(m))
+        except (ValueError, TypeError, OSError) as e:
+            name = _mesh_name(m)
+            message = f"mesh {b}: {e}" if name in str(e) else f"mesh {b} ({name}): {e}"
+            if on_error == "raise":
+                e.args = (message,)
+                raise
+            loaded.append(None)
+            failed[b] = message
+    out = _topovox.voxelize_many(loaded, _options(options), names, on_error == "skip")
+    failed.update({int(b): str(m) for b, m in out["errors"]})
+    return SparseBatch(out["coords"], out["features"], out["offsets"], out["grids"], out["columns"], failed)
+
+
+def _mesh_name(m: Any) -> str:
+    """How an error names an item: its path, or its type."""
+    if isinstance(m, (str, os.PathLike)):
+        return os.fsdecode(m)
+    if isinstance(m, Mesh):
+        return "Mesh"
+    return type(m).__name__
 
 
 def sdf(

@@ -7,7 +7,7 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
-__all__ = ["__version__", "FileFormatError", "Mesh", "VoxelGrid", "DistanceGrid", "load_mesh", "voxelize", "sdf", "Query", "sample", "remesh", "check_mesh", "load_voxels", "batch", "batch_plan", "process_one", "append_manifest", "options", "choices"]
+__all__ = ["__version__", "FileFormatError", "Mesh", "VoxelGrid", "DistanceGrid", "load_mesh", "voxelize", "voxelize_many", "features", "sdf", "Query", "sample", "remesh", "check_mesh", "load_voxels", "batch", "batch_plan", "process_one", "append_manifest", "options", "choices"]
 
 class FileFormatError(OSError):
     """A file's content does not follow its format (the message names the file)."""
@@ -185,6 +185,10 @@ def load_voxels(
     allow_external_paths: bool = False,
 ) -> VoxelGrid: ...
 def voxelize(mesh: Mesh, options: Optional[Dict[str, Any]] = None) -> VoxelGrid: ...
+def voxelize_many(
+    meshes: Sequence[Optional[Mesh]], options: Optional[Dict[str, Any]] = None, features: Sequence[str] = ..., skip_errors: bool = False
+) -> Dict[str, Any]: ...
+def features() -> List[Tuple[str, str]]: ...
 def options(command: str = "voxelize") -> List[Tuple[str, str, Any]]: ...
 def choices() -> Dict[str, List[str]]: ...
 def batch(

@@ -1,0 +1,261 @@
+//! The native `voxelize_many`: many meshes in one call, assembled into one
+//! sparse batch (coordinates with a batch column, per-voxel features,
+//! offsets) as sparse-convolution libraries take them.
+//!
+//! Each mesh runs exactly what `topovox.voxelize` runs for it alone (the
+//! same plan, the same job), so an item equals a single call voxel for
+//! voxel; the work is spread over the meshes (a rayon task each) and
+//! within them (the voxelizer's own threads share the same pool). The GIL
+//! is released throughout; Ctrl-C stops at the next mesh or slab.
+
+use std::sync::Arc;
+
+use numpy::ndarray::{Array1, Array2};
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use rayon::prelude::*;
+use topovox::attributes::carry::{CarryOptions, DEFAULT_COLOUR};
+use topovox::attributes::{VoxelAttributes, NO_MATERIAL};
+use topovox::voxelize::Stop;
+use topovox_job::{Choice, JobError, Plan};
+
+use crate::errors::{py_err, value_err};
+use crate::grids::{GridData, VoxelGrid};
+use crate::interrupt::interruptible;
+use crate::meshes::Mesh;
+use crate::options::job_options;
+
+topovox::choice! {
+    /// A per-voxel feature of a training batch (columns in the order asked).
+    pub enum Feature: "feature" default Occupancy {
+        /// 1 for every set voxel (one column).
+        Occupancy = "occupancy",
+        /// The area-weighted mean unit normal of the surface in the voxel (three columns; zero where none passes).
+        Normal = "normal",
+        /// sRGB colour in [0, 1] (three columns; the renderer's grey where the mesh has none).
+        Colour = "colour",
+        /// Surface area inside the voxel, in index space (one column).
+        Coverage = "coverage",
+        /// Material index, -1 for none (one column).
+        Material = "material",
+        /// Signed distance from the voxel centre to the mesh, world units, negative inside by the solid's rule (one column).
+        Sdf = "sdf",
+    }
+}
+
+impl Feature {
+    /// Columns it takes.
+    fn width(self) -> usize {
+        match self {
+            Feature::Normal | Feature::Colour => 3,
+            _ => 1,
+        }
+    }
+
+    /// Whether it needs the carried attributes.
+    fn carried(self) -> bool {
+        matches!(self, Feature::Normal | Feature::Colour | Feature::Coverage | Feature::Material)
+    }
+}
+
+/// One mesh's result: its grid and its rows of features (C order).
+struct Item {
+    data: GridData,
+    features: Vec<f32>,
+}
+
+/// The native voxelize_many: see `topovox.voxelize_many`. `meshes` holds
+/// `None` where the caller could not load a mesh (an empty item).
+#[pyfunction]
+#[pyo3(signature = (meshes, options=None, features=vec![], skip_errors=false))]
+pub(crate) fn voxelize_many<'py>(
+    py: Python<'py>,
+    meshes: Vec<Option<PyRef<'py, Mesh>>>,
+    options: Option<&Bound<'py, PyDict>>,
+    features: Vec<String>,
+    skip_errors: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let opts = job_options(options, &[])?;
+    let plan = opts.plan().map_err(py_err)?;
+    let features = features.iter().map(|f| Feature::parse(f).map_err(|e| value_err(e.to_string()))).collect::<PyResult<Vec<_>>>()?;
+    if plan.is_line() && features.iter().any(|f| f.carried()) {
+        return Err(value_err("line modes carry no attributes: ask for occupancy or sdf only"));
+    }
+    let mut carry = opts.export.carry();
+    carry.normals |= features.contains(&Feature::Normal);
+    let attributes = opts.export.carries() || features.iter().any(|f| f.carried());
+    let pool = opts.run.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
+    let inputs: Vec<Option<(Arc<topovox_io::LoadedMesh>, String)>> =
+        meshes.iter().map(|m| m.as_ref().map(|m| (m.inner.clone(), m.name()))).collect();
+    let stop = Stop::new();
+    let gpu = plan.request.method == topovox_job::Method::Gpu;
+    let results = interruptible(py, &stop, || {
+        let one = |input: &Option<(Arc<topovox_io::LoadedMesh>, String)>| -> Option<Result<Item, JobError>> {
+            let (mesh, name) = input.as_ref()?;
+            Some(item(&plan, mesh, name, &features, (attributes, &carry), &stop))
+        };
+        let run = || -> Vec<Option<Result<Item, JobError>>> {
+            // One device, one queue: GPU items run one after another.
+            if gpu {
+                inputs.iter().map(one).collect()
+            } else {
+                inputs.par_iter().map(one).collect()
+            }
+        };
+        match pool {
+            Some(p) => p.install(run),
+            None => run(),
+        }
+    })?;
+    let budget = topovox_job::budget(plan.request.max_memory);
+    assemble(py, results, &meshes, &features, (skip_errors, budget))
+}
+
+/// Voxelizes one mesh as `voxelize` would and measures its features.
+fn item(
+    plan: &Plan,
+    mesh: &topovox_io::LoadedMesh,
+    name: &str,
+    features: &[Feature],
+    (attributes, carry): (bool, &CarryOptions),
+    stop: &Stop,
+) -> Result<Item, JobError> {
+    if stop.requested() {
+        return Err(JobError::Interrupted);
+    }
+    let v = topovox_job::voxelize(plan, mesh.mesh.as_ref(), name, None, Some(stop))?;
+    let attrs = if attributes && !plan.is_line() {
+        topovox_job::check_attributes_carried(plan, &v)?;
+        topovox_job::attributes(plan, mesh.mesh.as_ref(), &mesh.appearance, &v, carry)
+    } else {
+        None
+    };
+    let mut facts = v.facts(plan);
+    facts["warnings"] = serde_json::json!(v.warnings);
+    let data = GridData::new(v.voxels, v.grid, attrs, facts);
+    let features = measure(&data, mesh, features)?;
+    Ok(Item { data, features })
+}
+
+/// The feature rows of `data`'s set voxels, in C order.
+fn measure(data: &GridData, mesh: &topovox_io::LoadedMesh, features: &[Feature]) -> Result<Vec<f32>, JobError> {
+    let order = data.ordered();
+    let width: usize = features.iter().map(|f| f.width()).sum();
+    let mut out = Vec::with_capacity(order.len() * width);
+    let query = if features.contains(&Feature::Sdf) {
+        Some(topovox::query::Query::new(mesh.mesh.as_ref(), topovox::query::Sign::Auto).map_err(|e| JobError::invalid(e.to_string()))?)
+    } else {
+        None
+    };
+    let attrs = data.attributes();
+    for &(ijk, slot) in order {
+        for f in features {
+            push_feature(&mut out, *f, ijk, slot, attrs, data, query.as_ref());
+        }
+    }
+    Ok(out)
+}
+
+fn push_feature(
+    out: &mut Vec<f32>,
+    f: Feature,
+    ijk: [u32; 3],
+    slot: usize,
+    attrs: Option<&VoxelAttributes>,
+    data: &GridData,
+    query: Option<&topovox::query::Query>,
+) {
+    match f {
+        Feature::Occupancy => out.push(1.0),
+        Feature::Normal => out.extend(attrs.and_then(|a| a.normal.as_ref()).map_or([0.0; 3], |n| n[slot])),
+        Feature::Colour => {
+            let c = attrs.and_then(|a| a.colour.as_ref()).map_or(DEFAULT_COLOUR, |c| c[slot]);
+            out.extend(c.map(|v| v as f32 / 255.0));
+        }
+        Feature::Coverage => out.push(attrs.and_then(|a| a.coverage.as_ref()).map_or(0.0, |c| c[slot])),
+        Feature::Material => {
+            let m = attrs.and_then(|a| a.material.as_ref()).map_or(NO_MATERIAL, |m| m[slot]);
+            out.push(if m == NO_MATERIAL { -1.0 } else { m as f32 });
+        }
+        Feature::Sdf => {
+            let q = query.expect("a query when sdf is asked");
+            out.push(q.signed_distance(data.grid().voxel_center(ijk)) as f32);
+        }
+    }
+}
+
+/// The batch's arrays and items; the first error (by index) raised unless
+/// `skip_errors`, when errors are listed instead.
+fn assemble<'py>(
+    py: Python<'py>,
+    results: Vec<Option<Result<Item, JobError>>>,
+    meshes: &[Option<PyRef<'py, Mesh>>],
+    features: &[Feature],
+    (skip_errors, budget): (bool, u64),
+) -> PyResult<Bound<'py, PyDict>> {
+    let width: usize = features.iter().map(|f| f.width()).sum();
+    let rows: u64 = results.iter().flatten().flatten().map(|it| it.data.ordered().len() as u64).sum();
+    let need = rows.saturating_mul(16 + 4 * width as u64);
+    if need > budget {
+        return Err(py_err(JobError::failed(format!(
+            "the batch's {rows} voxels need about {} as arrays, more than the {} this run may use; use fewer meshes per call or a coarser grid",
+            topovox_job::bytes(need),
+            topovox_job::bytes(budget)
+        ))));
+    }
+    let (grids, errors) = (PyList::empty(py), PyList::empty(py));
+    let mut offsets = vec![0i64];
+    // Sized once: growing them page-faulted a tenth of a small batch's time.
+    let (mut coords, mut feats) = (Vec::<i32>::with_capacity(rows as usize * 4), Vec::<f32>::with_capacity(rows as usize * width));
+    for (b, r) in results.into_iter().enumerate() {
+        match r {
+            Some(Ok(it)) => {
+                coords.extend(it.data.ordered().iter().flat_map(|(v, _)| [b as i32, v[0] as i32, v[1] as i32, v[2] as i32]));
+                feats.extend_from_slice(&it.features);
+                grids.append(Py::new(py, VoxelGrid { inner: Arc::new(it.data) })?)?;
+            }
+            Some(Err(JobError::Interrupted)) => return Err(py_err(JobError::Interrupted)),
+            Some(Err(e)) => {
+                let name = meshes[b].as_ref().map(|m| m.name()).unwrap_or_default();
+                let err = py_err(e);
+                let text = err.value(py).to_string();
+                let msg = if text.contains(&name) { format!("mesh {b}: {text}") } else { format!("mesh {b} ({name}): {text}") };
+                if !skip_errors {
+                    return Err(PyErr::from_type(err.get_type(py), msg));
+                }
+                errors.append((b, msg))?;
+                grids.append(py.None())?;
+            }
+            None => grids.append(py.None())?,
+        }
+        offsets.push(coords.len() as i64 / 4);
+    }
+    let d = PyDict::new(py);
+    let n = coords.len() / 4;
+    d.set_item("coords", Array2::from_shape_vec((n, 4), coords).expect("rows of four").into_pyarray(py))?;
+    d.set_item("features", Array2::from_shape_vec((n, width), feats).expect("rows of the features' width").into_pyarray(py))?;
+    d.set_item("offsets", Array1::from(offsets).into_pyarray(py))?;
+    d.set_item("grids", grids)?;
+    d.set_item("errors", errors)?;
+    d.set_item("columns", features.iter().flat_map(|f| columns(*f)).collect::<Vec<_>>())?;
+    Ok(d)
+}
+
+/// The names of a feature's columns.
+fn columns(f: Feature) -> Vec<String> {
+    match f.width() {
+        1 => vec![f.name().to_string()],
+        _ => ["x", "y", "z"]
+            .iter()
+            .zip(["r", "g", "b"])
+            .map(|(a, c)| format!("{}.{}", f.name(), if f == Feature::Colour { c } else { a }))
+            .collect(),
+    }
+}
+
+/// The features' names and help, for `topovox.FEATURES`.
+#[pyfunction]
+pub(crate) fn features() -> Vec<(&'static str, &'static str)> {
+    Feature::ALL.iter().map(|f| (f.name(), f.help())).collect()
+}
