@@ -27,12 +27,17 @@ import topovox
 
 
 def small_meshes(folder: pathlib.Path, count: int, faces: int, seed: int = 1):
-    rng = np.random.default_rng(seed)
     bases = []
     for p in sorted(folder.glob("*.obj")):
         m = topovox.load_mesh(p)
         f = np.asarray(m.faces)
         bases.append((np.asarray(m.vertices, dtype=np.float64), f[:: max(1, len(f) // faces)]))
+    return rotated(bases, count, seed)
+
+
+def rotated(bases, count: int, seed: int):
+    """`count` meshes cycling through `bases`, each rotated and scaled at random."""
+    rng = np.random.default_rng(seed)
     out = []
     for n in range(count):
         v, f = bases[n % len(bases)]

@@ -29,6 +29,9 @@ import numpy as np
 
 import topovox
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from bench_calls import rotated  # noqa: E402  (the same random rotations)
+
 
 def decimated(folder: pathlib.Path, seed: int):
     import open3d as o3d
@@ -45,16 +48,6 @@ def decimated(folder: pathlib.Path, seed: int):
     return out
 
 
-def meshes(bases, count: int, seed: int):
-    rng = np.random.default_rng(seed)
-    out = []
-    for n in range(count):
-        v, f = bases[n % len(bases)]
-        q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-        out.append((v @ q.T * rng.uniform(0.5, 2.0), f))
-    return out
-
-
 def main() -> int:
     here = pathlib.Path(__file__).resolve()
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -67,7 +60,7 @@ def main() -> int:
     import open3d as o3d
     import trimesh
 
-    pairs = meshes(decimated(a.meshes_dir, 1), a.meshes, 2)
+    pairs = rotated(decimated(a.meshes_dir, 1), a.meshes, 2)
     ours = [topovox.as_mesh(v, f) for v, f in pairs]
     o3d_meshes = [o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(v), o3d.utility.Vector3iVector(f.astype(np.int32))) for v, f in pairs]
     tri = [trimesh.Trimesh(v, f, process=False) for v, f in pairs[: a.trimesh]]
