@@ -51,7 +51,7 @@ def test_items_equal_single_calls_bit_for_bit(meshes, mode, resolution):
         one = topovox.voxelize(*m, mode=mode, resolution=resolution, fit="cube") if isinstance(m, tuple) else topovox.voxelize(m, mode=mode, resolution=resolution, fit="cube")
         assert np.array_equal(np.asarray(batch.item(b)), np.asarray(one)), b
         ijk, feats = batch.rows(b)
-        assert np.array_equal(ijk, one.indices()), b
+        assert np.array_equal(ijk, np.argwhere(np.asarray(one))), b
         assert np.all(batch.coords[batch.offsets[b] : batch.offsets[b + 1], 0] == b)
         assert np.all(feats == 1)
         assert np.array_equal(batch.origins[b], one.origin) and np.array_equal(batch.voxel_sizes[b], one.spacing)
@@ -91,6 +91,21 @@ def test_features_equal_the_attributes_and_the_queries(meshes):
     assert np.array_equal(batch.features[:, 0].view(np.uint32), field[i, j, k].view(np.uint32))
     dense = batch.to_dense(features=True)
     assert dense.shape == (1, 1, 40, 40, 40) and np.array_equal(dense[0, 0, i, j, k], batch.features[:, 0])
+
+
+def test_box_grids_and_sparse_items_in_c_order(meshes):
+    """fit="box" (dims differ per axis), a voxel size per axis, and a tiled
+    (sparse) item: rows in C order as NumPy's argwhere gives them."""
+    items = rotated(meshes, 11)[:3]
+    for kw in (dict(fit="box", resolution=45), dict(fit="box", voxel_size=(0.03, 0.05, 0.02)), dict(fit="box", resolution=40, tile=16)):
+        scale = [np.ptp(v, axis=0).max() for v, _ in items]
+        its = [(v / s, f) for (v, f), s in zip(items, scale)]
+        batch = topovox.voxelize_many(its, **kw)
+        for b, m in enumerate(its):
+            one = topovox.voxelize(*m, **kw)
+            assert np.array_equal(batch.rows(b)[0], np.argwhere(np.asarray(one))), (kw, b)
+            assert tuple(batch.dims[b]) == one.dims
+        assert batch.to_dense().shape[1:] == tuple(batch.dims.max(axis=0))
 
 
 def test_the_same_batch_on_any_thread_count(meshes):
