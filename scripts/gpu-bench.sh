@@ -13,7 +13,10 @@
 #   time by timestamps where the driver writes them;
 # - render --gpu of the city at 1920x1080 for each culling setting: GPU ms
 #   per frame (cull + depth + Hi-Z + shade), the median of 20 frames;
-# - spray of 1 M rays into the city (CPU; rays per second).
+# - spray of 1 M rays into the city (CPU; rays per second);
+# - 64 meshes at 64 and 128 (cover) in one `voxelize_many(method="gpu")`
+#   dispatch, one GPU call per mesh, and the CPU (needs the Python package:
+#   PYTHON, default python3, with topovox installed; else the row says so).
 # Needs a built `topovox` (TOPOVOX_BIN, else target/release/topovox, else
 # it builds one) and python3 for reading the JSON summaries.
 set -euo pipefail
@@ -27,9 +30,9 @@ REPEATS="${REPEATS:-3}"
 MESHES="${MESHES:-../shared/meshes}"
 BUNNY="$MESHES/stanford-bunny.obj"
 if [ -n "${QUICK:-}" ]; then
-    RES="64 128"; SIZE="320x180"; FRAMES=3; RAYS=20000
+    RES="64 128"; SIZE="320x180"; FRAMES=3; RAYS=20000; BATCH=8; BATCH_RES="32 64"
 else
-    RES="1024 2048"; SIZE="1920x1080"; FRAMES=20; RAYS=1000000
+    RES="1024 2048"; SIZE="1920x1080"; FRAMES=20; RAYS=1000000; BATCH=64; BATCH_RES="64 128"
 fi
 [ -f "$BUNNY" ] || { echo "gpu-bench: $BUNNY not found (set MESHES)" >&2; exit 1; }
 WORK="$(mktemp -d)"
@@ -92,3 +95,10 @@ done
 out="$("$BIN" spray "$WORK/city.obj" -o "$WORK/cloud.ply" --rays "$RAYS" --json)"
 rate="$(echo "$out" | python3 -c "import json,sys; print('%.2f M rays/s' % (json.load(sys.stdin)['rays_per_s'] / 1e6))")"
 echo "| spray $RAYS rays into the city | CPU | $(median_ms "$(echo "$out" | json_field spray_s)") | $rate |"
+
+PY="${PYTHON:-python3}"
+if "$PY" -c "import topovox" 2>/dev/null; then
+    "$PY" scripts/gpu_batch_bench.py "$MESHES" "$BATCH" "$BATCH_RES" "$REPEATS"
+else
+    echo "| $BATCH meshes, voxelize_many | skipped: no topovox Python package for $PY (pip install ./python) | | |"
+fi

@@ -4,9 +4,11 @@
 //!
 //! Each mesh runs exactly what `topovox.voxelize` runs for it alone (the
 //! same plan, the same job), so an item equals a single call voxel for
-//! voxel; the work is spread over the meshes (a rayon task each) and
-//! within them (the voxelizer's own threads share the same pool). The GIL
-//! is released throughout; Ctrl-C stops at the next mesh or slab.
+//! voxel (`topovox_job::many`: `method="gpu"` surface modes go to the GPU
+//! in one dispatch for the batch); the work is spread over the meshes (a
+//! rayon task each) and within them (the voxelizer's own threads share
+//! the same pool). The GIL is released throughout; Ctrl-C stops at the
+//! next mesh or slab.
 
 use std::sync::Arc;
 
@@ -18,7 +20,7 @@ use rayon::prelude::*;
 use topovox::attributes::carry::{CarryOptions, DEFAULT_COLOUR};
 use topovox::attributes::{VoxelAttributes, NO_MATERIAL};
 use topovox::voxelize::Stop;
-use topovox_job::{Choice, JobError, Plan};
+use topovox_job::{Choice, JobError, Plan, Voxelized};
 
 use crate::errors::{py_err, value_err};
 use crate::grids::{GridData, VoxelGrid};
@@ -89,19 +91,17 @@ pub(crate) fn voxelize_many<'py>(
     let inputs: Vec<Option<(Arc<topovox_io::LoadedMesh>, String)>> =
         meshes.iter().map(|m| m.as_ref().map(|m| (m.inner.clone(), m.name()))).collect();
     let stop = Stop::new();
-    let gpu = plan.request.method == topovox_job::Method::Gpu;
     let results = interruptible(py, &stop, || {
-        let one = |input: &Option<(Arc<topovox_io::LoadedMesh>, String)>| -> Option<Result<Item, JobError>> {
-            let (mesh, name) = input.as_ref()?;
-            Some(item(&plan, mesh, name, &features, (attributes, &carry), &stop))
-        };
         let run = || -> Vec<Option<Result<Item, JobError>>> {
-            // One device, one queue: GPU items run one after another.
-            if gpu {
-                inputs.iter().map(one).collect()
-            } else {
-                inputs.par_iter().map(one).collect()
-            }
+            let given: Vec<(&topovox_io::LoadedMesh, &str)> = inputs.iter().flatten().map(|(m, n)| (m.as_ref(), n.as_str())).collect();
+            let refs: Vec<(topovox::MeshRef<'_>, &str)> = given.iter().map(|(m, n)| (m.mesh.as_ref(), *n)).collect();
+            let mut voxelized = topovox_job::many::voxelize_many(&plan, &refs, &stop).into_iter();
+            let paired: Vec<Option<(&topovox_io::LoadedMesh, Result<Voxelized, JobError>)>> =
+                inputs.iter().map(|i| i.as_ref().map(|(m, _)| (m.as_ref(), voxelized.next().expect("a result per mesh")))).collect();
+            paired
+                .into_par_iter()
+                .map(|p| p.map(|(mesh, v)| v.and_then(|v| item(&plan, mesh, v, &features, (attributes, &carry)))))
+                .collect()
         };
         match pool {
             Some(p) => p.install(run),
@@ -112,19 +112,15 @@ pub(crate) fn voxelize_many<'py>(
     assemble(py, results, &meshes, &features, (skip_errors, budget))
 }
 
-/// Voxelizes one mesh as `voxelize` would and measures its features.
+/// One mesh's voxels as `voxelize` gives them, with their attributes and
+/// features measured.
 fn item(
     plan: &Plan,
     mesh: &topovox_io::LoadedMesh,
-    name: &str,
+    v: Voxelized,
     features: &[Feature],
     (attributes, carry): (bool, &CarryOptions),
-    stop: &Stop,
 ) -> Result<Item, JobError> {
-    if stop.requested() {
-        return Err(JobError::Interrupted);
-    }
-    let v = topovox_job::voxelize(plan, mesh.mesh.as_ref(), name, None, Some(stop))?;
     let attrs = if attributes && !plan.is_line() {
         topovox_job::check_attributes_carried(plan, &v)?;
         topovox_job::attributes(plan, mesh.mesh.as_ref(), &mesh.appearance, &v, carry)

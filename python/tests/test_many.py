@@ -223,3 +223,26 @@ def test_the_readme_training_loop_runs(meshes, tmp_path, monkeypatch):
         (tmp_path / n).write_bytes((meshes / n).read_bytes())
     monkeypatch.chdir(tmp_path)
     exec(compile(block.group(1).replace("meshes/", str(tmp_path) + "/"), "README.md", "exec"), {})
+
+
+def test_the_gpu_batch_is_one_dispatch_and_equals_the_cpu(meshes):
+    """method="gpu": the surface modes of the whole batch in one upload and
+    one dispatch (facts["gpu"]["batch"]), each item equal to the CPU's."""
+    import os
+
+    items = rotated(meshes, 13)
+    try:
+        topovox.voxelize(*items[0], method="gpu", resolution=8)
+    except RuntimeError as e:
+        if os.environ.get("TOPOVOX_REQUIRE_GPU") == "1":
+            raise
+        pytest.skip(f"no GPU adapter: {e}")
+    for mode, res in (("cover", 32), ("sep6", 64), ("sep26", 40)):
+        batch = topovox.voxelize_many(items, mode=mode, resolution=res, method="gpu", features=("occupancy", "normal"))
+        cpu = topovox.voxelize_many(items, mode=mode, resolution=res, features=("occupancy", "normal"))
+        assert np.array_equal(batch.coords, cpu.coords) and np.array_equal(batch.features, cpu.features), mode
+        for b in range(len(items)):
+            facts = batch.item(b).facts
+            assert facts["method"] == "gpu" and facts["gpu"]["batch"]["stacked"] == len(items), facts["gpu"]
+            alone = topovox.voxelize(*items[b], mode=mode, resolution=res, fit="cube", method="gpu")
+            assert np.array_equal(np.asarray(batch.item(b)), np.asarray(alone))

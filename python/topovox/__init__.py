@@ -455,9 +455,10 @@ def voxelize_many(
         ``"cube"`` (the default here): every item ``resolution**3`` voxels,
         the mesh centred (the ShapeNet/ModelNet convention).
     mode, resolution, voxel_size, origin, dims, pad, method, threads, ...
-        As :func:`voxelize`. ``method="gpu"`` voxelizes the meshes one
-        after another on the GPU (one dispatch per mesh; a single dispatch
-        for the whole batch is not built yet).
+        As :func:`voxelize`. ``method="gpu"`` voxelizes the surface modes
+        of the whole batch on the GPU in one upload and one dispatch (each
+        mesh in its own layers of one tall grid), the same voxels as one
+        call per mesh.
 
     Returns
     -------

@@ -17,6 +17,9 @@
 //! - **MSAA approximation**: 4× MSAA without conservative coverage, which
 //!   never sets a wrong voxel but misses some (counted in the report).
 //!
+//! Many meshes go in one dispatch ([`Gpu::voxelize_stacked`], `stacked.rs`):
+//! each moved by whole voxels into its own layers of one tall grid.
+//!
 //! And the **solid** by parity ([`Gpu::solid_parity`], `solid.rs`,
 //! `shaders/solid.wgsl`): triangle-parallel parity flips with `atomicXor`
 //! at each row's first inside voxel, then a prefix XOR per row — the
@@ -43,10 +46,12 @@ pub mod device;
 mod params;
 mod slabs;
 mod solid;
+mod stacked;
 
 pub use compute::{CoverReport, GpuMode, GpuPath, Timings};
 pub use device::Device;
 pub use solid::SolidGpuReport;
+pub use stacked::StackedReport;
 mod error;
 mod gpu;
 mod pipelines;

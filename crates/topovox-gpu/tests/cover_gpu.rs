@@ -218,3 +218,39 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn many_meshes_in_one_dispatch_equal_one_call_each() {
+    let Some(g) = gpu() else { return };
+    let mut r = rng(57);
+    let mut meshes = Vec::new();
+    for name in ["stanford-bunny.obj", "fandisk.obj", "suzanne.obj", "teapot.obj", "cow.obj"] {
+        meshes.push(rotated(&shared_mesh(name), random_rotation(&mut r)));
+    }
+    let mut items: Vec<(topovox::MeshRef<'_>, GridSpec)> = Vec::new();
+    for (n, m) in meshes.iter().enumerate() {
+        let b = m.as_ref().bounds();
+        items.push((m.as_ref(), GridSpec::from_resolution(&b, [24, 40, 33, 64, 17][n]).unwrap()));
+    }
+    // A rotated box in a grid of its middle layers: its faces reach past
+    // the grid in z, so it runs on its own.
+    let boxed = rotated(&topovox_testkit::box_mesh(DVec3::ZERO, DVec3::new(4.0, 3.0, 5.0)), random_rotation(&mut r));
+    let b = boxed.as_ref().bounds();
+    let h = (b.max - b.min).max_element() / 30.0;
+    let centre = (b.min + b.max) / 2.0;
+    let cut = GridSpec::new(centre - DVec3::new(15.0, 15.0, 5.0) * h, h, [30, 30, 10]).unwrap();
+    items.insert(2, (boxed.as_ref(), cut));
+    for mode in MODES {
+        let gm = GpuMode::of(mode).unwrap();
+        let (out, rep) = g.voxelize_stacked(gm, topovox_gpu::GpuPath::Compute, &items).unwrap();
+        assert_eq!((rep.stacked, rep.alone), (5, 1), "{mode:?}");
+        for (n, ((bits, report), (mesh, grid))) in out.iter().zip(&items).enumerate() {
+            let (one, one_rep) = g.voxelize(gm, *mesh, grid).unwrap();
+            if let Some(v) = bits.to_dense().first_difference(&one.to_dense()) {
+                panic!("{mode:?}, item {n}: stacked and alone differ at voxel {v:?} ({} and {} voxels)", bits.count(), one.count());
+            }
+            assert_eq!(report.voxels, one.count());
+            assert_eq!(report.prepare, one_rep.report.prepare, "{mode:?}, item {n}");
+        }
+    }
+}

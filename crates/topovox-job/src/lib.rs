@@ -27,6 +27,7 @@ mod solid;
 pub mod batch;
 pub mod check;
 pub mod distance;
+pub mod many;
 pub mod options;
 pub mod output;
 pub mod remesh;

@@ -89,25 +89,47 @@ pub struct Voxelized {
     pub tile_kernel: Option<&'static str>,
 }
 
-/// Runs `plan` on `mesh` (named `name` in messages) on the grid its request
-/// fits to `bounds`. Runs on the current rayon pool. Once `stop` is
-/// requested the work left is skipped and the result is
-/// [`JobError::Interrupted`].
-pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dyn Progress>, stop: Option<&Stop>) -> Result<Voxelized> {
-    let mut warnings = Vec::new();
+/// The mesh's refusal (a surface mode on segments alone) or what the
+/// user should know before voxelizing it.
+pub(crate) fn input_warnings(plan: &Plan, mesh: MeshRef<'_>, name: &str) -> Result<Vec<String>> {
     let is_line = plan.is_line();
     if !is_line && mesh.triangles.is_empty() {
         return Err(JobError::invalid(format!(
             "{name}: has only line segments; surface modes need triangles (use --mode line26 or line6)"
         )));
     }
-    if !is_line && !mesh.segments.is_empty() {
-        warnings.push(format!(
+    Ok(if !is_line && !mesh.segments.is_empty() {
+        vec![format!(
             "{name}: {} line segments ignored by surface mode {} (line26 and line6 voxelize them)",
             mesh.segments.len(),
             plan.request.mode.name()
-        ));
+        )]
+    } else {
+        Vec::new()
+    })
+}
+
+/// What the user should know of a result: empty, or with primitives skipped.
+pub(crate) fn output_warnings(plan: &Plan, name: &str, report: &Report, warnings: &mut Vec<String>) {
+    let p = report.prepare;
+    if report.voxels == 0 {
+        warnings.push(if plan.solid.is_none() && p.input > 0 && p.outside + p.degenerate + p.non_finite + p.invalid_index == p.input {
+            format!("{name}: the result is empty: every triangle lies outside the grid (or is degenerate)")
+        } else {
+            format!("{name}: the result is empty: no voxel is set")
+        });
     }
+    if p.non_finite + p.invalid_index > 0 {
+        warnings.push(format!("{name}: skipped {} primitives with invalid vertices", p.non_finite + p.invalid_index));
+    }
+}
+
+/// Runs `plan` on `mesh` (named `name` in messages) on the grid its request
+/// fits to `bounds`. Runs on the current rayon pool. Once `stop` is
+/// requested the work left is skipped and the result is
+/// [`JobError::Interrupted`].
+pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dyn Progress>, stop: Option<&Stop>) -> Result<Voxelized> {
+    let mut warnings = input_warnings(plan, mesh, name)?;
     let t = Instant::now();
     let grid = plan.request.grid.fit(&mesh.bounds())?;
     let budget = crate::memory::budget(plan.request.max_memory);
@@ -168,17 +190,7 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
         return Err(JobError::Interrupted);
     }
     let voxelize_s = t.elapsed().as_secs_f64();
-    let p = report.prepare;
-    if report.voxels == 0 {
-        warnings.push(if plan.solid.is_none() && p.input > 0 && p.outside + p.degenerate + p.non_finite + p.invalid_index == p.input {
-            format!("{name}: the result is empty: every triangle lies outside the grid (or is degenerate)")
-        } else {
-            format!("{name}: the result is empty: no voxel is set")
-        });
-    }
-    if p.non_finite + p.invalid_index > 0 {
-        warnings.push(format!("{name}: skipped {} primitives with invalid vertices", p.non_finite + p.invalid_index));
-    }
+    output_warnings(plan, name, &report, &mut warnings);
     Ok(Voxelized { voxels, grid, method, report, solid, gpu, warnings, voxelize_s, tile, tile_kernel })
 }
 
@@ -243,7 +255,7 @@ fn untiled_surface(
 /// densely in `budget` or whose whole-grid brick index (4 bytes per 8³
 /// voxels) would take more than a quarter of it, and for a solid with a
 /// sparse path whose dense grid would take more than a quarter of it.
-fn tile_for(plan: &Plan, grid: &GridSpec, budget: u64) -> Option<u32> {
+pub(crate) fn tile_for(plan: &Plan, grid: &GridSpec, budget: u64) -> Option<u32> {
     if plan.request.tile.is_some() {
         return plan.request.tile;
     }
@@ -364,13 +376,13 @@ impl Voxelized {
 
 /// A GPU error as the job reports it.
 #[cfg(feature = "gpu")]
-fn gpu_failed(e: topovox_gpu::GpuError) -> JobError {
+pub(crate) fn gpu_failed(e: topovox_gpu::GpuError) -> JobError {
     JobError::failed(format!("--method gpu: {e}"))
 }
 
 /// The GPU, and the mode and path a `--method gpu` run asks of it.
 #[cfg(feature = "gpu")]
-fn gpu_setup(mode: voxelize::Mode, path: GpuPath) -> Result<(topovox_gpu::Gpu, topovox_gpu::GpuMode, GpuPath)> {
+pub(crate) fn gpu_setup(mode: voxelize::Mode, path: GpuPath) -> Result<(topovox_gpu::Gpu, topovox_gpu::GpuMode, GpuPath)> {
     let gm = topovox_gpu::GpuMode::of(mode)
         .ok_or_else(|| JobError::invalid(format!("--method gpu: {} on the GPU is not built yet", mode.name())))?;
     Ok((topovox_gpu::Gpu::new().map_err(gpu_failed)?, gm, path))
