@@ -36,10 +36,12 @@ LAYOUTS: Dict[str, str] = {
     "(batch first since 2.1.0; earlier versions put it last)",
     "minkowski": "MinkowskiEngine 0.5 SparseTensor(features, coordinates): coordinates int32 (N, 4) "
     "[batch, x, y, z] (batch first since 0.4)",
-    "fvdb": "fVDB gridbatch_from_ijk(JaggedTensor ijk, voxel_sizes, origins): ijk int32 (N, 3) per item "
-    "(joffsets int64 (B + 1)), origins the world centre of voxel (0, 0, 0)",
-    "ocnn": "ocnn-pytorch Points(points, features=..., batch_size) then Octree(depth).build_octree: "
-    "points float32 (N, 3) in [-1, 1], batch_id float32 (N, 1) as ocnn's merge_points makes it",
+    "fvdb": "fVDB gridbatch_from_ijk(JaggedTensor ijk, voxel_sizes, origins), as openvdb.org/documentation/fvdb "
+    "documents it (read 2026-11): ijk int32 (N, 3) per item (joffsets int64 (B + 1)), origins the world centre "
+    "of voxel (0, 0, 0)",
+    "ocnn": "ocnn-pytorch Points(points, features=..., batch_size) then Octree(depth).build_octree, as "
+    "ocnn/octree/points.py of github.com/octree-nn/ocnn-pytorch documents it (read 2026-11): points float32 "
+    "(N, 3) in [-1, 1], batch_id float32 (N, 1) as its merge_points makes it",
 }
 
 
