@@ -27,6 +27,7 @@ use crate::grids::{GridData, VoxelGrid};
 use crate::interrupt::interruptible;
 use crate::meshes::Mesh;
 use crate::options::job_options;
+use crate::voxelize::grid_data;
 
 topovox::choice! {
     /// A per-voxel feature of a training batch (columns in the order asked).
@@ -100,7 +101,7 @@ pub(crate) fn voxelize_many<'py>(
                 inputs.iter().map(|i| i.as_ref().map(|(m, _)| (m.as_ref(), voxelized.next().expect("a result per mesh")))).collect();
             paired
                 .into_par_iter()
-                .map(|p| p.map(|(mesh, v)| v.and_then(|v| item(&plan, mesh, v, &features, (attributes, &carry)))))
+                .map(|p| p.map(|(mesh, v)| v.and_then(|v| item(&plan, mesh, v, &features, attributes.then_some(&carry)))))
                 .collect()
         };
         match pool {
@@ -112,24 +113,15 @@ pub(crate) fn voxelize_many<'py>(
     assemble(py, results, &meshes, &features, (skip_errors, budget))
 }
 
-/// One mesh's voxels as `voxelize` gives them, with their attributes and
-/// features measured.
+/// One mesh's grid as `voxelize` gives it, with its features measured.
 fn item(
     plan: &Plan,
     mesh: &topovox_io::LoadedMesh,
     v: Voxelized,
     features: &[Feature],
-    (attributes, carry): (bool, &CarryOptions),
+    carry: Option<&CarryOptions>,
 ) -> Result<Item, JobError> {
-    let attrs = if attributes && !plan.is_line() {
-        topovox_job::check_attributes_carried(plan, &v)?;
-        topovox_job::attributes(plan, mesh.mesh.as_ref(), &mesh.appearance, &v, carry)
-    } else {
-        None
-    };
-    let mut facts = v.facts(plan);
-    facts["warnings"] = serde_json::json!(v.warnings);
-    let data = GridData::new(v.voxels, v.grid, attrs, facts);
+    let data = grid_data(plan, mesh, v, carry)?;
     let features = measure(&data, mesh, features)?;
     Ok(Item { data, features })
 }

@@ -180,7 +180,7 @@ class SparseBatch:
             if x.columns != columns:
                 raise ValueError(f"batches with different feature columns: {list(columns)} and {list(x.columns)}")
         starts = np.cumsum([0] + [len(x) for x in batches])
-        coords = np.concatenate([x.coords + np.array([s, 0, 0, 0], dtype=np.int32) for x, s in zip(batches, starts)]) if batches else np.zeros((0, 4), np.int32)
+        coords = np.concatenate([x.coords + np.array([s, 0, 0, 0], dtype=np.int32) for x, s in zip(batches, starts)])
         rows = np.cumsum([0] + [len(x.coords) for x in batches])
         offsets = np.concatenate([[0]] + [x.offsets[1:] + r for x, r in zip(batches, rows)])
         errors = {int(s) + b: m for x, s in zip(batches, starts) for b, m in x.errors.items()}
