@@ -17,17 +17,17 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
-use topovox::attributes::carry::{CarryOptions, DEFAULT_COLOUR};
+use topovox::attributes::carry::DEFAULT_COLOUR;
 use topovox::attributes::{VoxelAttributes, NO_MATERIAL};
 use topovox::voxelize::Stop;
-use topovox_job::{Choice, JobError, Plan, Voxelized};
+use topovox_job::{Choice, JobError, Keep, Voxelized, Voxelizer};
 
 use crate::errors::{py_err, value_err};
 use crate::grids::{GridData, VoxelGrid};
 use crate::interrupt::interruptible;
 use crate::meshes::Mesh;
 use crate::options::job_options;
-use crate::voxelize::grid_data;
+use crate::voxelize::carried_grid;
 
 topovox::choice! {
     /// A per-voxel feature of a training batch (columns in the order asked).
@@ -79,15 +79,16 @@ pub(crate) fn voxelize_many<'py>(
     features: Vec<String>,
     skip_errors: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let opts = job_options(options, &[])?;
-    let plan = opts.plan().map_err(py_err)?;
+    let mut opts = job_options(options, &[])?;
     let features = features.iter().map(|f| Feature::parse(f).map_err(|e| value_err(e.to_string()))).collect::<PyResult<Vec<_>>>()?;
+    // The normal column needs the normals carried, as `normals=True` would.
+    opts.export.normals |= features.contains(&Feature::Normal);
+    let voxelizer = Voxelizer::new(&opts).map_err(py_err)?;
+    let plan = &voxelizer.plan;
     if plan.is_line() && features.iter().any(|f| f.carried()) {
         return Err(value_err("line modes carry no attributes: ask for occupancy or sdf only"));
     }
-    let mut carry = opts.export.carry();
-    carry.normals |= features.contains(&Feature::Normal);
-    let attributes = opts.export.carries() || features.iter().any(|f| f.carried());
+    let keep = Keep::Memory { also: features.iter().any(|f| f.carried()) };
     let pool = opts.run.threads.map(topovox_job::pool).transpose().map_err(py_err)?;
     let inputs: Vec<Option<(Arc<topovox_io::LoadedMesh>, String)>> =
         meshes.iter().map(|m| m.as_ref().map(|m| (m.inner.clone(), m.name()))).collect();
@@ -96,13 +97,10 @@ pub(crate) fn voxelize_many<'py>(
         let run = || -> Vec<Option<Result<Item, JobError>>> {
             let given: Vec<(&topovox_io::LoadedMesh, &str)> = inputs.iter().flatten().map(|(m, n)| (m.as_ref(), n.as_str())).collect();
             let refs: Vec<(topovox::MeshRef<'_>, &str)> = given.iter().map(|(m, n)| (m.mesh.as_ref(), *n)).collect();
-            let mut voxelized = topovox_job::many::voxelize_many(&plan, &refs, &stop).into_iter();
+            let mut voxelized = topovox_job::many::voxelize_many(plan, &refs, &stop).into_iter();
             let paired: Vec<Option<(&topovox_io::LoadedMesh, Result<Voxelized, JobError>)>> =
                 inputs.iter().map(|i| i.as_ref().map(|(m, _)| (m.as_ref(), voxelized.next().expect("a result per mesh")))).collect();
-            paired
-                .into_par_iter()
-                .map(|p| p.map(|(mesh, v)| v.and_then(|v| item(&plan, mesh, v, &features, attributes.then_some(&carry)))))
-                .collect()
+            paired.into_par_iter().map(|p| p.map(|(mesh, v)| v.and_then(|v| item(&voxelizer, mesh, v, &features, keep)))).collect()
         };
         match pool {
             Some(p) => p.install(run),
@@ -114,14 +112,8 @@ pub(crate) fn voxelize_many<'py>(
 }
 
 /// One mesh's grid as `voxelize` gives it, with its features measured.
-fn item(
-    plan: &Plan,
-    mesh: &topovox_io::LoadedMesh,
-    v: Voxelized,
-    features: &[Feature],
-    carry: Option<&CarryOptions>,
-) -> Result<Item, JobError> {
-    let data = grid_data(plan, mesh, v, carry)?;
+fn item(voxelizer: &Voxelizer, mesh: &topovox_io::LoadedMesh, v: Voxelized, features: &[Feature], keep: Keep) -> Result<Item, JobError> {
+    let data = carried_grid(voxelizer, mesh, v, keep)?;
     let features = measure(&data, mesh, features)?;
     Ok(Item { data, features })
 }

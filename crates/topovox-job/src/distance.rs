@@ -313,7 +313,7 @@ pub fn sdf(mesh: MeshRef<'_>, name: &str, req: &SdfRequest, stop: Option<&Stop>)
         warnings.extend(out.warnings);
         facts["sign"] = json!(out.method);
         sign = Some(out.method.to_string());
-        facts["solid"] = out.facts;
+        facts["solid"] = json!(out.facts);
         facts["inside_voxels"] = json!(out.bits.count());
         Some(out.bits)
     };

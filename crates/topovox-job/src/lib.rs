@@ -27,6 +27,7 @@ mod solid;
 pub mod batch;
 pub mod check;
 pub mod distance;
+pub mod facts;
 pub mod many;
 pub mod options;
 pub mod output;
@@ -36,16 +37,14 @@ pub mod table;
 
 pub use error::{JobError, Result};
 pub use grid::{Fit, GridOptions, GridRequest};
-pub use job::{Done, SdfDone, SdfJob, VoxelizeJob};
+pub use job::{Done, Keep, Made, SdfDone, SdfJob, VoxelizeJob, Voxelizer};
 pub use memory::{available_memory, budget, bytes, check_memory, dense_fits, parse_size, peak_memory};
 pub use options::{ExportOptions, JobOptions, RunOptions, KEYWORDS};
 pub use plan::{
     auto_method, gpu_has, resolve_method, Fill, GpuPath, Hollow, Method, Mode, Plan, Request, SolidMethod, SolidPlan, SurfaceMethod,
     GPU_AUTO_MIN_SIDE,
 };
-pub use run::{
-    attributes, attributes_for, check_attributes_carried, every_attribute, voxelize, Voxelized, Voxels, ATTRIBUTE_BYTES_PER_VOXEL,
-};
+pub use run::{attributes, check_attributes_carried, every_attribute, voxelize, Voxelized, Voxels, ATTRIBUTE_BYTES_PER_VOXEL};
 pub use solid::Outcome as SolidOutcome;
 pub use table::{Keyword, OptionValue, Table};
 pub use topovox::attributes::ColourRule;

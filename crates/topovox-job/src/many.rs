@@ -49,7 +49,6 @@ fn gpu_batch(_: &Plan, _: &[(MeshRef<'_>, &str)], _: &Stop) -> Option<Vec<Result
 fn gpu_batch(plan: &Plan, meshes: &[(MeshRef<'_>, &str)], stop: &Stop) -> Option<Vec<Result<Voxelized>>> {
     use crate::error::JobError;
     use crate::run::{input_warnings, output_warnings, Voxels};
-    use serde_json::{json, Value};
     if !batches_on_gpu(plan) {
         return None;
     }
@@ -86,12 +85,14 @@ fn gpu_batch(plan: &Plan, meshes: &[(MeshRef<'_>, &str)], stop: &Stop) -> Option
         }
     };
     let seconds = t.elapsed().as_secs_f64();
-    let facts = json!({
-        "path": plan.request.gpu_path.to_string(),
-        "adapter": adapter,
-        "software": software,
-        "batch": {"meshes": items.len(), "stacked": rep.stacked, "alone": rep.alone, "seconds": seconds},
-    });
+    let facts = crate::facts::GpuFacts {
+        path: plan.request.gpu_path.to_string(),
+        adapter,
+        software,
+        run: crate::facts::GpuRun::Batch {
+            batch: crate::facts::GpuBatch { meshes: items.len(), stacked: rep.stacked, alone: rep.alone, seconds },
+        },
+    };
     for ((n, grid, mut warnings), (bits, report)) in batch.into_iter().zip(done) {
         output_warnings(plan, meshes[n].1, &report, &mut warnings);
         out[n] = Some(Ok(Voxelized {
@@ -99,8 +100,8 @@ fn gpu_batch(plan: &Plan, meshes: &[(MeshRef<'_>, &str)], stop: &Stop) -> Option
             grid,
             method: "gpu",
             report,
-            solid: Value::Null,
-            gpu: facts.clone(),
+            solid: None,
+            gpu: Some(facts.clone()),
             warnings,
             voxelize_s: seconds,
             tile: None,

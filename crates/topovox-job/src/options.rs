@@ -165,9 +165,9 @@ crate::option_table! {
 pub const KEYWORDS: &[&[crate::table::Keyword]] = <JobOptions as Table>::KEYWORDS;
 
 impl ExportOptions {
-    /// Whether Python's `voxelize`, which writes no file, carries
-    /// attributes: when any is asked for (normals are one). Writers follow
-    /// [`crate::attributes_for`], which also asks what the format stores.
+    /// Whether any attribute is asked for (normals are one): what a grid
+    /// kept in memory carries by [`crate::Keep::wants`]; a file's format
+    /// decides too.
     pub fn carries(&self) -> bool {
         self.attributes || self.normals
     }

@@ -13,6 +13,8 @@ use std::time::Instant;
 
 use glam::DVec3;
 use serde_json::{json, Value};
+
+use crate::facts::SolidFacts;
 use topovox::choice::Choice;
 use topovox::distance::nearest::Hierarchy;
 use topovox::distance::Pieces;
@@ -173,10 +175,10 @@ pub struct RemeshFacts {
     /// the input, and from the input's vertices and face centres to the
     /// output (wrap and `check` only).
     pub distance: Option<[f64; 4]>,
-    /// Facts of the solid (its JSON).
-    pub solid: Value,
-    /// What `simplify` did (its JSON), `None` when not asked.
-    pub simplify: Option<Value>,
+    /// Facts of the solid.
+    pub solid: SolidFacts,
+    /// What `simplify` did, `None` when not asked.
+    pub simplify: Option<SimplifyFacts>,
 }
 
 impl RemeshFacts {
@@ -191,6 +193,21 @@ impl RemeshFacts {
             "distance_voxels": d, "solid": self.solid, "simplify": self.simplify,
         })
     }
+}
+
+/// What `--simplify` did.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct SimplifyFacts {
+    /// The bound asked for, in voxels.
+    pub error_voxels: f64,
+    /// Faces before.
+    pub faces_before: usize,
+    /// Faces after (before, when the result was not kept).
+    pub faces: usize,
+    /// The simplified surface passed its certificate and separation check.
+    pub kept: bool,
+    /// Seconds simplifying and checking.
+    pub seconds: f64,
 }
 
 /// A watertight mesh and how it was made.
@@ -245,7 +262,7 @@ fn inside(
     req: &RemeshRequest,
     grid: &GridSpec,
     stop: &Stop,
-) -> Result<(DenseBits, String, Value, Vec<String>)> {
+) -> Result<(DenseBits, String, SolidFacts, Vec<String>)> {
     let method = match req.inside {
         Inside::Auto | Inside::Wrap => SolidMethod::Auto,
         Inside::Parity => SolidMethod::Parity,
@@ -327,7 +344,7 @@ fn simplified(
     error: f64,
     stop: &Stop,
     warnings: &mut Vec<String>,
-) -> Result<(TriMesh, Option<Value>, Option<MeshCheck>)> {
+) -> Result<(TriMesh, Option<SimplifyFacts>, Option<MeshCheck>)> {
     if error <= 0.0 {
         return Ok((out, None, None));
     }
@@ -344,7 +361,13 @@ fn simplified(
         topovox::voxelize::solid::parity(r, grid).is_ok_and(|(solid, _)| solid == *bits)
     };
     let faces_before = out.triangles.len();
-    let facts = |kept: &TriMesh, ok: bool| json!({"error_voxels": error, "faces_before": faces_before, "faces": kept.triangles.len(), "kept": ok, "seconds": t.elapsed().as_secs_f64()});
+    let facts = |kept: &TriMesh, ok: bool| SimplifyFacts {
+        error_voxels: error,
+        faces_before,
+        faces: kept.triangles.len(),
+        kept: ok,
+        seconds: t.elapsed().as_secs_f64(),
+    };
     if !separates {
         warnings.push(format!(
             "--simplify {error}: the simplified surface failed its certificate or its separation check; the surface is left unsimplified (please report this mesh)"

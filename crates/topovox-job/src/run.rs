@@ -12,6 +12,9 @@ use topovox::voxelize::{self, Options, Progress, Report, Stop};
 use topovox::{DenseBits, GridSpec, MeshRef, VoxelSource};
 
 use crate::error::{JobError, Result};
+#[cfg(feature = "gpu")]
+use crate::facts::GpuCounts;
+use crate::facts::{GpuFacts, SolidFacts};
 use crate::plan::{GpuPath, Plan, SolidPlan, SurfaceMethod};
 
 /// A voxel set in whichever storage the path produced.
@@ -75,9 +78,9 @@ pub struct Voxelized {
     /// Triangle preparation counts (zero for solids) and the voxel count.
     pub report: Report,
     /// Solid modes: closedness, the winding number's work, fill and hollow facts.
-    pub solid: Value,
+    pub solid: Option<SolidFacts>,
     /// The GPU path: adapter, timings, triangles on each side.
-    pub gpu: Value,
+    pub gpu: Option<GpuFacts>,
     /// Things the user should know.
     pub warnings: Vec<String>,
     /// Seconds spent voxelizing: from the loaded mesh to the voxels in
@@ -152,19 +155,19 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
         opts.brick_capacity = brick_capacity(plan, mesh, &grid, name, budget)?;
     }
     let opts = opts;
-    let mut gpu = Value::Null;
+    let mut gpu = None;
     let mut tile_kernel = None;
     let (voxels, report, method, solid) = if let (Some(t), Some(sp)) = (tile, &plan.solid) {
         let out = crate::solid::run_sparse(sp, mesh, name, &grid, t, &opts)?;
         warnings.extend(out.warnings);
         let voxels = out.bits.count();
-        (Voxels::Sparse(out.bits), Report { voxels, prepare: Default::default() }, out.method, out.facts)
+        (Voxels::Sparse(out.bits), Report { voxels, prepare: Default::default() }, out.method, Some(out.facts))
     } else if let (Some(t), SurfaceMethod::Gpu) = (tile, surface_method) {
         // Each tile on the GPU: the same voxels as the GPU on the whole grid.
         let (s, r, facts) = gpu_tiled(plan.core, plan.request.gpu_path, mesh, &grid, t, &opts)?;
-        gpu = facts;
+        gpu = Some(facts);
         tile_kernel = Some("gpu");
-        (Voxels::Sparse(s), r, "tiled", Value::Null)
+        (Voxels::Sparse(s), r, "tiled", None)
     } else if let Some(t) = tile {
         // Each tile runs the fast path's kernel, or the scanline path's when
         // asked for (`auto` keeps the fast one: on the bunny at 4096–16384
@@ -176,15 +179,15 @@ pub fn voxelize(plan: &Plan, mesh: MeshRef<'_>, name: &str, progress: Option<&dy
         };
         let (s, r) = voxelize::tiled::tiled_with(plan.core, kernel, mesh, &grid, t, &opts).map_err(|e| JobError::invalid(e.to_string()))?;
         tile_kernel = Some(name);
-        (Voxels::Sparse(s), r, "tiled", Value::Null)
+        (Voxels::Sparse(s), r, "tiled", None)
     } else if let Some(sp) = &plan.solid {
         let out = crate::solid::run(sp, mesh, name, &grid, &opts)?;
         warnings.extend(out.warnings);
         let voxels = out.bits.count();
-        (Voxels::Dense(out.bits), Report { voxels, prepare: Default::default() }, out.method, out.facts)
+        (Voxels::Dense(out.bits), Report { voxels, prepare: Default::default() }, out.method, Some(out.facts))
     } else {
         let (v, r) = untiled_surface(plan, surface_method, mesh, &grid, &opts, (&mut gpu, &mut warnings))?;
-        (v, r, surface_method.name(), Value::Null)
+        (v, r, surface_method.name(), None)
     };
     if stop.is_some_and(Stop::requested) {
         return Err(JobError::Interrupted);
@@ -224,7 +227,7 @@ fn untiled_surface(
     mesh: MeshRef<'_>,
     grid: &GridSpec,
     opts: &Options<'_>,
-    out: (&mut Value, &mut Vec<String>),
+    out: (&mut Option<GpuFacts>, &mut Vec<String>),
 ) -> Result<(Voxels, Report)> {
     let mode = plan.core;
     Ok(match method {
@@ -243,7 +246,7 @@ fn untiled_surface(
         }
         SurfaceMethod::Gpu => {
             let (b, r, facts, w) = gpu_voxelize(mode, plan.request.gpu_path, mesh, grid)?;
-            *out.0 = facts;
+            *out.0 = Some(facts);
             out.1.extend(w);
             (Voxels::Bricks(b), r)
         }
@@ -315,32 +318,11 @@ pub fn check_attributes_carried(plan: &Plan, v: &Voxelized) -> Result<()> {
     Ok(())
 }
 
-/// The attributes an output needs: colours where the format stores them
-/// (or a `preview` picture shows them) and the mesh has them, every array
-/// for `.vti` and, when `asked`, for `.vdb` and `.zarr`; `None` otherwise.
-/// Errors when they would not fit in memory.
-pub fn attributes_for(
-    plan: &Plan,
-    loaded: &topovox_io::LoadedMesh,
-    v: &Voxelized,
-    format: crate::output::Output,
-    (preview, asked): (bool, bool),
-    opts: &CarryOptions,
-) -> Result<Option<VoxelAttributes>> {
-    let want_colour = loaded.appearance.has_colour() && (format.has_colour() || preview);
-    Ok(if (want_colour || every_attribute(format, asked)) && !plan.is_line() {
-        check_attributes_carried(plan, v)?;
-        attributes(plan, loaded.mesh.as_ref(), &loaded.appearance, v, opts)
-    } else {
-        None
-    })
-}
-
 impl Voxelized {
     /// A solid mode's test of the mesh: closed and consistently oriented
     /// (`Some(true)`), not (`Some(false)`); `None` when nothing tested it.
     pub fn mesh_closed(&self) -> Option<bool> {
-        self.solid.get("closed").and_then(Value::as_bool)
+        self.solid.as_ref().and_then(SolidFacts::closed)
     }
 
     /// The facts `topovox voxelize --json` reports about the voxelization
@@ -395,7 +377,7 @@ fn gpu_voxelize(
     path: GpuPath,
     mesh: MeshRef<'_>,
     grid: &GridSpec,
-) -> Result<(BrickBits, Report, Value, Vec<String>)> {
+) -> Result<(BrickBits, Report, GpuFacts, Vec<String>)> {
     use topovox_gpu::GpuPath as P;
     let (gpu, gm, gp) = gpu_setup(mode, path)?;
     let fail = gpu_failed;
@@ -412,21 +394,25 @@ fn gpu_voxelize(
         None
     };
     let t = r.timings;
-    let facts = json!({
-        "path": path.to_string(),
-        "hardware_conservative": gpu.hardware_conservative(),
-        "missed_voxels": missed,
-        "adapter": gpu.adapter(),
-        "software": gpu.is_software(),
-        "gpu_triangles": r.gpu_triangles,
-        "cpu_triangles": r.cpu_triangles,
-        "upload_s": t.upload_s,
-        "gpu_s": t.voxelize_s,
-        "gpu_time_s": t.gpu_s,
-        "download_s": t.download_s,
-        "cpu_share_s": t.cpu_s,
-        "slabs": t.slabs,
-    });
+    let facts = GpuFacts {
+        path: path.to_string(),
+        adapter: gpu.adapter(),
+        software: gpu.is_software(),
+        run: crate::facts::GpuRun::Whole {
+            counts: GpuCounts {
+                hardware_conservative: gpu.hardware_conservative(),
+                gpu_triangles: r.gpu_triangles,
+                cpu_triangles: r.cpu_triangles,
+            },
+            missed_voxels: missed,
+            upload_s: t.upload_s,
+            gpu_s: t.voxelize_s,
+            gpu_time_s: t.gpu_s,
+            download_s: t.download_s,
+            cpu_share_s: t.cpu_s,
+            slabs: t.slabs,
+        },
+    };
     Ok((bits, r.report, facts, warnings))
 }
 
@@ -441,7 +427,7 @@ fn gpu_tiled(
     grid: &GridSpec,
     tile: u32,
     opts: &Options<'_>,
-) -> Result<(SparseBricks, Report, Value)> {
+) -> Result<(SparseBricks, Report, GpuFacts)> {
     if path == GpuPath::MsaaApprox {
         return Err(JobError::invalid(
             "--gpu-path msaa-approx does not run tiled (it is checked against a whole-grid run); use compute or raster",
@@ -458,15 +444,15 @@ fn gpu_tiled(
     })
     .map_err(|e| JobError::invalid(e.to_string()))?
     .map_err(gpu_failed)?;
-    let facts = json!({
-        "path": path.to_string(),
-        "hardware_conservative": gpu.hardware_conservative(),
-        "adapter": gpu.adapter(),
-        "software": gpu.is_software(),
-        "gpu_triangles": c[0],
-        "cpu_triangles": c[1],
-        "tiles": c[2],
-    });
+    let facts = GpuFacts {
+        path: path.to_string(),
+        adapter: gpu.adapter(),
+        software: gpu.is_software(),
+        run: crate::facts::GpuRun::Tiled {
+            counts: GpuCounts { hardware_conservative: gpu.hardware_conservative(), gpu_triangles: c[0], cpu_triangles: c[1] },
+            tiles: c[2],
+        },
+    };
     Ok((s, r, facts))
 }
 
@@ -478,7 +464,7 @@ fn gpu_tiled(
     _grid: &GridSpec,
     _tile: u32,
     _opts: &Options<'_>,
-) -> Result<(SparseBricks, Report, Value)> {
+) -> Result<(SparseBricks, Report, GpuFacts)> {
     Err(no_gpu())
 }
 
@@ -494,6 +480,6 @@ fn gpu_voxelize(
     _path: GpuPath,
     _mesh: MeshRef<'_>,
     _grid: &GridSpec,
-) -> Result<(BrickBits, Report, Value, Vec<String>)> {
+) -> Result<(BrickBits, Report, GpuFacts, Vec<String>)> {
     Err(no_gpu())
 }

@@ -1,7 +1,6 @@
 //! The solid modes: choosing the method, running it, and the
 //! `solid+surface`, `fill flood` and `hollow` variants.
 
-use serde_json::{json, Value};
 use topovox::grid::dense::DenseBits;
 use topovox::grid::sparse::SparseBricks;
 use topovox::voxelize::{self, fill, solid, winding, Options, Stop};
@@ -10,6 +9,7 @@ use topovox::{GridSpec, MeshRef};
 use topovox::query::{Inside, Sign};
 
 use crate::error::{JobError, Result};
+use crate::facts::{ExactFacts, SolidFacts, SolidMade, WindingFacts};
 use crate::plan::{SolidMethod, SolidPlan};
 
 /// A solid and what was done to get it.
@@ -19,7 +19,7 @@ pub struct Outcome {
     /// The method that ran.
     pub method: &'static str,
     /// Facts for the summary and JSON.
-    pub facts: Value,
+    pub facts: SolidFacts,
     /// Things the user should know (an open mesh under parity, a leaking shell).
     pub warnings: Vec<String>,
 }
@@ -49,7 +49,7 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         if rep.enclosed == 0 {
             warnings.push(flood_leak_warning(surface));
         }
-        (bits, "flood", json!({"shell": surface.name(), "shell_voxels": rep.shell, "enclosed_voxels": rep.enclosed}))
+        (bits, "flood", SolidFacts::new(SolidMade::Flood { shell: surface.name(), shell_voxels: rep.shell, enclosed_voxels: rep.enclosed }))
     } else {
         // Snapped once: the closedness test and whichever method runs share it.
         let snapped = topovox::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
@@ -83,7 +83,7 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
             }
             SolidMethod::Auto | SolidMethod::Winding => {
                 let (b, r) = winding::winding_snapped(&snapped, dims, stop);
-                gwn = Some(json!({"boundary_cycles": r.cycles, "cap_triangles": r.cap_triangles, "evaluated_voxels": r.evaluated}));
+                gwn = Some(WindingFacts::from(&r));
                 near_half = r.near_half;
                 (b, r.solid, "winding")
             }
@@ -111,20 +111,18 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         let rule = if method == "parity" || method == "gpu-parity" { Sign::Parity } else { Sign::Winding };
         let (checked, fixes) = exact_fixes(mesh, grid, (rule, watertight), &near_half, stop, |[i, j, k]| bits.get(i, j, k));
         let changed = apply(&mut bits, &fixes);
-        let mut facts = mesh_facts(&rep);
-        facts["generalized_winding"] = gwn.unwrap_or(Value::Null);
-        facts["exact"] = json!({"checked_voxels": checked, "changed_voxels": changed});
-        (bits, method, facts)
+        let exact = ExactFacts { checked_voxels: checked, changed_voxels: changed as u64 };
+        (bits, method, SolidFacts::new(SolidMade::mesh(&rep, gwn, exact)))
     };
     if plan.surface.is_some() && plan.method != SolidMethod::Flood {
         let surface = plan.surface.unwrap_or(voxelize::Mode::Cover);
         let (shell, _) = voxelize::fast(surface, mesh, grid, opts);
         topovox::VoxelSource::for_each_set(&shell, &mut |i, j, k| bits.set(i, j, k));
-        facts["surface"] = json!(surface.name());
+        facts.surface = Some(surface.name());
     }
     if let Some(conn) = plan.hollow {
         bits = fill::hollow(&bits, conn);
-        facts["hollow"] = json!(if conn == topovox::topology::runs::Connectivity::Six { 6 } else { 26 });
+        facts.hollow = Some(connectivity(conn));
     }
     Ok(Outcome { bits, method, facts, warnings })
 }
@@ -136,7 +134,7 @@ pub struct SparseOutcome {
     /// The method that ran.
     pub method: &'static str,
     /// Facts for the summary and JSON.
-    pub facts: Value,
+    pub facts: SolidFacts,
     /// Things the user should know.
     pub warnings: Vec<String>,
 }
@@ -170,8 +168,8 @@ pub fn run_sparse(
         if rep.enclosed == 0 {
             warnings.push(flood_leak_warning(surface));
         }
-        let mut facts =
-            json!({"shell": surface.name(), "shell_voxels": rep.shell, "enclosed_voxels": rep.enclosed, "full_bricks": bits.full_bricks()});
+        let mut facts = SolidFacts::new(SolidMade::Flood { shell: surface.name(), shell_voxels: rep.shell, enclosed_voxels: rep.enclosed });
+        facts.full_bricks = Some(bits.full_bricks());
         let bits = hollow_sparse(plan, bits, &mut facts);
         return Ok(SparseOutcome { bits, method: "flood", facts, warnings });
     }
@@ -196,7 +194,7 @@ pub fn run_sparse(
         }
         _ if !watertight => {
             let (b, r) = winding::winding_sparse(&snapped, dims, stop);
-            gwn = Some(json!({"boundary_cycles": r.cycles, "cap_triangles": r.cap_triangles, "evaluated_voxels": r.evaluated}));
+            gwn = Some(WindingFacts::from(&r));
             near_half = r.near_half;
             (b, r.solid, "winding")
         }
@@ -214,14 +212,13 @@ pub fn run_sparse(
     let (checked, fixes) = exact_fixes(mesh, grid, (rule, watertight), &near_half, stop, |[i, j, k]| bits.get(i, j, k));
     let changed = fixes.len();
     let bits = if fixes.is_empty() { bits } else { bits.with_changes(&fixes) };
-    let mut facts = mesh_facts(&rep);
-    facts["generalized_winding"] = gwn.unwrap_or(Value::Null);
-    facts["exact"] = json!({"checked_voxels": checked, "changed_voxels": changed});
-    facts["full_bricks"] = json!(bits.full_bricks());
+    let exact = ExactFacts { checked_voxels: checked, changed_voxels: changed as u64 };
+    let mut facts = SolidFacts::new(SolidMade::mesh(&rep, gwn, exact));
+    facts.full_bricks = Some(bits.full_bricks());
     let bits = match plan.surface {
         Some(surface) => {
             let (shell, _) = voxelize::tiled::tiled(surface, mesh, grid, tile, opts).map_err(|e| JobError::invalid(e.to_string()))?;
-            facts["surface"] = json!(surface.name());
+            facts.surface = Some(surface.name());
             bits.union(&shell)
         }
         None => bits,
@@ -231,10 +228,10 @@ pub fn run_sparse(
 }
 
 /// `--hollow` on a sparse solid, if the plan asks.
-fn hollow_sparse(plan: &SolidPlan, bits: SparseBricks, facts: &mut Value) -> SparseBricks {
+fn hollow_sparse(plan: &SolidPlan, bits: SparseBricks, facts: &mut SolidFacts) -> SparseBricks {
     match plan.hollow {
         Some(conn) => {
-            facts["hollow"] = json!(if conn == topovox::topology::runs::Connectivity::Six { 6 } else { 26 });
+            facts.hollow = Some(connectivity(conn));
             fill::hollow_sparse(&bits, conn)
         }
         None => bits,
@@ -290,13 +287,11 @@ fn apply(bits: &mut DenseBits, fixes: &[([u32; 3], bool)]) -> usize {
     changed
 }
 
-/// What the solid learned about the mesh's closedness, as the JSON summary
-/// reports it (dense and sparse runs alike).
-fn mesh_facts(rep: &solid::SolidReport) -> Value {
-    json!({
-        "closed": rep.boundary_edges == 0,
-        "consistently_oriented": rep.unbalanced_edges == 0,
-        "boundary_edges": rep.boundary_edges,
-        "inconsistent_edges": rep.unbalanced_edges,
-    })
+/// The connectivity `--hollow` kept, as the summary says it.
+fn connectivity(conn: topovox::topology::runs::Connectivity) -> u8 {
+    if conn == topovox::topology::runs::Connectivity::Six {
+        6
+    } else {
+        26
+    }
 }

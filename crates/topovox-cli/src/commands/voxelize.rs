@@ -62,7 +62,7 @@ struct Times {
 
 /// The summary line, or with `--json` the JSON object.
 fn print_summary(a: &VoxelizeArgs, job: &VoxelizeJob, loaded: &topovox_io::LoadedMesh, done: &Done, t: &Times) -> Result<()> {
-    let (opts, format, plan) = (&a.job.options, job.format, &job.plan);
+    let (opts, format, plan) = (&a.job.options, job.format, job.plan());
     let (v, grid, attrs) = (&done.voxels, done.voxels.grid, done.attributes.as_ref());
     let (load_s, total_s, threads) = (t.load_s, t.total_s, t.threads);
     let (write_s, attributes_s, export_facts) = (done.write_s, done.attributes_s, &done.export);
