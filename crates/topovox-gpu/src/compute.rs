@@ -144,29 +144,7 @@ impl Gpu {
         dims: [u32; 3],
     ) -> Result<(BrickBits, CoverReport), GpuError> {
         let t0 = Instant::now();
-        let mut on_gpu: Vec<(GpuTri, [i64; 2])> = Vec::with_capacity(tris.len());
-        let mut on_cpu: Vec<LatticeTriangle> = Vec::new();
-        for t in tris {
-            let Some((lo, hi)) = t.voxel_bounds(dims) else { continue };
-            let base = lo.map(|c| c * ONE);
-            let rel = t.v.map(|p| [p[0] - base[0], p[1] - base[1], p[2] - base[2]]);
-            let box_reach = (0..3).map(|a| (hi[a] - lo[a] + 2) * ONE).max().unwrap_or(0);
-            let reach = rel.iter().flatten().map(|c| c.abs()).max().unwrap_or(0).max(box_reach);
-            if reach > mode.limit() {
-                on_cpu.push(*t);
-                continue;
-            }
-            let v = |p: [i64; 3]| [p[0] as i32, p[1] as i32, p[2] as i32, 0];
-            let g = GpuTri {
-                origin: [lo[0] as i32, lo[1] as i32, lo[2] as i32, 0],
-                size: [(hi[0] - lo[0] + 1) as u32, (hi[1] - lo[1] + 1) as u32, (hi[2] - lo[2] + 1) as u32, 0],
-                a: v(rel[0]),
-                b: v(rel[1]),
-                c: v(rel[2]),
-            };
-            on_gpu.push((g, [lo[2], hi[2]]));
-        }
-        on_gpu.sort_by_key(|t| t.1[0]);
+        let (on_gpu, on_cpu) = split_triangles(mode, tris, dims);
         let mut timings = Timings { upload_s: t0.elapsed().as_secs_f64(), ..Timings::default() };
 
         let slabs = self.slabs(dims)?;
@@ -205,57 +183,20 @@ impl Gpu {
                 match &target {
                     None => self.compute_pass(&mut encoder, &slabs, passes, &self.cover, &bind, batch.len() as u32),
                     Some(view) => {
-                        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                            label: Some("raster"),
-                            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                                view,
-                                depth_slice: None,
-                                resolve_target: None,
-                                ops: wgpu::Operations {
-                                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                                    store: wgpu::StoreOp::Discard,
-                                },
-                            })],
-                            depth_stencil_attachment: None,
-                            timestamp_writes: slabs.render_timestamps(passes),
-                            occlusion_query_set: None,
-                            multiview_mask: None,
-                        });
-                        pass.set_pipeline(if path == GpuPath::MsaaApprox { &self.raster.msaa } else { &self.raster.conservative });
-                        pass.set_bind_group(0, &bind, &[]);
+                        let pipeline = if path == GpuPath::MsaaApprox { &self.raster.msaa } else { &self.raster.conservative };
                         let per = if expand != 0 { 6 } else { 3 };
-                        pass.draw(0..per * batch.len() as u32, 0..1);
+                        raster_pass(&mut encoder, view, slabs.render_timestamps(passes), pipeline, &bind, per * batch.len() as u32);
                     }
                 }
                 passes += 1;
                 keep.push((tri_buf, par_buf, bind));
             }
             timings.upload_s += t_up.elapsed().as_secs_f64();
-            let done = self.finish_slab(&slabs, encoder, nk, passes, |words| {
-                for (row, chunk) in words.chunks_exact(words_per_row as usize).enumerate() {
-                    let (j, k) = (row as u32 % dims[1], k0 + row as u32 / dims[1]);
-                    for (w, &word) in chunk.iter().enumerate() {
-                        let mut m = word;
-                        while m != 0 {
-                            let b = m.trailing_zeros();
-                            m &= m - 1;
-                            bits.set(w as u32 * 32 + b, j, k);
-                        }
-                    }
-                }
-            })?;
+            let done = self.finish_slab(&slabs, encoder, nk, passes, |words| unpack_rows(words, words_per_row, k0, &mut bits))?;
             timings.add_slab(done);
         }
         let t_cpu = Instant::now();
-        if !on_cpu.is_empty() {
-            let o = Options::default();
-            let cpu = match mode {
-                GpuMode::Cover => topovox::voxelize::cover::cover_lattice(&on_cpu, dims, &o),
-                GpuMode::Sep26 => topovox::voxelize::sep26::sep26_lattice(&on_cpu, dims, &o),
-                GpuMode::Sep6 => topovox::voxelize::sep6::sep6_lattice(&on_cpu, dims, &o),
-            };
-            cpu.for_each_set(&mut |i, j, k| bits.set(i, j, k));
-        }
+        cpu_share(mode, &on_cpu, &mut bits);
         timings.cpu_s = t_cpu.elapsed().as_secs_f64();
         let voxels = bits.count();
         let report = CoverReport {
@@ -266,4 +207,95 @@ impl Gpu {
         };
         Ok((bits, report))
     }
+}
+
+/// Splits `tris` into those the shader takes (relative to their voxel
+/// box's corner, with their z range, sorted by it) and those whose
+/// coordinates pass the mode's i32 limit (the CPU's share); triangles
+/// outside the grid are dropped.
+fn split_triangles(mode: GpuMode, tris: &[LatticeTriangle], dims: [u32; 3]) -> (Vec<(GpuTri, [i64; 2])>, Vec<LatticeTriangle>) {
+    let mut on_gpu: Vec<(GpuTri, [i64; 2])> = Vec::with_capacity(tris.len());
+    let mut on_cpu: Vec<LatticeTriangle> = Vec::new();
+    for t in tris {
+        let Some((lo, hi)) = t.voxel_bounds(dims) else { continue };
+        let base = lo.map(|c| c * ONE);
+        let rel = t.v.map(|p| [p[0] - base[0], p[1] - base[1], p[2] - base[2]]);
+        let box_reach = (0..3).map(|a| (hi[a] - lo[a] + 2) * ONE).max().unwrap_or(0);
+        let reach = rel.iter().flatten().map(|c| c.abs()).max().unwrap_or(0).max(box_reach);
+        if reach > mode.limit() {
+            on_cpu.push(*t);
+            continue;
+        }
+        let v = |p: [i64; 3]| [p[0] as i32, p[1] as i32, p[2] as i32, 0];
+        let g = GpuTri {
+            origin: [lo[0] as i32, lo[1] as i32, lo[2] as i32, 0],
+            size: [(hi[0] - lo[0] + 1) as u32, (hi[1] - lo[1] + 1) as u32, (hi[2] - lo[2] + 1) as u32, 0],
+            a: v(rel[0]),
+            b: v(rel[1]),
+            c: v(rel[2]),
+        };
+        on_gpu.push((g, [lo[2], hi[2]]));
+    }
+    on_gpu.sort_by_key(|t| t.1[0]);
+    (on_gpu, on_cpu)
+}
+
+/// One raster pass drawing `vertices` into `view` (its colour discarded:
+/// the fragment shader writes the slab).
+fn raster_pass(
+    encoder: &mut wgpu::CommandEncoder,
+    view: &wgpu::TextureView,
+    timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    pipeline: &wgpu::RenderPipeline,
+    bind: &wgpu::BindGroup,
+    vertices: u32,
+) {
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("raster"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Discard },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, bind, &[]);
+    pass.draw(0..vertices, 0..1);
+}
+
+/// Sets in `bits` the voxels of a slab read back from layer `k0`: rows of
+/// `words_per_row` 32-bit words, one row per (j, k), j fastest.
+fn unpack_rows(words: &[u32], words_per_row: u64, k0: u32, bits: &mut BrickBits) {
+    let ny = bits.dims()[1];
+    for (row, chunk) in words.chunks_exact(words_per_row as usize).enumerate() {
+        let (j, k) = (row as u32 % ny, k0 + row as u32 / ny);
+        for (w, &word) in chunk.iter().enumerate() {
+            let mut m = word;
+            while m != 0 {
+                let b = m.trailing_zeros();
+                m &= m - 1;
+                bits.set(w as u32 * 32 + b, j, k);
+            }
+        }
+    }
+}
+
+/// The CPU's share (`on_cpu`, too large for the shader), voxelized by
+/// the same mode into `bits`.
+fn cpu_share(mode: GpuMode, on_cpu: &[LatticeTriangle], bits: &mut BrickBits) {
+    if on_cpu.is_empty() {
+        return;
+    }
+    let (o, dims) = (Options::default(), bits.dims());
+    let cpu = match mode {
+        GpuMode::Cover => topovox::voxelize::cover::cover_lattice(on_cpu, dims, &o),
+        GpuMode::Sep26 => topovox::voxelize::sep26::sep26_lattice(on_cpu, dims, &o),
+        GpuMode::Sep6 => topovox::voxelize::sep6::sep6_lattice(on_cpu, dims, &o),
+    };
+    cpu.for_each_set(&mut |i, j, k| bits.set(i, j, k));
 }

@@ -140,11 +140,54 @@ impl<'t> SpanSetup<'t> {
         // the plane value at the line's point; along a row F steps by
         // the quotient and remainder of V's step by |g|.
         let big_g = g.abs();
-        let v00 = dot(s.n, b) - s.bn;
         let (vx, vy) = (ONE * step * s.n[p], ONE * step * s.n[q]);
         let (qx, rx) = div_floor(vx, big_g);
         let sg = if g > 0 { -1 } else { 1 };
-        let (hq, hs) = (sg * qx, sg);
+        let rows = Rows { g, big_g, v00: dot(s.n, b) - s.bn, vx, vy, rx, hq: sg * qx, hs: sg, first: [x0, y0, zi], step, lo, hi };
+        let nx = (x1 - x0) / step;
+        let mut w = walkers;
+        for dy in 0..=(y1 - y0) / step {
+            if dy > 0 {
+                for x in w.iter_mut() {
+                    x.step();
+                }
+            }
+            let (mut a0, mut a1) = (0, nx);
+            for x in &w {
+                x.clip(&mut a0, &mut a1);
+            }
+            if a0 <= a1 {
+                rows.row::<O, Z, UP, UQ, UZ>(dy, (a0, a1), out);
+            }
+        }
+    }
+}
+
+/// The rows of lines [`Spans::emit`] walks: the plane value's steps and
+/// the first line's indices.
+struct Rows {
+    g: i64,
+    big_g: i64,
+    v00: i64,
+    vx: i64,
+    vy: i64,
+    rx: i64,
+    hq: i64,
+    hs: i64,
+    first: [i64; 3],
+    step: i64,
+    lo: [i64; 3],
+    hi: [i64; 3],
+}
+
+impl Rows {
+    /// Row `dy`'s lines `a0..=a1`: sets the voxel each line's straddling
+    /// segment lies in, inside the box. Inlined into `emit`'s loop.
+    #[inline(always)]
+    fn row<O: Sink, const Z: usize, const UP: i64, const UQ: i64, const UZ: i64>(&self, dy: i64, (a0, a1): (i64, i64), out: &mut O) {
+        let (p, q, z) = ((Z + 1) % 3, (Z + 2) % 3, Z);
+        let (lo, hi, [x0, y0, zi], step) = (self.lo, self.hi, self.first, self.step);
+        let (np, nq, nz) = (hi[p] - lo[p], hi[q] - lo[q], hi[z] - lo[z]);
         // The voxel of segment m along a line: its index plus m where u
         // steps up, minus m + 1 where it steps down.
         let along = |c: i64, m: i64| {
@@ -156,43 +199,26 @@ impl<'t> SpanSetup<'t> {
                 0
             }
         };
-        let (np, nq, nz) = (hi[p] - lo[p], hi[q] - lo[q], hi[z] - lo[z]);
-        let (nx, ny) = ((x1 - x0) / step, (y1 - y0) / step);
-        let mut w = walkers;
-        for dy in 0..=ny {
-            if dy > 0 {
-                for x in w.iter_mut() {
-                    x.step();
-                }
+        let (f, mut r) = div_floor(self.v00 + self.vy * dy + self.vx * a0, self.big_g);
+        let mut h = if self.g > 0 { -f - 1 } else { f };
+        // Voxel indices relative to the box's low corner.
+        let mut ip = x0 + a0 * step - lo[p];
+        let (iq, iz) = (y0 + dy * step - lo[q], zi - lo[z]);
+        for _ in a0..=a1 {
+            let m = h >> ONE_SHIFT;
+            let (vp, vq, vz) = (ip + along(UP, m), iq + along(UQ, m), iz + along(UZ, m));
+            // Inside the box: each index in 0 ..= its width, as unsigned.
+            if (vp as u64 <= np as u64) & (vq as u64 <= nq as u64) & (vz as u64 <= nz as u64) {
+                let mut ijk = [0i64; 3];
+                (ijk[p], ijk[q], ijk[z]) = (vp + lo[p], vq + lo[q], vz + lo[z]);
+                out.set(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
             }
-            let (mut a0, mut a1) = (0, nx);
-            for x in &w {
-                x.clip(&mut a0, &mut a1);
-            }
-            if a0 > a1 {
-                continue;
-            }
-            let (f, mut r) = div_floor(v00 + vy * dy + vx * a0, big_g);
-            let mut h = if g > 0 { -f - 1 } else { f };
-            // Voxel indices relative to the box's low corner.
-            let mut ip = x0 + a0 * step - lo[p];
-            let (iq, iz) = (y0 + dy * step - lo[q], zi - lo[z]);
-            for _ in a0..=a1 {
-                let m = h >> ONE_SHIFT;
-                let (vp, vq, vz) = (ip + along(UP, m), iq + along(UQ, m), iz + along(UZ, m));
-                // Inside the box: each index in 0 ..= its width, as unsigned.
-                if (vp as u64 <= np as u64) & (vq as u64 <= nq as u64) & (vz as u64 <= nz as u64) {
-                    let mut ijk = [0i64; 3];
-                    (ijk[p], ijk[q], ijk[z]) = (vp + lo[p], vq + lo[q], vz + lo[z]);
-                    out.set(ijk[0] as u32, ijk[1] as u32, ijk[2] as u32);
-                }
-                ip += step;
-                h += hq;
-                r += rx;
-                if r >= big_g {
-                    r -= big_g;
-                    h += hs;
-                }
+            ip += step;
+            h += self.hq;
+            r += self.rx;
+            if r >= self.big_g {
+                r -= self.big_g;
+                h += self.hs;
             }
         }
     }

@@ -36,7 +36,7 @@ use super::{Options, Report};
 use crate::geom::fixed::{PlaneInt, ONE};
 use crate::geom::lattice::LatticeTriangle;
 use crate::geom::perturb::P3;
-use crate::geom::setup::{dominant_axes, fits_i64, TriSetup};
+use crate::geom::setup::{dominant_axes, fits_i64, DirSetup, TriSetup};
 use crate::grid::bricks::{BoxBricks, BrickBits, BrickSlab};
 use crate::grid::spec::GridSpec;
 use crate::mesh::MeshRef;
@@ -237,58 +237,8 @@ fn project_w<T: PlaneInt, const W: usize, const DEFER: bool>(
             debug_assert!(!b.misses());
             let (ta, tb) = (plane.t0.max(lo[w]), plane.t1.min(hi[w]));
             if ta <= tb {
-                // Edges the pixel lies strictly inside of: a diagonal's
-                // crossing with the plane lies in the voxel, so projects into
-                // the pixel, and those edges' tests are known to pass.
-                let safe = b.strictly_inside_edges();
-                let all_safe = safe == [true; 3];
-                // The steepest diagonal crosses the plane in every voxel of
-                // the range: its edge values at the column's first voxel,
-                // then stepped along t (additions), decide most voxels.
-                let mut steep = [T::ZERO; 3];
-                if !all_safe {
-                    let mut corner = [0i64; 3];
-                    (corner[u], corner[v], corner[w]) = (iu * ONE, iv * ONE, ta * ONE);
-                    let p = s.local(corner);
-                    steep = s.line_values(&dirs[0].2, [p[0] + dirs[0].0[0], p[1] + dirs[0].0[1], p[2] + dirs[0].0[2]]);
-                }
-                for t in ta..=tb {
-                    let mut ijk = [0u32; 3];
-                    (ijk[u], ijk[v], ijk[w]) = (iu as u32, iv as u32, t as u32);
-                    // The corners straddle the plane, so the steepest
-                    // diagonal crosses it; the other three only matter
-                    // where it misses the triangle. With the slab driver
-                    // they are tested later, and only if no other
-                    // triangle has set the voxel by then (at 1024³, 1.9 M
-                    // voxels here, 32 k of them still unset then);
-                    // otherwise now, for the edges not known to pass.
-                    let others = || {
-                        let mut corner = [0i64; 3];
-                        (corner[u], corner[v], corner[w]) = (iu * ONE, iv * ONE, t * ONE);
-                        let p = s.local(corner);
-                        let vc = s.plane(p);
-                        dirs[1..]
-                            .iter()
-                            .any(|(o, vo, ds)| s.segment_hits_unsafe_edges(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]], vc + *vo, safe))
-                    };
-                    let hit = all_safe
-                        || dirs[0].2.inside(&steep)
-                        || if DEFER {
-                            deferred.push(ijk[0], ijk[1], ijk[2]);
-                            false
-                        } else {
-                            others()
-                        };
-                    if hit {
-                        match buf.as_deref_mut() {
-                            Some(b) => b.set(ijk[0], ijk[1], ijk[2]),
-                            None => slab.set(ijk[0], ijk[1], ijk[2]),
-                        }
-                    }
-                    for (x, d) in steep.iter_mut().zip(&steep_w) {
-                        *x = *x + *d;
-                    }
-                }
+                let col = Column { iu, iv, ta, tb, safe: b.strictly_inside_edges() };
+                column::<T, DEFER>(&s, &dirs, (u, v, w), &steep_w, col, (slab, buf.as_deref_mut(), deferred));
             }
             if iu == a1 {
                 break;
@@ -296,6 +246,82 @@ fn project_w<T: PlaneInt, const W: usize, const DEFER: bool>(
             iu += 1;
             plane.next_column(nu, nw);
             b.step(&delta);
+        }
+    }
+}
+
+/// A column of one pixel (`iu`, `iv`) of [`project_w`]'s projection:
+/// the voxels `ta..=tb` along `w` whose corners straddle the plane, and
+/// the pixel's edges it lies strictly inside of (`safe`).
+#[derive(Clone, Copy)]
+struct Column {
+    iu: i64,
+    iv: i64,
+    ta: i64,
+    tb: i64,
+    safe: [bool; 3],
+}
+
+/// Sets the voxels of `col` that meet the triangle (`s`, its diagonal
+/// directions `dirs`, the steepest first): into `buf` if given, else
+/// `slab`; with `DEFER`, the voxels only the other three diagonals could
+/// decide go to `deferred`. Inlined into [`project_w`]'s loop.
+#[inline(always)]
+fn column<T: PlaneInt, const DEFER: bool>(
+    s: &TriSetup<T>,
+    dirs: &[([T; 3], T, DirSetup<T>); 4],
+    (u, v, w): (usize, usize, usize),
+    steep_w: &[T; 3],
+    col: Column,
+    (slab, mut buf, deferred): (&mut BrickSlab<'_>, Option<&mut BoxBricks>, &mut Deferred<LatticeTriangle>),
+) {
+    let Column { iu, iv, ta, tb, safe } = col;
+    // Edges the pixel lies strictly inside of: a diagonal's crossing with
+    // the plane lies in the voxel, so projects into the pixel, and those
+    // edges' tests are known to pass.
+    let all_safe = safe == [true; 3];
+    // The steepest diagonal crosses the plane in every voxel of the range:
+    // its edge values at the column's first voxel, then stepped along t
+    // (additions), decide most voxels.
+    let mut steep = [T::ZERO; 3];
+    if !all_safe {
+        let mut corner = [0i64; 3];
+        (corner[u], corner[v], corner[w]) = (iu * ONE, iv * ONE, ta * ONE);
+        let p = s.local(corner);
+        steep = s.line_values(&dirs[0].2, [p[0] + dirs[0].0[0], p[1] + dirs[0].0[1], p[2] + dirs[0].0[2]]);
+    }
+    for t in ta..=tb {
+        let mut ijk = [0u32; 3];
+        (ijk[u], ijk[v], ijk[w]) = (iu as u32, iv as u32, t as u32);
+        // The corners straddle the plane, so the steepest diagonal crosses
+        // it; the other three only matter where it misses the triangle.
+        // With the slab driver they are tested later, and only if no other
+        // triangle has set the voxel by then (at 1024³, 1.9 M voxels here,
+        // 32 k of them still unset then); otherwise now, for the edges not
+        // known to pass.
+        let others = || {
+            let mut corner = [0i64; 3];
+            (corner[u], corner[v], corner[w]) = (iu * ONE, iv * ONE, t * ONE);
+            let p = s.local(corner);
+            let vc = s.plane(p);
+            dirs[1..].iter().any(|(o, vo, ds)| s.segment_hits_unsafe_edges(ds, [p[0] + o[0], p[1] + o[1], p[2] + o[2]], vc + *vo, safe))
+        };
+        let hit = all_safe
+            || dirs[0].2.inside(&steep)
+            || if DEFER {
+                deferred.push(ijk[0], ijk[1], ijk[2]);
+                false
+            } else {
+                others()
+            };
+        if hit {
+            match buf.as_deref_mut() {
+                Some(b) => b.set(ijk[0], ijk[1], ijk[2]),
+                None => slab.set(ijk[0], ijk[1], ijk[2]),
+            }
+        }
+        for (x, d) in steep.iter_mut().zip(steep_w) {
+            *x = *x + *d;
         }
     }
 }
