@@ -154,10 +154,7 @@ impl VoxelizeJob {
     /// `inputs`.
     pub fn prepare(options: &JobOptions, out: &Path, format: Output, inputs: &[PathBuf], preview: Option<&Path>) -> Result<VoxelizeJob> {
         crate::output::check_output_path(out)?;
-        crate::output::refuse_overwriting(out, format, inputs)?;
-        if let Some(p) = preview {
-            topovox_io::atomic::refuse_overwriting_inputs(p, inputs)?;
-        }
+        crate::output::refuse_overwriting_any(&written(out, format, preview), inputs)?;
         VoxelizeJob::new(options, format, preview)
     }
 
@@ -190,10 +187,7 @@ impl VoxelizeJob {
         stop: Option<&Arc<Stop>>,
     ) -> Result<Done> {
         // Nor any file the mesh led to (its .mtl, textures, buffers).
-        crate::output::refuse_overwriting(out, self.format, &loaded.sources)?;
-        if let Some(p) = &self.preview {
-            topovox_io::atomic::refuse_overwriting_inputs(p, &loaded.sources)?;
-        }
+        crate::output::refuse_overwriting_any(&written(out, self.format, self.preview.as_deref()), &loaded.sources)?;
         // A dense format for a grid past memory is refused before any work.
         let fitted = self.plan().request.grid.fit(&loaded.mesh.as_ref().bounds())?;
         crate::output::check_fits(self.format, &fitted, self.plan().request.max_memory)?;
@@ -206,6 +200,12 @@ impl VoxelizeJob {
         let export = crate::output::write(out, self.format, &v.voxels, &v.grid, made.attributes.as_ref(), &write)?;
         Ok(Done { voxels: v, attributes: made.attributes, export, attributes_s: made.attributes_s, write_s: t.elapsed().as_secs_f64() })
     }
+}
+
+/// Every file a voxelize run writes for `out` in `format`: the output's
+/// (a `.obj`'s `.mtl`, …) and the `preview`.
+fn written(out: &Path, format: Output, preview: Option<&Path>) -> Vec<PathBuf> {
+    crate::output::files_written(out, format).into_iter().chain(preview.map(Path::to_path_buf)).collect()
 }
 
 /// A distance-field job checked before any mesh is read.

@@ -190,8 +190,13 @@ pub fn files_written(out: &Path, target: Output) -> Vec<std::path::PathBuf> {
 /// it) that is one of `inputs` by identity — the same file by any name,
 /// link or hard link: one line naming both.
 pub fn refuse_overwriting(out: &Path, target: Output, inputs: &[std::path::PathBuf]) -> Result<()> {
-    for f in files_written(out, target) {
-        topovox_io::atomic::refuse_overwriting_inputs(&f, inputs)?;
+    refuse_overwriting_any(&files_written(out, target), inputs)
+}
+
+/// Refuses, before any work, when any of `outputs` is one of `inputs`.
+pub fn refuse_overwriting_any(outputs: &[std::path::PathBuf], inputs: &[std::path::PathBuf]) -> Result<()> {
+    for f in outputs {
+        topovox_io::atomic::refuse_overwriting_inputs(f, inputs)?;
     }
     Ok(())
 }
