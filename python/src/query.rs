@@ -126,7 +126,7 @@ pub fn sample<'py>(py: Python<'py>, mesh: &Mesh, options: Option<&Bound<'py, PyD
     let opts: SampleOptions = table_options(options, &[])?;
     let pool = pool(opts.run.threads)?;
     let (inner, name) = (mesh.inner.clone(), mesh.name());
-    let work = || topovox_job::sample::sample(inner.mesh.as_ref(), &name, &opts);
+    let work = || topovox_job::sample::sample(&inner, &name, &opts);
     let s = py
         .detach(|| match &pool {
             Some(p) => p.install(work),
@@ -140,6 +140,9 @@ pub fn sample<'py>(py: Python<'py>, mesh: &Mesh, options: Option<&Bound<'py, PyD
     d.set_item("occupancy", Array1::from_iter(samples.occupancy.iter().map(|&o| u8::from(o))).into_pyarray(py))?;
     d.set_item("normals", Array2::from_shape_fn((n, 3), |(i, a)| samples.normals[i][a]).into_pyarray(py))?;
     d.set_item("kind", Array1::from_iter(samples.kind.iter().map(|&k| k as u8)).into_pyarray(py))?;
+    if let Some(c) = &s.colours {
+        d.set_item("colours", Array2::from_shape_fn((n, 3), |(i, a)| c[i][a]).into_pyarray(py))?;
+    }
     d.set_item("offset", Array1::from(s.offset.to_array().to_vec()).into_pyarray(py))?;
     d.set_item("scale", s.scale)?;
     d.set_item("bounds", Array2::from_shape_fn((2, 3), |(r, a)| if r == 0 { s.bounds.0[a] } else { s.bounds.1[a] }).into_pyarray(py))?;

@@ -2,6 +2,8 @@
 distances and brute force, equal to the grids at voxel centres, and
 reproducible for a seed on any thread count."""
 
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -203,3 +205,64 @@ def test_batch_dask_and_the_cli_sample_folders_resumably(meshes, cli, tmp_path):
     bag.compute(scheduler="synchronous")
     for rel in ["cow.npz", "sub/teapot.npz"]:
         assert (tmp_path / "dask" / rel).read_bytes() == (py_out / rel).read_bytes(), rel
+
+
+def _srgb_to_linear(c):
+    s = np.asarray(c, dtype=np.float64) / 255.0
+    return np.where(s <= 0.04045, s / 12.92, ((s + 0.055) / 1.055) ** 2.4)
+
+
+def _linear_to_srgb(l):
+    l = np.clip(l, 0.0, 1.0)
+    return np.where(l <= 0.0031308, l * 12.92, 1.055 * l ** (1 / 2.4) - 0.055)
+
+
+def test_surface_samples_carry_the_colour_at_their_point(tmp_path, cli):
+    # A unit square of two triangles with a colour per corner (PLY), so
+    # each surface point's colour is its corners' colours interpolated in
+    # linear light, computed here from the point alone.
+    corners = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=np.float64)
+    rgb = np.array([[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]])
+    ply = tmp_path / "square.ply"
+    lines = ["ply", "format ascii 1.0", "element vertex 4", "property float x", "property float y", "property float z",
+             "property uchar red", "property uchar green", "property uchar blue", "element face 2",
+             "property list uchar int vertex_indices", "end_header"]
+    lines += [f"{x} {y} {z} {r} {g} {b}" for (x, y, z), (r, g, b) in zip(corners, rgb)]
+    lines += ["3 0 1 2", "3 0 2 3"]
+    ply.write_text("\n".join(lines) + "\n")
+    s = topovox.sample(ply, surface=2000, near=50, sigma=0.1, uniform=50, seed=3)
+    c = s["colours"]
+    assert c.shape == (2100, 3) and c.dtype == np.float32
+    surf = s["kind"] == 0
+    assert np.isnan(c[~surf]).all() and not np.isnan(c[surf]).any()
+    x, y = s["points"][surf, 0], s["points"][surf, 1]
+    lower = y <= x  # triangle (0, 1, 2): weights (1 - x, x - y, y); else (0, 2, 3): (1 - y, x, y - x)
+    w = np.where(lower[:, None], np.stack([1 - x, x - y, y], 1), np.stack([1 - y, x, y - x], 1))
+    lin = _srgb_to_linear(rgb)
+    tri = np.where(lower[:, None, None], lin[[0, 1, 2]][None], lin[[0, 2, 3]][None])
+    want = np.round(_linear_to_srgb(np.einsum("nc,nca->na", w, tri)) * 255) / 255
+    # Points on the diagonal may take either triangle; elsewhere exact to a byte.
+    off = np.abs(x - y) > 1e-9
+    assert np.abs(c[surf][off] - want[off]).max() <= 1.0 / 255 + 1e-6
+    assert np.mean(np.all(np.abs(c[surf][off] - want[off]) < 1e-6, axis=1)) > 0.99
+    # The command line writes the same colours; a mesh without any has none.
+    out = tmp_path / "s.npz"
+    subprocess.run([cli, "sample", ply, "-o", out, "--surface", "2000", "--near", "50", "--sigma", "0.1", "--uniform", "50", "--seed", "3"], check=True, capture_output=True)
+    assert np.array_equal(np.load(out)["colours"], c, equal_nan=True)
+    v, f = corners, np.array([[0, 1, 2], [0, 2, 3]])
+    assert "colours" not in topovox.sample(v, f, surface=10)
+
+
+def test_textured_surface_samples_take_a_texel_of_their_point(meshes):
+    from PIL import Image
+
+    spot = meshes / "spot-textured.obj"
+    s = topovox.sample(spot, surface=3000, seed=2)
+    c = s["colours"]
+    assert not np.isnan(c).any() and c.shape == (3000, 3)
+    texels = np.asarray(Image.open(spot.parent / "spot_texture.png").convert("RGB")).reshape(-1, 3)
+    known = {tuple(t) for t in np.unique(texels, axis=0)}
+    got = np.round(c * 255).astype(np.uint8)
+    # Nearest-texel lookup never invents a colour.
+    assert all(tuple(g) in known for g in got)
+    assert len(np.unique(got, axis=0)) > 20

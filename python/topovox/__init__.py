@@ -852,8 +852,11 @@ def sample(
         ``points`` (N, 3) float64 — surface points first, then near, then
         uniform; ``sdf`` (N,) float64; ``occupancy`` (N,) bool; ``normals``
         (N, 3) float64 (NaN except for surface points); ``kind`` (N,) uint8
-        (0 surface, 1 near, 2 uniform); ``offset`` (3,), ``scale`` and
-        ``bounds`` (2, 3); ``info``: counts, the sign rule, times.
+        (0 surface, 1 near, 2 uniform); ``colours`` (N, 3) float32, sRGB
+        in [0, 1] (NaN except for surface points), only when the mesh has
+        colours (a texture's nearest texel, vertex colours interpolated,
+        the material's colour); ``offset`` (3,), ``scale`` and ``bounds``
+        (2, 3); ``info``: counts, the sign rule, times.
 
     Examples
     --------

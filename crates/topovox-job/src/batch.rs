@@ -661,7 +661,7 @@ fn remesh_one(job: &RemeshJob, loaded: &topovox_io::LoadedMesh, name: &str, out:
 /// The training samples of one loaded mesh, written: the record's facts.
 fn sample_one(o: &SampleOptions, loaded: &topovox_io::LoadedMesh, name: &str, out: &Path) -> Result<Value> {
     topovox_io::atomic::refuse_overwriting_inputs(out, &loaded.sources)?;
-    let s = crate::sample::sample(loaded.mesh.as_ref(), name, o)?;
+    let s = crate::sample::sample(loaded, name, o)?;
     let t = Instant::now();
     s.write(out)?;
     let summary = s.summary();

@@ -123,20 +123,26 @@ pub struct Sampled {
     pub scale: f64,
     /// The uniform points' box.
     pub bounds: (DVec3, DVec3),
+    /// The colour of each surface point (sRGB in [0, 1]; NaN for the
+    /// other kinds), when the mesh has colours.
+    pub colours: Option<Vec<[f32; 3]>>,
     /// What the query knew of the mesh.
     pub facts: QueryFacts,
     /// Seconds: building the query, drawing and measuring.
     pub seconds: (f64, f64),
 }
 
-/// Bytes a sample takes while drawn and measured (point, normal, two
-/// f64 values, flags, the Morton order) and written (f32 copies).
-const BYTES_PER_SAMPLE: u64 = 136;
+/// Bytes a sample takes while drawn and measured (point, normal, its
+/// triangle and weights, two f64 values, flags, the Morton order, a
+/// colour) and written (f32 copies).
+const BYTES_PER_SAMPLE: u64 = 188;
 
-/// Draws `options`' samples of `mesh` (`name` in errors), refusing before
-/// any work a count that does not fit in `--max-memory` (default: 90 % of
-/// the memory available).
-pub fn sample(mesh: MeshRef<'_>, name: &str, options: &SampleOptions) -> Result<Sampled> {
+/// Draws `options`' samples of `loaded` (`name` in errors), refusing
+/// before any work a count that does not fit in `--max-memory` (default:
+/// 90 % of the memory available). Surface points carry the mesh's colour
+/// where it has colours ([`topovox::attributes::carry::colour_at`]).
+pub fn sample(loaded: &topovox_io::LoadedMesh, name: &str, options: &SampleOptions) -> Result<Sampled> {
+    let mesh = loaded.mesh.as_ref();
     let o = &options.draw;
     let total = o.surface + o.near + o.uniform;
     let (need, budget) = (total.saturating_mul(BYTES_PER_SAMPLE), crate::memory::budget(options.run.max_memory));
@@ -173,7 +179,24 @@ pub fn sample(mesh: MeshRef<'_>, name: &str, options: &SampleOptions) -> Result<
     };
     let t = Instant::now();
     let samples = draw(&q, &spec).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
-    Ok(Sampled { samples, offset, scale, bounds, facts: q.facts(), seconds: (built, t.elapsed().as_secs_f64()) })
+    let colours = loaded.appearance.has_colour().then(|| colours(mesh, &loaded.appearance, &samples));
+    Ok(Sampled { samples, offset, scale, bounds, colours, facts: q.facts(), seconds: (built, t.elapsed().as_secs_f64()) })
+}
+
+/// The colour of each surface sample, sRGB in [0, 1]; NaN for the others.
+fn colours(mesh: MeshRef<'_>, app: &topovox::attributes::Appearance, samples: &Samples) -> Vec<[f32; 3]> {
+    use rayon::prelude::*;
+    samples
+        .faces
+        .par_iter()
+        .map(|&(face, w)| {
+            if face == u32::MAX {
+                [f32::NAN; 3]
+            } else {
+                topovox::attributes::carry::colour_at(mesh, app, face as usize, w).map(|c| c as f32 / 255.0)
+            }
+        })
+        .collect()
 }
 
 impl Sampled {
@@ -183,6 +206,7 @@ impl Sampled {
         let inside = self.samples.occupancy.iter().filter(|&&x| x).count();
         json!({
             "points": self.samples.points.len(),
+            "colours": self.colours.is_some(),
             "surface": kinds(0), "near": kinds(1), "uniform": kinds(2),
             "inside": inside,
             "sign": Sign::from(self.facts.sign).name(),
@@ -198,14 +222,15 @@ impl Sampled {
     /// (N, 3) float32, `sdf` (N,) float32, `occupancy` (N,) bool,
     /// `normals` (N, 3) float32 (NaN except surface points), `kind` (N,)
     /// uint8 (0 surface, 1 near, 2 uniform), `offset` (3,) and `scale` ()
-    /// float64, `bounds` (2, 3) float64.
+    /// float64, `bounds` (2, 3) float64, and where the mesh has colours
+    /// `colours` (N, 3) float32 (sRGB in [0, 1], NaN except surface points).
     pub fn write(&self, path: &Path) -> Result<()> {
         use topovox_io::npz::{write_arrays, Member};
         let s = &self.samples;
         let n = s.points.len() as u64;
         let f32s = |v: &mut dyn Iterator<Item = f64>| v.flat_map(|x| (x as f32).to_le_bytes()).collect::<Vec<u8>>();
         let f64s = |v: &[f64]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-        let members = [
+        let mut members = vec![
             Member { name: "points", descr: "<f4", shape: vec![n, 3], bytes: f32s(&mut s.points.iter().flat_map(|p| p.to_array())) },
             Member { name: "sdf", descr: "<f4", shape: vec![n], bytes: f32s(&mut s.sdf.iter().copied()) },
             Member { name: "occupancy", descr: "|b1", shape: vec![n], bytes: s.occupancy.iter().map(|&o| u8::from(o)).collect() },
@@ -220,6 +245,14 @@ impl Sampled {
                 bytes: f64s(&[self.bounds.0.to_array(), self.bounds.1.to_array()].concat()),
             },
         ];
+        if let Some(c) = &self.colours {
+            members.push(Member {
+                name: "colours",
+                descr: "<f4",
+                shape: vec![n, 3],
+                bytes: f32s(&mut c.iter().flatten().map(|&x| x as f64)),
+            });
+        }
         topovox_io::atomic::write_atomically(path, |w| write_arrays(w, &members)).map_err(JobError::from)
     }
 }

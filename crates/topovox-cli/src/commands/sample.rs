@@ -20,7 +20,7 @@ pub fn run(a: &SampleArgs) -> Result<()> {
     topovox_io::atomic::refuse_overwriting_inputs(&a.output, &loaded.sources)?;
     let name = a.mesh.display().to_string();
     bar.phase("sampling");
-    let s = pool.install(|| topovox_job::sample::sample(loaded.mesh.as_ref(), &name, opts))?;
+    let s = pool.install(|| topovox_job::sample::sample(&loaded, &name, opts))?;
     bar.phase("writing");
     let t = Instant::now();
     s.write(&a.output)?;

@@ -461,7 +461,7 @@ impl<'a> Ctx<'a> {
     fn triangle(&self, t: usize, voxels: &[[u32; 3]], index: &SlotIndex<'_>, out: &mut Vec<Contribution>, hist: &mut Vec<(u32, f64)>) {
         let Some(p) = self.corners(t) else { return };
         let dims = self.grid.dims();
-        let shader = Shader::new(self, t, p);
+        let shader = Shader::new((self.mesh, self.app, self.rule), t, p);
         // Voxels in (i, j, k) order: the triangle clipped to the voxel's x
         // slab is shared along i, to its x and y slabs along (i, j), so each
         // voxel clips only along z (the same polygons as clipping to the box).
@@ -627,7 +627,7 @@ pub mod reference {
             found.sort_unstable();
             found.dedup();
             let Some(p) = ctx.corners(t) else { continue };
-            let shader = Shader::new(&ctx, t, p);
+            let shader = Shader::new((ctx.mesh, ctx.app, ctx.rule), t, p);
             for v in found {
                 let Ok(slot) = keys.binary_search(&VoxelAttributes::key(dims, v[0], v[1], v[2])) else { continue };
                 let lo = DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
@@ -646,6 +646,16 @@ fn centroid(poly: &[DVec3]) -> DVec3 {
     poly.iter().copied().sum::<DVec3>() / poly.len() as f64
 }
 
+/// The colour of `mesh`'s triangle `t` at barycentric weights `b`, as
+/// sRGB: its texture's nearest texel, its vertex colours interpolated in
+/// linear light and its material's factor, multiplied (the `blend` rule's
+/// colour at one point); white where the triangle has none. What surface
+/// samples carry.
+pub fn colour_at(mesh: MeshRef<'_>, app: &Appearance, t: usize, b: [f64; 3]) -> [u8; 3] {
+    let p = mesh.triangles[t].map(|v| mesh.positions[v as usize]);
+    linear_to_rgb(Shader::new((mesh, app, ColourRule::Blend), t, p).linear_colour(b))
+}
+
 /// The colour of one triangle at a point: texture × factor × vertex colour.
 struct Shader<'a> {
     rule: ColourRule,
@@ -659,8 +669,7 @@ struct Shader<'a> {
 }
 
 impl<'a> Shader<'a> {
-    fn new(ctx: &Ctx<'a>, t: usize, p: [DVec3; 3]) -> Shader<'a> {
-        let app = ctx.app;
+    fn new((mesh, app, rule): (MeshRef<'a>, &'a Appearance, ColourRule), t: usize, p: [DVec3; 3]) -> Shader<'a> {
         let material = app.triangle_material.get(t).and_then(|&m| app.materials.get(m as usize));
         let uv = app.triangle_uv.get(t).map(|uv| uv.map(|c| [c[0] as f64, c[1] as f64]));
         let texture = match (material.and_then(|m| m.texture).and_then(|i| app.textures.get(i as usize)), uv) {
@@ -668,7 +677,7 @@ impl<'a> Shader<'a> {
             _ => None,
         };
         let factor = material.map(|m| m.factor.map(|f| f as f64)).filter(|f| *f != [1.0; 3]);
-        let tri = ctx.mesh.triangles[t];
+        let tri = mesh.triangles[t];
         let vertex = if app.vertex_colour.is_empty() {
             None
         } else {
@@ -677,7 +686,7 @@ impl<'a> Shader<'a> {
         };
         let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
         let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
-        Shader { rule: ctx.rule, p0: p[0], e1, e2, d: [d00, d01, d11, d00 * d11 - d01 * d01], texture, factor, vertex }
+        Shader { rule, p0: p[0], e1, e2, d: [d00, d01, d11, d00 * d11 - d01 * d01], texture, factor, vertex }
     }
 
     /// Barycentric coordinates of `q` (on the triangle's plane), clamped.

@@ -113,7 +113,12 @@ impl Query {
     /// The mesh's triangles with valid indices, in mesh order (world
     /// coordinates), as the samples draw from them.
     pub fn triangles(&self) -> Vec<[DVec3; 3]> {
-        self.pieces.items.iter().zip(&self.pieces.element).filter(|(_, &e)| (e as usize) < self.triangles).map(|(p, _)| p.p).collect()
+        self.faces().into_iter().map(|(_, t)| t).collect()
+    }
+
+    /// [`Query::triangles`] with each one's number in the mesh.
+    pub fn faces(&self) -> Vec<(u32, [DVec3; 3])> {
+        self.pieces.items.iter().zip(&self.pieces.element).filter(|(_, &e)| (e as usize) < self.triangles).map(|(p, &e)| (e, p.p)).collect()
     }
 
     /// What the query knows of its mesh.

@@ -73,21 +73,25 @@ pub struct Samples {
     pub normals: Vec<DVec3>,
     /// Which draw each point came from.
     pub kind: Vec<Kind>,
+    /// The mesh's triangle a surface point lies on, and its barycentric
+    /// weights there (`u32::MAX` and NaN for the other kinds): where its
+    /// colour is read.
+    pub faces: Vec<(u32, [f64; 3])>,
 }
 
 /// Triangles with area, for drawing surface points.
 struct Areas {
-    tris: Vec<[DVec3; 3]>,
+    tris: Vec<(u32, [DVec3; 3])>,
     /// Running sum of the areas.
     cumulative: Vec<f64>,
 }
 
 impl Areas {
-    fn new(tris: Vec<[DVec3; 3]>) -> Areas {
+    fn new(tris: Vec<(u32, [DVec3; 3])>) -> Areas {
         let mut total = 0.0;
         let cumulative = tris
             .iter()
-            .map(|t| {
+            .map(|(_, t)| {
                 total += (t[1] - t[0]).cross(t[2] - t[0]).length() * 0.5;
                 total
             })
@@ -99,15 +103,17 @@ impl Areas {
         self.cumulative.last().copied().unwrap_or(0.0)
     }
 
-    /// A uniform point of the surface and its triangle's unit normal.
-    fn draw(&self, rng: &mut ChaCha8Rng) -> (DVec3, DVec3) {
+    /// A uniform point of the surface, its triangle's unit normal, and
+    /// the triangle's number and the point's weights on it.
+    fn draw(&self, rng: &mut ChaCha8Rng) -> (DVec3, DVec3, (u32, [f64; 3])) {
         let r = rng.random::<f64>() * self.total();
         let n = self.cumulative.partition_point(|&c| c <= r).min(self.tris.len() - 1);
-        let t = &self.tris[n];
+        let (face, t) = &self.tris[n];
         let (u, v): (f64, f64) = (rng.random(), rng.random());
         let s = u.sqrt();
-        let p = t[0] * (1.0 - s) + t[1] * (s * (1.0 - v)) + t[2] * (s * v);
-        (p, (t[1] - t[0]).cross(t[2] - t[0]).normalize())
+        let w = [1.0 - s, s * (1.0 - v), s * v];
+        let p = t[0] * w[0] + t[1] * w[1] + t[2] * w[2];
+        (p, (t[1] - t[0]).cross(t[2] - t[0]).normalize(), (*face, w))
     }
 }
 
@@ -134,7 +140,7 @@ pub enum SampleError {
 
 /// Draws `spec`'s samples of the mesh behind `query`.
 pub fn sample(query: &Query, spec: &SampleSpec) -> Result<Samples, SampleError> {
-    let areas = Areas::new(query.triangles());
+    let areas = Areas::new(query.faces());
     if (spec.surface > 0 || spec.near > 0) && !(areas.total() > 0.0 && areas.total().is_finite()) {
         return Err(SampleError::NoArea);
     }
@@ -149,7 +155,8 @@ pub fn sample(query: &Query, spec: &SampleSpec) -> Result<Samples, SampleError> 
     let nan = DVec3::NAN;
     let draws: [(Kind, usize); 3] = [(Kind::Surface, spec.surface), (Kind::Near, spec.near), (Kind::Uniform, spec.uniform)];
     for (kind, count) in draws {
-        let blocks: Vec<Vec<(DVec3, DVec3)>> = (0..count.div_ceil(BLOCK))
+        let none = (u32::MAX, [f64::NAN; 3]);
+        let blocks: Vec<Vec<(DVec3, DVec3, (u32, [f64; 3]))>> = (0..count.div_ceil(BLOCK))
             .into_par_iter()
             .map(|b| {
                 let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
@@ -161,20 +168,21 @@ pub fn sample(query: &Query, spec: &SampleSpec) -> Result<Samples, SampleError> 
                         Kind::Near => {
                             let sigma = spec.sigma[(b * BLOCK + i) % spec.sigma.len()];
                             let p = areas.draw(&mut rng).0;
-                            (p + DVec3::new(normal(&mut rng), normal(&mut rng), normal(&mut rng)) * sigma, nan)
+                            (p + DVec3::new(normal(&mut rng), normal(&mut rng), normal(&mut rng)) * sigma, nan, none)
                         }
                         Kind::Uniform => {
                             let t = DVec3::new(rng.random(), rng.random(), rng.random());
-                            (lo + (hi - lo) * t, nan)
+                            (lo + (hi - lo) * t, nan, none)
                         }
                     })
                     .collect()
             })
             .collect();
-        for (p, n) in blocks.into_iter().flatten() {
+        for (p, n, f) in blocks.into_iter().flatten() {
             out.points.push(p);
             out.normals.push(n);
             out.kind.push(kind);
+            out.faces.push(f);
         }
     }
     let mut inside = vec![0.0; out.points.len()];
