@@ -36,6 +36,7 @@ pub mod band;
 pub mod field;
 pub mod nearest;
 pub mod reference;
+mod wide;
 
 use glam::DVec3;
 

@@ -8,7 +8,9 @@
 //! fast Construction of SAH-based Bounding Volume Hierarchies", 2007, with
 //! the median for the surface-area heuristic: queries, not rays, visit
 //! it). A query descends nearer child first and skips every node whose box
-//! lies no nearer than the best distance found. Voxels are visited a row
+//! lies no nearer than the best distance found; queries walk the same tree
+//! collapsed four children wide ([`super::wide`]), which tests four boxes
+//! at once and finds the same piece. Voxels are visited a row
 //! (`k`) at a time, and the previous voxel's nearest piece gives the first
 //! bound, so most queries open only the few nodes around that piece.
 //!
@@ -20,6 +22,7 @@
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
+use super::wide::{self, Wide, WIDE_REACH};
 use super::{box_distance_squared, Piece, Pieces};
 use crate::stop::Stop;
 use crate::GridSpec;
@@ -87,6 +90,22 @@ pub struct Hierarchy {
     boxes: Vec<(Vec3, Vec3)>,
     /// The pieces in leaf order, so a leaf's pieces are adjacent in memory.
     sorted: Vec<Piece>,
+    /// The same tree four children wide ([`wide`]), which queries walk.
+    wide: Vec<Wide>,
+    /// The largest coordinate magnitude of the root's box.
+    reach: f64,
+}
+
+impl wide::Binary for Node {
+    fn bounds(&self) -> (Vec3, Vec3) {
+        (self.lo, self.hi)
+    }
+    fn start(&self) -> u32 {
+        self.start
+    }
+    fn count(&self) -> u32 {
+        self.count
+    }
 }
 
 impl Hierarchy {
@@ -132,7 +151,9 @@ impl Hierarchy {
         }
         let sorted: Vec<Piece> = order.iter().map(|&n| pieces.items[n as usize]).collect();
         let boxes = sorted.iter().map(|p| outward(p.lo, p.hi)).collect();
-        Hierarchy { nodes, order, boxes, sorted }
+        let wide = wide::widen(&nodes);
+        let reach = nodes[0].lo.abs().max(nodes[0].hi.abs()).max_element() as f64;
+        Hierarchy { nodes, order, boxes, sorted, wide, reach }
     }
 
     /// The box of every piece.
@@ -145,7 +166,32 @@ impl Hierarchy {
     /// `(f64::INFINITY, u32::MAX)`): only nearer pieces, or equally near
     /// ones with a smaller number, replace it. So among equally near pieces
     /// the lowest numbered is found, whatever the start.
-    pub fn nearest(&self, q: DVec3, mut best: (f64, u32)) -> (f64, u32) {
+    pub fn nearest(&self, q: DVec3, best: (f64, u32)) -> (f64, u32) {
+        if self.reach <= WIDE_REACH && q.abs().max_element() <= WIDE_REACH {
+            wide::nearest(&self.wide, self.reach, q, best, |start, count, best| self.leaf(start, count, q, best))
+        } else {
+            self.nearest_binary(q, best)
+        }
+    }
+
+    /// The best of `best` and the leaf's pieces `start .. start + count`.
+    #[inline(always)]
+    fn leaf(&self, start: u32, count: u32, q: DVec3, mut best: (f64, u32)) -> (f64, u32) {
+        let leaf = start as usize..(start + count) as usize;
+        for (i, (b, &n)) in leaf.clone().zip(self.boxes[leaf.clone()].iter().zip(&self.order[leaf])) {
+            if box_gap(b.0, b.1, q) <= best.0 {
+                let d = self.sorted[i].distance_squared(q);
+                if d < best.0 || (d == best.0 && n < best.1) {
+                    best = (d, n);
+                }
+            }
+        }
+        best
+    }
+
+    /// [`Hierarchy::nearest`] by the binary tree (coordinates past
+    /// [`WIDE_REACH`]; and the reference the wide walk is tested against).
+    pub fn nearest_binary(&self, q: DVec3, mut best: (f64, u32)) -> (f64, u32) {
         // Median splits of < 2^32 pieces make at most 32 levels, each
         // leaving one node on the stack: 64 slots never fill.
         let mut stack: [u32; 64] = [0; 64];
@@ -158,15 +204,7 @@ impl Hierarchy {
                 continue;
             }
             if node.count > 0 {
-                let leaf = node.start as usize..(node.start + node.count) as usize;
-                for (i, (b, &n)) in leaf.clone().zip(self.boxes[leaf.clone()].iter().zip(&self.order[leaf])) {
-                    if box_gap(b.0, b.1, q) <= best.0 {
-                        let d = self.sorted[i].distance_squared(q);
-                        if d < best.0 || (d == best.0 && n < best.1) {
-                            best = (d, n);
-                        }
-                    }
-                }
+                best = self.leaf(node.start, node.count, q, best);
                 continue;
             }
             let (a, b) = (node.start, node.start + 1);

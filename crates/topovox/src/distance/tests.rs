@@ -149,3 +149,36 @@ fn a_flat_triangle_is_its_edges() {
     assert_eq!(p.items[0].distance_squared(DVec3::new(3.0, 1.0, 0.0)), 1.0);
     assert_eq!(p.items[0].distance_squared(DVec3::new(5.0, 0.0, 0.0)), 1.0);
 }
+
+/// The four-wide walk finds the binary tree's nearest piece, bit for bit,
+/// from any start: points near and far, on corners, and at coordinates
+/// where the f32 slack matters (a soup moved far from the origin).
+#[test]
+fn the_wide_walk_equals_the_binary_one() {
+    let mut rng = Xorshift(0x9e37_79b9_7f4a_7c15);
+    for (round, shift) in [0.0, 3.0e5, -7.5e8].into_iter().enumerate() {
+        let mut m = soup(&mut rng, 300 + 200 * round);
+        m.positions.iter_mut().for_each(|p| *p += DVec3::splat(shift));
+        let pieces = Pieces::of(m.as_ref()).unwrap();
+        let tree = nearest::Hierarchy::new(&pieces);
+        let mut checked = 0;
+        for i in 0..3000 {
+            let r = |rng: &mut Xorshift| rng.signed(1_000_000) as f64 * 1e-5;
+            let q = match i % 4 {
+                0 => m.positions[rng.below(m.positions.len() as u64) as usize],
+                1 => DVec3::new(r(&mut rng), r(&mut rng), r(&mut rng)) * 0.1 + DVec3::splat(5.0 + shift),
+                2 => DVec3::new(r(&mut rng), r(&mut rng), r(&mut rng)) * 3.0 + DVec3::splat(shift),
+                _ => DVec3::new(r(&mut rng), r(&mut rng), r(&mut rng)) * 1e3 + DVec3::splat(shift),
+            };
+            let start = (f64::INFINITY, u32::MAX);
+            let got = tree.nearest(q, start);
+            assert_eq!(got, tree.nearest_binary(q, start), "round {round}, point {q}");
+            // Every piece measured: the nearest, the lowest numbered of ties.
+            let all = pieces.items.iter().enumerate().map(|(n, p)| (p.distance_squared(q), n as u32));
+            let want = all.min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))).unwrap();
+            assert_eq!(got, want, "round {round}, point {q}");
+            checked += 1;
+        }
+        assert_eq!(checked, 3000);
+    }
+}
