@@ -31,8 +31,9 @@ const EMPTY: u32 = u32::MAX;
 pub(super) const WIDE_REACH: f64 = 1e18;
 
 /// Four children's boxes (per axis, per lane) and what each is: a wide
-/// node (`count == 0`, `child` its index) or a leaf (`count` pieces from
-/// `child` in leaf order); `child == EMPTY` for an unused lane.
+/// node (`count == 0`, `child` its index) or a leaf (`count > 0`, `child`
+/// its number in the list [`widen`] returns); `child == EMPTY` for an
+/// unused lane.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub(super) struct Wide {
@@ -50,8 +51,10 @@ pub(super) trait Binary {
     fn count(&self) -> u32;
 }
 
-/// The wide tree of a binary one (`nodes[0]` its root).
-pub(super) fn widen<N: Binary>(nodes: &[N]) -> Vec<Wide> {
+/// The wide tree of a binary one (`nodes[0]` its root), and its leaves
+/// (`start`, `count` of each, numbered as the lanes name them).
+pub(super) fn widen<N: Binary>(nodes: &[N]) -> (Vec<Wide>, Vec<[u32; 2]>) {
+    let mut leaves = Vec::new();
     let empty = Wide { lo: [[f32::INFINITY; 4]; 3], hi: [[f32::NEG_INFINITY; 4]; 3], child: [EMPTY; 4], count: [0; 4] };
     let mut wide = vec![empty];
     let mut todo = vec![(0usize, 0usize)];
@@ -78,7 +81,8 @@ pub(super) fn widen<N: Binary>(nodes: &[N]) -> Vec<Wide> {
                 (node.lo[a][lane], node.hi[a][lane]) = (lo[a], hi[a]);
             }
             if nodes[k].count() > 0 {
-                (node.child[lane], node.count[lane]) = (nodes[k].start(), nodes[k].count());
+                (node.child[lane], node.count[lane]) = (leaves.len() as u32, nodes[k].count());
+                leaves.push([nodes[k].start(), nodes[k].count()]);
             } else {
                 node.child[lane] = wide.len() as u32;
                 todo.push((k, wide.len()));
@@ -87,7 +91,28 @@ pub(super) fn widen<N: Binary>(nodes: &[N]) -> Vec<Wide> {
         }
         wide[w] = node;
     }
-    wide
+    (wide, leaves)
+}
+
+/// The pieces under each wide node, `[start, end)` in leaf order (a
+/// subtree's leaves are adjacent there).
+pub(super) fn spans(wide: &[Wide], leaves: &[[u32; 2]]) -> Vec<[u32; 2]> {
+    let mut out = vec![[u32::MAX, 0]; wide.len()];
+    // Children come after their parents: the last ones first.
+    for w in (0..wide.len()).rev() {
+        let mut span = [u32::MAX, 0];
+        for l in 0..4 {
+            let (c, n) = (wide[w].child[l], wide[w].count[l]);
+            let s = match (c, n) {
+                (EMPTY, _) => continue,
+                (c, 0) => out[c as usize],
+                (c, _) => [leaves[c as usize][0], leaves[c as usize][0] + leaves[c as usize][1]],
+            };
+            span = [span[0].min(s[0]), span[1].max(s[1])];
+        }
+        out[w] = span;
+    }
+    out
 }
 
 /// Lower bounds of the squared distances from `q` to a node's four boxes
@@ -104,8 +129,9 @@ fn gaps(node: &Wide, q: [f32; 3], slack: f32) -> [f32; 4] {
     d2.map(|d| d * (1.0 - 1.0 / (1u32 << 20) as f32))
 }
 
-/// The nearest piece to `q` by the wide tree: `visit(start, count, best)`
-/// measures a leaf's pieces against the best so far and returns it.
+/// The nearest piece to `q` by the wide tree: `visit(leaf, best)`
+/// measures a leaf's pieces against the best so far and returns it;
+/// `cut(node, best)` may skip a wide node by a bound of its own.
 /// `reach` is the largest coordinate magnitude of the tree's boxes.
 #[inline]
 pub(super) fn nearest(
@@ -113,7 +139,8 @@ pub(super) fn nearest(
     reach: f64,
     q: DVec3,
     mut best: (f64, u32),
-    mut visit: impl FnMut(u32, u32, (f64, u32)) -> (f64, u32),
+    mut visit: impl FnMut(u32, (f64, u32)) -> (f64, u32),
+    cut: impl Fn(u32, f64) -> bool,
 ) -> (f64, u32) {
     let qf = [q.x as f32, q.y as f32, q.z as f32];
     let slack = ((q.abs().max_element() + reach) / (1u64 << 21) as f64) as f32;
@@ -129,7 +156,10 @@ pub(super) fn nearest(
             continue;
         }
         if count > 0 {
-            best = visit(child, count, best);
+            best = visit(child, best);
+            continue;
+        }
+        if cut(child, best.0) {
             continue;
         }
         let node = &wide[child as usize];
