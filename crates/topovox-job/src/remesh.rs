@@ -226,22 +226,30 @@ pub struct Remeshed {
 
 /// Refuses a grid whose voxels and surface would not fit in memory: one
 /// bit per voxel for the solid (wrap: three grids), eight for the blocky
-/// surface's half voxels, and per triangle (estimated as four per voxel
-/// face of the input's area, sixteen for blocky) about 100 bytes, plus the
+/// surface's half voxels, and per triangle — estimated as ten per voxel
+/// face of the input's area for the smooth surface, 44 for the blocky one
+/// (the bunny: 9.3 and 41.8) — 90 bytes (smooth: its vertices, the edge
+/// table, the distances at the lattice ends) or 60 (blocky), plus the
 /// output's distance pieces and hierarchy where the two-sided distance is
-/// measured (wrap, `check`) and the certificate's sorts where it runs.
+/// measured (wrap, `check`) and the certificate's sorts where it runs;
+/// plus the input's pieces and hierarchies (1000 bytes a piece) and 24 MiB
+/// for the process. Measured peaks on the bunny are 0.79–0.86 of it at
+/// 128, 256 (both surfaces), 1024 and 2048 (the earlier four faces and
+/// 100 bytes let the 2048 run peak at 8.0 GiB where it claimed 5.2).
 fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec) -> Result<()> {
     let cells = grid.voxel_count();
-    let grids = if req.inside == Inside::Wrap { 3 } else { 1 } + if req.surface == SurfaceKind::Blocky { 8 } else { 0 };
+    let blocky = req.surface == SurfaceKind::Blocky;
+    let grids = if req.inside == Inside::Wrap { 3 } else { 1 } + if blocky { 8 } else { 0 };
     let h = grid.voxel_size().0;
     let area: f64 = pieces.items.iter().map(|p| 0.5 * (p.p[1] - p.p[0]).cross(p.p[2] - p.p[0]).length()).sum();
-    let per_face = if req.surface == SurfaceKind::Blocky { 16.0 } else { 4.0 };
+    let (per_face, bytes_each) = if blocky { (44.0, 60) } else { (10.0, 90) };
     let triangles = area / (h.x * h.y).min(h.y * h.z).min(h.x * h.z) * per_face;
     let measured = req.inside == Inside::Wrap || req.check;
     let certified = req.check || cfg!(debug_assertions) || req.simplify > 0.0;
     let per_triangle =
-        100 + if measured { std::mem::size_of::<topovox::distance::Piece>() + 16 } else { 0 } + if certified { 150 } else { 0 };
-    let need = (cells / 8).saturating_mul(grids + 1).saturating_add((triangles * per_triangle as f64) as u64);
+        bytes_each + if measured { std::mem::size_of::<topovox::distance::Piece>() + 16 } else { 0 } + if certified { 150 } else { 0 };
+    let input = pieces.items.len() as u64 * 1000 + (24 << 20);
+    let need = (cells / 8).saturating_mul(grids + 1).saturating_add((triangles * per_triangle as f64) as u64).saturating_add(input);
     let limit = budget(req.max_memory);
     if need > limit {
         let [x, y, z] = grid.dims();

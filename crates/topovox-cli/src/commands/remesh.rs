@@ -42,6 +42,7 @@ pub fn run(a: &RemeshArgs) -> Result<()> {
             "load_s": load_s,
             "write_s": done.write_s,
             "total_s": total_s,
+            "peak_memory_bytes": topovox_job::peak_memory(),
             "threads": threads,
             "input": name,
             "output": a.output.display().to_string(),
