@@ -285,7 +285,7 @@ fn remesh_keeps_to_what_it_says_it_needs() {
             topovox(&["remesh", s(&mesh), "-o", s(&out), "--resolution", "384", "--surface", surface, "--max-memory", bound, "--json"])
         };
         // What the refusal says it needs, in MiB (the 2048 run once peaked
-        // at 8.0 GiB where it claimed 5.2).
+        // at 8.4 GiB where it claimed 5.2).
         let e = refused(&run("1M"));
         assert!(!out.exists());
         let words: Vec<&str> = e.split("needs about ").nth(1).unwrap().split_whitespace().collect();

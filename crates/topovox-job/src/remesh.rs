@@ -235,7 +235,7 @@ pub struct Remeshed {
 /// plus the input's pieces and hierarchies (1000 bytes a piece) and 24 MiB
 /// for the process. Measured peaks on the bunny are 0.79–0.86 of it at
 /// 128, 256 (both surfaces), 1024 and 2048 (the earlier four faces and
-/// 100 bytes let the 2048 run peak at 8.0 GiB where it claimed 5.2).
+/// 100 bytes let the 2048 run peak at 8.4 GiB where it claimed 5.2).
 fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec) -> Result<()> {
     let cells = grid.voxel_count();
     let blocky = req.surface == SurfaceKind::Blocky;
