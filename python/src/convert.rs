@@ -1,6 +1,7 @@
 //! Python values in and out: arrays of points and indices (any dtype NumPy
 //! converts, any strides), shapes as Python prints them, NumPy's
-//! `__array__` protocol, voxel sizes, and JSON facts as Python objects.
+//! `__array__` protocol, voxel sizes, material indices, and JSON facts as
+//! Python objects.
 
 use glam::DVec3;
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
@@ -10,6 +11,15 @@ use serde_json::Value;
 use topovox::VoxelSize;
 
 use crate::errors::value_err;
+
+/// A material index as Python sees it: -1 for none.
+pub(crate) fn material_index(m: u32) -> i64 {
+    if m == topovox::attributes::NO_MATERIAL {
+        -1
+    } else {
+        i64::from(m)
+    }
+}
 
 /// Copies an `(n, 3)` float array (float64 or float32, any strides) into
 /// points.

@@ -273,7 +273,7 @@ impl VoxelGrid {
     fn materials<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<i64>>> {
         let m = self.inner.attrs.as_ref()?.material.as_ref()?;
         let order = self.inner.ordered();
-        Some(order.iter().map(|o| if m[o.1] == NO_MATERIAL { -1 } else { m[o.1] as i64 }).collect::<Array1<i64>>().into_pyarray(py))
+        Some(order.iter().map(|o| crate::convert::material_index(m[o.1])).collect::<Array1<i64>>().into_pyarray(py))
     }
 
     /// Per set voxel mean surface normal, `(k, 3)` float32, aligned with `indices()`; None without (`normals=True`).

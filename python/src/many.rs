@@ -69,15 +69,16 @@ struct Item {
 }
 
 /// The native voxelize_many: see `topovox.voxelize_many`. `meshes` holds
-/// `None` where the caller could not load a mesh (an empty item).
+/// `None` where the caller could not load a mesh (an empty item); a mesh
+/// that fails leaves an empty item too, its exception listed in `errors`
+/// as is (the caller names the mesh and raises or keeps it).
 #[pyfunction]
-#[pyo3(signature = (meshes, options=None, features=vec![], skip_errors=false))]
+#[pyo3(signature = (meshes, options=None, features=vec![]))]
 pub(crate) fn voxelize_many<'py>(
     py: Python<'py>,
     meshes: Vec<Option<PyRef<'py, Mesh>>>,
     options: Option<&Bound<'py, PyDict>>,
     features: Vec<String>,
-    skip_errors: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut opts = job_options(options, &[])?;
     let features = features.iter().map(|f| Feature::parse(f).map_err(|e| value_err(e.to_string()))).collect::<PyResult<Vec<_>>>()?;
@@ -108,7 +109,7 @@ pub(crate) fn voxelize_many<'py>(
         }
     })?;
     let budget = topovox_job::budget(plan.request.max_memory);
-    assemble(py, results, &meshes, &features, (skip_errors, budget))
+    assemble(py, results, &features, budget)
 }
 
 /// One mesh's grid as `voxelize` gives it, with its features measured.
@@ -156,7 +157,7 @@ fn push_feature(
         Feature::Coverage => out.push(attrs.and_then(|a| a.coverage.as_ref()).map_or(0.0, |c| c[slot])),
         Feature::Material => {
             let m = attrs.and_then(|a| a.material.as_ref()).map_or(NO_MATERIAL, |m| m[slot]);
-            out.push(if m == NO_MATERIAL { -1.0 } else { m as f32 });
+            out.push(crate::convert::material_index(m) as f32);
         }
         Feature::Sdf => {
             let q = query.expect("a query when sdf is asked");
@@ -165,14 +166,12 @@ fn push_feature(
     }
 }
 
-/// The batch's arrays and items; the first error (by index) raised unless
-/// `skip_errors`, when errors are listed instead.
+/// The batch's arrays and items, and each failed mesh's exception.
 fn assemble<'py>(
     py: Python<'py>,
     results: Vec<Option<Result<Item, JobError>>>,
-    meshes: &[Option<PyRef<'py, Mesh>>],
     features: &[Feature],
-    (skip_errors, budget): (bool, u64),
+    budget: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let width: usize = features.iter().map(|f| f.width()).sum();
     let rows: u64 = results.iter().flatten().flatten().map(|it| it.data.ordered().len() as u64).sum();
@@ -197,14 +196,7 @@ fn assemble<'py>(
             }
             Some(Err(JobError::Interrupted)) => return Err(py_err(JobError::Interrupted)),
             Some(Err(e)) => {
-                let name = meshes[b].as_ref().map(|m| m.name()).unwrap_or_default();
-                let err = py_err(e);
-                let text = err.value(py).to_string();
-                let msg = if text.contains(&name) { format!("mesh {b}: {text}") } else { format!("mesh {b} ({name}): {text}") };
-                if !skip_errors {
-                    return Err(PyErr::from_type(err.get_type(py), msg));
-                }
-                errors.append((b, msg))?;
+                errors.append((b, py_err(e).into_value(py)))?;
                 grids.append(py.None())?;
             }
             None => grids.append(py.None())?,

@@ -8,7 +8,6 @@ use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use topovox::attributes::NO_MATERIAL;
 use topovox_io::LoadedMesh;
 
 use crate::convert::{as_array, indices_from, points_from, rows_of, shape};
@@ -187,7 +186,7 @@ impl Mesh {
     #[getter]
     fn face_materials<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<i64>>> {
         let m = &self.inner.appearance.triangle_material;
-        (!m.is_empty()).then(|| m.iter().map(|&x| if x == NO_MATERIAL { -1 } else { x as i64 }).collect::<Array1<i64>>().into_pyarray(py))
+        (!m.is_empty()).then(|| m.iter().map(|&x| crate::convert::material_index(x)).collect::<Array1<i64>>().into_pyarray(py))
     }
 
     /// Materials: a list of dicts with `name`, `colour` (linear RGB

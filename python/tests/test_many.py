@@ -162,6 +162,12 @@ def test_a_broken_mesh_fails_with_its_index_or_is_skipped(meshes, tmp_path):
     with pytest.raises(ValueError, match=r"mesh 1 \(tuple\): contains no triangles"):
         topovox.voxelize_many([good[0], nothing], resolution=32)
     assert list(topovox.voxelize_many([nothing, good[0]], resolution=32, on_error="skip").errors) == [0]
+    # A mesh that loads but fails to voxelize is named the same way.
+    lines = topovox.Mesh(np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0]], float), segments=np.array([[0, 1], [1, 2]]))
+    with pytest.raises(ValueError, match=r"^mesh 1: mesh: has only line segments"):
+        topovox.voxelize_many([good[0], lines], resolution=32)
+    kept = topovox.voxelize_many([good[0], lines], resolution=32, on_error="skip")
+    assert list(kept.errors) == [1] and kept.errors[1].startswith("mesh 1: mesh: has only line segments")
     with pytest.raises(ValueError, match="on_error"):
         topovox.voxelize_many(good, on_error="ignore")
     with pytest.raises(ValueError, match="unknown feature"):

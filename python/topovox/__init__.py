@@ -494,25 +494,27 @@ def voxelize_many(
         try:
             loaded.append(m if isinstance(m, Mesh) else as_mesh(*m) if isinstance(m, tuple) else as_mesh(m))
         except (ValueError, TypeError, OSError) as e:
-            name = _mesh_name(m)
-            message = f"mesh {b}: {e}" if name in str(e) else f"mesh {b} ({name}): {e}"
-            if on_error == "raise":
-                e.args = (message,)
-                raise
+            failed[b] = _item_error(b, m, e, on_error)
             loaded.append(None)
-            failed[b] = message
-    out = _topovox.voxelize_many(loaded, _options(options), names, on_error == "skip")
-    failed.update({int(b): str(m) for b, m in out["errors"]})
+    out = _topovox.voxelize_many(loaded, _options(options), names)
+    for b, exc in out["errors"]:
+        failed[int(b)] = _item_error(int(b), loaded[int(b)], exc, on_error)
     return SparseBatch(out["coords"], out["features"], out["offsets"], out["grids"], out["columns"], failed)
 
 
-def _mesh_name(m: Any) -> str:
-    """How an error names an item: its path, or its type."""
+def _item_error(b: int, m: Any, e: BaseException, on_error: str) -> str:
+    """Item ``b``'s error, named by its index (and its path, or its type,
+    when the message does not say): raised as it is
+    (``on_error="raise"``), or its message returned to be kept."""
     if isinstance(m, (str, os.PathLike)):
-        return os.fsdecode(m)
-    if isinstance(m, Mesh):
-        return "Mesh"
-    return type(m).__name__
+        name = os.fsdecode(m)
+    else:
+        name = (m.path or "mesh") if isinstance(m, Mesh) else type(m).__name__
+    message = f"mesh {b}: {e}" if name in str(e) else f"mesh {b} ({name}): {e}"
+    if on_error == "raise":
+        e.args = (message,)
+        raise e
+    return message
 
 
 def sdf(

@@ -120,10 +120,10 @@ pub(super) fn spans(wide: &[Wide], leaves: &[[u32; 2]]) -> Vec<[u32; 2]> {
 #[inline(always)]
 fn gaps(node: &Wide, q: [f32; 3], slack: f32) -> [f32; 4] {
     let mut d2 = [0f32; 4];
-    for a in 0..3 {
-        for l in 0..4 {
-            let g = ((node.lo[a][l] - q[a]).max(q[a] - node.hi[a][l]) - slack).max(0.0);
-            d2[l] += g * g;
+    for ((lo, hi), &qa) in node.lo.iter().zip(&node.hi).zip(&q) {
+        for ((d, &l), &h) in d2.iter_mut().zip(lo).zip(hi) {
+            let g = ((l - qa).max(qa - h) - slack).max(0.0);
+            *d += g * g;
         }
     }
     d2.map(|d| d * (1.0 - 1.0 / (1u32 << 20) as f32))
@@ -168,9 +168,9 @@ pub(super) fn nearest(
         // nearest is popped first.
         let mut lanes = [(0f32, 0usize); 4];
         let mut n = 0;
-        for l in 0..4 {
-            if node.child[l] != EMPTY && f64::from(d[l]) <= best.0 {
-                lanes[n] = (d[l], l);
+        for (l, &dl) in d.iter().enumerate() {
+            if node.child[l] != EMPTY && f64::from(dl) <= best.0 {
+                lanes[n] = (dl, l);
                 n += 1;
             }
         }

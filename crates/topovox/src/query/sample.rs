@@ -117,6 +117,10 @@ impl Areas {
     }
 }
 
+/// A drawn point, its normal (NaN off the surface), and its triangle and
+/// weights (`u32::MAX` and NaN off the surface).
+type Drawn = (DVec3, DVec3, (u32, [f64; 3]));
+
 /// A standard normal number (Box–Muller).
 fn normal(rng: &mut ChaCha8Rng) -> f64 {
     let u: f64 = 1.0 - rng.random::<f64>();
@@ -156,7 +160,7 @@ pub fn sample(query: &Query, spec: &SampleSpec) -> Result<Samples, SampleError> 
     let draws: [(Kind, usize); 3] = [(Kind::Surface, spec.surface), (Kind::Near, spec.near), (Kind::Uniform, spec.uniform)];
     for (kind, count) in draws {
         let none = (u32::MAX, [f64::NAN; 3]);
-        let blocks: Vec<Vec<(DVec3, DVec3, (u32, [f64; 3]))>> = (0..count.div_ceil(BLOCK))
+        let blocks: Vec<Vec<Drawn>> = (0..count.div_ceil(BLOCK))
             .into_par_iter()
             .map(|b| {
                 let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
