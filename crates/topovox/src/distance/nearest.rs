@@ -9,7 +9,7 @@
 //! the median for the surface-area heuristic: queries, not rays, visit
 //! it). A query descends nearer child first and skips every node whose box
 //! lies no nearer than the best distance found; queries walk the same tree
-//! collapsed four children wide ([`super::wide`]), which tests four boxes
+//! collapsed four children wide (`wide.rs`), which tests four boxes
 //! at once and finds the same piece. Voxels are visited a row
 //! (`k`) at a time, and the previous voxel's nearest piece gives the first
 //! bound, so most queries open only the few nodes around that piece.
@@ -278,7 +278,8 @@ impl Hierarchy {
     }
 
     /// [`Hierarchy::nearest`] by the binary tree (coordinates past
-    /// [`WIDE_REACH`]; and the reference the wide walk is tested against).
+    /// 10¹⁸, whose squares could overflow the wide walk's f32; and the
+    /// reference the wide walk is tested against).
     pub fn nearest_binary(&self, q: DVec3, mut best: (f64, u32)) -> (f64, u32) {
         // Median splits of < 2^32 pieces make at most 32 levels, each
         // leaving one node on the stack: 64 slots never fill.
