@@ -621,12 +621,12 @@ fn warnings<'a>(loaded: &'a topovox_io::LoadedMesh, work: &'a [String]) -> Vec<&
 /// Voxelizes one loaded mesh and writes it: the record's facts.
 fn voxelize_one(job: &VoxelizeJob, loaded: &topovox_io::LoadedMesh, name: &str, out: &Path, stop: Option<&Arc<Stop>>) -> Result<Value> {
     let done = job.run(out, loaded, name, None, stop)?;
-    let v = &done.voxels;
+    let v = &done.made.voxels;
     Ok(json!({
         "grid": grid_json(&v.grid),
         "voxels": v.report.voxels,
         "method": v.method,
-        "times": {"voxelize_s": v.voxelize_s, "attributes_s": done.attributes_s, "write_s": done.write_s},
+        "times": {"voxelize_s": v.voxelize_s, "attributes_s": done.made.attributes_s, "write_s": done.write_s},
         "warnings": warnings(loaded, &v.warnings),
     }))
 }

@@ -16,7 +16,6 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use serde_json::Value;
-use topovox::attributes::carry::CarryOptions;
 use topovox::attributes::VoxelAttributes;
 use topovox::voxelize::{Progress, Stop};
 use topovox_io::LoadedMesh;
@@ -88,11 +87,6 @@ impl Voxelizer {
         Ok(Voxelizer { plan: options.plan()?, options: options.clone() })
     }
 
-    /// What the attribute carrier computes.
-    pub fn carry(&self) -> CarryOptions {
-        self.options.export.carry()
-    }
-
     /// Voxelizes `loaded` (named `name` in messages) and carries the
     /// attributes `keep` wants; `stop` ends it early, `progress` hears of it.
     /// Runs on the current rayon pool.
@@ -118,7 +112,7 @@ impl Voxelizer {
             return Ok(None);
         }
         crate::run::check_attributes_carried(&self.plan, v)?;
-        Ok(crate::run::attributes(&self.plan, loaded.mesh.as_ref(), &loaded.appearance, v, &self.carry()))
+        Ok(crate::run::attributes(&self.plan, loaded.mesh.as_ref(), &loaded.appearance, v, &self.options.export.carry()))
     }
 }
 
@@ -136,14 +130,11 @@ pub struct VoxelizeJob {
 
 /// What [`VoxelizeJob::run`] made and wrote.
 pub struct Done {
-    /// The voxels and the facts of their making.
-    pub voxels: Voxelized,
-    /// The attributes carried, when the output or the preview wanted them.
-    pub attributes: Option<VoxelAttributes>,
+    /// The voxels, the attributes the output or the preview wanted, and
+    /// the seconds carrying them.
+    pub made: Made,
     /// What the writer reports (`.obj` faces, `.vox` models, …).
     pub export: Value,
-    /// Seconds carrying attributes.
-    pub attributes_s: f64,
     /// Seconds writing.
     pub write_s: f64,
 }
@@ -196,9 +187,9 @@ impl VoxelizeJob {
         progress.inspect(|p| p.phase("writing"));
         let t = Instant::now();
         let write = topovox_io::WriteOptions { stop: stop.cloned(), ..self.write.clone() };
-        let v = made.voxels;
+        let v = &made.voxels;
         let export = crate::output::write(out, self.format, &v.voxels, &v.grid, made.attributes.as_ref(), &write)?;
-        Ok(Done { voxels: v, attributes: made.attributes, export, attributes_s: made.attributes_s, write_s: t.elapsed().as_secs_f64() })
+        Ok(Done { made, export, write_s: t.elapsed().as_secs_f64() })
     }
 }
 

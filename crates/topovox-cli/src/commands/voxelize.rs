@@ -33,12 +33,12 @@ pub fn run(a: &VoxelizeArgs) -> Result<()> {
     let (loaded, load_s) = crate::console::load_mesh(&a.mesh, &opts.run.read_options(), &bar)?;
     let name = a.mesh.display().to_string();
     let done = pool.install(|| job.run(&a.output, &loaded, &name, Some(&bar), None))?;
-    for w in &done.voxels.warnings {
+    for w in &done.made.voxels.warnings {
         eprintln!("topovox: warning: {w}");
     }
     if let Some((path, o)) = &preview {
         bar.phase("rendering the preview");
-        let (v, attrs) = (&done.voxels, done.attributes.as_ref());
+        let (v, attrs) = (&done.made.voxels, done.made.attributes.as_ref());
         let o = &topovox::render::raycast::RenderOptions { voxel_shape: v.grid.voxel_size().0.to_array(), ..*o };
         let outline = a.picture.outline.then(|| crate::pictures::outline_triangles(loaded.mesh.as_ref(), &v.grid));
         match &v.voxels {
@@ -63,9 +63,9 @@ struct Times {
 /// The summary line, or with `--json` the JSON object.
 fn print_summary(a: &VoxelizeArgs, job: &VoxelizeJob, loaded: &topovox_io::LoadedMesh, done: &Done, t: &Times) -> Result<()> {
     let (opts, format, plan) = (&a.job.options, job.format, job.plan());
-    let (v, grid, attrs) = (&done.voxels, done.voxels.grid, done.attributes.as_ref());
+    let (v, grid, attrs) = (&done.made.voxels, done.made.voxels.grid, done.made.attributes.as_ref());
     let (load_s, total_s, threads) = (t.load_s, t.total_s, t.threads);
-    let (write_s, attributes_s, export_facts) = (done.write_s, done.attributes_s, &done.export);
+    let (write_s, attributes_s, export_facts) = (done.write_s, done.made.attributes_s, &done.export);
     // Said in the summary, not on stderr: a successful run is quiet there.
     let one_colour = format.has_colour() && !loaded.appearance.has_colour();
     let o = grid.origin();
