@@ -134,10 +134,11 @@ impl Oriented {
         Oriented { axes, lo: lo - grow, hi: hi + grow }
     }
 
-    /// A lower bound of the squared distance from `q` to the pieces: the distance to the oriented box, less `slack` an axis (it
-    /// covers `q`'s rounding in the frame, as the growth covers the
-    /// corners'; the axes are unit and orthogonal to within 10⁻¹⁵, so the
-    /// frame keeps lengths to that), less 10⁻¹² of itself.
+    /// A lower bound of the squared distance from `q` to the pieces: the
+    /// distance to the oriented box, less `slack` an axis (it covers `q`'s
+    /// rounding in the frame, as the growth covers the corners'; the axes
+    /// are unit and orthogonal to within 10⁻¹⁵, so the frame keeps lengths
+    /// to that), less 10⁻¹² of itself.
     #[inline(always)]
     fn gap(&self, q: DVec3, slack: f64) -> f64 {
         let f = DVec3::new(self.axes[0].dot(q), self.axes[1].dot(q), self.axes[2].dot(q));
