@@ -35,8 +35,8 @@ pub fn remesh<'py>(py: Python<'py>, mesh: &Mesh, options: Option<&Bound<'py, PyD
         }
     };
     let r = interruptible(py, &stop, run)?.map_err(py_err)?;
-    let mut facts = r.summary();
-    facts["warnings"] = serde_json::json!(r.warnings);
+    let mut facts = r.made.summary();
+    facts["warnings"] = serde_json::json!(r.made.warnings);
     let (positions, triangles) = (r.mesh.positions, r.mesh.triangles.iter().map(|t| t.map(i64::from)).collect());
     let loaded = py.detach(|| topovox_io::validate_mesh(positions, triangles, Vec::new())).map_err(|k| value_err(k.to_string()))?;
     Ok((Mesh { inner: Arc::new(loaded), path: None }, to_py(py, &facts)?))

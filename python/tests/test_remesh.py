@@ -239,6 +239,32 @@ def test_the_cli_writes_certified_files_in_every_format(meshes, cli, tmp_path, f
     assert back["watertight"] and back["faces"] == summary["triangles"]
 
 
+@pytest.mark.parametrize("fmt,resolution", [("obj", 40), ("ply", 40), ("stl", 40), ("glb", 40), ("ply", 560)])
+def test_a_streamed_file_is_the_mesh_made_whole(meshes, cli, tmp_path, fmt, resolution):
+    """Without --check the CLI makes and writes the surface slab by slab,
+    never whole (at 560 the bunny's grid is three slabs): the same file as
+    the --check run, which holds the mesh, and the mesh topovox.remesh
+    returns."""
+    src = meshes / "stanford-bunny.obj"
+    streamed, whole = tmp_path / f"s.{fmt}", tmp_path / f"w.{fmt}"
+    for out, extra in [(streamed, []), (whole, ["--check"])]:
+        subprocess.run([cli, "remesh", src, "-o", out, "--resolution", str(resolution), "--quiet", *extra], check=True)
+    if fmt == "obj":
+        # Each slab's vertices come before its faces: the same mesh, in
+        # another order of lines.
+        a, b = topovox.load_mesh(streamed), topovox.load_mesh(whole)
+        assert np.array_equal(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces)
+    else:
+        assert streamed.read_bytes() == whole.read_bytes()
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([streamed.name, whole.name]), "no scratch file is left"
+    if fmt != "stl" and resolution <= 40:
+        # (STL has no shared vertices to compare; its bytes are the --check run's.)
+        one = topovox.remesh(topovox.load_mesh(src), resolution=resolution)
+        back = topovox.load_mesh(streamed)
+        want = one.vertices.astype(np.float32) if fmt == "glb" else one.vertices
+        assert np.array_equal(back.vertices, want) and np.array_equal(back.faces, one.faces)
+
+
 def test_check_exits_non_zero_on_a_requested_failure(meshes, cli):
     r = subprocess.run([cli, "check", meshes / "stanford-bunny.obj"], capture_output=True, text=True)
     assert r.returncode == 1 and "not watertight" in r.stderr and "closed: NO (223 boundary edges" in r.stdout

@@ -162,6 +162,88 @@ pub fn stage(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<(
     }
 }
 
+/// A scratch section of an output that can only be placed once the
+/// writer has seen the end (a PLY's faces come after all vertices, but the
+/// header counts both): held in memory up to [`Spool::SPILL`] bytes, then
+/// in a file beside the output (the same file system, the same free
+/// space), or in the system's temporary folder for standard output and
+/// special files; named and removed like any temporary.
+pub struct Spool {
+    output: PathBuf,
+    /// Bytes held in memory before spilling.
+    limit: usize,
+    memory: Vec<u8>,
+    file: Option<(Temporary, BufWriter<File>)>,
+}
+
+impl Spool {
+    /// Bytes held in memory before the section goes to a file.
+    pub const SPILL: usize = 32 << 20;
+
+    /// A new, empty spool for `output` (nothing is created yet).
+    pub fn for_output(output: &Path) -> Spool {
+        Spool { output: output.to_path_buf(), limit: Self::SPILL, memory: Vec::new(), file: None }
+    }
+
+    /// The same, spilling past `limit` bytes (tests spill at once).
+    pub fn spilling_past(output: &Path, limit: usize) -> Spool {
+        Spool { limit, ..Spool::for_output(output) }
+    }
+
+    /// Makes room for `more` bytes about to be written (one allocation
+    /// instead of a doubling series while it stays in memory).
+    pub fn reserve(&mut self, more: usize) {
+        if self.file.is_none() && self.memory.len() + more <= self.limit {
+            self.memory.reserve_exact(more);
+        }
+    }
+
+    /// Moves what memory holds to a new scratch file.
+    fn spill(&mut self) -> std::io::Result<&mut BufWriter<File>> {
+        let beside = match target(&self.output) {
+            Target::Regular(real) => real,
+            Target::Stdout | Target::Special(_) => std::env::temp_dir().join("topovox-spool"),
+        };
+        let (temp, file) = Temporary::create_file(&beside)?;
+        let mut out = BufWriter::with_capacity(1 << 20, file);
+        out.write_all(&std::mem::take(&mut self.memory))?;
+        Ok(&mut self.file.insert((temp, out)).1)
+    }
+
+    /// Copies everything written so far to `w`; the scratch file, if any,
+    /// is removed.
+    pub fn copy_into(self, w: &mut dyn Write) -> std::io::Result<u64> {
+        match self.file {
+            None => w.write_all(&self.memory).map(|()| self.memory.len() as u64),
+            Some((temp, mut out)) => {
+                out.flush()?;
+                let mut back = File::open(temp.path())?;
+                std::io::copy(&mut back, w)
+            }
+        }
+    }
+}
+
+impl Write for Spool {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if let Some((_, out)) = &mut self.file {
+            return out.write(buf);
+        }
+        if self.memory.len() + buf.len() <= self.limit {
+            self.memory.extend_from_slice(buf);
+            return Ok(buf.len());
+        }
+        self.spill()?.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        match &mut self.file {
+            Some((_, out)) => out.flush(),
+            None => Ok(()),
+        }
+    }
+}
+
 /// The marker in every temporary name, between the output's name and the
 /// writing process's id: `.NAME.topovox-tmp-PID-N`.
 const TEMP_MARK: &str = ".topovox-tmp-";

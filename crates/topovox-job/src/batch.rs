@@ -647,11 +647,11 @@ fn sdf_one(job: &SdfJob, loaded: &topovox_io::LoadedMesh, name: &str, out: &Path
 /// The watertight mesh of one loaded mesh, written: the record's facts.
 fn remesh_one(job: &RemeshJob, loaded: &topovox_io::LoadedMesh, name: &str, out: &Path, stop: Option<&Stop>) -> Result<Value> {
     let done = job.run(out, loaded, name, None, stop)?;
-    let r = &done.remeshed;
+    let r = &done.made;
     Ok(json!({
         "grid": grid_json(&r.grid),
-        "vertices": r.mesh.positions.len(),
-        "faces": r.mesh.triangles.len(),
+        "vertices": r.vertices,
+        "faces": r.triangles,
         "remesh": r.summary(),
         "times": {"inside_s": r.facts.inside_s, "surface_s": r.facts.surface_s, "write_s": done.write_s},
         "warnings": warnings(loaded, &r.warnings),

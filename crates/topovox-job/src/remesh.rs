@@ -7,6 +7,12 @@
 //! self-intersection-free and separating every inside voxel centre from
 //! every other by construction (see `topovox::surface::tets`). Debug builds
 //! and `--check` certify the result exactly before it is written.
+//!
+//! A file output is made and written slab by slab ([`surface::Part`],
+//! `topovox_io::mesh_out::PartWriter`) unless something needs the whole
+//! mesh (the certificate, `--simplify`, wrap's two-sided distance): memory
+//! is then the solid's bits and one slab, not the mesh (the bunny at 2048:
+//! under 1 GiB for a 92 M-triangle surface).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -135,6 +141,17 @@ pub struct RemeshRequest {
     pub max_memory: Option<u64>,
 }
 
+impl RemeshRequest {
+    /// Whether a file output is made and written slab by slab, never held
+    /// whole: unless something needs the whole mesh — the certificate
+    /// (`check`, debug builds), `simplify`, and wrap's two-sided distance
+    /// (measured part by part, it held half the pieces of the bunny's
+    /// shell at 560 and took seven times as long).
+    pub fn streams(&self) -> bool {
+        !self.check && self.simplify <= 0.0 && self.inside != Inside::Wrap && !cfg!(debug_assertions)
+    }
+}
+
 impl RemeshOptions {
     /// The validated request; `single`: the output stores f32.
     pub fn request(&self, single: bool) -> Result<RemeshRequest> {
@@ -210,10 +227,8 @@ pub struct SimplifyFacts {
     pub seconds: f64,
 }
 
-/// A watertight mesh and how it was made.
-pub struct Remeshed {
-    /// The mesh.
-    pub mesh: TriMesh,
+/// How a watertight mesh was made: what the summary reports.
+pub struct RemeshMade {
     /// The grid of its voxels.
     pub grid: GridSpec,
     /// Facts for the summary.
@@ -222,20 +237,35 @@ pub struct Remeshed {
     pub certificate: Option<MeshCheck>,
     /// Things the user should know (an open mesh under parity).
     pub warnings: Vec<String>,
+    /// The mesh's vertices.
+    pub vertices: u64,
+    /// The mesh's triangles.
+    pub triangles: u64,
+}
+
+/// A watertight mesh and how it was made.
+pub struct Remeshed {
+    /// The mesh.
+    pub mesh: TriMesh,
+    /// How.
+    pub made: RemeshMade,
 }
 
 /// Refuses a grid whose voxels and surface would not fit in memory: one
 /// bit per voxel for the solid (wrap: three grids), eight for the blocky
-/// surface's half voxels, and per triangle — estimated as ten per voxel
-/// face of the input's area for the smooth surface, 44 for the blocky one
-/// (the bunny: 9.3 and 41.8) — 90 bytes (smooth: its vertices, the edge
-/// table, the distances at the lattice ends) or 60 (blocky), plus the
-/// output's distance pieces and hierarchy where the two-sided distance is
-/// measured (wrap, `check`) and the certificate's sorts where it runs;
+/// surface's half voxels, and per triangle held — estimated as ten per
+/// voxel face of the input's area for the smooth surface, 44 for the
+/// blocky one (the bunny: 9.3 and 41.8) — 90 bytes (smooth: its vertices,
+/// the edge table, the distances at the lattice ends) or 60 (blocky), plus
+/// the output's distance pieces and their copy in the hierarchy where the
+/// two-sided distance is measured (wrap, `check`: 2 × 328 + 128 bytes) and
+/// the certificate's sorts where it runs;
 /// plus the input's pieces and hierarchies (1000 bytes a piece) and 24 MiB
-/// for the process. Measured peaks on the bunny are 0.79–0.86 of it at
-/// 128, 256 (both surfaces), 1024 and 2048 (the earlier four faces and
-/// 100 bytes let the 2048 run peak at 8.4 GiB where it claimed 5.2).
+/// for the process. A streamed surface ([`RemeshRequest::streams`]) holds
+/// the triangles of one slab, counted as twice its share of the layers.
+/// Measured peaks on the bunny are 0.5–0.9 of it from 128 to 2048 (see
+/// BENCHMARKS.md; the 2048 run once peaked at 8.4 GiB where it claimed
+/// 5.2, before the surface was streamed and triangles counted as now).
 fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec) -> Result<()> {
     let cells = grid.voxel_count();
     let blocky = req.surface == SurfaceKind::Blocky;
@@ -247,9 +277,18 @@ fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec)
     let measured = req.inside == Inside::Wrap || req.check;
     let certified = req.check || cfg!(debug_assertions) || req.simplify > 0.0;
     let per_triangle =
-        bytes_each + if measured { std::mem::size_of::<topovox::distance::Piece>() + 16 } else { 0 } + if certified { 150 } else { 0 };
+        bytes_each + if measured { 2 * std::mem::size_of::<topovox::distance::Piece>() + 128 } else { 0 } + if certified { 150 } else { 0 };
+    // A streamed surface holds one slab at a time: its share of the
+    // layers, doubled for surfaces that crowd into some layers.
+    let held = if req.streams() {
+        let lattice = if blocky { grid.dims().map(|d| 2 * d) } else { grid.dims() };
+        let share = surface::slab_thickness(lattice) as f64 / lattice[2] as f64;
+        triangles * (2.0 * share).min(1.0)
+    } else {
+        triangles
+    };
     let input = pieces.items.len() as u64 * 1000 + (24 << 20);
-    let need = (cells / 8).saturating_mul(grids + 1).saturating_add((triangles * per_triangle as f64) as u64).saturating_add(input);
+    let need = (cells / 8).saturating_mul(grids + 1).saturating_add((held * per_triangle as f64) as u64).saturating_add(input);
     let limit = budget(req.max_memory);
     if need > limit {
         let [x, y, z] = grid.dims();
@@ -290,20 +329,27 @@ fn inside(
     Ok((surface::wrap(&solid.bits, &cover), format!("{}+wrap", solid.method), solid.facts, Vec::new()))
 }
 
-/// The watertight mesh of `mesh` (named `name` in messages).
-pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&Stop>) -> Result<Remeshed> {
-    let never = Stop::new();
-    let stop = stop.unwrap_or(&never);
-    let pieces = Pieces::of(mesh).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+/// The inside voxels a surface closes around, on their grid.
+struct Closed {
+    bits: DenseBits,
+    grid: GridSpec,
+    method: String,
+    solid: SolidFacts,
+    warnings: Vec<String>,
+    parts: u64,
+    dropped_parts: u64,
+    inside_voxels: u64,
+    inside_s: f64,
+}
+
+/// The inside voxels of `mesh` by `req`'s rule, small parts dropped; an
+/// error when the grid does not fit or nothing is inside.
+fn close(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, pieces: &Pieces, stop: &Stop) -> Result<Closed> {
     let grid = req.grid.fit(&mesh.bounds())?;
-    check_fits(name, req, &pieces, &grid)?;
-    // The input's hierarchy, built once when the smooth surface or the
-    // two-sided distance first needs it.
-    let tree = std::cell::OnceCell::new();
-    let input_tree = || tree.get_or_init(|| Hierarchy::new(&pieces));
+    check_fits(name, req, pieces, &grid)?;
     let t = Instant::now();
     let (bits, method, solid, warnings) = inside(mesh, name, req, &grid, stop)?;
-    let (bits, parts, dropped_parts) = surface::drop_small_parts(&bits, req.min_part);
+    let (bits, parts, dropped_parts) = surface::drop_small_parts(bits, req.min_part);
     let inside_voxels = bits.count();
     if inside_voxels == 0 {
         let why = if req.inside == Inside::Wrap {
@@ -313,32 +359,112 @@ pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&
         };
         return Err(JobError::invalid(format!("{name}: nothing to close on this grid: {why}")));
     }
-    let inside_s = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let made = match req.surface {
-        SurfaceKind::Blocky => surface::blocky(&bits, &grid, stop),
+    Ok(Closed { bits, grid, method, solid, warnings, parts, dropped_parts, inside_voxels, inside_s: t.elapsed().as_secs_f64() })
+}
+
+/// The surface around `c`, handed to `each` slab by slab ([`surface::Part`]);
+/// `tree` gives the input's hierarchy (built when first needed).
+fn surface_parts<'t, E>(
+    c: &Closed,
+    req: &RemeshRequest,
+    pieces: &Pieces,
+    tree: &dyn Fn() -> &'t Hierarchy,
+    stop: &Stop,
+    each: surface::Parts<'_, E>,
+) -> std::result::Result<Option<()>, E> {
+    match req.surface {
+        SurfaceKind::Blocky => surface::blocky_parts(&c.bits, &c.grid, stop, each),
         SurfaceKind::Smooth => {
             // Wrap's outside centres lie at least 1.5 voxels from the input
             // (no 26-neighbour's box meets it): its shell sits there.
-            let offset = (req.inside == Inside::Wrap).then(|| 1.5 * grid.voxel_size().0.max_element());
-            surface::smooth(&bits, &grid, &pieces, input_tree(), offset, stop)
+            let offset = (req.inside == Inside::Wrap).then(|| 1.5 * c.grid.voxel_size().0.max_element());
+            surface::smooth_parts(&c.bits, &c.grid, surface::Smooth { pieces, tree: tree(), offset }, stop, each)
         }
-    };
-    let mut out = made.ok_or(JobError::Interrupted)?;
+    }
+}
+
+impl Closed {
+    /// The summary's facts and the rest of what was made, once the surface is.
+    fn made(
+        self,
+        surface_s: f64,
+        extra: (Option<[f64; 4]>, Option<SimplifyFacts>),
+        certificate: Option<MeshCheck>,
+        counts: [u64; 2],
+    ) -> RemeshMade {
+        let Closed { grid, method, solid, warnings, parts, dropped_parts, inside_voxels, inside_s, .. } = self;
+        let (distance, simplify) = extra;
+        let facts = RemeshFacts { inside: method, inside_voxels, parts, dropped_parts, inside_s, surface_s, distance, solid, simplify };
+        RemeshMade { grid, facts, certificate, warnings, vertices: counts[0], triangles: counts[1] }
+    }
+}
+
+/// The watertight mesh of `mesh` (named `name` in messages).
+pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&Stop>) -> Result<Remeshed> {
+    let never = Stop::new();
+    let stop = stop.unwrap_or(&never);
+    let pieces = Pieces::of(mesh).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+    // The input's hierarchy, built once when the smooth surface or the
+    // two-sided distance first needs it.
+    let tree = std::cell::OnceCell::new();
+    let input_tree = || tree.get_or_init(|| Hierarchy::new(&pieces));
+    let mut c = close(mesh, name, req, &pieces, stop)?;
+    let t = Instant::now();
+    let mut out = TriMesh::default();
+    let made = surface_parts(&c, req, &pieces, &input_tree, stop, &mut |p: surface::Part| {
+        out.positions.extend(p.positions);
+        out.triangles.extend(p.triangles);
+        Ok::<(), std::convert::Infallible>(())
+    });
+    if !matches!(made, Ok(Some(()))) {
+        return Err(JobError::Interrupted);
+    }
     if req.single {
         out.positions.iter_mut().for_each(|p| *p = p.as_vec3().as_dvec3());
     }
-    let mut warnings = warnings;
-    let (out, simplify, certified) = simplified(out, &bits, &grid, req.simplify, stop, &mut warnings)?;
+    let (out, simplify, certified) = simplified(out, &c.bits, &c.grid, req.simplify, stop, &mut c.warnings)?;
     let surface_s = t.elapsed().as_secs_f64();
-    let distance = (req.check || req.inside == Inside::Wrap).then(|| two_sided(mesh, &pieces, input_tree(), &out, &grid));
+    let distance = (req.check || req.inside == Inside::Wrap).then(|| two_sided(mesh, &pieces, input_tree(), &out, &c.grid));
     let certificate = match certified {
         Some(c) => Some(c),
         None if req.check || cfg!(debug_assertions) => Some(certify(name, &out, stop)?),
         None => None,
     };
-    let facts = RemeshFacts { inside: method, inside_voxels, parts, dropped_parts, inside_s, surface_s, distance, solid, simplify };
-    Ok(Remeshed { mesh: out, grid, facts, certificate, warnings })
+    let counts = [out.positions.len() as u64, out.triangles.len() as u64];
+    Ok(Remeshed { made: c.made(surface_s, (distance, simplify), certificate, counts), mesh: out })
+}
+
+/// The watertight mesh of `mesh`, made and written to `out` as `format`
+/// slab by slab, never whole ([`RemeshRequest::streams`]); the made facts
+/// and the seconds spent putting the file together at the end.
+fn remesh_streamed(
+    mesh: MeshRef<'_>,
+    name: &str,
+    req: &RemeshRequest,
+    out: &Path,
+    format: MeshOut,
+    stop: &Stop,
+) -> Result<(RemeshMade, f64)> {
+    let pieces = Pieces::of(mesh).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+    let c = close(mesh, name, req, &pieces, stop)?;
+    let tree = std::cell::OnceCell::new();
+    let input_tree = || tree.get_or_init(|| Hierarchy::new(&pieces));
+    let t = Instant::now();
+    let mut writer = topovox_io::mesh_out::PartWriter::new(out, format);
+    let made = surface_parts(&c, req, &pieces, &input_tree, stop, &mut |mut p: surface::Part| {
+        if req.single {
+            p.positions.iter_mut().for_each(|p| *p = p.as_vec3().as_dvec3());
+        }
+        writer.part(p.positions, p.triangles)
+    });
+    if made?.is_none() {
+        return Err(JobError::Interrupted);
+    }
+    let surface_s = t.elapsed().as_secs_f64();
+    let counts = [writer.vertices(), writer.triangles()];
+    let t = Instant::now();
+    writer.finish(Some(stop))?;
+    Ok((c.made(surface_s, (None, None), None, counts), t.elapsed().as_secs_f64()))
 }
 
 /// `out` simplified within `error` voxels ([`surface::simplify`]; 0: as
@@ -387,7 +513,7 @@ fn simplified(
     Ok((fewer, Some(f), certificate))
 }
 
-impl Remeshed {
+impl RemeshMade {
     /// The summary's facts and the certificate (`null` when none ran), as
     /// JSON.
     pub fn summary(&self) -> Value {
@@ -424,9 +550,12 @@ fn two_sided(mesh: MeshRef<'_>, pieces: &Pieces, tree: &Hierarchy, out: &TriMesh
     let to_input = stats(tree, &out.positions);
     let out_ref = MeshRef { positions: &out.positions, triangles: &out.triangles, segments: &[] };
     let out_pieces = Pieces::of(out_ref).expect("a surface has triangles and finite vertices");
+    // The hierarchy keeps its own copy of the pieces.
+    let out_tree = Hierarchy::new(&out_pieces);
+    drop(out_pieces);
     let mut samples: Vec<DVec3> = pieces.items.iter().flat_map(|p| [p.p[0], (p.p[0] + p.p[1] + p.p[2]) / 3.0]).collect();
     samples.extend(mesh.positions.iter().filter(|p| p.is_finite()));
-    let to_output = stats(&Hierarchy::new(&out_pieces), &samples);
+    let to_output = stats(&out_tree, &samples);
     [to_input.0, to_input.1, to_output.0, to_output.1]
 }
 
@@ -441,8 +570,8 @@ pub struct RemeshJob {
 
 /// What [`RemeshJob::run`] made and wrote.
 pub struct RemeshDone {
-    /// The mesh and the facts of its making.
-    pub remeshed: Remeshed,
+    /// The facts of the mesh's making.
+    pub made: RemeshMade,
     /// Seconds writing.
     pub write_s: f64,
 }
@@ -482,10 +611,15 @@ impl RemeshJob {
     ) -> Result<RemeshDone> {
         topovox_io::atomic::refuse_overwriting_inputs(out, &loaded.sources)?;
         progress.inspect(|p| p.phase("remeshing"));
+        if self.request.streams() {
+            let never = Stop::new();
+            let (made, write_s) = remesh_streamed(loaded.mesh.as_ref(), name, &self.request, out, self.format, stop.unwrap_or(&never))?;
+            return Ok(RemeshDone { made, write_s });
+        }
         let remeshed = remesh(loaded.mesh.as_ref(), name, &self.request, stop)?;
         progress.inspect(|p| p.phase("writing"));
         let t = Instant::now();
         topovox_io::mesh_out::write_mesh(out, &remeshed.mesh.positions, &remeshed.mesh.triangles, self.format, stop)?;
-        Ok(RemeshDone { remeshed, write_s: t.elapsed().as_secs_f64() })
+        Ok(RemeshDone { made: remeshed.made, write_s: t.elapsed().as_secs_f64() })
     }
 }

@@ -22,7 +22,7 @@ pub fn run(a: &RemeshArgs) -> Result<()> {
     let (loaded, load_s) = crate::console::load_mesh(&a.mesh, &opts.run.read_options(), &bar)?;
     let name = a.mesh.display().to_string();
     let done = pool.install(|| job.run(&a.output, &loaded, &name, Some(&bar), None))?;
-    let r = &done.remeshed;
+    let r = &done.made;
     for w in &r.warnings {
         eprintln!("topovox: warning: {w}");
     }
@@ -37,8 +37,8 @@ pub fn run(a: &RemeshArgs) -> Result<()> {
             "voxel_size": topovox_io::size_json(g.voxel_size()),
             "dims": dims,
             "surface": opts.shell.surface.name(),
-            "vertices": r.mesh.positions.len(),
-            "triangles": r.mesh.triangles.len(),
+            "vertices": r.vertices,
+            "triangles": r.triangles,
             "load_s": load_s,
             "write_s": done.write_s,
             "total_s": total_s,
@@ -59,8 +59,8 @@ pub fn run(a: &RemeshArgs) -> Result<()> {
         };
         crate::console::print_stdout(&format!(
             "remesh: {} triangles, {} vertices ({} surface around {} inside voxels, {}, {} parts) on grid {}x{}x{}{certified}; total {:.2} s -> {}",
-            r.mesh.triangles.len(),
-            r.mesh.positions.len(),
+            r.triangles,
+            r.vertices,
             opts.shell.surface.name(),
             r.facts.inside_voxels,
             r.facts.inside,

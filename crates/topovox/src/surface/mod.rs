@@ -50,37 +50,107 @@ pub const MARGIN: f64 = 0.05;
 /// them apart by half a voxel.
 pub const WRAP_MARGIN: f64 = 0.25;
 
+/// One slab of a surface ([`tets::extract_slabs`]): the positions of
+/// vertices `first_vertex..`, and triangles on those and on the previous
+/// part's vertices. A surface's parts, concatenated, are the whole surface.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Part {
+    /// The id of the first of `positions`.
+    pub first_vertex: u32,
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Triangles (global vertex ids), counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// How a caller takes a surface's parts; its first error ends the surface.
+pub type Parts<'a, E> = &'a mut dyn FnMut(Part) -> Result<(), E>;
+
+/// Layers per slab on a grid of `dims` lattice points: about 2²⁶ points a
+/// slab, at least 8 layers (2048² in x and y: 16 layers; 512²: 256;
+/// 256²: the whole grid at once).
+pub fn slab_thickness(dims: [u32; 3]) -> u32 {
+    let layer = (dims[0] as u64 * dims[1] as u64).max(1);
+    ((1u64 << 26) / layer).clamp(8, u32::MAX as u64) as u32
+}
+
+/// The whole surface that `make` hands out in parts; `None` when stopped.
+fn whole(make: impl FnOnce(Parts<'_, std::convert::Infallible>) -> Result<Option<()>, std::convert::Infallible>) -> Option<TriMesh> {
+    let mut all = TriMesh::default();
+    let done = make(&mut |p: Part| {
+        all.positions.extend(p.positions);
+        all.triangles.extend(p.triangles);
+        Ok(())
+    });
+    match done {
+        Ok(d) => d.map(|()| all),
+        Err(never) => match never {},
+    }
+}
+
 /// The blocky surface of `inside` on `grid` (see the module doc).
 pub fn blocky(inside: &DenseBits, grid: &GridSpec, stop: &Stop) -> Option<TriMesh> {
+    whole(|each| blocky_parts(inside, grid, stop, each))
+}
+
+/// [`blocky`], handed to `each` slab by slab (see [`Part`]); `Ok(None)`
+/// when `stop` was requested.
+pub fn blocky_parts<E>(inside: &DenseBits, grid: &GridSpec, stop: &Stop, each: Parts<'_, E>) -> Result<Option<()>, E> {
     let halves = refine(inside);
-    let e = tets::extract(&halves, stop)?;
     let (o, q) = (grid.origin(), grid.voxel_size().0 / 4.0);
-    // Half-voxel centre s sits at (2s + 1) quarters; the middle of an edge
-    // at the sum of its ends' quarters, halved: exact integers.
-    let positions = e
-        .crossings
-        .par_iter()
-        .map(|(a, b)| {
-            let quarters = DVec3::new((a[0] + b[0] + 1) as f64, (a[1] + b[1] + 1) as f64, (a[2] + b[2] + 1) as f64);
-            o + quarters * q
-        })
-        .collect();
-    Some(TriMesh { positions, triangles: e.triangles })
+    tets::extract_slabs(&halves, slab_thickness(halves.dims()), stop, |s| {
+        // Half-voxel centre s sits at (2s + 1) quarters; the middle of an
+        // edge at the sum of its ends' quarters, halved: exact integers.
+        let positions = s
+            .crossings
+            .par_iter()
+            .map(|(a, b)| {
+                let quarters = DVec3::new((a[0] + b[0] + 1) as f64, (a[1] + b[1] + 1) as f64, (a[2] + b[2] + 1) as f64);
+                o + quarters * q
+            })
+            .collect();
+        each(Part { first_vertex: s.first_vertex, positions, triangles: s.triangles })
+    })
+}
+
+/// Where the smooth surface's vertices go: the signed distance's source and
+/// the rule (see [`smooth`]).
+#[derive(Clone, Copy)]
+pub struct Smooth<'a> {
+    /// The input's pieces.
+    pub pieces: &'a Pieces,
+    /// Their hierarchy (the caller may use it again).
+    pub tree: &'a Hierarchy,
+    /// Wrap's offset (world units), `None` for the input's own surface.
+    pub offset: Option<f64>,
 }
 
 /// The smooth surface of `inside` on `grid`: each vertex on the zero of
 /// the linear interpolation along its edge of the signed distance to
-/// `pieces` (negative at inside centres; `tree` is their hierarchy, which
-/// the caller may use again), clamped to
-/// [`MARGIN`]`..1 − MARGIN` of the edge; or with `offset` (world units)
+/// `at.pieces` (negative at inside centres), clamped to
+/// [`MARGIN`]`..1 − MARGIN` of the edge; or with `at.offset` (world units)
 /// of `distance − offset`, clamped to [`WRAP_MARGIN`] (wrap's shells,
 /// which sit off the input).
-pub fn smooth(inside: &DenseBits, grid: &GridSpec, pieces: &Pieces, tree: &Hierarchy, offset: Option<f64>, stop: &Stop) -> Option<TriMesh> {
-    let e = tets::extract(inside, stop)?;
+pub fn smooth(inside: &DenseBits, grid: &GridSpec, at: Smooth<'_>, stop: &Stop) -> Option<TriMesh> {
+    whole(|each| smooth_parts(inside, grid, at, stop, each))
+}
+
+/// [`smooth`], handed to `each` slab by slab (see [`Part`]): only a slab's
+/// lattice ends and vertices are held at once. `Ok(None)` when `stop` was
+/// requested.
+pub fn smooth_parts<E>(inside: &DenseBits, grid: &GridSpec, at: Smooth<'_>, stop: &Stop, each: Parts<'_, E>) -> Result<Option<()>, E> {
+    tets::extract_slabs(inside, slab_thickness(inside.dims()), stop, |s| {
+        let positions = smooth_positions(&s.crossings, grid, at);
+        each(Part { first_vertex: s.first_vertex, positions, triangles: s.triangles })
+    })
+}
+
+/// The smooth vertices on `crossings` (see [`smooth`]).
+fn smooth_positions(crossings: &[([i64; 3], [i64; 3])], grid: &GridSpec, at: Smooth<'_>) -> Vec<DVec3> {
     let centre = |p: [i64; 3]| grid.origin() + (DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) + 0.5) * grid.voxel_size().0;
     // Every end once: inside ends come grouped (crossings are in order of
     // them), outside ends are sorted out; runs of neighbours share bounds.
-    let mut ends: Vec<[i64; 3]> = e.crossings.iter().flat_map(|(a, b)| [*a, *b]).collect();
+    let mut ends: Vec<[i64; 3]> = crossings.iter().flat_map(|(a, b)| [*a, *b]).collect();
     ends.par_sort_unstable_by_key(|p| [p[2], p[1], p[0]]);
     ends.dedup();
     let dist: Vec<f64> = ends
@@ -90,29 +160,27 @@ pub fn smooth(inside: &DenseBits, grid: &GridSpec, pieces: &Pieces, tree: &Hiera
             chunk.iter().map(move |&p| {
                 let q = centre(p);
                 // The previous end's nearest piece bounds this search.
-                let bound = if best.1 == u32::MAX { best } else { (pieces.items[best.1 as usize].distance_squared(q), best.1) };
-                best = tree.nearest(q, bound);
+                let bound = if best.1 == u32::MAX { best } else { (at.pieces.items[best.1 as usize].distance_squared(q), best.1) };
+                best = at.tree.nearest(q, bound);
                 best.0.sqrt()
             })
         })
         .collect();
     let d = |p: &[i64; 3]| dist[ends.binary_search_by_key(&[p[2], p[1], p[0]], |e| [e[2], e[1], e[0]]).expect("every end is listed")];
-    let positions = e
-        .crossings
+    crossings
         .par_iter()
         .map(|(a, b)| {
             // The inside end's value ≤ 0, the outside end's ≥ 0.
-            let (fa, fb) = match offset {
+            let (fa, fb) = match at.offset {
                 None => (-d(a), d(b)),
                 Some(r) => ((d(a) - r).min(0.0), (d(b) - r).max(0.0)),
             };
             let t = if fb > fa { -fa / (fb - fa) } else { 0.5 };
             let (pa, pb) = (centre(*a), centre(*b));
-            let margin = if offset.is_some() { WRAP_MARGIN } else { MARGIN };
+            let margin = if at.offset.is_some() { WRAP_MARGIN } else { MARGIN };
             pa + (pb - pa) * t.clamp(margin, 1.0 - margin)
         })
-        .collect();
-    Some(TriMesh { positions, triangles: e.triangles })
+        .collect()
 }
 
 /// Wrap's inside voxels: `solid`, `cover` grown by one voxel (26
@@ -126,9 +194,10 @@ pub fn wrap(solid: &DenseBits, cover: &DenseBits) -> DenseBits {
 }
 
 /// `bits` without its parts (26-connected components) of fewer than `min`
-/// voxels, with how many parts were kept and dropped.
-pub fn drop_small_parts(bits: &DenseBits, min: u64) -> (DenseBits, u64, u64) {
-    let runs = Runs::of(bits, true);
+/// voxels, with how many parts were kept and dropped (`bits` itself, not a
+/// copy, when none is dropped).
+pub fn drop_small_parts(bits: DenseBits, min: u64) -> (DenseBits, u64, u64) {
+    let runs = Runs::of(&bits, true);
     // Labels are each component's smallest run index.
     let (label, count) = components(&runs, Connectivity::TwentySix);
     let mut size = vec![0u64; runs.len()];
@@ -137,6 +206,9 @@ pub fn drop_small_parts(bits: &DenseBits, min: u64) -> (DenseBits, u64, u64) {
     }
     let keep: Vec<bool> = size.iter().map(|&s| s >= min).collect();
     let kept = (0..runs.len()).filter(|&n| label[n] as usize == n && keep[n]).count() as u64;
+    if kept == count as u64 {
+        return (bits, kept, 0);
+    }
     let mut out = DenseBits::new(bits.dims());
     for (r, row) in out.rows_mut().enumerate() {
         for n in runs.row_start[r] as usize..runs.row_start[r + 1] as usize {

@@ -82,6 +82,62 @@ fn the_fast_extraction_equals_the_reference() {
     }
 }
 
+/// Slabs of any thickness concatenate to the whole surface, and each
+/// slab's triangles use only its own and the previous slab's vertices
+/// (what a writer streaming the parts relies on).
+#[test]
+fn slabs_of_any_thickness_are_the_whole_surface() {
+    let mut rng = Xorshift(23);
+    for round in 0..10 {
+        let dims = [5 + round % 4, 9, 6 + round];
+        let bits = random_bits(&mut rng, dims, 25 + 6 * round as u64);
+        let whole = tets::extract(&bits, &Stop::new()).unwrap();
+        for thickness in [1, 2, 3, 7, dims[2], u32::MAX] {
+            let mut all = tets::Extracted::default();
+            let mut previous_first = 0u32;
+            tets::extract_slabs(&bits, thickness, &Stop::new(), |s| {
+                assert_eq!(s.first_vertex as usize, all.crossings.len(), "thickness {thickness}");
+                let end = s.first_vertex + s.crossings.len() as u32;
+                assert!(s.triangles.iter().flatten().all(|&v| (previous_first..end).contains(&v)), "thickness {thickness}");
+                previous_first = s.first_vertex;
+                all.crossings.extend(s.crossings);
+                all.triangles.extend(s.triangles);
+                Ok::<(), ()>(())
+            })
+            .unwrap()
+            .unwrap();
+            assert_eq!(all, whole, "round {round}, thickness {thickness}");
+        }
+        let g = grid(dims);
+        let mut parts = TriMesh::default();
+        blocky_parts(&bits, &g, &Stop::new(), &mut |p: Part| {
+            assert_eq!(p.first_vertex as usize, parts.positions.len());
+            parts.positions.extend(p.positions);
+            parts.triangles.extend(p.triangles);
+            Ok::<(), ()>(())
+        })
+        .unwrap()
+        .unwrap();
+        assert_eq!(parts, blocky(&bits, &g, &Stop::new()).unwrap());
+    }
+}
+
+/// A stop requested before the surface is made gives `None`; an error
+/// from the taker ends it at the first slab.
+#[test]
+fn slabs_end_on_a_stop_or_an_error() {
+    let bits = random_bits(&mut Xorshift(3), [6, 6, 40], 40);
+    let stop = Stop::new();
+    stop.request();
+    assert_eq!(tets::extract(&bits, &stop), None);
+    let mut calls = 0;
+    let r = tets::extract_slabs(&bits, 8, &Stop::new(), |_| {
+        calls += 1;
+        Err("full")
+    });
+    assert_eq!((r, calls), (Err("full"), 1));
+}
+
 #[test]
 fn random_voxels_give_certified_separating_surfaces() {
     let mut rng = Xorshift(5);
@@ -97,7 +153,11 @@ fn random_voxels_give_certified_separating_surfaces() {
         let triangles = [[0, 1, 2], [3, 4, 5], [6, 7, 8], [0, 4, 8]];
         let pieces = Pieces::of(MeshRef { positions: &positions, triangles: &triangles, segments: &[] }).unwrap();
         for offset in [None, Some(0.3)] {
-            certified(&smooth(&bits, &g, &pieces, &Hierarchy::new(&pieces), offset, &Stop::new()).unwrap(), &bits, &g);
+            certified(
+                &smooth(&bits, &g, Smooth { pieces: &pieces, tree: &Hierarchy::new(&pieces), offset }, &Stop::new()).unwrap(),
+                &bits,
+                &g,
+            );
         }
     }
 }
@@ -122,7 +182,7 @@ fn smooth_surfaces_of_a_ball_are_certified_and_near_it() {
     let mesh = MeshRef { positions: &positions, triangles: &triangles, segments: &[] };
     let (g, inside) = ball(0.5, 10);
     let pieces = Pieces::of(mesh).unwrap();
-    let m = smooth(&inside, &g, &pieces, &Hierarchy::new(&pieces), None, &Stop::new()).unwrap();
+    let m = smooth(&inside, &g, Smooth { pieces: &pieces, tree: &Hierarchy::new(&pieces), offset: None }, &Stop::new()).unwrap();
     certified(&m, &inside, &g);
     let far = m.positions.iter().map(|p| ((*p - DVec3::splat(2.5)).length() - 2.0).abs()).fold(0.0, f64::max);
     assert!(far < 0.2, "a vertex {far} from the sphere");
@@ -198,8 +258,8 @@ fn small_parts_go_only_when_asked() {
     bits.set(5, 5, 5);
     bits.set(6, 6, 6); // 26-connected to (5, 5, 5): one part of two voxels
     bits.set(7, 0, 7);
-    assert_eq!(drop_small_parts(&bits, 0), (bits.clone(), 3, 0));
-    let (kept, n, dropped) = drop_small_parts(&bits, 2);
+    assert_eq!(drop_small_parts(bits.clone(), 0), (bits.clone(), 3, 0));
+    let (kept, n, dropped) = drop_small_parts(bits.clone(), 2);
     assert_eq!((n, dropped, kept.count()), (2, 1, 29));
     assert!(!kept.get(7, 0, 7) && kept.get(6, 6, 6));
 }
@@ -217,9 +277,10 @@ fn simplified_surfaces_keep_every_guarantee() {
         let dims = [6 + round % 3, 7, 5 + round % 4];
         let bits = random_bits(&mut rng, dims, 25 + 10 * round as u64);
         let g = grid(dims);
-        for m in
-            [blocky(&bits, &g, &Stop::new()).unwrap(), smooth(&bits, &g, &pieces, &Hierarchy::new(&pieces), None, &Stop::new()).unwrap()]
-        {
+        for m in [
+            blocky(&bits, &g, &Stop::new()).unwrap(),
+            smooth(&bits, &g, Smooth { pieces: &pieces, tree: &Hierarchy::new(&pieces), offset: None }, &Stop::new()).unwrap(),
+        ] {
             for bound in [0.25, 1.0, 2.0] {
                 let s = simplify::simplify(&m, &g, bound * 0.5, &Stop::new()).unwrap();
                 certified(&s, &bits, &g);

@@ -88,21 +88,89 @@ impl Layer {
 /// The surface between the set and clear points of `labels`. `None` when
 /// `stop` was requested.
 pub fn extract(labels: &DenseBits, stop: &Stop) -> Option<Extracted> {
-    let dims = labels.dims();
-    let mut layers: Vec<Layer> = (0..dims[2]).into_par_iter().map(|k| layer(labels, k)).collect();
-    // Vertex ids in order of (k, j, i, direction): the same for any threads.
-    let mut next = 0u32;
-    for l in &mut layers {
-        for &m in &l.mask {
-            l.first.push(next);
-            next += m.count_ones();
-        }
+    let mut all = Extracted::default();
+    let whole = extract_slabs(labels, labels.dims()[2].max(1), stop, |s| {
+        all.crossings.extend(s.crossings);
+        all.triangles.extend(s.triangles);
+        Ok::<(), std::convert::Infallible>(())
+    });
+    match whole {
+        Ok(done) => done.map(|()| all),
+        Err(never) => match never {},
     }
-    let tris: Option<Vec<Vec<[u32; 3]>>> =
-        (-1..dims[2] as i64).into_par_iter().map(|k| (!stop.requested()).then(|| layer_triangles(labels, &layers, k))).collect();
-    let triangles = tris?.into_iter().flatten().collect();
-    let crossings = layers.par_iter().enumerate().flat_map_iter(|(k, l)| crossings(l, k as i64)).collect();
-    Some(Extracted { crossings, triangles })
+}
+
+/// One slab of the surface ([`extract_slabs`]): the vertices whose inside
+/// end lies in its layers, numbered on from `first_vertex`, and the
+/// triangles among them and the previous slab's vertices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Slab {
+    /// The id of the first of `crossings`.
+    pub first_vertex: u32,
+    /// The crossing edges of this slab's vertices, in id order.
+    pub crossings: Vec<([i64; 3], [i64; 3])>,
+    /// Triangles on this slab's vertices and the previous slab's.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The same surface as [`extract`], handed to `each` slab by slab, in
+/// order: `thickness` layers of vertices at a time, with every triangle
+/// whose vertices have all been handed out (the cubes whose upper layer
+/// is the slab's last wait for the next slab). Concatenated, the slabs
+/// are [`extract`]'s result for any `thickness`; only two slabs' layers
+/// are held at once. `Ok(None)` when `stop` was requested; `each`'s first
+/// error ends it.
+pub fn extract_slabs<E>(
+    labels: &DenseBits,
+    thickness: u32,
+    stop: &Stop,
+    mut each: impl FnMut(Slab) -> Result<(), E>,
+) -> Result<Option<()>, E> {
+    let nz = labels.dims()[2];
+    let mut previous: Option<Layer> = None;
+    let mut next = 0u32;
+    let mut k0 = 0u32;
+    while k0 < nz {
+        let k1 = k0.saturating_add(thickness.max(1)).min(nz);
+        if stop.requested() {
+            return Ok(None);
+        }
+        let mut fresh: Vec<Layer> = (k0..k1).into_par_iter().map(|k| layer(labels, k)).collect();
+        // Vertex ids in order of (k, j, i, direction): the same for any
+        // threads and any thickness.
+        let first_vertex = next;
+        for l in &mut fresh {
+            for &m in &l.mask {
+                l.first.push(next);
+                next += m.count_ones();
+            }
+        }
+        let crossings = fresh.par_iter().enumerate().flat_map_iter(|(n, l)| crossings(l, k0 as i64 + n as i64)).collect();
+        let window = Window { base: k0 as i64 - previous.is_some() as i64, layers: previous.iter().chain(&fresh).collect() };
+        // Cubes k0 − 1 .. k1 − 1 (their upper layer is handed out), and the
+        // last layer's cubes, whose upper layer is outside the grid.
+        let end = if k1 == nz { k1 as i64 } else { k1 as i64 - 1 };
+        let tris: Option<Vec<Vec<[u32; 3]>>> =
+            (k0 as i64 - 1..end).into_par_iter().map(|k| (!stop.requested()).then(|| layer_triangles(labels, &window, k))).collect();
+        let Some(tris) = tris else { return Ok(None) };
+        each(Slab { first_vertex, crossings, triangles: tris.into_iter().flatten().collect() })?;
+        previous = fresh.pop();
+        k0 = k1;
+    }
+    Ok(Some(()))
+}
+
+/// Consecutive layers from layer `base`.
+struct Window<'a> {
+    base: i64,
+    layers: Vec<&'a Layer>,
+}
+
+impl Window<'_> {
+    /// Layer `k`, if held.
+    fn get(&self, k: i64) -> Option<&Layer> {
+        usize::try_from(k - self.base).ok().and_then(|n| self.layers.get(n).copied())
+    }
 }
 
 /// A layer's crossing edges as (inside point, outside point), in id order.
@@ -189,10 +257,10 @@ fn and_with_neighbours(acc: &mut [u64], r: &[u64]) {
 
 /// The triangles of the cubes with lower corner in layer `k` (−1 included)
 /// that have a boundary point as a corner.
-fn layer_triangles(labels: &DenseBits, layers: &[Layer], k: i64) -> Vec<[u32; 3]> {
+fn layer_triangles(labels: &DenseBits, layers: &Window<'_>, k: i64) -> Vec<[u32; 3]> {
     let mut cells: Vec<(i64, i64)> = Vec::new();
     for kk in [k, k + 1] {
-        if let Some(l) = usize::try_from(kk).ok().and_then(|kk| layers.get(kk)) {
+        if let Some(l) = layers.get(kk) {
             for j in 0..l.row_start.len() - 1 {
                 for n in l.row_start[j] as usize..l.row_start[j + 1] as usize {
                     for (dj, di) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
@@ -208,7 +276,7 @@ fn layer_triangles(labels: &DenseBits, layers: &[Layer], k: i64) -> Vec<[u32; 3]
     for (j, i) in cells {
         cube_triangles(labels, [i, j, k], &mut edges);
     }
-    edges.iter().map(|t| t.map(|(p, d)| layers[p[2] as usize].id(p, d))).collect()
+    edges.iter().map(|t| t.map(|(p, d)| layers.get(p[2]).expect("a cube's layers are held").id(p, d))).collect()
 }
 
 /// The corner with code `c` (`x = 1, y = 2, z = 4`) of the cube at `at`.
