@@ -177,6 +177,31 @@ fn ctrl_c_ends_a_run_at_once_with_130_and_leaves_nothing() {
     assert!(left.is_empty(), "left behind: {left:?}");
 }
 
+/// A remesh interrupted while its slabs go to scratch files beside the
+/// output leaves neither them nor the output.
+#[test]
+fn ctrl_c_during_a_streamed_remesh_leaves_no_scratch_file() {
+    let d = folder("interrupt-remesh");
+    let out = d.join("bunny.ply");
+    let mesh = topovox_testkit::shared_meshes_dir().join("stanford-bunny.obj");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_topovox"))
+        .args(["remesh", s(&mesh), "-o", s(&out), "--resolution", "1024", "--quiet"])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let listing =
+        || -> Vec<String> { std::fs::read_dir(&d).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect() };
+    let t = Instant::now();
+    while !listing().iter().any(|n| n.contains("topovox-tmp")) {
+        assert!(t.elapsed() < Duration::from_secs(60), "no scratch file appeared: {:?}", listing());
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{status:?}");
+    assert!(listing().is_empty(), "left behind: {:?}", listing());
+}
+
 #[test]
 fn small_files_claiming_huge_grids_are_refused_or_read_from_what_they_store() {
     let d = folder("claims");
