@@ -304,8 +304,9 @@ fn remesh_keeps_to_what_it_says_it_needs() {
     let d = folder("memory-remesh");
     let mesh = topovox_testkit::shared_meshes_dir().join("stanford-bunny.obj");
     let out = d.join("bunny.ply");
-    // 384: the surface in one slab; 768: made and written in six slabs;
-    // wrap: held whole, with the output's distance hierarchy.
+    // Run at the bound its refusal names, a streamed surface is made in
+    // slabs as thin as that bound needs (at 768, 8 layers each); wrap is held
+    // whole, with the output's distance hierarchy.
     for (resolution, surface, inside) in
         [("384", "smooth", "auto"), ("384", "blocky", "auto"), ("768", "smooth", "auto"), ("256", "smooth", "wrap")]
     {

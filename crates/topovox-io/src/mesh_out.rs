@@ -294,15 +294,15 @@ impl PartWriter {
         if let Some(s) = &mut self.second {
             s.reserve(second);
         }
+        let second = self.second.as_mut();
         match self.format {
             MeshOut::Obj => {
-                let w = &mut self.first;
-                obj_vertices(w, positions)?;
-                obj_faces(w, triangles)?;
+                in_chunks(&mut self.first, positions, |b, c| obj_vertices(b, c))?;
+                in_chunks(&mut self.first, triangles, |b, c| obj_faces(b, c))?;
             }
             MeshOut::Ply => {
-                ply_vertices(&mut self.first, positions)?;
-                ply_faces(self.second.as_mut().expect("PLY has two sections"), triangles)?;
+                in_chunks(&mut self.first, positions, |b, c| ply_vertices(b, c))?;
+                in_chunks(second.expect("PLY has two sections"), triangles, |b, c| ply_faces(b, c))?;
             }
             MeshOut::Stl => {
                 // The previous part's positions and this one's.
@@ -310,11 +310,12 @@ impl PartWriter {
                 self.window_first = lo;
                 self.window.extend_from_slice(positions);
                 let (window, first) = (&self.window, self.window_first);
-                stl_facets(&mut self.first, triangles, |v| window[(v as u64 - first) as usize])?;
+                in_chunks(&mut self.first, triangles, |b, c| stl_facets(b, c, |v| window[(v as u64 - first) as usize]))?;
             }
             MeshOut::Glb => {
-                glb_indices(&mut self.first, triangles)?;
-                glb_positions(self.second.as_mut().expect("GLB has two sections"), positions, &mut self.bounds)?;
+                in_chunks(&mut self.first, triangles, |b, c| glb_indices(b, c))?;
+                let bounds = &mut self.bounds;
+                in_chunks(second.expect("GLB has two sections"), positions, |b, c| glb_positions(b, c, bounds))?;
             }
         }
         self.previous_first = self.vertices;
@@ -366,6 +367,19 @@ impl PartWriter {
             Ok(())
         })
     }
+}
+
+/// Encodes `items` with `encode` into a buffer 65 536 at a time, each
+/// chunk written to `w` at once: a spool then takes a few large writes, not
+/// one per number.
+fn in_chunks<T>(w: &mut Spool, items: &[T], mut encode: impl FnMut(&mut Vec<u8>, &[T]) -> std::io::Result<()>) -> std::io::Result<()> {
+    let mut buf = Vec::new();
+    for chunk in items.chunks(1 << 16) {
+        buf.clear();
+        encode(&mut buf, chunk)?;
+        w.write_all(&buf)?;
+    }
+    Ok(())
 }
 
 /// Writes a binary glTF container: the 12-byte header, the JSON chunk

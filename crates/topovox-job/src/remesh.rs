@@ -8,11 +8,12 @@
 //! every other by construction (see `topovox::surface::tets`). Debug builds
 //! and `--check` certify the result exactly before it is written.
 //!
-//! A file output is made and written slab by slab ([`surface::Part`],
+//! A file output past what one slab may hold (1 GiB, or what the budget
+//! leaves) is made and written slab by slab ([`surface::Part`],
 //! `topovox_io::mesh_out::PartWriter`) unless something needs the whole
 //! mesh (the certificate, `--simplify`, wrap's two-sided distance): memory
 //! is then the solid's bits and one slab, not the mesh (the bunny at 2048:
-//! under 1 GiB for a 92 M-triangle surface).
+//! 1.3 GiB for a 92 M-triangle surface, 0.9 GiB under `--max-memory 2G`).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -251,22 +252,32 @@ pub struct Remeshed {
     pub made: RemeshMade,
 }
 
-/// Refuses a grid whose voxels and surface would not fit in memory: one
-/// bit per voxel for the solid (wrap: three grids), eight for the blocky
-/// surface's half voxels, and per triangle held — estimated as ten per
-/// voxel face of the input's area for the smooth surface, 44 for the
-/// blocky one (the bunny: 9.3 and 41.8) — 90 bytes (smooth: its vertices,
-/// the edge table, the distances at the lattice ends) or 60 (blocky), plus
-/// the output's distance pieces and their copy in the hierarchy where the
-/// two-sided distance is measured (wrap, `check`: 2 × 328 + 128 bytes) and
-/// the certificate's sorts where it runs;
-/// plus the input's pieces and hierarchies (1000 bytes a piece) and 24 MiB
-/// for the process. A streamed surface ([`RemeshRequest::streams`]) holds
-/// the triangles of one slab, counted as twice its share of the layers.
-/// Measured peaks on the bunny are 0.5–0.9 of it from 128 to 2048 (see
+/// The most one slab of a streamed surface may hold (estimated): enough
+/// that a surface of up to about 10 M triangles is made in one slab, as
+/// fast as a whole one, and a larger one costs at most this much.
+const SLAB_BYTES: u64 = 1 << 30;
+
+/// Refuses a grid whose voxels and surface would not fit in memory, and
+/// says how many lattice layers a slab of the surface holds.
+///
+/// The estimate: one bit per voxel for the solid (wrap: three grids),
+/// eight for the blocky surface's half voxels, and per triangle held —
+/// estimated as ten per voxel face of the input's area for the smooth
+/// surface, 44 for the blocky one (the bunny: 9.3 and 41.8) — 90 bytes
+/// (smooth: its vertices, the edge table, the distances at the lattice
+/// ends) or 60 (blocky), plus the output's distance pieces and their copy
+/// in the hierarchy where the two-sided distance is measured (wrap,
+/// `check`: 2 × 328 + 128 bytes) and the certificate's sorts where it
+/// runs; plus the input's pieces and hierarchies (1000 bytes a piece) and
+/// 24 MiB for the process. A streamed surface ([`RemeshRequest::streams`])
+/// holds one slab: the whole surface when it fits within [`SLAB_BYTES`]
+/// and what the budget leaves, else as many layers as keep twice their
+/// share of the triangles (surfaces crowd into some layers) within that,
+/// at least 8, plus the writer's two scratch sections in memory. Measured
+/// peaks on the bunny are 0.5–0.9 of the estimate from 128 to 2048 (see
 /// BENCHMARKS.md; the 2048 run once peaked at 8.4 GiB where it claimed
 /// 5.2, before the surface was streamed and triangles counted as now).
-fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec) -> Result<()> {
+fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec) -> Result<u32> {
     let cells = grid.voxel_count();
     let blocky = req.surface == SurfaceKind::Blocky;
     let grids = if req.inside == Inside::Wrap { 3 } else { 1 } + if blocky { 8 } else { 0 };
@@ -278,18 +289,33 @@ fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec)
     let certified = req.check || cfg!(debug_assertions) || req.simplify > 0.0;
     let per_triangle =
         bytes_each + if measured { 2 * std::mem::size_of::<topovox::distance::Piece>() + 128 } else { 0 } + if certified { 150 } else { 0 };
-    // A streamed surface holds one slab at a time: its share of the
-    // layers, doubled for surfaces that crowd into some layers.
-    let held = if req.streams() {
-        let lattice = if blocky { grid.dims().map(|d| 2 * d) } else { grid.dims() };
-        let share = surface::slab_thickness(lattice) as f64 / lattice[2] as f64;
-        triangles * (2.0 * share).min(1.0)
-    } else {
-        triangles
-    };
-    let input = pieces.items.len() as u64 * 1000 + (24 << 20);
-    let need = (cells / 8).saturating_mul(grids + 1).saturating_add((held * per_triangle as f64) as u64).saturating_add(input);
+    let surface = triangles * per_triangle as f64;
+    let fixed = (cells / 8).saturating_mul(grids + 1).saturating_add(pieces.items.len() as u64 * 1000 + (24 << 20));
     let limit = budget(req.max_memory);
+    let layers = if blocky { 2 * grid.dims()[2] } else { grid.dims()[2] } as u32;
+    // The whole surface at once, when it fits in a slab and the budget.
+    let whole = fixed.saturating_add(surface as u64);
+    if !req.streams() || (surface <= SLAB_BYTES as f64 && whole <= limit) {
+        refuse_past(name, grid, whole, limit)?;
+        return Ok(u32::MAX);
+    }
+    // Else slabs as thick as the budget allows, plus the writer's two
+    // scratch sections, held in memory up to a limit.
+    let scratch = 2 * topovox_io::atomic::Spool::SPILL as u64;
+    let slab = SLAB_BYTES.min(limit.saturating_sub(fixed + scratch)) as f64;
+    // A slab of t layers holds about 2·t/layers of the surface.
+    let thickness = ((slab / (2.0 * surface).max(1.0)) * layers as f64).clamp(8.0, layers.max(8) as f64) as u32;
+    let held = surface * (2.0 * thickness as f64 / layers as f64).min(1.0);
+    let streamed = fixed + scratch + held as u64;
+    if streamed > limit && whole <= limit {
+        return Ok(u32::MAX);
+    }
+    refuse_past(name, grid, whole.min(streamed), limit)?;
+    Ok(thickness)
+}
+
+/// The refusal of a run that needs `need` bytes where `limit` is allowed.
+fn refuse_past(name: &str, grid: &GridSpec, need: u64, limit: u64) -> Result<()> {
     if need > limit {
         let [x, y, z] = grid.dims();
         return Err(JobError::failed(format!(
@@ -333,6 +359,8 @@ fn inside(
 struct Closed {
     bits: DenseBits,
     grid: GridSpec,
+    /// Lattice layers per slab of the surface.
+    thickness: u32,
     method: String,
     solid: SolidFacts,
     warnings: Vec<String>,
@@ -346,7 +374,7 @@ struct Closed {
 /// error when the grid does not fit or nothing is inside.
 fn close(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, pieces: &Pieces, stop: &Stop) -> Result<Closed> {
     let grid = req.grid.fit(&mesh.bounds())?;
-    check_fits(name, req, pieces, &grid)?;
+    let thickness = check_fits(name, req, pieces, &grid)?;
     let t = Instant::now();
     let (bits, method, solid, warnings) = inside(mesh, name, req, &grid, stop)?;
     let (bits, parts, dropped_parts) = surface::drop_small_parts(bits, req.min_part);
@@ -359,7 +387,8 @@ fn close(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, pieces: &Pieces, st
         };
         return Err(JobError::invalid(format!("{name}: nothing to close on this grid: {why}")));
     }
-    Ok(Closed { bits, grid, method, solid, warnings, parts, dropped_parts, inside_voxels, inside_s: t.elapsed().as_secs_f64() })
+    let inside_s = t.elapsed().as_secs_f64();
+    Ok(Closed { bits, grid, thickness, method, solid, warnings, parts, dropped_parts, inside_voxels, inside_s })
 }
 
 /// The surface around `c`, handed to `each` slab by slab ([`surface::Part`]);
@@ -373,12 +402,12 @@ fn surface_parts<'t, E>(
     each: surface::Parts<'_, E>,
 ) -> std::result::Result<Option<()>, E> {
     match req.surface {
-        SurfaceKind::Blocky => surface::blocky_parts(&c.bits, &c.grid, stop, each),
+        SurfaceKind::Blocky => surface::blocky_parts(&c.bits, &c.grid, c.thickness, stop, each),
         SurfaceKind::Smooth => {
             // Wrap's outside centres lie at least 1.5 voxels from the input
             // (no 26-neighbour's box meets it): its shell sits there.
             let offset = (req.inside == Inside::Wrap).then(|| 1.5 * c.grid.voxel_size().0.max_element());
-            surface::smooth_parts(&c.bits, &c.grid, surface::Smooth { pieces, tree: tree(), offset }, stop, each)
+            surface::smooth_parts(&c.bits, &c.grid, surface::Smooth { pieces, tree: tree(), offset }, c.thickness, stop, each)
         }
     }
 }

@@ -66,14 +66,6 @@ pub struct Part {
 /// How a caller takes a surface's parts; its first error ends the surface.
 pub type Parts<'a, E> = &'a mut dyn FnMut(Part) -> Result<(), E>;
 
-/// Layers per slab on a grid of `dims` lattice points: about 2²⁶ points a
-/// slab, at least 8 layers (2048² in x and y: 16 layers; 512²: 256;
-/// 256²: the whole grid at once).
-pub fn slab_thickness(dims: [u32; 3]) -> u32 {
-    let layer = (dims[0] as u64 * dims[1] as u64).max(1);
-    ((1u64 << 26) / layer).clamp(8, u32::MAX as u64) as u32
-}
-
 /// The whole surface that `make` hands out in parts; `None` when stopped.
 fn whole(make: impl FnOnce(Parts<'_, std::convert::Infallible>) -> Result<Option<()>, std::convert::Infallible>) -> Option<TriMesh> {
     let mut all = TriMesh::default();
@@ -90,15 +82,15 @@ fn whole(make: impl FnOnce(Parts<'_, std::convert::Infallible>) -> Result<Option
 
 /// The blocky surface of `inside` on `grid` (see the module doc).
 pub fn blocky(inside: &DenseBits, grid: &GridSpec, stop: &Stop) -> Option<TriMesh> {
-    whole(|each| blocky_parts(inside, grid, stop, each))
+    whole(|each| blocky_parts(inside, grid, u32::MAX, stop, each))
 }
 
-/// [`blocky`], handed to `each` slab by slab (see [`Part`]); `Ok(None)`
-/// when `stop` was requested.
-pub fn blocky_parts<E>(inside: &DenseBits, grid: &GridSpec, stop: &Stop, each: Parts<'_, E>) -> Result<Option<()>, E> {
+/// [`blocky`], handed to `each` slab by slab, `thickness` layers of half
+/// voxels a slab (see [`Part`]); `Ok(None)` when `stop` was requested.
+pub fn blocky_parts<E>(inside: &DenseBits, grid: &GridSpec, thickness: u32, stop: &Stop, each: Parts<'_, E>) -> Result<Option<()>, E> {
     let halves = refine(inside);
     let (o, q) = (grid.origin(), grid.voxel_size().0 / 4.0);
-    tets::extract_slabs(&halves, slab_thickness(halves.dims()), stop, |s| {
+    tets::extract_slabs(&halves, thickness, stop, |s| {
         // Half-voxel centre s sits at (2s + 1) quarters; the middle of an
         // edge at the sum of its ends' quarters, halved: exact integers.
         let positions = s
@@ -132,14 +124,21 @@ pub struct Smooth<'a> {
 /// of `distance − offset`, clamped to [`WRAP_MARGIN`] (wrap's shells,
 /// which sit off the input).
 pub fn smooth(inside: &DenseBits, grid: &GridSpec, at: Smooth<'_>, stop: &Stop) -> Option<TriMesh> {
-    whole(|each| smooth_parts(inside, grid, at, stop, each))
+    whole(|each| smooth_parts(inside, grid, at, u32::MAX, stop, each))
 }
 
-/// [`smooth`], handed to `each` slab by slab (see [`Part`]): only a slab's
-/// lattice ends and vertices are held at once. `Ok(None)` when `stop` was
-/// requested.
-pub fn smooth_parts<E>(inside: &DenseBits, grid: &GridSpec, at: Smooth<'_>, stop: &Stop, each: Parts<'_, E>) -> Result<Option<()>, E> {
-    tets::extract_slabs(inside, slab_thickness(inside.dims()), stop, |s| {
+/// [`smooth`], handed to `each` slab by slab, `thickness` layers of voxel
+/// centres a slab (see [`Part`]): only a slab's lattice ends and vertices
+/// are held at once. `Ok(None)` when `stop` was requested.
+pub fn smooth_parts<E>(
+    inside: &DenseBits,
+    grid: &GridSpec,
+    at: Smooth<'_>,
+    thickness: u32,
+    stop: &Stop,
+    each: Parts<'_, E>,
+) -> Result<Option<()>, E> {
+    tets::extract_slabs(inside, thickness, stop, |s| {
         let positions = smooth_positions(&s.crossings, grid, at);
         each(Part { first_vertex: s.first_vertex, positions, triangles: s.triangles })
     })
