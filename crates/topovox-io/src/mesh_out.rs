@@ -297,12 +297,12 @@ impl PartWriter {
         let second = self.second.as_mut();
         match self.format {
             MeshOut::Obj => {
-                in_chunks(&mut self.first, positions, |b, c| obj_vertices(b, c))?;
-                in_chunks(&mut self.first, triangles, |b, c| obj_faces(b, c))?;
+                in_chunks(&mut self.first, positions, obj_vertices)?;
+                in_chunks(&mut self.first, triangles, obj_faces)?;
             }
             MeshOut::Ply => {
-                in_chunks(&mut self.first, positions, |b, c| ply_vertices(b, c))?;
-                in_chunks(second.expect("PLY has two sections"), triangles, |b, c| ply_faces(b, c))?;
+                in_chunks(&mut self.first, positions, ply_vertices)?;
+                in_chunks(second.expect("PLY has two sections"), triangles, ply_faces)?;
             }
             MeshOut::Stl => {
                 // The previous part's positions and this one's.
@@ -313,7 +313,7 @@ impl PartWriter {
                 in_chunks(&mut self.first, triangles, |b, c| stl_facets(b, c, |v| window[(v as u64 - first) as usize]))?;
             }
             MeshOut::Glb => {
-                in_chunks(&mut self.first, triangles, |b, c| glb_indices(b, c))?;
+                in_chunks(&mut self.first, triangles, glb_indices)?;
                 let bounds = &mut self.bounds;
                 in_chunks(second.expect("GLB has two sections"), positions, |b, c| glb_positions(b, c, bounds))?;
             }

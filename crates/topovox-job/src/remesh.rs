@@ -292,7 +292,7 @@ fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec)
     let surface = triangles * per_triangle as f64;
     let fixed = (cells / 8).saturating_mul(grids + 1).saturating_add(pieces.items.len() as u64 * 1000 + (24 << 20));
     let limit = budget(req.max_memory);
-    let layers = if blocky { 2 * grid.dims()[2] } else { grid.dims()[2] } as u32;
+    let layers = if blocky { 2 * grid.dims()[2] } else { grid.dims()[2] };
     // The whole surface at once, when it fits in a slab and the budget.
     let whole = fixed.saturating_add(surface as u64);
     if !req.streams() || (surface <= SLAB_BYTES as f64 && whole <= limit) {
