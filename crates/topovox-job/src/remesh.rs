@@ -273,10 +273,11 @@ const SLAB_BYTES: u64 = 1 << 30;
 /// holds one slab: the whole surface when it fits within [`SLAB_BYTES`]
 /// and what the budget leaves, else as many layers as keep twice their
 /// share of the triangles (surfaces crowd into some layers) within that,
-/// at least 8, plus the writer's two scratch sections in memory. Measured
-/// peaks on the bunny are 0.5–0.9 of the estimate from 128 to 2048 (see
-/// BENCHMARKS.md; the 2048 run once peaked at 8.4 GiB where it claimed
-/// 5.2, before the surface was streamed and triangles counted as now).
+/// at least 8, plus the writer's two scratch sections in memory; and a
+/// fifth more for the allocator's heap. Measured peaks on the bunny are
+/// 0.5–0.9 of the estimate from 128 to 2048 (see BENCHMARKS.md; the 2048
+/// run once peaked at 8.4 GiB where it claimed 5.2, before the surface
+/// was streamed and triangles counted as now).
 fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec) -> Result<u32> {
     let cells = grid.voxel_count();
     let blocky = req.surface == SurfaceKind::Blocky;
@@ -293,24 +294,29 @@ fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec)
     let fixed = (cells / 8).saturating_mul(grids + 1).saturating_add(pieces.items.len() as u64 * 1000 + (24 << 20));
     let limit = budget(req.max_memory);
     let layers = if blocky { 2 * grid.dims()[2] } else { grid.dims()[2] };
+    // What the allocator's heap keeps beside what is live: a fifth (see
+    // `memory::sparse_solid_estimate`; a 384 run peaked at 182 MiB where
+    // this estimate said 181 without it). Plans are made against the rest.
+    let usable = limit / 6 * 5;
+    let with_heap = |b: u64| b.saturating_add(b / 5);
     // The whole surface at once, when it fits in a slab and the budget.
     let whole = fixed.saturating_add(surface as u64);
-    if !req.streams() || (surface <= SLAB_BYTES as f64 && whole <= limit) {
-        refuse_past(name, grid, whole, limit)?;
+    if !req.streams() || (surface <= SLAB_BYTES as f64 && whole <= usable) {
+        refuse_past(name, grid, with_heap(whole), limit)?;
         return Ok(u32::MAX);
     }
     // Else slabs as thick as the budget allows, plus the writer's two
     // scratch sections, held in memory up to a limit.
     let scratch = 2 * topovox_io::atomic::Spool::SPILL as u64;
-    let slab = SLAB_BYTES.min(limit.saturating_sub(fixed + scratch)) as f64;
+    let slab = SLAB_BYTES.min(usable.saturating_sub(fixed + scratch)) as f64;
     // A slab of t layers holds about 2·t/layers of the surface.
     let thickness = ((slab / (2.0 * surface).max(1.0)) * layers as f64).clamp(8.0, layers.max(8) as f64) as u32;
     let held = surface * (2.0 * thickness as f64 / layers as f64).min(1.0);
     let streamed = fixed + scratch + held as u64;
-    if streamed > limit && whole <= limit {
+    if streamed > usable && whole <= usable {
         return Ok(u32::MAX);
     }
-    refuse_past(name, grid, whole.min(streamed), limit)?;
+    refuse_past(name, grid, with_heap(whole.min(streamed)), limit)?;
     Ok(thickness)
 }
 
