@@ -56,7 +56,7 @@ pub fn load_scene(
 
 /// Reads a spray cloud (`topovox spray`'s PLY).
 pub fn read_points(path: &Path) -> Result<Vec<topovox_view::spray::SprayPoint>> {
-    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let bytes = topovox_io::read_regular(path).with_context(|| format!("{}: cannot read", path.display()))?;
     topovox_io::fenced(|| topovox_io::spray_cloud::read_ply(&bytes))
         .unwrap_or_else(|msg| Err(format!("the PLY parser crashed on it ({msg})")))
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))

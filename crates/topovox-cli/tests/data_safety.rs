@@ -230,3 +230,76 @@ fn a_successful_run_prints_nothing_on_stderr() {
         assert_eq!(String::from_utf8_lossy(&out.stderr), "", "at {res}");
     }
 }
+
+/// A glTF whose one buffer is `uri` (42 bytes declared, three vertices).
+fn gltf_naming(uri: &str) -> String {
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"{uri}","byteLength":42}}],
+        "bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":6}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+                     {{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+        "nodes":[{{"mesh":0}}],"scenes":[{{"nodes":[0]}}],"scene":0}}"#
+    )
+}
+
+#[test]
+fn file_uris_to_system_files_are_refused_by_every_command() {
+    let d = folder("file-uri");
+    for (k, uri) in ["file:///etc/passwd", "file:///proc/self/environ", "FILE://localhost/etc/passwd", "file:/etc/hostname", "file:///dev/zero"]
+        .iter()
+        .enumerate()
+    {
+        let m = d.join(format!("m{k}.gltf"));
+        std::fs::write(&m, gltf_naming(uri)).unwrap();
+        let o = |name: &str| d.join(name).to_str().unwrap().to_string();
+        let runs: Vec<Vec<String>> = vec![
+            vec!["voxelize".into(), s(&m).into(), "-o".into(), o("v.npy"), "--resolution".into(), "8".into()],
+            vec!["sdf".into(), s(&m).into(), "-o".into(), o("f.npy"), "--resolution".into(), "8".into()],
+            vec!["sample".into(), s(&m).into(), "-o".into(), o("s.npz"), "--near".into(), "10".into()],
+            vec!["remesh".into(), s(&m).into(), "-o".into(), o("r.ply"), "--resolution".into(), "8".into()],
+            vec!["info".into(), s(&m).into()],
+            vec!["check".into(), s(&m).into()],
+        ];
+        for run in runs {
+            let args: Vec<&str> = run.iter().map(String::as_str).collect();
+            let line = refused(&topovox(&args));
+            assert!(line.contains("outside the model's folder") && line.contains("--allow-external-paths"), "{uri} {}: {line}", run[0]);
+            assert!(!line.contains("refers to vertex") && !line.contains("root"), "{uri}: {line}");
+        }
+    }
+}
+
+#[test]
+fn a_fifo_or_device_as_the_input_is_refused_not_waited_on() {
+    let d = folder("fifo-input");
+    let fifo = d.join("pipe.obj");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let zero = d.join("zero.stl");
+    std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
+    for input in [&fifo, &zero] {
+        for cmd in ["voxelize", "sdf", "remesh", "info"] {
+            let mut args = vec![cmd, s(input)];
+            let out = d.join(if cmd == "remesh" { "o.ply" } else { "o.npy" });
+            if cmd != "info" {
+                args.extend(["-o", s(&out), "--resolution", "8"]);
+            }
+            let mut child = Command::new(env!("CARGO_BIN_EXE_topovox"))
+                .args(&args)
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap();
+            let start = std::time::Instant::now();
+            while child.try_wait().unwrap().is_none() {
+                if start.elapsed() > std::time::Duration::from_secs(30) {
+                    let _ = child.kill();
+                    panic!("{cmd} {} waited on it", input.display());
+                }
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            }
+            let line = refused(&child.wait_with_output().unwrap());
+            assert!(line.contains("not a regular file"), "{cmd}: {line}");
+        }
+    }
+}

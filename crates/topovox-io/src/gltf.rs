@@ -18,24 +18,18 @@ use topovox::attributes::{Appearance, Material, Texture, Wrap, DEFAULT_ROUGHNESS
 
 use crate::error::ErrorKind;
 use crate::mesh_report::{finish, LoadedMesh};
-use crate::resources::Resources;
+use crate::resources::{uri_target, Resources, UriTarget};
 
 /// Parses glTF JSON or GLB bytes; `res` resolves external buffer and
 /// image URIs (a buffer outside the model's folder is an error, an image a
-/// warning).
+/// warning). Every file is read here, through `res`, never by the `gltf`
+/// crate (which would open `file:` URIs, devices and FIFOs wherever they
+/// are): it only decodes `data:` URIs and GLB chunks.
 pub(crate) fn read(bytes: &[u8], res: &Resources) -> Result<LoadedMesh, ErrorKind> {
     let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(bytes).map_err(|e| ErrorKind::malformed("glTF", e))?;
-    for b in document.buffers() {
-        if let gltf::buffer::Source::Uri(uri) = b.source() {
-            if let Some(reference) = Resources::uri_path(uri) {
-                res.resolve(&reference).map_err(|why| ErrorKind::malformed("glTF", format!("buffer {}: {why}", b.index())))?;
-            }
-        }
-    }
-    let base_dir = res.base();
-    let buffers = gltf::import_buffers(&document, base_dir, blob).map_err(|e| ErrorKind::malformed("glTF", format!("buffer: {e}")))?;
+    let buffers = load_buffers(&document, blob, res)?;
     let mut out = Builder::default();
-    out.materials(&document, &buffers, base_dir, res);
+    out.materials(&document, &buffers, res);
     let scene = document.default_scene().or_else(|| document.scenes().next());
     if let Some(scene) = &scene {
         check_instances(scene)?;
@@ -80,7 +74,7 @@ struct Builder {
 
 impl Builder {
     /// Every material of the document, plus glTF's default material (white, last).
-    fn materials(&mut self, document: &gltf::Document, buffers: &[gltf::buffer::Data], base_dir: Option<&Path>, res: &Resources) {
+    fn materials(&mut self, document: &gltf::Document, buffers: &[gltf::buffer::Data], res: &Resources) {
         let mut decoded: Vec<Option<Option<u32>>> = vec![None; document.textures().len()];
         for m in document.materials() {
             let pbr = m.pbr_metallic_roughness();
@@ -90,7 +84,7 @@ impl Builder {
             if let Some(info) = pbr.base_color_texture() {
                 set = info.tex_coord();
                 let t = info.texture();
-                texture = *decoded[t.index()].get_or_insert_with(|| match self.texture(&t, buffers, base_dir, res) {
+                texture = *decoded[t.index()].get_or_insert_with(|| match self.texture(&t, buffers, res) {
                     Ok(tex) => {
                         self.app.textures.push(tex);
                         Some(self.app.textures.len() as u32 - 1)
@@ -137,14 +131,8 @@ impl Builder {
         &self,
         t: &gltf::Texture<'_>,
         buffers: &[gltf::buffer::Data],
-        base_dir: Option<&Path>,
         res: &Resources,
     ) -> Result<Texture, String> {
-        if let gltf::image::Source::Uri { uri, .. } = t.source().source() {
-            if let Some(reference) = Resources::uri_path(uri) {
-                res.resolve(&reference).map_err(|why| format!("image {why}"))?;
-            }
-        }
         let wrap = |m: WrappingMode| match m {
             WrappingMode::ClampToEdge => Wrap::ClampToEdge,
             WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
@@ -152,8 +140,7 @@ impl Builder {
         };
         let sampler = t.sampler();
         let wrap = [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())];
-        let data = gltf::image::Data::from_source(t.source().source(), base_dir, buffers)
-            .map_err(|e| format!("image could not be loaded ({e})"))?;
+        let data = load_image(t.source().source(), buffers, res)?;
         let n = data.width as usize * data.height as usize;
         type Pick = fn(&[u8]) -> [u8; 4];
         let (step, pick): (usize, Pick) = match data.format {
@@ -236,6 +223,14 @@ impl Builder {
                 Some(i) => i.into_u32().map(|i| i as i64 + base).collect(),
                 None => (base..base + n).collect(),
             };
+            // Checked here, per primitive, so that no message quotes an
+            // index: a buffer's bytes come from a file the user did not name.
+            if let Some(at) = idx.iter().position(|&i| i >= base + n) {
+                return Err(ErrorKind::malformed(
+                    "glTF",
+                    format!("mesh {mi}: index {at} of a primitive refers past its {n} vertices"),
+                ));
+            }
             match mode {
                 Mode::Triangles => {
                     for t in idx.chunks_exact(3) {
@@ -352,6 +347,53 @@ fn check_instances(scene: &gltf::Scene<'_>) -> Result<(), ErrorKind> {
         ));
     }
     Ok(())
+}
+
+/// Every buffer of the document: the GLB chunk, a `data:` URI, or a file
+/// read through `res` (the folder rule, regular files only, exactly its
+/// `byteLength` bytes), padded to four bytes as the `gltf` crate pads.
+fn load_buffers(document: &gltf::Document, mut blob: Option<Vec<u8>>, res: &Resources) -> Result<Vec<gltf::buffer::Data>, ErrorKind> {
+    let mut out = Vec::with_capacity(document.buffers().len());
+    for b in document.buffers() {
+        let bad = |why: String| ErrorKind::malformed("glTF", format!("buffer {}: {why}", b.index()));
+        let mut data = match b.source() {
+            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| bad("refers to the GLB binary chunk, which is missing".into()))?,
+            gltf::buffer::Source::Uri(uri) => match uri_target(uri).map_err(bad)? {
+                UriTarget::Data(data) => gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(&data), None).map_err(|e| bad(e.to_string()))?.0,
+                UriTarget::Path(reference) => res.read(&reference, Some(b.length() as u64)).map_err(bad)?,
+            },
+        };
+        if data.len() < b.length() {
+            return Err(bad(format!("holds {} bytes, fewer than its byteLength {}", data.len(), b.length())));
+        }
+        data.resize(data.len().next_multiple_of(4), 0);
+        out.push(gltf::buffer::Data(data));
+    }
+    Ok(out)
+}
+
+/// An image's pixels: from a buffer view or a `data:` URI (decoded by the
+/// `gltf` crate, which then reads no file), or from a file read through
+/// `res` and decoded by [`crate::texture::decode`].
+fn load_image(source: gltf::image::Source<'_>, buffers: &[gltf::buffer::Data], res: &Resources) -> Result<gltf::image::Data, String> {
+    let reference = match source {
+        gltf::image::Source::View { .. } => None,
+        gltf::image::Source::Uri { uri, mime_type } => match uri_target(uri).map_err(|why| format!("image {why}"))? {
+            UriTarget::Data(data) => return decoded(gltf::image::Source::Uri { uri: &data, mime_type }, buffers),
+            UriTarget::Path(reference) => Some(reference),
+        },
+    };
+    let Some(reference) = reference else { return decoded(source, buffers) };
+    let bytes = res.read(&reference, None).map_err(|why| format!("image {why}"))?;
+    let t = crate::texture::decode(&bytes, &reference.display().to_string(), [Wrap::Repeat; 2])?;
+    Ok(gltf::image::Data { pixels: t.rgba, format: Format::R8G8B8A8, width: t.width, height: t.height })
+}
+
+/// An image from a buffer view or a `data:` URI, decoded by the `gltf`
+/// crate: its base folder is given (the crate asks for one) but never read
+/// from, since neither source names a file.
+fn decoded(source: gltf::image::Source<'_>, buffers: &[gltf::buffer::Data]) -> Result<gltf::image::Data, String> {
+    gltf::image::Data::from_source(source, Some(Path::new("")), buffers).map_err(|e| format!("image could not be loaded ({e})"))
 }
 
 /// Checks that an accessor's elements lie inside its buffer view and the

@@ -56,7 +56,7 @@ pub use fence::{fenced, panic_is_fenced};
 pub use mesh_report::{validate_mesh, LoadedMesh, MeshReport};
 pub use meshes::{is_mesh_file, read_mesh, read_mesh_bytes, read_svg, MeshFormat};
 pub use png::{write_png, write_png_rgba};
-pub use resources::ReadOptions;
+pub use resources::{open_regular, read_regular, ReadOptions};
 pub(crate) use runs::runs;
 pub(crate) use spacing::half_diagonal;
 pub use spacing::{size_from_json, size_json};

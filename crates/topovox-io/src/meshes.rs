@@ -50,7 +50,7 @@ pub fn read_mesh(path: &Path, opts: &ReadOptions) -> Result<LoadedMesh, IoError>
     let format = MeshFormat::from_extension(ext).ok_or_else(|| {
         IoError::new(path, ErrorKind::UnknownFormat { ext: ext.to_string(), expected: "obj, stl, ply, gltf, glb, off, lines" })
     })?;
-    let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+    let bytes = resources::read_regular(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let res = resources::Resources::new(Some(base), opts);
     let mut loaded = read_with(&bytes, format, &res).map_err(|kind| IoError::new(path, kind))?;
@@ -86,7 +86,7 @@ fn read_with(bytes: &[u8], format: MeshFormat, res: &resources::Resources) -> Re
 }
 /// Reads an SVG file's outlines (see [`svg`]).
 pub fn read_svg(path: &Path, opts: &svg::SvgOptions) -> Result<svg::LoadedSvg, IoError> {
-    let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+    let bytes = resources::read_regular(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
     fence("SVG", || svg::read(&bytes, opts)).map_err(|k| IoError::new(path, k))
 }
 
@@ -105,7 +105,7 @@ pub fn is_mesh_file(path: &Path) -> bool {
 fn ply_declares_faces(path: &Path) -> bool {
     use std::io::Read;
     let mut head = Vec::new();
-    let read = std::fs::File::open(path).and_then(|f| f.take(64 << 10).read_to_end(&mut head));
+    let read = resources::open_regular(path).and_then(|(f, _)| f.take(64 << 10).read_to_end(&mut head));
     if read.is_err() {
         return false;
     }

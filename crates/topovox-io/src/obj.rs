@@ -163,15 +163,21 @@ fn material_libraries(parsed: &[Chunk], res: &Resources, warnings: &mut Vec<Stri
         if res.base().is_none() {
             continue;
         }
-        match res.resolve(Path::new(lib)) {
-            Ok(full) => match tobj::load_mtl(&full) {
+        match res.read(Path::new(lib), None) {
+            Ok(bytes) => match tobj::load_mtl_buf(&mut &bytes[..]) {
                 Ok((mats, _)) => materials.extend(mats),
-                Err(_) => warnings.push(format!("material library {} could not be read; materials ignored", full.display())),
+                Err(_) => warnings.push(format!("material library {lib} could not be read; materials ignored")),
             },
             Err(why) => warnings.push(format!("material library {why}; materials ignored")),
         }
     }
     materials
+}
+
+/// A texture a material names, read through `res` (the folder rule,
+/// regular files only) and decoded.
+fn read_texture(res: &Resources, reference: &Path, wrap: [topovox::attributes::Wrap; 2]) -> Result<topovox::attributes::Texture, String> {
+    res.read(reference, None).and_then(|bytes| crate::texture::decode(&bytes, &reference.display().to_string(), wrap))
 }
 
 /// `materials` as topovox's (colours, textures, cut-out masks, emission,
@@ -181,7 +187,7 @@ fn add_materials(materials: &[tobj::Material], res: &Resources, app: &mut Appear
         let factor = mat.diffuse.unwrap_or([1.0; 3]);
         let texture = mat.diffuse_texture.as_deref().filter(|t| !t.trim().is_empty()).and_then(|statement| {
             let (reference, wrap) = crate::texture::parse_map_statement(statement);
-            match res.resolve(&reference).and_then(|path| crate::texture::load(&path, wrap)) {
+            match read_texture(res, &reference, wrap) {
                 Ok(t) => {
                     app.textures.push(t);
                     Some(app.textures.len() as u32 - 1)
@@ -198,7 +204,7 @@ fn add_materials(materials: &[tobj::Material], res: &Resources, app: &mut Appear
         // the alpha channel of its own texture.
         let alpha_texture = mat.dissolve_texture.as_deref().filter(|t| !t.trim().is_empty()).and_then(|statement| {
             let (reference, wrap) = crate::texture::parse_map_statement(statement);
-            match res.resolve(&reference).and_then(|path| crate::texture::load(&path, wrap)) {
+            match read_texture(res, &reference, wrap) {
                 Ok(mut t) => {
                     if t.rgba.chunks_exact(4).all(|p| p[3] == 255) {
                         t.rgba.chunks_exact_mut(4).for_each(|p| p[3] = p[0]);

@@ -120,7 +120,8 @@ impl Default for BlockPalette {
 impl BlockPalette {
     /// Reads a palette file: `namespace:block R G B` per line, `#` comments.
     pub fn read(path: &Path) -> Result<BlockPalette, IoError> {
-        let text = std::fs::read_to_string(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+        let bytes = crate::read_regular(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+        let text = String::from_utf8(bytes).map_err(|_| IoError::new(path, ErrorKind::malformed("palette", "not UTF-8 text")))?;
         let mut blocks = Vec::new();
         for (n, line) in text.lines().enumerate() {
             let line = line.split('#').next().unwrap_or("").trim();

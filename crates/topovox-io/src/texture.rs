@@ -1,18 +1,12 @@
 //! Texture images for coloured voxelization, decoded by the `image` crate
 //! (PNG and JPEG) into sRGB RGBA bytes.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use topovox::attributes::{Texture, Wrap};
 
 /// Largest texture accepted, in texels (a 16k × 16k image).
 const MAX_TEXELS: u64 = 1 << 28;
-
-/// Decodes an image file; the error is a message for a warning.
-pub fn load(path: &Path, wrap: [Wrap; 2]) -> Result<Texture, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("texture {} could not be read ({e})", path.display()))?;
-    decode(&bytes, &path.display().to_string(), wrap)
-}
 
 /// Decodes image bytes; `name` is used in messages.
 pub fn decode(bytes: &[u8], name: &str, wrap: [Wrap; 2]) -> Result<Texture, String> {

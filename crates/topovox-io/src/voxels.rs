@@ -8,7 +8,7 @@ use topovox::{DenseBits, GridSpec, VoxelSource};
 
 use crate::error::{ErrorKind, IoError};
 use crate::fence::fence;
-use crate::resources::ReadOptions;
+use crate::resources::{open_regular, read_regular, ReadOptions};
 use crate::{atomic, binvox, npy, npz, orient, points, schem, text, vdb, vox, voxel_mesh, vti, zarr};
 
 /// Voxel file formats topovox writes and reads.
@@ -201,7 +201,7 @@ pub fn is_voxel_file(path: &Path) -> bool {
     match VoxelFormat::from_path(path) {
         Some(VoxelFormat::Ply) => {
             let mut head = vec![0u8; 4096];
-            let n = std::fs::File::open(path).and_then(|mut f| std::io::Read::read(&mut f, &mut head)).unwrap_or(0);
+            let n = open_regular(path).and_then(|(mut f, _)| std::io::Read::read(&mut f, &mut head)).unwrap_or(0);
             points::is_voxel_cloud(&head[..n])
         }
         Some(_) => true,
@@ -223,18 +223,16 @@ pub fn read_voxels(path: &Path, opts: &ReadOptions) -> Result<LoadedVoxels, IoEr
         return zarr::read(path, opts);
     }
     if matches!(format, VoxelFormat::Npy | VoxelFormat::NpyBool) {
-        let file = std::fs::File::open(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
-        let total = file.metadata().map_err(|e| IoError::new(path, ErrorKind::Read(e)))?.len();
+        let (file, total) = open_regular(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
         let mut r = std::io::BufReader::new(file);
         return npy::read_stream(&mut r, total).map_err(|k| IoError::new(path, k));
     }
     if format == VoxelFormat::Npz {
         // Streamed from the file: the index array is never held whole.
-        let file = std::fs::File::open(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
-        let total = file.metadata().map_err(|e| IoError::new(path, ErrorKind::Read(e)))?.len();
+        let (file, total) = open_regular(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
         return fence("voxel", || npz::read_from(std::io::BufReader::new(file), total)).map_err(|k| IoError::new(path, k));
     }
-    let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+    let bytes = read_regular(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
     read_voxels_bytes(&bytes, format, opts).map_err(|k| IoError::new(path, k))
 }
 
@@ -263,13 +261,12 @@ pub fn read_voxels_sparse(path: &Path, opts: &ReadOptions) -> Result<SparseVoxel
     let attributes = opts.attributes;
     match VoxelFormat::from_path(path) {
         Some(VoxelFormat::Vdb) => {
-            let bytes = std::fs::read(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
+            let bytes = read_regular(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
             fence("VDB", || vdb::read_sparse(&bytes, attributes)).map_err(|k| IoError::new(path, k))
         }
         Some(VoxelFormat::Zarr) => zarr::read_sparse(path, attributes, opts),
         Some(VoxelFormat::Npz) => {
-            let file = std::fs::File::open(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
-            let total = file.metadata().map_err(|e| IoError::new(path, ErrorKind::Read(e)))?.len();
+            let (file, total) = open_regular(path).map_err(|e| IoError::new(path, ErrorKind::Read(e)))?;
             fence("NumPy .npz", || npz::read_sparse_from(std::io::BufReader::new(file), total)).map_err(|k| IoError::new(path, k))
         }
         _ => Err(IoError::new(path, ErrorKind::Unsupported("only .vdb, .zarr and .npz are read without a dense grid".into()))),

@@ -197,7 +197,7 @@ fn read_camera_path(path: &Path, up: Vec3) -> Result<Vec<Camera>> {
     if size > 1 << 20 {
         bail!("{}: a camera path of {size} bytes; at most 1 MiB", path.display());
     }
-    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read the camera path", path.display()))?;
+    let bytes = topovox_io::read_regular(path).with_context(|| format!("{}: cannot read the camera path", path.display()))?;
     let text = String::from_utf8(bytes).map_err(|_| anyhow::anyhow!("{}: the camera path is not UTF-8 text", path.display()))?;
     let mut cams = Vec::new();
     for (n, line) in text.lines().enumerate() {
