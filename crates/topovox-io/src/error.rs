@@ -52,6 +52,14 @@ pub enum ErrorKind {
         /// The offending value.
         value: f64,
     },
+    /// A vertex coordinate lies past ±[`topovox::COORDINATE_LIMIT`].
+    #[error("vertex {index} has the coordinate {value:e}, past ±2^100 (1.27e30), the range topovox computes in; scale the mesh first")]
+    OutOfRange {
+        /// Vertex index (0-based).
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
     /// A face refers to a vertex that does not exist.
     #[error("face {face} refers to vertex {index}, but there are only {count} vertices")]
     IndexOutOfRange {

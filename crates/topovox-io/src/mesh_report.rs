@@ -40,8 +40,9 @@ pub struct LoadedMesh {
     pub sources: Vec<std::path::PathBuf>,
 }
 
-/// Validates and packages reader output: every coordinate finite, every
-/// index in range, at least one triangle.
+/// Validates and packages reader output: every coordinate finite and
+/// within ±[`topovox::COORDINATE_LIMIT`], every index in range, at least
+/// one triangle.
 pub(crate) fn finish(positions: Vec<DVec3>, triangles: Vec<[i64; 3]>, warnings: Vec<String>) -> Result<LoadedMesh, ErrorKind> {
     finish_with_segments(positions, triangles, Vec::new(), warnings)
 }
@@ -64,6 +65,9 @@ pub(crate) fn finish_with_segments(
     for (index, p) in positions.iter().enumerate() {
         if let Some(&value) = p.to_array().iter().find(|c| !c.is_finite()) {
             return Err(ErrorKind::NonFinite { index, value });
+        }
+        if let Some(&value) = p.to_array().iter().find(|c| c.abs() > topovox::COORDINATE_LIMIT) {
+            return Err(ErrorKind::OutOfRange { index, value });
         }
     }
     let count = positions.len();

@@ -71,4 +71,4 @@ pub use grid::bricks::BrickBits;
 pub use grid::dense::DenseBits;
 pub use grid::spec::{GridError, GridSpec, VoxelSize};
 pub use grid::VoxelSource;
-pub use mesh::{Mesh, MeshRef};
+pub use mesh::{in_range, Mesh, MeshRef, COORDINATE_LIMIT, MIN_VOXEL_SIZE};

@@ -4,6 +4,25 @@ use glam::DVec3;
 
 use crate::aabb::Aabb;
 
+/// The largest coordinate magnitude topovox computes with: 2¹⁰⁰ (about
+/// 1.27e30). Past it a squared distance (2²⁰⁰) is still finite but the
+/// exact predicates' products of three coordinate differences (2³⁰⁰) come
+/// near the end of `f64`'s range, and one more factor overflows; meshes,
+/// grids and query points past it are refused (or, for a point, answered
+/// as a point that is not finite), never computed with into inf or NaN.
+pub const COORDINATE_LIMIT: f64 = 1_267_650_600_228_229_401_496_703_205_376.0;
+
+/// The smallest voxel size a grid may have: 2⁻¹⁰⁰ (about 7.9e-31), so that
+/// products of three voxel-sized differences (2⁻³⁰⁰) stay far from
+/// underflow, which would make exact tests inexact.
+pub const MIN_VOXEL_SIZE: f64 = 1.0 / COORDINATE_LIMIT;
+
+/// Whether every coordinate of `p` is finite and within ±[`COORDINATE_LIMIT`].
+#[inline]
+pub fn in_range(p: DVec3) -> bool {
+    p.is_finite() && p.abs().max_element() <= COORDINATE_LIMIT
+}
+
 /// An indexed triangle mesh.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {

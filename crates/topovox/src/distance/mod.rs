@@ -45,8 +45,9 @@ use crate::MeshRef;
 /// Why distances could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DistanceError {
-    /// A vertex used by a triangle or segment has a NaN or infinite coordinate.
-    #[error("vertex {0} has a non-finite coordinate")]
+    /// A vertex used by a triangle or segment has a NaN or infinite
+    /// coordinate, or one past ±[`crate::COORDINATE_LIMIT`].
+    #[error("vertex {0} has a coordinate that is not finite or lies past ±2^100 (1.27e30), the range topovox computes in")]
     NonFinite(u32),
     /// No triangle or segment to measure to.
     #[error("the mesh has no triangles or segments to measure a distance to")]
@@ -206,7 +207,7 @@ impl Pieces {
         let mut element = Vec::with_capacity(items.capacity());
         let at = |i: u32| -> Result<Option<DVec3>, DistanceError> {
             match mesh.positions.get(i as usize) {
-                Some(p) if p.is_finite() => Ok(Some(*p)),
+                Some(p) if crate::in_range(*p) => Ok(Some(*p)),
                 Some(_) => Err(DistanceError::NonFinite(i)),
                 None => Ok(None),
             }

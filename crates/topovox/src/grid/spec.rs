@@ -22,6 +22,10 @@ pub enum GridError {
     /// Origin has a NaN or infinite coordinate.
     #[error("grid origin must be finite, got {0:?}")]
     BadOrigin([f64; 3]),
+    /// The grid reaches past ±[`crate::COORDINATE_LIMIT`], or its voxel
+    /// size lies outside [`crate::MIN_VOXEL_SIZE`]`..=`[`crate::COORDINATE_LIMIT`].
+    #[error("the grid {0}, outside the range topovox computes in (coordinates within ±2^100 = 1.27e30, voxel sizes at least 2^-100 = 7.9e-31); scale the mesh first")]
+    OutOfRange(String),
     /// A dimension is zero or above [`MAX_DIM`].
     #[error("grid dims must each be between 1 and {MAX_DIM}, got {0:?}")]
     BadDims([u64; 3]),
@@ -128,6 +132,13 @@ impl GridSpec {
         }
         if dims.iter().any(|&d| d == 0 || d > MAX_DIM as u64) {
             return Err(GridError::BadDims(dims));
+        }
+        if let Some(&h) = voxel_size.to_array().iter().find(|&&h| !(crate::MIN_VOXEL_SIZE..=crate::COORDINATE_LIMIT).contains(&h)) {
+            return Err(GridError::OutOfRange(format!("has the voxel size {h:e}")));
+        }
+        let far = origin + DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64) * voxel_size;
+        if !crate::in_range(origin) || !crate::in_range(far) {
+            return Err(GridError::OutOfRange(format!("reaches {:e}", origin.abs().max(far.abs()).max_element())));
         }
         Ok(GridSpec { origin, voxel_size, dims: dims.map(|d| d as u32) })
     }

@@ -86,7 +86,7 @@ impl Inside {
     /// The winding number at `q`: an exact integer for a closed mesh, the
     /// generalized winding number otherwise (NaN for a point not finite).
     pub fn winding_number(&self, q: DVec3) -> f64 {
-        if !q.is_finite() {
+        if !crate::in_range(q) {
             return f64::NAN;
         }
         let j = self.mesh.crossings(q).winding + self.cap_rays.crossings(q).winding;
@@ -98,7 +98,7 @@ impl Inside {
 
     /// Whether `q` is inside, by the rule (false when not finite).
     pub fn contains(&self, q: DVec3) -> bool {
-        if !q.is_finite() {
+        if !crate::in_range(q) {
             return false;
         }
         match self.sign {

@@ -137,9 +137,10 @@ impl Query {
         self.tree.nearest(q, start)
     }
 
-    /// The distance from `q` to the mesh (NaN for a point not finite).
+    /// The distance from `q` to the mesh (NaN for a point not finite or
+    /// past ±[`crate::COORDINATE_LIMIT`], as every answer of a query).
     pub fn distance(&self, q: DVec3) -> f64 {
-        if !q.is_finite() {
+        if !crate::in_range(q) {
             return f64::NAN;
         }
         self.nearest(q, u32::MAX).0.sqrt()
@@ -152,7 +153,7 @@ impl Query {
 
     /// [`Query::closest`] with a piece to start from, and the nearest piece.
     fn closest_from(&self, q: DVec3, seed: u32) -> (Closest, u32) {
-        if !q.is_finite() {
+        if !crate::in_range(q) {
             return (Closest { point: DVec3::NAN, distance: f64::NAN, element: u32::MAX, weights: [f64::NAN; 3] }, seed);
         }
         let (d2, n) = self.nearest(q, seed);

@@ -140,6 +140,29 @@ pub enum SampleError {
     /// A box that is empty or not finite.
     #[error("bounds must be a finite box with low < high on every axis")]
     Bounds,
+    /// Samples that could lie past ±[`crate::COORDINATE_LIMIT`], where their
+    /// distances (and in f32, their coordinates) would not be finite.
+    #[error("{0} would place samples past ±2^100 (1.27e30), the range topovox computes in; nothing was drawn")]
+    Range(String),
+}
+
+/// How many standard deviations from its surface point a near sample can
+/// lie: [`normal`] draws from uniform numbers no smaller than 2⁻⁵³
+/// (`√(−2 ln 2⁻⁵³)` ≈ 8.6 per axis, 14.9 in all three), with a margin.
+const MOST_DEVIATIONS: f64 = 16.5;
+
+/// Refuses a spec whose samples could leave the range: a `sigma` so wide,
+/// or `bounds` so far, that a point (or its distance) would overflow.
+fn check_range(query: &Query, spec: &SampleSpec) -> Result<(), SampleError> {
+    let reach = query.faces().iter().flat_map(|(_, t)| t.iter().map(|p| p.abs().max_element())).fold(0.0, f64::max);
+    if let Some(&s) = spec.sigma.iter().filter(|_| spec.near > 0).find(|&&s| reach + MOST_DEVIATIONS * s > crate::COORDINATE_LIMIT) {
+        return Err(SampleError::Range(format!("sigma {s:e} (beside a mesh reaching {reach:e})")));
+    }
+    let (lo, hi) = spec.bounds;
+    if spec.uniform > 0 && !(crate::in_range(lo) && crate::in_range(hi)) {
+        return Err(SampleError::Range(format!("the bounds {:e}..{:e}", lo.min_element(), hi.max_element())));
+    }
+    Ok(())
 }
 
 /// Draws `spec`'s samples of the mesh behind `query`.
@@ -155,6 +178,7 @@ pub fn sample(query: &Query, spec: &SampleSpec) -> Result<Samples, SampleError> 
     if spec.uniform > 0 && !(lo.is_finite() && hi.is_finite() && lo.cmplt(hi).all()) {
         return Err(SampleError::Bounds);
     }
+    check_range(query, spec)?;
     let mut out = Samples::default();
     let nan = DVec3::NAN;
     let draws: [(Kind, usize); 3] = [(Kind::Surface, spec.surface), (Kind::Near, spec.near), (Kind::Uniform, spec.uniform)];
