@@ -74,3 +74,49 @@ def test_a_fifo_given_as_the_mesh_is_refused(tmp_path):
     os.mkfifo(fifo)
     with pytest.raises(OSError, match="not a regular file"):
         topovox.load_mesh(fifo)
+
+
+def test_dataset_skips_fifos_in_its_folder(tmp_path):
+    topovox.as_mesh(*TETRA).save(tmp_path / "a.obj")
+    os.mkfifo(tmp_path / "b.obj")
+    data = topovox.torch.Dataset(tmp_path, resolution=8)
+    assert [os.path.basename(p) for p in data.paths] == ["a.obj"]
+    assert data[0].coords.shape[0] > 0
+
+
+@pytest.mark.parametrize("scale", [1e308, 1e31, -1e300])
+def test_meshes_past_the_range_are_a_value_error(scale):
+    v, f = TETRA
+    with pytest.raises(ValueError, match="range topovox computes in"):
+        topovox.as_mesh(v * scale, f)
+
+
+def test_every_entry_point_answers_extreme_but_valid_meshes():
+    v, f = TETRA
+    for scale, offset in [(1e29, 0.0), (1e-25, 0.0), (1.0, 1e15), (1.0, -3e11)]:
+        mesh = topovox.as_mesh(v * scale + offset, f)
+        for call in (
+            lambda: topovox.voxelize(mesh, mode="solid", resolution=16),
+            lambda: topovox.sdf(mesh, resolution=16),
+            lambda: topovox.sample(mesh, near=100, uniform=50, seed=1),
+            lambda: topovox.remesh(mesh, resolution=16),
+            lambda: topovox.remesh(mesh, resolution=16, inside="wrap"),
+            lambda: topovox.voxelize_many([mesh], resolution=16, mode="solid", features=("occupancy", "sdf", "normal")),
+        ):
+            try:
+                out = call()
+            except ValueError:
+                continue
+            if isinstance(out, topovox.Mesh):
+                assert topovox.check_mesh(out)["watertight"], (scale, offset)
+        q = topovox.Query(mesh)
+        far = np.array([[1e308, 0, 0], [0, -1e200, 0], [np.inf, 0, 0]])
+        assert np.isnan(q.distance(far)).all() and not q.contains(far).any()
+
+
+def test_samples_that_would_not_be_finite_are_refused():
+    mesh = topovox.as_mesh(*TETRA)
+    with pytest.raises(ValueError, match="range topovox computes in"):
+        topovox.sample(mesh, near=10, sigma=(1e308,))
+    with pytest.raises(ValueError, match="range topovox computes in"):
+        topovox.sample(mesh, near=0, uniform=10, bounds=((-1e308,) * 3, (1e308,) * 3))

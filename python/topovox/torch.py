@@ -38,7 +38,8 @@ class Dataset:
     Parameters
     ----------
     meshes : path or sequence of paths
-        A folder (every mesh file in it and below, sorted) or the paths.
+        A folder (every regular mesh file in it and below, sorted; FIFOs
+        and devices are skipped) or the paths.
     labels : sequence, optional
         One label per mesh; items are then ``(batch, label)`` pairs.
     **options
@@ -51,7 +52,11 @@ class Dataset:
             root = os.fspath(meshes)
             if not os.path.isdir(root):
                 raise NotADirectoryError(f"{root}: not a folder of meshes")
-            found = [os.path.join(d, f) for d, _, fs in os.walk(root) for f in fs if f.lower().endswith(MESH_SUFFIXES)]
+            # Regular files only, as `topovox.batch` collects: a FIFO or a
+            # device named like a mesh would block the worker reading it.
+            found = [
+                p for d, _, fs in os.walk(root) for f in fs if f.lower().endswith(MESH_SUFFIXES) and os.path.isfile(p := os.path.join(d, f))
+            ]
             self.paths: List[str] = sorted(found)
         else:
             self.paths = [os.fspath(p) for p in meshes]

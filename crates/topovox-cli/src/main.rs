@@ -66,7 +66,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("topovox: error: {e:#}");
+            eprintln!("topovox: error: {}", console::one_line(&format!("{e:#}")));
             ExitCode::from(1)
         }
     }
@@ -96,7 +96,7 @@ fn usage_error(e: clap::Error) -> ExitCode {
     if let Some(ContextValue::Strings(valid)) = e.get(ContextKind::ValidValue) {
         line += &format!(" (expected one of: {})", valid.join(", "));
     }
-    eprintln!("topovox: error: {line}; see --help");
+    eprintln!("topovox: error: {}; see --help", console::one_line(&line));
     ExitCode::from(2)
 }
 

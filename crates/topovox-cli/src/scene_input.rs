@@ -48,7 +48,7 @@ pub fn load_scene(
         topovox_io::atomic::refuse_overwriting_inputs(out, &loaded.sources)?;
     }
     for w in &loaded.warnings {
-        eprintln!("topovox: warning: {}: {w}", input.display());
+        crate::console::warn(&format!("{}: {w}", input.display()));
     }
     scene.add_mesh(loaded.mesh.as_ref(), &loaded.appearance);
     Ok((scene, "mesh"))

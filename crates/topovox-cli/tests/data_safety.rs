@@ -303,3 +303,28 @@ fn a_fifo_or_device_as_the_input_is_refused_not_waited_on() {
         }
     }
 }
+
+#[test]
+fn names_with_control_and_bidirectional_characters_are_escaped_in_one_line() {
+    let d = folder("names");
+    for name in ["two\nlines.obj", "tab\there.obj", "rev\u{202e}lbo.obj", "bell\u{7}.obj"] {
+        let p = d.join(name);
+        std::fs::write(&p, "v 0 0 0\nf 1 2 3\n").unwrap();
+        let line = refused(&topovox(&["voxelize", s(&p), "-o", s(&d.join("o.npy")), "--resolution", "8"]));
+        assert!(!line.contains(['\n', '\t', '\u{202e}', '\u{7}']), "{line:?}");
+        assert!(line.contains("\\n") || line.contains("\\t") || line.contains("\\u{202e}") || line.contains("\\u{7}"), "{line:?}");
+    }
+}
+
+#[test]
+fn memory_sizes_too_large_say_so() {
+    let d = folder("max-memory");
+    let m = d.join("t.obj");
+    std::fs::write(&m, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    for size in ["18446744073709551615", "99999999999T", "2000T"] {
+        let line = refused(&topovox(&["voxelize", s(&m), "-o", s(&d.join("o.npy")), "--max-memory", size]));
+        assert!(line.contains("too large"), "{size}: {line}");
+    }
+    let line = refused(&topovox(&["voxelize", s(&m), "-o", s(&d.join("o.npy")), "--max-memory", "10K"]));
+    assert!(line.contains("at least 1M"), "{line}");
+}

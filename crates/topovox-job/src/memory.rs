@@ -109,6 +109,10 @@ pub fn sparse_solid_estimate(mesh: MeshRef<'_>, grid: &GridSpec, flood: bool) ->
     TiledEstimate { bricks: e.bricks, bytes: bytes + bytes / 3 }
 }
 
+/// The largest memory size accepted: 1024 TiB (2⁵⁰ bytes), far past any
+/// machine; larger numbers are a typo, and past 2⁶⁴ would not fit.
+const MAX_SIZE: u64 = 1 << 50;
+
 /// Parses a memory size: bytes, or a number with `K`, `M`, `G`, `T`
 /// (powers of 1024; `KiB`/`KB`/… accepted the same), e.g. `8G`, `1.5GiB`.
 pub fn parse_size(s: &str) -> Result<u64> {
@@ -125,8 +129,11 @@ pub fn parse_size(s: &str) -> Result<u64> {
     };
     let v: f64 = num.parse().map_err(|_| JobError::invalid(format!("--max-memory {s:?}: not a size (e.g. 8G, 512M)")))?;
     let b = v * (1u64 << shift) as f64;
-    if !(b.is_finite() && b >= (1u64 << 20) as f64 && b < 1.8e19) {
+    if !(b >= (1u64 << 20) as f64) {
         return Err(JobError::invalid(format!("--max-memory {s:?}: must be at least 1M")));
+    }
+    if !(b <= MAX_SIZE as f64) {
+        return Err(JobError::invalid(format!("--max-memory {s:?}: too large (at most 1024T)")));
     }
     Ok(b as u64)
 }

@@ -63,7 +63,7 @@ pub fn run(a: &BatchArgs) -> Result<()> {
     let pool = topovox_job::pool_for(a.jobs, "--jobs")?;
     let (items, warnings) = batch::items(&a.inputs, a.glob.as_deref(), &a.output, &opts)?;
     for w in &warnings {
-        eprintln!("topovox: warning: {w}");
+        crate::console::warn(w);
     }
 
     use std::io::IsTerminal;

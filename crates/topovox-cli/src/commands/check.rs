@@ -56,7 +56,7 @@ pub fn run(a: &CheckArgs) -> Result<()> {
                 &topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths, ..Default::default() },
             )?;
             for w in &m.warnings {
-                eprintln!("topovox: warning: {}: {w}", path.display());
+                crate::console::warn(&format!("{}: {w}", path.display()));
             }
             let (grid, source) = topovox_job::check::check_grid(
                 dims,
@@ -93,7 +93,7 @@ fn check_mesh_file(a: &CheckArgs, t0: Instant) -> Result<()> {
     let opts = topovox_io::ReadOptions { allow_external_paths: a.allow_external_paths, ..Default::default() };
     let loaded = topovox_io::read_mesh(&a.voxels, &opts)?;
     for w in &loaded.warnings {
-        eprintln!("topovox: warning: {}: {w}", a.voxels.display());
+        crate::console::warn(&format!("{}: {w}", a.voxels.display()));
     }
     let name = a.voxels.display().to_string();
     let c = mesh_certificate(loaded.mesh.as_ref(), &name, None)?;

@@ -38,7 +38,7 @@ pub fn run(a: &InfoArgs) -> Result<()> {
         crate::console::print_stdout(&v.to_string())?;
     } else {
         for w in &loaded.warnings {
-            eprintln!("topovox: warning: {}: {w}", a.mesh.display());
+            crate::console::warn(&format!("{}: {w}", a.mesh.display()));
         }
         let e = r.bounds.extent();
         crate::console::print_stdout(&format!(
