@@ -53,6 +53,16 @@ impl GridData {
         self.attrs.as_ref()
     }
 
+    /// The voxels as stored.
+    pub(crate) fn voxels(&self) -> &Voxels {
+        &self.voxels
+    }
+
+    /// How many voxels are set.
+    pub(crate) fn count(&self) -> u64 {
+        self.voxels.count()
+    }
+
     pub(crate) fn new(voxels: Voxels, grid: GridSpec, attrs: Option<VoxelAttributes>, facts: Value) -> GridData {
         GridData { voxels, grid, attrs, facts, dense: OnceLock::new(), order: OnceLock::new() }
     }

@@ -10,6 +10,7 @@
 //! the same pool). The GIL is released throughout; Ctrl-C stops at the
 //! next mesh or slab.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use numpy::ndarray::{Array1, Array2};
@@ -94,27 +95,107 @@ pub(crate) fn voxelize_many<'py>(
     let inputs: Vec<Option<(Arc<topovox_io::LoadedMesh>, String)>> =
         meshes.iter().map(|m| m.as_ref().map(|m| (m.inner.clone(), m.name()))).collect();
     let stop = Stop::new();
+    let budget = topovox_job::budget(plan.request.max_memory);
+    let reserve = Reserve { budget, taken: AtomicU64::new(0), stop: &stop, why: Default::default() };
     let results = interruptible(py, &stop, || {
         let run = || -> Vec<Option<Result<Item, JobError>>> {
             let given: Vec<(&topovox_io::LoadedMesh, &str)> = inputs.iter().flatten().map(|(m, n)| (m.as_ref(), n.as_str())).collect();
             let refs: Vec<(topovox::MeshRef<'_>, &str)> = given.iter().map(|(m, n)| (m.mesh.as_ref(), *n)).collect();
-            let mut voxelized = topovox_job::many::voxelize_many(plan, &refs, &stop).into_iter();
+            let each = per_item(plan, budget, refs.len());
+            let mut voxelized = topovox_job::many::voxelize_many(&each, &refs, &stop).into_iter();
             let paired: Vec<Option<(&topovox_io::LoadedMesh, Result<Voxelized, JobError>)>> =
                 inputs.iter().map(|i| i.as_ref().map(|(m, _)| (m.as_ref(), voxelized.next().expect("a result per mesh")))).collect();
-            paired.into_par_iter().map(|p| p.map(|(mesh, v)| v.and_then(|v| item(&voxelizer, mesh, v, &features, keep)))).collect()
+            paired.into_par_iter().map(|p| p.map(|(mesh, v)| v.and_then(|v| item(&voxelizer, mesh, v, &features, keep, &reserve)))).collect()
         };
         match pool {
             Some(p) => p.install(run),
             None => run(),
         }
     })?;
-    let budget = topovox_job::budget(plan.request.max_memory);
+    if let Some(e) = reserve.refused() {
+        return Err(py_err(e));
+    }
     assemble(py, results, &features, budget)
 }
 
-/// One mesh's grid as `voxelize` gives it, with its features measured.
-fn item(voxelizer: &Voxelizer, mesh: &topovox_io::LoadedMesh, v: Voxelized, features: &[Feature], keep: Keep) -> Result<Item, JobError> {
+/// The plan each mesh runs under: the batch's budget shared by the meshes
+/// that run at once (one a thread), so that their voxelizers together keep
+/// to it; a single mesh gets it whole, as `voxelize` does.
+fn per_item(plan: &topovox_job::Plan, budget: u64, meshes: usize) -> topovox_job::Plan {
+    let at_once = rayon::current_num_threads().min(meshes).max(1) as u64;
+    let mut each = plan.clone();
+    if at_once > 1 && budget != u64::MAX {
+        each.request.max_memory = Some((budget / at_once).max(1 << 20));
+    }
+    each
+}
+
+/// What the batch's items hold together after voxelizing: each reserves
+/// its rows (the ordered voxels, their features, their share of the
+/// arrays) and its grid's storage before allocating them, so a batch
+/// whose voxels cannot fit is refused the moment one item's count shows
+/// it, not after every item has run (a tetrahedron's solid at 2048 has
+/// 1.4 × 10⁹ voxels: 34 GiB of ordered voxels, which aborted the
+/// interpreter). Whether a batch fits is its total, whatever the order.
+struct Reserve<'a> {
+    budget: u64,
+    taken: AtomicU64,
+    stop: &'a Stop,
+    /// The first refusal's message.
+    why: std::sync::Mutex<Option<String>>,
+}
+
+/// Bytes a voxel's row takes: the ordered voxel (24, and a second copy
+/// while counting-sorted), coordinates (16), and per column the item's
+/// features and the batch's copy (4 + 4).
+fn row_bytes(width: usize) -> u64 {
+    48 + 16 + 8 * width as u64
+}
+
+impl Reserve<'_> {
+    /// Reserves `bytes` for `data`'s item, or stops the batch.
+    fn take(&self, data: &GridData, bytes: u64) -> Result<(), JobError> {
+        let total = self.taken.fetch_add(bytes, Ordering::SeqCst).saturating_add(bytes);
+        if total <= self.budget {
+            return Ok(());
+        }
+        let [x, y, z] = data.grid().dims();
+        let why = format!(
+            "the batch's voxels need more than the {} this run may use (a {x}x{y}x{z} item alone holds {} voxels, about {}); use fewer meshes per call, a coarser grid or a surface mode, or raise max_memory",
+            topovox_job::bytes(self.budget),
+            data.count(),
+            topovox_job::bytes(bytes)
+        );
+        self.why.lock().unwrap_or_else(|e| e.into_inner()).get_or_insert(why);
+        self.stop.request();
+        Err(JobError::Interrupted)
+    }
+
+    /// The refusal, if the batch did not fit.
+    fn refused(&self) -> Option<JobError> {
+        (self.taken.load(Ordering::SeqCst) > self.budget)
+            .then(|| JobError::failed(self.why.lock().unwrap_or_else(|e| e.into_inner()).take().unwrap_or_default()))
+    }
+}
+
+/// One mesh's grid as `voxelize` gives it, with its features measured
+/// once its share of the batch's memory is reserved.
+fn item(
+    voxelizer: &Voxelizer,
+    mesh: &topovox_io::LoadedMesh,
+    v: Voxelized,
+    features: &[Feature],
+    keep: Keep,
+    reserve: &Reserve<'_>,
+) -> Result<Item, JobError> {
     let data = carried_grid(voxelizer, mesh, v, keep)?;
+    let width: usize = features.iter().map(|f| f.width()).sum();
+    let query = if features.contains(&Feature::Sdf) { mesh.mesh.triangles.len() as u64 * 1000 } else { 0 };
+    let storage = match data.voxels() {
+        topovox_job::Voxels::Dense(_) => data.grid().dense_bytes(),
+        _ => data.count(),
+    };
+    reserve.take(&data, data.count().saturating_mul(row_bytes(width)).saturating_add(query).saturating_add(storage))?;
     let features = measure(&data, mesh, features)?;
     Ok(Item { data, features })
 }

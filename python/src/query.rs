@@ -15,6 +15,7 @@ use topovox_job::sample::SampleOptions;
 
 use crate::convert::{points_from, to_py};
 use crate::errors::{py_err, value_err};
+use crate::interrupt::interruptible_read;
 use crate::meshes::Mesh;
 use crate::options::table_options;
 
@@ -34,22 +35,24 @@ pub struct Query {
 }
 
 impl Query {
-    /// Runs `f` without the GIL on the query's threads.
-    fn run<T: Send>(&self, py: Python<'_>, f: impl FnOnce(&Core) -> T + Send) -> T {
-        let (inner, pool) = (&self.inner, &self.pool);
-        py.detach(|| match pool {
-            Some(p) => p.install(|| f(inner)),
-            None => f(inner),
+    /// Runs `f` without the GIL on the query's threads; Ctrl-C returns at
+    /// once (`KeyboardInterrupt`), the answers, which change nothing, are
+    /// dropped when they come.
+    fn run<T: Send + 'static>(&self, py: Python<'_>, f: impl FnOnce(&Core) -> T + Send + 'static) -> PyResult<T> {
+        let (inner, pool) = (self.inner.clone(), self.pool.clone());
+        interruptible_read(py, move || match pool {
+            Some(p) => p.install(|| f(&inner)),
+            None => f(&inner),
         })
     }
 
     fn values<'py>(&self, py: Python<'py>, points: &Bound<'py, PyAny>, ask: Ask) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let pts = points_from("points", points)?;
-        let out = self.run(py, |q| {
+        let out = self.run(py, move |q| {
             let mut out = vec![0.0; pts.len()];
             q.batch(&pts, ask, &mut out);
             out
-        });
+        })?;
         Ok(Array1::from(out).into_pyarray(py))
     }
 }
@@ -92,11 +95,11 @@ impl Query {
         points: &Bound<'py, PyAny>,
     ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<i64>>, Bound<'py, PyArray2<f64>>)> {
         let pts = points_from("points", points)?;
-        let got = self.run(py, |q| {
+        let got = self.run(py, move |q| {
             let mut out = vec![Closest { point: DVec3::NAN, distance: f64::NAN, element: u32::MAX, weights: [f64::NAN; 3] }; pts.len()];
             q.closest_batch(&pts, &mut out);
             out
-        });
+        })?;
         let n = got.len();
         let at = Array2::from_shape_fn((n, 3), |(i, a)| got[i].point[a]);
         let w = Array2::from_shape_fn((n, 3), |(i, a)| got[i].weights[a]);
@@ -126,13 +129,16 @@ pub fn sample<'py>(py: Python<'py>, mesh: &Mesh, options: Option<&Bound<'py, PyD
     let opts: SampleOptions = table_options(options, &[])?;
     let pool = pool(opts.run.threads)?;
     let (inner, name) = (mesh.inner.clone(), mesh.name());
-    let work = || topovox_job::sample::sample(&inner, &name, &opts);
-    let s = py
-        .detach(|| match &pool {
+    let job = opts.clone();
+    // Ctrl-C returns at once; the samples, which change nothing, are dropped.
+    let s = interruptible_read(py, move || {
+        let work = || topovox_job::sample::sample(&inner, &name, &job);
+        match &pool {
             Some(p) => p.install(work),
             None => work(),
-        })
-        .map_err(py_err)?;
+        }
+    })?
+    .map_err(py_err)?;
     let (samples, n) = (&s.samples, s.samples.points.len());
     let d = PyDict::new(py);
     d.set_item("points", Array2::from_shape_fn((n, 3), |(i, a)| samples.points[i][a]).into_pyarray(py))?;

@@ -125,3 +125,13 @@ def test_batch_runs_sdf_with_its_options_and_refuses_the_others(meshes, tmp_path
         topovox.batch(meshes / "cow.obj", tmp_path / "h", run="sdf", mode="solid")
     with pytest.raises(ValueError, match="run"):
         topovox.batch(meshes / "cow.obj", tmp_path / "i", run="render")
+
+
+def test_options_lists_every_commands_options_with_help_and_example():
+    assert set(topovox.options()) == set(topovox.OPTIONS)
+    assert all(help == topovox.OPTIONS[name] for name, (help, _) in topovox.options().items())
+    for command, name in [("sdf", "band"), ("remesh", "inside"), ("sample", "near"), ("batch", "resolution")]:
+        help, example = topovox.options(command)[name]
+        assert help and example is not None, (command, name)
+    with pytest.raises(ValueError, match="no command"):
+        topovox.options("paint")

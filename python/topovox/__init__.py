@@ -80,6 +80,7 @@ __all__ = [
     "METHODS",
     "FORMATS",
     "OPTIONS",
+    "options",
 ]
 
 # The names come from the one list the command line uses too.
@@ -109,6 +110,37 @@ FEATURES = {name: help for name, help in _topovox.features()}
 FeatureName = Literal["occupancy", "normal", "colour", "color", "coverage", "material", "sdf"]
 #: Every option :func:`voxelize` and :func:`batch` take, with its help.
 OPTIONS = {name: help for name, help, _example in _topovox.options()}
+
+CommandName = Literal["voxelize", "batch", "sdf", "remesh", "sample"]
+
+
+def options(command: CommandName = "voxelize") -> Dict[str, Tuple[str, Any]]:
+    """Every option a command takes, with its help and an example value.
+
+    The same rows as the CLI's flags (``resolution`` is ``--resolution``);
+    ``OPTIONS`` is ``options()`` without the examples.
+
+    Parameters
+    ----------
+    command : {"voxelize", "batch", "sdf", "remesh", "sample"}
+        Whose options: :func:`voxelize` and :func:`batch` (the default),
+        :func:`sdf`, :func:`remesh` or :func:`sample`.
+
+    Returns
+    -------
+    dict
+        ``{name: (help, example)}``, in the table's order.
+
+    Raises
+    ------
+    ValueError
+        For another command.
+
+    Examples
+    --------
+    >>> help, example = topovox.options("sdf")["band"]
+    """
+    return {name: (help, example) for name, help, example in _topovox.options(command)}
 
 MeshLike = Union[Mesh, Any]
 

@@ -4,12 +4,28 @@
 
 use crate::error::ErrorKind;
 
-/// Memory available to this process, from `/proc/meminfo` (None if unknown).
+/// Memory available to this process: the machine's (`/proc/meminfo`),
+/// and under an address-space limit (`ulimit -v`, `prlimit --as`) no more
+/// than what the limit leaves beside the address space already mapped
+/// (None if unknown): past it an allocation fails and aborts the process.
 pub fn available_memory() -> Option<u64> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
     let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
+    let machine = kb * 1024;
+    Some(address_space_left().map_or(machine, |left| left.min(machine)))
+}
+
+/// What the soft address-space limit leaves (`Max address space` of
+/// `/proc/self/limits` less `VmSize`), if there is a limit.
+fn address_space_left() -> Option<u64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = limits.lines().find(|l| l.starts_with("Max address space"))?;
+    let soft: u64 = line.split_whitespace().nth(3)?.parse().ok()?;
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let size = status.lines().find(|l| l.starts_with("VmSize:"))?;
+    let kb: u64 = size.split_whitespace().nth(1)?.parse().ok()?;
+    Some(soft.saturating_sub(kb * 1024))
 }
 
 /// Human-readable byte count.
