@@ -320,33 +320,12 @@ fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec)
     Ok(thickness)
 }
 
-/// Steps of the output's numbers a voxel must span, as a power of two: a
-/// smooth vertex keeps [`surface::MARGIN`] (a twentieth) of an edge from
-/// the lattice points, so 2⁸ steps a voxel keep some thirteen steps
-/// between any two vertices, and rounding can neither merge vertices nor fold a
-/// face. f64 has 53 bits, f32 (STL, GLB) 24.
-const STEPS_PER_VOXEL: i32 = 8;
-
 /// Refuses, before any work, a grid whose surface the output's numbers
-/// cannot hold: one whose voxels are too small beside its coordinates (a
-/// unit tetrahedron at 10¹⁵ on a 32³ grid: voxels of 0.03 where f64's
-/// steps are 0.125) would write merged vertices, degenerate faces and
-/// edges of more than two faces.
+/// cannot hold ([`surface::check_precision`]).
 fn check_precision(name: &str, req: &RemeshRequest, grid: &GridSpec) -> Result<()> {
-    let [x, y, z] = grid.dims();
-    let far = grid.origin() + DVec3::new(x as f64, y as f64, z as f64) * grid.voxel_size().0;
-    let m = grid.origin().abs().max(far.abs()).max_element();
-    let h = grid.voxel_size().0.min_element();
-    let (bits, numbers) = if req.single { (24, "f32 numbers (STL, GLB)") } else { (53, "f64 numbers") };
-    let most = 2f64.powi(bits - STEPS_PER_VOXEL);
-    if m / h > most {
-        return Err(JobError::invalid(format!(
-            "{name}: the {x}x{y}x{z} grid's voxels ({h:.3e}) are too small beside its coordinates (up to {m:.3e}) for the output's {numbers}: \
-             a surface needs voxels of at least 1/{most:.0} of the largest coordinate; move the mesh near the origin, lower the resolution{}",
-            if req.single { ", or write .obj or .ply (f64)" } else { "" }
-        )));
-    }
-    Ok(())
+    surface::check_precision(grid, req.single).map_err(|why| {
+        JobError::invalid(format!("{name}: {why}{}", if req.single { ", or write .obj or .ply (f64)" } else { "" }))
+    })
 }
 
 /// The refusal of a run that needs `need` bytes where `limit` is allowed.

@@ -50,6 +50,34 @@ pub const MARGIN: f64 = 0.05;
 /// them apart by half a voxel.
 pub const WRAP_MARGIN: f64 = 0.25;
 
+/// Steps of the output's numbers a voxel must span, as a power of two: a
+/// smooth vertex keeps [`MARGIN`] (a twentieth) of an edge from the
+/// lattice points, so 2⁸ steps a voxel keep some thirteen steps between
+/// any two vertices, and rounding can neither merge vertices nor fold a
+/// face. f64 has 53 bits, f32 (STL, GLB) 24.
+pub const STEPS_PER_VOXEL: i32 = 8;
+
+/// Whether a surface on `grid` survives being written in f64 (or, with
+/// `single`, f32) numbers; else why not. A grid whose voxels are too small
+/// beside its coordinates (a unit tetrahedron at 10¹⁵ on a 32³ grid:
+/// voxels of 0.03 where f64's steps are 0.125) would come out with merged
+/// vertices, degenerate faces and edges of more than two faces.
+pub fn check_precision(grid: &GridSpec, single: bool) -> Result<(), String> {
+    let [x, y, z] = grid.dims();
+    let far = grid.origin() + DVec3::new(x as f64, y as f64, z as f64) * grid.voxel_size().0;
+    let m = grid.origin().abs().max(far.abs()).max_element();
+    let h = grid.voxel_size().0.min_element();
+    let (bits, numbers) = if single { (24, "f32 numbers (STL, GLB)") } else { (53, "f64 numbers") };
+    let most = 2f64.powi(bits - STEPS_PER_VOXEL);
+    if m / h > most {
+        return Err(format!(
+            "the {x}x{y}x{z} grid's voxels ({h:.3e}) are too small beside its coordinates (up to {m:.3e}) for the output's {numbers}: \
+             a surface needs voxels of at least 1/{most:.0} of the largest coordinate; move the mesh near the origin, lower the resolution"
+        ));
+    }
+    Ok(())
+}
+
 /// One slab of a surface ([`tets::extract_slabs`]): the positions of
 /// vertices `first_vertex..`, and triangles on those and on the previous
 /// part's vertices. A surface's parts, concatenated, are the whole surface.
