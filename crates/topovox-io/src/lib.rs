@@ -30,6 +30,7 @@ pub mod off;
 pub mod orient;
 pub mod pixels;
 pub mod ply;
+mod ply_binary;
 pub mod png;
 pub mod points;
 pub mod polyline;

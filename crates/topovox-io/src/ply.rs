@@ -1,4 +1,5 @@
-//! PLY, ASCII and binary (both endiannesses), through the `ply-rs-bw` crate.
+//! PLY, ASCII and binary (both endiannesses): the header (and ASCII
+//! payloads) through the `ply-rs-bw` crate, binary payloads in place.
 //!
 //! Reads element `vertex` (properties `x`, `y`, `z`, any numeric type),
 //! element `face` (list property `vertex_indices` or `vertex_index`;
@@ -40,53 +41,110 @@ fn list(p: &Property) -> Option<Vec<i64>> {
     })
 }
 
-/// Parses PLY bytes.
+/// Parses PLY bytes: the header by `ply-rs-bw`, a binary payload in place
+/// ([`crate::ply_binary`]), an ASCII one by the crate ([`reference`]).
 pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
     let parser = Parser::<DefaultElement>::new();
     let mut reader = Reader::new(Cursor::new(bytes));
     let header = parser.read_header(&mut reader).map_err(|e| ErrorKind::malformed("PLY", e))?;
-    let payload_len = bytes.len() as u64 - reader.get_ref().position();
-    check_counts(&header, payload_len)?;
-    let payload = parser.read_payload(&mut reader, &header).map_err(|e| ErrorKind::malformed("PLY", e))?;
-    let verts = payload.get("vertex").ok_or_else(|| ErrorKind::malformed("PLY", "no 'vertex' element"))?;
-    let mut positions = Vec::with_capacity(verts.len());
-    let mut colours = Vec::new();
-    for (n, v) in verts.iter().enumerate() {
-        if let Some(c) = vertex_colour(v) {
-            colours.resize(n, [255; 3]);
-            colours.push(c);
-        }
-        let mut c = [0.0; 3];
-        for (a, name) in ["x", "y", "z"].iter().enumerate() {
-            c[a] = v
-                .get(*name)
-                .and_then(scalar)
-                .ok_or_else(|| ErrorKind::malformed("PLY", format!("vertex {n} has no numeric '{name}' property")))?;
-        }
-        positions.push(DVec3::from(c));
+    let start = reader.get_ref().position() as usize;
+    check_counts(&header, (bytes.len() - start) as u64)?;
+    if header.encoding == Encoding::Ascii {
+        return reference::payload(&parser, &mut reader, &header);
     }
+    let p = crate::ply_binary::read(&header, &bytes[start..])?;
     let mut triangles = Vec::new();
-    for idx in index_lists(&payload, "face")? {
-        fan(&idx, &mut triangles);
-    }
-    for idx in index_lists(&payload, "tristrips")? {
-        for strip in idx.split(|&v| v == -1) {
-            unstrip(strip, &mut triangles);
+    if let Some((idx, lens)) = &p.faces {
+        let mut at = 0;
+        for &n in lens {
+            fan(&idx[at..at + n as usize], &mut triangles);
+            at += n as usize;
         }
     }
-    if payload.get("face").is_none() && payload.get("tristrips").is_none() {
-        let names: Vec<&str> = header.elements.keys().map(String::as_str).collect();
-        return Err(ErrorKind::malformed(
-            "PLY",
-            format!("no 'face' or 'tristrips' element to read triangles from (it has: {})", names.join(", ")),
-        ));
+    if let Some((idx, lens)) = &p.strips {
+        let mut at = 0;
+        for &n in lens {
+            for strip in idx[at..at + n as usize].split(|&v| v == -1) {
+                unstrip(strip, &mut triangles);
+            }
+            at += n as usize;
+        }
     }
+    if p.faces.is_none() && p.strips.is_none() {
+        return Err(no_faces(&header));
+    }
+    let mut colours = p.colours;
     if !colours.is_empty() {
-        colours.resize(positions.len(), [255; 3]);
+        colours.resize(p.positions.len(), [255; 3]);
     }
-    let mut loaded = finish(positions, triangles, Vec::new())?;
+    let mut loaded = finish(p.positions, triangles, Vec::new())?;
     loaded.appearance.vertex_colour = colours;
     Ok(loaded)
+}
+
+fn no_faces(header: &Header) -> ErrorKind {
+    let names: Vec<&str> = header.elements.keys().map(String::as_str).collect();
+    ErrorKind::malformed("PLY", format!("no 'face' or 'tristrips' element to read triangles from (it has: {})", names.join(", ")))
+}
+
+/// The reader by `ply-rs-bw`'s payload parser, for every encoding: the
+/// reference the in-place binary reader is tested against, and the ASCII
+/// reader.
+pub mod reference {
+    use super::*;
+
+    /// Parses PLY bytes with the crate's payload parser.
+    pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
+        let parser = Parser::<DefaultElement>::new();
+        let mut reader = Reader::new(Cursor::new(bytes));
+        let header = parser.read_header(&mut reader).map_err(|e| ErrorKind::malformed("PLY", e))?;
+        let payload_len = bytes.len() as u64 - reader.get_ref().position();
+        check_counts(&header, payload_len)?;
+        payload(&parser, &mut reader, &header)
+    }
+
+    pub(super) fn payload(
+        parser: &Parser<DefaultElement>,
+        reader: &mut Reader<Cursor<&[u8]>>,
+        header: &Header,
+    ) -> Result<LoadedMesh, ErrorKind> {
+        let payload = parser.read_payload(reader, header).map_err(|e| ErrorKind::malformed("PLY", e))?;
+        let verts = payload.get("vertex").ok_or_else(|| ErrorKind::malformed("PLY", "no 'vertex' element"))?;
+        let mut positions = Vec::with_capacity(verts.len());
+        let mut colours = Vec::new();
+        for (n, v) in verts.iter().enumerate() {
+            if let Some(c) = vertex_colour(v) {
+                colours.resize(n, [255; 3]);
+                colours.push(c);
+            }
+            let mut c = [0.0; 3];
+            for (a, name) in ["x", "y", "z"].iter().enumerate() {
+                c[a] = v
+                    .get(*name)
+                    .and_then(scalar)
+                    .ok_or_else(|| ErrorKind::malformed("PLY", format!("vertex {n} has no numeric '{name}' property")))?;
+            }
+            positions.push(DVec3::from(c));
+        }
+        let mut triangles = Vec::new();
+        for idx in index_lists(&payload, "face")? {
+            fan(&idx, &mut triangles);
+        }
+        for idx in index_lists(&payload, "tristrips")? {
+            for strip in idx.split(|&v| v == -1) {
+                unstrip(strip, &mut triangles);
+            }
+        }
+        if payload.get("face").is_none() && payload.get("tristrips").is_none() {
+            return Err(no_faces(header));
+        }
+        if !colours.is_empty() {
+            colours.resize(positions.len(), [255; 3]);
+        }
+        let mut loaded = finish(positions, triangles, Vec::new())?;
+        loaded.appearance.vertex_colour = colours;
+        Ok(loaded)
+    }
 }
 
 /// The `vertex_indices` (or `vertex_index`) lists of every entry of
