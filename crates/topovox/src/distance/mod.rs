@@ -47,7 +47,7 @@ use crate::MeshRef;
 pub enum DistanceError {
     /// A vertex used by a triangle or segment has a NaN or infinite
     /// coordinate, or one past ±[`crate::COORDINATE_LIMIT`].
-    #[error("vertex {0} has a coordinate that is not finite or lies past ±2^100 (1.27e30), the range topovox computes in")]
+    #[error("vertex {0} has a non-finite coordinate or one past ±2^100 (1.27e30), the range topovox computes in")]
     NonFinite(u32),
     /// No triangle or segment to measure to.
     #[error("the mesh has no triangles or segments to measure a distance to")]
