@@ -34,7 +34,8 @@ fuzz_target!(|data: &[u8]| {
         return; // the readers refuse these (ErrorKind::OutOfRange)
     }
     let n = positions.len() as u32;
-    let mut triangles: Vec<[u32; 3]> = faces.chunks_exact(3).take(40).map(|t| [t[0] as u32 % n, t[1] as u32 % n, t[2] as u32 % n]).collect();
+    let mut triangles: Vec<[u32; 3]> =
+        faces.chunks_exact(3).take(40).map(|t| [t[0] as u32 % n, t[1] as u32 % n, t[2] as u32 % n]).collect();
     if triangles.is_empty() {
         // A closed tetrahedron of the first four vertices (or a triangle).
         triangles = if n >= 4 { vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]] } else { vec![[0, 1, 2]] };

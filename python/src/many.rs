@@ -105,7 +105,10 @@ pub(crate) fn voxelize_many<'py>(
             let mut voxelized = topovox_job::many::voxelize_many(&each, &refs, &stop).into_iter();
             let paired: Vec<Option<(&topovox_io::LoadedMesh, Result<Voxelized, JobError>)>> =
                 inputs.iter().map(|i| i.as_ref().map(|(m, _)| (m.as_ref(), voxelized.next().expect("a result per mesh")))).collect();
-            paired.into_par_iter().map(|p| p.map(|(mesh, v)| v.and_then(|v| item(&voxelizer, mesh, v, &features, keep, &reserve)))).collect()
+            paired
+                .into_par_iter()
+                .map(|p| p.map(|(mesh, v)| v.and_then(|v| item(&voxelizer, mesh, v, &features, keep, &reserve))))
+                .collect()
         };
         match pool {
             Some(p) => p.install(run),

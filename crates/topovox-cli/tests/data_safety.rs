@@ -246,9 +246,10 @@ fn gltf_naming(uri: &str) -> String {
 #[test]
 fn file_uris_to_system_files_are_refused_by_every_command() {
     let d = folder("file-uri");
-    for (k, uri) in ["file:///etc/passwd", "file:///proc/self/environ", "FILE://localhost/etc/passwd", "file:/etc/hostname", "file:///dev/zero"]
-        .iter()
-        .enumerate()
+    for (k, uri) in
+        ["file:///etc/passwd", "file:///proc/self/environ", "FILE://localhost/etc/passwd", "file:/etc/hostname", "file:///dev/zero"]
+            .iter()
+            .enumerate()
     {
         let m = d.join(format!("m{k}.gltf"));
         std::fs::write(&m, gltf_naming(uri)).unwrap();

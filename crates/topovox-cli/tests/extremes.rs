@@ -84,7 +84,11 @@ fn every_command_answers_extreme_scales_and_offsets() {
             if answered(&topovox(&args), &format!("{name} remesh {style:?} {out}")) {
                 let c = topovox(&["check", &out, "--json"]);
                 let text = String::from_utf8_lossy(&c.stdout);
-                assert!(c.status.success() && text.contains("\"watertight\":true"), "{name} {out}: {text}{}", String::from_utf8_lossy(&c.stderr));
+                assert!(
+                    c.status.success() && text.contains("\"watertight\":true"),
+                    "{name} {out}: {text}{}",
+                    String::from_utf8_lossy(&c.stderr)
+                );
             }
         }
     }

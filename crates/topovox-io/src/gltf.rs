@@ -127,12 +127,7 @@ impl Builder {
         self.tex_coord.push(0);
     }
 
-    fn texture(
-        &self,
-        t: &gltf::Texture<'_>,
-        buffers: &[gltf::buffer::Data],
-        res: &Resources,
-    ) -> Result<Texture, String> {
+    fn texture(&self, t: &gltf::Texture<'_>, buffers: &[gltf::buffer::Data], res: &Resources) -> Result<Texture, String> {
         let wrap = |m: WrappingMode| match m {
             WrappingMode::ClampToEdge => Wrap::ClampToEdge,
             WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
@@ -226,10 +221,7 @@ impl Builder {
             // Checked here, per primitive, so that no message quotes an
             // index: a buffer's bytes come from a file the user did not name.
             if let Some(at) = idx.iter().position(|&i| i >= base + n) {
-                return Err(ErrorKind::malformed(
-                    "glTF",
-                    format!("mesh {mi}: index {at} of a primitive refers past its {n} vertices"),
-                ));
+                return Err(ErrorKind::malformed("glTF", format!("mesh {mi}: index {at} of a primitive refers past its {n} vertices")));
             }
             match mode {
                 Mode::Triangles => {
@@ -359,7 +351,9 @@ fn load_buffers(document: &gltf::Document, mut blob: Option<Vec<u8>>, res: &Reso
         let mut data = match b.source() {
             gltf::buffer::Source::Bin => blob.take().ok_or_else(|| bad("refers to the GLB binary chunk, which is missing".into()))?,
             gltf::buffer::Source::Uri(uri) => match uri_target(uri).map_err(bad)? {
-                UriTarget::Data(data) => gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(&data), None).map_err(|e| bad(e.to_string()))?.0,
+                UriTarget::Data(data) => {
+                    gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(&data), None).map_err(|e| bad(e.to_string()))?.0
+                }
                 UriTarget::Path(reference) => res.read(&reference, Some(b.length() as u64)).map_err(bad)?,
             },
         };

@@ -170,10 +170,8 @@ fn vertices(el: &ElementDef, body: &[u8], at: usize, big: bool, out: &mut Payloa
     if let Some(c) = &colour {
         let float = matches!(c[0].1, ScalarType::Float | ScalarType::Double);
         let o = [off(&c[0]), off(&c[1]), off(&c[2])];
-        out.colours = body[at..end]
-            .chunks_exact(stride)
-            .map(|row| [0, 1, 2].map(|k| channel(number(&c[k].1, &row[o[k]..], big), float)))
-            .collect();
+        out.colours =
+            body[at..end].chunks_exact(stride).map(|row| [0, 1, 2].map(|k| channel(number(&c[k].1, &row[o[k]..], big), float))).collect();
     }
     Ok(end)
 }
@@ -230,7 +228,14 @@ fn skip_list(ct: &ScalarType, it: &ScalarType, body: &[u8], at: usize, big: bool
 /// Walks `el`'s entries from `body[at..]`, collecting the list property
 /// at `keep` (if any) into `lists` (the indices, and each list's length).
 /// Returns where the element ends.
-fn walk(el: &ElementDef, body: &[u8], at: usize, big: bool, keep: Option<usize>, lists: &mut (Vec<i64>, Vec<u32>)) -> Result<usize, ErrorKind> {
+fn walk(
+    el: &ElementDef,
+    body: &[u8],
+    at: usize,
+    big: bool,
+    keep: Option<usize>,
+    lists: &mut (Vec<i64>, Vec<u32>),
+) -> Result<usize, ErrorKind> {
     let props: Vec<&PropertyType> = el.properties.values().map(|p| &p.data_type).collect();
     let mut at = at;
     if keep.is_some() {

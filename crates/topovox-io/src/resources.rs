@@ -18,7 +18,8 @@ use std::sync::Mutex;
 /// would never end, a folder cannot be read. Checked before opening (so a
 /// FIFO never blocks the open) and again on the opened file.
 pub fn open_regular(path: &Path) -> std::io::Result<(File, u64)> {
-    let not_regular = || std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a regular file (a device, a FIFO, a socket or a folder)");
+    let not_regular =
+        || std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a regular file (a device, a FIFO, a socket or a folder)");
     if !std::fs::metadata(path)?.is_file() {
         return Err(not_regular());
     }
@@ -69,7 +70,11 @@ pub(crate) fn uri_target(uri: &str) -> Result<UriTarget, String> {
                     let slash = auth.find('/').unwrap_or(auth.len());
                     let host = &auth[..slash];
                     if !host.is_empty() && !host.eq_ignore_ascii_case("localhost") {
-                        return Err(format!("the URI {} names the host {}, and no file of another host is read", shown(), crate::error::quoted(host)));
+                        return Err(format!(
+                            "the URI {} names the host {}, and no file of another host is read",
+                            shown(),
+                            crate::error::quoted(host)
+                        ));
                     }
                     &auth[slash..]
                 }
@@ -203,10 +208,15 @@ impl Resources {
             return Err(format!("{shown} holds {size} bytes, fewer than the {want} its reference declares"));
         }
         if want > crate::read_limit() {
-            return Err(format!("{shown} is {} long, more than the {} a read may take", crate::bytes(want), crate::bytes(crate::read_limit())));
+            return Err(format!(
+                "{shown} is {} long, more than the {} a read may take",
+                crate::bytes(want),
+                crate::bytes(crate::read_limit())
+            ));
         }
         let mut out = Vec::with_capacity(want as usize);
-        std::io::Read::read_to_end(&mut std::io::Read::take(file, want), &mut out).map_err(|e| format!("{shown} could not be read ({e})"))?;
+        std::io::Read::read_to_end(&mut std::io::Read::take(file, want), &mut out)
+            .map_err(|e| format!("{shown} could not be read ({e})"))?;
         if (out.len() as u64) < want {
             return Err(format!("{shown} ended after {} of its {want} bytes", out.len()));
         }

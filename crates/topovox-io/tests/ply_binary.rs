@@ -116,8 +116,12 @@ fn file(l: Layout, vertices: usize, faces: usize, seed: u64) -> Vec<u8> {
 fn layouts() -> Vec<Layout> {
     let mut v = Vec::new();
     for big in [false, true] {
-        for (double, before, colour) in [(false, false, None), (true, true, Some(true)), (false, true, Some(false)), (true, false, Some(true))] {
-            for (count, index) in [("uchar", "int"), ("uchar", "uint"), ("ushort", "int"), ("int", "uint"), ("uchar", "ushort"), ("char", "short")] {
+        for (double, before, colour) in
+            [(false, false, None), (true, true, Some(true)), (false, true, Some(false)), (true, false, Some(true))]
+        {
+            for (count, index) in
+                [("uchar", "int"), ("uchar", "uint"), ("ushort", "int"), ("int", "uint"), ("uchar", "ushort"), ("char", "short")]
+            {
                 for (between, strips) in [(false, false), (true, false), (false, true)] {
                     v.push(Layout { big, double, before, colour, count, index, between, strips });
                 }
@@ -150,7 +154,8 @@ fn every_layout_reads_as_the_reference_reads_it() {
 
 #[test]
 fn every_truncation_is_refused_by_both() {
-    let l = Layout { big: false, double: false, before: true, colour: Some(true), count: "uchar", index: "int", between: true, strips: false };
+    let l =
+        Layout { big: false, double: false, before: true, colour: Some(true), count: "uchar", index: "int", between: true, strips: false };
     let bytes = file(l, 20, 30, 7);
     let header_end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
     for cut in header_end..bytes.len() {

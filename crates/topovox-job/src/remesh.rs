@@ -323,9 +323,8 @@ fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec)
 /// Refuses, before any work, a grid whose surface the output's numbers
 /// cannot hold ([`surface::check_precision`]).
 fn check_precision(name: &str, req: &RemeshRequest, grid: &GridSpec) -> Result<()> {
-    surface::check_precision(grid, req.single).map_err(|why| {
-        JobError::invalid(format!("{name}: {why}{}", if req.single { ", or write .obj or .ply (f64)" } else { "" }))
-    })
+    surface::check_precision(grid, req.single)
+        .map_err(|why| JobError::invalid(format!("{name}: {why}{}", if req.single { ", or write .obj or .ply (f64)" } else { "" })))
 }
 
 /// The refusal of a run that needs `need` bytes where `limit` is allowed.
