@@ -7,13 +7,18 @@
 
 #![cfg(unix)]
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use common::scratch;
 use topovox_io::{read_mesh, ReadOptions};
+
+/// A fresh folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("topovox-uris-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
 
 /// Three vertices and three `u16` indices: 42 bytes.
 fn triangle_buffer() -> Vec<u8> {

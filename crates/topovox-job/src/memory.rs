@@ -129,10 +129,10 @@ pub fn parse_size(s: &str) -> Result<u64> {
     };
     let v: f64 = num.parse().map_err(|_| JobError::invalid(format!("--max-memory {s:?}: not a size (e.g. 8G, 512M)")))?;
     let b = v * (1u64 << shift) as f64;
-    if !(b >= (1u64 << 20) as f64) {
+    if b < (1u64 << 20) as f64 {
         return Err(JobError::invalid(format!("--max-memory {s:?}: must be at least 1M")));
     }
-    if !(b <= MAX_SIZE as f64) {
+    if b > MAX_SIZE as f64 {
         return Err(JobError::invalid(format!("--max-memory {s:?}: too large (at most 1024T)")));
     }
     Ok(b as u64)
