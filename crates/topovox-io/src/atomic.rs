@@ -411,8 +411,19 @@ fn remove_path(path: &Path) {
 /// if `then_exit` is given, so no new temporary appears meanwhile.
 pub fn remove_live_temporaries(then_exit: Option<i32>) {
     let mut live = live();
-    for p in live.drain(..) {
-        remove_path(&p);
+    let gone: Vec<PathBuf> = live.drain(..).collect();
+    for p in &gone {
+        remove_path(p);
+    }
+    // A writer thread still filling a temporary folder (a Zarr array's
+    // chunks) can make its folders again (`create_dir_all`) just after
+    // they were removed: look again a few times before the process ends
+    // (2 of 16 signals left a `.out.zarr.topovox-tmp-PID-0` behind).
+    if !gone.is_empty() {
+        for _ in 0..4 {
+            std::thread::sleep(std::time::Duration::from_millis(5));
+            gone.iter().for_each(|p| remove_path(p));
+        }
     }
     if let Some(code) = then_exit {
         std::process::exit(code);
