@@ -156,16 +156,7 @@ fn gltf_buffers_outside_the_folder_are_an_error() {
         bin.extend(i.to_le_bytes());
     }
     std::fs::write(d.join("outside.bin"), &bin).unwrap();
-    let gltf = |uri: &str| {
-        format!(
-            r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"{uri}","byteLength":42}}],
-            "bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":6}}],
-            "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
-                         {{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}],
-            "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
-            "nodes":[{{"mesh":0}}],"scenes":[{{"nodes":[0]}}],"scene":0}}"#
-        )
-    };
+    let gltf = gltf_naming;
     let escaping = inner.join("escape.gltf");
     std::fs::write(&escaping, gltf("../outside.bin")).unwrap();
     let line = refused(&topovox(&["voxelize", s(&escaping), "-o", s(&d.join("o.npy")), "--resolution", "8"]));
