@@ -42,7 +42,7 @@ fn list(p: &Property) -> Option<Vec<i64>> {
 }
 
 /// Parses PLY bytes: the header by `ply-rs-bw`, a binary payload in place
-/// ([`crate::ply_binary`]), an ASCII one by the crate ([`reference`]).
+/// (`ply_binary.rs`), an ASCII one by the crate ([`reference`](mod@reference)).
 pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
     let parser = Parser::<DefaultElement>::new();
     let mut reader = Reader::new(Cursor::new(bytes));
