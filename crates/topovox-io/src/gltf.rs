@@ -371,13 +371,12 @@ fn load_buffers(document: &gltf::Document, mut blob: Option<Vec<u8>>, res: &Reso
 /// `res` and decoded by [`crate::texture::decode`].
 fn load_image(source: gltf::image::Source<'_>, buffers: &[gltf::buffer::Data], res: &Resources) -> Result<gltf::image::Data, String> {
     let reference = match source {
-        gltf::image::Source::View { .. } => None,
+        gltf::image::Source::View { .. } => return decoded(source, buffers),
         gltf::image::Source::Uri { uri, mime_type } => match uri_target(uri).map_err(|why| format!("image {why}"))? {
             UriTarget::Data(data) => return decoded(gltf::image::Source::Uri { uri: &data, mime_type }, buffers),
-            UriTarget::Path(reference) => Some(reference),
+            UriTarget::Path(reference) => reference,
         },
     };
-    let Some(reference) = reference else { return decoded(source, buffers) };
     let bytes = res.read(&reference, None).map_err(|why| format!("image {why}"))?;
     let t = crate::texture::decode(&bytes, &reference.display().to_string(), [Wrap::Repeat; 2])?;
     Ok(gltf::image::Data { pixels: t.rgba, format: Format::R8G8B8A8, width: t.width, height: t.height })

@@ -151,10 +151,11 @@ pub enum SampleError {
 /// (`√(−2 ln 2⁻⁵³)` ≈ 8.6 per axis, 14.9 in all three), with a margin.
 const MOST_DEVIATIONS: f64 = 16.5;
 
-/// Refuses a spec whose samples could leave the range: a `sigma` so wide,
-/// or `bounds` so far, that a point (or its distance) would overflow.
-fn check_range(query: &Query, spec: &SampleSpec) -> Result<(), SampleError> {
-    let reach = query.faces().iter().flat_map(|(_, t)| t.iter().map(|p| p.abs().max_element())).fold(0.0, f64::max);
+/// Refuses a spec whose samples could leave the range: a `sigma` so wide
+/// (beside the mesh's triangles, as [`sample`] draws from them), or
+/// `bounds` so far, that a point (or its distance) would overflow.
+fn check_range(areas: &Areas, spec: &SampleSpec) -> Result<(), SampleError> {
+    let reach = areas.tris.iter().flat_map(|(_, t)| t.iter().map(|p| p.abs().max_element())).fold(0.0, f64::max);
     if let Some(&s) = spec.sigma.iter().filter(|_| spec.near > 0).find(|&&s| reach + MOST_DEVIATIONS * s > crate::COORDINATE_LIMIT) {
         return Err(SampleError::Range(format!("sigma {s:e} (beside a mesh reaching {reach:e})")));
     }
@@ -178,7 +179,7 @@ pub fn sample(query: &Query, spec: &SampleSpec) -> Result<Samples, SampleError> 
     if spec.uniform > 0 && !(lo.is_finite() && hi.is_finite() && lo.cmplt(hi).all()) {
         return Err(SampleError::Bounds);
     }
-    check_range(query, spec)?;
+    check_range(&areas, spec)?;
     let mut out = Samples::default();
     let nan = DVec3::NAN;
     let draws: [(Kind, usize); 3] = [(Kind::Surface, spec.surface), (Kind::Near, spec.near), (Kind::Uniform, spec.uniform)];
