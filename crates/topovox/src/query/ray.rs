@@ -49,6 +49,10 @@ pub(crate) fn yz_side(u: DVec3, v: DVec3, q: DVec3) -> i32 {
     sign(u.y - v.y)
 }
 
+/// The most index entries per triangle (see [`RayIndex::fit_cells`]);
+/// a mesh's triangles, smaller than its cells, touch one to four.
+const MAX_ENTRIES_PER_TRIANGLE: u64 = 16;
+
 /// A triangle as the index keeps it.
 #[derive(Clone, Copy, Debug)]
 struct RayTri {
@@ -98,17 +102,45 @@ impl RayIndex {
         let ext = [(hi[0] - lo[0]).max(f64::MIN_POSITIVE), (hi[1] - lo[1]).max(f64::MIN_POSITIVE)];
         let n = (tris.len() as f64 * 2.0).max(1.0);
         let side = (ext[0] * ext[1] / n).sqrt().max(ext[0].max(ext[1]) / 4096.0);
-        let cells = if tris.is_empty() {
-            // Nothing to bin (a closed mesh's caps): one cell, not a grid
-            // sized by an empty box.
-            [1, 1]
-        } else {
-            [(ext[0] / side).ceil().clamp(1.0, 4096.0) as usize, (ext[1] / side).ceil().clamp(1.0, 4096.0) as usize]
-        };
-        let scale = [cells[0] as f64 / ext[0], cells[1] as f64 / ext[1]];
-        let mut out = RayIndex { tris, lo, hi, scale, cells, start: Vec::new(), items: Vec::new() };
+        let mut out = RayIndex { tris, lo, hi, scale: [1.0; 2], cells: [1, 1], start: Vec::new(), items: Vec::new() };
+        if !out.tris.is_empty() {
+            // Nothing to bin (a closed mesh's caps) keeps one cell, not a
+            // grid sized by an empty box.
+            out.fit_cells(ext, side);
+        }
         out.bin();
         out
+    }
+
+    /// Cells of about `side`, made coarser until the entries (a triangle
+    /// per cell its box touches) number at most [`MAX_ENTRIES_PER_TRIANGLE`]
+    /// per triangle: a soup of large triangles crossing each other would
+    /// otherwise put each in 10⁵ cells (10¹¹ entries for 10⁶ triangles).
+    /// Coarser cells cost queries time, never memory; one cell holds
+    /// every triangle once.
+    fn fit_cells(&mut self, ext: [f64; 2], mut side: f64) {
+        let limit = (self.tris.len() as u64).saturating_mul(MAX_ENTRIES_PER_TRIANGLE).clamp(1 << 22, u64::from(u32::MAX));
+        loop {
+            self.cells = [(ext[0] / side).ceil().clamp(1.0, 4096.0) as usize, (ext[1] / side).ceil().clamp(1.0, 4096.0) as usize];
+            self.scale = [self.cells[0] as f64 / ext[0], self.cells[1] as f64 / ext[1]];
+            let entries = self.entries();
+            if entries <= limit || self.cells == [1, 1] {
+                return;
+            }
+            side *= (entries as f64 / limit as f64).sqrt().max(1.25);
+        }
+    }
+
+    /// How many (cell, triangle) entries the current cells give.
+    fn entries(&self) -> u64 {
+        self.tris
+            .iter()
+            .map(|t| {
+                let y = (self.cell(0, t.hi.y) - self.cell(0, t.lo.y) + 1) as u64;
+                let z = (self.cell(1, t.hi.z) - self.cell(1, t.lo.z) + 1) as u64;
+                y * z
+            })
+            .sum()
     }
 
     /// The cell range `[first, last]` along `yz` axis `a` of coordinate `v`
@@ -178,4 +210,34 @@ pub fn crosses(t: &[DVec3; 3], q: DVec3) -> Option<i32> {
     // Inside the projection, so n_x has sign s; q + δ lies beyond the
     // plane in +x iff n · (q + δ − a) has that sign too.
     (plane_side(t, q) == s).then_some(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::Xorshift;
+
+    /// Large triangles crossing each other (a soup filling a box) would
+    /// put each in every cell: the index coarsens its cells to a bounded
+    /// number of entries, and still finds every crossing.
+    #[test]
+    fn a_soup_of_large_triangles_keeps_the_index_bounded_and_exact() {
+        let mut rng = Xorshift(11);
+        let mut point = || DVec3::new(rng.below(4096) as f64, rng.below(4096) as f64, rng.below(4096) as f64) / 1024.0;
+        let tris: Vec<[DVec3; 3]> = (0..3000).map(|_| [point(), point(), point()]).collect();
+        let index = RayIndex::new(tris.iter().copied());
+        assert!(index.items.len() as u64 <= 1 << 22, "{} entries for {} triangles", index.items.len(), tris.len());
+        assert!(index.cells[0] * index.cells[1] > 1, "coarsened to a single cell");
+        for _ in 0..200 {
+            let q = point();
+            let mut want = Crossings::default();
+            for t in &tris {
+                if let Some(s) = crosses(t, q) {
+                    want.count += 1;
+                    want.winding -= s as i64;
+                }
+            }
+            assert_eq!(index.crossings(q), want, "{q}");
+        }
+    }
 }
