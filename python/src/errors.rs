@@ -58,6 +58,7 @@ pub(crate) fn io_err(e: topovox_io::IoError) -> PyErr {
             K::AlreadyExists => PyFileExistsError::new_err(msg),
             _ => PyOSError::new_err(msg),
         },
+        topovox_io::ErrorKind::TooLargeToRead { .. } => pyo3::exceptions::PyMemoryError::new_err(msg),
         _ => FileFormatError::new_err(msg),
     }
 }

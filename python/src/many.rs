@@ -193,7 +193,7 @@ fn item(
 ) -> Result<Item, JobError> {
     let data = carried_grid(voxelizer, mesh, v, keep)?;
     let width: usize = features.iter().map(|f| f.width()).sum();
-    let query = if features.contains(&Feature::Sdf) { mesh.mesh.triangles.len() as u64 * 1000 } else { 0 };
+    let query = if features.contains(&Feature::Sdf) { topovox_job::query_bytes(mesh.mesh.as_ref()) } else { 0 };
     let storage = match data.voxels() {
         topovox_job::Voxels::Dense(_) => data.grid().dense_bytes(),
         _ => data.count(),

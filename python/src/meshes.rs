@@ -251,7 +251,7 @@ impl Mesh {
     }
 }
 
-/// load_mesh(path, allow_external_paths=False) -> Mesh
+/// load_mesh(path, allow_external_paths=False, max_memory=None) -> Mesh
 ///
 /// Reads a mesh file: OBJ (with its MTL and textures), STL, PLY, glTF/GLB,
 /// OFF (ModelNet's),
@@ -264,6 +264,10 @@ impl Mesh {
 /// allow_external_paths : bool
 ///     Read files the model names (material libraries, textures, buffers)
 ///     even outside its folder. Off by default.
+/// max_memory : int or str, optional
+///     The memory the read may take, in bytes or as ``"2G"``: a file
+///     whose reading would hold more is refused before it is parsed.
+///     Default: nine tenths of the available memory.
 ///
 /// Returns
 /// -------
@@ -273,15 +277,37 @@ impl Mesh {
 /// ------
 /// FileNotFoundError, PermissionError, FileFormatError
 ///     The file cannot be read, or its content is malformed.
+/// MemoryError
+///     Reading it would hold more than ``max_memory``.
 ///
 /// Examples
 /// --------
 /// >>> mesh = topovox.load_mesh("bunny.obj")
 #[pyfunction]
-#[pyo3(signature = (path, allow_external_paths=false))]
-pub(crate) fn load_mesh(py: Python<'_>, path: PathBuf, allow_external_paths: bool) -> PyResult<Mesh> {
+#[pyo3(signature = (path, allow_external_paths=false, max_memory=None))]
+pub(crate) fn load_mesh(
+    py: Python<'_>,
+    path: PathBuf,
+    allow_external_paths: bool,
+    max_memory: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Mesh> {
+    let max_memory = max_memory.filter(|m| !m.is_none()).map(memory_size).transpose()?;
     let p = path.clone();
-    let read = move || topovox_io::read_mesh(&p, &topovox_io::ReadOptions { allow_external_paths, ..Default::default() });
+    let read = move || topovox_io::read_mesh(&p, &topovox_io::ReadOptions { allow_external_paths, max_memory, ..Default::default() });
     let loaded = crate::interrupt::interruptible_read(py, read)?.map_err(io_err)?;
     Ok(Mesh { inner: Arc::new(loaded), path: Some(path) })
+}
+
+/// A memory size given as bytes (an int) or as text (`"2G"`).
+fn memory_size(v: &Bound<'_, PyAny>) -> PyResult<u64> {
+    if let Ok(n) = v.extract::<u64>() {
+        return Ok(n);
+    }
+    let text: String = v.extract().map_err(|_| {
+        crate::errors::value_err(format!(
+            "max_memory takes bytes or a size such as \"2G\", not {}",
+            v.repr().map(|r| r.to_string()).unwrap_or_default()
+        ))
+    })?;
+    topovox_job::parse_size(&text).map_err(crate::errors::py_err)
 }

@@ -235,7 +235,11 @@ def _from_open3d_tensor(m: Any) -> Mesh:
     return Mesh(positions, _as_index_array(_tensor_array(t["indices"]), "triangles"), vertex_colours=vc)
 
 
-def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]], faces: Optional[Any] = None) -> Mesh:
+def as_mesh(
+    mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]],
+    faces: Optional[Any] = None,
+    max_memory: Optional[Union[int, str]] = None,
+) -> Mesh:
     """A :class:`Mesh` from whatever holds a triangle mesh.
 
     Parameters
@@ -252,6 +256,9 @@ def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]]
         ``faces``.
     faces
         ``(m, 3)`` integer vertex indices, when vertices are given.
+    max_memory
+        For a path: the memory its reading may take (bytes, or ``"2G"``;
+        see :func:`load_mesh`).
 
     Returns
     -------
@@ -276,7 +283,7 @@ def as_mesh(mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]]
         return m
     if faces is None:
         if isinstance(m, (str, os.PathLike)):
-            return load_mesh(os.fspath(m))
+            return load_mesh(os.fspath(m), max_memory=max_memory)
         if isinstance(m, tuple) and len(m) == 2:
             return as_mesh(m[0], m[1])
         if isinstance(getattr(m, "geometry", None), dict):  # a trimesh.Scene (what trimesh.load("x.glb") returns)
@@ -422,7 +429,7 @@ def voxelize(
     >>> grid = topovox.voxelize("bunny.obj", mode="sep6", resolution=64)
     >>> occupancy = np.asarray(grid)
     """
-    mesh = as_mesh(mesh_or_vertices, faces)
+    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory)
     options = dict(locals())
     for k in ("mesh_or_vertices", "faces", "mesh"):
         options.pop(k)
@@ -524,7 +531,7 @@ def voxelize_many(
     failed: Dict[int, str] = {}
     for b, m in enumerate(meshes):
         try:
-            loaded.append(m if isinstance(m, Mesh) else as_mesh(*m) if isinstance(m, tuple) else as_mesh(m))
+            loaded.append(m if isinstance(m, Mesh) else as_mesh(*m) if isinstance(m, tuple) else as_mesh(m, max_memory=max_memory))
         except (ValueError, TypeError, OSError) as e:
             failed[b] = _item_error(b, m, e, on_error)
             loaded.append(None)
@@ -622,7 +629,7 @@ def sdf(
     >>> field = topovox.sdf("bunny.obj", resolution=128, band=3)
     >>> field.save("bunny.vdb")
     """
-    mesh = as_mesh(mesh_or_vertices, faces)
+    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory)
     options = dict(locals())
     for k in ("mesh_or_vertices", "faces", "mesh"):
         options.pop(k)
@@ -899,7 +906,7 @@ def sample(
     >>> s = topovox.sample("bunny.obj", near=500_000, sigma=(0.05, 0.0158),
     ...                    normalize="unit-sphere", seed=1)
     """
-    mesh = as_mesh(mesh_or_vertices, faces)
+    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory)
     options = dict(locals())
     for k in ("mesh_or_vertices", "faces", "mesh"):
         options.pop(k)
@@ -992,7 +999,7 @@ def remesh(
     >>> closed = topovox.remesh("bunny.obj", resolution=256)
     >>> closed.save("bunny-closed.ply")
     """
-    mesh = as_mesh(mesh_or_vertices, faces)
+    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory)
     options = dict(locals())
     for k in ("mesh_or_vertices", "faces", "mesh", "info"):
         options.pop(k)

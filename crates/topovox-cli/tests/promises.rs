@@ -279,6 +279,85 @@ fn max_memory_is_kept_or_the_run_is_refused_before_work() {
     assert!(peak <= 256 << 20, "peak {peak} bytes over the 256 MiB bound");
 }
 
+/// A binary STL soup of `n` triangles of side about 0.01 in the unit cube.
+fn small_soup(path: &Path, n: u32) {
+    let mut b = vec![0u8; 80];
+    b.extend(n.to_le_bytes());
+    let mut x = 0x2545_f491_u64;
+    let mut next = || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for _ in 0..n {
+        b.extend([0u8; 12]);
+        let c = [next(), next(), next()];
+        for _ in 0..3 {
+            for a in c {
+                b.extend(((a + 0.01 * next()) as f32).to_le_bytes());
+            }
+        }
+        b.extend([0u8; 2]);
+    }
+    std::fs::write(path, b).unwrap();
+}
+
+/// The bytes a refusal says a run needs ("needs about 2.3 GiB").
+fn said_need(e: &str) -> u64 {
+    let after = e.split("need about ").nth(1).or_else(|| e.split("needs about ").nth(1)).expect(e);
+    let mut words = after.split_whitespace();
+    let v: f64 = words.next().unwrap().parse().unwrap();
+    let unit = match words.next().unwrap().trim_end_matches(|c: char| !c.is_alphabetic()) {
+        "KiB" => 1u64 << 10,
+        "MiB" => 1 << 20,
+        "GiB" => 1 << 30,
+        _ => 1,
+    };
+    (v * unit as f64) as u64
+}
+
+#[test]
+fn sample_counts_the_meshs_query_and_keeps_its_bound() {
+    let d = folder("sample-memory");
+    let mesh = d.join("soup.stl");
+    small_soup(&mesh, 30_000);
+    let out = d.join("s.npz");
+    let run = |bound: &str| {
+        topovox(&["sample", s(&mesh), "-o", s(&out), "--surface", "20000", "--near", "20000", "--max-memory", bound, "--json"])
+    };
+    // Before #65 a sample counted only its points: this soup's query
+    // (about 2 KiB a triangle) was not counted at all.
+    let e = refused(&run("40M"));
+    assert!(e.contains("triangles need about") && e.contains("query"), "{e}");
+    assert!(!out.exists());
+    let need = said_need(&e);
+    let bound = format!("{}M", need.div_ceil(1 << 20) + 1);
+    let v = succeeded(&run(&bound));
+    let peak = v["peak_memory_bytes"].as_u64().unwrap();
+    assert!(peak <= need + (1 << 20), "peak {peak} bytes over the {need} the estimate said");
+}
+
+#[test]
+fn loading_is_counted_before_the_file_is_parsed() {
+    let d = folder("load-memory");
+    let mesh = d.join("soup.stl");
+    // 15 MB of file, about 80 MB at the reader's peak.
+    small_soup(&mesh, 300_000);
+    for cmd in ["voxelize", "sample", "remesh", "sdf"] {
+        let out = d.join(if cmd == "voxelize" || cmd == "sdf" {
+            "o.npy"
+        } else if cmd == "sample" {
+            "o.npz"
+        } else {
+            "o.ply"
+        });
+        let e = refused(&topovox(&[cmd, s(&mesh), "-o", s(&out), "--max-memory", "40M"]));
+        assert!(e.contains("soup.stl") && e.contains("reading it needs about"), "{cmd}: {e}");
+        assert!(!out.exists(), "{cmd}");
+    }
+}
+
 #[test]
 fn max_memory_is_kept_by_solids_of_open_meshes_or_refused_before_work() {
     let d = folder("memory-solid");

@@ -97,6 +97,15 @@ pub enum ErrorKind {
         /// Bytes available, human-readable.
         available: String,
     },
+    /// Reading the mesh would hold more memory than a read may take
+    /// (counted from the file before parsing).
+    #[error("reading it needs about {need} of memory, more than the {available} a read may take; raise --max-memory or simplify the mesh")]
+    TooLargeToRead {
+        /// Bytes needed, human-readable.
+        need: String,
+        /// Bytes a read may take, human-readable.
+        available: String,
+    },
 }
 
 impl ErrorKind {

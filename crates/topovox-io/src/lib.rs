@@ -20,6 +20,7 @@ pub mod error;
 mod fence;
 mod former_name;
 pub mod gltf;
+mod load_estimate;
 pub mod mesh_out;
 pub mod mesh_report;
 mod meshes;

@@ -40,6 +40,18 @@ pub fn read_regular(path: &Path) -> std::io::Result<Vec<u8>> {
     Ok(out)
 }
 
+/// [`read_regular`], refusing before reading a file longer than `limit`
+/// bytes (the memory a read may take).
+pub(crate) fn read_regular_within(path: &Path, limit: u64) -> Result<Vec<u8>, crate::ErrorKind> {
+    let (file, len) = open_regular(path).map_err(crate::ErrorKind::Read)?;
+    if len > limit {
+        return Err(crate::ErrorKind::TooLargeToRead { need: crate::bytes(len), available: crate::bytes(limit) });
+    }
+    let mut out = Vec::with_capacity(len as usize);
+    std::io::Read::read_to_end(&mut std::io::Read::take(file, len), &mut out).map_err(crate::ErrorKind::Read)?;
+    Ok(out)
+}
+
 /// What a glTF URI names, by RFC 3986: data embedded in the URI, or a file.
 #[derive(Debug, PartialEq, Eq)]
 pub(crate) enum UriTarget {
@@ -144,6 +156,19 @@ pub struct ReadOptions {
     pub up: crate::orient::Up,
     /// Sparse reads: the attribute grids or arrays too. Default: off.
     pub attributes: bool,
+    /// The memory a read may take (`--max-memory`): a mesh whose reading
+    /// would hold more is refused before it is parsed. Default: nine
+    /// tenths of the available memory.
+    pub max_memory: Option<u64>,
+}
+
+impl ReadOptions {
+    /// The memory a read may take: `max_memory`, else nine tenths of the
+    /// available memory (at most the process-wide cap, see
+    /// [`crate::set_dense_read_budget`]).
+    pub fn read_limit(&self) -> u64 {
+        self.max_memory.unwrap_or_else(crate::read_limit)
+    }
 }
 
 /// The model's folder and the files read through it.
@@ -151,6 +176,7 @@ pub(crate) struct Resources {
     base: Option<PathBuf>,
     canonical_base: Option<PathBuf>,
     allow: bool,
+    max_memory: Option<u64>,
     used: Mutex<Vec<PathBuf>>,
 }
 
@@ -158,7 +184,18 @@ impl Resources {
     /// References resolve against `base`; `None` reads no external file.
     pub fn new(base: Option<&Path>, opts: &ReadOptions) -> Resources {
         let canonical_base = base.and_then(|b| std::fs::canonicalize(if b.as_os_str().is_empty() { Path::new(".") } else { b }).ok());
-        Resources { base: base.map(Path::to_path_buf), canonical_base, allow: opts.allow_external_paths, used: Mutex::new(Vec::new()) }
+        Resources {
+            base: base.map(Path::to_path_buf),
+            canonical_base,
+            allow: opts.allow_external_paths,
+            max_memory: opts.max_memory,
+            used: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The memory a read may take (see [`ReadOptions::read_limit`]).
+    pub fn read_limit(&self) -> u64 {
+        self.max_memory.unwrap_or_else(crate::read_limit)
     }
 
     /// The model's folder, if external files may be read at all.
@@ -207,12 +244,9 @@ impl Resources {
         if want > size {
             return Err(format!("{shown} holds {size} bytes, fewer than the {want} its reference declares"));
         }
-        if want > crate::read_limit() {
-            return Err(format!(
-                "{shown} is {} long, more than the {} a read may take",
-                crate::bytes(want),
-                crate::bytes(crate::read_limit())
-            ));
+        let limit = self.read_limit();
+        if want > limit {
+            return Err(format!("{shown} is {} long, more than the {} a read may take", crate::bytes(want), crate::bytes(limit)));
         }
         let mut out = Vec::with_capacity(want as usize);
         std::io::Read::read_to_end(&mut std::io::Read::take(file, want), &mut out)

@@ -10,12 +10,16 @@ use glam::DVec3;
 use crate::error::ErrorKind;
 use crate::mesh_report::{finish, LoadedMesh};
 
+/// True when `bytes` read as ASCII STL: `solid`, then `facet` or
+/// `endsolid` within the first 4 KiB (a binary header may begin `solid`).
+pub(crate) fn looks_ascii(bytes: &[u8]) -> bool {
+    let head = &bytes[..bytes.len().min(4096)];
+    bytes.trim_ascii_start().starts_with(b"solid") && (head.windows(5).any(|w| w == b"facet") || head.windows(8).any(|w| w == b"endsolid"))
+}
+
 /// Parses STL bytes (ASCII or binary).
 pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
-    let head = &bytes[..bytes.len().min(4096)];
-    let looks_ascii = bytes.trim_ascii_start().starts_with(b"solid")
-        && (head.windows(5).any(|w| w == b"facet") || head.windows(8).any(|w| w == b"endsolid"));
-    if !looks_ascii {
+    if !looks_ascii(bytes) {
         if bytes.len() < 84 {
             return Err(ErrorKind::malformed("STL", format!("binary file of {} bytes is shorter than its 84-byte header", bytes.len())));
         }

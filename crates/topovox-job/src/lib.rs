@@ -38,7 +38,7 @@ pub mod table;
 pub use error::{JobError, Result};
 pub use grid::{Fit, GridOptions, GridRequest};
 pub use job::{Done, Keep, Made, SdfDone, SdfJob, VoxelizeJob, Voxelizer};
-pub use memory::{available_memory, budget, bytes, check_memory, dense_fits, parse_size, peak_memory};
+pub use memory::{available_memory, budget, bytes, check_memory, dense_fits, parse_size, peak_memory, query_bytes};
 pub use options::{ExportOptions, JobOptions, RunOptions, KEYWORDS};
 pub use plan::{
     auto_method, gpu_has, resolve_method, Fill, GpuPath, Hollow, Method, Mode, Plan, Request, SolidMethod, SolidPlan, SurfaceMethod,

@@ -194,7 +194,7 @@ impl ExportOptions {
 impl RunOptions {
     /// How meshes are read.
     pub fn read_options(&self) -> topovox_io::ReadOptions {
-        topovox_io::ReadOptions { allow_external_paths: self.allow_external_paths, ..Default::default() }
+        topovox_io::ReadOptions { allow_external_paths: self.allow_external_paths, max_memory: self.max_memory, ..Default::default() }
     }
 }
 

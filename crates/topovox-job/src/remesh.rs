@@ -274,11 +274,13 @@ const SLAB_BYTES: u64 = 1 << 30;
 /// and what the budget leaves, else as many layers as keep twice their
 /// share of the triangles (surfaces crowd into some layers) within that,
 /// at least 8, plus the writer's two scratch sections in memory; and a
-/// fifth more for the allocator's heap. Measured peaks on the bunny are
+/// fifth more for the allocator's heap. A caller that keeps the output
+/// (`held`: [`remesh`], Python's `topovox.remesh`) holds it whole, with
+/// its copy handed on (48 bytes a triangle). Measured peaks on the bunny are
 /// 0.5–0.9 of the estimate from 128 to 2048 (see BENCHMARKS.md; the 2048
 /// run once peaked at 8.4 GiB where it claimed 5.2, before the surface
 /// was streamed and triangles counted as now).
-fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec) -> Result<u32> {
+fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec, held: bool) -> Result<u32> {
     let cells = grid.voxel_count();
     let blocky = req.surface == SurfaceKind::Blocky;
     let grids = if req.inside == Inside::Wrap { 3 } else { 1 } + if blocky { 8 } else { 0 };
@@ -288,8 +290,10 @@ fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec)
     let triangles = area / (h.x * h.y).min(h.y * h.z).min(h.x * h.z) * per_face;
     let measured = req.inside == Inside::Wrap || req.check;
     let certified = req.check || cfg!(debug_assertions) || req.simplify > 0.0;
-    let per_triangle =
-        bytes_each + if measured { 2 * std::mem::size_of::<topovox::distance::Piece>() + 128 } else { 0 } + if certified { 150 } else { 0 };
+    let per_triangle = bytes_each
+        + if measured { 2 * std::mem::size_of::<topovox::distance::Piece>() + 128 } else { 0 }
+        + if certified { 150 } else { 0 }
+        + if held { 48 } else { 0 };
     let surface = triangles * per_triangle as f64;
     let fixed = (cells / 8).saturating_mul(grids + 1).saturating_add(pieces.items.len() as u64 * 1000 + (24 << 20));
     let limit = budget(req.max_memory);
@@ -301,7 +305,7 @@ fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec)
     let with_heap = |b: u64| b.saturating_add(b / 5);
     // The whole surface at once, when it fits in a slab and the budget.
     let whole = fixed.saturating_add(surface as u64);
-    if !req.streams() || (surface <= SLAB_BYTES as f64 && whole <= usable) {
+    if held || !req.streams() || (surface <= SLAB_BYTES as f64 && whole <= usable) {
         refuse_past(name, grid, with_heap(whole), limit)?;
         return Ok(u32::MAX);
     }
@@ -385,10 +389,11 @@ struct Closed {
 
 /// The inside voxels of `mesh` by `req`'s rule, small parts dropped; an
 /// error when the grid does not fit or nothing is inside.
-fn close(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, pieces: &Pieces, stop: &Stop) -> Result<Closed> {
+/// `held`: the caller keeps the whole output in memory (no streaming).
+fn close(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, pieces: &Pieces, held: bool, stop: &Stop) -> Result<Closed> {
     let grid = req.grid.fit(&mesh.bounds())?;
     check_precision(name, req, &grid)?;
-    let thickness = check_fits(name, req, pieces, &grid)?;
+    let thickness = check_fits(name, req, pieces, &grid, held)?;
     let t = Instant::now();
     let (bits, method, solid, warnings) = inside(mesh, name, req, &grid, stop)?;
     let (bits, parts, dropped_parts) = surface::drop_small_parts(bits, req.min_part);
@@ -451,7 +456,7 @@ pub fn remesh(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, stop: Option<&
     // two-sided distance first needs it.
     let tree = std::cell::OnceCell::new();
     let input_tree = || tree.get_or_init(|| Hierarchy::new(&pieces));
-    let mut c = close(mesh, name, req, &pieces, stop)?;
+    let mut c = close(mesh, name, req, &pieces, true, stop)?;
     let t = Instant::now();
     let mut out = TriMesh::default();
     let made = surface_parts(&c, req, &pieces, &input_tree, stop, &mut |p: surface::Part| {
@@ -489,7 +494,7 @@ fn remesh_streamed(
     stop: &Stop,
 ) -> Result<(RemeshMade, f64)> {
     let pieces = Pieces::of(mesh).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
-    let c = close(mesh, name, req, &pieces, stop)?;
+    let c = close(mesh, name, req, &pieces, false, stop)?;
     let tree = std::cell::OnceCell::new();
     let input_tree = || tree.get_or_init(|| Hierarchy::new(&pieces));
     let t = Instant::now();

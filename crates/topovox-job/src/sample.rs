@@ -138,18 +138,23 @@ pub struct Sampled {
 const BYTES_PER_SAMPLE: u64 = 188;
 
 /// Draws `options`' samples of `loaded` (`name` in errors), refusing
-/// before any work a count that does not fit in `--max-memory` (default:
-/// 90 % of the memory available). Surface points carry the mesh's colour
+/// before any work a count and a mesh that do not fit in `--max-memory`
+/// (default: 90 % of the memory available; see
+/// [`crate::memory::query_bytes`]). Surface points carry the mesh's colour
 /// where it has colours ([`topovox::attributes::carry::colour_at`]).
 pub fn sample(loaded: &topovox_io::LoadedMesh, name: &str, options: &SampleOptions) -> Result<Sampled> {
     let mesh = loaded.mesh.as_ref();
     let o = &options.draw;
     let total = o.surface + o.near + o.uniform;
-    let (need, budget) = (total.saturating_mul(BYTES_PER_SAMPLE), crate::memory::budget(options.run.max_memory));
+    let query = crate::memory::query_bytes(mesh);
+    let need = total.saturating_mul(BYTES_PER_SAMPLE).saturating_add(query);
+    let budget = crate::memory::budget(options.run.max_memory);
     if need > budget {
         return Err(JobError::failed(format!(
-            "{total} samples need about {} of memory, more than the {} this run may use; draw fewer or raise --max-memory",
+            "{total} samples of {} triangles need about {} of memory (the mesh's query {}), more than the {} this run may use; draw fewer, simplify the mesh or raise --max-memory",
+            mesh.triangles.len(),
             crate::memory::bytes(need),
+            crate::memory::bytes(query),
             crate::memory::bytes(budget)
         )));
     }

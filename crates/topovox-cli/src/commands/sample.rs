@@ -36,6 +36,7 @@ pub fn run(a: &SampleArgs) -> Result<()> {
             "input": name,
             "output": a.output.display().to_string(),
             "format": "npz",
+            "peak_memory_bytes": topovox_job::peak_memory(),
             "mesh": {"vertices": loaded.report.vertices, "triangles": loaded.report.triangles, "segments": loaded.report.segments},
             "warnings": loaded.warnings,
         });
