@@ -3,11 +3,16 @@
 //! the counts its file declares or its lines; a lying header stays the
 //! reader's own error.
 
-mod common;
+use std::path::{Path, PathBuf};
 
-use std::path::Path;
+/// A fresh folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("topovox-load-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
 
-use common::scratch;
 use topovox_io::{read_mesh, ErrorKind, ReadOptions};
 
 /// A binary STL of `n` triangles (no shared vertices: a soup).

@@ -71,7 +71,7 @@ fn base64(bytes: &[u8]) -> String {
     out
 }
 
-const ALLOW: ReadOptions = ReadOptions { allow_external_paths: true, up: topovox_io::orient::Up::Y, attributes: false };
+const ALLOW: ReadOptions = ReadOptions { allow_external_paths: true, up: topovox_io::orient::Up::Y, attributes: false, max_memory: None };
 
 /// Reads `text` as `dir/model/NAME.gltf` on a thread, failing the test if
 /// it takes a minute (a FIFO or a device would hang an unguarded read).

@@ -140,7 +140,7 @@ const BYTES_PER_SAMPLE: u64 = 188;
 /// Draws `options`' samples of `loaded` (`name` in errors), refusing
 /// before any work a count and a mesh that do not fit in `--max-memory`
 /// (default: 90 % of the memory available; see
-/// [`crate::memory::query_bytes`]). Surface points carry the mesh's colour
+/// [`crate::query_bytes`]). Surface points carry the mesh's colour
 /// where it has colours ([`topovox::attributes::carry::colour_at`]).
 pub fn sample(loaded: &topovox_io::LoadedMesh, name: &str, options: &SampleOptions) -> Result<Sampled> {
     let mesh = loaded.mesh.as_ref();
