@@ -14,7 +14,19 @@
 //! becomes `k − 2` triangles and is counted as one line: such files can
 //! take more than the estimate (about 40 bytes per extra triangle).
 
-use crate::meshes::MeshFormat;
+/// How a format's reading is counted (the reader's module maps its
+/// formats here, so this module needs none of them).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Counted {
+    /// STL: a binary file's declared triangles, or an ASCII file's lines.
+    Stl,
+    /// PLY: a binary file's declared elements, or an ASCII file's lines.
+    Ply,
+    /// OBJ, OFF, polylines: lines.
+    Lines,
+    /// glTF: counted by its reader from the accessors.
+    Gltf,
+}
 
 /// Estimates below this are not checked: reading `/proc/meminfo` for each
 /// of a hundred thousand small meshes would cost more than reading them.
@@ -42,26 +54,26 @@ mod per {
 /// About the bytes reading `bytes` as `format` holds at its peak, the
 /// file's own bytes included (glTF: the file's bytes only; see the module
 /// doc).
-pub(crate) fn peak(format: MeshFormat, bytes: &[u8]) -> u64 {
+pub(crate) fn peak(format: Counted, bytes: &[u8]) -> u64 {
     let file = bytes.len() as u64;
     let lines = || memchr::memchr_iter(b'\n', bytes).count() as u64 + 1;
     let extra = match format {
-        MeshFormat::Stl => match binary_stl_triangles(bytes) {
+        Counted::Stl => match binary_stl_triangles(bytes) {
             Some(t) => t.saturating_mul(per::STL_TRIANGLE),
             None => lines().saturating_mul(per::STL_TEXT_LINE),
         },
-        MeshFormat::Ply => match ply_counts(bytes) {
+        Counted::Ply => match ply_counts(bytes) {
             Some((v, f)) => v.min(file).saturating_mul(per::PLY_VERTEX).saturating_add(f.min(file).saturating_mul(per::PLY_FACE)),
             None => lines().saturating_mul(per::PLY_TEXT_LINE),
         },
-        MeshFormat::Obj | MeshFormat::Off | MeshFormat::Polyline => lines().saturating_mul(per::TEXT_LINE),
-        MeshFormat::Gltf => 0,
+        Counted::Lines => lines().saturating_mul(per::TEXT_LINE),
+        Counted::Gltf => 0,
     };
     file.saturating_add(extra)
 }
 
 /// Fails when reading `bytes` as `format` would hold more than `limit`.
-pub(crate) fn check(format: MeshFormat, bytes: &[u8], limit: impl FnOnce() -> u64) -> Result<(), crate::ErrorKind> {
+pub(crate) fn check(format: Counted, bytes: &[u8], limit: impl FnOnce() -> u64) -> Result<(), crate::ErrorKind> {
     let need = peak(format, bytes);
     if need < UNCHECKED {
         return Ok(());

@@ -53,7 +53,7 @@ pub fn read_mesh(path: &Path, opts: &ReadOptions) -> Result<LoadedMesh, IoError>
     let bytes = resources::read_regular_within(path, opts.read_limit()).map_err(|kind| IoError::new(path, kind))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let res = resources::Resources::new(Some(base), opts);
-    crate::load_estimate::check(format, &bytes, || res.read_limit()).map_err(|kind| IoError::new(path, kind))?;
+    crate::load_estimate::check(counted(format), &bytes, || res.read_limit()).map_err(|kind| IoError::new(path, kind))?;
     let mut loaded = read_with(&bytes, format, &res).map_err(|kind| IoError::new(path, kind))?;
     loaded.sources.push(std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()));
     loaded.sources.extend(res.used());
@@ -65,6 +65,17 @@ pub fn read_mesh(path: &Path, opts: &ReadOptions) -> Result<LoadedMesh, IoError>
 /// inside that folder only; `None` disables them.
 pub fn read_mesh_bytes(bytes: &[u8], format: MeshFormat, base_dir: Option<&Path>) -> Result<LoadedMesh, ErrorKind> {
     read_with(bytes, format, &resources::Resources::new(base_dir, &ReadOptions::default()))
+}
+
+/// How reading `format` is counted before parsing.
+fn counted(format: MeshFormat) -> crate::load_estimate::Counted {
+    use crate::load_estimate::Counted;
+    match format {
+        MeshFormat::Stl => Counted::Stl,
+        MeshFormat::Ply => Counted::Ply,
+        MeshFormat::Gltf => Counted::Gltf,
+        MeshFormat::Obj | MeshFormat::Off | MeshFormat::Polyline => Counted::Lines,
+    }
 }
 
 fn read_with(bytes: &[u8], format: MeshFormat, res: &resources::Resources) -> Result<LoadedMesh, ErrorKind> {
