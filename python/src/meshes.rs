@@ -291,23 +291,14 @@ pub(crate) fn load_mesh(
     allow_external_paths: bool,
     max_memory: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Mesh> {
-    let max_memory = max_memory.filter(|m| !m.is_none()).map(memory_size).transpose()?;
-    let p = path.clone();
-    let read = move || topovox_io::read_mesh(&p, &topovox_io::ReadOptions { allow_external_paths, max_memory, ..Default::default() });
+    // The job's own option parses max_memory, as for every other call.
+    let mut run = topovox_job::RunOptions { allow_external_paths, ..Default::default() };
+    if let Some(m) = max_memory.filter(|m| !m.is_none()) {
+        topovox_job::table::Table::set_named(&mut run, "max_memory", &crate::options::option_value("max_memory", m)?)
+            .map_err(crate::errors::py_err)?;
+    }
+    let (p, opts) = (path.clone(), run.read_options());
+    let read = move || topovox_io::read_mesh(&p, &opts);
     let loaded = crate::interrupt::interruptible_read(py, read)?.map_err(io_err)?;
     Ok(Mesh { inner: Arc::new(loaded), path: Some(path) })
-}
-
-/// A memory size given as bytes (an int) or as text (`"2G"`).
-fn memory_size(v: &Bound<'_, PyAny>) -> PyResult<u64> {
-    if let Ok(n) = v.extract::<u64>() {
-        return Ok(n);
-    }
-    let text: String = v.extract().map_err(|_| {
-        crate::errors::value_err(format!(
-            "max_memory takes bytes or a size such as \"2G\", not {}",
-            v.repr().map(|r| r.to_string()).unwrap_or_default()
-        ))
-    })?;
-    topovox_job::parse_size(&text).map_err(crate::errors::py_err)
 }

@@ -44,6 +44,12 @@ pub fn bytes(n: u64) -> String {
     }
 }
 
+/// Reads that need less than this are not checked against the available
+/// memory (every machine topovox runs on has that much): reading `/proc`
+/// for each of a hundred thousand small files would cost more than
+/// reading them.
+pub(crate) const UNCHECKED_BYTES: u64 = 64 << 20;
+
 /// The most memory a dense read may take, set by [`set_dense_read_budget`]
 /// (0: nine tenths of the available memory).
 static DENSE_READ_BUDGET: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
@@ -64,8 +70,8 @@ pub(crate) fn dense_grid(dims: [u32; 3]) -> Result<topovox::DenseBits, ErrorKind
     // In u128: three u32 extents overflow u64.
     let need = u64::try_from((dims[0] as u128).div_ceil(64) * 8 * dims[1] as u128 * dims[2] as u128).unwrap_or(u64::MAX);
     let budget = DENSE_READ_BUDGET.load(std::sync::atomic::Ordering::Relaxed);
-    // Small grids are never refused: reading /proc per file costs more.
-    if need > 64 << 20 || (budget != 0 && need > budget) {
+    // Small grids are never refused (see UNCHECKED_BYTES).
+    if need > UNCHECKED_BYTES || (budget != 0 && need > budget) {
         let limit = read_limit();
         if need > limit {
             return Err(ErrorKind::TooLarge { dims, need: bytes(need), available: bytes(limit) });

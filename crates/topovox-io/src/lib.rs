@@ -52,7 +52,7 @@ pub mod vti;
 pub mod zarr;
 
 pub use budget::{available_memory, bytes, set_dense_read_budget};
-pub(crate) use budget::{dense_grid, read_limit};
+pub(crate) use budget::{dense_grid, read_limit, UNCHECKED_BYTES};
 pub use error::{ErrorKind, IoError};
 pub use fence::{fenced, panic_is_fenced};
 pub use mesh_report::{validate_mesh, LoadedMesh, MeshReport};

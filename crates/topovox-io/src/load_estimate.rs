@@ -28,10 +28,6 @@ pub(crate) enum Counted {
     Gltf,
 }
 
-/// Estimates below this are not checked: reading `/proc/meminfo` for each
-/// of a hundred thousand small meshes would cost more than reading them.
-const UNCHECKED: u64 = 64 << 20;
-
 /// Bytes held per element at the peak of each reader beyond the file's
 /// bytes, measured on 10⁶-triangle grids and soups (2026-12-02, `topovox
 /// info` peak resident size) and rounded up.
@@ -74,8 +70,13 @@ pub(crate) fn peak(format: Counted, bytes: &[u8]) -> u64 {
 
 /// Fails when reading `bytes` as `format` would hold more than `limit`.
 pub(crate) fn check(format: Counted, bytes: &[u8], limit: impl FnOnce() -> u64) -> Result<(), crate::ErrorKind> {
-    let need = peak(format, bytes);
-    if need < UNCHECKED {
+    refuse_past(peak(format, bytes), limit)
+}
+
+/// Fails when a read needs more than `limit` bytes; needs below
+/// [`crate::UNCHECKED_BYTES`] are not checked (nor `limit` computed).
+pub(crate) fn refuse_past(need: u64, limit: impl FnOnce() -> u64) -> Result<(), crate::ErrorKind> {
+    if need < crate::UNCHECKED_BYTES {
         return Ok(());
     }
     let available = limit();

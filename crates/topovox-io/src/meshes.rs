@@ -50,7 +50,7 @@ pub fn read_mesh(path: &Path, opts: &ReadOptions) -> Result<LoadedMesh, IoError>
     let format = MeshFormat::from_extension(ext).ok_or_else(|| {
         IoError::new(path, ErrorKind::UnknownFormat { ext: ext.to_string(), expected: "obj, stl, ply, gltf, glb, off, lines" })
     })?;
-    let bytes = resources::read_regular_within(path, opts.read_limit()).map_err(|kind| IoError::new(path, kind))?;
+    let bytes = resources::read_regular_within(path, opts).map_err(|kind| IoError::new(path, kind))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let res = resources::Resources::new(Some(base), opts);
     crate::load_estimate::check(counted(format), &bytes, || res.read_limit()).map_err(|kind| IoError::new(path, kind))?;

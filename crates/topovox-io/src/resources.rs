@@ -35,21 +35,23 @@ pub fn open_regular(path: &Path) -> std::io::Result<(File, u64)> {
 /// (see [`open_regular`]); never more bytes than it had when opened.
 pub fn read_regular(path: &Path) -> std::io::Result<Vec<u8>> {
     let (file, len) = open_regular(path)?;
+    read_at_most(file, len)
+}
+
+/// The first `len` bytes of `file` (fewer if it ends first).
+fn read_at_most(file: File, len: u64) -> std::io::Result<Vec<u8>> {
     let mut out = Vec::with_capacity(len as usize);
     std::io::Read::read_to_end(&mut std::io::Read::take(file, len), &mut out)?;
     Ok(out)
 }
 
-/// [`read_regular`], refusing before reading a file longer than `limit`
-/// bytes (the memory a read may take).
-pub(crate) fn read_regular_within(path: &Path, limit: u64) -> Result<Vec<u8>, crate::ErrorKind> {
+/// [`read_regular`], refusing before reading a file longer than the
+/// memory a read may take (by the rule of the load estimate,
+/// `load_estimate::refuse_past`).
+pub(crate) fn read_regular_within(path: &Path, opts: &ReadOptions) -> Result<Vec<u8>, crate::ErrorKind> {
     let (file, len) = open_regular(path).map_err(crate::ErrorKind::Read)?;
-    if len > limit {
-        return Err(crate::ErrorKind::TooLargeToRead { need: crate::bytes(len), available: crate::bytes(limit) });
-    }
-    let mut out = Vec::with_capacity(len as usize);
-    std::io::Read::read_to_end(&mut std::io::Read::take(file, len), &mut out).map_err(crate::ErrorKind::Read)?;
-    Ok(out)
+    crate::load_estimate::refuse_past(len, || opts.read_limit())?;
+    read_at_most(file, len).map_err(crate::ErrorKind::Read)
 }
 
 /// What a glTF URI names, by RFC 3986: data embedded in the URI, or a file.
@@ -175,8 +177,7 @@ impl ReadOptions {
 pub(crate) struct Resources {
     base: Option<PathBuf>,
     canonical_base: Option<PathBuf>,
-    allow: bool,
-    max_memory: Option<u64>,
+    opts: ReadOptions,
     used: Mutex<Vec<PathBuf>>,
 }
 
@@ -184,18 +185,12 @@ impl Resources {
     /// References resolve against `base`; `None` reads no external file.
     pub fn new(base: Option<&Path>, opts: &ReadOptions) -> Resources {
         let canonical_base = base.and_then(|b| std::fs::canonicalize(if b.as_os_str().is_empty() { Path::new(".") } else { b }).ok());
-        Resources {
-            base: base.map(Path::to_path_buf),
-            canonical_base,
-            allow: opts.allow_external_paths,
-            max_memory: opts.max_memory,
-            used: Mutex::new(Vec::new()),
-        }
+        Resources { base: base.map(Path::to_path_buf), canonical_base, opts: *opts, used: Mutex::new(Vec::new()) }
     }
 
     /// The memory a read may take (see [`ReadOptions::read_limit`]).
     pub fn read_limit(&self) -> u64 {
-        self.max_memory.unwrap_or_else(crate::read_limit)
+        self.opts.read_limit()
     }
 
     /// The model's folder, if external files may be read at all.
@@ -214,7 +209,7 @@ impl Resources {
         let Ok(real) = std::fs::canonicalize(&joined) else {
             return Ok(joined);
         };
-        if !self.allow && !self.canonical_base.as_ref().is_some_and(|b| real.starts_with(b)) {
+        if !self.opts.allow_external_paths && !self.canonical_base.as_ref().is_some_and(|b| real.starts_with(b)) {
             return Err(format!(
                 "{} is outside the model's folder {} and is not read (--allow-external-paths reads it)",
                 reference.display(),
@@ -248,9 +243,7 @@ impl Resources {
         if want > limit {
             return Err(format!("{shown} is {} long, more than the {} a read may take", crate::bytes(want), crate::bytes(limit)));
         }
-        let mut out = Vec::with_capacity(want as usize);
-        std::io::Read::read_to_end(&mut std::io::Read::take(file, want), &mut out)
-            .map_err(|e| format!("{shown} could not be read ({e})"))?;
+        let out = read_at_most(file, want).map_err(|e| format!("{shown} could not be read ({e})"))?;
         if (out.len() as u64) < want {
             return Err(format!("{shown} ended after {} of its {want} bytes", out.len()));
         }

@@ -39,6 +39,10 @@ pub fn check_memory(grid: &GridSpec, budget: u64, why: &str) -> Result<()> {
     )))
 }
 
+/// What every estimate adds for the process itself: the binary, the mesh
+/// as read, one tile and the writer's buffers.
+pub(crate) const PROCESS_BYTES: u64 = 24 << 20;
+
 /// Bytes per brick a tiled run holds: the 64-byte brick and its 8-byte key
 /// (the 4-byte index that puts them in order comes and goes within the
 /// base below). With the per-triangle and base terms of
@@ -74,7 +78,7 @@ pub fn tiled_estimate(mesh: MeshRef<'_>, grid: &GridSpec) -> TiledEstimate {
     // at most, bounded here by the grid's longest axis per segment.
     let segments = mesh.segments.len() as u64 * dims.iter().copied().max().unwrap_or(1);
     let prims = (mesh.triangles.len() + mesh.segments.len()) as u64 * 88 + mesh.positions.len() as u64 * 24;
-    TiledEstimate { bricks: bricks + segments, bytes: (bricks + segments) * BYTES_PER_BRICK + prims + (24 << 20) }
+    TiledEstimate { bricks: bricks + segments, bytes: (bricks + segments) * BYTES_PER_BRICK + prims + PROCESS_BYTES }
 }
 
 /// Bytes a point query holds per triangle of its mesh: the distance
@@ -91,7 +95,7 @@ const QUERY_BYTES_PER_TRIANGLE: u64 = 2304;
 pub fn query_bytes(mesh: MeshRef<'_>) -> u64 {
     let triangles = (mesh.triangles.len() + mesh.segments.len()) as u64;
     let vertices = mesh.positions.len() as u64;
-    triangles.saturating_mul(QUERY_BYTES_PER_TRIANGLE + 12).saturating_add(vertices.saturating_mul(48)).saturating_add(24 << 20)
+    triangles.saturating_mul(QUERY_BYTES_PER_TRIANGLE + 12).saturating_add(vertices.saturating_mul(48)).saturating_add(PROCESS_BYTES)
 }
 
 /// Bytes per triangle a sparse solid holds beyond a tiled surface: the

@@ -295,7 +295,7 @@ fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec,
         + if certified { 150 } else { 0 }
         + if held { 48 } else { 0 };
     let surface = triangles * per_triangle as f64;
-    let fixed = (cells / 8).saturating_mul(grids + 1).saturating_add(pieces.items.len() as u64 * 1000 + (24 << 20));
+    let fixed = (cells / 8).saturating_mul(grids + 1).saturating_add(pieces.items.len() as u64 * 1000 + crate::memory::PROCESS_BYTES);
     let limit = budget(req.max_memory);
     let layers = if blocky { 2 * grid.dims()[2] } else { grid.dims()[2] };
     // What the allocator's heap keeps beside what is live: a fifth (see
