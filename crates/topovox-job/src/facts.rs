@@ -3,6 +3,7 @@
 //! they are, so the summaries keep their keys).
 
 use serde::Serialize;
+use topovox::query::orient::OrientReport;
 use topovox::voxelize::solid::SolidReport;
 use topovox::voxelize::winding::WindingReport;
 
@@ -21,6 +22,48 @@ pub struct SolidFacts {
     /// The connectivity `--hollow` kept (6 or 26).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hollow: Option<u8>,
+    /// The rule that decided inside: `parity`, `nonzero winding` (a mesh
+    /// closed once oriented), `generalized winding` (open) or `none
+    /// (sheets)` (wrap around sheets alone).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inside_rule: Option<&'static str>,
+    /// What orienting the mesh found and repaired (the winding rules).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub orientation: Option<OrientFacts>,
+}
+
+/// What [`topovox::query::orient`] found and repaired before the winding
+/// rules decided inside.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct OrientFacts {
+    /// Parts (triangles joined by manifold edges) with area.
+    pub parts: u64,
+    /// Of them closed.
+    pub closed_parts: u64,
+    /// Closed parts inside an odd number of others: cavities.
+    pub nested_parts: u64,
+    /// Open parts that enclose no volume.
+    pub sheets: u64,
+    /// Sheets left out of the inside decision beside parts with volume.
+    pub sheets_left_out: u64,
+    /// Triangles turned round.
+    pub faces_reoriented: u64,
+    /// Manifold edges left inconsistent (parts that cannot be oriented).
+    pub unorientable_edges: u64,
+}
+
+impl From<OrientReport> for OrientFacts {
+    fn from(r: OrientReport) -> OrientFacts {
+        OrientFacts {
+            parts: r.parts,
+            closed_parts: r.closed_parts,
+            nested_parts: r.nested_parts,
+            sheets: r.sheets,
+            sheets_left_out: r.sheets_left_out,
+            faces_reoriented: r.faces_reoriented,
+            unorientable_edges: r.inconsistent_edges,
+        }
+    }
 }
 
 /// A solid's method facts: a flood fill's shell, or a mesh test's.
@@ -96,7 +139,7 @@ impl SolidMade {
 impl SolidFacts {
     /// Facts with no variant applied yet.
     pub fn new(made: SolidMade) -> SolidFacts {
-        SolidFacts { made, full_bricks: None, surface: None, hollow: None }
+        SolidFacts { made, full_bricks: None, surface: None, hollow: None, inside_rule: None, orientation: None }
     }
 
     /// Whether the mesh was found closed (`None` for a flood fill, which

@@ -45,7 +45,7 @@ pub use plan::{
     GPU_AUTO_MIN_SIDE,
 };
 pub use run::{attributes, check_attributes_carried, every_attribute, voxelize, Voxelized, Voxels, ATTRIBUTE_BYTES_PER_VOXEL};
-pub use solid::Outcome as SolidOutcome;
+pub use solid::{has_volume, Outcome as SolidOutcome};
 pub use table::{Keyword, OptionValue, Table};
 pub use topovox::attributes::ColourRule;
 pub use topovox::choice::{Choice, Switch, UnknownChoice};

@@ -360,6 +360,11 @@ fn inside(
     };
     let plan = SolidPlan { method, surface: None, hollow: None };
     let opts = Options { stop: Some(stop), ..Default::default() };
+    if req.inside == Inside::Wrap {
+        if let Some(wrapped) = wrap_sheets(mesh, grid, &opts) {
+            return Ok(wrapped);
+        }
+    }
     let solid = crate::solid::run(&plan, mesh, name, grid, &opts)?;
     if stop.requested() {
         return Err(JobError::Interrupted);
@@ -370,6 +375,23 @@ fn inside(
     let cover = voxelize::fast(voxelize::Mode::Cover, mesh, grid, &opts).0.to_dense();
     // Wrap closes open meshes on purpose: parity's warning does not apply.
     Ok((surface::wrap(&solid.bits, &cover), format!("{}+wrap", solid.method), solid.facts, Vec::new()))
+}
+
+/// Wrap on a mesh whose every part is a sheet: no inside (the winding
+/// number's blobs beside a sheet are not volume), so the shell closes
+/// around the grown cover alone; `None` when some part encloses volume.
+fn wrap_sheets(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> Option<(DenseBits, String, SolidFacts, Vec<String>)> {
+    let report = topovox::query::orient::orient(mesh).report;
+    if report.parts == 0 || report.encloses_volume() {
+        return None;
+    }
+    let cover = voxelize::fast(voxelize::Mode::Cover, mesh, grid, opts).0.to_dense();
+    let nothing = DenseBits::new(grid.dims());
+    let exact = crate::facts::ExactFacts { checked_voxels: 0, changed_voxels: 0 };
+    let mut facts = SolidFacts::new(crate::facts::SolidMade::mesh(&Default::default(), None, exact));
+    facts.inside_rule = Some("none (sheets)");
+    facts.orientation = Some(report.into());
+    Some((surface::wrap(&nothing, &cover), "wrap".to_string(), facts, Vec::new()))
 }
 
 /// The inside voxels a surface closes around, on their grid.

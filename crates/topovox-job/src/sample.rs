@@ -169,6 +169,7 @@ pub fn sample(loaded: &topovox_io::LoadedMesh, name: &str, options: &SampleOptio
     let moved: Vec<DVec3> = mesh.positions.iter().map(|&p| (p - offset) * scale).collect();
     let m = MeshRef { positions: &moved, triangles: mesh.triangles, segments: mesh.segments };
     let q = Query::new(m, o.sign.into()).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+    crate::solid::has_volume(name, q.facts().orientation)?;
     let built = t.elapsed().as_secs_f64();
     let bounds = match &o.bounds {
         Some(b) => (DVec3::new(b[0], b[1], b[2]), DVec3::new(b[3], b[4], b[5])),

@@ -6,6 +6,7 @@ use topovox::grid::sparse::SparseBricks;
 use topovox::voxelize::{self, fill, solid, winding, Options, Stop};
 use topovox::{GridSpec, MeshRef};
 
+use topovox::query::orient::{orient, OrientReport, Oriented};
 use topovox::query::{Inside, Sign};
 
 use crate::error::{JobError, Result};
@@ -51,68 +52,7 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         }
         (bits, "flood", SolidFacts::new(SolidMade::Flood { shell: surface.name(), shell_voxels: rep.shell, enclosed_voxels: rep.enclosed }))
     } else {
-        // Snapped once: the closedness test and whichever method runs share it.
-        let snapped = topovox::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
-        let inspect = solid::inspect(&snapped);
-        let dims = grid.dims();
-        // Closed by the vertices as given: the rule the point queries use.
-        let watertight = topovox::query::inside::watertight(&topovox::query::inside::triangles(mesh));
-        let mut near_half = Vec::new();
-        let open = || {
-            format!(
-                "{name}: not closed and consistently oriented ({} boundary edges, {} inconsistently oriented edges)",
-                inspect.boundary_edges, inspect.unbalanced_edges
-            )
-        };
-        let mut gwn = None;
-        let (bits, rep, method) = match plan.method {
-            SolidMethod::Parity => {
-                if !watertight {
-                    warnings.push(format!("{}: ray parity may streak through holes", open()));
-                }
-                let (b, r) = solid::parity_snapped(&snapped, dims, stop);
-                (b, r, "parity")
-            }
-            SolidMethod::Auto if watertight => {
-                let (b, r) = solid::parity_snapped(&snapped, dims, stop);
-                (b, r, "parity")
-            }
-            SolidMethod::Winding if watertight => {
-                let (b, r) = solid::winding_closed_snapped(&snapped, dims, stop);
-                (b, r, "winding")
-            }
-            SolidMethod::Auto | SolidMethod::Winding => {
-                let (b, r) = winding::winding_snapped(&snapped, dims, stop);
-                gwn = Some(WindingFacts::from(&r));
-                near_half = r.near_half;
-                (b, r.solid, "winding")
-            }
-            SolidMethod::Reference if watertight => {
-                let (b, r) = solid::reference::solid(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
-                (b, r, "reference")
-            }
-            SolidMethod::Reference => {
-                let b = winding::reference::winding(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
-                let mut r = inspect;
-                r.voxels = b.count();
-                (b, r, "reference")
-            }
-            SolidMethod::GpuParity => {
-                if !watertight {
-                    warnings.push(format!("{}: ray parity may streak through holes", open()));
-                }
-                let (b, r) = gpu_parity(mesh, grid)?;
-                (b, r, "gpu-parity")
-            }
-            SolidMethod::Flood => unreachable!("handled above"),
-        };
-        let mut bits = bits;
-        // The references decide by the winding number (the definition).
-        let rule = if method == "parity" || method == "gpu-parity" { Sign::Parity } else { Sign::Winding };
-        let (checked, fixes) = exact_fixes(mesh, grid, (rule, watertight), &near_half, stop, |[i, j, k]| bits.get(i, j, k));
-        let changed = apply(&mut bits, &fixes);
-        let exact = ExactFacts { checked_voxels: checked, changed_voxels: changed as u64 };
-        (bits, method, SolidFacts::new(SolidMade::mesh(&rep, gwn, exact)))
+        mesh_solid(plan.method, mesh, name, grid, stop, &mut warnings)?
     };
     if plan.surface.is_some() && plan.method != SolidMethod::Flood {
         let surface = plan.surface.unwrap_or(voxelize::Mode::Cover);
@@ -125,6 +65,117 @@ pub fn run(plan: &SolidPlan, mesh: MeshRef<'_>, name: &str, grid: &GridSpec, opt
         facts.hollow = Some(connectivity(conn));
     }
     Ok(Outcome { bits, method, facts, warnings })
+}
+
+/// The mesh the winding rules decide on: `mesh` turned by
+/// [`topovox::query::orient`] (`None` for parity and flood fills, which do
+/// not depend on orientation); refused, in one line naming `--inside
+/// wrap`, when every part of it is a sheet.
+pub fn oriented(method: SolidMethod, mesh: MeshRef<'_>, name: &str) -> Result<Option<Oriented>> {
+    if matches!(method, SolidMethod::Parity | SolidMethod::GpuParity | SolidMethod::Flood) {
+        return Ok(None);
+    }
+    let o = orient(mesh);
+    has_volume(name, Some(o.report))?;
+    Ok(Some(o))
+}
+
+/// Refuses, in one line naming `--inside wrap`, a mesh whose every part
+/// is a sheet (`report` of [`orient`]; `None`: parity, no test).
+pub fn has_volume(name: &str, report: Option<OrientReport>) -> Result<()> {
+    match report {
+        Some(r) if r.parts > 0 && !r.encloses_volume() => {
+            let s = if r.sheets == 1 { "" } else { "s" };
+            Err(JobError::invalid(format!(
+                "{name}: encloses no volume ({} open sheet{s}, no closed or nearly closed part), so it has no inside: \
+                 `remesh --inside wrap` closes a shell around it (surface modes and unsigned distances need no inside)",
+                r.sheets
+            )))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The rule a mesh method decided by, as the JSON names it.
+fn inside_rule(method: &str, watertight: bool) -> &'static str {
+    match (method, watertight) {
+        ("parity" | "gpu-parity", _) => "parity",
+        (_, true) => "nonzero winding",
+        (_, false) => "generalized winding",
+    }
+}
+
+/// A dense solid by a mesh test (every method but flood fills), on the
+/// mesh as [`oriented`] turns it, decided again exactly near the surface.
+fn mesh_solid(
+    method: SolidMethod,
+    mesh: MeshRef<'_>,
+    name: &str,
+    grid: &GridSpec,
+    stop: &Stop,
+    warnings: &mut Vec<String>,
+) -> Result<(DenseBits, &'static str, SolidFacts)> {
+    let oriented = oriented(method, mesh, name)?;
+    let mesh = oriented.as_ref().map_or(mesh, |o| o.mesh(mesh));
+    // Snapped once: the closedness test and whichever method runs share it.
+    let snapped = topovox::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+    let inspect = solid::inspect(&snapped);
+    let dims = grid.dims();
+    // Closed by the vertices as given: the rule the point queries use.
+    let watertight = topovox::query::inside::watertight(&topovox::query::inside::triangles(mesh));
+    let streaks = || {
+        format!(
+            "{name}: not closed and consistently oriented ({} boundary edges, {} inconsistently oriented edges): ray parity may streak through holes",
+            inspect.boundary_edges, inspect.unbalanced_edges
+        )
+    };
+    let mut near_half = Vec::new();
+    let mut gwn = None;
+    let (mut bits, rep, label) = match method {
+        SolidMethod::Parity | SolidMethod::GpuParity => {
+            if !watertight {
+                warnings.push(streaks());
+            }
+            if method == SolidMethod::GpuParity {
+                let (b, r) = gpu_parity(mesh, grid)?;
+                (b, r, "gpu-parity")
+            } else {
+                let (b, r) = solid::parity_snapped(&snapped, dims, stop);
+                (b, r, "parity")
+            }
+        }
+        SolidMethod::Auto | SolidMethod::Winding if watertight => {
+            let (b, r) = solid::winding_closed_snapped(&snapped, dims, stop);
+            (b, r, "winding")
+        }
+        SolidMethod::Auto | SolidMethod::Winding => {
+            let (b, r) = winding::winding_snapped(&snapped, dims, stop);
+            gwn = Some(WindingFacts::from(&r));
+            near_half = r.near_half;
+            (b, r.solid, "winding")
+        }
+        SolidMethod::Reference if watertight => {
+            let (b, r) = solid::reference::solid(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+            (b, r, "reference")
+        }
+        SolidMethod::Reference => {
+            let b = winding::reference::winding(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
+            let mut r = inspect;
+            r.voxels = b.count();
+            (b, r, "reference")
+        }
+        SolidMethod::Flood => unreachable!("flood fills are not mesh tests"),
+    };
+    drop(snapped);
+    // The references decide by the winding number (the definition).
+    let rule = if label == "parity" || label == "gpu-parity" { Sign::Parity } else { Sign::Winding };
+    let (checked, fixes) = exact_fixes(mesh, grid, (rule, watertight), &near_half, stop, |[i, j, k]| bits.get(i, j, k));
+    let changed = apply(&mut bits, &fixes);
+    let exact = ExactFacts { checked_voxels: checked, changed_voxels: changed as u64 };
+    let mut facts = SolidFacts::new(SolidMade::mesh(&rep, gwn, exact));
+    facts.inside_rule = Some(inside_rule(label, watertight));
+    facts.orientation = oriented.map(|o| o.report.into());
+    Ok((bits, label, facts))
 }
 
 /// A sparse solid and what was done to get it (see [`run_sparse`]).
@@ -173,6 +224,9 @@ pub fn run_sparse(
         let bits = hollow_sparse(plan, bits, &mut facts);
         return Ok(SparseOutcome { bits, method: "flood", facts, warnings });
     }
+    let oriented = oriented(plan.method, mesh, name)?;
+    let shape = mesh;
+    let mesh = oriented.as_ref().map_or(mesh, |o| o.mesh(mesh));
     let snapped = topovox::topology::inside::snap_all(mesh, grid).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
     let inspect = solid::inspect(&snapped);
     let mut warnings = Vec::new();
@@ -198,13 +252,9 @@ pub fn run_sparse(
             near_half = r.near_half;
             (b, r.solid, "winding")
         }
-        SolidMethod::Winding => {
+        _ => {
             let (b, r) = solid::winding_closed_sparse(&snapped, dims, stop);
             (b, r, "winding")
-        }
-        _ => {
-            let (b, r) = solid::parity_sparse(&snapped, dims, stop);
-            (b, r, "parity")
         }
     };
     drop(snapped);
@@ -215,9 +265,11 @@ pub fn run_sparse(
     let exact = ExactFacts { checked_voxels: checked, changed_voxels: changed as u64 };
     let mut facts = SolidFacts::new(SolidMade::mesh(&rep, gwn, exact));
     facts.full_bricks = Some(bits.full_bricks());
+    facts.inside_rule = Some(inside_rule(method, watertight));
+    facts.orientation = oriented.map(|o| o.report.into());
     let bits = match plan.surface {
         Some(surface) => {
-            let (shell, _) = voxelize::tiled::tiled(surface, mesh, grid, tile, opts).map_err(|e| JobError::invalid(e.to_string()))?;
+            let (shell, _) = voxelize::tiled::tiled(surface, shape, grid, tile, opts).map_err(|e| JobError::invalid(e.to_string()))?;
             facts.surface = Some(surface.name());
             bits.union(&shell)
         }

@@ -1,14 +1,18 @@
 //! Inside at any point, by the grids' rules, on the vertices as given:
 //! ray parity or the integer winding number by exact crossings
 //! ([`super::ray`]), the generalized winding number with caps
-//! ([`super::caps`]). `Sign::Auto` is parity on a closed, consistently
-//! oriented mesh (vertices identified by equal coordinates), the winding
-//! number otherwise.
+//! ([`super::caps`]). The winding rules decide on the mesh as
+//! [`super::orient`] turns it (each part consistently, closed parts
+//! outward or inward by nesting, sheets left out beside volumes), so face
+//! orientation does not matter; `Sign::Auto` is the nonzero winding number
+//! on a mesh that is then closed (the union of overlapping shells), the
+//! generalized winding number `|w| ≥ ½` otherwise.
 
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
 use super::caps::Caps;
+use super::orient::{orient, OrientReport};
 use super::ray::RayIndex;
 use super::Sign;
 use crate::MeshRef;
@@ -24,23 +28,23 @@ pub struct Inside {
     watertight: bool,
     /// The rule, `Auto` resolved.
     sign: Sign,
+    /// What orienting the mesh did (`None` under parity, which ignores
+    /// orientation, and for triangles prepared as given).
+    orientation: Option<OrientReport>,
 }
 
 impl Inside {
     /// Prepares the triangles of `mesh` whose indices are valid and whose
-    /// corners are finite (others are left out, as the grids leave them).
+    /// corners are finite (others are left out, as the grids leave them),
+    /// oriented by [`orient`] unless `sign` is parity.
     pub fn new(mesh: MeshRef<'_>, sign: Sign) -> Inside {
-        Inside::of_triangles(triangles(mesh), sign)
-    }
-
-    /// The same mesh under another rule (`Auto` resolved again).
-    pub fn with_sign(mut self, sign: Sign) -> Inside {
-        self.sign = match sign {
-            Sign::Auto if self.watertight => Sign::Parity,
-            Sign::Auto => Sign::Winding,
-            s => s,
-        };
-        self
+        if sign == Sign::Parity {
+            return Inside::of_triangles(triangles(mesh), sign);
+        }
+        let oriented = orient(mesh);
+        let mut inside = Inside::of_triangles(triangles(oriented.mesh(mesh)), sign);
+        inside.orientation = Some(oriented.report);
+        inside
     }
 
     /// Prepares `tris` (world coordinates).
@@ -59,13 +63,17 @@ impl Inside {
     fn with_cycles(tris: Vec<[DVec3; 3]>, watertight: bool, cycles: &[Vec<DVec3>], sign: Sign) -> Inside {
         let caps = Caps::new(cycles);
         let sign = match sign {
-            Sign::Auto if watertight => Sign::Parity,
             Sign::Auto => Sign::Winding,
             s => s,
         };
         let mesh = RayIndex::new(tris.into_iter());
         let cap_rays = RayIndex::new(caps.tris.iter().copied());
-        Inside { mesh, cap_rays, caps, watertight, sign }
+        Inside { mesh, cap_rays, caps, watertight, sign, orientation: None }
+    }
+
+    /// What orienting the mesh found and did (`None` under parity).
+    pub fn orientation(&self) -> Option<OrientReport> {
+        self.orientation
     }
 
     /// Closed and consistently oriented.

@@ -29,6 +29,7 @@
 pub mod caps;
 pub mod grid;
 pub mod inside;
+pub mod orient;
 pub mod ray;
 pub mod sample;
 
@@ -43,7 +44,9 @@ pub use inside::Inside;
 /// Which rule decides inside.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Sign {
-    /// Parity on a closed, consistently oriented mesh, else the winding number.
+    /// The winding number on the mesh oriented by [`orient`]: nonzero
+    /// where it is closed (the union of overlapping shells), `|w| ≥ ½`
+    /// otherwise.
     #[default]
     Auto,
     /// Ray parity: an odd number of crossings.
@@ -81,6 +84,8 @@ pub struct QueryFacts {
     pub cycles: u64,
     /// The rule `Auto` resolved to.
     pub sign: Sign,
+    /// What orienting the mesh did (`None` under parity).
+    pub orientation: Option<orient::OrientReport>,
 }
 
 /// A mesh prepared for point queries (see the module doc).
@@ -106,6 +111,7 @@ impl Query {
             watertight: inside.watertight(),
             cycles: inside.cycles(),
             sign: inside.sign(),
+            orientation: inside.orientation(),
         };
         Ok(Query { pieces, tree, inside, facts, triangles: mesh_triangles })
     }

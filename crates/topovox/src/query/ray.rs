@@ -61,6 +61,12 @@ struct RayTri {
     hi: DVec3,
 }
 
+impl RayTri {
+    fn new(p: [DVec3; 3]) -> RayTri {
+        RayTri { p, lo: p[0].min(p[1]).min(p[2]), hi: p[0].max(p[1]).max(p[2]) }
+    }
+}
+
 /// The crossing count and signed sum at a point.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Crossings {
@@ -81,16 +87,27 @@ pub struct RayIndex {
     /// Cell `c`'s triangles are `items[start[c] .. start[c + 1]]`.
     start: Vec<u32>,
     items: Vec<u32>,
+    /// Each triangle's tag ([`RayIndex::tagged`]; empty otherwise).
+    tags: Vec<u32>,
 }
 
 impl RayIndex {
     /// The index over `tris` (world coordinates); triangles whose `yz`
     /// projection has no area are left out (no ray crosses them).
     pub fn new(tris: impl Iterator<Item = [DVec3; 3]>) -> RayIndex {
-        let tris: Vec<RayTri> = tris
-            .filter(|t| normal_signs(t)[0] != 0)
-            .map(|p| RayTri { p, lo: p[0].min(p[1]).min(p[2]), hi: p[0].max(p[1]).max(p[2]) })
-            .collect();
+        let tris: Vec<RayTri> = tris.filter(|t| normal_signs(t)[0] != 0).map(RayTri::new).collect();
+        RayIndex::of(tris, Vec::new())
+    }
+
+    /// The index over `tris`, each with a tag that
+    /// [`RayIndex::crossed_tags`] reports.
+    pub fn tagged(tris: impl Iterator<Item = ([DVec3; 3], u32)>) -> RayIndex {
+        let (tris, tags): (Vec<RayTri>, Vec<u32>) =
+            tris.filter(|t| normal_signs(&t.0)[0] != 0).map(|(p, tag)| (RayTri::new(p), tag)).unzip();
+        RayIndex::of(tris, tags)
+    }
+
+    fn of(tris: Vec<RayTri>, tags: Vec<u32>) -> RayIndex {
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for t in &tris {
             for a in 0..2 {
@@ -102,7 +119,7 @@ impl RayIndex {
         let ext = [(hi[0] - lo[0]).max(f64::MIN_POSITIVE), (hi[1] - lo[1]).max(f64::MIN_POSITIVE)];
         let n = (tris.len() as f64 * 2.0).max(1.0);
         let side = (ext[0] * ext[1] / n).sqrt().max(ext[0].max(ext[1]) / 4096.0);
-        let mut out = RayIndex { tris, lo, hi, scale: [1.0; 2], cells: [1, 1], start: Vec::new(), items: Vec::new() };
+        let mut out = RayIndex { tris, lo, hi, scale: [1.0; 2], cells: [1, 1], start: Vec::new(), items: Vec::new(), tags };
         if !out.tris.is_empty() {
             // Nothing to bin (a closed mesh's caps) keeps one cell, not a
             // grid sized by an empty box.
@@ -181,8 +198,25 @@ impl RayIndex {
     /// The crossings of `q`'s displaced `−x` ray (`q` finite).
     pub fn crossings(&self, q: DVec3) -> Crossings {
         let mut out = Crossings::default();
+        self.each_crossing(q, |_, s| {
+            out.count += 1;
+            out.winding -= s as i64;
+        });
+        out
+    }
+
+    /// The tag of each triangle `q`'s displaced `−x` ray crosses (an index
+    /// made by [`RayIndex::tagged`]; nothing otherwise).
+    pub fn crossed_tags(&self, q: DVec3, mut tag: impl FnMut(u32)) {
+        if !self.tags.is_empty() {
+            self.each_crossing(q, |n, _| tag(self.tags[n]));
+        }
+    }
+
+    /// Calls `f(triangle, sign of its n_x)` for each crossing.
+    fn each_crossing(&self, q: DVec3, mut f: impl FnMut(usize, i32)) {
         if self.tris.is_empty() || q.y < self.lo[0] || q.y > self.hi[0] || q.z < self.lo[1] || q.z > self.hi[1] {
-            return out;
+            return;
         }
         let c = self.cell(1, q.z) * self.cells[0] + self.cell(0, q.y);
         for &n in &self.items[self.start[c] as usize..self.start[c + 1] as usize] {
@@ -191,11 +225,9 @@ impl RayIndex {
                 continue;
             }
             if let Some(s) = crosses(&t.p, q) {
-                out.count += 1;
-                out.winding -= s as i64;
+                f(n as usize, s);
             }
         }
-        out
     }
 }
 
