@@ -22,8 +22,9 @@ Modes (``mode=``):
 - ``diagonal``: one alternating body diagonal per voxel (6-separating).
 - ``line26``, ``line6``: polylines, 26- or 6-connected.
 - ``pos``: the published projected optimal scanline algorithm (no guarantee).
-- ``solid``: voxels whose centre is inside (winding number; ray parity on
-  closed meshes); ``solid+surface``: united with a surface mode
+- ``solid``: voxels whose centre is inside (the winding number of the mesh
+  oriented by parts and nesting: flipped faces do not matter, overlapping
+  shells give their union, nested ones cavities); ``solid+surface``: united with a surface mode
   (``surface=``); ``fill="flood"`` and ``hollow=6|26`` as in the CLI.
 
 Grids: ``resolution=N`` (the longest side of the bounding box spans N
@@ -579,8 +580,9 @@ def sdf(
     centre to the nearest point of the mesh (every triangle; degenerate
     ones as their edges; segments too), exact to float32 rounding. Signed
     fields are negative exactly on the voxels :func:`voxelize` with
-    ``mode="solid"`` and the same ``method`` sets (parity on closed meshes,
-    the generalized winding number otherwise).
+    ``mode="solid"`` and the same ``method`` sets (the oriented mesh's
+    nonzero winding number where closed, the generalized winding number
+    otherwise).
 
     Parameters
     ----------
@@ -644,9 +646,10 @@ class Query:
     degenerate triangle counts as its edges; segments of a polyline count
     too), as :func:`sdf` measures them. Inside follows ``sign``:
 
-    - ``"auto"`` (default): ray parity on a closed, consistently oriented
-      mesh, the generalized winding number ``|w| >= 1/2`` otherwise — the
-      rule ``voxelize(mode="solid")`` uses;
+    - ``"auto"`` (default): the winding number of the mesh oriented by
+      parts and nesting (flipped faces do not matter; overlapping shells
+      give their union, nested ones cavities): nonzero where closed, ``|w| >= 1/2`` otherwise — the rule
+      ``voxelize(mode="solid")`` uses;
     - ``"parity"``: an odd number of crossings of a ray;
     - ``"winding"``: the winding number (exact integers on closed meshes).
 
@@ -716,8 +719,11 @@ class Query:
 
     @property
     def facts(self) -> Dict[str, Any]:
-        """``elements``, ``skipped``, ``watertight``, ``boundary_cycles`` and
-        the ``sign`` rule ``"auto"`` resolved to."""
+        """``elements``, ``skipped``, ``watertight``, ``boundary_cycles``,
+        the ``sign`` rule ``"auto"`` resolved to, and (unless parity)
+        ``orientation``: what orienting the mesh found and repaired
+        (``parts``, ``closed_parts``, ``nested_parts``, ``sheets``,
+        ``faces_reoriented``, ``unorientable_edges``)."""
         return self._q.facts
 
 

@@ -291,8 +291,16 @@ fn solid_modes_say_what_they_did() {
         json(&topovox(&args))
     };
     let s = run(&["--mode", "solid"]);
-    assert_eq!((s["voxels"].as_u64(), s["method"].as_str()), (Some(512), Some("parity")));
+    assert_eq!((s["voxels"].as_u64(), s["method"].as_str()), (Some(512), Some("winding")));
     assert_eq!(s["solid"]["closed"], true);
+    assert_eq!(s["solid"]["inside_rule"], "nonzero winding");
+    assert_eq!(s["solid"]["orientation"]["closed_parts"], 1);
+    assert_eq!(s["solid"]["orientation"]["faces_reoriented"], 0);
+    let p = run(&["--mode", "solid", "--method", "parity"]);
+    assert_eq!(
+        (p["voxels"].as_u64(), p["method"].as_str(), p["solid"]["inside_rule"].as_str()),
+        (Some(512), Some("parity"), Some("parity"))
+    );
     assert_eq!(run(&["--mode", "solid", "--method", "winding"])["voxels"], 512);
     assert_eq!(run(&["--mode", "solid", "--method", "reference"])["voxels"], 512);
     assert_eq!(run(&["--mode", "solid", "--hollow", "6"])["voxels"], 512 - 216);

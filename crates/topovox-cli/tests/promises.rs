@@ -290,7 +290,19 @@ fn small_soup(path: &Path, n: u32) {
         x ^= x << 17;
         (x >> 11) as f64 / (1u64 << 53) as f64
     };
-    for _ in 0..n {
+    // One closed tetrahedron among the loose triangles, so the soup
+    // encloses some volume and every command that decides inside takes it.
+    let tet = [[0.0, 0.0, 0.0], [0.05, 0.0, 0.0], [0.0, 0.05, 0.0], [0.0, 0.0, 0.05]].map(|p: [f32; 3]| p.map(|v| v + 0.5));
+    for f in [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]].iter().take(n as usize) {
+        b.extend([0u8; 12]);
+        for v in f {
+            for a in tet[*v] {
+                b.extend(a.to_le_bytes());
+            }
+        }
+        b.extend([0u8; 2]);
+    }
+    for _ in 0..n.saturating_sub(4) {
         b.extend([0u8; 12]);
         let c = [next(), next(), next()];
         for _ in 0..3 {

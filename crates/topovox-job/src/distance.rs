@@ -25,8 +25,9 @@ use crate::table::{choice, chosen, flag, number, shown, value, Example, OptionVa
 topovox::choice! {
     /// How the sign (inside or outside) of a distance is decided.
     pub enum Sign: "sign" default Auto {
-        /// As `--mode solid --method auto`: parity on closed, consistently
-        /// oriented meshes, the generalized winding number otherwise.
+        /// As `--mode solid --method auto`: the winding number of the mesh
+        /// oriented by parts and nesting (nonzero where closed, the
+        /// generalized `|w| ≥ ½` otherwise); meshes of sheets are refused.
         Auto = "auto",
         /// Ray parity (right for closed meshes; streaks through holes).
         Parity = "parity",

@@ -44,8 +44,6 @@ pub struct OrientFacts {
     pub nested_parts: u64,
     /// Open parts that enclose no volume.
     pub sheets: u64,
-    /// Sheets left out of the inside decision beside parts with volume.
-    pub sheets_left_out: u64,
     /// Triangles turned round.
     pub faces_reoriented: u64,
     /// Manifold edges left inconsistent (parts that cannot be oriented).
@@ -59,7 +57,6 @@ impl From<OrientReport> for OrientFacts {
             closed_parts: r.closed_parts,
             nested_parts: r.nested_parts,
             sheets: r.sheets,
-            sheets_left_out: r.sheets_left_out,
             faces_reoriented: r.faces_reoriented,
             unorientable_edges: r.inconsistent_edges,
         }

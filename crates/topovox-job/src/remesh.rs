@@ -44,8 +44,9 @@ use crate::table::{choice, chosen, flag, int, number, value, Example, Shape};
 topovox::choice! {
     /// Which voxels the surface closes around.
     pub enum Inside: "inside" default Auto {
-        /// As `--mode solid --method auto`: parity on closed, consistently
-        /// oriented meshes, the generalized winding number otherwise.
+        /// As `--mode solid --method auto`: the winding number of the mesh
+        /// oriented by parts and nesting (nonzero where closed, the
+        /// generalized `|w| ≥ ½` otherwise); meshes of sheets are refused.
         Auto = "auto",
         /// Ray parity (right for closed meshes; streaks through holes).
         Parity = "parity",

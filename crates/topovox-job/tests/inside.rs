@@ -286,18 +286,3 @@ fn sheets_are_refused_in_one_line_naming_wrap() {
         }
     }
 }
-
-/// A closed shell beside a sheet (a model with a flag): the sheet is left
-/// out of the inside, which is the shell's.
-#[test]
-fn sheets_beside_a_volume_are_left_out() {
-    let ball = sphere(DVec3::ZERO, 1.0, 20);
-    let flag = Mesh {
-        positions: vec![DVec3::new(1.2, -0.5, 0.0), DVec3::new(2.5, -0.5, 0.1), DVec3::new(2.5, 0.5, 0.3), DVec3::new(1.2, 0.5, 0.0)],
-        triangles: vec![[0, 1, 2], [0, 2, 3]],
-        segments: Vec::new(),
-    };
-    let whole = joined(&[ball.clone(), flag]);
-    let grid = GridSpec::from_resolution(&whole.as_ref().bounds(), 32).unwrap();
-    assert_same(&auto_solid(&whole, &grid, 2).unwrap(), &parity(&ball, &grid), "a ball with a flag");
-}

@@ -34,12 +34,15 @@ fn on_lattice(m: &Mesh, grid: &GridSpec) -> Mesh {
     out
 }
 
-/// The grid solid by `q`'s rule, as `voxelize --mode solid` picks it.
+/// The grid solid by `q`'s rule, as `voxelize --mode solid` picks it:
+/// the winding rules on the mesh as `orient` turns it.
 fn grid_solid(m: &Mesh, grid: &GridSpec, sign: Sign, watertight: bool) -> DenseBits {
+    let oriented = topovox::query::orient::orient(m.as_ref());
+    let o = oriented.mesh(m.as_ref());
     match (sign, watertight) {
-        (Sign::Parity, _) | (Sign::Auto, true) => solid::parity(m.as_ref(), grid).unwrap().0,
-        (_, true) => solid::winding_closed(m.as_ref(), grid).unwrap().0,
-        (_, false) => winding::winding(m.as_ref(), grid).unwrap().0,
+        (Sign::Parity, _) => solid::parity(m.as_ref(), grid).unwrap().0,
+        (_, true) => solid::winding_closed(o, grid).unwrap().0,
+        (_, false) => winding::winding(o, grid).unwrap().0,
     }
 }
 

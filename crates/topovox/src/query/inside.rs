@@ -3,7 +3,7 @@
 //! ([`super::ray`]), the generalized winding number with caps
 //! ([`super::caps`]). The winding rules decide on the mesh as
 //! [`super::orient`] turns it (each part consistently, closed parts
-//! outward or inward by nesting, sheets left out beside volumes), so face
+//! outward or inward by nesting), so face
 //! orientation does not matter; `Sign::Auto` is the nonzero winding number
 //! on a mesh that is then closed (the union of overlapping shells), the
 //! generalized winding number `|w| ≥ ½` otherwise.

@@ -11,9 +11,9 @@
 //!   after rounding to f32.
 //! - **Inside** follows [`Sign`]: ray parity ([`ray`]), the integer
 //!   winding number of a closed mesh, or the generalized winding number
-//!   `|w| ≥ ½` ([`caps`]); `Auto` is parity on a closed, consistently
-//!   oriented mesh and the winding number otherwise — the rule of
-//!   `voxelize --mode solid`. It is decided on the vertices as given, in
+//!   `|w| ≥ ½` ([`caps`]); `Auto` is the winding number of the mesh as
+//!   [`orient`] turns it (nonzero where closed, `|w| ≥ ½` otherwise) — the
+//!   rule of `voxelize --mode solid`. It is decided on the vertices as given, in
 //!   exact arithmetic, with the grids' tie rule; the grids decide on the
 //!   vertices snapped to their 1/4096-voxel lattice, so at a voxel centre
 //!   the two agree exactly whenever the mesh's vertices lie on that

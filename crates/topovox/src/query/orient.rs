@@ -1,7 +1,7 @@
 //! Orienting a mesh before anything decides its inside: each connected
 //! part consistently across its manifold edges, closed parts outward by
 //! their signed volume and inward where nested an odd number of times,
-//! and sheets (open parts that enclose no volume) named.
+//! and sheets (open parts that enclose no volume) counted.
 //!
 //! This work is based on: the consistent-orientation walk over manifold
 //! edges of T. Ju, "Robust Repair of Polygonal Models" (SIGGRAPH 2004, §2
@@ -25,13 +25,16 @@
 //! is positive, then reversed when its *depth* — the number of other
 //! closed parts that contain it (every vertex of it not shared with
 //! another closed part lies inside that part by exact ray parity) — is
-//! odd. An open part is turned so its signed volume about its first vertex
-//! is positive (ties: the orientation most of its area had). An open part
-//! is a *sheet* when its holes span at least half its area
-//! (`|Σ area vectors| ≥ ½ Σ areas`: a flat or gently curved sheet, a
-//! triangle of a soup, a bowl shallower than a hemisphere); sheets enclose
-//! no volume and are left out of the inside decision when another part
-//! encloses volume. Zero-area parts are kept as they are.
+//! odd. An open part is turned so its signed volume about the centroid of
+//! its boundary's vertices is positive — the volume it closes with caps
+//! fanned from there, as the generalized winding number's caps close it
+//! (ties: the orientation most of its area had). An open part
+//! is a *sheet* when its holes span at least three quarters of its area
+//! (`|Σ area vectors| ≥ ¾ Σ areas`: a flat or gently curved sheet, a
+//! triangle of a soup; a hemisphere gives ½, a half pipe ⅔, a beetle's
+//! shell open underneath ½): it encloses no volume, and a mesh of sheets
+//! only has no inside. Sheets beside other parts are kept (a teapot's lid
+//! is a sheet that closes its body). Zero-area parts are kept as they are.
 //!
 //! **Guarantee.** For a mesh of closed parts that meet only at shared
 //! vertices and edges, the result's nonzero winding number is the same
@@ -66,10 +69,8 @@ pub struct OrientReport {
     pub closed_parts: u64,
     /// Closed parts inside an odd number of others: cavities.
     pub nested_parts: u64,
-    /// Open parts whose holes span at least half their area.
+    /// Open parts whose holes span at least three quarters of their area.
     pub sheets: u64,
-    /// Sheets left out of the inside decision (another part encloses volume).
-    pub sheets_left_out: u64,
     /// Triangles whose orientation was reversed.
     pub faces_reoriented: u64,
     /// Manifold edges still used the same way by both triangles (parts
@@ -88,7 +89,7 @@ impl OrientReport {
 #[derive(Clone, Debug)]
 pub struct Oriented {
     /// The input's triangles in order, each reversed where its part needs
-    /// it, sheets left out where [`OrientReport::sheets_left_out`] says.
+    /// it.
     pub triangles: Vec<[u32; 3]>,
     /// What was found and done.
     pub report: OrientReport,
@@ -103,17 +104,17 @@ impl Oriented {
 
 /// Orients `mesh`'s triangles (see the module doc).
 pub fn orient(mesh: MeshRef<'_>) -> Oriented {
-    let ids = vertex_ids(mesh);
+    let (ids, points) = vertex_ids(mesh);
     let edges = sorted_edges(&ids);
     let links = links(&ids, &edges);
     let walk = walk(&links);
     let mut parts = measure(mesh, &walk);
-    mark_open(&edges, &walk, &mut parts);
-    drop(edges);
-    drop(links);
+    mark_open(&edges, &points, &walk, &mut parts);
+    drop((edges, links, points));
     let mut flip = walk.flip;
     for part in &mut parts {
-        part.outward = part.volume < 0.0 || (part.volume == 0.0 && 2.0 * part.agree < part.area);
+        let volume = part.closing_volume();
+        part.outward = volume < 0.0 || (volume == 0.0 && 2.0 * part.agree < part.area);
     }
     let depth = nesting(mesh, &ids, &walk.part, &flip, &parts);
     let mut report = OrientReport { inconsistent_edges: walk.conflicts, ..OrientReport::default() };
@@ -132,7 +133,6 @@ pub fn orient(mesh: MeshRef<'_>) -> Oriented {
             report.sheets += 1;
         }
     }
-    let leave_out = report.encloses_volume() && report.sheets > 0;
     let mut triangles = Vec::with_capacity(mesh.triangles.len());
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let p = walk.part[t];
@@ -140,11 +140,7 @@ pub fn orient(mesh: MeshRef<'_>) -> Oriented {
             triangles.push(*tri);
             continue;
         }
-        let part = &parts[p as usize];
-        if leave_out && part.area > 0.0 && !part.closed && part.sheet() {
-            continue;
-        }
-        flip[t] ^= part.outward;
+        flip[t] ^= parts[p as usize].outward;
         if flip[t] {
             report.faces_reoriented += 1;
             triangles.push([tri[0], tri[2], tri[1]]);
@@ -152,18 +148,17 @@ pub fn orient(mesh: MeshRef<'_>) -> Oriented {
             triangles.push(*tri);
         }
     }
-    if leave_out {
-        report.sheets_left_out = report.sheets;
-    }
     Oriented { triangles, report }
 }
 
 /// Each triangle's corners as vertex numbers shared by equal coordinates
-/// (`−0` as `+0`); [`NONE`] for a triangle with an index out of range or a
-/// corner that is not finite.
-fn vertex_ids(mesh: MeshRef<'_>) -> Vec<[u32; 3]> {
+/// (`−0` as `+0`), [`NONE`] for a triangle with an index out of range or a
+/// corner that is not finite; and each number's point.
+fn vertex_ids(mesh: MeshRef<'_>) -> (Vec<[u32; 3]>, Vec<DVec3>) {
     let mut numbers: FxHashMap<[u64; 3], u32> = FxHashMap::default();
-    mesh.triangles
+    let mut points = Vec::new();
+    let ids = mesh
+        .triangles
         .iter()
         .map(|t| {
             let p = |i: u32| mesh.positions.get(i as usize).copied().filter(|p| p.is_finite());
@@ -172,11 +167,14 @@ fn vertex_ids(mesh: MeshRef<'_>) -> Vec<[u32; 3]> {
             };
             [a, b, c].map(|q| {
                 let key = q.to_array().map(|v| (v + 0.0).to_bits());
-                let next = numbers.len() as u32;
-                *numbers.entry(key).or_insert(next)
+                *numbers.entry(key).or_insert_with(|| {
+                    points.push(q);
+                    (points.len() - 1) as u32
+                })
             })
         })
-        .collect()
+        .collect();
+    (ids, points)
 }
 
 /// One use of an edge: its vertices `(lo, hi)`, the triangle, and
@@ -301,13 +299,25 @@ struct Part {
     origin: Option<DVec3>,
     bounds: Aabb,
     closed: bool,
+    /// The sum and number of its boundary edges' end points.
+    boundary: (DVec3, u32),
     /// Reverse the whole part (outward by volume, then by nesting).
     outward: bool,
 }
 
 impl Part {
+    /// The signed volume about the centroid of the boundary's end points
+    /// (any point, for a closed part): `V(o) = V(origin) − (o − origin) ·
+    /// area vector / 3`.
+    fn closing_volume(&self) -> f64 {
+        match (self.origin, self.boundary) {
+            (Some(origin), (sum, n)) if n > 0 => self.volume - (sum / f64::from(n) - origin).dot(self.vector_area) / 3.0,
+            _ => self.volume,
+        }
+    }
+
     fn sheet(&self) -> bool {
-        self.vector_area.length() >= 0.5 * self.area
+        self.vector_area.length() >= 0.75 * self.area
     }
 }
 
@@ -321,6 +331,7 @@ fn measure(mesh: MeshRef<'_>, walk: &Walk) -> Vec<Part> {
         origin: None,
         bounds: Aabb::EMPTY,
         closed: true,
+        boundary: (DVec3::ZERO, 0),
         outward: false,
     };
     let mut parts = vec![empty; walk.parts];
@@ -348,8 +359,8 @@ fn measure(mesh: MeshRef<'_>, walk: &Walk) -> Vec<Part> {
 }
 
 /// Marks open every part that uses some edge more often one way than the
-/// other (in the walk's orientation).
-fn mark_open(edges: &[EdgeUse], walk: &Walk, parts: &mut [Part]) {
+/// other (in the walk's orientation), and sums those edges' end points.
+fn mark_open(edges: &[EdgeUse], points: &[DVec3], walk: &Walk, parts: &mut [Part]) {
     let mut net: Vec<(u32, i32)> = Vec::new();
     for g in groups(edges) {
         net.clear();
@@ -361,7 +372,11 @@ fn mark_open(edges: &[EdgeUse], walk: &Walk, parts: &mut [Part]) {
         net.sort_unstable_by_key(|x| x.0);
         for run in net.chunk_by(|a, b| a.0 == b.0) {
             if run.iter().map(|x| x.1).sum::<i32>() != 0 {
-                parts[run[0].0 as usize].closed = false;
+                let part = &mut parts[run[0].0 as usize];
+                part.closed = false;
+                let (lo, hi) = ((g[0].key >> 32) as usize, (g[0].key & 0xffff_ffff) as usize);
+                part.boundary.0 += points[lo] + points[hi];
+                part.boundary.1 += 2;
             }
         }
     }
