@@ -182,6 +182,9 @@ pub struct RemeshFacts {
     pub inside: String,
     /// Inside voxels the surface closes around.
     pub inside_voxels: u64,
+    /// Faces between inside and outside voxels: the surface has at most
+    /// [`TRIANGLES_PER_BOUNDARY_FACE`] triangles for each.
+    pub boundary_voxel_faces: u64,
     /// Parts (26-connected) kept and dropped by `min_part`.
     pub parts: u64,
     /// Parts dropped.
@@ -207,7 +210,7 @@ impl RemeshFacts {
             json!({"output_to_input_max": d[0], "output_to_input_mean": d[1], "input_to_output_max": d[2], "input_to_output_mean": d[3]})
         });
         json!({
-            "inside": self.inside, "inside_voxels": self.inside_voxels, "parts": self.parts,
+            "inside": self.inside, "inside_voxels": self.inside_voxels, "boundary_voxel_faces": self.boundary_voxel_faces, "parts": self.parts,
             "dropped_parts": self.dropped_parts, "inside_s": self.inside_s, "surface_s": self.surface_s,
             "distance_voxels": d, "solid": self.solid, "simplify": self.simplify,
         })
@@ -253,6 +256,22 @@ pub struct Remeshed {
     pub made: RemeshMade,
 }
 
+/// The most triangles the smooth surface has per boundary voxel face
+/// ([`RemeshFacts::boundary_voxel_faces`]): each of Kuhn's six tetrahedra
+/// in a lattice cube gives at most two triangles, a cube gives any only
+/// when one of its twelve axis edges joins an inside centre to an outside
+/// one, and each such edge — a boundary voxel face — lies in four cubes:
+/// 6 · 2 · 4. The blocky surface, on half voxels, has at most four times
+/// as many. Measured at 128 (smooth, blocky): 6.2–6.9 and 28–30 on the
+/// bunny, cow, homer and fandisk; 8.0 and 32 on a box with walls 0.6 voxel
+/// thin, 4.9 and 25 on it rotated.
+pub const TRIANGLES_PER_BOUNDARY_FACE: u64 = 48;
+
+/// Triangles per boundary voxel face the memory estimate counts once the
+/// inside is known (smooth, blocky): the largest measured (see
+/// [`TRIANGLES_PER_BOUNDARY_FACE`]), a tenth more.
+const MEASURED_PER_BOUNDARY_FACE: (f64, f64) = (8.8, 35.0);
+
 /// The most one slab of a streamed surface may hold (estimated): enough
 /// that a surface of up to about 10 M triangles is made in one slab, as
 /// fast as a whole one, and a larger one costs at most this much.
@@ -264,7 +283,10 @@ const SLAB_BYTES: u64 = 1 << 30;
 /// The estimate: one bit per voxel for the solid (wrap: three grids),
 /// eight for the blocky surface's half voxels, and per triangle held —
 /// estimated as ten per voxel face of the input's area for the smooth
-/// surface, 44 for the blocky one (the bunny: 9.3 and 41.8) — 90 bytes
+/// surface, 44 for the blocky one (the bunny: 9.3 and 41.8), and once the
+/// inside is known (`boundary`: its boundary voxel faces), before the
+/// surface is made, as [`MEASURED_PER_BOUNDARY_FACE`] per boundary face
+/// where that is half again more than the area said — 90 bytes
 /// (smooth: its vertices, the edge table, the distances at the lattice
 /// ends) or 60 (blocky), plus the output's distance pieces and their copy
 /// in the hierarchy where the two-sided distance is measured (wrap,
@@ -281,14 +303,21 @@ const SLAB_BYTES: u64 = 1 << 30;
 /// 0.5–0.9 of the estimate from 128 to 2048 (see BENCHMARKS.md; the 2048
 /// run once peaked at 8.4 GiB where it claimed 5.2, before the surface
 /// was streamed and triangles counted as now).
-fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec, held: bool) -> Result<u32> {
+fn check_fits(name: &str, req: &RemeshRequest, pieces: &Pieces, grid: &GridSpec, held: bool, boundary: Option<u64>) -> Result<u32> {
     let cells = grid.voxel_count();
     let blocky = req.surface == SurfaceKind::Blocky;
     let grids = if req.inside == Inside::Wrap { 3 } else { 1 } + if blocky { 8 } else { 0 };
     let h = grid.voxel_size().0;
     let area: f64 = pieces.items.iter().map(|p| 0.5 * (p.p[1] - p.p[0]).cross(p.p[2] - p.p[0]).length()).sum();
     let (per_face, bytes_each) = if blocky { (44.0, 60) } else { (10.0, 90) };
-    let triangles = area / (h.x * h.y).min(h.y * h.z).min(h.x * h.z) * per_face;
+    let per_boundary = if blocky { MEASURED_PER_BOUNDARY_FACE.1 } else { MEASURED_PER_BOUNDARY_FACE.0 };
+    // Before the inside is known, from the input's area; after, from the
+    // inside's boundary where that is half again more (thin walls and
+    // loose parts have more boundary than area), so a run the first
+    // estimate admitted at its stated need is not refused by the second.
+    let by_area = area / (h.x * h.y).min(h.y * h.z).min(h.x * h.z) * per_face;
+    let faces = boundary.unwrap_or(0);
+    let triangles = if faces as f64 * per_boundary > 1.5 * by_area { faces as f64 * per_boundary } else { by_area };
     let measured = req.inside == Inside::Wrap || req.check;
     let certified = req.check || cfg!(debug_assertions) || req.simplify > 0.0;
     let per_triangle = bytes_each
@@ -407,6 +436,7 @@ struct Closed {
     parts: u64,
     dropped_parts: u64,
     inside_voxels: u64,
+    boundary_voxel_faces: u64,
     inside_s: f64,
 }
 
@@ -416,7 +446,7 @@ struct Closed {
 fn close(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, pieces: &Pieces, held: bool, stop: &Stop) -> Result<Closed> {
     let grid = req.grid.fit(&mesh.bounds())?;
     check_precision(name, req, &grid)?;
-    let thickness = check_fits(name, req, pieces, &grid, held)?;
+    check_fits(name, req, pieces, &grid, held, None)?;
     let t = Instant::now();
     let (bits, method, solid, warnings) = inside(mesh, name, req, &grid, stop)?;
     let (bits, parts, dropped_parts) = surface::drop_small_parts(bits, req.min_part);
@@ -430,7 +460,10 @@ fn close(mesh: MeshRef<'_>, name: &str, req: &RemeshRequest, pieces: &Pieces, he
         return Err(JobError::invalid(format!("{name}: nothing to close on this grid: {why}")));
     }
     let inside_s = t.elapsed().as_secs_f64();
-    Ok(Closed { bits, grid, thickness, method, solid, warnings, parts, dropped_parts, inside_voxels, inside_s })
+    let boundary_voxel_faces = bits.boundary_faces();
+    // Counted again from the surface's own size, before it is made.
+    let thickness = check_fits(name, req, pieces, &grid, held, Some(boundary_voxel_faces))?;
+    Ok(Closed { bits, grid, thickness, method, solid, warnings, parts, dropped_parts, inside_voxels, boundary_voxel_faces, inside_s })
 }
 
 /// The surface around `c`, handed to `each` slab by slab ([`surface::Part`]);
@@ -463,9 +496,20 @@ impl Closed {
         certificate: Option<MeshCheck>,
         counts: [u64; 2],
     ) -> RemeshMade {
-        let Closed { grid, method, solid, warnings, parts, dropped_parts, inside_voxels, inside_s, .. } = self;
+        let Closed { grid, method, solid, warnings, parts, dropped_parts, inside_voxels, boundary_voxel_faces, inside_s, .. } = self;
         let (distance, simplify) = extra;
-        let facts = RemeshFacts { inside: method, inside_voxels, parts, dropped_parts, inside_s, surface_s, distance, solid, simplify };
+        let facts = RemeshFacts {
+            inside: method,
+            inside_voxels,
+            boundary_voxel_faces,
+            parts,
+            dropped_parts,
+            inside_s,
+            surface_s,
+            distance,
+            solid,
+            simplify,
+        };
         RemeshMade { grid, facts, certificate, warnings, vertices: counts[0], triangles: counts[1] }
     }
 }

@@ -147,6 +147,50 @@ impl DenseBits {
         self.words.par_chunks(1 << 16).map(super::count_bits).sum()
     }
 
+    /// Faces between a set voxel and an unset one or the grid's outside:
+    /// the area of the set's boundary, in voxel faces.
+    pub fn boundary_faces(&self) -> u64 {
+        self.boundary_faces_by_layer().iter().sum()
+    }
+
+    /// [`DenseBits::boundary_faces`] by `k` layer: a layer's faces across
+    /// `x` and `y`, and across `z` those below it (the last layer also
+    /// those above).
+    pub fn boundary_faces_by_layer(&self) -> Vec<u64> {
+        let [_, ny, nz] = self.dims.map(|d| d as usize);
+        let w = self.words_per_row;
+        let row = |j: usize, k: usize| &self.words[(k * ny + j) * w..(k * ny + j + 1) * w];
+        let differ = |a: &[u64], b: Option<&[u64]>| -> u64 {
+            a.iter().enumerate().map(|(n, &x)| u64::from((x ^ b.map_or(0, |b| b[n])).count_ones())).sum()
+        };
+        (0..nz)
+            .into_par_iter()
+            .map(|k| {
+                let mut faces = 0;
+                for j in 0..ny {
+                    let r = row(j, k);
+                    // Along x: changes between neighbours, the ends against
+                    // the outside (padding bits are zero).
+                    let mut carry = 0;
+                    for &x in r {
+                        faces += u64::from((x ^ ((x << 1) | carry)).count_ones());
+                        carry = x >> 63;
+                    }
+                    faces += carry;
+                    faces += differ(r, (j + 1 < ny).then(|| row(j + 1, k)));
+                    faces += differ(r, k.checked_sub(1).map(|b| row(j, b)));
+                    if j == 0 {
+                        faces += differ(r, None);
+                    }
+                    if k + 1 == nz {
+                        faces += differ(r, None);
+                    }
+                }
+                faces
+            })
+            .collect()
+    }
+
     /// Calls `f(i, j, k)` for every set voxel, in order of `k`, then `j`, then `i`.
     pub fn for_each_set(&self, mut f: impl FnMut(u32, u32, u32)) {
         let wpr = self.words_per_row;
@@ -268,6 +312,39 @@ impl super::VoxelSource for DenseBits {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn boundary_faces_count_every_face_against_the_outside() {
+        for dims in [[1, 1, 1], [5, 3, 2], [64, 2, 3], [70, 4, 5]] {
+            let mut b = DenseBits::new(dims);
+            let mut brute = 0;
+            let mut x = 7u64;
+            for k in 0..dims[2] {
+                for j in 0..dims[1] {
+                    for i in 0..dims[0] {
+                        x = x.wrapping_mul(6364136223846793005).wrapping_add(1);
+                        if x >> 62 != 0 {
+                            b.set(i, j, k);
+                        }
+                    }
+                }
+            }
+            let set = |i: i64, j: i64, k: i64| b.get_signed(i, j, k);
+            for k in 0..dims[2] as i64 {
+                for j in 0..dims[1] as i64 {
+                    for i in 0..dims[0] as i64 {
+                        if set(i, j, k) {
+                            brute += [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
+                                .iter()
+                                .filter(|d| !set(i + d.0, j + d.1, k + d.2))
+                                .count() as u64;
+                        }
+                    }
+                }
+            }
+            assert_eq!(b.boundary_faces(), brute, "{dims:?}");
+        }
+    }
     use super::*;
 
     #[test]

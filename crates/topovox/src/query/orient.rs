@@ -105,9 +105,10 @@ impl Oriented {
 /// Orients `mesh`'s triangles (see the module doc).
 pub fn orient(mesh: MeshRef<'_>) -> Oriented {
     let (ids, points) = vertex_ids(mesh);
-    let edges = sorted_edges(&ids);
+    let copy_of = copies(&ids);
+    let edges = sorted_edges(&ids, &copy_of);
     let links = links(&ids, &edges);
-    let walk = walk(&links);
+    let walk = walk(&links, &ids, &copy_of);
     let mut parts = measure(mesh, &walk);
     mark_open(&edges, &points, &walk, &mut parts);
     drop((edges, links, points));
@@ -116,7 +117,7 @@ pub fn orient(mesh: MeshRef<'_>) -> Oriented {
         let volume = part.closing_volume();
         part.outward = volume < 0.0 || (volume == 0.0 && 2.0 * part.agree < part.area);
     }
-    let depth = nesting(mesh, &ids, &walk.part, &flip, &parts);
+    let depth = nesting(mesh, &ids, &copy_of, &walk.part, &flip, &parts);
     let mut report = OrientReport { inconsistent_edges: walk.conflicts, ..OrientReport::default() };
     for (p, part) in parts.iter_mut().enumerate() {
         if part.area == 0.0 {
@@ -177,6 +178,32 @@ fn vertex_ids(mesh: MeshRef<'_>) -> (Vec<[u32; 3]>, Vec<DVec3>) {
     (ids, points)
 }
 
+/// For each triangle, the lowest-numbered triangle on the same three
+/// vertices (itself when it is the first; [`NONE`] when invalid): copies
+/// (a shell given twice, doubled faces) follow their first and make no
+/// edge non-manifold.
+fn copies(ids: &[[u32; 3]]) -> Vec<u32> {
+    let mut first: FxHashMap<[u32; 3], u32> = FxHashMap::default();
+    ids.iter()
+        .enumerate()
+        .map(|(t, v)| {
+            if v[0] == NONE {
+                return NONE;
+            }
+            let mut key = *v;
+            key.sort_unstable();
+            *first.entry(key).or_insert(t as u32)
+        })
+        .collect()
+}
+
+/// Whether triangle `b` runs its vertices the other way round from `a`
+/// (both on the same three vertices).
+fn reversed(a: [u32; 3], b: [u32; 3]) -> bool {
+    let turn = |v: [u32; 3], k: usize| [v[k], v[(k + 1) % 3], v[(k + 2) % 3]];
+    !(0..3).any(|k| turn(b, k) == a)
+}
+
 /// One use of an edge: its vertices `(lo, hi)`, the triangle, and
 /// whether the triangle goes from `lo` to `hi`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -195,16 +222,17 @@ impl EdgeUse {
     }
 }
 
-/// Every edge use of every valid triangle (edges between distinct
-/// vertices), sorted by edge.
-fn sorted_edges(ids: &[[u32; 3]]) -> Vec<EdgeUse> {
+/// Every edge use of every valid triangle that is not a copy (edges
+/// between distinct vertices), sorted by edge.
+fn sorted_edges(ids: &[[u32; 3]], copy_of: &[u32]) -> Vec<EdgeUse> {
     let mut edges: Vec<EdgeUse> = ids
         .par_iter()
         .enumerate()
         .flat_map_iter(|(t, v)| {
+            let first = copy_of[t] == t as u32;
             (0..3).filter_map(move |e| {
                 let (a, b) = (v[e], v[(e + 1) % 3]);
-                (a != NONE && a != b).then(|| {
+                (first && a != b).then(|| {
                     let (lo, hi) = if a < b { (a, b) } else { (b, a) };
                     EdgeUse { key: (u64::from(lo) << 32) | u64::from(hi), use_: ((t as u32) << 1) | u32::from(a < b) }
                 })
@@ -257,13 +285,14 @@ struct Walk {
     conflicts: u64,
 }
 
-/// Breadth-first over the links from each part's lowest triangle.
-fn walk(links: &[[Option<Link>; 3]]) -> Walk {
+/// Breadth-first over the links from each part's lowest triangle; a copy
+/// takes its first's part and turns the same way.
+fn walk(links: &[[Option<Link>; 3]], ids: &[[u32; 3]], copy_of: &[u32]) -> Walk {
     let n = links.len();
     let mut w = Walk { part: vec![NONE; n], flip: vec![false; n], parts: 0, conflicts: 0 };
     let mut queue = std::collections::VecDeque::new();
     for seed in 0..n {
-        if w.part[seed] != NONE {
+        if w.part[seed] != NONE || copy_of[seed] != seed as u32 {
             continue;
         }
         let p = w.parts as u32;
@@ -282,6 +311,13 @@ fn walk(links: &[[Option<Link>; 3]]) -> Walk {
                     w.conflicts += 1;
                 }
             }
+        }
+    }
+    for t in 0..n {
+        let first = copy_of[t] as usize;
+        if copy_of[t] != NONE && first != t {
+            w.part[t] = w.part[first];
+            w.flip[t] = w.flip[first] ^ reversed(ids[first], ids[t]);
         }
     }
     w
@@ -383,7 +419,7 @@ fn mark_open(edges: &[EdgeUse], points: &[DVec3], walk: &Walk, parts: &mut [Part
 }
 
 /// How many other closed parts contain each part (0 for open parts).
-fn nesting(mesh: MeshRef<'_>, ids: &[[u32; 3]], part: &[u32], flip: &[bool], parts: &[Part]) -> Vec<u32> {
+fn nesting(mesh: MeshRef<'_>, ids: &[[u32; 3]], copy_of: &[u32], part: &[u32], flip: &[bool], parts: &[Part]) -> Vec<u32> {
     let mut depth = vec![0u32; parts.len()];
     let closed: Vec<bool> = parts.iter().map(|p| p.closed && p.area > 0.0).collect();
     if closed.iter().filter(|&&c| c).count() < 2 {
@@ -395,7 +431,8 @@ fn nesting(mesh: MeshRef<'_>, ids: &[[u32; 3]], part: &[u32], flip: &[bool], par
     let mut owner = vec![NONE; vertices];
     let mut shared = vec![false; vertices];
     for (t, &p) in part.iter().enumerate() {
-        if p == NONE || !closed[p as usize] {
+        // Copies would cross every ray twice: parity needs each face once.
+        if p == NONE || !closed[p as usize] || copy_of[t] != t as u32 {
             continue;
         }
         members[p as usize].push(t as u32);
@@ -472,4 +509,126 @@ fn odd_tags(index: &RayIndex, q: DVec3, skip: u32) -> Vec<u32> {
         }
     }
     odd
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Mesh;
+
+    fn cube(lo: f64, hi: f64) -> Mesh {
+        let positions = (0..8)
+            .map(|c| DVec3::new(if c & 1 == 1 { hi } else { lo }, if c & 2 == 2 { hi } else { lo }, if c & 4 == 4 { hi } else { lo }))
+            .collect();
+        let q = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let triangles = q.iter().flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]]).collect();
+        Mesh { positions, triangles, segments: Vec::new() }
+    }
+
+    fn joined(a: &Mesh, b: &Mesh) -> Mesh {
+        let mut m = a.clone();
+        let base = m.positions.len() as u32;
+        m.positions.extend(&b.positions);
+        m.triangles.extend(b.triangles.iter().map(|t| t.map(|i| i + base)));
+        m
+    }
+
+    fn volume(m: &Mesh, tris: &[[u32; 3]]) -> f64 {
+        tris.iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| m.positions[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    #[test]
+    fn a_cube_with_faces_flipped_comes_back_outward() {
+        let clean = cube(0.0, 1.0);
+        assert!((volume(&clean, &clean.triangles) - 1.0).abs() < 1e-12);
+        for mask in [0u32, 0b1, 0b1010_0101, 0xfff] {
+            let mut m = clean.clone();
+            for (t, tri) in m.triangles.iter_mut().enumerate() {
+                if mask >> t & 1 == 1 {
+                    tri.swap(1, 2);
+                }
+            }
+            let o = orient(m.as_ref());
+            assert_eq!(o.report.faces_reoriented, u64::from(mask.count_ones()), "{mask:b}");
+            assert_eq!((o.report.parts, o.report.closed_parts, o.report.sheets), (1, 1, 0));
+            assert!((volume(&m, &o.triangles) - 1.0).abs() < 1e-12, "{mask:b}");
+        }
+    }
+
+    #[test]
+    fn nesting_turns_inner_shells_inward_and_duplicates_stay_outward() {
+        let (outer, inner, core) = (cube(0.0, 4.0), cube(1.0, 3.0), cube(1.5, 2.5));
+        let all = joined(&joined(&outer, &inner), &core);
+        let o = orient(all.as_ref());
+        assert_eq!((o.report.closed_parts, o.report.nested_parts), (3, 1));
+        // 64 − 8 + 1: the cavity between the inner boxes is taken out.
+        assert!((volume(&all, &o.triangles) - 57.0).abs() < 1e-9);
+        // The same shell twice (a copy, some faces of it reversed) is one
+        // part, both copies outward: not nested in itself.
+        let mut twice = joined(&outer, &outer);
+        twice.triangles[15].swap(0, 1);
+        let o = orient(twice.as_ref());
+        assert_eq!((o.report.parts, o.report.closed_parts, o.report.nested_parts), (1, 1, 0));
+        assert!((volume(&twice, &o.triangles) - 128.0).abs() < 1e-9);
+        // Overlapping boxes are not nested.
+        let shifted = {
+            let mut m = cube(0.0, 4.0);
+            m.transform(|p| p + DVec3::new(2.0, 1.0, 0.5));
+            m
+        };
+        assert_eq!(orient(joined(&outer, &shifted).as_ref()).report.nested_parts, 0);
+    }
+
+    #[test]
+    fn sheets_and_open_boxes() {
+        let sheet = Mesh {
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.1)],
+            triangles: vec![[0, 1, 3], [0, 3, 2]],
+            segments: Vec::new(),
+        };
+        let o = orient(sheet.as_ref());
+        assert_eq!((o.report.parts, o.report.sheets), (1, 1));
+        assert!(!o.report.encloses_volume());
+        // A box without its lid encloses volume; its walk agrees.
+        let mut open = cube(0.0, 1.0);
+        open.triangles.remove(3);
+        open.triangles.remove(2);
+        open.triangles[0].swap(1, 2);
+        let o = orient(open.as_ref());
+        assert_eq!((o.report.parts, o.report.closed_parts, o.report.sheets, o.report.faces_reoriented), (1, 0, 0, 1));
+        assert!(o.report.encloses_volume());
+        // Nothing valid: no parts, nothing refused.
+        let none = Mesh { positions: vec![DVec3::ZERO], triangles: vec![[0, 0, 0], [0, 5, 6]], segments: Vec::new() };
+        let o = orient(none.as_ref());
+        assert_eq!(o.report.parts, 0);
+        assert_eq!(o.triangles, none.triangles);
+    }
+
+    #[test]
+    fn a_moebius_band_keeps_one_inconsistent_edge() {
+        let n = 12;
+        let mut positions = Vec::new();
+        for s in 0..n {
+            let a = s as f64 / n as f64 * std::f64::consts::TAU;
+            for w in [-0.2, 0.2] {
+                let r = 1.0 + w * (a / 2.0).cos();
+                positions.push(DVec3::new(r * a.cos(), r * a.sin(), w * (a / 2.0).sin()));
+            }
+        }
+        let mut triangles = Vec::new();
+        for s in 0..n {
+            let (a0, a1) = (2 * s as u32, 2 * s as u32 + 1);
+            // The last strip joins the first one turned over.
+            let (b0, b1) = if s + 1 == n { (1, 0) } else { (a0 + 2, a1 + 2) };
+            triangles.push([a0, b0, b1]);
+            triangles.push([a0, b1, a1]);
+        }
+        let o = orient(Mesh { positions, triangles, segments: Vec::new() }.as_ref());
+        assert_eq!((o.report.parts, o.report.closed_parts, o.report.inconsistent_edges), (1, 0, 1));
+    }
 }
