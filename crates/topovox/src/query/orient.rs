@@ -105,8 +105,14 @@ impl Oriented {
 /// Orients `mesh`'s triangles (see the module doc).
 pub fn orient(mesh: MeshRef<'_>) -> Oriented {
     let (ids, points) = vertex_ids(mesh);
-    let copy_of = copies(&ids);
-    let edges = sorted_edges(&ids, &copy_of);
+    let mut copy_of: Vec<u32> = ids.iter().enumerate().map(|(t, v)| if v[0] == NONE { NONE } else { t as u32 }).collect();
+    let mut edges = sorted_edges(&ids, &copy_of);
+    // Copies can only make an edge have more than two uses (or pair up
+    // alone, harmlessly): a manifold mesh skips looking for them.
+    if groups(&edges).any(|g| g.len() > 2) {
+        copy_of = copies(&ids);
+        edges = sorted_edges(&ids, &copy_of);
+    }
     let links = links(&ids, &edges);
     let walk = walk(&links, &ids, &copy_of);
     let mut parts = measure(mesh, &walk);
@@ -156,23 +162,30 @@ pub fn orient(mesh: MeshRef<'_>) -> Oriented {
 /// (`−0` as `+0`), [`NONE`] for a triangle with an index out of range or a
 /// corner that is not finite; and each number's point.
 fn vertex_ids(mesh: MeshRef<'_>) -> (Vec<[u32; 3]>, Vec<DVec3>) {
-    let mut numbers: FxHashMap<[u64; 3], u32> = FxHashMap::default();
+    // The finite positions sorted by coordinates (in parallel): equal ones
+    // become neighbours and share the first's number.
+    let key = |q: DVec3| q.to_array().map(|v| (v + 0.0).to_bits());
+    let mut order: Vec<([u64; 3], u32)> =
+        mesh.positions.par_iter().enumerate().filter(|(_, q)| q.is_finite()).map(|(i, &q)| (key(q), i as u32)).collect();
+    order.par_sort_unstable();
+    let mut number = vec![NONE; mesh.positions.len()];
     let mut points = Vec::new();
+    for run in order.chunk_by(|a, b| a.0 == b.0) {
+        for &(_, i) in run {
+            number[i as usize] = points.len() as u32;
+        }
+        points.push(mesh.positions[run[0].1 as usize]);
+    }
     let ids = mesh
         .triangles
-        .iter()
+        .par_iter()
         .map(|t| {
-            let p = |i: u32| mesh.positions.get(i as usize).copied().filter(|p| p.is_finite());
-            let (Some(a), Some(b), Some(c)) = (p(t[0]), p(t[1]), p(t[2])) else {
-                return [NONE; 3];
-            };
-            [a, b, c].map(|q| {
-                let key = q.to_array().map(|v| (v + 0.0).to_bits());
-                *numbers.entry(key).or_insert_with(|| {
-                    points.push(q);
-                    (points.len() - 1) as u32
-                })
-            })
+            let v = t.map(|i| number.get(i as usize).copied().unwrap_or(NONE));
+            if v.contains(&NONE) {
+                [NONE; 3]
+            } else {
+                v
+            }
         })
         .collect();
     (ids, points)
@@ -398,7 +411,14 @@ fn measure(mesh: MeshRef<'_>, walk: &Walk) -> Vec<Part> {
 /// other (in the walk's orientation), and sums those edges' end points.
 fn mark_open(edges: &[EdgeUse], points: &[DVec3], walk: &Walk, parts: &mut [Part]) {
     let mut net: Vec<(u32, i32)> = Vec::new();
+    let way = |u: &EdgeUse| if u.forward() ^ walk.flip[u.triangle()] { 1 } else { -1 };
     for g in groups(edges) {
+        // Most edges: two uses in one part, opposite ways.
+        if let [a, b] = g {
+            if walk.part[a.triangle()] == walk.part[b.triangle()] && way(a) + way(b) == 0 {
+                continue;
+            }
+        }
         net.clear();
         for u in g {
             let t = u.triangle();
