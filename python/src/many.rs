@@ -209,9 +209,7 @@ fn measure(data: &GridData, mesh: &topovox_io::LoadedMesh, features: &[Feature])
     let width: usize = features.iter().map(|f| f.width()).sum();
     let mut out = Vec::with_capacity(order.len() * width);
     let query = if features.contains(&Feature::Sdf) {
-        let q = topovox::query::Query::new(mesh.mesh.as_ref(), topovox::query::Sign::Auto).map_err(|e| JobError::invalid(e.to_string()))?;
-        topovox_job::has_volume("the sdf feature", q.facts().orientation)?;
-        Some(q)
+        Some(topovox::query::Query::new(mesh.mesh.as_ref(), topovox::query::Sign::Auto).map_err(|e| JobError::invalid(e.to_string()))?)
     } else {
         None
     };

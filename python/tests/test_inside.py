@@ -110,16 +110,20 @@ def test_overlapping_shells_give_their_union_and_nested_ones_cavities():
 def test_sheets_are_refused_and_wrapped(tmp_path, cli):
     sheet = wavy_sheet()
     path = tmp_path / "sheet.obj"
-    path.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in sheet.vertices) + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in sheet.faces))
+    path.write_text("".join(f"v {float(x)!r} {float(y)!r} {float(z)!r}\n" for x, y, z in sheet.vertices) + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in sheet.faces))
     for args in (["voxelize", str(path), "-o", str(tmp_path / "s.npy"), "--mode", "solid"],
                  ["sdf", str(path), "-o", str(tmp_path / "s.vdb")],
-                 ["sample", str(path), "-o", str(tmp_path / "s.npz")],
                  ["remesh", str(path), "-o", str(tmp_path / "s.obj")]):
         r = subprocess.run([str(cli), *args], capture_output=True, text=True)
         assert r.returncode != 0 and len(r.stderr.strip().splitlines()) == 1, (args, r.stderr)
         assert "encloses no volume" in r.stderr and "--inside wrap" in r.stderr, r.stderr
     with pytest.raises(ValueError, match="inside wrap"):
         topovox.voxelize(sheet, mode="solid", resolution=32)
+    # Samples keep their exact distances and say the signs are a guess.
+    r = subprocess.run([str(cli), "sample", str(path), "-o", str(tmp_path / "s.npz"), "--json"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    info = json.loads(r.stdout)
+    assert any("encloses no volume" in w for w in info["warnings"]) and info["orientation"]["sheets"] == 1, info
     for res in (64, 128):
         r = subprocess.run([str(cli), "remesh", str(path), "-o", str(tmp_path / "w.obj"), "--inside", "wrap", "--resolution", str(res), "--check", "--json"],
                            capture_output=True, text=True)

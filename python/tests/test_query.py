@@ -44,7 +44,9 @@ def test_distances_equal_the_analytic_box_sdf(seed):
     assert np.allclose(np.linalg.norm(pts - p @ r.T, axis=1), np.abs(want), atol=1e-9)
     corners = (v @ r.T)[f[tri]]
     assert np.allclose(np.einsum("nk,nkj->nj", bary, corners), pts, atol=1e-9)
-    assert q.facts["watertight"] and q.facts["sign"] == "parity"
+    # A closed mesh: auto is the nonzero winding number of the oriented mesh.
+    assert q.facts["watertight"] and q.facts["sign"] == "winding"
+    assert q.facts["orientation"]["closed_parts"] == 1 and q.facts["orientation"]["faces_reoriented"] == 0
 
 
 def dyadic(mesh, res):

@@ -159,7 +159,7 @@ def test_random_rotations_and_soups(meshes):
             try:
                 out = topovox.remesh(soup, resolution=16, inside=inside, surface="smooth")
             except ValueError as e:
-                assert inside != "wrap" and "nothing to close" in str(e)
+                assert inside != "wrap" and ("nothing to close" in str(e) or "encloses no volume" in str(e))
                 continue
             certify(out)
 

@@ -169,7 +169,6 @@ pub fn sample(loaded: &topovox_io::LoadedMesh, name: &str, options: &SampleOptio
     let moved: Vec<DVec3> = mesh.positions.iter().map(|&p| (p - offset) * scale).collect();
     let m = MeshRef { positions: &moved, triangles: mesh.triangles, segments: mesh.segments };
     let q = Query::new(m, o.sign.into()).map_err(|e| JobError::invalid(format!("{name}: {e}")))?;
-    crate::solid::has_volume(name, q.facts().orientation)?;
     let built = t.elapsed().as_secs_f64();
     let bounds = match &o.bounds {
         Some(b) => (DVec3::new(b[0], b[1], b[2]), DVec3::new(b[3], b[4], b[5])),
@@ -206,6 +205,14 @@ fn colours(mesh: MeshRef<'_>, app: &topovox::attributes::Appearance, samples: &S
 }
 
 impl Sampled {
+    /// The warning for a mesh of sheets only: its points and distances
+    /// are exact, its signs a guess (solids refuse it).
+    pub fn sign_warning(&self, name: &str) -> Option<String> {
+        crate::solid::has_volume(name, self.facts.orientation)
+            .err()
+            .map(|_| format!("{name}: encloses no volume (only open sheets): distances are exact, but the signs and occupancy are the generalized winding number's guess"))
+    }
+
     /// The facts of a summary: counts, the rule, normalization, times.
     pub fn summary(&self) -> Value {
         let kinds = |k: u8| self.samples.kind.iter().filter(|&&x| x as u8 == k).count();
@@ -218,6 +225,7 @@ impl Sampled {
             "sign": Sign::from(self.facts.sign).name(),
             "watertight": self.facts.watertight,
             "boundary_cycles": self.facts.cycles,
+            "orientation": self.facts.orientation.map(crate::facts::OrientFacts::from),
             "offset": self.offset.to_array(), "scale": self.scale,
             "bounds": [self.bounds.0.to_array(), self.bounds.1.to_array()],
             "times": {"query_s": self.seconds.0, "sample_s": self.seconds.1},

@@ -27,6 +27,13 @@ pub fn run(a: &SampleArgs) -> Result<()> {
     let write_s = t.elapsed().as_secs_f64();
     bar.finish();
     let total_s = t_total.elapsed().as_secs_f64();
+    let mut warnings = loaded.warnings.clone();
+    warnings.extend(s.sign_warning(&name));
+    if !a.json {
+        for w in &warnings[loaded.warnings.len()..] {
+            crate::console::warn(w);
+        }
+    }
     if a.json {
         let extra = json!({
             "load_s": load_s,
@@ -38,7 +45,7 @@ pub fn run(a: &SampleArgs) -> Result<()> {
             "format": "npz",
             "peak_memory_bytes": topovox_job::peak_memory(),
             "mesh": {"vertices": loaded.report.vertices, "triangles": loaded.report.triangles, "segments": loaded.report.segments},
-            "warnings": loaded.warnings,
+            "warnings": warnings,
         });
         let j = crate::console::summary_json(s.summary(), extra);
         crate::console::print_stdout(&j.to_string())?;

@@ -304,8 +304,8 @@ fn walk(links: &[[Option<Link>; 3]], ids: &[[u32; 3]], copy_of: &[u32]) -> Walk 
     let n = links.len();
     let mut w = Walk { part: vec![NONE; n], flip: vec![false; n], parts: 0, conflicts: 0 };
     let mut queue = std::collections::VecDeque::new();
-    for seed in 0..n {
-        if w.part[seed] != NONE || copy_of[seed] != seed as u32 {
+    for (seed, &first) in copy_of.iter().enumerate() {
+        if w.part[seed] != NONE || first != seed as u32 {
             continue;
         }
         let p = w.parts as u32;
@@ -326,9 +326,9 @@ fn walk(links: &[[Option<Link>; 3]], ids: &[[u32; 3]], copy_of: &[u32]) -> Walk 
             }
         }
     }
-    for t in 0..n {
-        let first = copy_of[t] as usize;
-        if copy_of[t] != NONE && first != t {
+    for (t, &first) in copy_of.iter().enumerate() {
+        let first = first as usize;
+        if first != NONE as usize && first != t {
             w.part[t] = w.part[first];
             w.flip[t] = w.flip[first] ^ reversed(ids[first], ids[t]);
         }
