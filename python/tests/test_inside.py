@@ -84,6 +84,12 @@ def test_flipped_faces_give_the_clean_solid(meshes):
         out = topovox.remesh(m, resolution=32, check=True, info=info)
         assert info["certificate"]["watertight"] and info["parts"] == 1
         no_self_intersection(out)
+    # voxelize_many's solids too: the flipped item equals the clean one.
+    batch = topovox.voxelize_many([spot, flipped(spot, 0.3, 9)], mode="solid", resolution=32)
+    n = batch.offsets
+    assert n[1] - n[0] == n[2] - n[1] > 0
+    coords = np.asarray(batch.coords)
+    assert np.array_equal(coords[n[0] : n[1], 1:], coords[n[1] : n[2], 1:])
 
 
 def test_overlapping_shells_give_their_union_and_nested_ones_cavities():

@@ -99,8 +99,10 @@ pub fn query_bytes(mesh: MeshRef<'_>) -> u64 {
 }
 
 /// Bytes per triangle a sparse solid holds beyond a tiled surface: the
-/// snapped triangles, the copy closed by caps, and their band bins.
-const SOLID_BYTES_PER_TRIANGLE: u64 = 160;
+/// snapped triangles, the copy closed by caps, their band bins, and the
+/// oriented triangles the winding rules decide on (12; orienting's own
+/// scratch, about 130 a triangle, is freed before the solid starts).
+const SOLID_BYTES_PER_TRIANGLE: u64 = 172;
 
 /// Bytes per surface brick a sparse solid holds beyond a tiled surface:
 /// the runs of full bricks between them, and one band's ray crossings and

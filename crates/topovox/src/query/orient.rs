@@ -629,6 +629,38 @@ mod tests {
         assert_eq!(o.triangles, none.triangles);
     }
 
+    /// Random meshes over a few vertices (non-manifold edges, copies,
+    /// degenerate and invalid triangles, a NaN): no panic, every valid
+    /// triangle kept with its own vertices, and the same answer for the
+    /// same input.
+    #[test]
+    fn hostile_meshes_are_oriented_without_panics() {
+        let mut x = 11u64;
+        let mut next = |n: u64| {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (x >> 33) % n
+        };
+        for round in 0..300 {
+            let nv = 3 + next(8) as u32;
+            let mut positions: Vec<DVec3> = (0..nv).map(|_| DVec3::new(next(3) as f64, next(3) as f64, next(3) as f64)).collect();
+            if round % 7 == 0 {
+                positions[0].x = f64::NAN;
+            }
+            let triangles: Vec<[u32; 3]> =
+                (0..1 + next(40)).map(|_| [next(nv as u64 + 1) as u32, next(nv as u64) as u32, next(nv as u64) as u32]).collect();
+            let m = Mesh { positions, triangles, segments: Vec::new() };
+            let o = orient(m.as_ref());
+            assert_eq!(o.triangles.len(), m.triangles.len());
+            for (a, b) in m.triangles.iter().zip(&o.triangles) {
+                let (mut a, mut b) = (*a, *b);
+                a.sort_unstable();
+                b.sort_unstable();
+                assert_eq!(a, b);
+            }
+            assert_eq!(orient(m.as_ref()).triangles, o.triangles);
+        }
+    }
+
     #[test]
     fn a_moebius_band_keeps_one_inconsistent_edge() {
         let n = 12;
