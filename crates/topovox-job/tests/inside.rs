@@ -278,11 +278,56 @@ fn sheets_are_refused_in_one_line_naming_wrap() {
     let mut p = || DVec3::new(r.unit(), r.unit(), r.unit());
     let tris: Vec<[DVec3; 3]> = (0..40).map(|_| [p(), p(), p()]).collect();
     let soup = topovox_testkit::soup(&tris);
-    for (name, m) in [("a sheet", sheet), ("a soup of sheets", soup)] {
+    // Waves up to half the sheet's width: pockets on both sides.
+    let wavy = height_field(40, |x, y| 0.5 * (6.0 * x).sin() * (5.0 * y).cos());
+    let pockets = joined(&[wavy.clone(), {
+        let mut w = wavy.clone();
+        w.transform(|p| p + DVec3::new(1.5, 0.2, 0.1));
+        w
+    }]);
+    for (name, m) in [("a sheet", sheet), ("a soup of sheets", soup), ("a wavy sheet", wavy), ("two wavy sheets", pockets)] {
         let grid = GridSpec::from_resolution(&m.as_ref().bounds(), 16).unwrap();
         for e in [auto_solid(&m, &grid, 1).err(), sdf_inside(&m, &grid).err()] {
             let e = e.unwrap_or_else(|| panic!("{name}: not refused")).to_string();
             assert!(e.contains("encloses no volume") && e.contains("--inside wrap") && !e.contains('\n'), "{name}: {e}");
         }
+    }
+}
+
+/// A sheet `z = f(x, y)` over the unit square, `n × n` vertices.
+fn height_field(n: u32, f: impl Fn(f64, f64) -> f64) -> Mesh {
+    let mut m = Mesh::default();
+    for r in 0..n {
+        for c in 0..n {
+            let (x, y) = (f64::from(c) / f64::from(n - 1), f64::from(r) / f64::from(n - 1));
+            m.positions.push(DVec3::new(x, y, f(x, y)));
+        }
+    }
+    for r in 0..n - 1 {
+        for c in 0..n - 1 {
+            let a = r * n + c;
+            m.triangles.push([a, a + 1, a + n]);
+            m.triangles.push([a + 1, a + n + 1, a + n]);
+        }
+    }
+    m
+}
+
+/// Open surfaces that wrap around some volume are not sheets: a half
+/// pipe, a hemisphere and the bunny keep the generalized winding number.
+#[test]
+fn open_surfaces_around_a_volume_are_not_sheets() {
+    let pipe = height_field(30, |_, _| 0.0);
+    let mut pipe = pipe;
+    pipe.transform(|p| {
+        let a = p.x * std::f64::consts::PI;
+        DVec3::new(a.cos(), a.sin(), 3.0 * p.y)
+    });
+    let mut dome = sphere(DVec3::ZERO, 1.0, 24);
+    dome.triangles.retain(|t| t.iter().map(|&i| dome.positions[i as usize].z).sum::<f64>() > 0.0);
+    for (name, m) in [("a half pipe", pipe), ("a hemisphere", dome), ("the bunny", shared_mesh("stanford-bunny.obj"))] {
+        let grid = GridSpec::from_resolution(&m.as_ref().bounds(), 24).unwrap();
+        let solid = auto_solid(&m, &grid, 2).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(solid.count() > 0, "{name}: empty");
     }
 }
