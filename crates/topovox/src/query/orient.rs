@@ -127,7 +127,7 @@ pub fn orient(mesh: MeshRef<'_>) -> Oriented {
     let mut flip = walk.flip;
     for part in &mut parts {
         let volume = part.closing_volume();
-        part.outward = volume < 0.0 || (volume == 0.0 && 2.0 * part.agree < part.area);
+        part.reverse = volume < 0.0 || (volume == 0.0 && 2.0 * part.agree < part.area);
     }
     let depth = nesting(mesh, &ids, &copy_of, &walk.part, &flip, &parts);
     let mut report = OrientReport { inconsistent_edges: walk.conflicts, ..OrientReport::default() };
@@ -140,7 +140,7 @@ pub fn orient(mesh: MeshRef<'_>) -> Oriented {
             report.closed_parts += 1;
             if depth[p] % 2 == 1 {
                 report.nested_parts += 1;
-                part.outward = !part.outward;
+                part.reverse = !part.reverse;
             }
         } else if part.sheet() {
             report.sheets += 1;
@@ -153,7 +153,7 @@ pub fn orient(mesh: MeshRef<'_>) -> Oriented {
             triangles.push(*tri);
             continue;
         }
-        flip[t] ^= parts[p as usize].outward;
+        flip[t] ^= parts[p as usize].reverse;
         if flip[t] {
             report.faces_reoriented += 1;
             triangles.push([tri[0], tri[2], tri[1]]);
@@ -357,7 +357,7 @@ struct Part {
     /// The sum and number of its boundary edges' end points.
     boundary: (DVec3, u32),
     /// Reverse the whole part (outward by volume, then by nesting).
-    outward: bool,
+    reverse: bool,
 }
 
 impl Part {
@@ -389,7 +389,7 @@ fn measure(mesh: MeshRef<'_>, walk: &Walk) -> Vec<Part> {
         bounds: Aabb::EMPTY,
         closed: true,
         boundary: (DVec3::ZERO, 0),
-        outward: false,
+        reverse: false,
     };
     let mut parts = vec![empty; walk.parts];
     for (t, tri) in mesh.triangles.iter().enumerate() {
