@@ -123,13 +123,13 @@ pub fn orient(mesh: MeshRef<'_>) -> Oriented {
     let walk = walk(&links, &ids, &copy_of);
     let mut parts = measure(mesh, &walk);
     mark_open(&edges, &points, &walk, &mut parts);
-    drop((edges, links, points));
+    drop((edges, links));
     let mut flip = walk.flip;
     for part in &mut parts {
         let volume = part.closing_volume();
         part.reverse = volume < 0.0 || (volume == 0.0 && 2.0 * part.agree < part.area);
     }
-    let depth = nesting(mesh, &ids, &copy_of, &walk.part, &flip, &parts);
+    let depth = nesting(&points, &ids, &copy_of, &walk.part, &flip, &parts);
     let mut report = OrientReport { inconsistent_edges: walk.conflicts, ..OrientReport::default() };
     for (p, part) in parts.iter_mut().enumerate() {
         if part.area == 0.0 {
@@ -447,7 +447,7 @@ fn mark_open(edges: &[EdgeUse], points: &[DVec3], walk: &Walk, parts: &mut [Part
 }
 
 /// How many other closed parts contain each part (0 for open parts).
-fn nesting(mesh: MeshRef<'_>, ids: &[[u32; 3]], copy_of: &[u32], part: &[u32], flip: &[bool], parts: &[Part]) -> Vec<u32> {
+fn nesting(points: &[DVec3], ids: &[[u32; 3]], copy_of: &[u32], part: &[u32], flip: &[bool], parts: &[Part]) -> Vec<u32> {
     let mut depth = vec![0u32; parts.len()];
     let closed: Vec<bool> = parts.iter().map(|p| p.closed && p.area > 0.0).collect();
     if closed.iter().filter(|&&c| c).count() < 2 {
@@ -455,9 +455,8 @@ fn nesting(mesh: MeshRef<'_>, ids: &[[u32; 3]], copy_of: &[u32], part: &[u32], f
     }
     // Members of each closed part, and vertices shared by closed parts.
     let mut members: Vec<Vec<u32>> = vec![Vec::new(); parts.len()];
-    let vertices = ids.iter().flatten().filter(|&&v| v != NONE).max().map_or(0, |&v| v as usize + 1);
-    let mut owner = vec![NONE; vertices];
-    let mut shared = vec![false; vertices];
+    let mut owner = vec![NONE; points.len()];
+    let mut shared = vec![false; points.len()];
     for (t, &p) in part.iter().enumerate() {
         // Copies would cross every ray twice: parity needs each face once.
         if p == NONE || !closed[p as usize] || copy_of[t] != t as u32 {
@@ -474,7 +473,7 @@ fn nesting(mesh: MeshRef<'_>, ids: &[[u32; 3]], copy_of: &[u32], part: &[u32], f
         }
     }
     let corners = |t: usize| {
-        let [a, b, c] = mesh.triangles[t].map(|i| mesh.positions[i as usize]);
+        let [a, b, c] = ids[t].map(|v| points[v as usize]);
         if flip[t] {
             [a, c, b]
         } else {
@@ -486,26 +485,19 @@ fn nesting(mesh: MeshRef<'_>, ids: &[[u32; 3]], copy_of: &[u32], part: &[u32], f
         let mut own: Vec<u32> = members[p].iter().flat_map(|&t| ids[t as usize]).filter(|&v| !shared[v as usize]).collect();
         own.sort_unstable();
         own.dedup();
-        *d = containers(&index, p as u32, &own, &members[p], ids, mesh, parts);
+        *d = containers(&index, p as u32, &own, points, parts);
     });
     depth
 }
 
 /// How many closed parts other than `p` hold every vertex of `own`
 /// (`p`'s vertices not shared with another closed part).
-fn containers(index: &RayIndex, p: u32, own: &[u32], members: &[u32], ids: &[[u32; 3]], mesh: MeshRef<'_>, parts: &[Part]) -> u32 {
-    // A position of each of p's own vertices.
-    let mut at: FxHashMap<u32, DVec3> = FxHashMap::default();
-    for &t in members {
-        for (c, &v) in ids[t as usize].iter().enumerate() {
-            at.entry(v).or_insert(mesh.positions[mesh.triangles[t as usize][c] as usize]);
-        }
-    }
+fn containers(index: &RayIndex, p: u32, own: &[u32], points: &[DVec3], parts: &[Part]) -> u32 {
     let Some(&first) = own.first() else {
         return 0;
     };
     let bounds = parts[p as usize].bounds;
-    let mut candidates = odd_tags(index, at[&first], p);
+    let mut candidates = odd_tags(index, points[first as usize], p);
     candidates.retain(|&q| {
         let b = parts[q as usize].bounds;
         b.min.cmple(bounds.min).all() && b.max.cmpge(bounds.max).all()
@@ -514,7 +506,7 @@ fn containers(index: &RayIndex, p: u32, own: &[u32], members: &[u32], ids: &[[u3
         if candidates.is_empty() {
             break;
         }
-        let odd = odd_tags(index, at[v], p);
+        let odd = odd_tags(index, points[*v as usize], p);
         candidates.retain(|q| odd.contains(q));
     }
     candidates.len() as u32
