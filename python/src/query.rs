@@ -119,23 +119,12 @@ impl Query {
         d.set_item("boundary_cycles", f.cycles)?;
         d.set_item("sign", sign_name(f.sign))?;
         if let Some(o) = f.orientation {
-            let facts = topovox_job::facts::OrientFacts::from(o);
-            d.set_item("orientation", pythonize_orientation(py, &facts)?)?;
+            // The keys of the JSON summaries, from the same serialization.
+            let facts = serde_json::to_value(topovox_job::facts::OrientFacts::from(o)).map_err(|e| value_err(e.to_string()))?;
+            d.set_item("orientation", to_py(py, &facts)?)?;
         }
         Ok(d)
     }
-}
-
-/// The orientation facts as a dict (the keys of the JSON summaries).
-fn pythonize_orientation<'py>(py: Python<'py>, f: &topovox_job::facts::OrientFacts) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("parts", f.parts)?;
-    d.set_item("closed_parts", f.closed_parts)?;
-    d.set_item("nested_parts", f.nested_parts)?;
-    d.set_item("sheets", f.sheets)?;
-    d.set_item("faces_reoriented", f.faces_reoriented)?;
-    d.set_item("unorientable_edges", f.unorientable_edges)?;
-    Ok(d)
 }
 
 /// The native `topovox.sample`: see its documentation. Returns a dict of arrays.
