@@ -412,7 +412,7 @@ fn inside(
 /// around the grown cover alone; `None` when some part encloses volume.
 fn wrap_sheets(mesh: MeshRef<'_>, grid: &GridSpec, opts: &Options<'_>) -> Option<(DenseBits, String, SolidFacts, Vec<String>)> {
     let report = topovox::query::orient::orient(mesh).report;
-    if report.parts == 0 || report.encloses_volume() {
+    if !report.only_sheets() {
         return None;
     }
     let cover = voxelize::fast(voxelize::Mode::Cover, mesh, grid, opts).0.to_dense();

@@ -208,9 +208,9 @@ impl Sampled {
     /// The warning for a mesh of sheets only: its points and distances
     /// are exact, its signs a guess (solids refuse it).
     pub fn sign_warning(&self, name: &str) -> Option<String> {
-        crate::solid::has_volume(name, self.facts.orientation)
-            .err()
-            .map(|_| format!("{name}: encloses no volume (only open sheets): distances are exact, but the signs and occupancy are the generalized winding number's guess"))
+        self.facts.orientation.filter(|r| r.only_sheets()).map(|_| {
+            format!("{name}: encloses no volume (only open sheets): distances are exact, but the signs and occupancy are the generalized winding number's guess")
+        })
     }
 
     /// The facts of a summary: counts, the rule, normalization, times.

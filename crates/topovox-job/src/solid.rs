@@ -84,7 +84,7 @@ pub fn oriented(method: SolidMethod, mesh: MeshRef<'_>, name: &str) -> Result<Op
 /// is a sheet (`report` of [`orient`]; `None`: parity, no test).
 pub fn has_volume(name: &str, report: Option<OrientReport>) -> Result<()> {
     match report {
-        Some(r) if r.parts > 0 && !r.encloses_volume() => {
+        Some(r) if r.only_sheets() => {
             let s = if r.sheets == 1 { "" } else { "s" };
             Err(JobError::invalid(format!(
                 "{name}: encloses no volume ({} open sheet{s}, no closed or nearly closed part), so it has no inside: \

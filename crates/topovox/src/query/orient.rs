@@ -89,6 +89,12 @@ impl OrientReport {
     pub fn encloses_volume(&self) -> bool {
         self.parts > self.sheets
     }
+
+    /// Every part with area is a sheet: nothing has an inside (a mesh
+    /// with no part of positive area is not called one).
+    pub fn only_sheets(&self) -> bool {
+        self.parts > 0 && !self.encloses_volume()
+    }
 }
 
 /// A mesh's triangles as [`orient`] turned them.
