@@ -150,13 +150,6 @@ impl DenseBits {
     /// Faces between a set voxel and an unset one or the grid's outside:
     /// the area of the set's boundary, in voxel faces.
     pub fn boundary_faces(&self) -> u64 {
-        self.boundary_faces_by_layer().iter().sum()
-    }
-
-    /// [`DenseBits::boundary_faces`] by `k` layer: a layer's faces across
-    /// `x` and `y`, and across `z` those below it (the last layer also
-    /// those above).
-    pub fn boundary_faces_by_layer(&self) -> Vec<u64> {
         let [_, ny, nz] = self.dims.map(|d| d as usize);
         let w = self.words_per_row;
         let row = |j: usize, k: usize| &self.words[(k * ny + j) * w..(k * ny + j + 1) * w];
@@ -188,7 +181,7 @@ impl DenseBits {
                 }
                 faces
             })
-            .collect()
+            .sum()
     }
 
     /// Calls `f(i, j, k)` for every set voxel, in order of `k`, then `j`, then `i`.
@@ -312,6 +305,7 @@ impl super::VoxelSource for DenseBits {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
 
     #[test]
     fn boundary_faces_count_every_face_against_the_outside() {
@@ -345,7 +339,6 @@ mod tests {
             assert_eq!(b.boundary_faces(), brute, "{dims:?}");
         }
     }
-    use super::*;
 
     #[test]
     fn set_get_count_and_iterate() {
