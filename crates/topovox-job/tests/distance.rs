@@ -5,12 +5,14 @@
 //! every sign rule; the band and `--band all` paths equal where both
 //! store; every thread count byte-identical; bad input refused.
 
+mod common;
+
 use glam::DVec3;
 use proptest::prelude::*;
 use topovox::distance::reference;
 use topovox::Mesh;
 use topovox_job::distance::{sdf, write, DistanceFormat, Sdf, SdfRequest, Sign, Width};
-use topovox_job::{GridOptions, GridRequest, JobError, Method, Mode, Plan, Request};
+use topovox_job::{GridOptions, GridRequest, JobError, Method};
 use topovox_testkit::{box_grid, random_rotation, rng, rotated, shared_mesh, soup, sphere};
 
 fn request(resolution: u64, width: Width, sign: Sign, unsigned: bool) -> SdfRequest {
@@ -48,26 +50,7 @@ fn assert_close(want: &[f64], s: &Sdf, what: &str) {
 
 /// `sdf < 0` exactly on the voxels `--mode solid --method M` sets; how many.
 fn assert_sign_is_solid(mesh: &Mesh, s: &Sdf, method: Method, what: &str) -> usize {
-    let solid = Plan::new(Request {
-        mode: Mode::parse("solid").unwrap(),
-        method,
-        grid: GridRequest::new(&GridOptions {
-            origin: Some(s.grid.origin().to_array().to_vec()),
-            voxel_size: Some(s.grid.voxel_size()),
-            dims: Some(s.grid.dims().map(|d| d as u64).to_vec()),
-            ..GridOptions::default()
-        })
-        .unwrap(),
-        surface: None,
-        fill: None,
-        hollow: None,
-        gpu_path: topovox_job::GpuPath::Compute,
-        seed: 0,
-        tile: None,
-        max_memory: None,
-        writer_bytes_per_brick: 0,
-    })
-    .unwrap();
+    let solid = common::plan_with("solid", method, common::on_grid(&s.grid), None);
     let v = topovox_job::voxelize(&solid, mesh.as_ref(), "mesh", None, None).unwrap().voxels.to_dense();
     let d = s.field.dense();
     let [_, ny, nz] = s.grid.dims().map(|x| x as usize);

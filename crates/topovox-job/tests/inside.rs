@@ -7,11 +7,13 @@
 //! each clean shell (`topovox::voxelize::solid::parity`, which ignores
 //! orientation), OR-ed for unions, of the whole for nesting.
 
+mod common;
+
 use glam::DVec3;
 use topovox::voxelize::solid;
 use topovox::{DenseBits, GridSpec, Mesh};
 use topovox_job::distance::{sdf, DistanceFormat, SdfRequest, Sign, Width};
-use topovox_job::{GridOptions, GridRequest, JobError, Method, Mode, Plan, Request};
+use topovox_job::{JobError, Method};
 use topovox_testkit::{box_mesh, random_rotation, rng, rotated, shared_mesh, sphere};
 
 /// A small seeded generator (no `rand` in this crate's tests).
@@ -53,31 +55,9 @@ fn inverted(m: &Mesh) -> Mesh {
     out
 }
 
-fn fixed_grid(grid: &GridSpec) -> GridRequest {
-    GridRequest::new(&GridOptions {
-        origin: Some(grid.origin().to_array().to_vec()),
-        voxel_size: Some(grid.voxel_size()),
-        dims: Some(grid.dims().map(u64::from).to_vec()),
-        ..GridOptions::default()
-    })
-    .unwrap()
-}
-
 /// `voxelize --mode solid --method auto` of `m` on `grid` with `threads`.
 fn auto_solid(m: &Mesh, grid: &GridSpec, threads: usize) -> Result<DenseBits, JobError> {
-    let plan = Plan::new(Request {
-        mode: Mode::parse("solid").unwrap(),
-        method: Method::parse("auto").unwrap(),
-        grid: fixed_grid(grid),
-        surface: None,
-        fill: None,
-        hollow: None,
-        gpu_path: topovox_job::GpuPath::Compute,
-        seed: 0,
-        tile: None,
-        max_memory: None,
-        writer_bytes_per_brick: 0,
-    })?;
+    let plan = common::plan_with("solid", Method::Auto, common::on_grid(grid), None);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     pool.install(|| topovox_job::voxelize(&plan, m.as_ref(), "mesh", None, None)).map(|v| v.voxels.to_dense())
 }
@@ -85,7 +65,7 @@ fn auto_solid(m: &Mesh, grid: &GridSpec, threads: usize) -> Result<DenseBits, Jo
 /// The inside of `sdf` (its sparse solid path) on `grid`.
 fn sdf_inside(m: &Mesh, grid: &GridSpec) -> Result<DenseBits, JobError> {
     let req = SdfRequest {
-        grid: fixed_grid(grid),
+        grid: common::on_grid(grid),
         width: Width::Voxels(2.0),
         unsigned: false,
         sign: Sign::Auto,
