@@ -2,6 +2,7 @@
 //! reader ends with.
 
 use glam::DVec3;
+use rayon::prelude::*;
 use topovox::attributes::Appearance;
 use topovox::{Aabb, Mesh};
 
@@ -62,13 +63,13 @@ pub(crate) fn finish_with_segments(
     segments: Vec<[i64; 2]>,
     warnings: Vec<String>,
 ) -> Result<LoadedMesh, ErrorKind> {
-    for (index, p) in positions.iter().enumerate() {
-        if let Some(&value) = p.to_array().iter().find(|c| !c.is_finite()) {
-            return Err(ErrorKind::NonFinite { index, value });
-        }
-        if let Some(&value) = p.to_array().iter().find(|c| c.abs() > topovox::COORDINATE_LIMIT) {
-            return Err(ErrorKind::OutOfRange { index, value });
-        }
+    // In parallel; the first bad vertex is named, as a sequential pass would.
+    if let Some(index) = positions.par_iter().position_first(|p| !topovox::in_range(*p)) {
+        let p = positions[index].to_array();
+        return Err(match p.iter().find(|c| !c.is_finite()) {
+            Some(&value) => ErrorKind::NonFinite { index, value },
+            None => ErrorKind::OutOfRange { index, value: *p.iter().find(|c| c.abs() > topovox::COORDINATE_LIMIT).expect("out of range") },
+        });
     }
     let count = positions.len();
     let tris = checked_indices(&triangles, count, |face, index| ErrorKind::IndexOutOfRange { face, index, count })?;
@@ -97,14 +98,11 @@ fn checked_indices<const N: usize>(
     count: usize,
     bad: impl Fn(usize, i64) -> ErrorKind,
 ) -> Result<Vec<[u32; N]>, ErrorKind> {
-    items
-        .iter()
-        .enumerate()
-        .map(|(e, t)| match t.iter().find(|&&i| i < 0 || i as usize >= count) {
-            Some(&index) => Err(bad(e, index)),
-            None => Ok(t.map(|i| i as u32)),
-        })
-        .collect()
+    let out_of_range = |i: &i64| *i < 0 || *i as usize >= count;
+    if let Some(e) = items.par_iter().position_first(|t| t.iter().any(out_of_range)) {
+        return Err(bad(e, *items[e].iter().find(|i| out_of_range(i)).expect("an index out of range")));
+    }
+    Ok(items.par_iter().map(|t| t.map(|i| i as u32)).collect())
 }
 
 /// Fan-triangulates a polygon given by vertex indices: (0,1,2), (0,2,3), …

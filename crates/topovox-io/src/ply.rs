@@ -1,5 +1,6 @@
-//! PLY, ASCII and binary (both endiannesses): the header (and ASCII
-//! payloads) through the `ply-rs-bw` crate, binary payloads in place.
+//! PLY, ASCII and binary (both endiannesses): the header through the
+//! `ply-rs-bw` crate, payloads in place (`ply_binary.rs`, `ply_ascii.rs`;
+//! the crate's payload parser is their [`reference`](mod@reference)).
 //!
 //! Reads element `vertex` (properties `x`, `y`, `z`, any numeric type),
 //! element `face` (list property `vertex_indices` or `vertex_index`;
@@ -41,26 +42,21 @@ fn list(p: &Property) -> Option<Vec<i64>> {
     })
 }
 
-/// Parses PLY bytes: the header by `ply-rs-bw`, a binary payload in place
-/// (`ply_binary.rs`), an ASCII one by the crate ([`reference`](mod@reference)).
+/// Parses PLY bytes: the header by `ply-rs-bw`, the payload in place
+/// (`ply_binary.rs`, `ply_ascii.rs`).
 pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
     let parser = Parser::<DefaultElement>::new();
     let mut reader = Reader::new(Cursor::new(bytes));
     let header = parser.read_header(&mut reader).map_err(|e| ErrorKind::malformed("PLY", e))?;
     let start = reader.get_ref().position() as usize;
     check_counts(&header, (bytes.len() - start) as u64)?;
-    if header.encoding == Encoding::Ascii {
-        return reference::payload(&parser, &mut reader, &header);
-    }
-    let p = crate::ply_binary::read(&header, &bytes[start..])?;
-    let mut triangles = Vec::new();
-    if let Some((idx, lens)) = &p.faces {
-        let mut at = 0;
-        for &n in lens {
-            fan(&idx[at..at + n as usize], &mut triangles);
-            at += n as usize;
-        }
-    }
+    let p = if header.encoding == Encoding::Ascii {
+        let header_lines = memchr::memchr_iter(b'\n', &bytes[..start]).count();
+        crate::ply_ascii::read(&header, &bytes[start..], header_lines)?
+    } else {
+        crate::ply_binary::read(&header, &bytes[start..])?
+    };
+    let mut triangles = p.triangles;
     if let Some((idx, lens)) = &p.strips {
         let mut at = 0;
         for &n in lens {
@@ -70,7 +66,7 @@ pub fn read(bytes: &[u8]) -> Result<LoadedMesh, ErrorKind> {
             at += n as usize;
         }
     }
-    if p.faces.is_none() && p.strips.is_none() {
+    if !p.faces && p.strips.is_none() {
         return Err(no_faces(&header));
     }
     let mut colours = p.colours;
@@ -88,8 +84,7 @@ fn no_faces(header: &Header) -> ErrorKind {
 }
 
 /// The reader by `ply-rs-bw`'s payload parser, for every encoding: the
-/// reference the in-place binary reader is tested against, and the ASCII
-/// reader.
+/// reference the in-place readers are tested against.
 pub mod reference {
     use super::*;
 

@@ -15,18 +15,7 @@ use glam::DVec3;
 use ply_rs_bw::ply::{ElementDef, Encoding, Header, PropertyType, ScalarType};
 
 use crate::error::ErrorKind;
-
-/// What a payload holds for a mesh.
-#[derive(Default)]
-pub(crate) struct Payload {
-    pub positions: Vec<DVec3>,
-    /// sRGB per vertex, when the vertices have colour properties.
-    pub colours: Vec<[u8; 3]>,
-    /// The index lists of `face`, flattened, with each list's length.
-    pub faces: Option<(Vec<i64>, Vec<u32>)>,
-    /// The index lists of `tristrips`, likewise.
-    pub strips: Option<(Vec<i64>, Vec<u32>)>,
-}
+use crate::ply_payload::{channel, index_list, At, Lists, Payload, VertexLayout};
 
 /// Byte size of a scalar.
 pub(crate) fn size(t: &ScalarType) -> usize {
@@ -92,33 +81,20 @@ pub(crate) fn read(header: &Header, body: &[u8]) -> Result<Payload, ErrorKind> {
     for (name, el) in &header.elements {
         at = match name.as_str() {
             "vertex" => vertices(el, body, at, big, &mut out)?,
-            "face" | "tristrips" => {
-                let keep = index_list(el);
-                let is_index = keep.is_some_and(|k| match &el.properties[k].data_type {
-                    PropertyType::List(_, it) => !matches!(it, ScalarType::Float | ScalarType::Double),
-                    PropertyType::Scalar(_) => false,
-                });
-                if !is_index && el.count > 0 {
-                    return Err(ErrorKind::malformed("PLY", format!("{name} 0 has no 'vertex_indices' list")));
-                }
-                let mut lists = (Vec::new(), Vec::new());
-                let end = walk(el, body, at, big, keep, &mut lists)?;
-                if name == "face" {
-                    out.faces = Some(lists);
-                } else {
-                    out.strips = Some(lists);
-                }
-                end
+            "face" => {
+                out.faces = true;
+                let keep = index_list(el)?;
+                walk(el, body, at, big, keep.map(|k| (k, Lists::Fanned(&mut out.triangles))))?
             }
-            _ => walk(el, body, at, big, None, &mut (Vec::new(), Vec::new()))?,
+            "tristrips" => {
+                let keep = index_list(el)?;
+                let strips = out.strips.insert((Vec::new(), Vec::new()));
+                walk(el, body, at, big, keep.map(|k| (k, Lists::Flat(strips))))?
+            }
+            _ => walk(el, body, at, big, None)?,
         };
     }
     Ok(out)
-}
-
-/// The position of the index list among `el`'s properties.
-fn index_list(el: &ElementDef) -> Option<usize> {
-    el.properties.get_index_of("vertex_indices").or_else(|| el.properties.get_index_of("vertex_index"))
 }
 
 fn ended(el: &ElementDef, entry: usize) -> ErrorKind {
@@ -137,52 +113,26 @@ fn vertices(el: &ElementDef, body: &[u8], at: usize, big: bool, out: &mut Payloa
             _ => None,
         };
     }
-    let scalar_at = |name: &str| -> Option<(usize, ScalarType)> {
-        let i = el.properties.get_index_of(name)?;
-        match &el.properties[i].data_type {
-            PropertyType::Scalar(t) => Some((i, t.clone())),
-            PropertyType::List(..) => None,
-        }
-    };
-    let mut xyz = Vec::with_capacity(3);
-    for (a, name) in ["x", "y", "z"].iter().enumerate() {
-        let Some(found) = scalar_at(name) else {
-            return Err(ErrorKind::malformed("PLY", format!("vertex 0 has no numeric '{name}' property")));
-        };
-        debug_assert_eq!(xyz.len(), a);
-        xyz.push(found);
-    }
-    let colour = [["red", "green", "blue"], ["r", "g", "b"], ["diffuse_red", "diffuse_green", "diffuse_blue"]]
-        .iter()
-        .find_map(|n| Some([scalar_at(n[0])?, scalar_at(n[1])?, scalar_at(n[2])?]));
+    let layout = VertexLayout::of(el)?;
     let Some(stride) = stride.filter(|&s| s > 0) else {
-        return vertices_walked(el, body, at, big, &xyz, colour.as_ref(), out);
+        return vertices_walked(el, body, at, big, &layout, out);
     };
     let end = stride.checked_mul(el.count).and_then(|n| n.checked_add(at)).filter(|&e| e <= body.len());
     let Some(end) = end else { return Err(ended(el, (body.len() - at.min(body.len())) / stride)) };
-    let off = |(i, _): &(usize, ScalarType)| offsets[*i].expect("every property is a scalar");
+    let off = |(i, _): &At| offsets[*i].expect("every property is a scalar");
+    let xyz = &layout.xyz;
     let [ox, oy, oz] = [off(&xyz[0]), off(&xyz[1]), off(&xyz[2])];
     let [tx, ty, tz] = [xyz[0].1.clone(), xyz[1].1.clone(), xyz[2].1.clone()];
-    out.positions.reserve(el.count);
-    for row in body[at..end].chunks_exact(stride) {
-        out.positions.push(DVec3::new(number(&tx, &row[ox..], big), number(&ty, &row[oy..], big), number(&tz, &row[oz..], big)));
-    }
-    if let Some(c) = &colour {
-        let float = matches!(c[0].1, ScalarType::Float | ScalarType::Double);
+    let rows = body[at..end].chunks_exact(stride);
+    out.positions =
+        rows.map(|row| DVec3::new(number(&tx, &row[ox..], big), number(&ty, &row[oy..], big), number(&tz, &row[oz..], big))).collect();
+    if let Some(c) = &layout.colour {
+        let float = layout.float_colour();
         let o = [off(&c[0]), off(&c[1]), off(&c[2])];
         out.colours =
             body[at..end].chunks_exact(stride).map(|row| [0, 1, 2].map(|k| channel(number(&c[k].1, &row[o[k]..], big), float))).collect();
     }
     Ok(end)
-}
-
-/// A colour channel as sRGB: bytes as they are, floats in [0, 1] scaled.
-fn channel(x: f64, float: bool) -> u8 {
-    if float {
-        (x.clamp(0.0, 1.0) * 255.0).round() as u8
-    } else {
-        x.clamp(0.0, 255.0) as u8
-    }
 }
 
 /// Vertices with a list property among their properties, entry by entry.
@@ -191,12 +141,12 @@ fn vertices_walked(
     body: &[u8],
     at: usize,
     big: bool,
-    xyz: &[(usize, ScalarType)],
-    colour: Option<&[(usize, ScalarType); 3]>,
+    layout: &VertexLayout,
     out: &mut Payload,
 ) -> Result<usize, ErrorKind> {
     let mut at = at;
     let mut values = vec![0.0; el.properties.len()];
+    let xyz = &layout.xyz;
     for entry in 0..el.count {
         for (k, p) in el.properties.values().enumerate() {
             at = match &p.data_type {
@@ -209,9 +159,8 @@ fn vertices_walked(
             };
         }
         out.positions.push(DVec3::new(values[xyz[0].0], values[xyz[1].0], values[xyz[2].0]));
-        if let Some(c) = colour {
-            let float = matches!(c[0].1, ScalarType::Float | ScalarType::Double);
-            out.colours.push([0, 1, 2].map(|k| channel(values[c[k].0], float)));
+        if let Some(c) = &layout.colour {
+            out.colours.push([0, 1, 2].map(|k| channel(values[c[k].0], layout.float_colour())));
         }
     }
     Ok(at)
@@ -225,36 +174,29 @@ fn skip_list(ct: &ScalarType, it: &ScalarType, body: &[u8], at: usize, big: bool
     (end <= body.len()).then_some(end)
 }
 
-/// Walks `el`'s entries from `body[at..]`, collecting the list property
-/// at `keep` (if any) into `lists` (the indices, and each list's length).
-/// Returns where the element ends.
-fn walk(
-    el: &ElementDef,
-    body: &[u8],
-    at: usize,
-    big: bool,
-    keep: Option<usize>,
-    lists: &mut (Vec<i64>, Vec<u32>),
-) -> Result<usize, ErrorKind> {
+/// Walks `el`'s entries from `body[at..]`, handing the list property at
+/// `keep.0` (if any) of each to `keep.1`. Returns where the element ends.
+fn walk(el: &ElementDef, body: &[u8], at: usize, big: bool, keep: Option<(usize, Lists<'_>)>) -> Result<usize, ErrorKind> {
     let props: Vec<&PropertyType> = el.properties.values().map(|p| &p.data_type).collect();
-    let mut at = at;
-    if keep.is_some() {
-        // Most faces are triangles: three indices each.
-        lists.0.reserve(el.count.min(body.len()) * 3);
-        lists.1.reserve(el.count.min(body.len()));
+    let (keep, mut lists) = keep.unzip();
+    if let Some(l) = &mut lists {
+        l.reserve(el.count.min(body.len()));
     }
+    let mut at = at;
+    let mut list = Vec::new();
     for entry in 0..el.count {
         for (k, p) in props.iter().enumerate() {
             at = match p {
                 PropertyType::Scalar(t) => Some(at + size(t)).filter(|&e| e <= body.len()).ok_or_else(|| ended(el, entry))?,
-                PropertyType::List(ct, it) if keep == Some(k) => {
+                PropertyType::List(ct, it) => {
                     let end = skip_list(ct, it, body, at, big).ok_or_else(|| ended(el, entry))?;
-                    let items = &body[at + size(ct)..end];
-                    lists.0.extend(items.chunks_exact(size(it)).map(|b| integer(it, b, big)));
-                    lists.1.push((items.len() / size(it)) as u32);
+                    if let (Some(l), true) = (&mut lists, keep == Some(k)) {
+                        list.clear();
+                        list.extend(body[at + size(ct)..end].chunks_exact(size(it)).map(|b| integer(it, b, big)));
+                        l.push(&list);
+                    }
                     end
                 }
-                PropertyType::List(ct, it) => skip_list(ct, it, body, at, big).ok_or_else(|| ended(el, entry))?,
             };
         }
     }
