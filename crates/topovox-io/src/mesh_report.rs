@@ -63,8 +63,11 @@ pub(crate) fn finish_with_segments(
     segments: Vec<[i64; 2]>,
     warnings: Vec<String>,
 ) -> Result<LoadedMesh, ErrorKind> {
-    // In parallel; the first bad vertex is named, as a sequential pass would.
-    if let Some(index) = positions.par_iter().position_first(|p| !topovox::in_range(*p)) {
+    // In parallel for large meshes; the first bad vertex is named, as a sequential pass would.
+    let bad_vertex = |p: &DVec3| !topovox::in_range(*p);
+    let first_bad =
+        if positions.len() < PARALLEL_ITEMS { positions.iter().position(bad_vertex) } else { positions.par_iter().position_first(bad_vertex) };
+    if let Some(index) = first_bad {
         let p = positions[index].to_array();
         return Err(match p.iter().find(|c| !c.is_finite()) {
             Some(&value) => ErrorKind::NonFinite { index, value },
@@ -99,11 +102,19 @@ fn checked_indices<const N: usize>(
     bad: impl Fn(usize, i64) -> ErrorKind,
 ) -> Result<Vec<[u32; N]>, ErrorKind> {
     let out_of_range = |i: &i64| *i < 0 || *i as usize >= count;
-    if let Some(e) = items.par_iter().position_first(|t| t.iter().any(out_of_range)) {
+    let bad_item = |t: &[i64; N]| t.iter().any(out_of_range);
+    let small = items.len() < PARALLEL_ITEMS;
+    let first_bad = if small { items.iter().position(bad_item) } else { items.par_iter().position_first(bad_item) };
+    if let Some(e) = first_bad {
         return Err(bad(e, *items[e].iter().find(|i| out_of_range(i)).expect("an index out of range")));
     }
-    Ok(items.par_iter().map(|t| t.map(|i| i as u32)).collect())
+    let narrow = |t: &[i64; N]| t.map(|i| i as u32);
+    Ok(if small { items.iter().map(narrow).collect() } else { items.par_iter().map(narrow).collect() })
 }
+
+/// Items from which the checks run on all threads (below, waking the
+/// thread pool costs more than the pass).
+const PARALLEL_ITEMS: usize = 1 << 15;
 
 /// Fan-triangulates a polygon given by vertex indices: (0,1,2), (0,2,3), …
 pub(crate) fn fan(poly: &[i64], out: &mut Vec<[i64; 3]>) {

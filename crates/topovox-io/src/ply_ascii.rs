@@ -74,11 +74,12 @@ impl<'a> Block<'a> {
         el: &ElementDef,
         parse: impl Fn(&mut Entries<'a, '_>) -> Result<T, ErrorKind> + Sync,
     ) -> Result<Vec<T>, ErrorKind> {
-        let results: Vec<Result<T, ErrorKind>> = self
-            .pieces
-            .par_iter()
-            .map(|&(entry, bytes)| parse(&mut Entries { lines: bytes.split(|&b| b == b'\n'), el, first_line: self.first_line, entry }))
-            .collect();
+        let one = |&(entry, bytes): &(usize, &'a [u8])| {
+            parse(&mut Entries { lines: bytes.split(|&b| b == b'\n'), el, first_line: self.first_line, entry })
+        };
+        // One piece is parsed here: waking the thread pool costs more.
+        let results: Vec<Result<T, ErrorKind>> =
+            if self.pieces.len() < 2 { self.pieces.iter().map(one).collect() } else { self.pieces.par_iter().map(one).collect() };
         results.into_iter().collect()
     }
 }

@@ -97,7 +97,11 @@ impl MeshRef<'_> {
             }
             b
         };
-        let parts: Vec<Aabb> = self.positions.par_chunks(PASS_CHUNK).zip(used.par_chunks(PASS_CHUNK)).map(chunk).collect();
+        let parts: Vec<Aabb> = if self.positions.len() <= PASS_CHUNK {
+            vec![chunk((self.positions, &used))]
+        } else {
+            self.positions.par_chunks(PASS_CHUNK).zip(used.par_chunks(PASS_CHUNK)).map(chunk).collect()
+        };
         let mut b = Aabb::EMPTY;
         for part in parts.iter().filter(|p| !p.is_empty()) {
             b.grow(part.min);
@@ -122,11 +126,15 @@ impl MeshRef<'_> {
                 _ => false,
             }
         };
+        if self.triangles.len() <= PASS_CHUNK {
+            return self.triangles.iter().filter(degenerate).count();
+        }
         self.triangles.par_chunks(PASS_CHUNK).map(|c| c.iter().filter(degenerate).count()).sum()
     }
 }
 
 /// Items per task of the whole-mesh passes ([`MeshRef::bounds`],
 /// [`MeshRef::degenerate_count`]): fixed, so results never depend on the
-/// thread count, and large enough that a small mesh is one task.
+/// thread count, and large enough that a small mesh is one task, done on
+/// the caller's thread (waking the pool costs more than a small pass).
 const PASS_CHUNK: usize = 1 << 15;
