@@ -65,8 +65,11 @@ pub(crate) fn finish_with_segments(
 ) -> Result<LoadedMesh, ErrorKind> {
     // In parallel for large meshes; the first bad vertex is named, as a sequential pass would.
     let bad_vertex = |p: &DVec3| !topovox::in_range(*p);
-    let first_bad =
-        if positions.len() < PARALLEL_ITEMS { positions.iter().position(bad_vertex) } else { positions.par_iter().position_first(bad_vertex) };
+    let first_bad = if positions.len() < PARALLEL_ITEMS {
+        positions.iter().position(bad_vertex)
+    } else {
+        positions.par_iter().position_first(bad_vertex)
+    };
     if let Some(index) = first_bad {
         let p = positions[index].to_array();
         return Err(match p.iter().find(|c| !c.is_finite()) {
@@ -81,14 +84,8 @@ pub(crate) fn finish_with_segments(
         return Err(ErrorKind::Empty);
     }
     let mesh = Mesh { positions, triangles: tris, segments: segs };
-    let r = mesh.as_ref();
-    let report = MeshReport {
-        vertices: count,
-        triangles: mesh.triangles.len(),
-        degenerate: r.degenerate_count(),
-        segments: mesh.segments.len(),
-        bounds: r.bounds(),
-    };
+    let (bounds, degenerate) = mesh.as_ref().bounds_and_degenerate_count();
+    let report = MeshReport { vertices: count, triangles: mesh.triangles.len(), degenerate, segments: mesh.segments.len(), bounds };
     // A warning may quote the file (a material library's name): never at length.
     let warnings = warnings.iter().map(|w| crate::error::cut(w, crate::error::MAX_MESSAGE)).collect();
     Ok(LoadedMesh { mesh, report, warnings, appearance: Appearance::default(), sources: Vec::new() })
@@ -102,14 +99,14 @@ fn checked_indices<const N: usize>(
     bad: impl Fn(usize, i64) -> ErrorKind,
 ) -> Result<Vec<[u32; N]>, ErrorKind> {
     let out_of_range = |i: &i64| *i < 0 || *i as usize >= count;
-    let bad_item = |t: &[i64; N]| t.iter().any(out_of_range);
-    let small = items.len() < PARALLEL_ITEMS;
-    let first_bad = if small { items.iter().position(bad_item) } else { items.par_iter().position_first(bad_item) };
-    if let Some(e) = first_bad {
-        return Err(bad(e, *items[e].iter().find(|i| out_of_range(i)).expect("an index out of range")));
-    }
-    let narrow = |t: &[i64; N]| t.map(|i| i as u32);
-    Ok(if small { items.iter().map(narrow).collect() } else { items.par_iter().map(narrow).collect() })
+    // One pass narrows and checks; only a refused mesh is looked at again, for its first bad index.
+    let narrow = |t: &[i64; N]| if t.iter().any(out_of_range) { None } else { Some(t.map(|i| i as u32)) };
+    let narrowed: Option<Vec<[u32; N]>> =
+        if items.len() < PARALLEL_ITEMS { items.iter().map(narrow).collect() } else { items.par_iter().map(narrow).collect() };
+    narrowed.ok_or_else(|| {
+        let e = items.iter().position(|t| t.iter().any(out_of_range)).expect("a refused item");
+        bad(e, *items[e].iter().find(|i| out_of_range(i)).expect("an index out of range"))
+    })
 }
 
 /// Items from which the checks run on all threads (below, waking the

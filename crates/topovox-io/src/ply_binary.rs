@@ -83,8 +83,10 @@ pub(crate) fn read(header: &Header, body: &[u8]) -> Result<Payload, ErrorKind> {
             "vertex" => vertices(el, body, at, big, &mut out)?,
             "face" => {
                 out.faces = true;
-                let keep = index_list(el)?;
-                walk(el, body, at, big, keep.map(|k| (k, Lists::Fanned(&mut out.triangles))))?
+                match (index_list(el)?, el.properties.len()) {
+                    (Some(0), 1) => faces_only(el, body, at, big, &mut out.triangles)?,
+                    (keep, _) => walk(el, body, at, big, keep.map(|k| (k, Lists::Fanned(&mut out.triangles))))?,
+                }
             }
             "tristrips" => {
                 let keep = index_list(el)?;
@@ -199,6 +201,56 @@ fn walk(el: &ElementDef, body: &[u8], at: usize, big: bool, keep: Option<(usize,
                 }
             };
         }
+    }
+    Ok(at)
+}
+
+/// A `face` element whose only property is its index list (what most
+/// writers make): the walk without the per-property loop, with the
+/// index type's decoding chosen once for the common little-endian types.
+fn faces_only(el: &ElementDef, body: &[u8], at: usize, big: bool, triangles: &mut Vec<[i64; 3]>) -> Result<usize, ErrorKind> {
+    let PropertyType::List(ct, it) = &el.properties[0].data_type else { unreachable!("an index list") };
+    match (ct, it, big) {
+        (ScalarType::UChar, ScalarType::Int, false) => {
+            faces_with(el, body, at, |b| b[0] as usize, 1, |b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as i64, 4, triangles)
+        }
+        (ScalarType::UChar, ScalarType::UInt, false) => {
+            faces_with(el, body, at, |b| b[0] as usize, 1, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as i64, 4, triangles)
+        }
+        _ => {
+            let count = |b: &[u8]| usize::try_from(integer(ct, b, big)).unwrap_or(usize::MAX);
+            faces_with(el, body, at, count, size(ct), |b| integer(it, b, big), size(it), triangles)
+        }
+    }
+}
+
+/// [`faces_only`] with the count and index decoders given (and their sizes).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn faces_with(
+    el: &ElementDef,
+    body: &[u8],
+    mut at: usize,
+    count: impl Fn(&[u8]) -> usize,
+    count_size: usize,
+    index: impl Fn(&[u8]) -> i64,
+    index_size: usize,
+    triangles: &mut Vec<[i64; 3]>,
+) -> Result<usize, ErrorKind> {
+    triangles.reserve(el.count.min(body.len()));
+    let mut list = Vec::new();
+    for entry in 0..el.count {
+        let n = body.get(at..at + count_size).map(&count).ok_or_else(|| ended(el, entry))?;
+        let items =
+            n.checked_mul(index_size).and_then(|len| body.get(at + count_size..at + count_size + len)).ok_or_else(|| ended(el, entry))?;
+        if n == 3 {
+            triangles.push([index(items), index(&items[index_size..]), index(&items[2 * index_size..])]);
+        } else {
+            list.clear();
+            list.extend(items.chunks_exact(index_size).map(&index));
+            Lists::Fanned(triangles).push(&list);
+        }
+        at += count_size + items.len();
     }
     Ok(at)
 }

@@ -38,6 +38,8 @@ struct Layout {
     strips: bool,
     /// ASCII, with this separator between numbers and this line end.
     ascii: Option<(&'static str, &'static str)>,
+    /// A property after the index list (else the list alone: the fast path).
+    flags: bool,
 }
 
 /// Writes entries as a layout's encoding: binary scalars, or numbers
@@ -114,7 +116,8 @@ fn file(l: Layout, vertices: usize, faces: usize, seed: u64) -> Vec<u8> {
         h += "element edge 2\nproperty int vertex1\nproperty list uchar int extra\n";
     }
     let (el, list) = if l.strips { ("tristrips", "vertex_indices") } else { ("face", "vertex_indices") };
-    h += &format!("element {el} {faces}\nproperty list {} {} {list}\nproperty uchar flags\nend_header\n", l.count, l.index);
+    h += &format!("element {el} {faces}\nproperty list {} {} {list}\n", l.count, l.index);
+    h += if l.flags { "property uchar flags\nend_header\n" } else { "end_header\n" };
     let mut out = Out { bytes: h.into_bytes(), big: l.big, ascii: l.ascii };
     for _ in 0..vertices {
         if l.before {
@@ -151,7 +154,9 @@ fn file(l: Layout, vertices: usize, faces: usize, seed: u64) -> Vec<u8> {
             let v = if l.index.starts_with('u') && v < 0.0 { 0.0 } else { v };
             out.put(l.index, v);
         }
-        out.put("uchar", 1.0);
+        if l.flags {
+            out.put("uchar", 1.0);
+        }
         out.end();
     }
     out.bytes
@@ -167,8 +172,8 @@ fn layouts() -> Vec<Layout> {
             for (count, index) in
                 [("uchar", "int"), ("uchar", "uint"), ("ushort", "int"), ("int", "uint"), ("uchar", "ushort"), ("char", "short")]
             {
-                for (between, strips) in [(false, false), (true, false), (false, true)] {
-                    v.push(Layout { big, double, before, colour, count, index, between, strips, ascii });
+                for (between, strips, flags) in [(false, false, true), (false, false, false), (true, false, true), (false, true, true)] {
+                    v.push(Layout { big, double, before, colour, count, index, between, strips, ascii, flags });
                 }
             }
         }
@@ -211,6 +216,7 @@ fn long_elements_read_in_pieces_as_the_reference_reads_them() {
             between: true,
             strips: false,
             ascii,
+            flags: ascii.is_none(),
         };
         let mut bytes = file(l, 20_000, 40_000, 11);
         same(&bytes, "long");
@@ -237,6 +243,7 @@ fn every_truncation_is_refused_by_both() {
             between: true,
             strips: false,
             ascii,
+            flags: ascii.is_none(),
         };
         let bytes = file(l, 20, 30, 7);
         let header_end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
@@ -277,6 +284,7 @@ fn missing_or_wrong_properties_are_refused_like_the_reference() {
             between: false,
             strips: false,
             ascii,
+            flags: false,
         };
         let good = file(l, 10, 5, 3);
         for (from, to) in [

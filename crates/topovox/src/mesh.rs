@@ -117,24 +117,100 @@ impl MeshRef<'_> {
 
     /// Triangles with two equal indices or zero area (exactly, in f64).
     pub fn degenerate_count(&self) -> usize {
-        let degenerate = |t: &&[u32; 3]| {
-            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-                return true;
+        self.bounds_and_degenerate_count().1
+    }
+
+    /// [`bounds`](Self::bounds) and [`degenerate_count`](Self::degenerate_count)
+    /// in one pass over the triangles (what a reader reports): each
+    /// triangle's corners are read once for both. The same box as
+    /// `bounds` (to the sign of a zero), for any thread count.
+    pub fn bounds_and_degenerate_count(&self) -> (Aabb, usize) {
+        let per_chunk = |c: &[[u32; 3]]| {
+            let (mut b, mut degenerate) = (Aabb::EMPTY, 0);
+            for t in c {
+                let corners = t.map(|i| self.positions.get(i as usize));
+                for p in corners.iter().flatten().filter(|p| p.is_finite()) {
+                    b.grow(**p);
+                }
+                let zero = match corners {
+                    _ if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] => true,
+                    [Some(a), Some(b), Some(c)] => (*b - *a).cross(*c - *a) == DVec3::ZERO,
+                    _ => false,
+                };
+                degenerate += zero as usize;
             }
-            match (self.positions.get(t[0] as usize), self.positions.get(t[1] as usize), self.positions.get(t[2] as usize)) {
-                (Some(a), Some(b), Some(c)) => (*b - *a).cross(*c - *a) == DVec3::ZERO,
-                _ => false,
-            }
+            (b, degenerate)
         };
-        if self.triangles.len() <= PASS_CHUNK {
-            return self.triangles.iter().filter(degenerate).count();
+        let parts: Vec<(Aabb, usize)> = if self.triangles.len() <= PASS_CHUNK {
+            vec![per_chunk(self.triangles)]
+        } else {
+            self.triangles.par_chunks(PASS_CHUNK).map(per_chunk).collect()
+        };
+        let (mut b, mut degenerate) = (Aabb::EMPTY, 0);
+        for (part, n) in &parts {
+            degenerate += n;
+            if !part.is_empty() {
+                b.grow(part.min);
+                b.grow(part.max);
+            }
         }
-        self.triangles.par_chunks(PASS_CHUNK).map(|c| c.iter().filter(degenerate).count()).sum()
+        for p in self.segments.iter().flatten().filter_map(|&i| self.positions.get(i as usize)).filter(|p| p.is_finite()) {
+            b.grow(*p);
+        }
+        (b, degenerate)
     }
 }
 
 /// Items per task of the whole-mesh passes ([`MeshRef::bounds`],
-/// [`MeshRef::degenerate_count`]): fixed, so results never depend on the
+/// [`MeshRef::bounds_and_degenerate_count`]): fixed, so results never depend on the
 /// thread count, and large enough that a small mesh is one task, done on
 /// the caller's thread (waking the pool costs more than a small pass).
 const PASS_CHUNK: usize = 1 << 15;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The passes against their definitions, sequential and over every
+    /// corner: small and past one chunk (parallel), with unused vertices,
+    /// non-finite ones, out-of-range indices, repeated indices and
+    /// collinear corners.
+    #[test]
+    fn bounds_and_degenerate_count_are_their_definitions() {
+        let mut state = 7u64;
+        let mut next = move || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 33) as u32
+        };
+        for (vertices, triangles) in [(40, 30), (1000, 3 * PASS_CHUNK + 17), (200_000, 2 * PASS_CHUNK)] {
+            let mut positions: Vec<DVec3> =
+                (0..vertices).map(|_| DVec3::new(next() as f64, next() as f64, -(next() as f64)) / 1e6).collect();
+            positions[3] = DVec3::new(f64::NAN, 1.0, 2.0);
+            positions[5] = DVec3::new(1e9, 1e9, 1e9); // used by no triangle
+            positions[6..9].copy_from_slice(&[DVec3::ZERO, DVec3::ONE, DVec3::splat(2.0)]); // collinear
+            let mut tris: Vec<[u32; 3]> = (0..triangles)
+                .map(|_| [0, 1, 2].map(|_| next() % vertices as u32))
+                .filter(|t| !t.contains(&5))
+                .collect();
+            tris.extend([[6, 7, 8], [1, 1, 2], [0, 1, vertices as u32 + 4], [3, 4, 9]]);
+            let segments = vec![[2, 9], [vertices as u32, 1]];
+            let m = MeshRef { positions: &positions, triangles: &tris, segments: &segments };
+            let mut want = Aabb::EMPTY;
+            for &i in tris.iter().flatten().chain(segments.iter().flatten()) {
+                if let Some(p) = positions.get(i as usize).filter(|p| p.is_finite()) {
+                    want.grow(*p);
+                }
+            }
+            let degenerate = tris
+                .iter()
+                .filter(|t| {
+                    let p = t.map(|i| positions.get(i as usize));
+                    t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || matches!(p, [Some(a), Some(b), Some(c)] if (*b - *a).cross(*c - *a) == DVec3::ZERO)
+                })
+                .count();
+            assert_eq!(m.bounds(), want, "{vertices} {triangles}");
+            assert_eq!(m.bounds_and_degenerate_count(), (want, degenerate), "{vertices} {triangles}");
+            assert!(degenerate >= 2 && want.max.x < 1e9);
+        }
+    }
+}
