@@ -58,6 +58,25 @@ def test_load_mesh_reads_no_file_outside_the_folder(tmp_path, spelling):
     assert topovox.load_mesh(model / "m.gltf", allow_external_paths=True).faces.shape == (1, 3)
 
 
+def test_every_call_taking_a_path_passes_allow_external_paths_on(tmp_path):
+    model = tmp_path / "model"
+    model.mkdir()
+    (tmp_path / "outside.bin").write_bytes(triangle_buffer())
+    (model / "m.gltf").write_text(gltf_naming("../outside.bin"))
+    path = model / "m.gltf"
+    calls = {
+        "voxelize": lambda **kw: topovox.voxelize(path, resolution=8, **kw),
+        "voxelize_many": lambda **kw: topovox.voxelize_many([path], resolution=8, **kw),
+        "sdf": lambda **kw: topovox.sdf(path, resolution=8, **kw),
+        "sample": lambda **kw: topovox.sample(path, surface=10, **kw),
+        "remesh": lambda **kw: topovox.remesh(path, resolution=8, inside="wrap", **kw),
+    }
+    for name, call in calls.items():
+        with pytest.raises((topovox.FileFormatError, ValueError), match="outside the model's folder"):
+            call()
+        call(allow_external_paths=True)
+
+
 @pytest.mark.parametrize("uri", ["file:///etc/passwd", "file:///proc/self/environ", "file:///dev/zero", "/etc/passwd"])
 def test_system_files_are_neither_read_nor_quoted(tmp_path, uri):
     (tmp_path / "m.gltf").write_text(gltf_naming(uri))

@@ -131,7 +131,8 @@ def test_points_in_any_layout_and_bad_points():
 
 
 def test_samples_are_reproducible_and_consistent(meshes):
-    kw = dict(surface=3000, near=6000, sigma=(0.01, 0.05), uniform=5000, normalize="unit-cube", seed=4)
+    # The values as computed (float64): the distances are checked against the query's.
+    kw = dict(surface=3000, near=6000, sigma=(0.01, 0.05), uniform=5000, normalize="unit-cube", seed=4, dtype=np.float64)
     one = topovox.sample(meshes / "stanford-bunny.obj", threads=1, **kw)
     two = topovox.sample(meshes / "stanford-bunny.obj", threads=2, **kw)
     for k in ("points", "sdf", "occupancy", "normals", "kind"):
@@ -232,7 +233,7 @@ def test_surface_samples_carry_the_colour_at_their_point(tmp_path, cli):
     lines += [f"{x} {y} {z} {r} {g} {b}" for (x, y, z), (r, g, b) in zip(corners, rgb)]
     lines += ["3 0 1 2", "3 0 2 3"]
     ply.write_text("\n".join(lines) + "\n")
-    s = topovox.sample(ply, surface=2000, near=50, sigma=0.1, uniform=50, seed=3)
+    s = topovox.sample(ply, surface=2000, near=50, sigma=0.1, uniform=50, seed=3, dtype=np.float64)
     c = s["colours"]
     assert c.shape == (2100, 3) and c.dtype == np.float32
     surf = s["kind"] == 0
@@ -268,3 +269,15 @@ def test_textured_surface_samples_take_a_texel_of_their_point(meshes):
     # Nearest-texel lookup never invents a colour.
     assert all(tuple(g) in known for g in got)
     assert len(np.unique(got, axis=0)) > 20
+
+
+def test_samples_come_in_float32_as_models_train_or_float64_when_asked(meshes):
+    kw = dict(surface=50, near=60, sigma=0.02, uniform=40, seed=4)
+    single = topovox.sample(meshes / "suzanne.obj", **kw)
+    double = topovox.sample(meshes / "suzanne.obj", dtype=np.float64, **kw)
+    for k in ("points", "sdf", "normals"):
+        assert single[k].dtype == np.float32 and double[k].dtype == np.float64, k
+        assert np.array_equal(single[k], double[k].astype(np.float32), equal_nan=True), k
+    assert np.array_equal(single["occupancy"], double["occupancy"]) and single["offset"].dtype == np.float64
+    with pytest.raises(ValueError, match="float32 or float64"):
+        topovox.sample(meshes / "suzanne.obj", dtype=np.int32, **kw)

@@ -240,6 +240,7 @@ def as_mesh(
     mesh_or_vertices: Union[MeshLike, np.ndarray, str, os.PathLike[str]],
     faces: Optional[Any] = None,
     max_memory: Optional[Union[int, str]] = None,
+    allow_external_paths: bool = False,
 ) -> Mesh:
     """A :class:`Mesh` from whatever holds a triangle mesh.
 
@@ -257,9 +258,9 @@ def as_mesh(
         ``faces``.
     faces
         ``(m, 3)`` integer vertex indices, when vertices are given.
-    max_memory
-        For a path: the memory its reading may take (bytes, or ``"2G"``;
-        see :func:`load_mesh`).
+    max_memory, allow_external_paths
+        For a path: the memory its reading may take (bytes, or ``"2G"``)
+        and whether it may read files outside its folder (see :func:`load_mesh`).
 
     Returns
     -------
@@ -284,7 +285,7 @@ def as_mesh(
         return m
     if faces is None:
         if isinstance(m, (str, os.PathLike)):
-            return load_mesh(os.fspath(m), max_memory=max_memory)
+            return load_mesh(os.fspath(m), allow_external_paths=allow_external_paths, max_memory=max_memory)
         if isinstance(m, tuple) and len(m) == 2:
             return as_mesh(m[0], m[1])
         if isinstance(getattr(m, "geometry", None), dict):  # a trimesh.Scene (what trimesh.load("x.glb") returns)
@@ -430,7 +431,7 @@ def voxelize(
     >>> grid = topovox.voxelize("bunny.obj", mode="sep6", resolution=64)
     >>> occupancy = np.asarray(grid)
     """
-    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory)
+    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory, allow_external_paths=allow_external_paths)
     options = dict(locals())
     for k in ("mesh_or_vertices", "faces", "mesh"):
         options.pop(k)
@@ -532,7 +533,7 @@ def voxelize_many(
     failed: Dict[int, str] = {}
     for b, m in enumerate(meshes):
         try:
-            loaded.append(m if isinstance(m, Mesh) else as_mesh(*m) if isinstance(m, tuple) else as_mesh(m, max_memory=max_memory))
+            loaded.append(m if isinstance(m, Mesh) else as_mesh(*m) if isinstance(m, tuple) else as_mesh(m, max_memory=max_memory, allow_external_paths=allow_external_paths))
         except (ValueError, TypeError, OSError) as e:
             failed[b] = _item_error(b, m, e, on_error)
             loaded.append(None)
@@ -631,7 +632,7 @@ def sdf(
     >>> field = topovox.sdf("bunny.obj", resolution=128, band=3)
     >>> field.save("bunny.vdb")
     """
-    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory)
+    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory, allow_external_paths=allow_external_paths)
     options = dict(locals())
     for k in ("mesh_or_vertices", "faces", "mesh"):
         options.pop(k)
@@ -860,6 +861,7 @@ def sample(
     threads: Optional[int] = None,
     max_memory: Optional[Union[int, str]] = None,
     allow_external_paths: bool = False,
+    dtype: Any = np.float32,
 ) -> Dict[str, Any]:
     """Training samples: points on, near and around the mesh with their
     signed distance and occupancy (the :class:`Query`'s, so ``sdf < 0``
@@ -892,13 +894,17 @@ def sample(
     max_memory, allow_external_paths
         As :func:`voxelize`: a count of samples that needs more memory is
         refused before any work.
+    dtype : {numpy.float32, numpy.float64}
+        The type of ``points``, ``sdf`` and ``normals``: float32 (the
+        default, as ``topovox sample`` writes them and as models train), or
+        float64 for the exact values computed (float32 is their rounding).
 
     Returns
     -------
     dict
-        ``points`` (N, 3) float64 — surface points first, then near, then
-        uniform; ``sdf`` (N,) float64; ``occupancy`` (N,) bool; ``normals``
-        (N, 3) float64 (NaN except for surface points); ``kind`` (N,) uint8
+        ``points`` (N, 3) ``dtype`` — surface points first, then near, then
+        uniform; ``sdf`` (N,) ``dtype``; ``occupancy`` (N,) bool; ``normals``
+        (N, 3) ``dtype`` (NaN except for surface points); ``kind`` (N,) uint8
         (0 surface, 1 near, 2 uniform); ``colours`` (N, 3) float32, sRGB
         in [0, 1] (NaN except for surface points), only when the mesh has
         colours (a texture's nearest texel, vertex colours interpolated,
@@ -912,14 +918,19 @@ def sample(
     >>> s = topovox.sample("bunny.obj", near=500_000, sigma=(0.05, 0.0158),
     ...                    normalize="unit-sphere", seed=1)
     """
-    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory)
+    kind = np.dtype(dtype)
+    if kind not in (np.float32, np.float64):
+        raise ValueError(f"dtype must be float32 or float64; got {kind}")
+    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory, allow_external_paths=allow_external_paths)
     options = dict(locals())
-    for k in ("mesh_or_vertices", "faces", "mesh"):
+    for k in ("mesh_or_vertices", "faces", "mesh", "dtype", "kind"):
         options.pop(k)
     if options["bounds"] is not None:
         options["bounds"] = np.asarray(options["bounds"], dtype=np.float64).reshape(-1).tolist()
     out = _topovox.sample(mesh, _options(options))
     out["occupancy"] = out["occupancy"].astype(bool)
+    for k in ("points", "sdf", "normals"):
+        out[k] = out[k].astype(kind, copy=False)
     return out
 
 def remesh(
@@ -1005,7 +1016,7 @@ def remesh(
     >>> closed = topovox.remesh("bunny.obj", resolution=256)
     >>> closed.save("bunny-closed.ply")
     """
-    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory)
+    mesh = as_mesh(mesh_or_vertices, faces, max_memory=max_memory, allow_external_paths=allow_external_paths)
     options = dict(locals())
     for k in ("mesh_or_vertices", "faces", "mesh", "info"):
         options.pop(k)
