@@ -4,6 +4,15 @@ same files (issue 69).
 
     python python/benchmarks/bench_load.py [MESH] [--sizes 1k,5k,69k,278k,1.1M]
         [--formats ply,ply-ascii,stl,obj,off,glb] [--repeats 15] [--json]
+    python python/benchmarks/bench_load.py --many 200 [--resolution 32]
+
+`--many N` times a dataset instead: N small binary PLY files (the shared
+meshes, every k-th face to at most 5,000 faces, rotated at random, as
+bench_calls.py makes them), voxelized from their paths by one
+`topovox.voxelize_many(paths)` against Open3D's loop of
+`read_triangle_mesh` and `VoxelGrid.create_from_triangle_mesh` over the
+same files, and against `voxelize_many` on the meshes already in memory.
+2 threads for both (`threads=2`, `OMP_NUM_THREADS=2`), `fit="cube"`.
 
 The files are written once into a temporary folder by trimesh from MESH
 (default: the shared Stanford bunny): its first 1 k and 5 k faces, the
@@ -16,12 +25,19 @@ count known), Open3D a `TriangleMesh`, trimesh a `Trimesh` (unprocessed).
 
 import argparse
 import json
+import os
 import pathlib
 import platform
 import statistics
 import sys
 import tempfile
 import time
+from typing import Any, Dict, List
+
+os.environ.setdefault("OMP_NUM_THREADS", "2")
+# OpenMP threads left spinning after Open3D's call would take the cores
+# from the next tool in the alternation.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import numpy as np
 
@@ -80,6 +96,48 @@ def faces_of(tool: str, m) -> int:
     return len(m.faces)
 
 
+def many(folder: pathlib.Path, count: int, resolution: int, repeats: int) -> Dict[str, Any]:
+    """Meshes per second from files: voxelize_many(paths) against Open3D's loop."""
+    import trimesh
+
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+    from bench_calls import small_meshes
+
+    pairs = small_meshes(folder, count, 5000)
+    with tempfile.TemporaryDirectory() as tmp:
+        paths = []
+        for n, (v, f) in enumerate(pairs):
+            paths.append(os.path.join(tmp, f"{n:05d}.ply"))
+            trimesh.Trimesh(v, f, process=False).export(paths[-1], encoding="binary")
+        in_memory = [topovox.as_mesh(v, f) for v, f in pairs]
+        tools = {
+            "topovox voxelize_many(paths)": lambda: topovox.voxelize_many(paths, resolution=resolution, fit="cube", threads=2),
+            "topovox voxelize_many(meshes in memory)": lambda: topovox.voxelize_many(in_memory, resolution=resolution, fit="cube", threads=2),
+        }
+        try:
+            import open3d as o3d
+
+            def o3d_loop():
+                for p in paths:
+                    m = o3d.io.read_triangle_mesh(p)
+                    size = float(np.max(m.get_max_bound() - m.get_min_bound())) / resolution
+                    o3d.geometry.VoxelGrid.create_from_triangle_mesh(m, voxel_size=size)
+
+            tools["Open3D read + VoxelGrid loop"] = o3d_loop
+        except ImportError:
+            print("open3d is not installed: its row is left out", file=sys.stderr)
+        times: Dict[str, List[float]] = {t: [] for t in tools}
+        for _ in range(repeats):
+            for t, run in tools.items():
+                start = time.perf_counter()
+                run()
+                times[t].append(time.perf_counter() - start)
+    rows = {t: count / statistics.median(s) for t, s in times.items()}
+    for t, rate in rows.items():
+        print(f"{t:>42}: {rate:8.0f} meshes/s at {resolution}", flush=True)
+    return rows
+
+
 def main() -> int:
     here = pathlib.Path(__file__).resolve()
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -88,7 +146,14 @@ def main() -> int:
     ap.add_argument("--formats", default=",".join(FORMATS))
     ap.add_argument("--repeats", type=int, default=15)
     ap.add_argument("--json", action="store_true")
+    ap.add_argument("--many", type=int, default=0, help="time a dataset of this many small files instead")
+    ap.add_argument("--resolution", type=int, default=32)
     a = ap.parse_args()
+    if a.many:
+        rows = many(a.mesh.parent, a.many, a.resolution, a.repeats)
+        if a.json:
+            print(json.dumps({"machine": platform.platform(), "meshes_per_second": rows}, indent=1))
+        return 0
     run = tools()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:

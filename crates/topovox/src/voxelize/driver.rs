@@ -30,7 +30,7 @@
 //! set, brick by brick with a bit mask: kernels only set voxels of their
 //! box. At small grids the per-triangle path is short enough that a wide
 //! load of an array just written by narrow stores (a store-forwarding
-//! stall) shows in the profile; BENCHMARKS.md lists the ones removed. In
+//! stall) shows in the profile; docs/bench-log/ lists the ones removed. In
 //! the slab driver a kernel may put costly voxel tests off (`Deferred`,
 //! `Kernel::run_deferring`/`finish`) until the slab's other triangles have
 //! run, and then test only the voxels still unset: the union is the same.

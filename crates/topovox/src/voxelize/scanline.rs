@@ -83,7 +83,7 @@ pub fn scanline_lattice(mode: Mode, tris: &[LatticeTriangle], dims: [u32; 3], op
 
 /// Whether the scanline path is expected to beat the triangle-box fast path
 /// by a wide margin (20 % or more) for `mode` on this mesh and grid (what
-/// `--method auto` asks), from the measurements in BENCHMARKS.md on two
+/// `--method auto` asks), from the measurements in docs/bench-log/ on two
 /// machines: with triangles of up to a hundred voxels the two are within
 /// −23 %…+16 % of each other, the sign changing with the machine and the
 /// mesh, so the fast path is kept; on faces of hundreds of voxels
