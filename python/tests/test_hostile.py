@@ -67,7 +67,7 @@ def test_every_call_taking_a_path_passes_allow_external_paths_on(tmp_path):
     calls = {
         "voxelize": lambda **kw: topovox.voxelize(path, resolution=8, **kw),
         "voxelize_many": lambda **kw: topovox.voxelize_many([path], resolution=8, **kw),
-        "sdf": lambda **kw: topovox.sdf(path, resolution=8, **kw),
+        "sdf": lambda **kw: topovox.sdf(path, resolution=8, unsigned=True, **kw),
         "sample": lambda **kw: topovox.sample(path, surface=10, **kw),
         "remesh": lambda **kw: topovox.remesh(path, resolution=8, inside="wrap", **kw),
     }
