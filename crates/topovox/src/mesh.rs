@@ -188,10 +188,8 @@ mod tests {
             positions[3] = DVec3::new(f64::NAN, 1.0, 2.0);
             positions[5] = DVec3::new(1e9, 1e9, 1e9); // used by no triangle
             positions[6..9].copy_from_slice(&[DVec3::ZERO, DVec3::ONE, DVec3::splat(2.0)]); // collinear
-            let mut tris: Vec<[u32; 3]> = (0..triangles)
-                .map(|_| [0, 1, 2].map(|_| next() % vertices as u32))
-                .filter(|t| !t.contains(&5))
-                .collect();
+            let mut tris: Vec<[u32; 3]> =
+                (0..triangles).map(|_| [0, 1, 2].map(|_| next() % vertices as u32)).filter(|t| !t.contains(&5)).collect();
             tris.extend([[6, 7, 8], [1, 1, 2], [0, 1, vertices as u32 + 4], [3, 4, 9]]);
             let segments = vec![[2, 9], [vertices as u32, 1]];
             let m = MeshRef { positions: &positions, triangles: &tris, segments: &segments };
@@ -205,7 +203,10 @@ mod tests {
                 .iter()
                 .filter(|t| {
                     let p = t.map(|i| positions.get(i as usize));
-                    t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || matches!(p, [Some(a), Some(b), Some(c)] if (*b - *a).cross(*c - *a) == DVec3::ZERO)
+                    t[0] == t[1]
+                        || t[1] == t[2]
+                        || t[0] == t[2]
+                        || matches!(p, [Some(a), Some(b), Some(c)] if (*b - *a).cross(*c - *a) == DVec3::ZERO)
                 })
                 .count();
             assert_eq!(m.bounds(), want, "{vertices} {triangles}");
