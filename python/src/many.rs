@@ -10,7 +10,7 @@
 //! the same pool). The GIL is released throughout; Ctrl-C stops at the
 //! next mesh or slab.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use numpy::ndarray::{Array1, Array2};
@@ -25,7 +25,7 @@ use topovox_job::{Choice, JobError, Keep, Voxelized, Voxelizer};
 
 use crate::errors::{py_err, value_err};
 use crate::grids::{GridData, VoxelGrid};
-use crate::interrupt::interruptible;
+use crate::interrupt::interruptible_ticking;
 use crate::meshes::Mesh;
 use crate::options::job_options;
 use crate::voxelize::carried_grid;
@@ -73,13 +73,16 @@ struct Item {
 /// `None` where the caller could not load a mesh (an empty item); a mesh
 /// that fails leaves an empty item too, its exception listed in `errors`
 /// as is (the caller names the mesh and raises or keeps it).
+/// `progress(finished, total)` is called on this thread, from the loop
+/// that watches for Ctrl-C, whenever the count of meshes voxelized changed.
 #[pyfunction]
-#[pyo3(signature = (meshes, options=None, features=vec![]))]
+#[pyo3(signature = (meshes, options=None, features=vec![], progress=None))]
 pub(crate) fn voxelize_many<'py>(
     py: Python<'py>,
     meshes: Vec<Option<PyRef<'py, Mesh>>>,
     options: Option<&Bound<'py, PyDict>>,
     features: Vec<String>,
+    progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut opts = job_options(options, &[])?;
     let features = features.iter().map(|f| Feature::parse(f).map_err(|e| value_err(e.to_string()))).collect::<PyResult<Vec<_>>>()?;
@@ -97,12 +100,23 @@ pub(crate) fn voxelize_many<'py>(
     let stop = Stop::new();
     let budget = topovox_job::budget(plan.request.max_memory);
     let reserve = Reserve { budget, taken: AtomicU64::new(0), stop: &stop, why: Default::default() };
-    let results = interruptible(py, &stop, || {
+    let (finished, total) = (AtomicUsize::new(0), inputs.iter().flatten().count());
+    let mut shown = None;
+    let tick = |_: Python<'_>| -> PyResult<()> {
+        let Some(f) = &progress else { return Ok(()) };
+        let now = finished.load(Ordering::Relaxed);
+        if shown != Some(now) {
+            shown = Some(now);
+            f.call1((now, total))?;
+        }
+        Ok(())
+    };
+    let results = interruptible_ticking(py, &stop, || {
         let run = || -> Vec<Option<Result<Item, JobError>>> {
             let given: Vec<(&topovox_io::LoadedMesh, &str)> = inputs.iter().flatten().map(|(m, n)| (m.as_ref(), n.as_str())).collect();
             let refs: Vec<(topovox::MeshRef<'_>, &str)> = given.iter().map(|(m, n)| (m.mesh.as_ref(), *n)).collect();
             let each = per_item(plan, budget, refs.len());
-            let mut voxelized = topovox_job::many::voxelize_many(&each, &refs, &stop).into_iter();
+            let mut voxelized = topovox_job::many::voxelize_many(&each, &refs, &stop, &finished).into_iter();
             let paired: Vec<Option<(&topovox_io::LoadedMesh, Result<Voxelized, JobError>)>> =
                 inputs.iter().map(|i| i.as_ref().map(|(m, _)| (m.as_ref(), voxelized.next().expect("a result per mesh")))).collect();
             paired
@@ -114,7 +128,7 @@ pub(crate) fn voxelize_many<'py>(
             Some(p) => p.install(run),
             None => run(),
         }
-    })?;
+    }, tick)?;
     if let Some(e) = reserve.refused() {
         return Err(py_err(e));
     }

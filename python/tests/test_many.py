@@ -252,3 +252,22 @@ def test_the_gpu_batch_is_one_dispatch_and_equals_the_cpu(meshes):
             assert facts["method"] == "gpu" and facts["gpu"]["batch"]["stacked"] == len(items), facts["gpu"]
             alone = topovox.voxelize(*items[b], mode=mode, resolution=res, fit="cube", method="gpu")
             assert np.array_equal(np.asarray(batch.item(b)), np.asarray(alone))
+
+
+def test_progress_counts_the_meshes_voxelized(meshes, capfd):
+    paths = [meshes / n for n in ("cow.obj", "fandisk.obj", "suzanne.obj", "teapot.obj")]
+    seen = []
+    batch = topovox.voxelize_many(paths, resolution=24, progress=lambda done, total: seen.append((done, total)))
+    assert len(batch) == 4 and seen and seen[-1] == (4, 4), seen
+    assert all(t == 4 for _, t in seen) and [d for d, _ in seen] == sorted({d for d, _ in seen})
+    plain = topovox.voxelize_many(paths, resolution=24)
+    assert np.array_equal(plain.coords, batch.coords)
+    assert "meshes" not in capfd.readouterr().err
+    topovox.voxelize_many(paths, resolution=24, progress=True)
+    assert "topovox voxelize_many: 4/4 meshes" in capfd.readouterr().err
+
+    def stop(done, total):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        topovox.voxelize_many(paths * 50, resolution=64, progress=stop)

@@ -469,6 +469,7 @@ def voxelize_many(
     block_palette: Optional[Union[str, os.PathLike[str]]] = None,
     allow_external_paths: bool = False,
     color_rule: Optional[ColourRuleName] = None,
+    progress: Union[None, bool, Callable[[int, int], Any]] = None,
 ) -> SparseBatch:
     """Voxelizes many meshes in one call into one sparse training batch.
 
@@ -500,6 +501,12 @@ def voxelize_many(
         of the whole batch on the GPU in one upload and one dispatch (each
         mesh in its own layers of one tall grid), the same voxels as one
         call per mesh.
+    progress : bool or callable, optional
+        ``True``: ``finished/total meshes`` on one line of stderr while the
+        meshes are voxelized; a callable is called as ``progress(finished,
+        total)`` on the calling thread whenever the count changed (from the
+        loop that watches for Ctrl-C; an exception it raises stops the
+        batch). Off by default, as in a data loader's workers.
 
     Returns
     -------
@@ -527,8 +534,9 @@ def voxelize_many(
     given: List[str] = [features] if isinstance(features, str) else [str(f) for f in features]
     names = ["colour" if f.lower() == "color" else f for f in given]
     options = dict(locals())
-    for k in ("meshes", "features", "on_error", "given", "names"):
+    for k in ("meshes", "features", "on_error", "given", "names", "progress"):
         options.pop(k)
+    report = _stderr_progress("topovox voxelize_many") if progress is True else progress or None
     loaded: List[Optional[Mesh]] = []
     failed: Dict[int, str] = {}
     for b, m in enumerate(meshes):
@@ -537,7 +545,7 @@ def voxelize_many(
         except (ValueError, TypeError, OSError) as e:
             failed[b] = _item_error(b, m, e, on_error)
             loaded.append(None)
-    out = _topovox.voxelize_many(loaded, _options(options), names)
+    out = _topovox.voxelize_many(loaded, _options(options), names, report)
     for b, exc in out["errors"]:
         failed[int(b)] = _item_error(int(b), loaded[int(b)], exc, on_error)
     return SparseBatch(out["coords"], out["features"], out["offsets"], out["grids"], out["columns"], failed)
@@ -1165,7 +1173,7 @@ def batch(
     return _topovox.batch([os.fsdecode(p) for p in paths], os.fsdecode(out_dir), format=format, glob=glob, options=opts, progress=report)
 
 
-def _stderr_progress() -> Callable[[int, int], None]:
+def _stderr_progress(label: str = "topovox batch") -> Callable[[int, int], None]:
     """``finished/total meshes`` on one line of stderr, as the CLI shows it."""
     import sys
     import time
@@ -1174,7 +1182,7 @@ def _stderr_progress() -> Callable[[int, int], None]:
 
     def show(finished: int, total: int) -> None:
         end = "\n" if finished >= total else ""
-        sys.stderr.write(f"\rtopovox batch: {finished}/{total} meshes ({time.monotonic() - start:.1f} s){end}")
+        sys.stderr.write(f"\r{label}: {finished}/{total} meshes ({time.monotonic() - start:.1f} s){end}")
         sys.stderr.flush()
 
     return show

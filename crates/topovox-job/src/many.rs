@@ -3,6 +3,8 @@
 //! all of them ([`topovox_gpu::Gpu::voxelize_stacked`]) instead of one
 //! device and one dispatch per mesh.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use topovox::voxelize::Stop;
 use topovox::MeshRef;
 
@@ -12,13 +14,20 @@ use crate::run::Voxelized;
 
 /// Each mesh (with its name for messages) voxelized by `plan`: item for
 /// item what [`crate::voxelize`] gives, voxel for voxel. Runs on the
-/// current rayon pool; the GPU batch runs on this thread.
-pub fn voxelize_many(plan: &Plan, meshes: &[(MeshRef<'_>, &str)], stop: &Stop) -> Vec<Result<Voxelized>> {
+/// current rayon pool; the GPU batch runs on this thread. `finished`
+/// counts the meshes done as they finish (the GPU batch's all at once), for
+/// a caller's progress.
+pub fn voxelize_many(plan: &Plan, meshes: &[(MeshRef<'_>, &str)], stop: &Stop, finished: &AtomicUsize) -> Vec<Result<Voxelized>> {
     use rayon::prelude::*;
     if let Some(done) = gpu_batch(plan, meshes, stop) {
+        finished.fetch_add(meshes.len(), Ordering::Relaxed);
         return done;
     }
-    let one = |(m, name): &(MeshRef<'_>, &str)| crate::voxelize(plan, *m, name, None, Some(stop));
+    let one = |(m, name): &(MeshRef<'_>, &str)| {
+        let v = crate::voxelize(plan, *m, name, None, Some(stop));
+        finished.fetch_add(1, Ordering::Relaxed);
+        v
+    };
     if plan.request.method == crate::plan::Method::Gpu {
         // One device at a time.
         meshes.iter().map(one).collect()
