@@ -52,6 +52,7 @@ fn _topovox(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(remesh::remesh, m)?)?;
     m.add_function(wrap_pyfunction!(remesh::check_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(meshes::load_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(meshes::load_meshes, m)?)?;
     m.add_function(wrap_pyfunction!(voxelize::voxelize, m)?)?;
     m.add_function(wrap_pyfunction!(many::voxelize_many, m)?)?;
     m.add_function(wrap_pyfunction!(many::features, m)?)?;

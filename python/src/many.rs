@@ -111,24 +111,29 @@ pub(crate) fn voxelize_many<'py>(
         }
         Ok(())
     };
-    let results = interruptible_ticking(py, &stop, || {
-        let run = || -> Vec<Option<Result<Item, JobError>>> {
-            let given: Vec<(&topovox_io::LoadedMesh, &str)> = inputs.iter().flatten().map(|(m, n)| (m.as_ref(), n.as_str())).collect();
-            let refs: Vec<(topovox::MeshRef<'_>, &str)> = given.iter().map(|(m, n)| (m.mesh.as_ref(), *n)).collect();
-            let each = per_item(plan, budget, refs.len());
-            let mut voxelized = topovox_job::many::voxelize_many(&each, &refs, &stop, &finished).into_iter();
-            let paired: Vec<Option<(&topovox_io::LoadedMesh, Result<Voxelized, JobError>)>> =
-                inputs.iter().map(|i| i.as_ref().map(|(m, _)| (m.as_ref(), voxelized.next().expect("a result per mesh")))).collect();
-            paired
-                .into_par_iter()
-                .map(|p| p.map(|(mesh, v)| v.and_then(|v| item(&voxelizer, mesh, v, &features, keep, &reserve))))
-                .collect()
-        };
-        match pool {
-            Some(p) => p.install(run),
-            None => run(),
-        }
-    }, tick)?;
+    let results = interruptible_ticking(
+        py,
+        &stop,
+        || {
+            let run = || -> Vec<Option<Result<Item, JobError>>> {
+                let given: Vec<(&topovox_io::LoadedMesh, &str)> = inputs.iter().flatten().map(|(m, n)| (m.as_ref(), n.as_str())).collect();
+                let refs: Vec<(topovox::MeshRef<'_>, &str)> = given.iter().map(|(m, n)| (m.mesh.as_ref(), *n)).collect();
+                let each = per_item(plan, budget, refs.len());
+                let mut voxelized = topovox_job::many::voxelize_many(&each, &refs, &stop, &finished).into_iter();
+                let paired: Vec<Option<(&topovox_io::LoadedMesh, Result<Voxelized, JobError>)>> =
+                    inputs.iter().map(|i| i.as_ref().map(|(m, _)| (m.as_ref(), voxelized.next().expect("a result per mesh")))).collect();
+                paired
+                    .into_par_iter()
+                    .map(|p| p.map(|(mesh, v)| v.and_then(|v| item(&voxelizer, mesh, v, &features, keep, &reserve))))
+                    .collect()
+            };
+            match pool {
+                Some(p) => p.install(run),
+                None => run(),
+            }
+        },
+        tick,
+    )?;
     if let Some(e) = reserve.refused() {
         return Err(py_err(e));
     }

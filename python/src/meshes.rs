@@ -302,3 +302,40 @@ pub(crate) fn load_mesh(
     let loaded = crate::interrupt::interruptible_read(py, read)?.map_err(io_err)?;
     Ok(Mesh { inner: Arc::new(loaded), path: Some(path) })
 }
+
+/// load_meshes(paths, allow_external_paths=False, threads=None) -> list
+///
+/// Reads many mesh files at once, on all threads (or ``threads``): for
+/// each path, in order, its :class:`Mesh` or the exception
+/// :func:`load_mesh` would raise for it (returned, not raised). Each read
+/// is what ``load_mesh(path, allow_external_paths)`` does; the native
+/// half of ``voxelize_many(paths)``.
+#[pyfunction]
+#[pyo3(signature = (paths, allow_external_paths=false, threads=None))]
+pub(crate) fn load_meshes(
+    py: Python<'_>,
+    paths: Vec<PathBuf>,
+    allow_external_paths: bool,
+    threads: Option<usize>,
+) -> PyResult<Vec<Py<PyAny>>> {
+    use rayon::prelude::*;
+    let opts = topovox_job::RunOptions { allow_external_paths, ..Default::default() }.read_options();
+    let pool = threads.map(topovox_job::pool).transpose().map_err(crate::errors::py_err)?;
+    let given = paths.clone();
+    let read = move || {
+        let all = || given.par_iter().map(|p| topovox_io::read_mesh(p, &opts)).collect::<Vec<_>>();
+        match pool {
+            Some(p) => p.install(all),
+            None => all(),
+        }
+    };
+    let loaded = crate::interrupt::interruptible_read(py, read)?;
+    loaded
+        .into_iter()
+        .zip(paths)
+        .map(|(r, path)| match r {
+            Ok(m) => Ok(Py::new(py, Mesh { inner: Arc::new(m), path: Some(path) })?.into_any()),
+            Err(e) => Ok(io_err(e).into_value(py).into_any()),
+        })
+        .collect()
+}

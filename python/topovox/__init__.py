@@ -537,11 +537,18 @@ def voxelize_many(
     for k in ("meshes", "features", "on_error", "given", "names", "progress"):
         options.pop(k)
     report = _stderr_progress("topovox voxelize_many") if progress is True else progress or None
+    items = list(meshes)
+    # Paths are read together, on all threads; with max_memory, one at a time, each within it.
+    paths = [b for b, m in enumerate(items) if isinstance(m, (str, os.PathLike))] if max_memory is None else []
+    read = dict(zip(paths, _topovox.load_meshes([items[b] for b in paths], allow_external_paths, threads)))
     loaded: List[Optional[Mesh]] = []
     failed: Dict[int, str] = {}
-    for b, m in enumerate(meshes):
+    for b, m in enumerate(items):
         try:
-            loaded.append(m if isinstance(m, Mesh) else as_mesh(*m) if isinstance(m, tuple) else as_mesh(m, max_memory=max_memory, allow_external_paths=allow_external_paths))
+            r = read.get(b)
+            if isinstance(r, BaseException):
+                raise r
+            loaded.append(r if r is not None else m if isinstance(m, Mesh) else as_mesh(*m) if isinstance(m, tuple) else as_mesh(m, max_memory=max_memory, allow_external_paths=allow_external_paths))
         except (ValueError, TypeError, OSError) as e:
             failed[b] = _item_error(b, m, e, on_error)
             loaded.append(None)

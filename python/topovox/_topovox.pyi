@@ -7,7 +7,7 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
-__all__ = ["__version__", "FileFormatError", "Mesh", "VoxelGrid", "DistanceGrid", "load_mesh", "voxelize", "voxelize_many", "features", "sdf", "Query", "sample", "remesh", "check_mesh", "load_voxels", "batch", "batch_plan", "process_one", "append_manifest", "options", "choices"]
+__all__ = ["__version__", "FileFormatError", "Mesh", "VoxelGrid", "DistanceGrid", "load_mesh", "load_meshes", "voxelize", "voxelize_many", "features", "sdf", "Query", "sample", "remesh", "check_mesh", "load_voxels", "batch", "batch_plan", "process_one", "append_manifest", "options", "choices"]
 
 class FileFormatError(OSError):
     """A file's content does not follow its format (the message names the file)."""
@@ -179,6 +179,9 @@ def check_mesh(mesh: Mesh) -> Dict[str, Any]: ...
 def load_mesh(
     path: Union[str, PathLike[str]], allow_external_paths: bool = False, max_memory: Optional[Union[int, str]] = None
 ) -> Mesh: ...
+def load_meshes(
+    paths: Sequence[Union[str, PathLike[str]]], allow_external_paths: bool = False, threads: Optional[int] = None
+) -> List[Union[Mesh, BaseException]]: ...
 def load_voxels(
     path: Union[str, PathLike[str]],
     origin: Optional[Sequence[float]] = None,
