@@ -18,7 +18,7 @@ use topovox_job::{JobError, OptionValue};
 
 use crate::convert::to_py;
 use crate::errors::{py_err, value_err};
-use crate::interrupt::interruptible_ticking;
+use crate::interrupt::{interruptible_ticking, progress_tick};
 use crate::options::{job_options, option_value, table_options};
 
 /// `(input, output, done)` per mesh of a batch, and the options' fingerprint.
@@ -105,16 +105,7 @@ pub(crate) fn batch<'py>(
     }
     let stop = Arc::new(Stop::new());
     let counts = Counts::default();
-    let mut shown = None;
-    let tick = |_: Python<'_>| -> PyResult<()> {
-        let Some(f) = &progress else { return Ok(()) };
-        let now = (counts.finished.load(Ordering::Relaxed), counts.total.load(Ordering::Relaxed));
-        if now.1 > 0 && shown != Some(now) {
-            shown = Some(now);
-            f.call1(now)?;
-        }
-        Ok(())
-    };
+    let tick = progress_tick(progress.as_ref(), || (counts.finished.load(Ordering::Relaxed), counts.total.load(Ordering::Relaxed)));
     let work = || -> Result<(topovox_job::batch::Summary, Vec<String>), JobError> {
         let (items, warnings) = topovox_job::batch::items(&inputs, glob.as_deref(), &out_dir, &opts)?;
         let pool = topovox_job::pool_for(jobs, "jobs")?;

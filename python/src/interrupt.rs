@@ -55,6 +55,28 @@ pub(crate) fn interruptible_ticking<T: Send>(
     })
 }
 
+/// The `tick` of a call that takes `progress=`, for [`interruptible_ticking`]:
+/// calls `progress(finished, total)` whenever `now()` gives a new count
+/// and the total is known (above zero); nothing without a callable.
+pub(crate) fn progress_tick<'a, 'py>(
+    progress: Option<&'a Bound<'py, PyAny>>,
+    now: impl Fn() -> (u64, u64) + 'a,
+) -> impl FnMut(Python<'_>) -> PyResult<()> + 'a
+where
+    'py: 'a,
+{
+    let mut shown = None;
+    move |_| {
+        let Some(f) = progress else { return Ok(()) };
+        let counts = now();
+        if counts.1 > 0 && shown != Some(counts) {
+            shown = Some(counts);
+            f.call1(counts)?;
+        }
+        Ok(())
+    }
+}
+
 /// [`interruptible`] for work that cannot be stopped part way and changes
 /// nothing (a read, a check): on Ctrl-C the caller returns at once and the
 /// work, left to finish on its own thread, is dropped when it ends.

@@ -25,7 +25,7 @@ use topovox_job::{Choice, JobError, Keep, Voxelized, Voxelizer};
 
 use crate::errors::{py_err, value_err};
 use crate::grids::{GridData, VoxelGrid};
-use crate::interrupt::interruptible_ticking;
+use crate::interrupt::{interruptible_ticking, progress_tick};
 use crate::meshes::Mesh;
 use crate::options::job_options;
 use crate::voxelize::carried_grid;
@@ -101,16 +101,7 @@ pub(crate) fn voxelize_many<'py>(
     let budget = topovox_job::budget(plan.request.max_memory);
     let reserve = Reserve { budget, taken: AtomicU64::new(0), stop: &stop, why: Default::default() };
     let (finished, total) = (AtomicUsize::new(0), inputs.iter().flatten().count());
-    let mut shown = None;
-    let tick = |_: Python<'_>| -> PyResult<()> {
-        let Some(f) = &progress else { return Ok(()) };
-        let now = finished.load(Ordering::Relaxed);
-        if shown != Some(now) {
-            shown = Some(now);
-            f.call1((now, total))?;
-        }
-        Ok(())
-    };
+    let tick = progress_tick(progress.as_ref(), || (finished.load(Ordering::Relaxed) as u64, total as u64));
     let results = interruptible_ticking(
         py,
         &stop,
