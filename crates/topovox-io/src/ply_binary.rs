@@ -148,7 +148,7 @@ fn vertices_walked(
 ) -> Result<usize, ErrorKind> {
     let mut at = at;
     let mut values = vec![0.0; el.properties.len()];
-    let xyz = &layout.xyz;
+    let (xyz, float) = (&layout.xyz, layout.float_colour());
     for entry in 0..el.count {
         for (k, p) in el.properties.values().enumerate() {
             at = match &p.data_type {
@@ -162,7 +162,7 @@ fn vertices_walked(
         }
         out.positions.push(DVec3::new(values[xyz[0].0], values[xyz[1].0], values[xyz[2].0]));
         if let Some(c) = &layout.colour {
-            out.colours.push([0, 1, 2].map(|k| channel(values[c[k].0], layout.float_colour())));
+            out.colours.push([0, 1, 2].map(|k| channel(values[c[k].0], float)));
         }
     }
     Ok(at)
@@ -248,7 +248,7 @@ fn faces_with(
         } else {
             list.clear();
             list.extend(items.chunks_exact(index_size).map(&index));
-            Lists::Fanned(triangles).push(&list);
+            crate::mesh_report::fan(&list, triangles);
         }
         at += count_size + items.len();
     }

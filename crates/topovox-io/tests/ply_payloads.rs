@@ -202,22 +202,29 @@ fn every_layout_reads_as_the_reference_reads_it() {
     }
 }
 
+/// A little-endian layout with every part a file may have (a property
+/// before the coordinates, byte colours, an element between), a property
+/// after the index list in binary, the list alone in ASCII.
+fn every_part(ascii: Option<(&'static str, &'static str)>) -> Layout {
+    Layout {
+        big: false,
+        double: false,
+        before: true,
+        colour: Some(true),
+        count: "uchar",
+        index: "int",
+        between: true,
+        strips: false,
+        ascii,
+        flags: ascii.is_none(),
+    }
+}
+
 #[test]
 fn long_elements_read_in_pieces_as_the_reference_reads_them() {
     // More lines than one parallel piece (8192), and a last line without its newline.
     for ascii in [Some((" ", "\n")), Some(("\t", "\r\n")), None] {
-        let l = Layout {
-            big: false,
-            double: false,
-            before: true,
-            colour: Some(true),
-            count: "uchar",
-            index: "int",
-            between: true,
-            strips: false,
-            ascii,
-            flags: ascii.is_none(),
-        };
+        let l = every_part(ascii);
         let mut bytes = file(l, 20_000, 40_000, 11);
         same(&bytes, "long");
         if ascii.is_some() {
@@ -232,19 +239,9 @@ fn long_elements_read_in_pieces_as_the_reference_reads_them() {
 
 #[test]
 fn every_truncation_is_refused_by_both() {
-    for ascii in [None, Some((" ", "\n")), Some(("  ", "\r\n"))] {
-        let l = Layout {
-            big: false,
-            double: false,
-            before: true,
-            colour: Some(true),
-            count: "uchar",
-            index: "int",
-            between: true,
-            strips: false,
-            ascii,
-            flags: ascii.is_none(),
-        };
+    for (ascii, flags) in [(None, true), (None, false), (Some((" ", "\n")), false), (Some(("  ", "\r\n")), true)] {
+        // Binary without a property after the list takes the fast path for faces.
+        let l = Layout { flags, ..every_part(ascii) };
         let bytes = file(l, 20, 30, 7);
         let header_end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
         // An ASCII file may lose the end of its last line.
@@ -274,18 +271,7 @@ fn ascii_errors_name_the_line_and_the_entry() {
 #[test]
 fn missing_or_wrong_properties_are_refused_like_the_reference() {
     for ascii in [None, Some((" ", "\n"))] {
-        let l = Layout {
-            big: false,
-            double: false,
-            before: false,
-            colour: None,
-            count: "uchar",
-            index: "int",
-            between: false,
-            strips: false,
-            ascii,
-            flags: false,
-        };
+        let l = Layout { before: false, colour: None, between: false, flags: false, ..every_part(ascii) };
         let good = file(l, 10, 5, 3);
         for (from, to) in [
             ("property float y\n", "property float w\n"),
@@ -320,18 +306,7 @@ fn mutated_files_never_refuse_what_the_reference_reads() {
     let mut r = Lcg(99);
     let alphabet = b"0123456789 -+.e\n\r\t3";
     for (n, ascii) in [None, Some((" ", "\n")), Some(("\t", "\r\n"))].into_iter().enumerate() {
-        let l = Layout {
-            big: false,
-            double: false,
-            before: true,
-            colour: Some(true),
-            count: "uchar",
-            index: "int",
-            between: true,
-            strips: false,
-            ascii,
-            flags: n == 1,
-        };
+        let l = Layout { flags: n == 1, ..every_part(ascii) };
         let good = file(l, 12, 16, n as u64);
         let header_end = good.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
         for round in 0..3000 {
